@@ -1,0 +1,95 @@
+"""The interface every engine adapter implements.
+
+Canonical form, in the engine's own joint coordinates q (positions) and v (velocities):
+
+    M(q) v̇ + h(q, v) = τ
+
+M is the joint-space mass matrix (symmetric positive definite), h the bias forces (Coriolis,
+centrifugal *and gravity*, so that h(q, 0) = ∂V/∂q), τ the applied generalized forces; all
+are covariant, in the engine's joint coordinates and sign conventions. Energies: T = ½ vᵀ M v;
+V as the engine computes it (its datum is the engine's, not the book's). All methods take
+batches: q, v, τ, v̇ of shape (n, nv); they return (n, nv, nv), (n, nv) or (n,).
+Adapters never see the book's coordinates: the comparison layer maps them.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from dyncheck.cases.multibody import Multibody
+from dyncheck.errors import EngineError
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """Sampled states: ``t`` (k,), ``q`` and ``v`` (k, nv), engine coordinates."""
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+
+
+@dataclass(frozen=True)
+class LoadedBody:
+    """A body's mass (kg) and inertia about its centre of mass (kg·m², body axes) as the engine
+    holds it after loading the model — read back, not assumed."""
+
+    name: str
+    mass: float
+    inertia: np.ndarray
+
+
+class Adapter(ABC):
+    """One engine behind the canonical form ``M(q) v̇ + h(q, v) = τ``."""
+
+    name: ClassVar[str]
+    """Implementation name, as used on the command line."""
+    package: ClassVar[str]
+    """The pip package that provides the engine."""
+    integrators: ClassVar[tuple[str, ...]]
+    """Fixed-step integrators :meth:`simulate` accepts."""
+
+    def __init__(self, model: Multibody) -> None:
+        self.spec = model
+
+    @staticmethod
+    @abstractmethod
+    def version() -> str:
+        """The engine's version string."""
+
+    @abstractmethod
+    def loaded_bodies(self) -> list[LoadedBody]:
+        """Masses and inertias as loaded, in the spec's body order."""
+
+    @abstractmethod
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray: ...
+
+    @abstractmethod
+    def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray: ...
+
+    @abstractmethod
+    def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray: ...
+
+    @abstractmethod
+    def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray: ...
+
+    @abstractmethod
+    def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray: ...
+
+    @abstractmethod
+    def potential_energy(self, q: np.ndarray) -> np.ndarray: ...
+
+    @abstractmethod
+    def simulate(
+        self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
+    ) -> Trajectory:
+        """Fixed-step integration from (q0, v0) for ``round(duration / dt)`` steps, τ = 0."""
+
+    def _check(self, what: str, value: np.ndarray) -> np.ndarray:
+        if not np.all(np.isfinite(value)):
+            raise EngineError(f"{self.name}: {what} returned a non-finite value")
+        return value

@@ -1,0 +1,63 @@
+"""Fixed-step integrators defined as MuJoCo defines them, for engines that have none.
+
+MuJoCo (``mj_Euler``, ``mj_implicit``, ``mj_RungeKutta``; see its Computation chapter):
+
+- ``euler``: semi-implicit Euler, v' = v + h·v̇(q, v), then q' = q + h·v' (new velocity).
+- ``implicitfast``: v' = v + h·(M − h·D)⁻¹(τ − h(q, v) + f_passive) with D = ∂f/∂v of the
+  passive and actuator forces only (Coriolis derivatives dropped), then q' = q + h·v'. With no
+  damping and no actuators D = 0, and it is the same map as ``euler``.
+- ``rk4``: the classic four-stage Runge–Kutta tableau on x = (q, v), ẋ = (v, v̇).
+
+Nominal orders: 1, 1, 4. Hinge coordinates live in ℝⁿ, so q + h·v is exact position update.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+Acceleration = Callable[[np.ndarray, np.ndarray], np.ndarray]
+"""v̇(q, v) for one state, shapes (nv,) → (nv,)."""
+
+NOMINAL_ORDER = {"euler": 1, "implicitfast": 1, "rk4": 4}
+
+
+def _euler(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float) -> tuple:
+    v_new = v + h * acc(q, v)
+    return q + h * v_new, v_new
+
+
+def _rk4(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float) -> tuple:
+    k1q, k1v = v, acc(q, v)
+    k2q = v + 0.5 * h * k1v
+    k2v = acc(q + 0.5 * h * k1q, k2q)
+    k3q = v + 0.5 * h * k2v
+    k3v = acc(q + 0.5 * h * k2q, k3q)
+    k4q = v + h * k3v
+    k4v = acc(q + h * k3q, k4q)
+    dq = (k1q + 2 * k2q + 2 * k3q + k4q) / 6
+    dv = (k1v + 2 * k2v + 2 * k3v + k4v) / 6
+    return q + h * dq, v + h * dv
+
+
+STEPPERS: dict[str, Callable[..., tuple]] = {
+    "euler": _euler,
+    "implicitfast": _euler,  # D = 0: no damping, no actuators (see module docstring)
+    "rk4": _rk4,
+}
+
+
+def integrate(
+    acc: Acceleration, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, integrator: str
+) -> tuple[np.ndarray, np.ndarray]:
+    """States after 0..steps steps, shapes (steps + 1, nv)."""
+    step = STEPPERS[integrator]
+    qs = np.empty((steps + 1, q0.shape[0]))
+    vs = np.empty_like(qs)
+    q, v = np.array(q0, float), np.array(v0, float)
+    qs[0], vs[0] = q, v
+    for k in range(1, steps + 1):
+        q, v = step(acc, q, v, dt)
+        qs[k], vs[k] = q, v
+    return qs, vs

@@ -1,0 +1,143 @@
+"""Pinocchio behind the canonical form, two ways: built programmatically from the
+engine-neutral model (``pinocchio``) and loaded from the same MJCF file through Pinocchio's own
+MJCF parser (``pinocchio-mjcf``).
+
+Pinocchio's names: M = ``crba`` (upper triangle filled, mirrored here); h = ``rnea(q, v, 0)``
+(= ``nonLinearEffects``, gravity included); forward dynamics ``aba``; inverse ``rnea``;
+``computeKineticEnergy``, ``computePotentialEnergy`` (V = −Σ mᵢ g·cᵢ). Pinocchio has no time
+integrator: :mod:`.integrators` supplies MuJoCo's definitions so integrators compare like for
+like.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from typing import ClassVar
+
+import numpy as np
+import pinocchio as pin
+
+from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.integrators import STEPPERS, integrate
+from dyncheck.adapters.mjcf import to_mjcf
+from dyncheck.cases.multibody import Body, Multibody
+
+_AXIS_JOINTS = {
+    (1.0, 0.0, 0.0): pin.JointModelRX,
+    (0.0, 1.0, 0.0): pin.JointModelRY,
+    (0.0, 0.0, 1.0): pin.JointModelRZ,
+}
+
+
+def _joint(body: Body) -> pin.JointModel:
+    axis = tuple(float(x) for x in body.joint_axis)
+    if axis in _AXIS_JOINTS:
+        return _AXIS_JOINTS[axis]()
+    return pin.JointModelRevoluteUnaligned(np.asarray(axis))
+
+
+def build_model(model: Multibody) -> pin.Model:
+    """A ``pin.Model`` built with ``addJoint`` and ``appendBodyToJoint``; point masses exact."""
+    pm = pin.Model()
+    pm.name = model.name
+    pm.gravity = pin.Motion(np.asarray(model.gravity, float), np.zeros(3))
+    joint_of: dict[str | None, int] = {None: 0}
+    for body, jname in zip(model.bodies, model.joint_names, strict=True):
+        placement = pin.SE3(np.eye(3), np.asarray(body.joint_pos, float))
+        jid = pm.addJoint(joint_of[body.parent], _joint(body), placement, jname)
+        inertia = pin.Inertia(body.mass, np.asarray(body.com, float), np.asarray(body.inertia))
+        pm.appendBodyToJoint(jid, inertia, pin.SE3.Identity())
+        joint_of[body.name] = jid
+    return pm
+
+
+def load_mjcf(xml: str) -> pin.Model:
+    """``pin.buildModelFromMJCF`` on the MJCF text (through a temporary file)."""
+    fd, path = tempfile.mkstemp(suffix=".xml")
+    try:
+        with os.fdopen(fd, "w") as f:
+            f.write(xml)
+        return pin.buildModelFromMJCF(path)
+    finally:
+        os.unlink(path)
+
+
+class PinocchioAdapter(Adapter):
+    name: ClassVar[str] = "pinocchio"
+    package: ClassVar[str] = "pin"
+    integrators: ClassVar[tuple[str, ...]] = tuple(STEPPERS)
+
+    def __init__(self, model: Multibody) -> None:
+        super().__init__(model)
+        self.model = self._build(model)
+        self.data = self.model.createData()
+        # body name → joint index: the body's inertia is attached to its joint
+        self._joint_ids = [self.model.getJointId(j) for j in self._joint_names(model)]
+
+    def _build(self, model: Multibody) -> pin.Model:
+        return build_model(model)
+
+    def _joint_names(self, model: Multibody) -> tuple[str, ...]:
+        return model.joint_names
+
+    @staticmethod
+    def version() -> str:
+        return pin.__version__
+
+    def loaded_bodies(self) -> list[LoadedBody]:
+        return [
+            LoadedBody(b.name, float(self.model.inertias[j].mass),
+                       np.array(self.model.inertias[j].inertia))
+            for b, j in zip(self.spec.bodies, self._joint_ids, strict=True)
+        ]
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        out = np.empty((q.shape[0], self.model.nv, self.model.nv))
+        for k in range(q.shape[0]):
+            upper = np.triu(pin.crba(self.model, self.data, q[k]))
+            out[k] = upper + np.triu(upper, 1).T
+        return self._check("mass matrix", out)
+
+    def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        zero = np.zeros(self.model.nv)
+        out = np.array([pin.rnea(self.model, self.data, q[k], v[k], zero) for k in range(len(q))])
+        return self._check("bias forces", out)
+
+    def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        out = np.array([pin.aba(self.model, self.data, q[k], v[k], tau[k]) for k in range(len(q))])
+        return self._check("forward dynamics", out)
+
+    def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        out = np.array([pin.rnea(self.model, self.data, q[k], v[k], a[k]) for k in range(len(q))])
+        return self._check("inverse dynamics", out)
+
+    def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        out = [pin.computeKineticEnergy(self.model, self.data, q[k], v[k]) for k in range(len(q))]
+        return self._check("kinetic energy", np.array(out))
+
+    def potential_energy(self, q: np.ndarray) -> np.ndarray:
+        out = [pin.computePotentialEnergy(self.model, self.data, q[k]) for k in range(len(q))]
+        return self._check("potential energy", np.array(out))
+
+    def simulate(
+        self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
+    ) -> Trajectory:
+        zero = np.zeros(self.model.nv)
+
+        def acc(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+            return pin.aba(self.model, self.data, q, v, zero)
+
+        steps = round(duration / dt)
+        qs, vs = integrate(acc, np.asarray(q0), np.asarray(v0), dt, steps, integrator)
+        return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)
+
+
+class PinocchioMJCFAdapter(PinocchioAdapter):
+    """The very same MJCF file MuJoCo loads, read by Pinocchio's MJCF parser."""
+
+    name: ClassVar[str] = "pinocchio-mjcf"
+
+    def _build(self, model: Multibody) -> pin.Model:
+        self.xml = to_mjcf(model)
+        return load_mjcf(self.xml)

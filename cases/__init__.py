@@ -1,0 +1,32 @@
+"""Cases: every system defined once, in one sorted registry."""
+
+from __future__ import annotations
+
+from dyncheck.cases.base import INTEGRATORS, NOMINAL_ORDER, Case, StateSample, TrajectorySpec
+from dyncheck.cases.pendulums import CompoundPendulum, SimplePendulum
+from dyncheck.errors import UnknownName
+
+CASES: dict[str, type[Case]] = {
+    "compound_pendulum": CompoundPendulum,
+    "simple_pendulum": SimplePendulum,
+}
+"""Case name → case class with the book's default parameters; kept sorted by name."""
+
+
+def get_case(name: str) -> Case:
+    """The case ``name`` with its default parameters."""
+    try:
+        return CASES[name]()
+    except KeyError:
+        raise UnknownName("case", name, CASES) from None
+
+
+__all__ = [
+    "CASES",
+    "INTEGRATORS",
+    "NOMINAL_ORDER",
+    "Case",
+    "StateSample",
+    "TrajectorySpec",
+    "get_case",
+]

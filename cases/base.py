@@ -1,0 +1,139 @@
+"""The case record: a system defined once, in the book's coordinates and sign conventions."""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+
+from dyncheck.cases.coordinate_maps import LinearMap
+from dyncheck.cases.multibody import Multibody
+from dyncheck.cases.validate import finite_array, positive
+from dyncheck.errors import InvalidInput
+
+INTEGRATORS: tuple[str, ...] = ("euler", "implicitfast", "rk4")
+"""Fixed-step integrators as MuJoCo defines them; nominal orders 1, 1, 4."""
+
+NOMINAL_ORDER: dict[str, int] = {"euler": 1, "implicitfast": 1, "rk4": 4}
+
+
+@dataclass(frozen=True)
+class StateSample:
+    """Book-coordinate states at which every implementation is evaluated.
+
+    Shapes: ``q``, ``v``, ``tau`` (applied generalized forces, covariant, for forward dynamics)
+    and ``a`` (accelerations, for inverse dynamics) are all (n, ndof).
+    """
+
+    q: np.ndarray
+    v: np.ndarray
+    tau: np.ndarray
+    a: np.ndarray
+
+    def __len__(self) -> int:
+        return self.q.shape[0]
+
+
+@dataclass(frozen=True)
+class TrajectorySpec:
+    """An initial state (book coordinates), a duration (s) and, per integrator, a halving
+    sequence of step sizes (s), coarsest first, each dividing the duration."""
+
+    q0: tuple[float, ...]
+    v0: tuple[float, ...]
+    duration: float
+    steps: dict[str, tuple[float, ...]]
+
+    def __post_init__(self) -> None:
+        positive("duration", self.duration)
+        finite_array("q0", self.q0, (len(self.q0),))
+        finite_array("v0", self.v0, (len(self.q0),))
+        for integrator, dts in self.steps.items():
+            if integrator not in INTEGRATORS:
+                raise InvalidInput("integrator", integrator, f"one of {', '.join(INTEGRATORS)}")
+            if len(dts) < 2:
+                raise InvalidInput(f"steps[{integrator}]", dts, "at least two step sizes")
+            for dt in dts:
+                positive(f"steps[{integrator}] dt", dt)
+                n = self.duration / dt
+                if abs(n - round(n)) > 1e-9 * n:
+                    raise InvalidInput(
+                        f"steps[{integrator}] dt", dt, f"a divisor of duration {self.duration}"
+                    )
+            for coarse, fine in zip(dts, dts[1:], strict=False):
+                if not math.isclose(coarse, 2 * fine, rel_tol=1e-12):
+                    raise InvalidInput(f"steps[{integrator}]", dts, "a halving sequence")
+        for integrator, dts in self.steps.items():
+            ratio = self.grid_step / dts[0]
+            if abs(ratio - round(ratio)) > 1e-9 * ratio:
+                raise InvalidInput(f"steps[{integrator}]", dts, "steps dividing the coarsest")
+
+    @property
+    def grid_step(self) -> float:
+        """The spacing of the common comparison grid: the coarsest step of all integrators."""
+        return max(dts[0] for dts in self.steps.values())
+
+    def grid(self) -> np.ndarray:
+        """Times (s) at which trajectories are compared, shape (k,)."""
+        return np.arange(round(self.duration / self.grid_step) + 1) * self.grid_step
+
+
+@dataclass(frozen=True)
+class Case(ABC):
+    """A system of the book: parameters in its coordinates, sampled states, a trajectory.
+
+    Subclasses add the physical parameters (SI units, documented per field) and implement the
+    engine-neutral model and the map from book coordinates to engine joint coordinates.
+    """
+
+    name: ClassVar[str]
+    title: ClassVar[str]
+    book_refs: ClassVar[str]
+    coordinates: ClassVar[tuple[str, ...]]
+
+    n_states: int = 16
+    seed: int = 20261122
+    trajectory: TrajectorySpec = field(default=None)  # type: ignore[assignment]
+
+    @property
+    def ndof(self) -> int:
+        return len(self.coordinates)
+
+    @abstractmethod
+    def params(self) -> dict[str, float]:
+        """The physical parameters by the book's names (m, l, g, …)."""
+
+    @abstractmethod
+    def multibody(self) -> Multibody:
+        """The engine-neutral model every adapter builds from."""
+
+    @abstractmethod
+    def engine_map(self) -> LinearMap:
+        """x̄(x): the engine's joint coordinates as functions of the book's (2.2.2)."""
+
+    @abstractmethod
+    def rest(self) -> np.ndarray:
+        """A configuration (book coordinates) used as the datum of potential energy."""
+
+    @abstractmethod
+    def state_scale(self) -> tuple[float, float, float]:
+        """Ranges (max |q̇|, max |τ|, max |q̈|) for sampled states."""
+
+    def sample_states(self, n: int | None = None) -> StateSample:
+        """Deterministic states: the rest state first, then seeded uniform samples with
+        angles in (−π, π)."""
+        n = self.n_states if n is None else n
+        if n < 1:
+            raise InvalidInput("n_states", n, "a positive integer")
+        rng = np.random.default_rng(self.seed)
+        vmax, taumax, amax = self.state_scale()
+        d = self.ndof
+        q = rng.uniform(-np.pi, np.pi, (n, d))
+        v = rng.uniform(-vmax, vmax, (n, d))
+        tau = rng.uniform(-taumax, taumax, (n, d))
+        a = rng.uniform(-amax, amax, (n, d))
+        q[0], v[0], tau[0], a[0] = self.rest(), 0.0, 0.0, 0.0
+        return StateSample(q=q, v=v, tau=tau, a=a)

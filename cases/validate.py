@@ -1,0 +1,47 @@
+"""Validators shared by case records: each raises :class:`InvalidInput` naming the field."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from dyncheck.errors import InvalidInput
+
+
+def positive(field: str, value: float) -> float:
+    """A finite, strictly positive number (mass, length, gravity, step size, duration)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise InvalidInput(field, value, "a positive finite number")
+    if not math.isfinite(value) or value <= 0:
+        raise InvalidInput(field, value, "a positive finite number")
+    return float(value)
+
+
+def finite_array(field: str, value: Sequence[float] | np.ndarray, shape: tuple[int, ...]) -> None:
+    """An array of the given shape with no NaN or inf."""
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != shape:
+        raise InvalidInput(field, value, f"of shape {shape}, not {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise InvalidInput(field, value, "finite (no NaN or inf)")
+
+
+def inertia_tensor(field: str, value: np.ndarray, *, allow_zero: bool = False) -> None:
+    """A symmetric positive-definite (or, for a point mass, zero) 3×3 inertia obeying the
+    triangle inequality of principal moments, I_a + I_b ≥ I_c (from (2.2.39))."""
+    arr = np.asarray(value, dtype=float)
+    finite_array(field, arr, (3, 3))
+    if allow_zero and not np.any(arr):
+        return
+    if not np.allclose(arr, arr.T, rtol=0, atol=1e-12 * max(1.0, float(np.abs(arr).max()))):
+        raise InvalidInput(field, arr.tolist(), "a symmetric 3x3 matrix")
+    moments = np.linalg.eigvalsh(arr)
+    if moments[0] <= 0:
+        raise InvalidInput(field, arr.tolist(), "positive definite")
+    slack = 1e-12 * moments[-1]
+    if moments[0] + moments[1] < moments[2] - slack:
+        raise InvalidInput(
+            field, arr.tolist(), "an inertia whose principal moments obey I1 + I2 >= I3"
+        )

@@ -1,0 +1,9 @@
+"""dyncheck: a textbook's dynamics checked against MuJoCo and Pinocchio.
+
+Subpackages: ``dyncheck.cases`` (systems, defined once), ``dyncheck.reference`` (the book,
+clean-room), ``dyncheck.adapters`` (engines, one interface). The comparison layer
+(``dyncheck.comparison``, ``dyncheck.trajectories``) is the only code that sees both the
+reference and the engines.
+"""
+
+__version__ = "0.1.0"

@@ -1,0 +1,3 @@
+from dyncheck.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,79 @@
+"""Book ↔ engine coordinates: the book's transformation laws, written once.
+
+With x̄ = x̄(x) the engine's coordinates as functions of the book's (2.2.2), J = ∂x̄/∂x:
+
+- velocities are contravariant (2.2.4): v̄ = J v;
+- accelerations pick up the second-derivative term of (2.2.5): ā = J a + (∂²x̄/∂x∂x) v v;
+- generalized forces are covariant: τ = Jᵀ τ̄;
+- the mass matrix is a covariant 2-tensor (the metric of (2.2.21) times mass): M = Jᵀ M̄ J;
+- bias forces follow from the engine's equation M̄ ā + h̄ = τ̄ pulled back:
+  h = Jᵀ (h̄ + M̄ (∂²x̄/∂x∂x) v v);
+- energies are scalars (potential energy up to its datum, (2.2.20)).
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+
+class CoordinateMap(Protocol):
+    def to_engine(self, q: np.ndarray) -> np.ndarray: ...
+    def to_book(self, qe: np.ndarray) -> np.ndarray: ...
+    def jacobian(self, q: np.ndarray) -> np.ndarray: ...
+    def hessian_term(self, q: np.ndarray, v: np.ndarray) -> np.ndarray: ...
+
+
+def _mv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
+    return np.einsum("nij,nj->ni", A, x)
+
+
+def _mtv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
+    return np.einsum("nji,nj->ni", A, x)
+
+
+def velocity_to_engine(cmap: CoordinateMap, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """v̄ = J v (2.2.4)."""
+    return _mv(cmap.jacobian(q), v)
+
+
+def velocity_to_book(cmap: CoordinateMap, q: np.ndarray, ve: np.ndarray) -> np.ndarray:
+    """v = J⁻¹ v̄."""
+    return np.linalg.solve(cmap.jacobian(q), ve[..., None])[..., 0]
+
+
+def acceleration_to_engine(cmap: CoordinateMap, q: np.ndarray, v: np.ndarray,
+                           a: np.ndarray) -> np.ndarray:
+    """ā = J a + (∂²x̄/∂x∂x) v v (2.2.5)."""
+    return _mv(cmap.jacobian(q), a) + cmap.hessian_term(q, v)
+
+
+def acceleration_to_book(cmap: CoordinateMap, q: np.ndarray, v: np.ndarray,
+                         ae: np.ndarray) -> np.ndarray:
+    """a = J⁻¹ (ā − (∂²x̄/∂x∂x) v v)."""
+    rhs = ae - cmap.hessian_term(q, v)
+    return np.linalg.solve(cmap.jacobian(q), rhs[..., None])[..., 0]
+
+
+def force_to_book(cmap: CoordinateMap, q: np.ndarray, tau_e: np.ndarray) -> np.ndarray:
+    """τ = Jᵀ τ̄ (covariant)."""
+    return _mtv(cmap.jacobian(q), tau_e)
+
+
+def force_to_engine(cmap: CoordinateMap, q: np.ndarray, tau: np.ndarray) -> np.ndarray:
+    """τ̄ = J⁻ᵀ τ."""
+    J = cmap.jacobian(q)
+    return np.linalg.solve(np.swapaxes(J, -1, -2), tau[..., None])[..., 0]
+
+
+def mass_matrix_to_book(cmap: CoordinateMap, q: np.ndarray, Me: np.ndarray) -> np.ndarray:
+    """M = Jᵀ M̄ J (covariant 2-tensor)."""
+    J = cmap.jacobian(q)
+    return np.swapaxes(J, -1, -2) @ Me @ J
+
+
+def bias_to_book(cmap: CoordinateMap, q: np.ndarray, v: np.ndarray, Me: np.ndarray,
+                 he: np.ndarray) -> np.ndarray:
+    """h = Jᵀ (h̄ + M̄ (∂²x̄/∂x∂x) v v)."""
+    return force_to_book(cmap, q, he + _mv(Me, cmap.hessian_term(q, v)))

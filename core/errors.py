@@ -1,0 +1,47 @@
+"""dyncheck's own exceptions: one base class, a few subclasses.
+
+Adapters translate engine errors into these, in dyncheck's words. Every message is one line
+that names the field (or argument) and the offending value.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+
+class DyncheckError(Exception):
+    """Base class of every error dyncheck raises on purpose."""
+
+
+class InvalidInput(DyncheckError, ValueError):
+    """A case parameter, state, option or file is not acceptable."""
+
+    def __init__(self, field: str, value: object, expected: str) -> None:
+        self.field, self.value, self.expected = field, value, expected
+        super().__init__(f"{field} must be {expected}, got {value!r}")
+
+
+class UnknownName(DyncheckError, KeyError):
+    """A case, implementation, integrator or quantity name that does not exist."""
+
+    def __init__(self, kind: str, name: str, valid: Iterable[str]) -> None:
+        self.kind, self.name, self.valid = kind, name, sorted(valid)
+        super().__init__(f"unknown {kind} {name!r}; valid: {', '.join(self.valid)}")
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return self.args[0]
+
+
+class EngineNotInstalled(DyncheckError, ImportError):
+    """An implementation whose engine package cannot be imported."""
+
+    def __init__(self, implementation: str, package: str, reason: str) -> None:
+        self.implementation, self.package = implementation, package
+        super().__init__(
+            f"implementation {implementation!r} needs {package!r}, which is not installed "
+            f"({reason}); pip install {package}"
+        )
+
+
+class EngineError(DyncheckError, RuntimeError):
+    """An engine call failed or returned a non-finite value."""

@@ -1,0 +1,206 @@
+"""Every implementation behind one face, in the book's coordinates.
+
+``book`` (the printed equations) and ``reference`` (the general method) come from
+:mod:`dyncheck.reference`; the engines come from :mod:`dyncheck.adapters` and cross the case's
+coordinate map by the laws in :mod:`dyncheck.coordinates`. This module and the comparison are
+the only code that sees both sides.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from dyncheck import coordinates as co
+from dyncheck.adapters import ENGINE_PACKAGES, Adapter, get_adapter
+from dyncheck.cases import Case, StateSample
+from dyncheck.errors import UnknownName
+from dyncheck.reference import pendulum
+from dyncheck.reference.trajectory import solve
+
+QUANTITIES: tuple[str, ...] = (
+    "mass_matrix",
+    "bias_forces",
+    "forward_dynamics",
+    "inverse_dynamics",
+    "kinetic_energy",
+    "potential_energy",
+)
+
+IMPLEMENTATIONS: tuple[str, ...] = ("reference", "book", "pinocchio", "pinocchio-mjcf", "mujoco")
+"""All implementation names, most trusted first: in a pair the earlier one is ``desired``."""
+
+_REFERENCE: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
+    "simple_pendulum": (pendulum.simple_pendulum, pendulum.simple_pendulum_printed),
+    "compound_pendulum": (pendulum.compound_pendulum, pendulum.compound_pendulum_printed),
+}
+
+
+def general_method(case: Case, inertia: tuple[float, ...] | None = None):
+    """The reference's general method for ``case``; ``inertia`` = rotational inertia about each
+    body's centre around its hinge axis (a model variant, kg·m²), zero by default."""
+    general, _ = _REFERENCE[case.name]
+    return general(**case.params(), inertia=inertia or (0.0,) * case.ndof)
+
+
+def printed_equations(case: Case):
+    """The equations exactly as the book prints them."""
+    _, printed = _REFERENCE[case.name]
+    return printed(**case.params())
+
+
+@dataclass(frozen=True)
+class Variant:
+    """How an implementation's model departs from the book's, as far as it can be predicted:
+    the rotational inertia about each hinge axis (kg·m²) its bodies carry (book: zero)."""
+
+    hinge_inertia: tuple[float, ...]
+
+    @property
+    def is_book(self) -> bool:
+        return not any(self.hinge_inertia)
+
+
+class Implementation(ABC):
+    """One implementation of a case, evaluated in the book's coordinates."""
+
+    name: ClassVar[str]
+    integrators: tuple[str, ...] = ()
+
+    def __init__(self, case: Case) -> None:
+        self.case = case
+
+    @abstractmethod
+    def variant(self) -> Variant | None:
+        """The model variant, or ``None`` when the model differs in a way not predicted."""
+
+    @abstractmethod
+    def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]: ...
+
+    @abstractmethod
+    def _potential(self, q: np.ndarray) -> np.ndarray: ...
+
+    def evaluate(self, s: StateSample) -> dict[str, np.ndarray]:
+        """Every quantity at every state; potential energy relative to the case's rest state."""
+        out = self._dynamics(s.q, s)
+        out["potential_energy"] = self._potential(s.q) - self._potential(self.case.rest()[None])
+        return out
+
+    def simulate(self, dt: float, integrator: str) -> tuple[np.ndarray, np.ndarray]:
+        raise NotImplementedError(f"{self.name} has no fixed-step integrator")
+
+
+class _Equations(Implementation):
+    """An implementation backed by numeric book dynamics (printed or general)."""
+
+    def __init__(self, case: Case) -> None:
+        super().__init__(case)
+        self.dyn = self._build(case)
+
+    @abstractmethod
+    def _build(self, case: Case) -> Any: ...
+
+    def variant(self) -> Variant:
+        return Variant((0.0,) * self.case.ndof)
+
+    def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]:
+        d = self.dyn
+        return {
+            "mass_matrix": d.mass_matrix(q),
+            "bias_forces": d.bias(q, s.v),
+            "forward_dynamics": d.forward(q, s.v, s.tau),
+            "inverse_dynamics": d.inverse(q, s.v, s.a),
+            "kinetic_energy": d.kinetic_energy(q, s.v),
+        }
+
+    def _potential(self, q: np.ndarray) -> np.ndarray:
+        return self.dyn.potential_energy(q)
+
+
+class BookImplementation(_Equations):
+    name: ClassVar[str] = "book"
+
+    def _build(self, case: Case) -> Any:
+        return printed_equations(case)
+
+
+class ReferenceImplementation(_Equations):
+    name: ClassVar[str] = "reference"
+
+    def _build(self, case: Case) -> Any:
+        return general_method(case)
+
+
+class EngineImplementation(Implementation):
+    """An engine adapter seen through the case's coordinate map."""
+
+    def __init__(self, case: Case, adapter: type[Adapter]) -> None:
+        super().__init__(case)
+        self.name = adapter.name  # type: ignore[misc]
+        self.adapter = adapter(case.multibody())
+        self.map = case.engine_map()
+        self.integrators = adapter.integrators
+
+    def variant(self) -> Variant | None:
+        spec = self.case.multibody()
+        out = []
+        for body, loaded in zip(spec.bodies, self.adapter.loaded_bodies(), strict=True):
+            if loaded.mass != body.mass:
+                return None
+            axis = np.asarray(body.joint_axis)
+            extra = loaded.inertia - np.asarray(body.inertia)
+            if not np.allclose(extra, (axis @ extra @ axis) * np.eye(3), rtol=0, atol=0):
+                return None  # not an isotropic floor: not a convention we can predict
+            out.append(float(axis @ extra @ axis))
+        return Variant(tuple(out))
+
+    def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]:
+        m, a = self.map, self.adapter
+        qe, ve = m.to_engine(q), co.velocity_to_engine(m, q, s.v)
+        Me = a.mass_matrix(qe)
+        tau_e = co.force_to_engine(m, q, s.tau)
+        return {
+            "mass_matrix": co.mass_matrix_to_book(m, q, Me),
+            "bias_forces": co.bias_to_book(m, q, s.v, Me, a.bias(qe, ve)),
+            "forward_dynamics": co.acceleration_to_book(m, q, s.v, a.forward(qe, ve, tau_e)),
+            "inverse_dynamics": co.force_to_book(
+                m, q, a.inverse(qe, ve, co.acceleration_to_engine(m, q, s.v, s.a))
+            ),
+            "kinetic_energy": a.kinetic_energy(qe, ve),
+        }
+
+    def _potential(self, q: np.ndarray) -> np.ndarray:
+        return self.adapter.potential_energy(self.map.to_engine(q))
+
+    def simulate(self, dt: float, integrator: str) -> tuple[np.ndarray, np.ndarray]:
+        """Times and book-coordinate configurations of a fixed-step run, shapes (k,), (k, N)."""
+        spec = self.case.trajectory
+        q0 = np.asarray(spec.q0)[None]
+        qe0 = self.map.to_engine(q0)[0]
+        ve0 = co.velocity_to_engine(self.map, q0, np.asarray(spec.v0)[None])[0]
+        traj = self.adapter.simulate(qe0, ve0, spec.duration, dt, integrator)
+        return traj.t, self.map.to_book(traj.q)
+
+
+def make_implementation(name: str, case: Case) -> Implementation:
+    """The implementation ``name`` of ``case``; raises UnknownName or EngineNotInstalled."""
+    if name == "book":
+        return BookImplementation(case)
+    if name == "reference":
+        return ReferenceImplementation(case)
+    if name in ENGINE_PACKAGES:
+        return EngineImplementation(case, get_adapter(name))
+    raise UnknownName("implementation", name, IMPLEMENTATIONS)
+
+
+def reference_trajectory(case: Case, variant: Variant, t: np.ndarray, *, rtol: float = 1e-13,
+                         ) -> np.ndarray:
+    """q(t) of the general method for ``variant`` by DOP853 (book coordinates)."""
+    spec = case.trajectory
+    q, _ = solve(general_method(case, variant.hinge_inertia), np.asarray(spec.q0),
+                 np.asarray(spec.v0), t, rtol=rtol, atol=rtol)
+    return q

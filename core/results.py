@@ -1,0 +1,90 @@
+"""Result records, the long tables they form, and atomic writing."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Iterable
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+
+import pandas as pd
+
+VERDICTS = ("passed", "explained", "failed", "skipped")
+
+
+@dataclass(frozen=True)
+class Discrepancy:
+    """One case × quantity × pair of implementations (× integrator × step for trajectories).
+
+    ``impl_a`` is the trusted side (``desired``), ``impl_b`` the one checked against it.
+    Errors: ``max_abs_err`` in the quantity's units (book coordinates); ``max_rel_err`` divided
+    by the quantity's scale (max |desired|). ``worst_state`` is the index of the sampled state
+    (or, for trajectories, of the grid time) where the largest error occurred.
+    """
+
+    case: str
+    quantity: str
+    impl_a: str
+    impl_b: str
+    integrator: str
+    dt: float
+    max_abs_err: float
+    max_rel_err: float
+    tolerance: float
+    tolerance_basis: str
+    verdict: str
+    convention: str
+    note: str
+    worst_state: int
+
+    def __post_init__(self) -> None:
+        if self.verdict not in VERDICTS:
+            raise ValueError(f"verdict must be one of {VERDICTS}, got {self.verdict!r}")
+
+
+@dataclass(frozen=True)
+class ConvergencePoint:
+    """One step of an order-of-accuracy study: the max configuration error (rad) over the
+    comparison grid against the reference of the implementation's own model."""
+
+    case: str
+    impl: str
+    integrator: str
+    dt: float
+    error: float
+    observed_order: float
+    nominal_order: int
+    reference_error: float
+    asymptotic: bool
+
+
+DISCREPANCY_KEY = ["case", "quantity", "impl_a", "impl_b", "integrator", "dt"]
+CONVERGENCE_KEY = ["case", "impl", "integrator", "dt"]
+
+
+def table(records: Iterable[object], record_type: type, key: list[str]) -> pd.DataFrame:
+    """Records as a DataFrame with the record's columns, sorted by ``key``."""
+    columns = [f.name for f in fields(record_type)]
+    frame = pd.DataFrame([asdict(r) for r in records], columns=columns)  # type: ignore[arg-type]
+    return frame.sort_values(key, kind="stable").reset_index(drop=True)
+
+
+def write_atomic(path: Path, content: str | bytes) -> None:
+    """Write to a temporary file in the same folder, then rename over ``path``."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    mode = "wb" if isinstance(content, bytes) else "w"
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, mode) as f:
+            f.write(content)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def to_csv(frame: pd.DataFrame) -> str:
+    """Deterministic CSV text: fixed float format, LF line ends."""
+    return frame.to_csv(index=False, float_format="%.6e", lineterminator="\n")

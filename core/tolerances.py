@@ -1,0 +1,63 @@
+"""Tolerances as named records, each with its basis; checked to cover every quantity.
+
+Instantaneous quantities are compared normwise: max |actual − desired| over all states and
+components, divided by the quantity's scale, max |desired| over the states. Each engine or
+formula evaluates an entry in O(10) floating-point operations on values of that scale, so
+round-off is a few ε; 64 ε (1.4e-14) leaves room for the coordinate map (a few more products)
+without admitting any modelling difference (the smallest one dyncheck explains is ~1e-9).
+Forward dynamics solves M v̇ = τ − h, whose relative error is amplified by κ(M) (the
+2-norm condition number, the largest over the sampled states).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from dyncheck.implementations import QUANTITIES
+
+EPS = float(np.finfo(float).eps)
+ROUNDOFF_FACTOR = 64
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    """A relative tolerance and the reason for its size."""
+
+    rtol: float
+    basis: str
+
+
+def instantaneous(quantity: str, condition: float) -> Tolerance:
+    """The tolerance for ``quantity``; ``condition`` = max κ(M) over the states."""
+    if quantity not in QUANTITIES:
+        raise KeyError(quantity)
+    if quantity == "forward_dynamics":
+        return Tolerance(ROUNDOFF_FACTOR * EPS * condition,
+                         f"round-off: {ROUNDOFF_FACTOR} eps x cond(M) = {condition:.3g}")
+    return Tolerance(ROUNDOFF_FACTOR * EPS, f"round-off: {ROUNDOFF_FACTOR} eps")
+
+
+def accumulated(steps: int) -> Tolerance:
+    """Two runs of the same integrator on the same model: round-off accumulates at most
+    linearly over the steps (no exponential growth on these regular orbits)."""
+    return Tolerance(ROUNDOFF_FACTOR * EPS * steps,
+                     f"accumulated round-off: {ROUNDOFF_FACTOR} eps x {steps} steps")
+
+
+ORDER_SLACK = 0.1
+"""Observed order must lie within nominal ± this, in the asymptotic range."""
+
+REFERENCE_MARGIN = 100.0
+"""A step's error counts in the order study only if it exceeds this many times the reference
+trajectory's own error estimate."""
+
+
+def check_coverage() -> None:
+    """Every quantity has a tolerance (fails loudly when a quantity is added without one)."""
+    for q in QUANTITIES:
+        instantaneous(q, 1.0)
+
+
+check_coverage()

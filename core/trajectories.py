@@ -1,0 +1,196 @@
+"""Trajectories: the observed order of accuracy of every engine × integrator, and
+engine-against-engine runs of the same integrator.
+
+Each run starts from the case's initial state (book coordinates, mapped to the engine's) and
+is compared on a common grid of times against the reference trajectory of *the same model*
+(the general method on the implementation's model variant, DOP853 at rtol = atol = 1e-13), so
+that the study measures the integrator alone. The observed order between steps h₁ = 2h₂ is
+p = ln(E₁/E₂)/ln(h₁/h₂) (Roy 2005); a step counts as asymptotic only where its error exceeds
+100× the reference's own error estimate |ref(1e-13) − ref(2.5e-14)| (2.5e-14 is near the
+smallest rtol DOP853 accepts).
+
+Two engines with the same integrator and step are compared step by step: on the same model
+they must agree to accumulated round-off; on models that differ by a named convention, their
+difference must equal the predicted one — the reference's equations for the two model
+variants stepped by the same fixed-step integrator (MuJoCo's definition), within that
+round-off. A run passes when the
+finest asymptotic pair shows the nominal order ± 0.1; a large error at a coarse step is the
+integrator's truncation error, reported with its size, not a failure.
+"""
+
+from __future__ import annotations
+
+from itertools import combinations
+
+import numpy as np
+
+from dyncheck.cases import NOMINAL_ORDER, Case
+from dyncheck.comparison import POINT_INERTIA
+from dyncheck.adapters.integrators import integrate
+from dyncheck.implementations import (
+    IMPLEMENTATIONS,
+    Implementation,
+    Variant,
+    general_method,
+    reference_trajectory,
+)
+from dyncheck.results import ConvergencePoint, Discrepancy
+from dyncheck.tolerances import ORDER_SLACK, REFERENCE_MARGIN, accumulated
+
+TRUNCATION = "integrator truncation error"
+
+
+class References:
+    """Reference trajectories on the case's grid, per model variant, with error estimates."""
+
+    def __init__(self, case: Case) -> None:
+        self.case = case
+        self.t = case.trajectory.grid()
+        self._cache: dict[Variant, tuple[np.ndarray, float]] = {}
+        self._discrete: dict[tuple[Variant, str, float], np.ndarray] = {}
+
+    def __call__(self, variant: Variant) -> tuple[np.ndarray, float]:
+        """(q on the grid, estimated max error of q)."""
+        if variant not in self._cache:
+            ref = reference_trajectory(self.case, variant, self.t, rtol=1e-13)
+            tighter = reference_trajectory(self.case, variant, self.t, rtol=2.5e-14)
+            self._cache[variant] = ref, float(np.abs(ref - tighter).max())
+        return self._cache[variant]
+
+    def discrete(self, variant: Variant, integrator: str, dt: float) -> np.ndarray:
+        """q at every step of the general method stepped by a fixed-step integrator."""
+        key = (variant, integrator, dt)
+        if key not in self._discrete:
+            dyn = general_method(self.case, variant.hinge_inertia)
+            zero = np.zeros((1, self.case.ndof))
+
+            def acc(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+                return dyn.forward(q[None], v[None], zero)[0]
+
+            spec = self.case.trajectory
+            steps = round(spec.duration / dt)
+            self._discrete[key], _ = integrate(acc, np.asarray(spec.q0, float),
+                                               np.asarray(spec.v0, float), dt, steps, integrator)
+        return self._discrete[key]
+
+
+def observed_orders(dts: list[float], errors: list[float]) -> list[float]:
+    """p between consecutive steps; NaN for the first."""
+    out = [float("nan")]
+    for i in range(1, len(dts)):
+        out.append(float(np.log(errors[i - 1] / errors[i]) / np.log(dts[i - 1] / dts[i])))
+    return out
+
+
+def study(
+    case: Case, impls: dict[str, Implementation | Exception]
+) -> tuple[list[ConvergencePoint], list[Discrepancy]]:
+    """The order-of-accuracy study and the engine-against-engine trajectory rows."""
+    spec = case.trajectory
+    refs = References(case)
+    points: list[ConvergencePoint] = []
+    rows: list[Discrepancy] = []
+    runs: dict[tuple[str, str, float], np.ndarray] = {}
+    variants: dict[str, Variant | None] = {}
+    engines = [n for n in IMPLEMENTATIONS if n in impls and n not in ("book", "reference")]
+    for name in engines:
+        impl = impls[name]
+        if isinstance(impl, Exception):
+            rows.append(_unavailable(case, name, impl))
+            continue
+        variant = variants[name] = impl.variant()
+        for integrator, dts in spec.steps.items():
+            if integrator not in impl.integrators:
+                continue
+            nominal = NOMINAL_ORDER[integrator]
+            ref, ref_err = refs(variant or Variant((0.0,) * case.ndof))
+            errors, worst = [], []
+            for dt in dts:
+                _, q = impl.simulate(dt, integrator)
+                runs[name, integrator, dt] = q
+                diff = np.abs(q[:: round(spec.grid_step / dt)] - ref).max(axis=1)
+                errors.append(float(diff.max()))
+                worst.append(int(diff.argmax()))
+            orders = observed_orders(list(dts), errors)
+            asym = [e > REFERENCE_MARGIN * ref_err for e in errors]
+            finest = [i for i in range(1, len(dts)) if asym[i] and asym[i - 1]]
+            if variant is None:
+                verdict, note = "failed", "model differs from the book in an unpredicted way"
+            elif not finest:
+                verdict, note = "failed", "no pair of steps in the asymptotic range"
+            else:
+                p = orders[finest[-1]]
+                ok = abs(p - nominal) <= ORDER_SLACK
+                verdict = "passed" if ok else "failed"
+                note = (f"observed order {p:.3f} (nominal {nominal}) at dt={dts[finest[-1]]:g}; "
+                        f"reference error estimate {ref_err:.1e}")
+                if variant != Variant((0.0,) * case.ndof):
+                    note += f"; against the reference of the same model (hinge inertia "
+                    note += f"{list(variant.hinge_inertia)} kg m^2)"
+            scale_q = float(np.abs(ref).max())
+            for dt, err, p, a, w in zip(dts, errors, orders, asym, worst, strict=True):
+                points.append(ConvergencePoint(case.name, name, integrator, dt, err, p, nominal,
+                                               ref_err, a))
+                rows.append(Discrepancy(
+                    case=case.name, quantity="trajectory", impl_a="reference", impl_b=name,
+                    integrator=integrator, dt=dt, max_abs_err=err, max_rel_err=err / scale_q,
+                    tolerance=float("nan"),
+                    tolerance_basis=f"order study: observed order within {nominal} ± "
+                                    f"{ORDER_SLACK}", verdict=verdict,
+                    convention=f"{TRUNCATION} (order {nominal})", note=note, worst_state=w))
+    rows += _engine_pairs(case, engines, runs, variants, refs)
+    return points, rows
+
+
+def _unavailable(case: Case, name: str, exc: Exception) -> Discrepancy:
+    from dyncheck.errors import EngineNotInstalled
+
+    verdict = "skipped" if isinstance(exc, EngineNotInstalled) else "failed"
+    return Discrepancy(case.name, "trajectory", "reference", name, "", float("nan"),
+                       float("nan"), float("nan"), float("nan"), "", verdict, "", str(exc), -1)
+
+
+def _engine_pairs(
+    case: Case,
+    engines: list[str],
+    runs: dict[tuple[str, str, float], np.ndarray],
+    variants: dict[str, Variant | None],
+    refs: References,
+) -> list[Discrepancy]:
+    """Same integrator, same step, two engines: equal to accumulated round-off, or differing
+    by the predicted effect of their model variants on the trajectory."""
+    rows = []
+    spec = case.trajectory
+    for a, b in combinations(engines, 2):
+        for integrator, dts in spec.steps.items():
+            for dt in dts:
+                if (a, integrator, dt) not in runs or (b, integrator, dt) not in runs:
+                    continue
+                qa, qb = runs[a, integrator, dt], runs[b, integrator, dt]
+                steps = qa.shape[0] - 1
+                tol = accumulated(steps)
+                scale_q = float(np.abs(qa).max())
+                diff = np.abs(qb - qa).max(axis=1)
+                worst = int(diff.argmax())
+                err = float(diff[worst])
+                row = dict(case=case.name, quantity="trajectory", impl_a=a, impl_b=b,
+                           integrator=integrator, dt=dt, max_abs_err=err,
+                           max_rel_err=err / scale_q, tolerance=tol.rtol,
+                           tolerance_basis=tol.basis, worst_state=worst)
+                va, vb = variants[a], variants[b]
+                if err / scale_q <= tol.rtol:
+                    rows.append(Discrepancy(**row, verdict="passed", convention="", note=""))
+                elif va is not None and vb is not None and va != vb:
+                    predicted = (refs.discrete(vb, integrator, dt)
+                                 - refs.discrete(va, integrator, dt))
+                    res_rel = float(np.abs(qb - qa - predicted).max()) / scale_q
+                    note = (f"predicted by the reference equations of both models, stepped by "
+                            f"{integrator}: max {np.abs(predicted).max():.3g} rad; residual "
+                            f"{res_rel:.3g}")
+                    verdict = "explained" if res_rel <= tol.rtol else "failed"
+                    rows.append(Discrepancy(**row, verdict=verdict, convention=POINT_INERTIA,
+                                            note=note))
+                else:
+                    rows.append(Discrepancy(**row, verdict="failed", convention="",
+                                            note="unexplained: no convention predicts this"))
+    return rows

@@ -1,0 +1,136 @@
+"""The general method: Lagrange's equations (2.2.23)–(2.2.26) from T and V, derived exactly.
+
+Given T(x, ẋ) and V(x) as sympy expressions, the Euler–Lagrange equations (2.2.26) with
+L = T − V (2.2.25) are written in the canonical form
+
+    M(x) ẍ + h(x, ẋ) = τ,
+
+where M_rs = ∂²T/∂ẋʳ∂ẋˢ (the metric of (2.2.21) times the mass, from (2.2.22)),
+h_r = (∂²T/∂ẋʳ∂xⁿ) ẋⁿ − ∂T/∂xʳ + ∂V/∂xʳ (velocity terms of (2.2.22) and the conservative
+force of (2.2.20) moved to the left), and τ_r the remaining (non-potential) generalized force
+Q_r of (2.2.23), a covariant vector. Everything is evaluated on batches: q, v of shape (n, N).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+
+def particle_energies(
+    masses: Sequence[sp.Expr],
+    positions: Sequence[Sequence[sp.Expr]],
+    q: Sequence[sp.Symbol],
+    qd: Sequence[sp.Symbol],
+    g: sp.Expr,
+) -> tuple[sp.Expr, sp.Expr]:
+    """T = Σ ½ m_k |ṙ_k|² (2.2.21)/(2.2.27) and V = Σ m_k g y_k (gravity along −y, V = −W
+    of (2.2.20)) for particles at Cartesian positions r_k(q) = (x_k, y_k)."""
+    T = sp.Integer(0)
+    V = sp.Integer(0)
+    for m, r in zip(masses, positions, strict=True):
+        rdot = [sum(sp.diff(c, qi) * qdi for qi, qdi in zip(q, qd, strict=True)) for c in r]
+        T += sp.Rational(1, 2) * m * sum(c**2 for c in rdot)
+        V += m * g * r[1]
+    return T, V
+
+
+def _vectorize(expr: sp.Expr, args: Sequence[sp.Symbol]) -> Callable[..., np.ndarray]:
+    """A numpy function of batched arguments; constants broadcast to the batch shape."""
+    f = sp.lambdify(args, expr, modules="numpy", cse=True)
+
+    def evaluate(*values: np.ndarray) -> np.ndarray:
+        out = np.asarray(f(*values), dtype=float)
+        return np.broadcast_to(out, np.broadcast(*values).shape).copy()
+
+    return evaluate
+
+
+@dataclass(frozen=True)
+class SymbolicSystem:
+    """T(x, ẋ) and V(x) with parameter symbols; :meth:`numeric` binds parameter values."""
+
+    q: tuple[sp.Symbol, ...]
+    qd: tuple[sp.Symbol, ...]
+    params: tuple[sp.Symbol, ...]
+    T: sp.Expr
+    V: sp.Expr
+
+    def equations(self) -> tuple[sp.Matrix, sp.Matrix]:
+        """(M, h) of the canonical form, from (2.2.22)–(2.2.26)."""
+        n = len(self.q)
+        p = [sp.diff(self.T, qdi) for qdi in self.qd]  # ∂T/∂ẋʳ
+        M = sp.Matrix(n, n, lambda r, s: sp.simplify(sp.diff(p[r], self.qd[s])))
+        h = sp.Matrix(
+            n,
+            1,
+            lambda r, _: sp.simplify(
+                sum(sp.diff(p[r], qn) * qdn for qn, qdn in zip(self.q, self.qd, strict=True))
+                - sp.diff(self.T, self.q[r])
+                + sp.diff(self.V, self.q[r])
+            ),
+        )
+        return M, h
+
+    def numeric(self, values: dict[str, float]) -> LagrangianDynamics:
+        missing = {s.name for s in self.params} - set(values)
+        if missing:
+            raise KeyError(f"missing parameter values: {sorted(missing)}")
+        M, h = self.equations()
+        args = (*self.q, *self.qd, *self.params)
+        n = len(self.q)
+        return LagrangianDynamics(
+            ndof=n,
+            param_values=tuple(float(values[s.name]) for s in self.params),
+            M_entries=tuple(tuple(_vectorize(M[r, c], args) for c in range(n)) for r in range(n)),
+            h_entries=tuple(_vectorize(h[r, 0], args) for r in range(n)),
+            T_fn=_vectorize(self.T, args),
+            V_fn=_vectorize(self.V, args),
+        )
+
+
+@dataclass(frozen=True)
+class LagrangianDynamics:
+    """Numeric M(q), h(q, v), forward and inverse dynamics, T, V on batches (n, N)."""
+
+    ndof: int
+    param_values: tuple[float, ...]
+    M_entries: tuple[tuple[Callable[..., np.ndarray], ...], ...]
+    h_entries: tuple[Callable[..., np.ndarray], ...]
+    T_fn: Callable[..., np.ndarray]
+    V_fn: Callable[..., np.ndarray]
+
+    def _args(self, q: np.ndarray, v: np.ndarray | None = None) -> list[np.ndarray]:
+        q = np.atleast_2d(q)
+        v = np.zeros_like(q) if v is None else np.atleast_2d(v)
+        return [*q.T, *v.T, *self.param_values]
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        """M(q), shape (n, N, N)."""
+        args = self._args(q)
+        return np.stack([np.stack([f(*args) for f in row], -1) for row in self.M_entries], -2)
+
+    def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """h(q, v) = velocity terms + gravity, shape (n, N)."""
+        args = self._args(q, v)
+        return np.stack([f(*args) for f in self.h_entries], -1)
+
+    def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """ẍ = M⁻¹(τ − h), shape (n, N)."""
+        rhs = np.atleast_2d(tau) - self.bias(q, v)
+        return np.linalg.solve(self.mass_matrix(q), rhs[..., None])[..., 0]
+
+    def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """τ = M ẍ + h, shape (n, N)."""
+        return np.einsum("nij,nj->ni", self.mass_matrix(q), np.atleast_2d(a)) + self.bias(q, v)
+
+    def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """T, shape (n,)."""
+        return self.T_fn(*self._args(q, v))
+
+    def potential_energy(self, q: np.ndarray) -> np.ndarray:
+        """V, shape (n,)."""
+        return self.V_fn(*self._args(q))
