@@ -46,5 +46,12 @@ def get_adapter(name: str) -> type[Adapter]:
     raise UnknownName("implementation", name, ENGINE_PACKAGES)
 
 
-__all__ = ["ADAPTERS", "ENGINE_PACKAGES", "MISSING", "Adapter", "LoadedBody", "Trajectory",
-           "get_adapter"]
+__all__ = [
+    "ADAPTERS",
+    "ENGINE_PACKAGES",
+    "MISSING",
+    "Adapter",
+    "LoadedBody",
+    "Trajectory",
+    "get_adapter",
+]

@@ -21,19 +21,37 @@ def to_mjcf(model: Multibody, *, timestep: float = 0.002, integrator: str = "Eul
     """
     root = ET.Element("mujoco", model=model.name)
     ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false", autolimits="true")
-    option = ET.SubElement(root, "option", gravity=_fmt(model.gravity),
-                           timestep=repr(float(timestep)), integrator=integrator)
+    option = ET.SubElement(
+        root,
+        "option",
+        gravity=_fmt(model.gravity),
+        timestep=repr(float(timestep)),
+        integrator=integrator,
+    )
     ET.SubElement(option, "flag", energy="enable", contact="disable")
     parents: dict[str | None, ET.Element] = {None: ET.SubElement(root, "worldbody")}
     for body, joint in zip(model.bodies, model.joint_names, strict=True):
         el = ET.SubElement(parents[body.parent], "body", name=body.name, pos=_fmt(body.joint_pos))
-        ET.SubElement(el, "joint", name=joint, type=body.joint_type, axis=_fmt(body.joint_axis),
-                      pos="0 0 0", damping="0", armature="0")
+        ET.SubElement(
+            el,
+            "joint",
+            name=joint,
+            type=body.joint_type,
+            axis=_fmt(body.joint_axis),
+            pos="0 0 0",
+            damping="0",
+            armature="0",
+        )
         inertia = np.asarray(body.inertia, float)
         if body.is_point_mass:
             inertia = model.mjcf_point_inertia * np.eye(3)
-        ET.SubElement(el, "inertial", pos=_fmt(body.com), mass=repr(float(body.mass)),
-                      fullinertia=_fmt(inertia[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]))
+        ET.SubElement(
+            el,
+            "inertial",
+            pos=_fmt(body.com),
+            mass=repr(float(body.mass)),
+            fullinertia=_fmt(inertia[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]),
+        )
         parents[body.name] = el
     ET.indent(root)
     return ET.tostring(root, encoding="unicode") + "\n"

@@ -87,8 +87,9 @@ class PinocchioAdapter(Adapter):
 
     def loaded_bodies(self) -> list[LoadedBody]:
         return [
-            LoadedBody(b.name, float(self.model.inertias[j].mass),
-                       np.array(self.model.inertias[j].inertia))
+            LoadedBody(
+                b.name, float(self.model.inertias[j].mass), np.array(self.model.inertias[j].inertia)
+            )
             for b, j in zip(self.spec.bodies, self._joint_ids, strict=True)
         ]
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
@@ -63,7 +64,7 @@ class TrajectorySpec:
                     raise InvalidInput(
                         f"steps[{integrator}] dt", dt, f"a divisor of duration {self.duration}"
                     )
-            for coarse, fine in zip(dts, dts[1:], strict=False):
+            for coarse, fine in itertools.pairwise(dts):
                 if not math.isclose(coarse, 2 * fine, rel_tol=1e-12):
                     raise InvalidInput(f"steps[{integrator}]", dts, "a halving sequence")
         for integrator, dts in self.steps.items():

@@ -32,10 +32,10 @@ STEPS = {
 class SimplePendulum(Case):
     """Example 7: a point mass m on a massless rod of length ℓ::
 
-            O  pivot
-             \\ θ
-              \\  ℓ
-               ●  m
+    O  pivot
+     \\ θ
+      \\  ℓ
+       ●  m
     """
 
     name: ClassVar[str] = "simple_pendulum"
@@ -45,7 +45,7 @@ class SimplePendulum(Case):
 
     m: float = 1.3
     """bob mass, kg"""
-    l: float = 0.9  # noqa: E741 — the book's name
+    l: float = 0.9
     """rod length, m"""
     g: float = 9.81
     """gravity, m/s²"""

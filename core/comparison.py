@@ -76,32 +76,69 @@ def judge(
     predict: VariantPredictor,
 ) -> Discrepancy:
     """Compare b (actual) with a (desired) on one quantity."""
-    row = dict(case=case.name, quantity=quantity, impl_a=a.name, impl_b=b.name, integrator="",
-               dt=float("nan"), tolerance=tol.rtol, tolerance_basis=tol.basis)
+    row = dict(
+        case=case.name,
+        quantity=quantity,
+        impl_a=a.name,
+        impl_b=b.name,
+        integrator="",
+        dt=float("nan"),
+        tolerance=tol.rtol,
+        tolerance_basis=tol.basis,
+    )
     if a.values is None or b.values is None:
         bad = a if a.values is None else b
-        return Discrepancy(**row, max_abs_err=float("nan"), max_rel_err=float("nan"),
-                           verdict="skipped" if bad.skipped else "failed", convention="",
-                           note=f"{bad.name}: {bad.error}", worst_state=-1)
+        return Discrepancy(
+            **row,
+            max_abs_err=float("nan"),
+            max_rel_err=float("nan"),
+            verdict="skipped" if bad.skipped else "failed",
+            convention="",
+            note=f"{bad.name}: {bad.error}",
+            worst_state=-1,
+        )
     desired, actual = a.values[quantity], b.values[quantity]
     abs_err, rel_err, worst = _error(actual, desired)
     if rel_err <= tol.rtol:
-        return Discrepancy(**row, max_abs_err=abs_err, max_rel_err=rel_err, verdict="passed",
-                           convention="", note="", worst_state=worst)
+        return Discrepancy(
+            **row,
+            max_abs_err=abs_err,
+            max_rel_err=rel_err,
+            verdict="passed",
+            convention="",
+            note="",
+            worst_state=worst,
+        )
     if a.variant is not None and b.variant is not None and a.variant != b.variant:
         pa, pb = predict(a.variant), predict(b.variant)
         _, predicted, _ = _error(pb[quantity], pa[quantity])
         residual = (actual - desired) - (pb[quantity] - pa[quantity])
         res_rel = float(np.abs(residual).max()) / scale(desired)
-        note = (f"hinge inertia {b.name} {list(b.variant.hinge_inertia)} vs {a.name} "
-                f"{list(a.variant.hinge_inertia)} kg m^2: predicted rel. difference "
-                f"{predicted:.3g}, residual after prediction {res_rel:.3g}")
+        note = (
+            f"hinge inertia {b.name} {list(b.variant.hinge_inertia)} vs {a.name} "
+            f"{list(a.variant.hinge_inertia)} kg m^2: predicted rel. difference "
+            f"{predicted:.3g}, residual after prediction {res_rel:.3g}"
+        )
         verdict = "explained" if res_rel <= tol.rtol else "failed"
-        return Discrepancy(**row, max_abs_err=abs_err, max_rel_err=rel_err, verdict=verdict,
-                           convention=POINT_INERTIA, note=note, worst_state=worst)
+        return Discrepancy(
+            **row,
+            max_abs_err=abs_err,
+            max_rel_err=rel_err,
+            verdict=verdict,
+            convention=POINT_INERTIA,
+            note=note,
+            worst_state=worst,
+        )
     note = "unexplained: no convention predicts this difference"
-    return Discrepancy(**row, max_abs_err=abs_err, max_rel_err=rel_err, verdict="failed",
-                       convention="", note=note, worst_state=worst)
+    return Discrepancy(
+        **row,
+        max_abs_err=abs_err,
+        max_rel_err=rel_err,
+        verdict="failed",
+        convention="",
+        note=note,
+        worst_state=worst,
+    )
 
 
 def evaluate(impl: Implementation | Exception, name: str, sample: StateSample) -> Evaluation:

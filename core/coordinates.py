@@ -43,14 +43,16 @@ def velocity_to_book(cmap: CoordinateMap, q: np.ndarray, ve: np.ndarray) -> np.n
     return np.linalg.solve(cmap.jacobian(q), ve[..., None])[..., 0]
 
 
-def acceleration_to_engine(cmap: CoordinateMap, q: np.ndarray, v: np.ndarray,
-                           a: np.ndarray) -> np.ndarray:
+def acceleration_to_engine(
+    cmap: CoordinateMap, q: np.ndarray, v: np.ndarray, a: np.ndarray
+) -> np.ndarray:
     """ā = J a + (∂²x̄/∂x∂x) v v (2.2.5)."""
     return _mv(cmap.jacobian(q), a) + cmap.hessian_term(q, v)
 
 
-def acceleration_to_book(cmap: CoordinateMap, q: np.ndarray, v: np.ndarray,
-                         ae: np.ndarray) -> np.ndarray:
+def acceleration_to_book(
+    cmap: CoordinateMap, q: np.ndarray, v: np.ndarray, ae: np.ndarray
+) -> np.ndarray:
     """a = J⁻¹ (ā − (∂²x̄/∂x∂x) v v)."""
     rhs = ae - cmap.hessian_term(q, v)
     return np.linalg.solve(cmap.jacobian(q), rhs[..., None])[..., 0]
@@ -73,7 +75,8 @@ def mass_matrix_to_book(cmap: CoordinateMap, q: np.ndarray, Me: np.ndarray) -> n
     return np.swapaxes(J, -1, -2) @ Me @ J
 
 
-def bias_to_book(cmap: CoordinateMap, q: np.ndarray, v: np.ndarray, Me: np.ndarray,
-                 he: np.ndarray) -> np.ndarray:
+def bias_to_book(
+    cmap: CoordinateMap, q: np.ndarray, v: np.ndarray, Me: np.ndarray, he: np.ndarray
+) -> np.ndarray:
     """h = Jᵀ (h̄ + M̄ (∂²x̄/∂x∂x) v v)."""
     return force_to_book(cmap, q, he + _mv(Me, cmap.hessian_term(q, v)))

@@ -197,10 +197,21 @@ def make_implementation(name: str, case: Case) -> Implementation:
     raise UnknownName("implementation", name, IMPLEMENTATIONS)
 
 
-def reference_trajectory(case: Case, variant: Variant, t: np.ndarray, *, rtol: float = 1e-13,
-                         ) -> np.ndarray:
+def reference_trajectory(
+    case: Case,
+    variant: Variant,
+    t: np.ndarray,
+    *,
+    rtol: float = 1e-13,
+) -> np.ndarray:
     """q(t) of the general method for ``variant`` by DOP853 (book coordinates)."""
     spec = case.trajectory
-    q, _ = solve(general_method(case, variant.hinge_inertia), np.asarray(spec.q0),
-                 np.asarray(spec.v0), t, rtol=rtol, atol=rtol)
+    q, _ = solve(
+        general_method(case, variant.hinge_inertia),
+        np.asarray(spec.q0),
+        np.asarray(spec.v0),
+        t,
+        rtol=rtol,
+        atol=rtol,
+    )
     return q

@@ -34,16 +34,20 @@ def instantaneous(quantity: str, condition: float) -> Tolerance:
     if quantity not in QUANTITIES:
         raise KeyError(quantity)
     if quantity == "forward_dynamics":
-        return Tolerance(ROUNDOFF_FACTOR * EPS * condition,
-                         f"round-off: {ROUNDOFF_FACTOR} eps x cond(M) = {condition:.3g}")
+        return Tolerance(
+            ROUNDOFF_FACTOR * EPS * condition,
+            f"round-off: {ROUNDOFF_FACTOR} eps x cond(M) = {condition:.3g}",
+        )
     return Tolerance(ROUNDOFF_FACTOR * EPS, f"round-off: {ROUNDOFF_FACTOR} eps")
 
 
 def accumulated(steps: int) -> Tolerance:
     """Two runs of the same integrator on the same model: round-off accumulates at most
     linearly over the steps (no exponential growth on these regular orbits)."""
-    return Tolerance(ROUNDOFF_FACTOR * EPS * steps,
-                     f"accumulated round-off: {ROUNDOFF_FACTOR} eps x {steps} steps")
+    return Tolerance(
+        ROUNDOFF_FACTOR * EPS * steps,
+        f"accumulated round-off: {ROUNDOFF_FACTOR} eps x {steps} steps",
+    )
 
 
 ORDER_SLACK = 0.1

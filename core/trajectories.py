@@ -20,13 +20,14 @@ integrator's truncation error, reported with its size, not a failure.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from itertools import combinations
 
 import numpy as np
 
+from dyncheck.adapters.integrators import integrate
 from dyncheck.cases import NOMINAL_ORDER, Case
 from dyncheck.comparison import POINT_INERTIA
-from dyncheck.adapters.integrators import integrate
 from dyncheck.implementations import (
     IMPLEMENTATIONS,
     Implementation,
@@ -69,8 +70,9 @@ class References:
 
             spec = self.case.trajectory
             steps = round(spec.duration / dt)
-            self._discrete[key], _ = integrate(acc, np.asarray(spec.q0, float),
-                                               np.asarray(spec.v0, float), dt, steps, integrator)
+            self._discrete[key], _ = integrate(
+                acc, np.asarray(spec.q0, float), np.asarray(spec.v0, float), dt, steps, integrator
+            )
         return self._discrete[key]
 
 
@@ -82,12 +84,26 @@ def observed_orders(dts: list[float], errors: list[float]) -> list[float]:
     return out
 
 
+@dataclass
+class TrajectoryFigures:
+    """What the report plots: the book model's reference on the grid, and per engine ×
+    integrator the finest run's configuration and its error against its own reference."""
+
+    t: np.ndarray
+    reference: np.ndarray
+    runs: dict[tuple[str, str], np.ndarray] = field(default_factory=dict)
+    errors: dict[tuple[str, str], np.ndarray] = field(default_factory=dict)
+    steps: dict[tuple[str, str], float] = field(default_factory=dict)
+
+
 def study(
     case: Case, impls: dict[str, Implementation | Exception]
-) -> tuple[list[ConvergencePoint], list[Discrepancy]]:
-    """The order-of-accuracy study and the engine-against-engine trajectory rows."""
+) -> tuple[list[ConvergencePoint], list[Discrepancy], TrajectoryFigures]:
+    """The order-of-accuracy study, the engine-against-engine trajectory rows, and the data
+    for the report's figures."""
     spec = case.trajectory
     refs = References(case)
+    figures = TrajectoryFigures(refs.t, refs(Variant((0.0,) * case.ndof))[0])
     points: list[ConvergencePoint] = []
     rows: list[Discrepancy] = []
     runs: dict[tuple[str, str, float], np.ndarray] = {}
@@ -111,6 +127,9 @@ def study(
                 diff = np.abs(q[:: round(spec.grid_step / dt)] - ref).max(axis=1)
                 errors.append(float(diff.max()))
                 worst.append(int(diff.argmax()))
+            figures.runs[name, integrator] = q[:: round(spec.grid_step / dt)]
+            figures.errors[name, integrator] = diff
+            figures.steps[name, integrator] = dt
             orders = observed_orders(list(dts), errors)
             asym = [e > REFERENCE_MARGIN * ref_err for e in errors]
             finest = [i for i in range(1, len(dts)) if asym[i] and asym[i - 1]]
@@ -122,32 +141,61 @@ def study(
                 p = orders[finest[-1]]
                 ok = abs(p - nominal) <= ORDER_SLACK
                 verdict = "passed" if ok else "failed"
-                note = (f"observed order {p:.3f} (nominal {nominal}) at dt={dts[finest[-1]]:g}; "
-                        f"reference error estimate {ref_err:.1e}")
+                note = (
+                    f"observed order {p:.3f} (nominal {nominal}) at dt={dts[finest[-1]]:g}; "
+                    f"reference error estimate {ref_err:.1e}"
+                )
                 if variant != Variant((0.0,) * case.ndof):
-                    note += f"; against the reference of the same model (hinge inertia "
+                    note += "; against the reference of the same model (hinge inertia "
                     note += f"{list(variant.hinge_inertia)} kg m^2)"
             scale_q = float(np.abs(ref).max())
             for dt, err, p, a, w in zip(dts, errors, orders, asym, worst, strict=True):
-                points.append(ConvergencePoint(case.name, name, integrator, dt, err, p, nominal,
-                                               ref_err, a))
-                rows.append(Discrepancy(
-                    case=case.name, quantity="trajectory", impl_a="reference", impl_b=name,
-                    integrator=integrator, dt=dt, max_abs_err=err, max_rel_err=err / scale_q,
-                    tolerance=float("nan"),
-                    tolerance_basis=f"order study: observed order within {nominal} ± "
-                                    f"{ORDER_SLACK}", verdict=verdict,
-                    convention=f"{TRUNCATION} (order {nominal})", note=note, worst_state=w))
+                points.append(
+                    ConvergencePoint(case.name, name, integrator, dt, err, p, nominal, ref_err, a)
+                )
+                rows.append(
+                    Discrepancy(
+                        case=case.name,
+                        quantity="trajectory",
+                        impl_a="reference",
+                        impl_b=name,
+                        integrator=integrator,
+                        dt=dt,
+                        max_abs_err=err,
+                        max_rel_err=err / scale_q,
+                        tolerance=float("nan"),
+                        tolerance_basis=f"order study: observed order within {nominal} ± "
+                        f"{ORDER_SLACK}",
+                        verdict=verdict,
+                        convention=f"{TRUNCATION} (order {nominal})",
+                        note=note,
+                        worst_state=w,
+                    )
+                )
     rows += _engine_pairs(case, engines, runs, variants, refs)
-    return points, rows
+    return points, rows, figures
 
 
 def _unavailable(case: Case, name: str, exc: Exception) -> Discrepancy:
     from dyncheck.errors import EngineNotInstalled
 
     verdict = "skipped" if isinstance(exc, EngineNotInstalled) else "failed"
-    return Discrepancy(case.name, "trajectory", "reference", name, "", float("nan"),
-                       float("nan"), float("nan"), float("nan"), "", verdict, "", str(exc), -1)
+    return Discrepancy(
+        case.name,
+        "trajectory",
+        "reference",
+        name,
+        "",
+        float("nan"),
+        float("nan"),
+        float("nan"),
+        float("nan"),
+        "",
+        verdict,
+        "",
+        str(exc),
+        -1,
+    )
 
 
 def _engine_pairs(
@@ -173,24 +221,43 @@ def _engine_pairs(
                 diff = np.abs(qb - qa).max(axis=1)
                 worst = int(diff.argmax())
                 err = float(diff[worst])
-                row = dict(case=case.name, quantity="trajectory", impl_a=a, impl_b=b,
-                           integrator=integrator, dt=dt, max_abs_err=err,
-                           max_rel_err=err / scale_q, tolerance=tol.rtol,
-                           tolerance_basis=tol.basis, worst_state=worst)
+                row = dict(
+                    case=case.name,
+                    quantity="trajectory",
+                    impl_a=a,
+                    impl_b=b,
+                    integrator=integrator,
+                    dt=dt,
+                    max_abs_err=err,
+                    max_rel_err=err / scale_q,
+                    tolerance=tol.rtol,
+                    tolerance_basis=tol.basis,
+                    worst_state=worst,
+                )
                 va, vb = variants[a], variants[b]
                 if err / scale_q <= tol.rtol:
                     rows.append(Discrepancy(**row, verdict="passed", convention="", note=""))
                 elif va is not None and vb is not None and va != vb:
-                    predicted = (refs.discrete(vb, integrator, dt)
-                                 - refs.discrete(va, integrator, dt))
+                    predicted = refs.discrete(vb, integrator, dt) - refs.discrete(
+                        va, integrator, dt
+                    )
                     res_rel = float(np.abs(qb - qa - predicted).max()) / scale_q
-                    note = (f"predicted by the reference equations of both models, stepped by "
-                            f"{integrator}: max {np.abs(predicted).max():.3g} rad; residual "
-                            f"{res_rel:.3g}")
+                    note = (
+                        f"predicted by the reference equations of both models, stepped by "
+                        f"{integrator}: max {np.abs(predicted).max():.3g} rad; residual "
+                        f"{res_rel:.3g}"
+                    )
                     verdict = "explained" if res_rel <= tol.rtol else "failed"
-                    rows.append(Discrepancy(**row, verdict=verdict, convention=POINT_INERTIA,
-                                            note=note))
+                    rows.append(
+                        Discrepancy(**row, verdict=verdict, convention=POINT_INERTIA, note=note)
+                    )
                 else:
-                    rows.append(Discrepancy(**row, verdict="failed", convention="",
-                                            note="unexplained: no convention predicts this"))
+                    rows.append(
+                        Discrepancy(
+                            **row,
+                            verdict="failed",
+                            convention="",
+                            note="unexplained: no convention predicts this",
+                        )
+                    )
     return rows

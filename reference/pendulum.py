@@ -40,7 +40,7 @@ def compound_pendulum_symbolic() -> SymbolicSystem:
 
 
 @cache
-def _simple_numeric(m: float, l: float, g: float, inertia: float) -> LagrangianDynamics:  # noqa: E741
+def _simple_numeric(m: float, l: float, g: float, inertia: float) -> LagrangianDynamics:
     return simple_pendulum_symbolic().numeric({"m": m, "l": l, "g": g, "I": inertia})
 
 
@@ -51,7 +51,7 @@ def _compound_numeric(*values: float) -> LagrangianDynamics:
 
 
 def simple_pendulum(
-    m: float, l: float, g: float, *, inertia: tuple[float] = (0.0,)  # noqa: E741
+    m: float, l: float, g: float, *, inertia: tuple[float] = (0.0,)
 ) -> LagrangianDynamics:
     """General method for Example 7; ``inertia`` = (I,) about the bob's centre, kg·m²."""
     return _simple_numeric(m, l, g, inertia[0])
@@ -64,7 +64,7 @@ def compound_pendulum(
     return _compound_numeric(m1, m2, L1, L2, g, *map(float, inertia))
 
 
-def simple_pendulum_printed(m: float, l: float, g: float) -> PrintedDynamics:  # noqa: E741
+def simple_pendulum_printed(m: float, l: float, g: float) -> PrintedDynamics:
     """Example 7 as printed: θ̈ + (g/ℓ) sin θ = 0 — Lagrange's equation divided by mℓ²;
     T = ½ mℓ²θ̇², V = mgℓ(1 − cos θ)."""
 
@@ -94,16 +94,26 @@ def compound_pendulum_printed(
 
     def residual(q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         d = q[:, 0] - q[:, 1]
-        e1 = (L1 * a[:, 0] + mu * L2 * a[:, 1] * np.cos(d) + mu * L2 * v[:, 1] ** 2 * np.sin(d)
-              + g * np.sin(q[:, 0]))
-        e2 = (L1 * a[:, 0] * np.cos(d) + L2 * a[:, 1] - L1 * v[:, 0] ** 2 * np.sin(d)
-              + g * np.sin(q[:, 1]))
+        e1 = (
+            L1 * a[:, 0]
+            + mu * L2 * a[:, 1] * np.cos(d)
+            + mu * L2 * v[:, 1] ** 2 * np.sin(d)
+            + g * np.sin(q[:, 0])
+        )
+        e2 = (
+            L1 * a[:, 0] * np.cos(d)
+            + L2 * a[:, 1]
+            - L1 * v[:, 0] ** 2 * np.sin(d)
+            + g * np.sin(q[:, 1])
+        )
         return np.stack([e1, e2], -1)
 
     def kinetic(q: np.ndarray, v: np.ndarray) -> np.ndarray:  # (2.2.29)
-        return (0.5 * (m1 + m2) * L1**2 * v[:, 0] ** 2
-                + m2 * L1 * L2 * v[:, 0] * v[:, 1] * np.cos(q[:, 0] - q[:, 1])
-                + 0.5 * m2 * L2**2 * v[:, 1] ** 2)
+        return (
+            0.5 * (m1 + m2) * L1**2 * v[:, 0] ** 2
+            + m2 * L1 * L2 * v[:, 0] * v[:, 1] * np.cos(q[:, 0] - q[:, 1])
+            + 0.5 * m2 * L2**2 * v[:, 1] ** 2
+        )
 
     return PrintedDynamics(
         residual=residual,

@@ -34,8 +34,10 @@ class PrintedDynamics:
         q = np.atleast_2d(q)
         v = np.zeros_like(q)
         e0 = self.residual(q, v, np.zeros_like(q))
-        cols = [self.residual(q, v, np.broadcast_to(np.eye(self.ndof)[j], q.shape)) - e0
-                for j in range(self.ndof)]
+        cols = [
+            self.residual(q, v, np.broadcast_to(np.eye(self.ndof)[j], q.shape)) - e0
+            for j in range(self.ndof)
+        ]
         return self.row_factors[:, None] * np.stack(cols, -1)
 
     def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -30,8 +30,15 @@ def solve(
     def rhs(_t: float, y: np.ndarray) -> np.ndarray:
         return np.concatenate([y[n:], dynamics.forward(y[None, :n], y[None, n:], zero)[0]])
 
-    sol = solve_ivp(rhs, (t_eval[0], t_eval[-1]), np.concatenate([q0, v0]), method="DOP853",
-                    t_eval=t_eval, rtol=rtol, atol=atol)
+    sol = solve_ivp(
+        rhs,
+        (t_eval[0], t_eval[-1]),
+        np.concatenate([q0, v0]),
+        method="DOP853",
+        t_eval=t_eval,
+        rtol=rtol,
+        atol=atol,
+    )
     if not sol.success:
         raise RuntimeError(f"reference integration failed: {sol.message}")
     return sol.y[:n].T, sol.y[n:].T

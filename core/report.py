@@ -1,0 +1,316 @@
+"""The verification report: Markdown pages, PNG figures and the CSV tables, written atomically."""
+
+from __future__ import annotations
+
+import io
+import platform
+import subprocess
+import sys
+from datetime import UTC, datetime
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+
+from dyncheck.cases import Case
+from dyncheck.comparison import POINT_INERTIA
+from dyncheck.results import to_csv, write_atomic
+from dyncheck.run import RunResult
+from dyncheck.tolerances import ORDER_SLACK
+from dyncheck.trajectories import TRUNCATION, TrajectoryFigures
+
+CONVENTIONS = {
+    POINT_INERTIA: (
+        "MuJoCo's compiler rejects a moving body whose mass or inertia is below mjMINVAL "
+        "(1e-15), so the MJCF gives each of the book's point masses a small isotropic inertia "
+        "(`Multibody.mjcf_point_inertia`). MuJoCo and `pinocchio-mjcf` read it; `pinocchio` "
+        "(built programmatically) holds exact point masses. The reference predicts the "
+        "difference exactly: the general method with ½ I θ̇² added per body (the planar case "
+        "of (2.2.40); θ absolute). A row is `explained` only when observed − predicted is "
+        "within round-off."
+    ),
+    TRUNCATION: (
+        "A fixed-step integrator's error against the exact solution of the same model. Judged "
+        "by the order study: the error must shrink at the nominal order (1 for `euler` and "
+        "`implicitfast`, 4 for `rk4`) within ±0.1 in the asymptotic range."
+    ),
+}
+
+
+def versions() -> dict[str, str]:
+    """Versions of everything that produced the numbers."""
+    import numpy
+    import scipy
+    import sympy
+
+    from dyncheck import __version__
+    from dyncheck.adapters import ADAPTERS
+
+    out = {
+        "python": platform.python_version(),
+        "numpy": numpy.__version__,
+        "scipy": scipy.__version__,
+        "sympy": sympy.__version__,
+        "pandas": pd.__version__,
+    }
+    for name, pkg in (("mujoco", "mujoco"), ("pinocchio", "pinocchio")):
+        out[pkg] = ADAPTERS[name].version() if name in ADAPTERS else "not installed"
+    out["dyncheck"] = __version__
+    try:
+        commit = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"],
+            capture_output=True,
+            text=True,
+            cwd=Path(__file__).parent,
+            check=True,
+        ).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        commit = "unknown"
+    out["dyncheck commit"] = commit
+    out["platform"] = f"{platform.system()} {platform.machine()}"
+    return out
+
+
+def _md(frame: pd.DataFrame) -> str:
+    return frame.to_markdown(index=False, floatfmt=".3g") if len(frame) else "_(none)_"
+
+
+def _cell(group: pd.DataFrame) -> str:
+    worst = group["max_rel_err"].max()
+    verdicts = sorted(set(group["verdict"]), key=["failed", "skipped", "explained", "passed"].index)
+    return f"{verdicts[0]} {worst:.1e}" if np.isfinite(worst) else verdicts[0]
+
+
+def instantaneous_matrix(d: pd.DataFrame, case: str) -> pd.DataFrame:
+    rows = d[(d["case"] == case) & (d["quantity"] != "trajectory")].copy()
+    rows["pair"] = rows["impl_a"] + " vs " + rows["impl_b"]
+    out = rows.groupby(["quantity", "pair"], sort=False).apply(_cell, include_groups=False)
+    return out.unstack("pair").reset_index()
+
+
+def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) -> pd.DataFrame:
+    """Per case × engine × integrator: the finest asymptotic observed order and verdict."""
+    rows = []
+    for (c, impl, integ), g in conv.groupby(["case", "impl", "integrator"]):
+        if case is not None and c != case:
+            continue
+        g = g.sort_values("dt", ascending=False)
+        ok = g["asymptotic"].to_numpy()
+        idx = [i for i in range(1, len(g)) if ok[i] and ok[i - 1]]
+        p = g["observed_order"].iloc[idx[-1]] if idx else float("nan")
+        verdict = d[
+            (d.case == c)
+            & (d.quantity == "trajectory")
+            & (d.impl_a == "reference")
+            & (d.impl_b == impl)
+            & (d.integrator == integ)
+        ]["verdict"].iloc[0]
+        rows.append(
+            {
+                "case": c,
+                "implementation": impl,
+                "integrator": integ,
+                "nominal order": int(g["nominal_order"].iloc[0]),
+                "observed order": p,
+                "finest dt": g["dt"].min(),
+                "error at finest dt": g["error"].iloc[-1],
+                "verdict": verdict,
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def _summary(d: pd.DataFrame) -> pd.DataFrame:
+    counts = d.groupby(["case", "verdict"]).size().unstack("verdict", fill_value=0)
+    for v in ("passed", "explained", "failed", "skipped"):
+        if v not in counts:
+            counts[v] = 0
+    return counts[["passed", "explained", "failed", "skipped"]].reset_index()
+
+
+def _png(fig: plt.Figure) -> bytes:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90, metadata={"Software": None})
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str, bytes]:
+    """Deterministic PNGs: trajectory, error against time, error against step size."""
+    plt.rcParams.update({"font.family": "DejaVu Sans", "font.size": 9})
+    out = {}
+    fig, axes = plt.subplots(case.ndof, 1, figsize=(7, 2.2 * case.ndof), squeeze=False)
+    for i, ax in enumerate(axes[:, 0]):
+        ax.plot(data.t, data.reference[:, i], "k-", lw=2, label="reference (DOP853)")
+        for (impl, integ), q in sorted(data.runs.items()):
+            if integ == "rk4":
+                ax.plot(data.t, q[:, i], "--", lw=1, label=f"{impl} rk4")
+        ax.set_ylabel(f"{case.coordinates[i]} (rad)")
+    axes[-1, 0].set_xlabel("t (s)")
+    axes[0, 0].legend(fontsize=7, loc="best")
+    axes[0, 0].set_title(f"{case.title}: trajectory in the book's coordinates")
+    fig.tight_layout()
+    out["trajectory"] = _png(fig)
+
+    fig, ax = plt.subplots(figsize=(7, 3.2))
+    for (impl, integ), err in sorted(data.errors.items()):
+        ax.semilogy(
+            data.t,
+            np.maximum(err, 1e-17),
+            lw=1,
+            label=f"{impl} {integ} dt={data.steps[impl, integ]:g}",
+        )
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("max |q - q_ref| (rad)")
+    ax.set_title("Error against time (finest step of each integrator)")
+    ax.legend(fontsize=6, ncol=2)
+    fig.tight_layout()
+    out["error_time"] = _png(fig)
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    c = conv[conv["case"] == case.name]
+    for (impl, integ), g in c.groupby(["impl", "integrator"]):
+        ax.loglog(g["dt"], g["error"], "o-", ms=3, lw=1, label=f"{impl} {integ}")
+    for _integ, g in c.groupby("integrator"):
+        p = int(g["nominal_order"].iloc[0])
+        dts = np.sort(g["dt"].unique())
+        anchor = g[g["dt"] == dts[-1]]["error"].max()
+        ax.loglog(dts, anchor * (dts / dts[-1]) ** p, "k:", lw=1)
+        ax.annotate(f"slope {p}", (dts[0], anchor * (dts[0] / dts[-1]) ** p), fontsize=7)
+    ax.set_xlabel("dt (s)")
+    ax.set_ylabel("max error (rad)")
+    ax.set_title("Error against step size (dotted: nominal slopes)")
+    ax.legend(fontsize=6, ncol=2)
+    fig.tight_layout()
+    out["convergence"] = _png(fig)
+    return out
+
+
+def case_page(case: Case, result: RunResult) -> str:
+    d, conv = result.discrepancies, result.convergence
+    params = pd.DataFrame({"parameter": list(case.params()), "value": list(case.params().values())})
+    cmap = case.engine_map()
+    mb = case.multibody()
+    pairs = d[(d.case == case.name) & (d.quantity == "trajectory") & (d.impl_a != "reference")]
+    lines = [
+        f"# {case.title}",
+        "",
+        f"Book: {case.book_refs}. Coordinates: {', '.join(case.coordinates)} (absolute angles "
+        "from the downward vertical). Engine joint coordinates: "
+        f"{cmap.description}; MJCF point-mass inertia {mb.mjcf_point_inertia:g} kg m^2.",
+        "",
+        "### Parameters (SI)",
+        "",
+        _md(params),
+        "",
+        "### Instantaneous quantities: verdict and worst relative error, per pair",
+        "",
+        f"{len(case.sample_states())} seeded states (seed {case.seed}); relative error = max "
+        "|actual − desired| / max |desired|; `impl_a vs impl_b` with impl_a trusted.",
+        "",
+        _md(instantaneous_matrix(d, case.name)),
+        "",
+        "### Order of accuracy against the reference of the same model",
+        "",
+        _md(order_table(conv, d, case.name)),
+        "",
+        "### Step-by-step study",
+        "",
+        _md(conv[conv.case == case.name].drop(columns=["case"])),
+        "",
+        "### Engine against engine, same integrator and step",
+        "",
+        _md(pairs[["impl_a", "impl_b", "integrator", "dt", "max_rel_err", "tolerance", "verdict"]]),
+        "",
+        "### Figures",
+        "",
+        f"![trajectory](figures/{case.name}_trajectory.png)",
+        "",
+        f"![error against time](figures/{case.name}_error_time.png)",
+        "",
+        f"![error against step](figures/{case.name}_convergence.png)",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def index_page(result: RunResult, *, date: str) -> str:
+    d, conv = result.discrepancies, result.convergence
+    prov = pd.DataFrame(
+        {"item": ["date (UTC)", *versions()], "value": [date, *versions().values()]}
+    )
+    failed = d[d.verdict.isin(["failed", "skipped"])]
+    used = sorted(set(d.loc[d.verdict == "explained", "convention"]) | {TRUNCATION})
+    lines = [
+        "# dyncheck verification report",
+        "",
+        "Generated by `dyncheck run`; do not edit. The long tables are "
+        "[discrepancies.csv](discrepancies.csv) and [convergence.csv](convergence.csv).",
+        "",
+        "### Provenance",
+        "",
+        _md(prov),
+        "",
+        "### Verdicts per case (rows of discrepancies.csv)",
+        "",
+        _md(_summary(d)),
+        "",
+        f"### Order of accuracy (finest asymptotic pair of steps, nominal ± {ORDER_SLACK})",
+        "",
+        _md(order_table(conv, d)),
+        "",
+        "### Failed or skipped rows",
+        "",
+        _md(
+            failed[
+                [
+                    "case",
+                    "quantity",
+                    "impl_a",
+                    "impl_b",
+                    "integrator",
+                    "dt",
+                    "max_rel_err",
+                    "verdict",
+                    "note",
+                ]
+            ]
+        ),
+        "",
+        "### Conventions that explain differences",
+        "",
+        *[f"- **{name}**: {CONVENTIONS.get(name, '')}" for name in used],
+        "",
+        "### Case pages",
+        "",
+        *[f"- [{c.title}]({c.name}.md)" for c in result.cases],
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def write(result: RunResult, out: Path, *, date: str | None = None) -> list[Path]:
+    """Write every file of the report under ``out``; each file atomically."""
+    date = date or datetime.now(UTC).strftime("%Y-%m-%d")
+    files: dict[Path, str | bytes] = {
+        out / "discrepancies.csv": to_csv(result.discrepancies),
+        out / "convergence.csv": to_csv(result.convergence),
+    }
+    for case in result.cases:
+        files[out / f"{case.name}.md"] = case_page(case, result)
+        for kind, png in figures(case, result.figures[case.name], result.convergence).items():
+            files[out / "figures" / f"{case.name}_{kind}.png"] = png
+    files[out / "README.md"] = index_page(result, date=date)
+    for path, content in files.items():
+        write_atomic(path, content)
+    return list(files)
+
+
+def stderr_progress(message: str) -> None:
+    """Per-case progress lines on a terminal; quiet when stderr is not one (CI logs)."""
+    if sys.stderr.isatty():
+        print(f"dyncheck: {message}", file=sys.stderr, flush=True)
