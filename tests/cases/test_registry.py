@@ -1,0 +1,64 @@
+"""The case registry: sorted, every case valid and loadable in every adapter; bad input."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from dyncheck.adapters import get_adapter
+from dyncheck.cases import CASES, get_case
+from dyncheck.errors import InvalidInput, UnknownName
+
+from ..conftest import CASE_NAMES, ENGINES
+
+
+def test_registry_is_sorted():
+    assert list(CASES) == sorted(CASES)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("case", CASE_NAMES)
+def test_case_loads_in_every_adapter(case, engine):
+    c = get_case(case)
+    adapter = get_adapter(engine)(c.multibody())
+    assert adapter.mass_matrix(c.engine_map().to_engine(c.rest()[None])).shape == (
+        1,
+        c.ndof,
+        c.ndof,
+    )
+
+
+@pytest.mark.parametrize("case", CASE_NAMES)
+def test_samples_are_deterministic(case):
+    a, b = get_case(case).sample_states(), get_case(case).sample_states()
+    assert np.array_equal(a.q, b.q) and np.array_equal(a.tau, b.tau)
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [
+        ("m", -1.0, "m must be a positive finite number, got -1.0"),
+        ("l", 0.0, "l must be a positive finite number, got 0.0"),
+        ("g", float("nan"), "g must be a positive finite number, got nan"),
+    ],
+)
+def test_bad_parameters_name_field_and_value(field, value, message):
+    with pytest.raises(InvalidInput, match=f"^{message}$"):
+        dataclasses.replace(get_case("simple_pendulum"), **{field: value})
+
+
+def test_bad_step_size():
+    case = get_case("simple_pendulum")
+    with pytest.raises(InvalidInput, match=r"^steps\[euler\] dt must be a divisor of duration"):
+        dataclasses.replace(case.trajectory, steps={"euler": (0.003, 0.0015)})
+    with pytest.raises(InvalidInput, match="must be a halving sequence"):
+        dataclasses.replace(case.trajectory, steps={"euler": (0.004, 0.001)})
+    with pytest.raises(InvalidInput, match="duration must be a positive finite number"):
+        dataclasses.replace(case.trajectory, duration=-1.0)
+
+
+def test_unknown_case_lists_valid_names():
+    with pytest.raises(UnknownName, match="unknown case 'pendulum'; valid: compound_pendulum"):
+        get_case("pendulum")

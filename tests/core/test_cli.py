@@ -1,0 +1,91 @@
+"""The command line end to end, into temporary folders."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from dyncheck.cli import main
+from dyncheck.results import ConvergencePoint, Discrepancy
+
+
+def test_run_writes_report_with_schema(tmp_path, capsys):
+    out = tmp_path / "rep"
+    assert main(["run", "simple_pendulum", "--out", str(out)]) == 0
+    d = pd.read_csv(out / "discrepancies.csv")
+    assert list(d.columns) == [f.name for f in Discrepancy.__dataclass_fields__.values()]
+    for col in (
+        "case",
+        "quantity",
+        "impl_a",
+        "impl_b",
+        "integrator",
+        "dt",
+        "max_abs_err",
+        "max_rel_err",
+        "tolerance",
+        "verdict",
+        "note",
+    ):
+        assert col in d.columns
+    c = pd.read_csv(out / "convergence.csv")
+    assert list(c.columns) == list(ConvergencePoint.__dataclass_fields__)
+    readme = (out / "README.md").read_text()
+    for word in ("mujoco", "pinocchio", "numpy", "scipy", "python", "platform"):
+        assert word in readme
+    assert (out / "simple_pendulum.md").exists()
+    assert (out / "figures" / "simple_pendulum_convergence.png").stat().st_size > 1000
+    assert not list(out.rglob("*.tmp")), "no temporary file left behind"
+    assert "0 failed" in capsys.readouterr().out
+
+
+def test_two_runs_give_identical_csv_bytes(tmp_path):
+    for name in ("a", "b"):
+        assert (
+            main(
+                [
+                    "run",
+                    "simple_pendulum",
+                    "--impl",
+                    "reference",
+                    "--impl",
+                    "mujoco",
+                    "--impl",
+                    "pinocchio",
+                    "--out",
+                    str(tmp_path / name),
+                ]
+            )
+            == 0
+        )
+    for f in ("discrepancies.csv", "convergence.csv"):
+        assert (tmp_path / "a" / f).read_bytes() == (tmp_path / "b" / f).read_bytes()
+
+
+def test_unknown_case_is_usage_error(tmp_path, capsys):
+    out = tmp_path / "rep"
+    assert main(["run", "nope", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        "dyncheck: error: unknown case 'nope'; valid: compound_pendulum, simple_pendulum"
+    )
+    assert not out.exists()
+
+
+def test_unknown_implementation_is_usage_error(tmp_path, capsys):
+    assert main(["run", "--impl", "bullet", "--out", str(tmp_path / "r")]) == 2
+    assert "unknown implementation 'bullet'; valid: book, mujoco" in capsys.readouterr().err
+
+
+def test_out_that_is_a_file_is_usage_error(tmp_path, capsys):
+    f = tmp_path / "file"
+    f.write_text("keep")
+    assert main(["run", "simple_pendulum", "--out", str(f)]) == 2
+    assert "--out must be a directory" in capsys.readouterr().err
+    assert f.read_text() == "keep"
+
+
+def test_list_names_engine_versions(capsys):
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    assert "simple_pendulum" in out
+    assert "mujoco 4" in out or "mujoco 3" in out

@@ -1,0 +1,69 @@
+"""Order of accuracy: each engine × integrator shows its nominal order within ±0.1
+(expected from the integrators' definitions: 1 for Euler and implicitfast, 4 for RK4)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from dyncheck.cases import INTEGRATORS, NOMINAL_ORDER
+from dyncheck.trajectories import observed_orders
+
+from ..conftest import CASE_NAMES, ENGINES
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("case", CASE_NAMES)
+def test_observed_order(full_run, case, engine, integrator):
+    c = full_run.convergence
+    g = c[(c.case == case) & (c.impl == engine) & (c.integrator == integrator)]
+    g = g.sort_values("dt", ascending=False)
+    asym = g.asymptotic.to_numpy()
+    idx = [i for i in range(1, len(g)) if asym[i] and asym[i - 1]]
+    assert idx, f"{case}-{engine}-{integrator}: no asymptotic pair of steps"
+    p = g.observed_order.iloc[idx[-1]]
+    assert abs(p - NOMINAL_ORDER[integrator]) <= 0.1, f"{case}-{engine}-{integrator}: p={p}"
+    assert np.all(np.diff(g.error.to_numpy()) < 0), "error must shrink as dt halves"
+
+
+def test_engine_pairs_on_the_same_model_agree_to_roundoff(full_run):
+    """mujoco and pinocchio-mjcf read the same MJCF: same integrator, same step, same states."""
+    d = full_run.discrepancies
+    rows = d[(d.quantity == "trajectory") & (d.impl_a == "pinocchio-mjcf") & (d.impl_b == "mujoco")]
+    assert len(rows) == len(CASE_NAMES) * 12
+    assert (rows.verdict == "passed").all()
+    assert (rows.max_rel_err <= rows.tolerance).all()
+
+
+def test_engine_pairs_on_different_models_are_predicted(full_run):
+    d = full_run.discrepancies
+    rows = d[(d.quantity == "trajectory") & (d.impl_a == "pinocchio")]
+    assert (rows.verdict == "explained").all()
+
+
+def test_observed_orders_formula():
+    """p = ln(E₁/E₂)/ln(h₁/h₂) on exact power laws."""
+    dts = [0.4, 0.2, 0.1]
+    assert observed_orders(dts, [3 * h**2 for h in dts])[1:] == pytest.approx([2, 2], rel=1e-12)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_an_error_that_does_not_shrink_fails(engine, monkeypatch):
+    """A run with a constant error offset (a wrong model, not a truncation error) fails."""
+    from dyncheck import trajectories
+    from dyncheck.cases import get_case
+    from dyncheck.implementations import make_implementation
+
+    case = get_case("simple_pendulum")
+    impl = make_implementation(engine, case)
+    real = impl.simulate
+
+    def offset(dt, integrator):
+        t, q = real(dt, integrator)
+        return t, q + 1e-3
+
+    impl.simulate = offset
+    _, rows, _ = trajectories.study(case, {engine: impl})
+    study_rows = [r for r in rows if r.impl_a == "reference"]
+    assert study_rows and all(r.verdict == "failed" for r in study_rows)
