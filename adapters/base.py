@@ -52,6 +52,8 @@ class Adapter(ABC):
     """The pip package that provides the engine."""
     integrators: ClassVar[tuple[str, ...]]
     """Fixed-step integrators :meth:`simulate` accepts."""
+    adaptive: ClassVar[bool] = False
+    """Whether :meth:`solve` (error-controlled integration by scipy) is offered."""
 
     def __init__(self, model: Multibody) -> None:
         self.spec = model
@@ -88,6 +90,10 @@ class Adapter(ABC):
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:
         """Fixed-step integration from (q0, v0) for ``round(duration / dt)`` steps, τ = 0."""
+
+    def solve(self, q0: np.ndarray, v0: np.ndarray, t_eval: np.ndarray, rtol: float) -> Trajectory:
+        """Error-controlled integration (scipy's DOP853) of the engine's forward dynamics."""
+        raise NotImplementedError(f"{self.name} offers no error-controlled integration")
 
     def _check(self, what: str, value: np.ndarray) -> np.ndarray:
         if not np.all(np.isfinite(value)):

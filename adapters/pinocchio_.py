@@ -6,7 +6,7 @@ Pinocchio's names: M = ``crba`` (upper triangle filled, mirrored here); h = ``rn
 (= ``nonLinearEffects``, gravity included); forward dynamics ``aba``; inverse ``rnea``;
 ``computeKineticEnergy``, ``computePotentialEnergy`` (V = −Σ mᵢ g·cᵢ). Pinocchio has no time
 integrator: :mod:`.integrators` supplies MuJoCo's definitions so integrators compare like for
-like.
+like, and :meth:`PinocchioAdapter.solve` integrates with scipy's error-controlled DOP853.
 """
 
 from __future__ import annotations
@@ -17,11 +17,13 @@ from typing import ClassVar
 
 import numpy as np
 import pinocchio as pin
+from scipy.integrate import solve_ivp
 
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.integrators import STEPPERS, integrate
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Body, Multibody
+from dyncheck.errors import EngineError
 
 _AXIS_JOINTS = {
     (1.0, 0.0, 0.0): pin.JointModelRX,
@@ -67,6 +69,7 @@ class PinocchioAdapter(Adapter):
     name: ClassVar[str] = "pinocchio"
     package: ClassVar[str] = "pin"
     integrators: ClassVar[tuple[str, ...]] = tuple(STEPPERS)
+    adaptive: ClassVar[bool] = True
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
@@ -132,6 +135,26 @@ class PinocchioAdapter(Adapter):
         steps = round(duration / dt)
         qs, vs = integrate(acc, np.asarray(q0), np.asarray(v0), dt, steps, integrator)
         return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)
+
+    def solve(self, q0: np.ndarray, v0: np.ndarray, t_eval: np.ndarray, rtol: float) -> Trajectory:
+        """scipy's DOP853 on (q, v)' = (v, aba(q, v, 0)), rtol = atol = ``rtol``."""
+        nv, zero = self.model.nv, np.zeros(self.model.nv)
+
+        def rhs(_t: float, y: np.ndarray) -> np.ndarray:
+            return np.concatenate([y[nv:], pin.aba(self.model, self.data, y[:nv], y[nv:], zero)])
+
+        sol = solve_ivp(
+            rhs,
+            (t_eval[0], t_eval[-1]),
+            np.concatenate([q0, v0]),
+            method="DOP853",
+            t_eval=t_eval,
+            rtol=rtol,
+            atol=rtol,
+        )
+        if not sol.success:
+            raise EngineError(f"{self.name}: solve_ivp failed: {sol.message}")
+        return Trajectory(t_eval, self._check("solve", sol.y[:nv].T), sol.y[nv:].T)
 
 
 class PinocchioMJCFAdapter(PinocchioAdapter):

@@ -185,6 +185,14 @@ class EngineImplementation(Implementation):
         traj = self.adapter.simulate(qe0, ve0, spec.duration, dt, integrator)
         return traj.t, self.map.to_book(traj.q)
 
+    def solve(self, t: np.ndarray, rtol: float) -> np.ndarray:
+        """Book-coordinate configurations of an error-controlled run at times ``t``."""
+        spec = self.case.trajectory
+        q0 = np.asarray(spec.q0)[None]
+        qe0 = self.map.to_engine(q0)[0]
+        ve0 = co.velocity_to_engine(self.map, q0, np.asarray(spec.v0)[None])[0]
+        return self.map.to_book(self.adapter.solve(qe0, ve0, t, rtol).q)
+
 
 def make_implementation(name: str, case: Case) -> Implementation:
     """The implementation ``name`` of ``case``; raises UnknownName or EngineNotInstalled."""

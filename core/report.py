@@ -238,6 +238,25 @@ def case_page(case: Case, result: RunResult) -> str:
     return "\n".join(lines)
 
 
+def errata(d: pd.DataFrame) -> tuple[str, pd.DataFrame]:
+    """The book's printed equations (``book``) against the general method (``reference``)."""
+    rows = d[(d.impl_a == "reference") & (d.impl_b == "book")]
+    table = rows[["case", "quantity", "max_rel_err", "tolerance", "verdict"]]
+    bad = rows[rows.verdict != "passed"]
+    if len(bad):
+        lead = (
+            f"**{len(bad)} printed quantities disagree with the general method** — errata "
+            "of the book unless the general method is wrong:"
+        )
+    else:
+        lead = (
+            f"No erratum: all {len(rows)} printed quantities (equations of motion, T, V of "
+            f"{', '.join(sorted(set(rows.case)))}) agree with the general method at "
+            "round-off."
+        )
+    return lead, table
+
+
 def index_page(result: RunResult, *, date: str) -> str:
     d, conv = result.discrepancies, result.convergence
     prov = pd.DataFrame(
@@ -262,6 +281,12 @@ def index_page(result: RunResult, *, date: str) -> str:
         f"### Order of accuracy (finest asymptotic pair of steps, nominal ± {ORDER_SLACK})",
         "",
         _md(order_table(conv, d)),
+        "",
+        "### Errata: the book's printed equations against the general method",
+        "",
+        errata(d)[0],
+        "",
+        _md(errata(d)[1]),
         "",
         "### Failed or skipped rows",
         "",

@@ -172,8 +172,44 @@ def study(
                         worst_state=w,
                     )
                 )
+        if getattr(getattr(impl, "adapter", None), "adaptive", False):
+            rows.append(_adaptive(case, impl, variant, refs))
     rows += _engine_pairs(case, engines, runs, variants, refs)
     return points, rows, figures
+
+
+ADAPTIVE_RTOL = 1e-13
+
+
+def _adaptive(
+    case: Case, impl: Implementation, variant: Variant | None, refs: References
+) -> Discrepancy:
+    """The engine's forward dynamics under the reference's own integrator and tolerance: both
+    solutions carry an error of the size of the reference's estimate e, so |q − q_ref| ≤ 2e;
+    allowed 4e (the engine's error is estimated, not measured)."""
+    ref, ref_err = refs(variant or Variant((0.0,) * case.ndof))
+    q = impl.solve(refs.t, ADAPTIVE_RTOL)  # type: ignore[attr-defined]
+    diff = np.abs(q - ref).max(axis=1)
+    scale_q = float(np.abs(ref).max())
+    err = float(diff.max())
+    allowed = 4 * ref_err
+    verdict = "passed" if variant is not None and err <= allowed else "failed"
+    return Discrepancy(
+        case.name,
+        "trajectory",
+        "reference",
+        impl.name,
+        "dop853",
+        float("nan"),
+        err,
+        err / scale_q,
+        allowed / scale_q,
+        f"4 x reference error estimate {ref_err:.1e} (both DOP853, rtol {ADAPTIVE_RTOL:g})",
+        verdict,
+        "",
+        "scipy solve_ivp on the engine's forward dynamics, same model",
+        int(diff.argmax()),
+    )
 
 
 def _unavailable(case: Case, name: str, exc: Exception) -> Discrepancy:

@@ -67,3 +67,12 @@ def test_an_error_that_does_not_shrink_fails(engine, monkeypatch):
     _, rows, _ = trajectories.study(case, {engine: impl})
     study_rows = [r for r in rows if r.impl_a == "reference"]
     assert study_rows and all(r.verdict == "failed" for r in study_rows)
+
+
+def test_pinocchio_under_solve_ivp_matches_reference(full_run):
+    """Pinocchio's forward dynamics integrated by DOP853 at the reference's tolerance."""
+    d = full_run.discrepancies
+    rows = d[(d.quantity == "trajectory") & (d.integrator == "dop853")]
+    assert sorted(set(rows.impl_b)) == ["pinocchio", "pinocchio-mjcf"]
+    assert len(rows) == 2 * len(CASE_NAMES)
+    assert (rows.verdict == "passed").all() and (rows.max_rel_err <= rows.tolerance).all()
