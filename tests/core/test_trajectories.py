@@ -65,7 +65,7 @@ def test_an_error_that_does_not_shrink_fails(engine, monkeypatch):
 
     impl.simulate = offset
     _, rows, _ = trajectories.study(case, {engine: impl})
-    study_rows = [r for r in rows if r.impl_a == "reference"]
+    study_rows = [r for r in rows if r.impl_a == "reference" and r.integrator != "dop853"]
     assert study_rows and all(r.verdict == "failed" for r in study_rows)
 
 
