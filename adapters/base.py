@@ -91,6 +91,21 @@ class Adapter(ABC):
     ) -> Trajectory:
         """Fixed-step integration from (q0, v0) for ``round(duration / dt)`` steps, τ = 0."""
 
+    def evaluate_all(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
+    ) -> dict[str, np.ndarray]:
+        """Every quantity at each state, keyed ``mass_matrix``, ``bias_forces``,
+        ``forward_dynamics`` (at τ), ``inverse_dynamics`` (at v̇ = a), ``kinetic_energy``,
+        ``potential_energy``. Engines override this with their cheapest batched path."""
+        return {
+            "mass_matrix": self.mass_matrix(q),
+            "bias_forces": self.bias(q, v),
+            "forward_dynamics": self.forward(q, v, tau),
+            "inverse_dynamics": self.inverse(q, v, a),
+            "kinetic_energy": self.kinetic_energy(q, v),
+            "potential_energy": self.potential_energy(q),
+        }
+
     def solve(self, q0: np.ndarray, v0: np.ndarray, t_eval: np.ndarray, rtol: float) -> Trajectory:
         """Error-controlled integration (scipy's DOP853) of the engine's forward dynamics."""
         raise NotImplementedError(f"{self.name} offers no error-controlled integration")

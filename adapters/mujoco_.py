@@ -99,6 +99,37 @@ class MuJoCoAdapter(Adapter):
             out[k] = d.energy[0]
         return self._check("potential energy", out)
 
+    def evaluate_all(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
+    ) -> dict[str, np.ndarray]:
+        """One ``mj_forward`` (M, h, v̇, energies) and one ``mj_inverse`` per state."""
+        m, d = self.model, self.data
+        n, nv = q.shape
+        M = np.empty((n, nv, nv))
+        bias, fwd, inv, energy = (
+            np.empty((n, nv)),
+            np.empty((n, nv)),
+            np.empty((n, nv)),
+            np.empty((n, 2)),
+        )
+        for k in range(n):
+            d.qpos[:], d.qvel[:], d.qfrc_applied[:] = q[k], v[k], tau[k]
+            mujoco.mj_forward(m, d)
+            mujoco.mj_fullM(m, d, M[k])
+            bias[k], fwd[k], energy[k] = d.qfrc_bias, d.qacc, d.energy
+            d.qacc[:] = a[k]
+            mujoco.mj_inverse(m, d)
+            inv[k] = d.qfrc_inverse
+        out = {
+            "mass_matrix": M,
+            "bias_forces": bias,
+            "forward_dynamics": fwd,
+            "inverse_dynamics": inv,
+            "kinetic_energy": energy[:, 1],
+            "potential_energy": energy[:, 0],
+        }
+        return {key: self._check(key, val) for key, val in out.items()}
+
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:

@@ -25,6 +25,9 @@ from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Body, Multibody
 from dyncheck.errors import EngineError
 
+THREADS = max(1, min(2, os.cpu_count() or 1))
+"""Threads for Pinocchio's batched ABA/RNEA (the machines this runs on have 2 cores)."""
+
 _AXIS_JOINTS = {
     (1.0, 0.0, 0.0): pin.JointModelRX,
     (0.0, 1.0, 0.0): pin.JointModelRY,
@@ -75,6 +78,7 @@ class PinocchioAdapter(Adapter):
         super().__init__(model)
         self.model = self._build(model)
         self.data = self.model.createData()
+        self.__pool: pin.ModelPool | None = None
         # body name → joint index: the body's inertia is attached to its joint
         self._joint_ids = [self.model.getJointId(j) for j in self._joint_names(model)]
 
@@ -135,6 +139,48 @@ class PinocchioAdapter(Adapter):
         steps = round(duration / dt)
         qs, vs = integrate(acc, np.asarray(q0), np.asarray(v0), dt, steps, integrator)
         return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)
+
+    def evaluate_all(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
+    ) -> dict[str, np.ndarray]:
+        """One pass over the states with preallocated outputs: ``crba``, ``rnea`` (h),
+        ``aba``, ``rnea`` (τ) and the two energies — the same calls as the one-quantity
+        methods, without their per-call allocation."""
+        m, d = self.model, self.data
+        n, nv = q.shape
+        zero = np.zeros(nv)
+        M, bias, fwd, inv = (
+            np.empty((n, nv, nv)),
+            np.empty((n, nv)),
+            np.empty((n, nv)),
+            np.empty((n, nv)),
+        )
+        kin, pot = np.empty(n), np.empty(n)
+        crba, rnea, aba = pin.crba, pin.rnea, pin.aba
+        for k in range(n):
+            qk, vk = q[k], v[k]
+            M[k] = crba(m, d, qk)
+            bias[k] = rnea(m, d, qk, vk, zero)
+            fwd[k] = aba(m, d, qk, vk, tau[k])
+            inv[k] = rnea(m, d, qk, vk, a[k])
+            kin[k] = pin.computeKineticEnergy(m, d, qk, vk)
+            pot[k] = pin.computePotentialEnergy(m, d, qk)
+        M = np.triu(M) + np.swapaxes(np.triu(M, 1), 1, 2)
+        out = {
+            "mass_matrix": M,
+            "bias_forces": bias,
+            "forward_dynamics": fwd,
+            "inverse_dynamics": inv,
+            "kinetic_energy": kin,
+            "potential_energy": pot,
+        }
+        return {key: self._check(key, val) for key, val in out.items()}
+
+    @property
+    def _pool(self) -> pin.ModelPool:
+        if self.__pool is None:
+            self.__pool = pin.ModelPool(self.model, THREADS)
+        return self.__pool
 
     def solve(self, q0: np.ndarray, v0: np.ndarray, t_eval: np.ndarray, rtol: float) -> Trajectory:
         """scipy's DOP853 on (q, v)' = (v, aba(q, v, 0)), rtol = atol = ``rtol``."""

@@ -5,6 +5,7 @@ from __future__ import annotations
 import itertools
 import math
 from abc import ABC, abstractmethod
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -123,18 +124,25 @@ class Case(ABC):
     def state_scale(self) -> tuple[float, float, float]:
         """Ranges (max |q̇|, max |τ|, max |q̈|) for sampled states."""
 
-    def sample_states(self, n: int | None = None) -> StateSample:
-        """Deterministic states: the rest state first, then seeded uniform samples with
-        angles in (−π, π)."""
+    def iter_states(self, n: int | None = None, chunk: int = 8192) -> Iterator[StateSample]:
+        """Deterministic states in chunks of at most ``chunk``: the rest state first, then
+        seeded uniform samples, angles in (−π, π). Each array has its own random stream, so
+        the states do not depend on the chunk size."""
         n = self.n_states if n is None else n
-        if n < 1:
-            raise InvalidInput("n_states", n, "a positive integer")
-        rng = np.random.default_rng(self.seed)
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise InvalidInput("states", n, "a positive integer")
+        streams = [np.random.default_rng(s) for s in np.random.SeedSequence(self.seed).spawn(4)]
         vmax, taumax, amax = self.state_scale()
-        d = self.ndof
-        q = rng.uniform(-np.pi, np.pi, (n, d))
-        v = rng.uniform(-vmax, vmax, (n, d))
-        tau = rng.uniform(-taumax, taumax, (n, d))
-        a = rng.uniform(-amax, amax, (n, d))
-        q[0], v[0], tau[0], a[0] = self.rest(), 0.0, 0.0, 0.0
-        return StateSample(q=q, v=v, tau=tau, a=a)
+        bounds = (np.pi, vmax, taumax, amax)
+        for start in range(0, n, chunk):
+            k = min(chunk, n - start)
+            q, v, tau, a = (
+                g.uniform(-b, b, (k, self.ndof)) for g, b in zip(streams, bounds, strict=True)
+            )
+            if start == 0:
+                q[0], v[0], tau[0], a[0] = self.rest(), 0.0, 0.0, 0.0
+            yield StateSample(q=q, v=v, tau=tau, a=a)
+
+    def sample_states(self, n: int | None = None) -> StateSample:
+        """All of :meth:`iter_states` in one sample."""
+        return next(self.iter_states(n, chunk=n or self.n_states))

@@ -1,4 +1,4 @@
-"""The ``dyncheck`` command line: ``list`` and ``run``.
+"""The ``dyncheck`` command line: ``list``, ``run`` and ``bench``.
 
 Exit status: 0 when nothing failed unexplained, 1 when a check failed, 2 for bad usage or
 bad input (a one-line message naming the argument and the value).
@@ -28,7 +28,40 @@ def _parser() -> argparse.ArgumentParser:
         help="implementation to include (repeatable; default: all)",
     )
     r.add_argument("--out", type=Path, default=Path("reports"), help="report folder")
+    r.add_argument(
+        "--states",
+        type=int,
+        default=None,
+        metavar="N",
+        help="sampled states per case (default: each case's own, 16)",
+    )
+    b = sub.add_parser("bench", help="time the engines, adapters, reference and a sweep")
+    b.add_argument("case", nargs="?", default="compound_pendulum", metavar="CASE")
+    b.add_argument("--states", type=int, default=100_000, metavar="N")
+    b.add_argument("--repeats", type=int, default=3, metavar="R")
+    b.add_argument(
+        "--memory",
+        type=int,
+        nargs="*",
+        default=[100_000, 1_000_000],
+        metavar="N",
+        help="sweep sizes whose peak memory is measured in fresh processes",
+    )
+    b.add_argument("--out", type=Path, default=Path("reports"), help="report folder")
     return p
+
+
+def _bench(args: argparse.Namespace) -> int:
+    from dyncheck import bench
+    from dyncheck.cases import get_case
+
+    _check_out(args.out)
+    get_case(args.case)
+    for name in ("states", "repeats"):
+        if getattr(args, name) < 1:
+            raise InvalidInput(f"--{name}", getattr(args, name), "a positive integer")
+    print(bench.main(args.case, args.states, args.repeats, args.memory, args.out))
+    return 0
 
 
 def _list() -> int:
@@ -71,7 +104,9 @@ def _run(args: argparse.Namespace) -> int:
 
     _check_out(args.out)
     cases, impls = resolve(args.cases, args.impl)
-    result = run(cases, impls, progress=report.stderr_progress)
+    if args.states is not None and args.states < 1:
+        raise InvalidInput("--states", args.states, "a positive integer")
+    result = run(cases, impls, states=args.states, progress=report.stderr_progress)
     report.write(result, args.out)
     counts = result.discrepancies["verdict"].value_counts()
     print(
@@ -86,6 +121,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if args.command == "list":
             return _list()
+        if args.command == "bench":
+            return _bench(args)
         return _run(args)
     except DyncheckError as exc:
         print(f"dyncheck: error: {exc}", file=sys.stderr)

@@ -5,16 +5,21 @@ tolerance; ``explained`` when the two models differ by a named convention whose 
 reference predicts — the general method evaluated on each implementation's model variant —
 and the observed difference equals the predicted one within the same tolerance; otherwise
 ``failed``. An explanation is never a free pass: it predicts the difference itself.
+
+States stream through in chunks: each pair keeps running maxima (error, scale, residual after
+prediction, and the state where the error peaked), so memory stays flat however many states.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Iterable
+from dataclasses import dataclass, field
 from itertools import combinations
 
 import numpy as np
 
 from dyncheck.cases import Case, StateSample
+from dyncheck.errors import EngineNotInstalled
 from dyncheck.implementations import (
     IMPLEMENTATIONS,
     QUANTITIES,
@@ -24,59 +29,117 @@ from dyncheck.implementations import (
     general_method,
 )
 from dyncheck.results import Discrepancy
-from dyncheck.tolerances import Tolerance, instantaneous
+from dyncheck.tolerances import instantaneous
 
 POINT_INERTIA = "point-mass inertia floor"
 
 
-@dataclass(frozen=True)
-class Evaluation:
-    """One implementation's values (book coordinates) at the sample, or why it has none."""
+def _per_state(x: np.ndarray) -> np.ndarray:
+    """max |x| over everything but the state axis, shape (n,)."""
+    return np.abs(x).reshape(len(x), -1).max(axis=1)
+
+
+def _fmt(x: np.ndarray) -> str:
+    return "[" + ", ".join(f"{v:.6g}" for v in x) + "]"
+
+
+@dataclass
+class PairStats:
+    """Running maxima for one quantity of one pair (a = desired, b = actual)."""
+
+    max_abs: float = 0.0
+    worst: int = -1
+    worst_values: str = ""
+    scale: float = 0.0
+    residual: float = 0.0
+    predicted: float = 0.0
+
+    def update(
+        self,
+        offset: int,
+        s: StateSample,
+        actual: np.ndarray,
+        desired: np.ndarray,
+        predicted: np.ndarray | None,
+    ) -> None:
+        diff = _per_state(actual - desired)
+        k = int(np.argmax(diff))
+        if diff[k] > self.max_abs or self.worst < 0:
+            self.max_abs, self.worst = float(diff[k]), offset + k
+            self.worst_values = (
+                f"q={_fmt(s.q[k])} v={_fmt(s.v[k])} tau={_fmt(s.tau[k])} a={_fmt(s.a[k])}"
+            )
+        self.scale = max(self.scale, float(np.abs(desired).max()))
+        if predicted is not None:
+            self.predicted = max(self.predicted, float(np.abs(predicted).max()))
+            self.residual = max(self.residual, float(np.abs(actual - desired - predicted).max()))
+
+
+@dataclass
+class Evaluator:
+    """One implementation across the chunks; the first exception ends it (a failed row)."""
 
     name: str
-    values: dict[str, np.ndarray] | None
-    variant: Variant | None
+    impl: Implementation | Exception
+    variant: Variant | None = None
     error: str = ""
     skipped: bool = False
+    values: dict[str, np.ndarray] | None = field(default=None, repr=False)
 
+    def __post_init__(self) -> None:
+        if isinstance(self.impl, Exception):
+            self.error = str(self.impl)
+            self.skipped = isinstance(self.impl, EngineNotInstalled)
+        else:
+            try:
+                self.variant = self.impl.variant()
+            except Exception as exc:
+                self.error = f"{type(exc).__name__}: {exc}"
 
-def scale(desired: np.ndarray) -> float:
-    """A quantity's scale: max |desired| over all states (1 where it is identically zero)."""
-    return float(np.abs(desired).max()) or 1.0
+    @property
+    def ok(self) -> bool:
+        return not self.error
 
-
-def _error(actual: np.ndarray, desired: np.ndarray) -> tuple[float, float, int]:
-    """(max abs error, max abs error / scale(desired), index of the worst state)."""
-    diff = np.abs(actual - desired).reshape(len(desired), -1).max(axis=1)
-    worst = int(np.argmax(diff))
-    return float(diff[worst]), float(diff[worst]) / scale(desired), worst
+    def step(self, s: StateSample) -> None:
+        self.values = None
+        if not self.ok:
+            return
+        try:
+            values = self.impl.evaluate(s)  # type: ignore[union-attr]
+            for q, x in values.items():
+                if not np.all(np.isfinite(x)):
+                    raise FloatingPointError(f"non-finite {q}")
+            self.values = values
+        except Exception as exc:  # a report run survives one implementation crashing
+            self.error = f"{type(exc).__name__}: {exc}"
 
 
 class VariantPredictor:
-    """The general method evaluated on model variants, cached per variant."""
+    """The general method evaluated on model variants for the current chunk."""
 
-    def __init__(self, case: Case, sample: StateSample) -> None:
-        self.case, self.sample = case, sample
-        self._cache: dict[Variant, dict[str, np.ndarray]] = {}
+    def __init__(self, case: Case) -> None:
+        self.case = case
+        self._impls: dict[Variant, ReferenceImplementation] = {}
+        self._values: dict[Variant, dict[str, np.ndarray]] = {}
+
+    def new_chunk(self, s: StateSample) -> None:
+        self.sample, self._values = s, {}
 
     def __call__(self, variant: Variant) -> dict[str, np.ndarray]:
-        if variant not in self._cache:
-            impl = ReferenceImplementation(self.case)
-            impl.dyn = general_method(self.case, variant.hinge_inertia)
-            self._cache[variant] = impl.evaluate(self.sample)
-        return self._cache[variant]
+        if variant not in self._values:
+            if variant not in self._impls:
+                impl = ReferenceImplementation(self.case)
+                impl.dyn = general_method(self.case, variant.hinge_inertia)
+                self._impls[variant] = impl
+            self._values[variant] = self._impls[variant].evaluate(self.sample)
+        return self._values[variant]
 
 
-def judge(
-    case: Case,
-    quantity: str,
-    a: Evaluation,
-    b: Evaluation,
-    tol: Tolerance,
-    predict: VariantPredictor,
+def _row(
+    case: Case, quantity: str, a: Evaluator, b: Evaluator, st: PairStats, condition: float
 ) -> Discrepancy:
-    """Compare b (actual) with a (desired) on one quantity."""
-    row = dict(
+    tol = instantaneous(quantity, condition)
+    base = dict(
         case=case.name,
         quantity=quantity,
         impl_a=a.name,
@@ -86,84 +149,78 @@ def judge(
         tolerance=tol.rtol,
         tolerance_basis=tol.basis,
     )
-    if a.values is None or b.values is None:
-        bad = a if a.values is None else b
+    if not (a.ok and b.ok):
+        bad = a if not a.ok else b
         return Discrepancy(
-            **row,
+            **base,
             max_abs_err=float("nan"),
             max_rel_err=float("nan"),
             verdict="skipped" if bad.skipped else "failed",
             convention="",
             note=f"{bad.name}: {bad.error}",
             worst_state=-1,
+            worst_state_values="",
         )
-    desired, actual = a.values[quantity], b.values[quantity]
-    abs_err, rel_err, worst = _error(actual, desired)
-    if rel_err <= tol.rtol:
-        return Discrepancy(
-            **row,
-            max_abs_err=abs_err,
-            max_rel_err=rel_err,
-            verdict="passed",
-            convention="",
-            note="",
-            worst_state=worst,
-        )
-    if a.variant is not None and b.variant is not None and a.variant != b.variant:
-        pa, pb = predict(a.variant), predict(b.variant)
-        _, predicted, _ = _error(pb[quantity], pa[quantity])
-        residual = (actual - desired) - (pb[quantity] - pa[quantity])
-        res_rel = float(np.abs(residual).max()) / scale(desired)
-        note = (
-            f"hinge inertia {b.name} {list(b.variant.hinge_inertia)} vs {a.name} "
-            f"{list(a.variant.hinge_inertia)} kg m^2: predicted rel. difference "
-            f"{predicted:.3g}, residual after prediction {res_rel:.3g}"
-        )
-        verdict = "explained" if res_rel <= tol.rtol else "failed"
-        return Discrepancy(
-            **row,
-            max_abs_err=abs_err,
-            max_rel_err=rel_err,
-            verdict=verdict,
-            convention=POINT_INERTIA,
-            note=note,
-            worst_state=worst,
-        )
-    note = "unexplained: no convention predicts this difference"
+    scale = st.scale or 1.0
+    rel = st.max_abs / scale
+    verdict, convention, note = "passed", "", ""
+    if rel > tol.rtol:
+        if a.variant is not None and b.variant is not None and a.variant != b.variant:
+            convention = POINT_INERTIA
+            note = (
+                f"hinge inertia {b.name} {list(b.variant.hinge_inertia)} vs {a.name} "
+                f"{list(a.variant.hinge_inertia)} kg m^2: predicted rel. difference "
+                f"{st.predicted / scale:.3g}, residual after prediction "
+                f"{st.residual / scale:.3g}"
+            )
+            verdict = "explained" if st.residual / scale <= tol.rtol else "failed"
+        else:
+            verdict, note = "failed", "unexplained: no convention predicts this difference"
     return Discrepancy(
-        **row,
-        max_abs_err=abs_err,
-        max_rel_err=rel_err,
-        verdict="failed",
-        convention="",
+        **base,
+        max_abs_err=st.max_abs,
+        max_rel_err=rel,
+        verdict=verdict,
+        convention=convention,
         note=note,
-        worst_state=worst,
+        worst_state=st.worst,
+        worst_state_values=st.worst_values,
     )
 
 
-def evaluate(impl: Implementation | Exception, name: str, sample: StateSample) -> Evaluation:
-    """Run one implementation; an exception becomes a failed (or skipped) evaluation."""
-    from dyncheck.errors import EngineNotInstalled
-
-    if isinstance(impl, Exception):
-        return Evaluation(name, None, None, str(impl), isinstance(impl, EngineNotInstalled))
-    try:
-        return Evaluation(name, impl.evaluate(sample), impl.variant())
-    except Exception as exc:  # a report run survives one implementation crashing
-        return Evaluation(name, None, None, f"{type(exc).__name__}: {exc}")
-
-
 def compare_instantaneous(
-    case: Case, impls: dict[str, Implementation | Exception], sample: StateSample
+    case: Case,
+    impls: dict[str, Implementation | Exception],
+    chunks: StateSample | Iterable[StateSample],
 ) -> list[Discrepancy]:
-    """Rows for every pair (trusted first, in IMPLEMENTATIONS order) and quantity."""
+    """Rows for every pair (trusted first, in IMPLEMENTATIONS order) and quantity, over all
+    states of ``chunks`` (one sample or an iterable of chunks)."""
+    if isinstance(chunks, StateSample):
+        chunks = [chunks]
     names = [n for n in IMPLEMENTATIONS if n in impls]
-    evals = {n: evaluate(impls[n], n, sample) for n in names}
-    predict = VariantPredictor(case, sample)
-    condition = float(np.linalg.cond(predict(Variant((0.0,) * case.ndof))["mass_matrix"]).max())
-    rows = []
-    for quantity in QUANTITIES:
-        tol = instantaneous(quantity, condition)
-        for a, b in combinations(names, 2):
-            rows.append(judge(case, quantity, evals[a], evals[b], tol, predict))
-    return rows
+    evals = {n: Evaluator(n, impls[n]) for n in names}
+    pairs = list(combinations(names, 2))
+    stats = {(q, a, b): PairStats() for q in QUANTITIES for a, b in pairs}
+    predict = VariantPredictor(case)
+    book = Variant((0.0,) * case.ndof)
+    condition, offset = 1.0, 0
+    for s in chunks:
+        predict.new_chunk(s)
+        condition = max(condition, float(np.linalg.cond(predict(book)["mass_matrix"]).max()))
+        for ev in evals.values():
+            ev.step(s)
+        for a, b in pairs:
+            ea, eb = evals[a], evals[b]
+            if ea.values is None or eb.values is None:
+                continue
+            differ = ea.variant is not None and eb.variant is not None and ea.variant != eb.variant
+            pa, pb = (predict(ea.variant), predict(eb.variant)) if differ else (None, None)
+            for q in QUANTITIES:
+                predicted = pb[q] - pa[q] if differ else None
+                stats[q, a, b].update(offset, s, eb.values[q], ea.values[q], predicted)
+        offset += len(s)
+    return [
+        _row(case, q, evals[a], evals[b], stats[q, a, b], condition)
+        for q in QUANTITIES
+        for a, b in pairs
+    ]

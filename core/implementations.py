@@ -87,7 +87,9 @@ class Implementation(ABC):
     def evaluate(self, s: StateSample) -> dict[str, np.ndarray]:
         """Every quantity at every state; potential energy relative to the case's rest state."""
         out = self._dynamics(s.q, s)
-        out["potential_energy"] = self._potential(s.q) - self._potential(self.case.rest()[None])
+        if "potential_energy" not in out:
+            out["potential_energy"] = self._potential(s.q)
+        out["potential_energy"] = out["potential_energy"] - self._potential(self.case.rest()[None])
         return out
 
     def simulate(self, dt: float, integrator: str) -> tuple[np.ndarray, np.ndarray]:
@@ -159,18 +161,19 @@ class EngineImplementation(Implementation):
         return Variant(tuple(out))
 
     def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]:
-        m, a = self.map, self.adapter
+        m = self.map
         qe, ve = m.to_engine(q), co.velocity_to_engine(m, q, s.v)
-        Me = a.mass_matrix(qe)
-        tau_e = co.force_to_engine(m, q, s.tau)
+        raw = self.adapter.evaluate_all(
+            qe, ve, co.force_to_engine(m, q, s.tau), co.acceleration_to_engine(m, q, s.v, s.a)
+        )
+        Me = raw["mass_matrix"]
         return {
             "mass_matrix": co.mass_matrix_to_book(m, q, Me),
-            "bias_forces": co.bias_to_book(m, q, s.v, Me, a.bias(qe, ve)),
-            "forward_dynamics": co.acceleration_to_book(m, q, s.v, a.forward(qe, ve, tau_e)),
-            "inverse_dynamics": co.force_to_book(
-                m, q, a.inverse(qe, ve, co.acceleration_to_engine(m, q, s.v, s.a))
-            ),
-            "kinetic_energy": a.kinetic_energy(qe, ve),
+            "bias_forces": co.bias_to_book(m, q, s.v, Me, raw["bias_forces"]),
+            "forward_dynamics": co.acceleration_to_book(m, q, s.v, raw["forward_dynamics"]),
+            "inverse_dynamics": co.force_to_book(m, q, raw["inverse_dynamics"]),
+            "kinetic_energy": raw["kinetic_energy"],
+            "potential_energy": raw["potential_energy"],
         }
 
     def _potential(self, q: np.ndarray) -> np.ndarray:

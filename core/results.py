@@ -20,7 +20,8 @@ class Discrepancy:
     ``impl_a`` is the trusted side (``desired``), ``impl_b`` the one checked against it.
     Errors: ``max_abs_err`` in the quantity's units (book coordinates); ``max_rel_err`` divided
     by the quantity's scale (max |desired|). ``worst_state`` is the index of the sampled state
-    (or, for trajectories, of the grid time) where the largest error occurred.
+    (or, for trajectories, of the grid time) where the largest error occurred, and
+    ``worst_state_values`` that state (book coordinates), to reproduce it.
     """
 
     case: str
@@ -37,6 +38,7 @@ class Discrepancy:
     convention: str
     note: str
     worst_state: int
+    worst_state_values: str = ""
 
     def __post_init__(self) -> None:
         if self.verdict not in VERDICTS:

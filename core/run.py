@@ -49,9 +49,11 @@ def run(
     cases: Sequence[Case],
     impl_names: Sequence[str],
     *,
+    states: int | None = None,
     progress: Callable[[str], None] = lambda _msg: None,
 ) -> RunResult:
-    """Evaluate, compare and study every case; an implementation that cannot be built (not
+    """Evaluate, compare and study every case (``states`` sampled states each, default the
+    case's own); an implementation that cannot be built (not
     installed, or raising) becomes skipped or failed rows, never an aborted run."""
     rows: list[Discrepancy] = []
     points: list[ConvergencePoint] = []
@@ -64,7 +66,7 @@ def run(
                 impls[name] = make_implementation(name, case)
             except Exception as exc:  # reported as a row, the run goes on
                 impls[name] = exc
-        rows += compare_instantaneous(case, impls, case.sample_states())
+        rows += compare_instantaneous(case, impls, case.iter_states(states))
         progress(f"{case.name}: trajectories and order of accuracy")
         p, r, figures[case.name] = study(case, impls)
         points += p

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import sympy as sp
@@ -75,20 +76,32 @@ class SymbolicSystem:
         )
         return M, h
 
+    @cached_property
+    def compiled(self) -> tuple:
+        """(M entries, h entries, T, V) as numpy functions of (x, ẋ, parameters), derived and
+        compiled once per system and shared by every set of parameter values."""
+        M, h = self.equations()
+        args = (*self.q, *self.qd, *self.params)
+        n = len(self.q)
+        return (
+            tuple(tuple(_vectorize(M[r, c], args) for c in range(n)) for r in range(n)),
+            tuple(_vectorize(h[r, 0], args) for r in range(n)),
+            _vectorize(self.T, args),
+            _vectorize(self.V, args),
+        )
+
     def numeric(self, values: dict[str, float]) -> LagrangianDynamics:
         missing = {s.name for s in self.params} - set(values)
         if missing:
             raise KeyError(f"missing parameter values: {sorted(missing)}")
-        M, h = self.equations()
-        args = (*self.q, *self.qd, *self.params)
-        n = len(self.q)
+        M_entries, h_entries, T_fn, V_fn = self.compiled
         return LagrangianDynamics(
-            ndof=n,
+            ndof=len(self.q),
             param_values=tuple(float(values[s.name]) for s in self.params),
-            M_entries=tuple(tuple(_vectorize(M[r, c], args) for c in range(n)) for r in range(n)),
-            h_entries=tuple(_vectorize(h[r, 0], args) for r in range(n)),
-            T_fn=_vectorize(self.T, args),
-            V_fn=_vectorize(self.V, args),
+            M_entries=M_entries,
+            h_entries=h_entries,
+            T_fn=T_fn,
+            V_fn=V_fn,
         )
 
 

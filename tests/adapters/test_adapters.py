@@ -131,3 +131,23 @@ def test_unknown_engine_lists_valid_names():
 
 def test_every_engine_is_installed_here():
     assert sorted(ADAPTERS) == ENGINES
+
+
+def test_batched_path_equals_per_quantity_methods(adapter_and_states):
+    """evaluate_all (the fast path) against the one-quantity methods, same engine."""
+    adapter, (q, v, a) = adapter_and_states
+    tau = a[::-1].copy()
+    batched = adapter.evaluate_all(q, v, tau, a)
+    single = {
+        "mass_matrix": adapter.mass_matrix(q),
+        "bias_forces": adapter.bias(q, v),
+        "forward_dynamics": adapter.forward(q, v, tau),
+        "inverse_dynamics": adapter.inverse(q, v, a),
+        "kinetic_energy": adapter.kinetic_energy(q, v),
+        "potential_energy": adapter.potential_energy(q),
+    }
+    assert set(batched) == set(single)
+    for key, value in single.items():
+        assert_allclose(
+            batched[key], value, rtol=0, atol=1e-13 * max(1, np.abs(value).max()), err_msg=key
+        )

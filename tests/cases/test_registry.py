@@ -62,3 +62,21 @@ def test_bad_step_size():
 def test_unknown_case_lists_valid_names():
     with pytest.raises(UnknownName, match="unknown case 'pendulum'; valid: compound_pendulum"):
         get_case("pendulum")
+
+
+@pytest.mark.parametrize("case", CASE_NAMES)
+def test_states_do_not_depend_on_chunk_size(case):
+    c = get_case(case)
+    whole = c.sample_states(1000)
+    chunks = list(c.iter_states(1000, chunk=300))
+    assert [len(s) for s in chunks] == [300, 300, 300, 100]
+    for name in ("q", "v", "tau", "a"):
+        assert np.array_equal(
+            np.concatenate([getattr(s, name) for s in chunks]), getattr(whole, name)
+        )
+
+
+@pytest.mark.parametrize("n", [0, -3, 2.5, True])
+def test_bad_state_count(n):
+    with pytest.raises(InvalidInput, match=r"^states must be a positive integer"):
+        get_case("simple_pendulum").sample_states(n)

@@ -89,3 +89,57 @@ def test_list_names_engine_versions(capsys):
     out = capsys.readouterr().out
     assert "simple_pendulum" in out
     assert "mujoco 4" in out or "mujoco 3" in out
+
+
+def test_states_option_sweeps_more_states(tmp_path):
+    out = tmp_path / "rep"
+    assert (
+        main(
+            [
+                "run",
+                "compound_pendulum",
+                "--states",
+                "2000",
+                "--impl",
+                "reference",
+                "--impl",
+                "pinocchio",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
+    d = pd.read_csv(out / "discrepancies.csv")
+    inst = d[d.quantity != "trajectory"]
+    assert inst.worst_state.max() >= 16  # states beyond the default 16 were visited
+    assert (inst.verdict == "passed").all()
+
+
+def test_bad_states_option(tmp_path, capsys):
+    assert main(["run", "--states", "0", "--out", str(tmp_path / "r")]) == 2
+    assert "--states must be a positive integer, got 0" in capsys.readouterr().err
+
+
+def test_bench_writes_its_tables(tmp_path, capsys):
+    """The benchmark runs end to end (timings are not asserted: they are not tests)."""
+    assert (
+        main(
+            [
+                "bench",
+                "simple_pendulum",
+                "--states",
+                "200",
+                "--repeats",
+                "1",
+                "--memory",
+                "--out",
+                str(tmp_path),
+            ]
+        )
+        == 0
+    )
+    b = pd.read_csv(tmp_path / "benchmark.csv")
+    assert {"raw engine calls", "adapter batched", "whole sweep"} <= set(b.part.dropna())
+    assert "whole sweep / sum of raw engine calls" in set(b.ratio.dropna())
+    assert (tmp_path / "benchmark.md").exists()

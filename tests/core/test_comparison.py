@@ -6,12 +6,14 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.comparison import POINT_INERTIA, compare_instantaneous
 from dyncheck.implementations import QUANTITIES, make_implementation
+from dyncheck.results import DISCREPANCY_KEY, Discrepancy, table
 
 from ..conftest import CASE_NAMES, ENGINES
 
@@ -83,6 +85,9 @@ def test_an_implementation_that_raises_becomes_a_failed_row():
     case = get_case("simple_pendulum")
 
     class Broken:
+        def variant(self):
+            return None
+
         def evaluate(self, sample):
             raise FloatingPointError("boom")
 
@@ -91,3 +96,25 @@ def test_an_implementation_that_raises_becomes_a_failed_row():
     assert all(r.verdict == "failed" and "boom" in r.note for r in rows)
     assert len(rows) == len(QUANTITIES)
     assert np.isnan(rows[0].max_abs_err)
+
+
+def test_streaming_equals_one_chunk():
+    """Running maxima over chunks give the same rows as one pass over all states."""
+    case = get_case("compound_pendulum")
+    impls = {n: make_implementation(n, case) for n in ("reference", "book", "mujoco")}
+    one = compare_instantaneous(case, impls, case.sample_states(500))
+    many = compare_instantaneous(case, impls, case.iter_states(500, chunk=64))
+    pd.testing.assert_frame_equal(
+        table(one, Discrepancy, DISCREPANCY_KEY), table(many, Discrepancy, DISCREPANCY_KEY)
+    )
+
+
+def test_worst_state_is_reported_and_reproducible():
+    case = get_case("compound_pendulum")
+    impls = {n: make_implementation(n, case) for n in ("reference", "mujoco")}
+    rows = compare_instantaneous(case, impls, case.iter_states(300, chunk=50))
+    row = next(r for r in rows if r.quantity == "forward_dynamics")
+    s = case.sample_states(300)
+    k = row.worst_state
+    assert 0 <= k < 300
+    assert row.worst_state_values.startswith(f"q=[{s.q[k][0]:.6g}, {s.q[k][1]:.6g}]")

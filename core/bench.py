@@ -1,0 +1,246 @@
+"""``dyncheck bench``: where a sweep's time goes, as ratios against the engines' raw calls.
+
+Measured in one process, one run, medians of repeats (time.perf_counter):
+
+- raw engine calls: the plainest loop a user would write over the states — MuJoCo
+  ``mj_forward`` + ``mj_fullM`` + ``mj_inverse``; Pinocchio ``crba``, ``rnea`` (h),
+  ``aba``, ``rnea`` (τ), ``computeKineticEnergy``, ``computePotentialEnergy``;
+- each adapter's batched path (``evaluate_all``), engine coordinates;
+- the reference's and the printed equations' batched paths;
+- the whole sweep: every implementation, every quantity, coordinate maps, predictions and
+  streaming comparison (``compare_instantaneous``).
+
+Peak memory of a sweep is measured in a fresh child process per size (its max RSS).
+Timings are not test assertions; they go to ``benchmark.csv`` and ``benchmark.md``.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import platform
+import resource
+import statistics
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from dyncheck.cases import Case, get_case
+from dyncheck.implementations import (
+    IMPLEMENTATIONS,
+    EngineImplementation,
+    make_implementation,
+)
+from dyncheck.results import to_csv, write_atomic
+
+
+def _median_time(fn: Callable[[], object], repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def _raw_mujoco(adapter, qe, ve, te, ae) -> Callable[[], None]:
+    import mujoco
+
+    m, d = adapter.model, adapter.data
+    M = np.empty((m.nv, m.nv))
+
+    def loop() -> None:
+        for k in range(len(qe)):
+            d.qpos[:], d.qvel[:], d.qfrc_applied[:] = qe[k], ve[k], te[k]
+            mujoco.mj_forward(m, d)
+            mujoco.mj_fullM(m, d, M)
+            d.qacc[:] = ae[k]
+            mujoco.mj_inverse(m, d)
+
+    return loop
+
+
+def _raw_pinocchio(adapter, qe, ve, te, ae) -> Callable[[], None]:
+    import pinocchio as pin
+
+    m, d = adapter.model, adapter.data
+    zero = np.zeros(m.nv)
+
+    def loop() -> None:
+        for k in range(len(qe)):
+            q, v = qe[k], ve[k]
+            pin.crba(m, d, q)
+            pin.rnea(m, d, q, v, zero)
+            pin.aba(m, d, q, v, te[k])
+            pin.rnea(m, d, q, v, ae[k])
+            pin.computeKineticEnergy(m, d, q, v)
+            pin.computePotentialEnergy(m, d, q)
+
+    return loop
+
+
+RAW = {"mujoco": _raw_mujoco, "pinocchio": _raw_pinocchio, "pinocchio-mjcf": _raw_pinocchio}
+
+
+def _sweep_rss(case_name: str, states: int, queue: mp.Queue) -> None:
+    from dyncheck.comparison import compare_instantaneous
+
+    case = get_case(case_name)
+    impls = {n: make_implementation(n, case) for n in IMPLEMENTATIONS}
+    compare_instantaneous(case, impls, case.iter_states(states))
+    queue.put(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
+
+
+def peak_memory_kib(case_name: str, states: int) -> int:
+    """Max RSS (KiB) of a fresh process that runs one sweep of ``states`` states."""
+    ctx = mp.get_context("spawn")
+    queue = ctx.Queue()
+    proc = ctx.Process(target=_sweep_rss, args=(case_name, states, queue))
+    proc.start()
+    rss = queue.get()
+    proc.join()
+    return int(rss)
+
+
+def bench(case: Case, states: int, repeats: int) -> pd.DataFrame:
+    """Per-state times (µs) of every part and the whole sweep, one row each."""
+    from dyncheck import coordinates as co
+    from dyncheck.comparison import compare_instantaneous
+
+    sample = case.sample_states(states)
+    impls = {n: make_implementation(n, case) for n in IMPLEMENTATIONS}
+    rows = []
+
+    def add(part: str, impl: str, seconds: float) -> None:
+        rows.append(
+            {
+                "case": case.name,
+                "states": states,
+                "part": part,
+                "implementation": impl,
+                "us_per_state": 1e6 * seconds / states,
+            }
+        )
+
+    for name, impl in impls.items():
+        if isinstance(impl, EngineImplementation):
+            cmap, q = impl.map, sample.q
+            qe, ve = cmap.to_engine(q), co.velocity_to_engine(cmap, q, sample.v)
+            te = co.force_to_engine(cmap, q, sample.tau)
+            ae = co.acceleration_to_engine(cmap, q, sample.v, sample.a)
+            add(
+                "raw engine calls",
+                name,
+                _median_time(RAW[name](impl.adapter, qe, ve, te, ae), repeats),
+            )
+            add(
+                "adapter batched",
+                name,
+                _median_time(
+                    lambda impl=impl, qe=qe, ve=ve, te=te, ae=ae: impl.adapter.evaluate_all(
+                        qe, ve, te, ae
+                    ),
+                    repeats,
+                ),
+            )
+        add(
+            "implementation (book coordinates)",
+            name,
+            _median_time(lambda impl=impl: impl.evaluate(sample), repeats),
+        )
+    add(
+        "whole sweep",
+        "all",
+        _median_time(lambda: compare_instantaneous(case, impls, case.iter_states(states)), repeats),
+    )
+    return pd.DataFrame(rows)
+
+
+def ratios(t: pd.DataFrame) -> pd.DataFrame:
+    """The ratios the targets are stated in."""
+
+    def us(part: str, impl: str) -> float:
+        sel = t[(t.part == part) & (t.implementation == impl)]
+        return float(sel.us_per_state.iloc[0]) if len(sel) else float("nan")
+
+    engines = [n for n in ("mujoco", "pinocchio", "pinocchio-mjcf") if n in set(t.implementation)]
+    raw_sum = sum(us("raw engine calls", e) for e in engines)
+    fastest_raw = min(us("raw engine calls", e) for e in engines)
+    parts = sum(
+        us("implementation (book coordinates)", n)
+        for n in IMPLEMENTATIONS
+        if n in set(t.implementation)
+    )
+    out = [
+        {
+            "ratio": f"adapter / raw engine ({e})",
+            "value": us("adapter batched", e) / us("raw engine calls", e),
+        }
+        for e in engines
+    ]
+    out += [
+        {
+            "ratio": "reference / fastest raw engine",
+            "value": us("implementation (book coordinates)", "reference") / fastest_raw,
+        },
+        {
+            "ratio": "whole sweep / sum of raw engine calls",
+            "value": us("whole sweep", "all") / raw_sum,
+        },
+        {
+            "ratio": "whole sweep / sum of implementation parts",
+            "value": us("whole sweep", "all") / parts,
+        },
+    ]
+    return pd.DataFrame(out)
+
+
+def write(times: pd.DataFrame, rat: pd.DataFrame, memory: pd.DataFrame, out: Path) -> None:
+    from dyncheck.report import versions
+
+    v = versions()
+    lines = [
+        "# dyncheck benchmark",
+        "",
+        "Generated by `dyncheck bench`; timings vary from machine to machine, ratios less. "
+        f"Platform: {platform.processor() or platform.machine()}, {v['platform']}; "
+        f"Python {v['python']}, numpy {v['numpy']}, MuJoCo {v['mujoco']}, "
+        f"Pinocchio {v['pinocchio']}.",
+        "",
+        "### Time per state (µs), medians of repeats",
+        "",
+        times.to_markdown(index=False, floatfmt=".3g"),
+        "",
+        "### Ratios",
+        "",
+        rat.to_markdown(index=False, floatfmt=".3g"),
+        "",
+        "### Peak memory of a sweep (fresh process, max RSS)",
+        "",
+        memory.to_markdown(index=False) if len(memory) else "_(not measured)_",
+        "",
+    ]
+    write_atomic(out / "benchmark.csv", to_csv(pd.concat([times, rat, memory])))
+    write_atomic(out / "benchmark.md", "\n".join(lines))
+
+
+def main(case_name: str, states: int, repeats: int, memory_sizes: list[int], out: Path) -> str:
+    case = get_case(case_name)
+    times = bench(case, states, repeats)
+    rat = ratios(times)
+    mem = pd.DataFrame(
+        [
+            {
+                "case": case_name,
+                "states": n,
+                "peak_rss_MiB": round(peak_memory_kib(case_name, n) / 1024, 1),
+            }
+            for n in memory_sizes
+        ]
+    )
+    write(times, rat, mem, out)
+    return "\n\n".join(
+        [times.to_string(index=False), rat.to_string(index=False), mem.to_string(index=False)]
+    )
