@@ -30,18 +30,19 @@ def to_mjcf(model: Multibody, *, timestep: float = 0.002, integrator: str = "Eul
     )
     ET.SubElement(option, "flag", energy="enable", contact="disable")
     parents: dict[str | None, ET.Element] = {None: ET.SubElement(root, "worldbody")}
-    for body, joint in zip(model.bodies, model.joint_names, strict=True):
+    for body in model.bodies:
         el = ET.SubElement(parents[body.parent], "body", name=body.name, pos=_fmt(body.joint_pos))
-        ET.SubElement(
-            el,
-            "joint",
-            name=joint,
-            type=body.joint_type,
-            axis=_fmt(body.joint_axis),
-            pos="0 0 0",
-            damping="0",
-            armature="0",
-        )
+        for joint in body.joints:
+            ET.SubElement(
+                el,
+                "joint",
+                name=joint.name,
+                type=joint.type,
+                axis=_fmt(joint.axis),
+                pos="0 0 0",
+                damping="0",
+                armature="0",
+            )
         inertia = np.asarray(body.inertia, float)
         if body.is_point_mass:
             inertia = model.mjcf_point_inertia * np.eye(3)

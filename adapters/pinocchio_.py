@@ -22,37 +22,48 @@ from scipy.integrate import solve_ivp
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.integrators import STEPPERS, integrate
 from dyncheck.adapters.mjcf import to_mjcf
-from dyncheck.cases.multibody import Body, Multibody
+from dyncheck.cases.multibody import Joint, Multibody
 from dyncheck.errors import EngineError
 
 THREADS = max(1, min(2, os.cpu_count() or 1))
 """Threads for Pinocchio's batched ABA/RNEA (the machines this runs on have 2 cores)."""
 
 _AXIS_JOINTS = {
-    (1.0, 0.0, 0.0): pin.JointModelRX,
-    (0.0, 1.0, 0.0): pin.JointModelRY,
-    (0.0, 0.0, 1.0): pin.JointModelRZ,
+    ("hinge", (1.0, 0.0, 0.0)): pin.JointModelRX,
+    ("hinge", (0.0, 1.0, 0.0)): pin.JointModelRY,
+    ("hinge", (0.0, 0.0, 1.0)): pin.JointModelRZ,
+    ("slide", (1.0, 0.0, 0.0)): pin.JointModelPX,
+    ("slide", (0.0, 1.0, 0.0)): pin.JointModelPY,
+    ("slide", (0.0, 0.0, 1.0)): pin.JointModelPZ,
 }
 
 
-def _joint(body: Body) -> pin.JointModel:
-    axis = tuple(float(x) for x in body.joint_axis)
-    if axis in _AXIS_JOINTS:
-        return _AXIS_JOINTS[axis]()
-    return pin.JointModelRevoluteUnaligned(np.asarray(axis))
+def _joint(joint: Joint) -> pin.JointModel:
+    axis = tuple(float(x) for x in joint.axis)
+    if (joint.type, axis) in _AXIS_JOINTS:
+        return _AXIS_JOINTS[joint.type, axis]()
+    if joint.type == "hinge":
+        return pin.JointModelRevoluteUnaligned(np.asarray(axis))
+    return pin.JointModelPrismaticUnaligned(np.asarray(axis))
 
 
 def build_model(model: Multibody) -> pin.Model:
-    """A ``pin.Model`` built with ``addJoint`` and ``appendBodyToJoint``; point masses exact."""
+    """A ``pin.Model`` built with ``addJoint`` and ``appendBodyToJoint``; a body with several
+    joints becomes a chain of joints (massless links between them); point masses exact.
+    Each body gets a BODY frame of its name on its last joint."""
     pm = pin.Model()
     pm.name = model.name
     pm.gravity = pin.Motion(np.asarray(model.gravity, float), np.zeros(3))
     joint_of: dict[str | None, int] = {None: 0}
-    for body, jname in zip(model.bodies, model.joint_names, strict=True):
+    for body in model.bodies:
+        jid = joint_of[body.parent]
         placement = pin.SE3(np.eye(3), np.asarray(body.joint_pos, float))
-        jid = pm.addJoint(joint_of[body.parent], _joint(body), placement, jname)
+        for joint in body.joints:
+            jid = pm.addJoint(jid, _joint(joint), placement, joint.name)
+            placement = pin.SE3.Identity()
         inertia = pin.Inertia(body.mass, np.asarray(body.com, float), np.asarray(body.inertia))
         pm.appendBodyToJoint(jid, inertia, pin.SE3.Identity())
+        pm.addFrame(pin.Frame(body.name, jid, 0, pin.SE3.Identity(), pin.FrameType.BODY))
         joint_of[body.name] = jid
     return pm
 
@@ -79,14 +90,15 @@ class PinocchioAdapter(Adapter):
         self.model = self._build(model)
         self.data = self.model.createData()
         self.__pool: pin.ModelPool | None = None
-        # body name → joint index: the body's inertia is attached to its joint
-        self._joint_ids = [self.model.getJointId(j) for j in self._joint_names(model)]
+        # the joint that carries each body's inertia, found through the body's frame
+        self._joint_ids = [self._body_joint(b.name) for b in model.bodies]
 
     def _build(self, model: Multibody) -> pin.Model:
         return build_model(model)
 
-    def _joint_names(self, model: Multibody) -> tuple[str, ...]:
-        return model.joint_names
+    def _body_joint(self, name: str) -> int:
+        frame = self.model.frames[self.model.getFrameId(name, pin.FrameType.BODY)]
+        return int(frame.parentJoint)
 
     @staticmethod
     def version() -> str:

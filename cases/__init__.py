@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 from dyncheck.cases.base import INTEGRATORS, NOMINAL_ORDER, Case, StateSample, TrajectorySpec
+from dyncheck.cases.particles import CylindricalCoordinates, SphericalCoordinates
 from dyncheck.cases.pendulums import CompoundPendulum, SimplePendulum
 from dyncheck.errors import UnknownName
 
 CASES: dict[str, type[Case]] = {
     "compound_pendulum": CompoundPendulum,
+    "cylindrical_coordinates": CylindricalCoordinates,
     "simple_pendulum": SimplePendulum,
+    "spherical_coordinates": SphericalCoordinates,
 }
 """Case name → case class with the book's default parameters; kept sorted by name."""
 

@@ -104,6 +104,10 @@ class Case(ABC):
     def ndof(self) -> int:
         return len(self.coordinates)
 
+    @property
+    def n_bodies(self) -> int:
+        return len(self.multibody().bodies)
+
     @abstractmethod
     def params(self) -> dict[str, float]:
         """The physical parameters by the book's names (m, l, g, …)."""
@@ -124,6 +128,10 @@ class Case(ABC):
     def state_scale(self) -> tuple[float, float, float]:
         """Ranges (max |q̇|, max |τ|, max |q̈|) for sampled states."""
 
+    def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Sampling box of the book's coordinates, away from the chart's singular set."""
+        return np.full(self.ndof, -np.pi), np.full(self.ndof, np.pi)
+
     def iter_states(self, n: int | None = None, chunk: int = 8192) -> Iterator[StateSample]:
         """Deterministic states in chunks of at most ``chunk``: the rest state first, then
         seeded uniform samples, angles in (−π, π). Each array has its own random stream, so
@@ -133,11 +141,13 @@ class Case(ABC):
             raise InvalidInput("states", n, "a positive integer")
         streams = [np.random.default_rng(s) for s in np.random.SeedSequence(self.seed).spawn(4)]
         vmax, taumax, amax = self.state_scale()
-        bounds = (np.pi, vmax, taumax, amax)
+        low, high = self.q_bounds()
+        bounds = ((low, high), (-vmax, vmax), (-taumax, taumax), (-amax, amax))
         for start in range(0, n, chunk):
             k = min(chunk, n - start)
             q, v, tau, a = (
-                g.uniform(-b, b, (k, self.ndof)) for g, b in zip(streams, bounds, strict=True)
+                g.uniform(lo, hi, (k, self.ndof))
+                for g, (lo, hi) in zip(streams, bounds, strict=True)
             )
             if start == 0:
                 q[0], v[0], tau[0], a[0] = self.rest(), 0.0, 0.0, 0.0

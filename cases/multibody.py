@@ -1,46 +1,64 @@
 """An engine-neutral description of a kinematic tree, from which every adapter builds its model.
 
-Units: SI (kg, m, kg·m², m/s²). Frames: each body frame sits at its joint; ``joint_pos`` is that
+Units: SI (kg, m, kg·m², m/s²). Frames: each body frame sits at its joints; ``joint_pos`` is that
 origin in the parent's frame (world for the first body); ``com`` and ``inertia`` (about the
 centre of mass, in body axes) are in the body's frame. A point mass has a zero inertia tensor.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from dyncheck.cases.validate import finite_array, inertia_tensor, positive
+from dyncheck.errors import InvalidInput
 
 Vec3 = tuple[float, float, float]
 Mat3 = tuple[Vec3, Vec3, Vec3]
 ZERO3: Mat3 = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
+JOINT_TYPES = ("hinge", "slide")
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A one-degree-of-freedom joint: ``hinge`` (angle about ``axis``, rad) or ``slide``
+    (displacement along ``axis``, m); ``axis`` a unit vector in the body frame."""
+
+    name: str
+    type: str
+    axis: Vec3
+
+    def __post_init__(self) -> None:
+        if self.type not in JOINT_TYPES:
+            raise InvalidInput(f"{self.name}.type", self.type, f"one of {JOINT_TYPES}")
+        finite_array(f"{self.name}.axis", self.axis, (3,))
+        if abs(float(np.linalg.norm(self.axis)) - 1.0) > 1e-12:
+            raise InvalidInput(f"{self.name}.axis", self.axis, "a unit vector")
+
+
 @dataclass(frozen=True)
 class Body:
-    """One rigid body on a hinge joint to its parent (``None`` = the world)."""
+    """One rigid body moved relative to its parent (``None`` = the world) by its joints,
+    applied in order (the first is nearest the parent), all at the body frame's origin."""
 
     name: str
     parent: str | None
     joint_pos: Vec3
-    joint_axis: Vec3
+    joints: tuple[Joint, ...]
     mass: float
     com: Vec3
     inertia: Mat3 = ZERO3
-    joint_type: str = "hinge"
 
     def __post_init__(self) -> None:
         positive(f"{self.name}.mass", self.mass)
         finite_array(f"{self.name}.joint_pos", self.joint_pos, (3,))
-        finite_array(f"{self.name}.joint_axis", self.joint_axis, (3,))
         finite_array(f"{self.name}.com", self.com, (3,))
         inertia_tensor(f"{self.name}.inertia", np.asarray(self.inertia), allow_zero=True)
-        if self.joint_type != "hinge":
-            raise ValueError(f"{self.name}.joint_type must be 'hinge', got {self.joint_type!r}")
-        if abs(float(np.linalg.norm(self.joint_axis)) - 1.0) > 1e-12:
-            raise ValueError(f"{self.name}.joint_axis must be a unit vector, got {self.joint_axis}")
+        if not self.joints:
+            raise InvalidInput(f"{self.name}.joints", self.joints, "at least one joint")
 
     @property
     def is_point_mass(self) -> bool:
@@ -60,7 +78,6 @@ class Multibody:
     bodies: tuple[Body, ...]
     gravity: Vec3
     mjcf_point_inertia: float = 1e-8
-    joint_names: tuple[str, ...] = field(default=())
 
     def __post_init__(self) -> None:
         finite_array("gravity", self.gravity, (3,))
@@ -70,9 +87,12 @@ class Multibody:
             if body.parent not in seen:
                 raise ValueError(f"body {body.name!r}: parent {body.parent!r} must come first")
             seen.add(body.name)
-        if not self.joint_names:
-            object.__setattr__(self, "joint_names", tuple(f"{b.name}_joint" for b in self.bodies))
+
+    @property
+    def joints(self) -> tuple[Joint, ...]:
+        """All joints, in coordinate order."""
+        return tuple(j for b in self.bodies for j in b.joints)
 
     @property
     def nv(self) -> int:
-        return len(self.bodies)
+        return len(self.joints)

@@ -16,7 +16,7 @@ import numpy as np
 
 from dyncheck.cases.base import Case, TrajectorySpec
 from dyncheck.cases.coordinate_maps import LinearMap
-from dyncheck.cases.multibody import Body, Multibody
+from dyncheck.cases.multibody import Body, Joint, Multibody
 from dyncheck.cases.validate import positive
 
 Y_AXIS = (0.0, 1.0, 0.0)
@@ -61,8 +61,10 @@ class SimplePendulum(Case):
         return {"m": self.m, "l": self.l, "g": self.g}
 
     def multibody(self) -> Multibody:
-        bob = Body("bob", None, (0, 0, 0), Y_AXIS, self.m, (0.0, 0.0, -self.l))
-        return Multibody(self.name, (bob,), (0.0, 0.0, -self.g), joint_names=("hinge",))
+        bob = Body(
+            "bob", None, (0, 0, 0), (Joint("hinge", "hinge", Y_AXIS),), self.m, (0.0, 0.0, -self.l)
+        )
+        return Multibody(self.name, (bob,), (0.0, 0.0, -self.g))
 
     def engine_map(self) -> LinearMap:
         return LinearMap(((-1.0,),), (0.0,), "α = −θ (hinge about +y)")
@@ -116,11 +118,23 @@ class CompoundPendulum(Case):
         return {"m1": self.m1, "m2": self.m2, "L1": self.L1, "L2": self.L2, "g": self.g}
 
     def multibody(self) -> Multibody:
-        upper = Body("upper", None, (0, 0, 0), Y_AXIS, self.m1, (0.0, 0.0, -self.L1))
-        lower = Body("lower", "upper", (0, 0, -self.L1), Y_AXIS, self.m2, (0.0, 0.0, -self.L2))
-        return Multibody(
-            self.name, (upper, lower), (0.0, 0.0, -self.g), joint_names=("shoulder", "elbow")
+        upper = Body(
+            "upper",
+            None,
+            (0, 0, 0),
+            (Joint("shoulder", "hinge", Y_AXIS),),
+            self.m1,
+            (0.0, 0.0, -self.L1),
         )
+        lower = Body(
+            "lower",
+            "upper",
+            (0, 0, -self.L1),
+            (Joint("elbow", "hinge", Y_AXIS),),
+            self.m2,
+            (0.0, 0.0, -self.L2),
+        )
+        return Multibody(self.name, (upper, lower), (0.0, 0.0, -self.g))
 
     def engine_map(self) -> LinearMap:
         return LinearMap(

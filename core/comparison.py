@@ -129,7 +129,7 @@ class VariantPredictor:
         if variant not in self._values:
             if variant not in self._impls:
                 impl = ReferenceImplementation(self.case)
-                impl.dyn = general_method(self.case, variant.hinge_inertia)
+                impl.dyn = general_method(self.case, variant.point_inertia)
                 self._impls[variant] = impl
             self._values[variant] = self._impls[variant].evaluate(self.sample)
         return self._values[variant]
@@ -168,8 +168,8 @@ def _row(
         if a.variant is not None and b.variant is not None and a.variant != b.variant:
             convention = POINT_INERTIA
             note = (
-                f"hinge inertia {b.name} {list(b.variant.hinge_inertia)} vs {a.name} "
-                f"{list(a.variant.hinge_inertia)} kg m^2: predicted rel. difference "
+                f"point-mass inertia {b.name} {list(b.variant.point_inertia)} vs {a.name} "
+                f"{list(a.variant.point_inertia)} kg m^2: predicted rel. difference "
                 f"{st.predicted / scale:.3g}, residual after prediction "
                 f"{st.residual / scale:.3g}"
             )
@@ -202,7 +202,7 @@ def compare_instantaneous(
     pairs = list(combinations(names, 2))
     stats = {(q, a, b): PairStats() for q in QUANTITIES for a, b in pairs}
     predict = VariantPredictor(case)
-    book = Variant((0.0,) * case.ndof)
+    book = Variant((0.0,) * case.n_bodies)
     condition, offset = 1.0, 0
     for s in chunks:
         predict.new_chunk(s)

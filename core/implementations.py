@@ -19,7 +19,8 @@ from dyncheck import coordinates as co
 from dyncheck.adapters import ENGINE_PACKAGES, Adapter, get_adapter
 from dyncheck.cases import Case, StateSample
 from dyncheck.errors import UnknownName
-from dyncheck.reference import pendulum
+from dyncheck.reference import particle, pendulum
+from dyncheck.reference.coordinates import cylindrical, spherical
 from dyncheck.reference.trajectory import solve
 
 QUANTITIES: tuple[str, ...] = (
@@ -37,14 +38,25 @@ IMPLEMENTATIONS: tuple[str, ...] = ("reference", "book", "pinocchio", "pinocchio
 _REFERENCE: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
     "simple_pendulum": (pendulum.simple_pendulum, pendulum.simple_pendulum_printed),
     "compound_pendulum": (pendulum.compound_pendulum, pendulum.compound_pendulum_printed),
+    "spherical_coordinates": (
+        lambda M, g, inertia: particle.particle(spherical(), M, g, inertia=inertia),
+        particle.example5_printed,
+    ),
+    "cylindrical_coordinates": (
+        lambda M, g, inertia: particle.particle(cylindrical(), M, g, inertia=inertia),
+        lambda M, g: particle.lagrange_form(cylindrical(), M, g),
+    ),
 }
+"""Case name → (general method, the book's printed form). For the cylindrical particle the
+book prints no equations; its "printed" form is (2.2.23) with the closed-form metric and
+Christoffel symbols (exercise 6)."""
 
 
 def general_method(case: Case, inertia: tuple[float, ...] | None = None):
-    """The reference's general method for ``case``; ``inertia`` = rotational inertia about each
-    body's centre around its hinge axis (a model variant, kg·m²), zero by default."""
+    """The reference's general method for ``case``; ``inertia`` = isotropic rotational inertia
+    about each body's centre (a model variant, kg·m²), zero by default."""
     general, _ = _REFERENCE[case.name]
-    return general(**case.params(), inertia=inertia or (0.0,) * case.ndof)
+    return general(**case.params(), inertia=inertia or (0.0,) * case.n_bodies)
 
 
 def printed_equations(case: Case):
@@ -56,13 +68,14 @@ def printed_equations(case: Case):
 @dataclass(frozen=True)
 class Variant:
     """How an implementation's model departs from the book's, as far as it can be predicted:
-    the rotational inertia about each hinge axis (kg·m²) its bodies carry (book: zero)."""
+    the isotropic rotational inertia (kg·m², about the centre of mass) each of its bodies
+    carries where the book has a point mass (book: zero)."""
 
-    hinge_inertia: tuple[float, ...]
+    point_inertia: tuple[float, ...]
 
     @property
     def is_book(self) -> bool:
-        return not any(self.hinge_inertia)
+        return not any(self.point_inertia)
 
 
 class Implementation(ABC):
@@ -107,7 +120,7 @@ class _Equations(Implementation):
     def _build(self, case: Case) -> Any: ...
 
     def variant(self) -> Variant:
-        return Variant((0.0,) * self.case.ndof)
+        return Variant((0.0,) * self.case.n_bodies)
 
     def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]:
         d = self.dyn
@@ -153,11 +166,10 @@ class EngineImplementation(Implementation):
         for body, loaded in zip(spec.bodies, self.adapter.loaded_bodies(), strict=True):
             if loaded.mass != body.mass:
                 return None
-            axis = np.asarray(body.joint_axis)
             extra = loaded.inertia - np.asarray(body.inertia)
-            if not np.allclose(extra, (axis @ extra @ axis) * np.eye(3), rtol=0, atol=0):
+            if not np.array_equal(extra, extra[0, 0] * np.eye(3)):
                 return None  # not an isotropic floor: not a convention we can predict
-            out.append(float(axis @ extra @ axis))
+            out.append(float(extra[0, 0]))
         return Variant(tuple(out))
 
     def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]:
@@ -218,7 +230,7 @@ def reference_trajectory(
     """q(t) of the general method for ``variant`` by DOP853 (book coordinates)."""
     spec = case.trajectory
     q, _ = solve(
-        general_method(case, variant.hinge_inertia),
+        general_method(case, variant.point_inertia),
         np.asarray(spec.q0),
         np.asarray(spec.v0),
         t,

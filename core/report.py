@@ -29,9 +29,10 @@ CONVENTIONS = {
         "(1e-15), so the MJCF gives each of the book's point masses a small isotropic inertia "
         "(`Multibody.mjcf_point_inertia`). MuJoCo and `pinocchio-mjcf` read it; `pinocchio` "
         "(built programmatically) holds exact point masses. The reference predicts the "
-        "difference exactly: the general method with ½ I θ̇² added per body (the planar case "
-        "of (2.2.40); θ absolute). A row is `explained` only when observed − predicted is "
-        "within round-off."
+        "difference exactly: the general method with ½ I |ω|² added per body (from (2.2.40); "
+        "ω = θ̇ for a pendulum bob with θ absolute, the rotation of the coordinate triad for a "
+        "particle carried by coordinate joints). A row is `explained` only when observed − "
+        "predicted is within round-off."
     ),
     TRUNCATION: (
         "A fixed-step integrator's error against the exact solution of the same model. Judged "

@@ -62,7 +62,7 @@ class References:
         """q at every step of the general method stepped by a fixed-step integrator."""
         key = (variant, integrator, dt)
         if key not in self._discrete:
-            dyn = general_method(self.case, variant.hinge_inertia)
+            dyn = general_method(self.case, variant.point_inertia)
             zero = np.zeros((1, self.case.ndof))
 
             def acc(q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -103,7 +103,7 @@ def study(
     for the report's figures."""
     spec = case.trajectory
     refs = References(case)
-    figures = TrajectoryFigures(refs.t, refs(Variant((0.0,) * case.ndof))[0])
+    figures = TrajectoryFigures(refs.t, refs(Variant((0.0,) * case.n_bodies))[0])
     points: list[ConvergencePoint] = []
     rows: list[Discrepancy] = []
     runs: dict[tuple[str, str, float], np.ndarray] = {}
@@ -119,7 +119,7 @@ def study(
             if integrator not in impl.integrators:
                 continue
             nominal = NOMINAL_ORDER[integrator]
-            ref, ref_err = refs(variant or Variant((0.0,) * case.ndof))
+            ref, ref_err = refs(variant or Variant((0.0,) * case.n_bodies))
             errors, worst = [], []
             for dt in dts:
                 _, q = impl.simulate(dt, integrator)
@@ -145,9 +145,9 @@ def study(
                     f"observed order {p:.3f} (nominal {nominal}) at dt={dts[finest[-1]]:g}; "
                     f"reference error estimate {ref_err:.1e}"
                 )
-                if variant != Variant((0.0,) * case.ndof):
-                    note += "; against the reference of the same model (hinge inertia "
-                    note += f"{list(variant.hinge_inertia)} kg m^2)"
+                if variant != Variant((0.0,) * case.n_bodies):
+                    note += "; against the reference of the same model (point-mass inertia "
+                    note += f"{list(variant.point_inertia)} kg m^2)"
             scale_q = float(np.abs(ref).max())
             for dt, err, p, a, w in zip(dts, errors, orders, asym, worst, strict=True):
                 points.append(
@@ -187,7 +187,7 @@ def _adaptive(
     """The engine's forward dynamics under the reference's own integrator and tolerance: both
     solutions carry an error of the size of the reference's estimate e, so |q − q_ref| ≤ 2e;
     allowed 4e (the engine's error is estimated, not measured)."""
-    ref, ref_err = refs(variant or Variant((0.0,) * case.ndof))
+    ref, ref_err = refs(variant or Variant((0.0,) * case.n_bodies))
     q = impl.solve(refs.t, ADAPTIVE_RTOL)  # type: ignore[attr-defined]
     diff = np.abs(q - ref).max(axis=1)
     scale_q = float(np.abs(ref).max())

@@ -1,0 +1,122 @@
+"""A particle carried by joints that *are* a coordinate system (Example 5; exercises 6, 7).
+
+The engine model is one body with three joints applied in order at the origin; its position
+is the coordinate map itself, so the engine's mass matrix must be M g_ij and its bias
+M g_ij {j; m n} q̇ᵐ q̇ⁿ plus gravity. The joint order differs from the book's coordinate order:
+a permutation, crossed like any coordinate map.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+
+from dyncheck.cases.base import Case, TrajectorySpec
+from dyncheck.cases.coordinate_maps import LinearMap
+from dyncheck.cases.multibody import Body, Joint, Multibody
+from dyncheck.cases.validate import positive
+
+X, Y, Z = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
+STEPS = {
+    "euler": (2e-3, 1e-3, 5e-4, 2.5e-4),
+    "implicitfast": (2e-3, 1e-3, 5e-4, 2.5e-4),
+    "rk4": (1e-2, 5e-3, 2.5e-3, 1.25e-3),
+}
+COARSE_RK4 = {**STEPS, "rk4": (1e-1, 5e-2, 2.5e-2, 1.25e-2)}
+"""The cylindrical particle's free fall is so smooth in (r, θ, z) that RK4 reaches the
+reference's accuracy at 1e-2 already: its study starts coarser."""
+PERMUTE_REVERSE = ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0), (1.0, 0.0, 0.0))
+
+
+@dataclass(frozen=True)
+class _Particle(Case):
+    M: float = 1.5
+    """particle mass, kg"""
+    g: float = 9.81
+    """gravity along −z, m/s²"""
+
+    def __post_init__(self) -> None:
+        positive("M", self.M)
+        positive("g", self.g)
+
+    def params(self) -> dict[str, float]:
+        return {"M": self.M, "g": self.g}
+
+    def state_scale(self) -> tuple[float, float, float]:
+        return 2.0, 2 * self.M * self.g, 2 * self.g
+
+
+@dataclass(frozen=True)
+class SphericalCoordinates(_Particle):
+    """Spherical coordinates (ρ, θ, φ) of Example 5 as a joint chain::
+
+    hinge φ about z  →  hinge θ about y  →  slide ρ along z  →  ● M
+    position R_z(φ) R_y(θ) (0, 0, ρ) = (ρ sin θ cos φ, ρ sin θ sin φ, ρ cos θ)
+    """
+
+    name: ClassVar[str] = "spherical_coordinates"
+    title: ClassVar[str] = "Particle in spherical coordinates (Example 5)"
+    book_refs: ClassVar[str] = "Example 5; (2.2.5), (2.2.21)-(2.2.23); exercise 7"
+    coordinates: ClassVar[tuple[str, ...]] = ("ρ", "θ", "φ")
+    trajectory: TrajectorySpec = field(
+        default_factory=lambda: TrajectorySpec(
+            q0=(1.2, 1.2, 0.4), v0=(0.3, -0.2, 0.5), duration=1.0, steps=STEPS
+        )
+    )
+
+    def multibody(self) -> Multibody:
+        joints = (Joint("phi", "hinge", Z), Joint("theta", "hinge", Y), Joint("rho", "slide", Z))
+        bob = Body("particle", None, (0, 0, 0), joints, self.M, (0.0, 0.0, 0.0))
+        return Multibody(self.name, (bob,), (0.0, 0.0, -self.g))
+
+    def engine_map(self) -> LinearMap:
+        return LinearMap(
+            PERMUTE_REVERSE, (0.0, 0.0, 0.0), "joints (φ, θ, ρ) = book (ρ, θ, φ) reversed"
+        )
+
+    def rest(self) -> np.ndarray:
+        return np.array([1.0, np.pi / 2, 0.0])
+
+    def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """ρ > 0 and θ ∉ {0, π}: the chart is singular on the z axis."""
+        return np.array([0.5, 0.3, -np.pi]), np.array([2.0, np.pi - 0.3, np.pi])
+
+
+@dataclass(frozen=True)
+class CylindricalCoordinates(_Particle):
+    """Cylindrical coordinates (r, θ, z) of exercise 6 as a joint chain::
+
+    hinge θ about z  →  slide z along z  →  slide r along x  →  ● M
+    position R_z(θ) (r, 0, z) = (r cos θ, r sin θ, z)
+    """
+
+    name: ClassVar[str] = "cylindrical_coordinates"
+    title: ClassVar[str] = "Particle in cylindrical coordinates (exercise 6)"
+    book_refs: ClassVar[str] = "(2.2.5), (2.2.21)-(2.2.23); exercise 6"
+    coordinates: ClassVar[tuple[str, ...]] = ("r", "θ", "z")
+    trajectory: TrajectorySpec = field(
+        default_factory=lambda: TrajectorySpec(
+            q0=(0.6, 0.3, 0.5), v0=(-0.5, 1.5, 1.0), duration=1.0, steps=COARSE_RK4
+        )
+    )
+
+    def multibody(self) -> Multibody:
+        joints = (Joint("theta", "hinge", Z), Joint("z", "slide", Z), Joint("r", "slide", X))
+        bob = Body("particle", None, (0, 0, 0), joints, self.M, (0.0, 0.0, 0.0))
+        return Multibody(self.name, (bob,), (0.0, 0.0, -self.g))
+
+    def engine_map(self) -> LinearMap:
+        return LinearMap(
+            ((0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)),
+            (0.0, 0.0, 0.0),
+            "joints (θ, z, r) = book (r, θ, z) rotated",
+        )
+
+    def rest(self) -> np.ndarray:
+        return np.array([1.0, 0.0, 0.0])
+
+    def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """r > 0: the chart is singular on the z axis."""
+        return np.array([0.5, -np.pi, -1.0]), np.array([2.0, np.pi, 1.0])
