@@ -66,7 +66,8 @@ def test_unknown_case_is_usage_error(tmp_path, capsys):
     assert main(["run", "nope", "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip()
     assert err == (
-        "dyncheck: error: unknown case 'nope'; valid: compound_pendulum, simple_pendulum"
+        "dyncheck: error: unknown case 'nope'; valid: compound_pendulum, "
+        "cylindrical_coordinates, simple_pendulum, spherical_coordinates"
     )
     assert not out.exists()
 
