@@ -68,6 +68,10 @@ class Adapter(ABC):
         """Masses and inertias as loaded, in the spec's body order."""
 
     @abstractmethod
+    def loaded_gravity(self) -> np.ndarray:
+        """The gravity vector (m/s², world frame) the engine holds after loading."""
+
+    @abstractmethod
     def mass_matrix(self, q: np.ndarray) -> np.ndarray: ...
 
     @abstractmethod

@@ -7,6 +7,10 @@ MuJoCo (``mj_Euler``, ``mj_implicit``, ``mj_RungeKutta``; see its Computation ch
   passive and actuator forces only (Coriolis derivatives dropped), then q' = q + h·v'. With no
   damping and no actuators D = 0, and it is the same map as ``euler``.
 - ``rk4``: the classic four-stage Runge–Kutta tableau on x = (q, v), ẋ = (v, v̇).
+- ``rk4-held-force``: the same tableau with a state-dependent external force evaluated once at
+  the start of the step and held over the stages — what MuJoCo does with a force written to
+  ``xfrc_applied`` before ``mj_step``. The force's error over a step is O(h²), so the
+  predicted order is 1.
 
 Nominal orders: 1, 1, 4. Hinge coordinates live in ℝⁿ, so q + h·v is exact position update.
 """
@@ -17,10 +21,11 @@ from collections.abc import Callable
 
 import numpy as np
 
-Acceleration = Callable[[np.ndarray, np.ndarray], np.ndarray]
-"""v̇(q, v) for one state, shapes (nv,) → (nv,)."""
+Acceleration = Callable[..., np.ndarray]
+"""v̇(q, v, held) for one state, shapes (nv,) → (nv,); ``held`` is ``None`` (evaluate every
+state-dependent external force now) or what ``freeze`` returned at the start of the step."""
 
-NOMINAL_ORDER = {"euler": 1, "implicitfast": 1, "rk4": 4}
+NOMINAL_ORDER = {"euler": 1, "implicitfast": 1, "rk4": 4, "rk4-held-force": 1}
 
 
 def _euler(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float) -> tuple:
@@ -45,19 +50,41 @@ STEPPERS: dict[str, Callable[..., tuple]] = {
     "euler": _euler,
     "implicitfast": _euler,  # D = 0: no damping, no actuators (see module docstring)
     "rk4": _rk4,
+    "rk4-held-force": _rk4,
 }
 
 
 def integrate(
-    acc: Acceleration, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, integrator: str
+    acc: Acceleration,
+    q0: np.ndarray,
+    v0: np.ndarray,
+    dt: float,
+    steps: int,
+    integrator: str,
+    *,
+    freeze: Callable[[np.ndarray, np.ndarray], object] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """States after 0..steps steps, shapes (steps + 1, nv)."""
+    """States after 0..steps steps, shapes (steps + 1, nv). With ``rk4-held-force``,
+    ``freeze(q, v)`` is evaluated at the start of each step and passed to every stage."""
     step = STEPPERS[integrator]
     qs = np.empty((steps + 1, q0.shape[0]))
     vs = np.empty_like(qs)
     q, v = np.array(q0, float), np.array(v0, float)
     qs[0], vs[0] = q, v
+    held = integrator == "rk4-held-force" and freeze is not None
     for k in range(1, steps + 1):
-        q, v = step(acc, q, v, dt)
+        if held:
+            frozen = freeze(q, v)
+
+            def stage(qq: np.ndarray, vv: np.ndarray, frozen=frozen) -> np.ndarray:
+                return acc(qq, vv, frozen)
+        else:
+
+            def stage(qq: np.ndarray, vv: np.ndarray) -> np.ndarray:
+                return acc(qq, vv, None)
+
+        q, v = step(stage, q, v, dt)
         qs[k], vs[k] = q, v
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+            raise FloatingPointError(f"{integrator} diverged at step {k} (t = {k * dt:g})")
     return qs, vs

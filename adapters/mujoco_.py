@@ -4,10 +4,18 @@ MuJoCo's names: M from ``mj_fullM``; h = ``qfrc_bias`` (Coriolis, centrifugal an
 forward dynamics ``qacc`` after ``mj_forward`` with ``qfrc_applied`` = τ; inverse dynamics
 ``qfrc_inverse`` after ``mj_inverse``; energies ``data.energy`` = (V, T), computed inside
 ``mj_forward`` when the ``energy`` flag is enabled. Integrators are MuJoCo's own.
+
+An external field (``Multibody.central_mu``) enters through MuJoCo's external-force input
+``xfrc_applied`` (force at the body's centre of mass). ``qfrc_inverse`` is the *total*
+generalized force, so the field's Jᵀ F (``mj_applyFT``) is subtracted to give τ. In a
+simulation, a force written to ``xfrc_applied`` before ``mj_step`` is held over all RK4 stages
+(``rk4-held-force``); evaluating it at every stage needs the passive-force callback
+``mjcb_passive``, which MuJoCo calls inside every stage's forward pass.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import ClassVar
 
 import mujoco
@@ -21,6 +29,7 @@ _INTEGRATORS = {
     "euler": mujoco.mjtIntegrator.mjINT_EULER,
     "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
     "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+    "rk4-held-force": mujoco.mjtIntegrator.mjINT_RK4,
 }
 
 
@@ -34,6 +43,8 @@ class MuJoCoAdapter(Adapter):
         self.xml = to_mjcf(model)
         self.model = mujoco.MjModel.from_xml_string(self.xml)
         self.data = mujoco.MjData(self.model)
+        self._body_ids = [self.model.body(b.name).id for b in model.bodies]
+        self._zero3 = np.zeros(3)
 
     @staticmethod
     def version() -> str:
@@ -41,8 +52,7 @@ class MuJoCoAdapter(Adapter):
 
     def loaded_bodies(self) -> list[LoadedBody]:
         out = []
-        for body in self.spec.bodies:
-            i = self.model.body(body.name).id
+        for body, i in zip(self.spec.bodies, self._body_ids, strict=True):
             rot = np.zeros(9)
             mujoco.mju_quat2Mat(rot, self.model.body_iquat[i])
             rot = rot.reshape(3, 3)
@@ -50,15 +60,42 @@ class MuJoCoAdapter(Adapter):
             out.append(LoadedBody(body.name, float(self.model.body_mass[i]), inertia))
         return out
 
-    def _eval(self, q: np.ndarray, v: np.ndarray | None = None, tau: np.ndarray | None = None):
-        """Yield after ``mj_forward`` at each state of the batch."""
+    def loaded_gravity(self) -> np.ndarray:
+        return np.array(self.model.opt.gravity)
+
+    # --- the external field ---------------------------------------------------------------
+
+    def _field_xfrc(self, d: mujoco.MjData) -> None:
+        """xfrc_applied from the field at the current body positions (kinematics done)."""
+        for body, i in zip(self.spec.bodies, self._body_ids, strict=True):
+            d.xfrc_applied[i, :3] = self.spec.central_force(body.mass, d.xipos[i])
+
+    def _field_generalized(self, d: mujoco.MjData, out: np.ndarray) -> np.ndarray:
+        """out += Jᵀ F of the field (positions from the last forward pass)."""
+        for body, i in zip(self.spec.bodies, self._body_ids, strict=True):
+            F = self.spec.central_force(body.mass, d.xipos[i])
+            mujoco.mj_applyFT(self.model, d, F, self._zero3, d.xipos[i].copy(), i, out)
+        return out
+
+    def _set(self, q: np.ndarray, v: np.ndarray | None, tau: np.ndarray | None) -> None:
         d = self.data
+        d.qpos[:] = q
+        d.qvel[:] = 0.0 if v is None else v
+        d.qfrc_applied[:] = 0.0 if tau is None else tau
+        if self.spec.central_mu:
+            mujoco.mj_kinematics(self.model, d)
+            self._field_xfrc(d)
+
+    def _eval(
+        self, q: np.ndarray, v: np.ndarray | None = None, tau: np.ndarray | None = None
+    ) -> Iterator[tuple[int, mujoco.MjData]]:
+        """Yield after ``mj_forward`` at each state of the batch."""
         for k in range(q.shape[0]):
-            d.qpos[:] = q[k]
-            d.qvel[:] = 0.0 if v is None else v[k]
-            d.qfrc_applied[:] = 0.0 if tau is None else tau[k]
-            mujoco.mj_forward(self.model, d)
-            yield k, d
+            self._set(q[k], None if v is None else v[k], None if tau is None else tau[k])
+            mujoco.mj_forward(self.model, self.data)
+            yield k, self.data
+
+    # --- the canonical form ----------------------------------------------------------------
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         out = np.empty((q.shape[0], self.model.nv, self.model.nv))
@@ -78,13 +115,20 @@ class MuJoCoAdapter(Adapter):
             out[k] = d.qacc
         return self._check("forward dynamics", out)
 
+    def _inverse_one(self, a: np.ndarray) -> np.ndarray:
+        d = self.data
+        d.qacc[:] = a
+        mujoco.mj_inverse(self.model, d)
+        tau = d.qfrc_inverse.copy()
+        if self.spec.central_mu:
+            tau -= self._field_generalized(d, np.zeros(self.model.nv))
+        return tau
+
     def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         out = np.empty_like(q, dtype=float)
-        d = self.data
         for k in range(q.shape[0]):
-            d.qpos[:], d.qvel[:], d.qacc[:] = q[k], v[k], a[k]
-            mujoco.mj_inverse(self.model, d)
-            out[k] = d.qfrc_inverse
+            self._set(q[k], v[k], None)
+            out[k] = self._inverse_one(a[k])
         return self._check("inverse dynamics", out)
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -106,20 +150,14 @@ class MuJoCoAdapter(Adapter):
         m, d = self.model, self.data
         n, nv = q.shape
         M = np.empty((n, nv, nv))
-        bias, fwd, inv, energy = (
-            np.empty((n, nv)),
-            np.empty((n, nv)),
-            np.empty((n, nv)),
-            np.empty((n, 2)),
-        )
+        bias, fwd, inv = np.empty((n, nv)), np.empty((n, nv)), np.empty((n, nv))
+        energy = np.empty((n, 2))
         for k in range(n):
-            d.qpos[:], d.qvel[:], d.qfrc_applied[:] = q[k], v[k], tau[k]
+            self._set(q[k], v[k], tau[k])
             mujoco.mj_forward(m, d)
             mujoco.mj_fullM(m, d, M[k])
             bias[k], fwd[k], energy[k] = d.qfrc_bias, d.qacc, d.energy
-            d.qacc[:] = a[k]
-            mujoco.mj_inverse(m, d)
-            inv[k] = d.qfrc_inverse
+            inv[k] = self._inverse_one(a[k])
         out = {
             "mass_matrix": M,
             "bias_forces": bias,
@@ -142,7 +180,23 @@ class MuJoCoAdapter(Adapter):
         qs = np.empty((steps + 1, m.nq))
         vs = np.empty((steps + 1, m.nv))
         qs[0], vs[0] = d.qpos, d.qvel
-        for k in range(1, steps + 1):
-            mujoco.mj_step(m, d)
-            qs[k], vs[k] = d.qpos, d.qvel
+        held = integrator == "rk4-held-force"
+        field = bool(self.spec.central_mu)
+        if field and not held:
+            mujoco.set_mjcb_passive(self._passive)
+        try:
+            for k in range(1, steps + 1):
+                if field and held:
+                    mujoco.mj_kinematics(m, d)
+                    self._field_xfrc(d)
+                mujoco.mj_step(m, d)
+                qs[k], vs[k] = d.qpos, d.qvel
+        finally:
+            if field and not held:
+                mujoco.set_mjcb_passive(None)
         return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)
+
+    def _passive(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
+        """mjcb_passive: the field's Jᵀ F added at every stage of every step."""
+        if m is self.model:
+            self._field_generalized(d, d.qfrc_passive)

@@ -112,6 +112,36 @@ class PinocchioAdapter(Adapter):
             for b, j in zip(self.spec.bodies, self._joint_ids, strict=True)
         ]
 
+    def loaded_gravity(self) -> np.ndarray:
+        return np.array(self.model.gravity.linear)
+
+    def _fext(self, q: np.ndarray) -> pin.StdVec_Force | None:
+        """The field as Pinocchio's external forces: per joint, in the joint's local frame,
+        the force at each body's centre of mass (``None`` without a field)."""
+        if not self.spec.central_mu:
+            return None
+        m, d = self.model, self.data
+        pin.forwardKinematics(m, d, q)
+        fext = pin.StdVec_Force()
+        fext.extend([pin.Force.Zero() for _ in range(m.njoints)])
+        for body, j in zip(self.spec.bodies, self._joint_ids, strict=True):
+            c = d.oMi[j].act(m.inertias[j].lever)
+            F = self.spec.central_force(body.mass, c)
+            fext[j] = fext[j] + d.oMi[j].actInv(pin.Force(F, np.cross(c, F)))
+        return fext
+
+    def _aba(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, fext=None) -> np.ndarray:
+        fext = self._fext(q) if fext is None else fext
+        if fext is None:
+            return pin.aba(self.model, self.data, q, v, tau)
+        return pin.aba(self.model, self.data, q, v, tau, fext)
+
+    def _rnea(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        fext = self._fext(q)
+        if fext is None:
+            return pin.rnea(self.model, self.data, q, v, a)
+        return pin.rnea(self.model, self.data, q, v, a, fext)
+
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         out = np.empty((q.shape[0], self.model.nv, self.model.nv))
         for k in range(q.shape[0]):
@@ -125,11 +155,11 @@ class PinocchioAdapter(Adapter):
         return self._check("bias forces", out)
 
     def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        out = np.array([pin.aba(self.model, self.data, q[k], v[k], tau[k]) for k in range(len(q))])
+        out = np.array([self._aba(q[k], v[k], tau[k]) for k in range(len(q))])
         return self._check("forward dynamics", out)
 
     def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        out = np.array([pin.rnea(self.model, self.data, q[k], v[k], a[k]) for k in range(len(q))])
+        out = np.array([self._rnea(q[k], v[k], a[k]) for k in range(len(q))])
         return self._check("inverse dynamics", out)
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -145,11 +175,19 @@ class PinocchioAdapter(Adapter):
     ) -> Trajectory:
         zero = np.zeros(self.model.nv)
 
-        def acc(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-            return pin.aba(self.model, self.data, q, v, zero)
+        def acc(q: np.ndarray, v: np.ndarray, held=None) -> np.ndarray:
+            return self._aba(q, v, zero, held)
 
         steps = round(duration / dt)
-        qs, vs = integrate(acc, np.asarray(q0), np.asarray(v0), dt, steps, integrator)
+        qs, vs = integrate(
+            acc,
+            np.asarray(q0),
+            np.asarray(v0),
+            dt,
+            steps,
+            integrator,
+            freeze=lambda q, v: self._fext(q),
+        )
         return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)
 
     def evaluate_all(
@@ -169,12 +207,17 @@ class PinocchioAdapter(Adapter):
         )
         kin, pot = np.empty(n), np.empty(n)
         crba, rnea, aba = pin.crba, pin.rnea, pin.aba
+        field = bool(self.spec.central_mu)
         for k in range(n):
             qk, vk = q[k], v[k]
             M[k] = crba(m, d, qk)
             bias[k] = rnea(m, d, qk, vk, zero)
-            fwd[k] = aba(m, d, qk, vk, tau[k])
-            inv[k] = rnea(m, d, qk, vk, a[k])
+            if field:
+                fwd[k] = self._aba(qk, vk, tau[k])
+                inv[k] = self._rnea(qk, vk, a[k])
+            else:
+                fwd[k] = aba(m, d, qk, vk, tau[k])
+                inv[k] = rnea(m, d, qk, vk, a[k])
             kin[k] = pin.computeKineticEnergy(m, d, qk, vk)
             pot[k] = pin.computePotentialEnergy(m, d, qk)
         M = np.triu(M) + np.swapaxes(np.triu(M, 1), 1, 2)
@@ -199,7 +242,7 @@ class PinocchioAdapter(Adapter):
         nv, zero = self.model.nv, np.zeros(self.model.nv)
 
         def rhs(_t: float, y: np.ndarray) -> np.ndarray:
-            return np.concatenate([y[nv:], pin.aba(self.model, self.data, y[:nv], y[nv:], zero)])
+            return np.concatenate([y[nv:], self._aba(y[:nv], y[nv:], zero)])
 
         sol = solve_ivp(
             rhs,

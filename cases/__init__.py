@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from dyncheck.cases.base import INTEGRATORS, NOMINAL_ORDER, Case, StateSample, TrajectorySpec
-from dyncheck.cases.particles import CylindricalCoordinates, SphericalCoordinates
+from dyncheck.cases.particles import CylindricalCoordinates, Kepler, SphericalCoordinates
 from dyncheck.cases.pendulums import CompoundPendulum, SimplePendulum
 from dyncheck.errors import UnknownName
 
 CASES: dict[str, type[Case]] = {
     "compound_pendulum": CompoundPendulum,
     "cylindrical_coordinates": CylindricalCoordinates,
+    "kepler": Kepler,
     "simple_pendulum": SimplePendulum,
     "spherical_coordinates": SphericalCoordinates,
 }

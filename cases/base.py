@@ -11,15 +11,18 @@ from typing import ClassVar
 
 import numpy as np
 
-from dyncheck.cases.coordinate_maps import LinearMap
+from dyncheck.cases.coordinate_maps import CoordinateMap
 from dyncheck.cases.multibody import Multibody
 from dyncheck.cases.validate import finite_array, positive
 from dyncheck.errors import InvalidInput
 
-INTEGRATORS: tuple[str, ...] = ("euler", "implicitfast", "rk4")
-"""Fixed-step integrators as MuJoCo defines them; nominal orders 1, 1, 4."""
+INTEGRATORS: tuple[str, ...] = ("euler", "implicitfast", "rk4", "rk4-held-force")
+"""Fixed-step integrators as MuJoCo defines them; nominal orders 1, 1, 4. ``rk4-held-force``
+is RK4 with a state-dependent external force evaluated once per step and held over the
+stages (what setting MuJoCo's ``xfrc_applied`` before ``mj_step`` does): its predicted
+order is 1."""
 
-NOMINAL_ORDER: dict[str, int] = {"euler": 1, "implicitfast": 1, "rk4": 4}
+NOMINAL_ORDER: dict[str, int] = {"euler": 1, "implicitfast": 1, "rk4": 4, "rk4-held-force": 1}
 
 
 @dataclass(frozen=True)
@@ -95,6 +98,8 @@ class Case(ABC):
     title: ClassVar[str]
     book_refs: ClassVar[str]
     coordinates: ClassVar[tuple[str, ...]]
+    periodic: ClassVar[tuple[bool, ...]] = ()
+    """Per coordinate: an angle whose differences are taken modulo 2π (default: none)."""
 
     n_states: int = 16
     seed: int = 20261122
@@ -117,7 +122,7 @@ class Case(ABC):
         """The engine-neutral model every adapter builds from."""
 
     @abstractmethod
-    def engine_map(self) -> LinearMap:
+    def engine_map(self) -> CoordinateMap:
         """x̄(x): the engine's joint coordinates as functions of the book's (2.2.2)."""
 
     @abstractmethod

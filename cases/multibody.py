@@ -78,10 +78,15 @@ class Multibody:
     bodies: tuple[Body, ...]
     gravity: Vec3
     mjcf_point_inertia: float = 1e-8
+    central_mu: float = 0.0
+    """μ of an inverse-square attraction F = −μ m r/|r|³ toward the world origin on every
+    body's centre of mass (m³/s²), applied through each engine's external-force input."""
 
     def __post_init__(self) -> None:
         finite_array("gravity", self.gravity, (3,))
         positive("mjcf_point_inertia", self.mjcf_point_inertia)
+        if self.central_mu:
+            positive("central_mu", self.central_mu)
         seen: set[str | None] = {None}
         for body in self.bodies:
             if body.parent not in seen:
@@ -92,6 +97,11 @@ class Multibody:
     def joints(self) -> tuple[Joint, ...]:
         """All joints, in coordinate order."""
         return tuple(j for b in self.bodies for j in b.joints)
+
+    def central_force(self, mass: float, position: np.ndarray) -> np.ndarray:
+        """F = −μ m r/|r|³ on a body of ``mass`` at world ``position`` (zero if μ = 0)."""
+        r = np.linalg.norm(position)
+        return -self.central_mu * mass * position / r**3 if self.central_mu else np.zeros(3)
 
     @property
     def nv(self) -> int:

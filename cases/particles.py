@@ -14,7 +14,7 @@ from typing import ClassVar
 import numpy as np
 
 from dyncheck.cases.base import Case, TrajectorySpec
-from dyncheck.cases.coordinate_maps import LinearMap
+from dyncheck.cases.coordinate_maps import LinearMap, SphericalToCartesian
 from dyncheck.cases.multibody import Body, Joint, Multibody
 from dyncheck.cases.validate import positive
 
@@ -120,3 +120,79 @@ class CylindricalCoordinates(_Particle):
     def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """r > 0: the chart is singular on the z axis."""
         return np.array([0.5, -np.pi, -1.0]), np.array([2.0, np.pi, 1.0])
+
+
+def _kepler_initial_state(mu: float, a: float, e: float, incl: float) -> tuple[tuple, tuple]:
+    """Perihelion of an orbit of semi-major axis a, eccentricity e, inclined by ``incl`` about
+    the x axis, in the book's spherical coordinates (ρ, θ, φ) and their rates."""
+    rp = a * (1 - e)
+    vp = np.sqrt(mu * (1 + e) / rp)  # vis-viva at perihelion
+    rot = np.array([[1, 0, 0], [0, np.cos(incl), -np.sin(incl)], [0, np.sin(incl), np.cos(incl)]])
+    yaw = np.array([[np.cos(0.4), -np.sin(0.4), 0], [np.sin(0.4), np.cos(0.4), 0], [0, 0, 1]])
+    x = yaw @ rot @ np.array([rp, 0.0, 0.0])
+    xd = yaw @ rot @ np.array([0.0, vp, 0.0])
+    rho = np.linalg.norm(x)
+    th, ph = np.arccos(x[2] / rho), np.arctan2(x[1], x[0])
+    # invert (2.2.4): v_cart = J v_book
+    J = SphericalToCartesian().jacobian(np.array([[rho, th, ph]]))[0]
+    v = np.linalg.solve(J, xd)
+    return (float(rho), float(th), float(ph)), tuple(float(c) for c in v)
+
+
+@dataclass(frozen=True)
+class Kepler(Case):
+    """Exercise 25: a particle attracted to the origin by F = −μM r/|r|³, the force applied
+    through each engine's external-force input; book coordinates spherical (ρ, θ, φ), engine
+    joints three Cartesian slides::
+
+        slide x  →  slide y  →  slide z  →  ● M        ← F = −μ M r/|r|³ (external)
+
+    Orbit: a = 1.2, e = 0.3, inclined 30°; period 2π√(a³/μ) ≈ 8.26 s for μ = 1.
+    """
+
+    name: ClassVar[str] = "kepler"
+    title: ClassVar[str] = "Kepler orbit (exercise 25)"
+    book_refs: ClassVar[str] = "exercise 25; Example 5; (2.2.5), (2.2.20), (2.2.23)"
+    coordinates: ClassVar[tuple[str, ...]] = ("ρ", "θ", "φ")
+    periodic: ClassVar[tuple[bool, ...]] = (False, False, True)
+
+    M: float = 1.0
+    """particle mass, kg"""
+    mu: float = 1.0
+    """gravitational parameter G·M_sun, m³/s²"""
+    trajectory: TrajectorySpec = field(
+        default_factory=lambda: TrajectorySpec(
+            *_kepler_initial_state(1.0, 1.2, 0.3, np.pi / 6),
+            duration=4.0,
+            steps={
+                "euler": (4e-3, 2e-3, 1e-3, 5e-4),
+                "implicitfast": (4e-3, 2e-3, 1e-3, 5e-4),
+                "rk4": (4e-2, 2e-2, 1e-2, 5e-3),
+                "rk4-held-force": (4e-3, 2e-3, 1e-3, 5e-4),
+            },
+        )
+    )
+
+    def __post_init__(self) -> None:
+        positive("M", self.M)
+        positive("mu", self.mu)
+
+    def params(self) -> dict[str, float]:
+        return {"M": self.M, "mu": self.mu}
+
+    def multibody(self) -> Multibody:
+        joints = (Joint("x", "slide", X), Joint("y", "slide", Y), Joint("z", "slide", Z))
+        body = Body("particle", None, (0, 0, 0), joints, self.M, (0.0, 0.0, 0.0))
+        return Multibody(self.name, (body,), (0.0, 0.0, 0.0), central_mu=self.mu)
+
+    def engine_map(self) -> SphericalToCartesian:
+        return SphericalToCartesian()
+
+    def rest(self) -> np.ndarray:
+        return np.array([1.0, np.pi / 2, 0.0])
+
+    def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.array([0.5, 0.3, -np.pi]), np.array([2.0, np.pi - 0.3, np.pi])
+
+    def state_scale(self) -> tuple[float, float, float]:
+        return 1.5, 2 * self.M * self.mu, 4 * self.mu

@@ -21,17 +21,25 @@ import numpy as np
 from dyncheck.cases import Case, StateSample
 from dyncheck.errors import EngineNotInstalled
 from dyncheck.implementations import (
+    GRAVITY_DEFAULT,
     IMPLEMENTATIONS,
+    POINT_INERTIA,
     QUANTITIES,
     Implementation,
     ReferenceImplementation,
     Variant,
+    book_variant,
     general_method,
 )
+
+__all__ = ["GRAVITY_DEFAULT", "POINT_INERTIA", "compare_instantaneous"]
 from dyncheck.results import Discrepancy
 from dyncheck.tolerances import instantaneous
 
-POINT_INERTIA = "point-mass inertia floor"
+
+def describe(v: Variant) -> str:
+    """A variant in a few words, for notes."""
+    return f"(point inertia {list(v.point_inertia)} kg m^2, gravity {list(v.gravity)} m/s^2)"
 
 
 def _per_state(x: np.ndarray) -> np.ndarray:
@@ -129,7 +137,7 @@ class VariantPredictor:
         if variant not in self._values:
             if variant not in self._impls:
                 impl = ReferenceImplementation(self.case)
-                impl.dyn = general_method(self.case, variant.point_inertia)
+                impl.dyn = general_method(self.case, variant)
                 self._impls[variant] = impl
             self._values[variant] = self._impls[variant].evaluate(self.sample)
         return self._values[variant]
@@ -166,10 +174,10 @@ def _row(
     verdict, convention, note = "passed", "", ""
     if rel > tol.rtol:
         if a.variant is not None and b.variant is not None and a.variant != b.variant:
-            convention = POINT_INERTIA
+            convention = "; ".join(a.variant.conventions(b.variant))
             note = (
-                f"point-mass inertia {b.name} {list(b.variant.point_inertia)} vs {a.name} "
-                f"{list(a.variant.point_inertia)} kg m^2: predicted rel. difference "
+                f"{convention}: {b.name} {describe(b.variant)} vs {a.name} "
+                f"{describe(a.variant)}; predicted rel. difference "
                 f"{st.predicted / scale:.3g}, residual after prediction "
                 f"{st.residual / scale:.3g}"
             )
@@ -202,7 +210,7 @@ def compare_instantaneous(
     pairs = list(combinations(names, 2))
     stats = {(q, a, b): PairStats() for q in QUANTITIES for a, b in pairs}
     predict = VariantPredictor(case)
-    book = Variant((0.0,) * case.n_bodies)
+    book = book_variant(case)
     condition, offset = 1.0, 0
     for s in chunks:
         predict.new_chunk(s)

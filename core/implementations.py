@@ -42,6 +42,12 @@ _REFERENCE: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
         lambda M, g, inertia: particle.particle(spherical(), M, g, inertia=inertia),
         particle.example5_printed,
     ),
+    "kepler": (
+        # the engines carry the particle on three slides: its body never rotates, so a
+        # point-mass inertia floor has no effect (inertia is not passed on)
+        lambda M, mu, g, inertia: particle.particle(spherical(), M, g, mu=mu),
+        lambda M, mu: particle.example5_printed(M, mu=mu),
+    ),
     "cylindrical_coordinates": (
         lambda M, g, inertia: particle.particle(cylindrical(), M, g, inertia=inertia),
         lambda M, g: particle.lagrange_form(cylindrical(), M, g),
@@ -52,11 +58,13 @@ book prints no equations; its "printed" form is (2.2.23) with the closed-form me
 Christoffel symbols (exercise 6)."""
 
 
-def general_method(case: Case, inertia: tuple[float, ...] | None = None):
-    """The reference's general method for ``case``; ``inertia`` = isotropic rotational inertia
-    about each body's centre (a model variant, kg·m²), zero by default."""
+def general_method(case: Case, variant: Variant | None = None):
+    """The reference's general method for ``case``, on the book's model or on a model
+    ``variant`` (the point-mass inertias and gravity an implementation actually holds)."""
     general, _ = _REFERENCE[case.name]
-    return general(**case.params(), inertia=inertia or (0.0,) * case.n_bodies)
+    variant = variant or book_variant(case)
+    params = case.params() | {"g": -variant.gravity[2]}
+    return general(**params, inertia=variant.point_inertia)
 
 
 def printed_equations(case: Case):
@@ -67,15 +75,32 @@ def printed_equations(case: Case):
 
 @dataclass(frozen=True)
 class Variant:
-    """How an implementation's model departs from the book's, as far as it can be predicted:
-    the isotropic rotational inertia (kg·m², about the centre of mass) each of its bodies
-    carries where the book has a point mass (book: zero)."""
+    """How an implementation's model departs from the book's, as far as the reference can
+    predict it: the isotropic rotational inertia (kg·m², about the centre of mass) each body
+    carries where the book has a point mass (book: zero), and the gravity vector (m/s²) the
+    implementation actually uses (book: the case's)."""
 
     point_inertia: tuple[float, ...]
+    gravity: tuple[float, float, float]
 
-    @property
-    def is_book(self) -> bool:
-        return not any(self.point_inertia)
+    def conventions(self, other: Variant) -> list[str]:
+        """Names of the conventions in which two variants differ."""
+        out = []
+        if self.point_inertia != other.point_inertia:
+            out.append(POINT_INERTIA)
+        if self.gravity != other.gravity:
+            out.append(GRAVITY_DEFAULT)
+        return out
+
+
+POINT_INERTIA = "point-mass inertia floor"
+GRAVITY_DEFAULT = "MJCF gravity option not read"
+
+
+def book_variant(case: Case) -> Variant:
+    """The book's model: point masses, the case's gravity."""
+    mb = case.multibody()
+    return Variant((0.0,) * len(mb.bodies), tuple(float(x) for x in mb.gravity))
 
 
 class Implementation(ABC):
@@ -120,7 +145,7 @@ class _Equations(Implementation):
     def _build(self, case: Case) -> Any: ...
 
     def variant(self) -> Variant:
-        return Variant((0.0,) * self.case.n_bodies)
+        return book_variant(self.case)
 
     def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]:
         d = self.dyn
@@ -170,7 +195,10 @@ class EngineImplementation(Implementation):
             if not np.array_equal(extra, extra[0, 0] * np.eye(3)):
                 return None  # not an isotropic floor: not a convention we can predict
             out.append(float(extra[0, 0]))
-        return Variant(tuple(out))
+        gravity = tuple(float(x) for x in self.adapter.loaded_gravity())
+        if gravity[0] or gravity[1]:
+            return None  # the reference models gravity along −z only
+        return Variant(tuple(out), gravity)
 
     def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]:
         m = self.map
@@ -230,7 +258,7 @@ def reference_trajectory(
     """q(t) of the general method for ``variant`` by DOP853 (book coordinates)."""
     spec = case.trajectory
     q, _ = solve(
-        general_method(case, variant.point_inertia),
+        general_method(case, variant),
         np.asarray(spec.q0),
         np.asarray(spec.v0),
         t,

@@ -52,13 +52,20 @@ def _vectorize(expr: sp.Expr, args: Sequence[sp.Symbol]) -> Callable[..., np.nda
 
 @dataclass(frozen=True)
 class SymbolicSystem:
-    """T(x, ẋ) and V(x) with parameter symbols; :meth:`numeric` binds parameter values."""
+    """T(x, ẋ) and V(x) with parameter symbols; :meth:`numeric` binds parameter values.
+
+    ``field`` is the potential of a force applied from outside the model (e.g. a central
+    attraction an engine receives through its external-force input): its generalized force
+    Q_r = −∂V_f/∂xʳ (2.2.20) is applied in forward and inverse dynamics but kept out of h and
+    V, as an engine keeps it out of its bias forces and energies.
+    """
 
     q: tuple[sp.Symbol, ...]
     qd: tuple[sp.Symbol, ...]
     params: tuple[sp.Symbol, ...]
     T: sp.Expr
     V: sp.Expr
+    field: sp.Expr | int = 0
 
     def equations(self) -> tuple[sp.Matrix, sp.Matrix]:
         """(M, h) of the canonical form, from (2.2.22)–(2.2.26)."""
@@ -88,14 +95,18 @@ class SymbolicSystem:
             tuple(_vectorize(h[r, 0], args) for r in range(n)),
             _vectorize(self.T, args),
             _vectorize(self.V, args),
+            tuple(_vectorize(-sp.diff(self.field, qi), args) for qi in self.q),
+            _vectorize(self.field, args),
         )
 
     def numeric(self, values: dict[str, float]) -> LagrangianDynamics:
         missing = {s.name for s in self.params} - set(values)
         if missing:
             raise KeyError(f"missing parameter values: {sorted(missing)}")
-        M_entries, h_entries, T_fn, V_fn = self.compiled
+        M_entries, h_entries, T_fn, V_fn, F_entries, Vf_fn = self.compiled
         return LagrangianDynamics(
+            F_entries=F_entries,
+            Vf_fn=Vf_fn,
             ndof=len(self.q),
             param_values=tuple(float(values[s.name]) for s in self.params),
             M_entries=M_entries,
@@ -115,6 +126,21 @@ class LagrangianDynamics:
     h_entries: tuple[Callable[..., np.ndarray], ...]
     T_fn: Callable[..., np.ndarray]
     V_fn: Callable[..., np.ndarray]
+    F_entries: tuple[Callable[..., np.ndarray], ...] = ()
+    Vf_fn: Callable[..., np.ndarray] | None = None
+
+    def field_force(self, q: np.ndarray) -> np.ndarray:
+        """Q_r = −∂V_f/∂xʳ of the external field, shape (n, N) (zero without a field)."""
+        q = np.atleast_2d(q)
+        if not self.F_entries:
+            return np.zeros_like(q, dtype=float)
+        args = self._args(q)
+        return np.stack([f(*args) for f in self.F_entries], -1)
+
+    def field_potential(self, q: np.ndarray) -> np.ndarray:
+        """V_f of the external field, shape (n,)."""
+        q = np.atleast_2d(q)
+        return np.zeros(len(q)) if self.Vf_fn is None else self.Vf_fn(*self._args(q))
 
     def _args(self, q: np.ndarray, v: np.ndarray | None = None) -> list[np.ndarray]:
         q = np.atleast_2d(q)
@@ -132,13 +158,17 @@ class LagrangianDynamics:
         return np.stack([f(*args) for f in self.h_entries], -1)
 
     def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        """ẍ = M⁻¹(τ − h), shape (n, N)."""
-        rhs = np.atleast_2d(tau) - self.bias(q, v)
+        """ẍ = M⁻¹(τ + Q_field − h), shape (n, N)."""
+        rhs = np.atleast_2d(tau) + self.field_force(q) - self.bias(q, v)
         return np.linalg.solve(self.mass_matrix(q), rhs[..., None])[..., 0]
 
     def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        """τ = M ẍ + h, shape (n, N)."""
-        return np.einsum("nij,nj->ni", self.mass_matrix(q), np.atleast_2d(a)) + self.bias(q, v)
+        """τ = M ẍ + h − Q_field, shape (n, N)."""
+        return (
+            np.einsum("nij,nj->ni", self.mass_matrix(q), np.atleast_2d(a))
+            + self.bias(q, v)
+            - self.field_force(q)
+        )
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """T, shape (n,)."""

@@ -65,21 +65,31 @@ def frame_rotation_squared(cs: CoordinateSystem) -> sp.Expr:
 
 
 @cache
-def particle_symbolic(cs: CoordinateSystem) -> SymbolicSystem:
+def particle_symbolic(cs: CoordinateSystem, central: bool = False) -> SymbolicSystem:
     """T = ½ M g_ij ẋⁱ ẋʲ (2.2.21) + ½ I |ω|² (a body turning with the coordinate triad,
-    I = 0 for the book's particle), V = M g z (gravity along −z, (2.2.20))."""
-    M, g, inertia = sp.symbols("M g I", positive=True)
+    I = 0 for the book's particle), V = M g z (gravity along −z, (2.2.20)); with ``central``,
+    an inverse-square attraction toward the origin as an external field V_f = −μM/|x|
+    (exercise 25)."""
+    M, g, mu, inertia = sp.symbols("M g mu I", positive=True)
     qd = tuple(sp.Symbol(f"{s.name}dot") for s in cs.q)
     v = sp.Matrix(qd)
     T = (M * (v.T * cs.metric * v)[0, 0] + inertia * frame_rotation_squared(cs)) / 2
-    return SymbolicSystem(cs.q, qd, (M, g, inertia), sp.expand(T), M * g * cs.x[2])
+    r = sp.sqrt(sp.trigsimp(sp.expand(sum(e**2 for e in cs.x))))
+    field = -mu * M / r if central else 0
+    return SymbolicSystem(cs.q, qd, (M, g, mu, inertia), sp.expand(T), M * g * cs.x[2], field)
 
 
 def particle(
-    cs: CoordinateSystem, M: float, g: float, *, inertia: tuple[float] = (0.0,)
+    cs: CoordinateSystem,
+    M: float,
+    g: float = 0.0,
+    *,
+    mu: float = 0.0,
+    inertia: tuple[float] = (0.0,),
 ) -> LagrangianDynamics:
-    """The general method (2.2.22)–(2.2.26) for a particle of mass M in ``cs``."""
-    return particle_symbolic(cs).numeric({"M": M, "g": g, "I": inertia[0]})
+    """The general method (2.2.22)–(2.2.26) for a particle of mass M in ``cs``, under gravity
+    g along −z and (if μ > 0) the central attraction of exercise 25 as an applied field."""
+    return particle_symbolic(cs, mu > 0).numeric({"M": M, "g": g, "mu": mu, "I": inertia[0]})
 
 
 def lagrange_form(cs: CoordinateSystem, M: float, g: float) -> PrintedDynamics:
@@ -116,14 +126,15 @@ def _closed_christoffel(cs: CoordinateSystem) -> Callable[[np.ndarray], np.ndarr
     return evaluate
 
 
-def example5_printed(M: float, g: float) -> PrintedDynamics:
+def example5_printed(M: float, g: float = 0.0, mu: float = 0.0) -> PrintedDynamics:
     """Example 5 exactly as printed, spherical (ρ, θ, φ), with d/dt expanded:
 
         Q₁ = M[ρ̈ − ρθ̇² − ρ sin²θ φ̇²]
         Q₂ = M[d/dt(ρ²θ̇) − ρ² sin θ cos θ φ̇²]
         Q₃ = M[d/dt(ρ² sin²θ φ̇)]
 
-    with Q_r = −∂V/∂xʳ for V = M g ρ cos θ (gravity along −z)."""
+    with Q_r = −∂V/∂xʳ for V = M g ρ cos θ (gravity along −z) and, if μ > 0, the central
+    attraction Q = (−μM/ρ², 0, 0) applied as an external field (exercise 25)."""
 
     def residual(q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         rho, th = q[:, 0], q[:, 1]
@@ -136,6 +147,11 @@ def example5_printed(M: float, g: float) -> PrintedDynamics:
         )
         gravity = np.stack([M * g * c, -M * g * rho * s, np.zeros_like(rho)], -1)  # ∂V/∂x
         return np.stack([e1, e2, e3], -1) + gravity
+
+    def central(q: np.ndarray) -> np.ndarray:
+        out = np.zeros_like(q, dtype=float)
+        out[:, 0] = -mu * M / q[:, 0] ** 2
+        return out
 
     return PrintedDynamics(
         residual=residual,
@@ -150,6 +166,7 @@ def example5_printed(M: float, g: float) -> PrintedDynamics:
             )
         ),
         V=lambda q: M * g * q[:, 0] * np.cos(q[:, 1]),
+        field=central if mu > 0 else None,
     )
 
 

@@ -24,6 +24,12 @@ class PrintedDynamics:
     row_factors: np.ndarray
     T: Callable[[np.ndarray, np.ndarray], np.ndarray]
     V: Callable[[np.ndarray], np.ndarray]
+    field: Callable[[np.ndarray], np.ndarray] | None = None
+    """Generalized force Q_r(x) of an external field, applied like τ (not part of h)."""
+
+    def field_force(self, q: np.ndarray) -> np.ndarray:
+        q = np.atleast_2d(q)
+        return np.zeros_like(q, dtype=float) if self.field is None else self.field(q)
 
     @property
     def ndof(self) -> int:
@@ -45,12 +51,12 @@ class PrintedDynamics:
         return self.row_factors * self.residual(q, v, np.zeros_like(q))
 
     def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        rhs = np.atleast_2d(tau) - self.bias(q, v)
+        rhs = np.atleast_2d(tau) + self.field_force(q) - self.bias(q, v)
         return np.linalg.solve(self.mass_matrix(q), rhs[..., None])[..., 0]
 
     def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         q, v, a = np.atleast_2d(q), np.atleast_2d(v), np.atleast_2d(a)
-        return self.row_factors * self.residual(q, v, a)
+        return self.row_factors * self.residual(q, v, a) - self.field_force(q)
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         return self.T(np.atleast_2d(q), np.atleast_2d(v))

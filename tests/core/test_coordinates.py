@@ -9,17 +9,34 @@ from numpy.testing import assert_allclose
 
 from dyncheck import coordinates as co
 from dyncheck.cases import get_case
-from dyncheck.cases.coordinate_maps import LinearMap
+from dyncheck.cases.coordinate_maps import LinearMap, SphericalToCartesian
 
 from ..conftest import CASE_NAMES
 
 
-def test_linear_maps_round_trip():
+def test_maps_round_trip():
     rng = np.random.default_rng(1)
     for name in CASE_NAMES:
-        cmap = get_case(name).engine_map()
-        q = rng.uniform(-3, 3, (10, cmap.A.shape[1]))
-        assert_allclose(cmap.to_book(cmap.to_engine(q)), q, rtol=0, atol=1e-15)
+        case = get_case(name)
+        cmap = case.engine_map()
+        low, high = case.q_bounds()
+        q = rng.uniform(low, high, (10, case.ndof))
+        assert_allclose(cmap.to_book(cmap.to_engine(q)), q, rtol=0, atol=1e-14)
+
+
+def test_spherical_map_derivatives():
+    """SphericalToCartesian against the reference's exact Jacobian, and its (2.2.5) term
+    against the flat-space identity ∂ₘ∂ₙx = {i; m n} ∂ᵢx."""
+    from dyncheck.reference.coordinates import spherical
+
+    rng = np.random.default_rng(3)
+    q = np.column_stack([rng.uniform(0.5, 2, 9), rng.uniform(0.3, 2.8, 9), rng.uniform(-3, 3, 9)])
+    v = rng.uniform(-1, 1, (9, 3))
+    cmap = SphericalToCartesian()
+    J = spherical().numeric.jacobian(q)
+    assert_allclose(cmap.jacobian(q), J, rtol=1e-14, atol=1e-15)
+    expected = np.einsum("nki,nimj,nm,nj->nk", J, spherical().numeric.christoffel(q), v, v)
+    assert_allclose(cmap.hessian_term(q, v), expected, rtol=1e-12, atol=1e-13)
 
 
 @dataclass(frozen=True)

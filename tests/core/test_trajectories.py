@@ -6,16 +6,19 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dyncheck.cases import INTEGRATORS, NOMINAL_ORDER
+from dyncheck.cases import NOMINAL_ORDER, get_case
+from dyncheck.comparison import GRAVITY_DEFAULT
 from dyncheck.trajectories import observed_orders
 
 from ..conftest import CASE_NAMES, ENGINES
 
+STUDIES = [(c, i) for c in CASE_NAMES for i in get_case(c).trajectory.steps]
 
-@pytest.mark.parametrize("integrator", INTEGRATORS)
+
 @pytest.mark.parametrize("engine", ENGINES)
-@pytest.mark.parametrize("case", CASE_NAMES)
+@pytest.mark.parametrize(("case", "integrator"), STUDIES)
 def test_observed_order(full_run, case, engine, integrator):
+    """Nominal order ± 0.1; for ``rk4-held-force`` the predicted order 1 (a finding)."""
     c = full_run.convergence
     g = c[(c.case == case) & (c.impl == engine) & (c.integrator == integrator)]
     g = g.sort_values("dt", ascending=False)
@@ -28,18 +31,29 @@ def test_observed_order(full_run, case, engine, integrator):
 
 
 def test_engine_pairs_on_the_same_model_agree_to_roundoff(full_run):
-    """mujoco and pinocchio-mjcf read the same MJCF: same integrator, same step, same states."""
+    """mujoco and pinocchio-mjcf read the same MJCF: same integrator, same step, same states —
+    except where Pinocchio's parser ignores the file's gravity (kepler: gravity 0), which the
+    reference's prediction must then explain."""
     d = full_run.discrepancies
     rows = d[(d.quantity == "trajectory") & (d.impl_a == "pinocchio-mjcf") & (d.impl_b == "mujoco")]
-    assert len(rows) == len(CASE_NAMES) * 12
-    assert (rows.verdict == "passed").all()
-    assert (rows.max_rel_err <= rows.tolerance).all()
+    assert len(rows) == sum(len(get_case(c).trajectory.steps) for c in CASE_NAMES)
+    default_g = rows[rows.case != "kepler"]
+    assert (default_g.verdict == "passed").all()
+    assert (default_g.max_rel_err <= default_g.tolerance).all()
+    zero_g = rows[rows.case == "kepler"]
+    assert (zero_g.verdict == "explained").all()
+    assert zero_g.convention.str.contains(GRAVITY_DEFAULT).all()
 
 
 def test_engine_pairs_on_different_models_are_predicted(full_run):
+    """pinocchio (exact point masses) against the MJCF-loaded engines: explained by the
+    reference's prediction where the models differ visibly (the pendulums), equal where the
+    difference has no effect (a particle on slides never rotates)."""
     d = full_run.discrepancies
     rows = d[(d.quantity == "trajectory") & (d.impl_a == "pinocchio")]
-    assert (rows.verdict == "explained").all()
+    assert set(rows.verdict) <= {"passed", "explained"}
+    pend = rows[rows.case.isin(["simple_pendulum", "compound_pendulum"])]
+    assert (pend.verdict == "explained").all() and len(pend) > 0
 
 
 def test_observed_orders_formula():
