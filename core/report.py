@@ -327,6 +327,8 @@ def index_page(result: RunResult, *, date: str) -> str:
         "",
         *[f"- **{name}**: {CONVENTIONS.get(name, '')}" for name in used],
         "",
+        "Performance: [benchmark.md](benchmark.md), written by `dyncheck bench`.",
+        "",
         "### Case pages",
         "",
         *[f"- [{c.title}]({c.name}.md)" for c in result.cases],

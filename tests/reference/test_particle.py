@@ -179,3 +179,22 @@ def test_kepler_orbit_exercise_25():
     assert energy[0] == pytest.approx(-case.mu * case.M / (2 * 1.2), rel=1e-12)  # vis-viva
     assert_allclose(x[-1], x[0], atol=1e-8)
     assert np.linalg.norm(x[200] - x[0]) > 1.0  # it did go round
+
+
+def test_physical_components_exercise_6():
+    """Cylindrical: physical velocity (ṙ, rθ̇, ż) and acceleration (r̈ − rθ̇², rθ̈ + 2ṙθ̇, z̈)."""
+    rng = np.random.default_rng(9)
+    q = np.column_stack([rng.uniform(0.5, 2, 10), rng.uniform(-3, 3, 10), rng.uniform(-1, 1, 10)])
+    v, a = rng.uniform(-1, 1, (10, 3)), rng.uniform(-1, 1, (10, 3))
+    cs = cylindrical()
+    r, rd, thd = q[:, 0], v[:, 0], v[:, 1]
+    assert_allclose(
+        P.physical_components(cs, q, v), np.column_stack([rd, r * thd, v[:, 2]]), rtol=1e-14
+    )
+    f = P.physical_components(cs, q, P.acceleration(cs, q, v, a))
+    assert_allclose(
+        f,
+        np.column_stack([a[:, 0] - r * thd**2, r * a[:, 1] + 2 * rd * thd, a[:, 2]]),
+        rtol=1e-13,
+        atol=1e-15,
+    )
