@@ -12,9 +12,11 @@ from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.errors import EngineNotInstalled, UnknownName
 
 ENGINE_PACKAGES: dict[str, str] = {
+    "drake": "drake",
     "mujoco": "mujoco",
     "pinocchio": "pin",
     "pinocchio-mjcf": "pin",
+    "sympy-mechanics": "sympy",
 }
 """Every engine implementation dyncheck knows, installed or not → its pip package."""
 
@@ -27,6 +29,20 @@ try:
     ADAPTERS[MuJoCoAdapter.name] = MuJoCoAdapter
 except ImportError as exc:  # pragma: no cover - depends on the environment
     MISSING["mujoco"] = str(exc)
+
+try:
+    from dyncheck.adapters.sympy_mechanics import SympyMechanicsAdapter
+
+    ADAPTERS[SympyMechanicsAdapter.name] = SympyMechanicsAdapter
+except ImportError as exc:  # pragma: no cover - sympy is a core dependency
+    MISSING["sympy-mechanics"] = str(exc)
+
+try:
+    from dyncheck.adapters.drake_ import DrakeAdapter
+
+    ADAPTERS[DrakeAdapter.name] = DrakeAdapter
+except ImportError as exc:  # pragma: no cover - depends on the environment
+    MISSING["drake"] = str(exc)
 
 try:
     from dyncheck.adapters.pinocchio_ import PinocchioAdapter, PinocchioMJCFAdapter

@@ -81,7 +81,40 @@ def _raw_pinocchio(adapter, qe, ve, te, ae) -> Callable[[], None]:
     return loop
 
 
-RAW = {"mujoco": _raw_mujoco, "pinocchio": _raw_pinocchio, "pinocchio-mjcf": _raw_pinocchio}
+def _raw_drake(adapter, qe, ve, te, ae) -> Callable[[], None]:
+    from pydrake.multibody.tree import MultibodyForces
+
+    plant, ctx = adapter.plant, adapter.context
+    tau_port = plant.get_applied_generalized_force_input_port()
+    acc_port = plant.get_generalized_acceleration_output_port()
+    forces = MultibodyForces(plant)
+
+    def loop() -> None:
+        for k in range(len(qe)):
+            plant.SetPositions(ctx, qe[k])
+            plant.SetVelocities(ctx, ve[k])
+            plant.CalcMassMatrix(ctx)
+            plant.CalcBiasTerm(ctx)
+            plant.CalcGravityGeneralizedForces(ctx)
+            tau_port.FixValue(ctx, te[k])
+            acc_port.Eval(ctx)
+            forces.SetZero()
+            plant.CalcForceElementsContribution(ctx, forces)
+            plant.CalcInverseDynamics(ctx, ae[k], forces)
+            plant.CalcKineticEnergy(ctx)
+            plant.CalcPotentialEnergy(ctx)
+
+    return loop
+
+
+RAW = {
+    "mujoco": _raw_mujoco,
+    "pinocchio": _raw_pinocchio,
+    "pinocchio-mjcf": _raw_pinocchio,
+    "drake": _raw_drake,
+}
+"""The engines' plainest loops (sympy-mechanics is dyncheck's own symbolic peer: no raw
+engine call to compare with)."""
 
 
 def _sweep_rss(case_name: str, states: int, queue: mp.Queue) -> None:
@@ -125,7 +158,7 @@ def bench(case: Case, states: int, repeats: int) -> pd.DataFrame:
         )
 
     for name, impl in impls.items():
-        if isinstance(impl, EngineImplementation):
+        if isinstance(impl, EngineImplementation) and name in RAW:
             cmap, q = impl.map, sample.q
             qe, ve = cmap.to_engine(q), co.velocity_to_engine(cmap, q, sample.v)
             te = co.force_to_engine(cmap, q, sample.tau)

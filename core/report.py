@@ -73,7 +73,7 @@ def versions() -> dict[str, str]:
         "sympy": sympy.__version__,
         "pandas": pd.__version__,
     }
-    for name, pkg in (("mujoco", "mujoco"), ("pinocchio", "pinocchio")):
+    for name, pkg in (("mujoco", "mujoco"), ("pinocchio", "pinocchio"), ("drake", "drake")):
         out[pkg] = ADAPTERS[name].version() if name in ADAPTERS else "not installed"
     out["dyncheck"] = __version__
     try:
@@ -322,6 +322,13 @@ def index_page(result: RunResult, *, date: str) -> str:
                 ]
             ]
         ),
+        "",
+        "### What the MJCF parsers ignore (their own words, this run)",
+        "",
+        "Pinocchio's parser does not read `<option gravity>` (measured: see the convention "
+        "below); Drake's parser reports:",
+        "",
+        *[f"- `{impl}`: {msg}" for impl, msgs in result.parser_notes.items() for msg in msgs],
         "",
         "### Conventions that explain differences",
         "",

@@ -27,6 +27,8 @@ class RunResult:
     discrepancies: pd.DataFrame
     convergence: pd.DataFrame
     figures: dict[str, TrajectoryFigures]
+    parser_notes: dict[str, list[str]]
+    """Per implementation, what its MJCF parser said it ignores (its own warnings)."""
 
     @property
     def failed(self) -> bool:
@@ -58,6 +60,7 @@ def run(
     rows: list[Discrepancy] = []
     points: list[ConvergencePoint] = []
     figures: dict[str, TrajectoryFigures] = {}
+    notes: dict[str, set[str]] = {}
     for case in cases:
         progress(f"{case.name}: instantaneous quantities")
         impls: dict[str, Implementation | Exception] = {}
@@ -66,6 +69,8 @@ def run(
                 impls[name] = make_implementation(name, case)
             except Exception as exc:  # reported as a row, the run goes on
                 impls[name] = exc
+            warnings = getattr(getattr(impls[name], "adapter", None), "parser_warnings", [])
+            notes.setdefault(name, set()).update(warnings)
         rows += compare_instantaneous(case, impls, case.iter_states(states))
         progress(f"{case.name}: trajectories and order of accuracy")
         p, r, figures[case.name] = study(case, impls)
@@ -76,4 +81,5 @@ def run(
         table(rows, Discrepancy, DISCREPANCY_KEY),
         table(points, ConvergencePoint, CONVERGENCE_KEY),
         figures,
+        {k: sorted(v) for k, v in notes.items() if v},
     )

@@ -74,7 +74,7 @@ def test_unknown_case_is_usage_error(tmp_path, capsys):
 
 def test_unknown_implementation_is_usage_error(tmp_path, capsys):
     assert main(["run", "--impl", "bullet", "--out", str(tmp_path / "r")]) == 2
-    assert "unknown implementation 'bullet'; valid: book, mujoco" in capsys.readouterr().err
+    assert "unknown implementation 'bullet'; valid: book, drake, mujoco" in capsys.readouterr().err
 
 
 def test_out_that_is_a_file_is_usage_error(tmp_path, capsys):

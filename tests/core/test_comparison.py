@@ -12,7 +12,7 @@ import pytest
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.comparison import GRAVITY_DEFAULT, POINT_INERTIA, compare_instantaneous
-from dyncheck.implementations import QUANTITIES, make_implementation
+from dyncheck.implementations import IMPLEMENTATIONS, QUANTITIES, make_implementation
 from dyncheck.results import DISCREPANCY_KEY, Discrepancy, table
 
 from ..conftest import CASE_NAMES, ENGINES
@@ -31,7 +31,7 @@ def test_against_reference(full_run, case, impl, quantity):
     ].iloc[0]
     assert row.verdict in ("passed", "explained"), f"{case}-{impl}-{quantity}: {row.note}"
     if row.verdict == "explained":
-        assert impl in ("mujoco", "pinocchio-mjcf")
+        assert impl in ("mujoco", "pinocchio-mjcf", "drake")  # the MJCF readers
         named = set(row.convention.split("; "))
         assert named <= {POINT_INERTIA, GRAVITY_DEFAULT} and named
     else:
@@ -41,7 +41,8 @@ def test_against_reference(full_run, case, impl, quantity):
 def test_every_instantaneous_pair_is_passed_or_explained(full_run):
     d = full_run.discrepancies
     inst = d[d.quantity != "trajectory"]
-    assert len(inst) == len(CASE_NAMES) * len(QUANTITIES) * 10  # 5 implementations: 10 pairs
+    n = len(IMPLEMENTATIONS)
+    assert len(inst) == len(CASE_NAMES) * len(QUANTITIES) * n * (n - 1) // 2
     assert set(inst.verdict) <= {"passed", "explained"}
 
 
@@ -126,3 +127,25 @@ def test_worst_state_is_reported_and_reproducible():
     k = row.worst_state
     assert 0 <= k < 300
     assert row.worst_state_values.startswith(f"q=[{s.q[k][0]:.6g}, {s.q[k][1]:.6g}]")
+
+
+def test_missing_engine_is_skipped_never_passed(monkeypatch):
+    """An engine that is not installed gives `skipped` rows with the pip hint, never `passed`."""
+    from dyncheck import adapters
+    from dyncheck.run import run
+
+    monkeypatch.delitem(adapters.ADAPTERS, "drake")
+    monkeypatch.setitem(adapters.MISSING, "drake", "No module named 'pydrake'")
+    result = run([get_case("simple_pendulum")], ["reference", "drake"])
+    d = result.discrepancies
+    rows = d[(d.impl_a == "drake") | (d.impl_b == "drake")]
+    assert len(rows) > 0 and (rows.verdict == "skipped").all()
+    assert rows.note.str.contains("pip install drake").all()
+    assert not result.failed
+
+
+def test_drake_parser_reports_what_it_ignores():
+    from dyncheck.adapters import get_adapter
+
+    drake = get_adapter("drake")(get_case("simple_pendulum").multibody())
+    assert any("timestep" in w for w in drake.parser_warnings)

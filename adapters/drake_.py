@@ -1,0 +1,259 @@
+"""Drake behind the canonical form: a continuous-time ``MultibodyPlant`` built by Drake's own
+MJCF parser from the very file MuJoCo loads.
+
+Drake's names: M = ``CalcMassMatrix``; ``CalcBiasTerm`` is C(q, v) v *without* gravity and
+``CalcGravityGeneralizedForces`` returns τ_g, the generalized force *of* gravity, so the
+canonical h = C v − τ_g (the sign convention to mind); forward dynamics is the plant's
+``generalized_acceleration`` output with τ on the applied-generalized-force input; inverse
+dynamics ``CalcInverseDynamics`` with gravity added by ``CalcForceElementsContribution``;
+``CalcKineticEnergy``, ``CalcPotentialEnergy``. The external field enters through the
+applied-spatial-force input (``ExternallyAppliedSpatialForce`` at the centre of mass).
+
+Integrators (Drake's own, fixed step, by ``ResetIntegratorFromFlags``): ``euler`` is
+``semi_explicit_euler`` (v first, then q with the new v: MuJoCo's Euler), ``rk2``
+``runge_kutta2`` (order 2), ``rk3`` ``runge_kutta3`` in fixed-step mode (order 3; it is
+error-controlled by default). Drake has no classic RK4.
+The parser's warnings (what it ignores) are kept in :attr:`DrakeAdapter.parser_warnings`.
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import ClassVar
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.multibody.math import SpatialForce
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
+from pydrake.multibody.tree import JacobianWrtVariable, MultibodyForces
+from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
+
+from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.mjcf import to_mjcf
+from dyncheck.cases.multibody import Multibody
+
+_INTEGRATORS = {
+    "euler": "semi_explicit_euler",
+    "rk2": "runge_kutta2",
+    "rk3": "runge_kutta3",
+}
+"""dyncheck's name → Drake's scheme name for ``ResetIntegratorFromFlags``."""
+
+
+class _Capture(logging.Handler):
+    def __init__(self) -> None:
+        super().__init__()
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.messages.append(record.getMessage())
+
+
+class _Field(LeafSystem):
+    """Reads the plant's state, outputs the field as externally applied spatial forces —
+    evaluated at every stage of every step."""
+
+    def __init__(self, adapter: DrakeAdapter) -> None:
+        super().__init__()
+        self._a = adapter
+        n = adapter.plant.num_positions() + adapter.plant.num_velocities()
+        self._state = self.DeclareVectorInputPort("state", n)
+        self.DeclareAbstractOutputPort(
+            "forces", lambda: AbstractValue.Make([ExternallyAppliedSpatialForce()]), self._calc
+        )
+        self._ctx = adapter.plant.CreateDefaultContext()
+
+    def _calc(self, context, output) -> None:
+        x = self._state.Eval(context)
+        self._a.plant.SetPositionsAndVelocities(self._ctx, x)
+        output.set_value(self._a._field_forces(self._ctx))
+
+
+class DrakeAdapter(Adapter):
+    name: ClassVar[str] = "drake"
+    package: ClassVar[str] = "drake"
+    integrators: ClassVar[tuple[str, ...]] = tuple(_INTEGRATORS)
+
+    def __init__(self, model: Multibody) -> None:
+        super().__init__(model)
+        self.xml = to_mjcf(model)
+        self.plant, self.parser_warnings = self._parse(self.xml)
+        self.context = self.plant.CreateDefaultContext()
+        self._bodies = [self.plant.GetBodyByName(b.name) for b in model.bodies]
+        # engine coordinates in the spec's joint order; Drake orders its own
+        self._iq = np.array(
+            [self.plant.GetJointByName(j.name).position_start() for j in model.joints]
+        )
+        self._iv = np.array(
+            [self.plant.GetJointByName(j.name).velocity_start() for j in model.joints]
+        )
+        self._tau_port = self.plant.get_applied_generalized_force_input_port()
+        self._force_port = self.plant.get_applied_spatial_force_input_port()
+        self._acc_port = self.plant.get_generalized_acceleration_output_port()
+
+    @staticmethod
+    def _parse(xml: str, time_step: float = 0.0) -> tuple[MultibodyPlant, list[str]]:
+        plant = MultibodyPlant(time_step)
+        capture = _Capture()
+        log = logging.getLogger("drake")
+        log.addHandler(capture)
+        propagate, log.propagate = log.propagate, False
+        try:
+            Parser(plant).AddModelsFromString(xml, "xml")
+        finally:
+            log.removeHandler(capture)
+            log.propagate = propagate
+        plant.Finalize()
+        return plant, [m.split("warning: ", 1)[-1] for m in capture.messages]
+
+    @staticmethod
+    def version() -> str:
+        from importlib.metadata import version
+
+        return version("drake")
+
+    def loaded_bodies(self) -> list[LoadedBody]:
+        out = []
+        for spec, body in zip(self.spec.bodies, self._bodies, strict=True):
+            m = body.default_mass()
+            c = np.asarray(body.default_com())
+            I_o = body.default_rotational_inertia().CopyToFullMatrix3()  # about the origin
+            I_c = I_o - m * (c @ c * np.eye(3) - np.outer(c, c))  # parallel-axis theorem
+            out.append(LoadedBody(spec.name, float(m), I_c))
+        return out
+
+    def loaded_gravity(self) -> np.ndarray:
+        return np.asarray(self.plant.gravity_field().gravity_vector())
+
+    # --- state and the field ---------------------------------------------------------------
+
+    def _set(self, q: np.ndarray, v: np.ndarray | None = None) -> None:
+        qd = np.zeros(self.plant.num_positions())
+        vd = np.zeros(self.plant.num_velocities())
+        qd[self._iq] = q
+        if v is not None:
+            vd[self._iv] = v
+        self.plant.SetPositions(self.context, qd)
+        self.plant.SetVelocities(self.context, vd)
+
+    def _field_forces(self, context) -> list[ExternallyAppliedSpatialForce]:
+        out = []
+        if not self.spec.central_mu:
+            return out
+        world = self.plant.world_frame()
+        for spec, body in zip(self.spec.bodies, self._bodies, strict=True):
+            p = self.plant.CalcPointsPositions(
+                context, body.body_frame(), np.asarray(spec.com, float), world
+            )[:, 0]
+            f = ExternallyAppliedSpatialForce()
+            f.body_index = body.index()
+            f.p_BoBq_B = np.asarray(spec.com, float)
+            f.F_Bq_W = SpatialForce(np.zeros(3), self.spec.central_force(spec.mass, p))
+            out.append(f)
+        return out
+
+    def _field_generalized(self) -> np.ndarray:
+        """Jᵀ F of the field at the current state, spec joint order."""
+        tau = np.zeros(self.plant.num_velocities())
+        if not self.spec.central_mu:
+            return tau[self._iv]
+        world = self.plant.world_frame()
+        for f, body in zip(self._field_forces(self.context), self._bodies, strict=True):
+            J = self.plant.CalcJacobianTranslationalVelocity(
+                self.context, JacobianWrtVariable.kV, body.body_frame(), f.p_BoBq_B, world, world
+            )
+            tau += J.T @ f.F_Bq_W.translational()
+        return tau[self._iv]
+
+    # --- the canonical form ----------------------------------------------------------------
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        out = np.empty((len(q), len(self._iv), len(self._iv)))
+        for k in range(len(q)):
+            self._set(q[k])
+            out[k] = self.plant.CalcMassMatrix(self.context)[np.ix_(self._iv, self._iv)]
+        return self._check("mass matrix", out)
+
+    def _h(self) -> np.ndarray:
+        ctx = self.context
+        return self.plant.CalcBiasTerm(ctx) - self.plant.CalcGravityGeneralizedForces(ctx)
+
+    def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        out = np.empty_like(q, dtype=float)
+        for k in range(len(q)):
+            self._set(q[k], v[k])
+            out[k] = self._h()[self._iv]
+        return self._check("bias forces", out)
+
+    def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        out = np.empty_like(q, dtype=float)
+        for k in range(len(q)):
+            self._set(q[k], v[k])
+            t = np.zeros(self.plant.num_velocities())
+            t[self._iv] = tau[k]
+            self._tau_port.FixValue(self.context, t)
+            self._force_port.FixValue(self.context, self._field_forces(self.context))
+            out[k] = self._acc_port.Eval(self.context)[self._iv]
+        return self._check("forward dynamics", out)
+
+    def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        out = np.empty_like(q, dtype=float)
+        forces = MultibodyForces(self.plant)
+        for k in range(len(q)):
+            self._set(q[k], v[k])
+            forces.SetZero()
+            self.plant.CalcForceElementsContribution(self.context, forces)  # gravity
+            vdot = np.zeros(self.plant.num_velocities())
+            vdot[self._iv] = a[k]
+            tau = self.plant.CalcInverseDynamics(self.context, vdot, forces)[self._iv]
+            out[k] = tau - self._field_generalized()
+        return self._check("inverse dynamics", out)
+
+    def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        out = np.empty(len(q))
+        for k in range(len(q)):
+            self._set(q[k], v[k])
+            out[k] = self.plant.CalcKineticEnergy(self.context)
+        return self._check("kinetic energy", out)
+
+    def potential_energy(self, q: np.ndarray) -> np.ndarray:
+        out = np.empty(len(q))
+        for k in range(len(q)):
+            self._set(q[k])
+            out[k] = self.plant.CalcPotentialEnergy(self.context)
+        return self._check("potential energy", out)
+
+    def simulate(
+        self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
+    ) -> Trajectory:
+        builder = DiagramBuilder()
+        plant = builder.AddSystem(self._parse(self.xml)[0])
+        if self.spec.central_mu:
+            field = builder.AddSystem(_Field(self))
+            builder.Connect(plant.get_state_output_port(), field.get_input_port(0))
+            builder.Connect(field.get_output_port(0), plant.get_applied_spatial_force_input_port())
+        diagram = builder.Build()
+        simulator = Simulator(diagram)
+        root = simulator.get_mutable_context()
+        ctx = plant.GetMyMutableContextFromRoot(root)
+        qd = np.zeros(plant.num_positions())
+        vd = np.zeros(plant.num_velocities())
+        qd[self._iq], vd[self._iv] = q0, v0
+        plant.SetPositions(ctx, qd)
+        plant.SetVelocities(ctx, vd)
+        integ = ResetIntegratorFromFlags(simulator, _INTEGRATORS[integrator], dt)
+        if integrator == "rk3":  # error-controlled by default: pin it to the step
+            integ.set_fixed_step_mode(True)
+            integ.set_maximum_step_size(dt)
+        simulator.Initialize()
+        steps = round(duration / dt)
+        qs = np.empty((steps + 1, len(self._iq)))
+        vs = np.empty((steps + 1, len(self._iv)))
+        qs[0], vs[0] = q0, v0
+        for k in range(1, steps + 1):
+            simulator.AdvanceTo(k * dt)
+            qs[k] = plant.GetPositions(ctx)[self._iq]
+            vs[k] = plant.GetVelocities(ctx)[self._iv]
+        return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)

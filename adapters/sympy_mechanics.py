@@ -1,0 +1,184 @@
+"""sympy.physics.mechanics as a symbolic peer engine: the case's engine-neutral model written
+as frames, points and particles, Lagrange's equations by ``LagrangesMethod``, numbers by
+``lambdify``. It shares no code with :mod:`dyncheck.reference` (adapters never import it), so
+its agreement is independent evidence.
+
+Construction, per body: the parent's frame and point; each joint in order either rotates the
+frame (hinge: ``orientnew('Axis')``) or moves the point along the current frame's axis
+(slide); the centre of mass is located in the final frame. Point masses are ``Particle``s,
+bodies with inertia ``RigidBody``s. Gravity enters as loads; the Lagrangian is T alone, so
+``LagrangesMethod`` gives M q̈ = F with F = τ_loads − (velocity terms). The canonical h is
+−F without the field's loads; the field's generalized force is F(field) − F(no field).
+Energies: ``kinetic_energy`` and V = −Σ m g·r.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import ClassVar
+
+import numpy as np
+import sympy as sp
+import sympy.physics.mechanics as me
+
+from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.integrators import integrate
+from dyncheck.cases.multibody import Multibody
+
+
+def _vec(frame: me.ReferenceFrame, xyz) -> me.Vector:
+    return sum(
+        (sp.nsimplify(float(c)) * e for c, e in zip(xyz, (frame.x, frame.y, frame.z), strict=True)),
+        me.Vector(0),
+    )
+
+
+def _batched(exprs: list[sp.Expr], args: list[sp.Symbol]) -> Callable[..., np.ndarray]:
+    fns = [sp.lambdify(args, e, modules="numpy", cse=True) for e in exprs]
+
+    def evaluate(*values: np.ndarray) -> np.ndarray:
+        n = np.broadcast(*values).shape[0]
+        return np.stack([np.broadcast_to(np.asarray(f(*values), float), (n,)) for f in fns], -1)
+
+    return evaluate
+
+
+class SympyMechanicsAdapter(Adapter):
+    name: ClassVar[str] = "sympy-mechanics"
+    package: ClassVar[str] = "sympy"
+    integrators: ClassVar[tuple[str, ...]] = ("rk4",)
+    """RK4 only: each step costs Python-level evaluations of the lambdified equations, and one
+    integrator suffices to show this symbolic peer integrates the same dynamics."""
+
+    def __init__(self, model: Multibody) -> None:
+        super().__init__(model)
+        n = model.nv
+        q = me.dynamicsymbols(f"q0:{n}")
+        qd = [qi.diff() for qi in q]
+        N = me.ReferenceFrame("N")
+        O = me.Point("O")
+        O.set_vel(N, 0)
+        frames = {None: N}
+        points = {None: O}
+        particles, gravity_loads, field_loads, V = [], [], [], sp.Integer(0)
+        g = _vec(N, model.gravity)
+        k = 0
+        for body in model.bodies:
+            frame = frames[body.parent]
+            point = points[body.parent].locatenew(f"{body.name}_j", _vec(frame, body.joint_pos))
+            for joint in body.joints:
+                if joint.type == "hinge":
+                    frame = frame.orientnew(
+                        f"{joint.name}_F", "Axis", (q[k], _vec(frame, joint.axis))
+                    )
+                else:
+                    point = point.locatenew(f"{joint.name}_P", q[k] * _vec(frame, joint.axis))
+                k += 1
+            com = point.locatenew(f"{body.name}_c", _vec(frame, body.com))
+            r = com.pos_from(O)
+            com.set_vel(N, r.dt(N))
+            frame.set_ang_vel(N, frame.ang_vel_in(N))
+            m = sp.nsimplify(float(body.mass))
+            if body.is_point_mass:
+                particles.append(me.Particle(body.name, com, m))
+            else:
+                I = np.asarray(body.inertia, float)
+                dyad = me.inertia(
+                    frame,
+                    *(
+                        sp.nsimplify(float(x))
+                        for x in (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[1, 2], I[0, 2])
+                    ),
+                )
+                particles.append(me.RigidBody(body.name, com, frame, m, (dyad, com)))
+            gravity_loads.append((com, m * g))
+            V -= m * g.dot(r)
+            if model.central_mu:
+                dist = sp.sqrt(r.dot(r))
+                field_loads.append((com, -sp.nsimplify(model.central_mu) * m * r / dist**3))
+            frames[body.name], points[body.name] = frame, point
+        T = me.kinetic_energy(N, *particles)
+        qs, vs = sp.symbols(f"x0:{n}"), sp.symbols(f"v0:{n}")
+        plain = dict(zip(qd, vs, strict=True)) | dict(zip(q, qs, strict=True))
+
+        def forcing(loads: list) -> sp.Matrix:
+            lm = me.LagrangesMethod(T, q, forcelist=loads or None, frame=N)
+            lm.form_lagranges_equations()
+            return lm.mass_matrix, lm.forcing
+
+        M, F_free = forcing(gravity_loads)
+        args = [*qs, *vs]
+        self._M = _batched([sp.simplify(e.subs(plain)) for e in M], args)
+        self._h = _batched([(-e).subs(plain) for e in F_free], args)
+        if field_loads:
+            _, F_field = forcing(gravity_loads + field_loads)
+            self._field = _batched(
+                [(a - b).subs(plain) for a, b in zip(F_field, F_free, strict=True)], args
+            )
+        else:
+            self._field = None
+        self._T = _batched([T.subs(plain)], args)
+        self._V = _batched([V.subs(plain)], args)
+        self._n = n
+
+    @staticmethod
+    def version() -> str:
+        return sp.__version__
+
+    def loaded_bodies(self) -> list[LoadedBody]:
+        return [LoadedBody(b.name, b.mass, np.asarray(b.inertia, float)) for b in self.spec.bodies]
+
+    def loaded_gravity(self) -> np.ndarray:
+        return np.asarray(self.spec.gravity, float)
+
+    def _args(self, q: np.ndarray, v: np.ndarray | None = None) -> list[np.ndarray]:
+        v = np.zeros_like(q) if v is None else v
+        return [*np.atleast_2d(q).T, *np.atleast_2d(v).T]
+
+    def _field_force(self, q: np.ndarray) -> np.ndarray:
+        return np.zeros_like(q) if self._field is None else self._field(*self._args(q))
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        return self._check("mass matrix", self._M(*self._args(q)).reshape(-1, self._n, self._n))
+
+    def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return self._check("bias forces", self._h(*self._args(q, v)))
+
+    def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        rhs = tau + self._field_force(q) - self.bias(q, v)
+        return self._check(
+            "forward dynamics", np.linalg.solve(self.mass_matrix(q), rhs[..., None])[..., 0]
+        )
+
+    def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        out = np.einsum("nij,nj->ni", self.mass_matrix(q), a) + self.bias(q, v)
+        return self._check("inverse dynamics", out - self._field_force(q))
+
+    def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return self._check("kinetic energy", self._T(*self._args(q, v))[:, 0])
+
+    def potential_energy(self, q: np.ndarray) -> np.ndarray:
+        return self._check("potential energy", self._V(*self._args(q))[:, 0])
+
+    def simulate(
+        self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
+    ) -> Trajectory:
+        zero = np.zeros((1, self._n))
+
+        def acc(q: np.ndarray, v: np.ndarray, held=None) -> np.ndarray:
+            if held is None:
+                return self.forward(q[None], v[None], zero)[0]
+            rhs = held - self._field_force(q[None])
+            return self.forward(q[None], v[None], rhs)[0]
+
+        steps = round(duration / dt)
+        qs, vs = integrate(
+            acc,
+            np.asarray(q0, float),
+            np.asarray(v0, float),
+            dt,
+            steps,
+            integrator,
+            freeze=lambda q, v: self._field_force(q[None])[0],
+        )
+        return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)
