@@ -23,6 +23,9 @@ import numpy as np
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import EngineError
 
+DIVERGED = 1e12
+"""A coordinate beyond this (rad or m) means a run has blown up: no case here comes near it."""
+
 
 @dataclass(frozen=True)
 class Trajectory:
@@ -117,4 +120,6 @@ class Adapter(ABC):
     def _check(self, what: str, value: np.ndarray) -> np.ndarray:
         if not np.all(np.isfinite(value)):
             raise EngineError(f"{self.name}: {what} returned a non-finite value")
+        if what == "simulate" and np.abs(value).max() > DIVERGED:
+            raise EngineError(f"{self.name}: simulate diverged (|q| > {DIVERGED:g})")
         return value

@@ -24,6 +24,13 @@ import numpy as np
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Multibody
+from dyncheck.errors import EngineError
+
+_DIVERGED = (
+    mujoco.mjtWarning.mjWARN_BADQPOS,
+    mujoco.mjtWarning.mjWARN_BADQVEL,
+    mujoco.mjtWarning.mjWARN_BADQACC,
+)
 
 _INTEGRATORS = {
     "euler": mujoco.mjtIntegrator.mjINT_EULER,
@@ -190,6 +197,12 @@ class MuJoCoAdapter(Adapter):
                     mujoco.mj_kinematics(m, d)
                     self._field_xfrc(d)
                 mujoco.mj_step(m, d)
+                if any(d.warning[w].number for w in _DIVERGED):
+                    # MuJoCo resets a diverged state and goes on; dyncheck reports it
+                    raise EngineError(
+                        f"mujoco {integrator} diverged at step {k} (t = {k * dt:g}): NaN or "
+                        "huge qpos/qvel/qacc, state reset by MuJoCo"
+                    )
                 qs[k], vs[k] = d.qpos, d.qvel
         finally:
             if field and not held:

@@ -7,6 +7,7 @@ bad input (a one-line message naming the argument and the value).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -89,11 +90,13 @@ def _list() -> int:
 
 
 def _check_out(out: Path) -> None:
+    """--out must be a directory, or creatable: its nearest existing ancestor a writable
+    directory (checked before any work, so bad usage changes nothing)."""
     if out.exists() and not out.is_dir():
         raise InvalidInput("--out", str(out), "a directory")
     probe = out if out.exists() else next((p for p in out.parents if p.exists()), Path("."))
-    import os
-
+    if not probe.is_dir():
+        raise InvalidInput("--out", str(out), f"a directory path ({probe} is a file)")
     if not os.access(probe, os.W_OK):
         raise InvalidInput("--out", str(out), "a writable directory")
 

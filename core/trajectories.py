@@ -153,12 +153,16 @@ def study(
             nominal = NOMINAL_ORDER[integrator]
             ref, ref_err = refs(variant or book_variant(case))
             errors, worst = [], []
-            for dt in dts:
-                _, q = impl.simulate(dt, integrator)
-                runs[name, integrator, dt] = q
-                diff = difference(case, q[:: round(spec.grid_step / dt)], ref).max(axis=1)
-                errors.append(float(diff.max()))
-                worst.append(int(diff.argmax()))
+            try:
+                for dt in dts:
+                    _, q = impl.simulate(dt, integrator)
+                    runs[name, integrator, dt] = q
+                    diff = difference(case, q[:: round(spec.grid_step / dt)], ref).max(axis=1)
+                    errors.append(float(diff.max()))
+                    worst.append(int(diff.argmax()))
+            except Exception as exc:  # a diverging or crashing run is a row, not a crash
+                rows.append(_unavailable(case, name, exc, integrator, dt))
+                continue
             figures.runs[name, integrator] = q[:: round(spec.grid_step / dt)]
             figures.errors[name, integrator] = diff
             figures.steps[name, integrator] = dt
@@ -247,24 +251,29 @@ def _adaptive(
     )
 
 
-def _unavailable(case: Case, name: str, exc: Exception) -> Discrepancy:
+def _unavailable(
+    case: Case, name: str, exc: Exception, integrator: str = "", dt: float = float("nan")
+) -> Discrepancy:
+    """A skipped (engine not installed) or failed (raised, diverged) trajectory row."""
     from dyncheck.errors import EngineNotInstalled
 
     verdict = "skipped" if isinstance(exc, EngineNotInstalled) else "failed"
+    nan = float("nan")
+    message = str(exc) if verdict == "skipped" else f"{type(exc).__name__}: {exc}"
     return Discrepancy(
         case.name,
         "trajectory",
         "reference",
         name,
-        "",
-        float("nan"),
-        float("nan"),
-        float("nan"),
-        float("nan"),
+        integrator,
+        dt,
+        nan,
+        nan,
+        nan,
         "",
         verdict,
         "",
-        str(exc),
+        message,
         -1,
     )
 

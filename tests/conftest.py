@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+from hypothesis import settings
 
 from dyncheck.adapters import ENGINE_PACKAGES, MISSING
 from dyncheck.cases import CASES, get_case
@@ -18,3 +19,10 @@ def full_run() -> RunResult:
     # An engine that is not installed is a test failure, never a skip counted as a pass.
     assert not MISSING, f"engines not installed: {MISSING}"
     return run([get_case(n) for n in CASE_NAMES], IMPLEMENTATIONS)
+
+
+# Property tests: a fast profile for CI (the default) and a larger one for a nightly run,
+# chosen with pytest's --hypothesis-profile=nightly.
+settings.register_profile("ci", max_examples=8, deadline=None, derandomize=True)
+settings.register_profile("nightly", max_examples=300, deadline=None)
+settings.load_profile("ci")
