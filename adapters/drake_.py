@@ -33,6 +33,7 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Multibody
+from dyncheck.errors import Unsupported
 
 _INTEGRATORS = {
     "euler": "semi_explicit_euler",
@@ -78,6 +79,11 @@ class DrakeAdapter(Adapter):
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
+        if any(j.type == "ball" for j in model.joints):
+            raise Unsupported(
+                "Drake's MJCF parser turns a ball joint into a BallRpyJoint (roll-pitch-yaw "
+                "chart); dyncheck maps no rpy chart"
+            )
         self.xml = to_mjcf(model)
         self.plant, self.parser_warnings = self._parse(self.xml)
         self.context = self.plant.CreateDefaultContext()

@@ -1,4 +1,5 @@
-"""MJCF (MuJoCo's XML) written from the engine-neutral model, read by MuJoCo and Pinocchio."""
+"""MJCF (MuJoCo's XML) written from the engine-neutral model, read by MuJoCo, Pinocchio and
+Drake."""
 
 from __future__ import annotations
 
@@ -33,16 +34,16 @@ def to_mjcf(model: Multibody, *, timestep: float = 0.002, integrator: str = "Eul
     for body in model.bodies:
         el = ET.SubElement(parents[body.parent], "body", name=body.name, pos=_fmt(body.joint_pos))
         for joint in body.joints:
-            ET.SubElement(
-                el,
-                "joint",
-                name=joint.name,
-                type=joint.type,
-                axis=_fmt(joint.axis),
-                pos="0 0 0",
-                damping="0",
-                armature="0",
-            )
+            attrs = {
+                "name": joint.name,
+                "type": joint.type,
+                "pos": "0 0 0",
+                "damping": "0",
+                "armature": "0",
+            }
+            if joint.type != "ball":
+                attrs["axis"] = _fmt(joint.axis)
+            ET.SubElement(el, "joint", attrs)
         inertia = np.asarray(body.inertia, float)
         if body.is_point_mass:
             inertia = model.mjcf_point_inertia * np.eye(3)

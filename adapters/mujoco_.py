@@ -111,13 +111,13 @@ class MuJoCoAdapter(Adapter):
         return self._check("mass matrix", out)
 
     def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        out = np.empty_like(q, dtype=float)
+        out = np.empty_like(v, dtype=float)
         for k, d in self._eval(q, v):
             out[k] = d.qfrc_bias
         return self._check("bias forces", out)
 
     def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        out = np.empty_like(q, dtype=float)
+        out = np.empty_like(v, dtype=float)
         for k, d in self._eval(q, v, tau):
             out[k] = d.qacc
         return self._check("forward dynamics", out)
@@ -132,7 +132,7 @@ class MuJoCoAdapter(Adapter):
         return tau
 
     def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        out = np.empty_like(q, dtype=float)
+        out = np.empty_like(v, dtype=float)
         for k in range(q.shape[0]):
             self._set(q[k], v[k], None)
             out[k] = self._inverse_one(a[k])
@@ -155,7 +155,7 @@ class MuJoCoAdapter(Adapter):
     ) -> dict[str, np.ndarray]:
         """One ``mj_forward`` (M, h, v̇, energies) and one ``mj_inverse`` per state."""
         m, d = self.model, self.data
-        n, nv = q.shape
+        n, nv = v.shape
         M = np.empty((n, nv, nv))
         bias, fwd, inv = np.empty((n, nv)), np.empty((n, nv)), np.empty((n, nv))
         energy = np.empty((n, 2))

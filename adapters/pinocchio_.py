@@ -23,7 +23,7 @@ from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.integrators import STEPPERS, integrate
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Joint, Multibody
-from dyncheck.errors import EngineError
+from dyncheck.errors import EngineError, Unsupported
 
 THREADS = max(1, min(2, os.cpu_count() or 1))
 """Threads for Pinocchio's batched ABA/RNEA (the machines this runs on have 2 cores)."""
@@ -39,6 +39,8 @@ _AXIS_JOINTS = {
 
 
 def _joint(joint: Joint) -> pin.JointModel:
+    if joint.type == "ball":
+        return pin.JointModelSpherical()  # q = (x, y, z, w), v = angular velocity, local
     axis = tuple(float(x) for x in joint.axis)
     if (joint.type, axis) in _AXIS_JOINTS:
         return _AXIS_JOINTS[joint.type, axis]()
@@ -61,7 +63,7 @@ def build_model(model: Multibody) -> pin.Model:
         for joint in body.joints:
             jid = pm.addJoint(jid, _joint(joint), placement, joint.name)
             placement = pin.SE3.Identity()
-        inertia = pin.Inertia(body.mass, np.asarray(body.com, float), np.asarray(body.inertia))
+        inertia = pin.Inertia(body.mass, np.asarray(body.com, float), model.body_inertia(body))
         pm.appendBodyToJoint(jid, inertia, pin.SE3.Identity())
         pm.addFrame(pin.Frame(body.name, jid, 0, pin.SE3.Identity(), pin.FrameType.BODY))
         joint_of[body.name] = jid
@@ -82,6 +84,8 @@ def load_mjcf(xml: str) -> pin.Model:
 class PinocchioAdapter(Adapter):
     name: ClassVar[str] = "pinocchio"
     package: ClassVar[str] = "pin"
+    naive_group_rk4: ClassVar[bool] = True
+    """dyncheck's RK4 sums stage velocities from different tangent spaces (order 2 on SO(3))."""
     integrators: ClassVar[tuple[str, ...]] = tuple(STEPPERS)
     adaptive: ClassVar[bool] = True
 
@@ -187,6 +191,7 @@ class PinocchioAdapter(Adapter):
             steps,
             integrator,
             freeze=lambda q, v: self._fext(q),
+            integrate_pos=lambda q, v, h: pin.integrate(self.model, q, h * v),
         )
         return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)
 
@@ -197,7 +202,7 @@ class PinocchioAdapter(Adapter):
         ``aba``, ``rnea`` (τ) and the two energies — the same calls as the one-quantity
         methods, without their per-call allocation."""
         m, d = self.model, self.data
-        n, nv = q.shape
+        n, nv = v.shape
         zero = np.zeros(nv)
         M, bias, fwd, inv = (
             np.empty((n, nv, nv)),
@@ -239,6 +244,11 @@ class PinocchioAdapter(Adapter):
 
     def solve(self, q0: np.ndarray, v0: np.ndarray, t_eval: np.ndarray, rtol: float) -> Trajectory:
         """scipy's DOP853 on (q, v)' = (v, aba(q, v, 0)), rtol = atol = ``rtol``."""
+        if self.model.nq != self.model.nv:
+            raise Unsupported(
+                f"{self.name}: scipy's DOP853 integrates q' = v only where "
+                "positions and velocities match; a quaternion state needs a chart"
+            )
         nv, zero = self.model.nv, np.zeros(self.model.nv)
 
         def rhs(_t: float, y: np.ndarray) -> np.ndarray:

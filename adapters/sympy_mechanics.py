@@ -24,6 +24,7 @@ import sympy.physics.mechanics as me
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.integrators import integrate
 from dyncheck.cases.multibody import Multibody
+from dyncheck.errors import Unsupported
 
 
 def _vec(frame: me.ReferenceFrame, xyz) -> me.Vector:
@@ -46,12 +47,19 @@ def _batched(exprs: list[sp.Expr], args: list[sp.Symbol]) -> Callable[..., np.nd
 class SympyMechanicsAdapter(Adapter):
     name: ClassVar[str] = "sympy-mechanics"
     package: ClassVar[str] = "sympy"
+    naive_group_rk4: ClassVar[bool] = True
+    """dyncheck's RK4 sums stage velocities from different tangent spaces (order 2 on SO(3))."""
     integrators: ClassVar[tuple[str, ...]] = ("rk4",)
     """RK4 only: each step costs Python-level evaluations of the lambdified equations, and one
     integrator suffices to show this symbolic peer integrates the same dynamics."""
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
+        if any(j.type == "ball" for j in model.joints):
+            raise Unsupported(
+                "a ball joint needs a three-angle chart in sympy.physics.mechanics; dyncheck "
+                "builds none"
+            )
         n = model.nv
         q = me.dynamicsymbols(f"q0:{n}")
         qd = [qi.diff() for qi in q]

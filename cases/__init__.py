@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dyncheck.cases.base import INTEGRATORS, NOMINAL_ORDER, Case, StateSample, TrajectorySpec
 from dyncheck.cases.particles import CylindricalCoordinates, Kepler, SphericalCoordinates
-from dyncheck.cases.pendulums import CompoundPendulum, SimplePendulum
+from dyncheck.cases.pendulums import CompoundPendulum, SimplePendulum, SphericalPendulum
 from dyncheck.errors import UnknownName
 
 CASES: dict[str, type[Case]] = {
@@ -13,6 +13,7 @@ CASES: dict[str, type[Case]] = {
     "kepler": Kepler,
     "simple_pendulum": SimplePendulum,
     "spherical_coordinates": SphericalCoordinates,
+    "spherical_pendulum": SphericalPendulum,
 }
 """Case name → case class with the book's default parameters; kept sorted by name."""
 

@@ -108,3 +108,126 @@ class SphericalToCartesian:
         )
         hz = -2 * rd * thd * st - rho * thd**2 * ct
         return np.column_stack([hx, hy, hz])
+
+
+def _quat_from_matrix(R: np.ndarray) -> np.ndarray:
+    """Unit quaternions (w, x, y, z), w ≥ 0, of rotation matrices (n, 3, 3) (Shepperd's
+    method, the branch on the largest of w², x², y², z²)."""
+    n = R.shape[0]
+    tr = np.trace(R, axis1=1, axis2=2)
+    cand = np.stack(
+        [1 + tr, 1 + 2 * R[:, 0, 0] - tr, 1 + 2 * R[:, 1, 1] - tr, 1 + 2 * R[:, 2, 2] - tr], -1
+    )
+    k = np.argmax(cand, axis=1)
+    q = np.empty((n, 4))
+    for i in range(n):
+        r, c = R[i], cand[i, k[i]]
+        s = 0.5 / np.sqrt(c)
+        if k[i] == 0:
+            q[i] = [
+                0.25 / s,
+                (r[2, 1] - r[1, 2]) * s,
+                (r[0, 2] - r[2, 0]) * s,
+                (r[1, 0] - r[0, 1]) * s,
+            ]
+        elif k[i] == 1:
+            q[i] = [
+                (r[2, 1] - r[1, 2]) * s,
+                0.25 / s,
+                (r[0, 1] + r[1, 0]) * s,
+                (r[0, 2] + r[2, 0]) * s,
+            ]
+        elif k[i] == 2:
+            q[i] = [
+                (r[0, 2] - r[2, 0]) * s,
+                (r[0, 1] + r[1, 0]) * s,
+                0.25 / s,
+                (r[1, 2] + r[2, 1]) * s,
+            ]
+        else:
+            q[i] = [
+                (r[1, 0] - r[0, 1]) * s,
+                (r[0, 2] + r[2, 0]) * s,
+                (r[1, 2] + r[2, 1]) * s,
+                0.25 / s,
+            ]
+    q *= np.where(q[:, :1] < 0, -1.0, 1.0)
+    return q
+
+
+def quat_to_matrix(q: np.ndarray) -> np.ndarray:
+    """Rotation matrices (n, 3, 3) of quaternions (n, 4) in (w, x, y, z) order."""
+    q = q / np.linalg.norm(q, axis=1, keepdims=True)
+    w, x, y, z = q.T
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        -2,
+    )
+
+
+@dataclass(frozen=True)
+class SphericalPendulumMap:
+    """Exercise 28's angles (φ, θ) — z axis down, φ from the z axis, θ from the y axis, bob
+    at ℓ(sin φ sin θ, sin φ cos θ, cos φ) in the book's axes — to a ball joint's state.
+
+    The book's axes are the world's turned by π about x (x_b = x, y_b = −y, z_b = −z; the
+    world's z is up). The orientation is R = R_z(θ + π) R_x(φ), which takes the body's
+    (0, 0, −ℓ) to the bob; positions are unit quaternions (w, x, y, z) — each engine's storage
+    order is applied by the comparison layer. Velocities are the body-frame angular velocity
+    *without spin about the rod*, ω = Rᵀ (r̂ × ṙ̂): a point mass's spin is no degree of
+    freedom of the book's, and a ball joint conserves ω·r̂, so states with ω·r̂ = 0 stay so.
+    J (3×2) maps (φ̇, θ̇) to ω and the (2.2.5)-type term is Rᵀ r̂ × (∂²r̂/∂q∂q) q̇ q̇.
+    """
+
+    description: str = "ball joint: R = Rz(θ+π) Rx(φ), ω = Rᵀ(r̂ × ṙ̂) (no spin)"
+
+    @staticmethod
+    def _rotation(q: np.ndarray) -> np.ndarray:
+        phi, th = q.T
+        a = th + np.pi
+        ca, sa, cp, sp_ = np.cos(a), np.sin(a), np.cos(phi), np.sin(phi)
+        z, o = np.zeros_like(phi), np.ones_like(phi)
+        Rz = np.stack(
+            [np.stack([ca, -sa, z], -1), np.stack([sa, ca, z], -1), np.stack([z, z, o], -1)], -2
+        )
+        Rx = np.stack(
+            [np.stack([o, z, z], -1), np.stack([z, cp, -sp_], -1), np.stack([z, sp_, cp], -1)], -2
+        )
+        return Rz @ Rx
+
+    @staticmethod
+    def _rhat(q: np.ndarray) -> tuple[np.ndarray, ...]:
+        """r̂ (world) and its first and second partial derivatives in (φ, θ)."""
+        phi, th = q.T
+        sp_, cp, st, ct = np.sin(phi), np.cos(phi), np.sin(th), np.cos(th)
+        z = np.zeros_like(phi)
+        r = np.stack([sp_ * st, -sp_ * ct, -cp], -1)
+        r_p = np.stack([cp * st, -cp * ct, sp_], -1)
+        r_t = np.stack([sp_ * ct, sp_ * st, z], -1)
+        r_pt = np.stack([cp * ct, cp * st, z], -1)
+        r_tt = np.stack([-sp_ * st, sp_ * ct, z], -1)
+        return r, r_p, r_t, -r, r_pt, r_tt
+
+    def to_engine(self, q: np.ndarray) -> np.ndarray:
+        return _quat_from_matrix(self._rotation(q))
+
+    def to_book(self, qe: np.ndarray) -> np.ndarray:
+        """(φ, θ) of the bob's direction r̂ = R (0, 0, −1), whatever the spin."""
+        r = -quat_to_matrix(qe)[:, :, 2]
+        return np.column_stack([np.arccos(np.clip(-r[:, 2], -1, 1)), np.arctan2(r[:, 0], -r[:, 1])])
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        r, r_p, r_t, *_ = self._rhat(q)
+        Jw = np.stack([np.cross(r, r_p), np.cross(r, r_t)], -1)
+        return np.swapaxes(self._rotation(q), 1, 2) @ Jw
+
+    def hessian_term(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        r, _, _, r_pp, r_pt, r_tt = self._rhat(q)
+        pd, td = v[:, :1], v[:, 1:]
+        second = r_pp * pd**2 + 2 * r_pt * pd * td + r_tt * td**2
+        Hw = np.cross(r, second)
+        return np.einsum("nji,nj->ni", self._rotation(q), Hw)

@@ -19,17 +19,22 @@ Mat3 = tuple[Vec3, Vec3, Vec3]
 ZERO3: Mat3 = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
-JOINT_TYPES = ("hinge", "slide")
+JOINT_TYPES = ("hinge", "slide", "ball")
+NQ = {"hinge": 1, "slide": 1, "ball": 4}
+"""Position coordinates per joint type: a ball joint's orientation is a unit quaternion."""
+NV = {"hinge": 1, "slide": 1, "ball": 3}
+"""Velocity coordinates per joint type: a ball joint's is an angular velocity."""
 
 
 @dataclass(frozen=True)
 class Joint:
-    """A one-degree-of-freedom joint: ``hinge`` (angle about ``axis``, rad) or ``slide``
-    (displacement along ``axis``, m); ``axis`` a unit vector in the body frame."""
+    """``hinge`` (angle about ``axis``, rad), ``slide`` (displacement along ``axis``, m) or
+    ``ball`` (a rotation about the joint's origin; ``axis`` unused); ``axis`` a unit vector
+    in the body frame."""
 
     name: str
     type: str
-    axis: Vec3
+    axis: Vec3 = (0.0, 0.0, 1.0)
 
     def __post_init__(self) -> None:
         if self.type not in JOINT_TYPES:
@@ -104,5 +109,17 @@ class Multibody:
         return -self.central_mu * mass * position / r**3 if self.central_mu else np.zeros(3)
 
     @property
+    def nq(self) -> int:
+        return sum(NQ[j.type] for j in self.joints)
+
+    @property
     def nv(self) -> int:
-        return len(self.joints)
+        return sum(NV[j.type] for j in self.joints)
+
+    def body_inertia(self, body: Body) -> np.ndarray:
+        """The inertia a model must hold for ``body``: its own, or — for a point mass on a
+        ball joint, whose spin about the rod would otherwise have no inertia and make M
+        singular — the isotropic floor ``mjcf_point_inertia``."""
+        if body.is_point_mass and any(j.type == "ball" for j in body.joints):
+            return self.mjcf_point_inertia * np.eye(3)
+        return np.asarray(body.inertia, float)

@@ -15,7 +15,7 @@ from typing import ClassVar
 import numpy as np
 
 from dyncheck.cases.base import Case, TrajectorySpec
-from dyncheck.cases.coordinate_maps import LinearMap
+from dyncheck.cases.coordinate_maps import LinearMap, SphericalPendulumMap
 from dyncheck.cases.multibody import Body, Joint, Multibody
 from dyncheck.cases.validate import positive
 
@@ -149,3 +149,61 @@ class CompoundPendulum(Case):
     def state_scale(self) -> tuple[float, float, float]:
         w = np.sqrt(self.g / min(self.L1, self.L2))
         return 2 * w, (self.m1 + self.m2) * self.g * self.L1, 2 * w * w
+
+
+@dataclass(frozen=True)
+class SphericalPendulum(Case):
+    """Exercise 28: a bob on a wire of length ℓ, free to swing in any direction; the book's z
+    axis points down, φ from it, θ from the y axis. Engines: one ball joint::
+
+                O  ball joint
+               /
+              /  ℓ        (φ, θ) ↔ unit quaternion, (φ̇, θ̇) ↔ angular velocity
+             ● m
+
+    A point mass on a ball joint has no inertia about the wire: every engine's model carries
+    the isotropic floor ``mjcf_point_inertia`` (explained like the MJCF's)."""
+
+    name: ClassVar[str] = "spherical_pendulum"
+    title: ClassVar[str] = "Spherical pendulum (exercise 28)"
+    book_refs: ClassVar[str] = "exercise 28; (2.2.21), (2.2.25), (2.2.26)"
+    coordinates: ClassVar[tuple[str, ...]] = ("φ", "θ")
+    periodic: ClassVar[tuple[bool, ...]] = (False, True)
+
+    m: float = 1.3
+    """bob mass, kg"""
+    l: float = 1.1
+    """wire length, m"""
+    g: float = 9.81
+    """gravity, m/s²"""
+    trajectory: TrajectorySpec = field(
+        default_factory=lambda: TrajectorySpec(
+            q0=(0.8, 0.3), v0=(0.2, 1.5), duration=2.0, steps=STEPS
+        )
+    )
+
+    def __post_init__(self) -> None:
+        for name in ("m", "l", "g"):
+            positive(name, getattr(self, name))
+
+    def params(self) -> dict[str, float]:
+        return {"m": self.m, "l": self.l, "g": self.g}
+
+    def multibody(self) -> Multibody:
+        bob = Body("bob", None, (0, 0, 0), (Joint("ball", "ball"),), self.m, (0.0, 0.0, -self.l))
+        return Multibody(self.name, (bob,), (0.0, 0.0, -self.g))
+
+    def engine_map(self) -> SphericalPendulumMap:
+        return SphericalPendulumMap()
+
+    def rest(self) -> np.ndarray:
+        """A datum off the pole φ = 0 (where the chart is singular)."""
+        return np.array([1.0, 0.0])
+
+    def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """φ ∉ {0, π}: the chart is singular on the vertical."""
+        return np.array([0.2, -np.pi]), np.array([np.pi - 0.2, np.pi])
+
+    def state_scale(self) -> tuple[float, float, float]:
+        w = np.sqrt(self.g / self.l)
+        return 2 * w, self.m * self.g * self.l, 2 * w * w

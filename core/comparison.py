@@ -19,7 +19,7 @@ from itertools import combinations
 import numpy as np
 
 from dyncheck.cases import Case, StateSample
-from dyncheck.errors import EngineNotInstalled
+from dyncheck.errors import EngineNotInstalled, Unsupported
 from dyncheck.implementations import (
     GRAVITY_DEFAULT,
     IMPLEMENTATIONS,
@@ -97,7 +97,7 @@ class Evaluator:
     def __post_init__(self) -> None:
         if isinstance(self.impl, Exception):
             self.error = str(self.impl)
-            self.skipped = isinstance(self.impl, EngineNotInstalled)
+            self.skipped = isinstance(self.impl, EngineNotInstalled | Unsupported)
         else:
             try:
                 self.variant = self.impl.variant()

@@ -38,9 +38,19 @@ def velocity_to_engine(cmap: CoordinateMap, q: np.ndarray, v: np.ndarray) -> np.
     return _mv(cmap.jacobian(q), v)
 
 
+def _left_solve(J: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """y with J y = x: J⁻¹ x for a square J; for an embedding (more engine coordinates than
+    book ones: a constraint, or a ball joint's spin) the least-squares (JᵀJ)⁻¹ Jᵀ x, exact
+    when x lies in J's range, as it does for states of the book's model."""
+    if J.shape[-1] == J.shape[-2]:
+        return np.linalg.solve(J, x[..., None])[..., 0]
+    Jt = np.swapaxes(J, -1, -2)
+    return np.linalg.solve(Jt @ J, _mv(Jt, x)[..., None])[..., 0]
+
+
 def velocity_to_book(cmap: CoordinateMap, q: np.ndarray, ve: np.ndarray) -> np.ndarray:
-    """v = J⁻¹ v̄."""
-    return np.linalg.solve(cmap.jacobian(q), ve[..., None])[..., 0]
+    """v = J⁻¹ v̄ (least squares for an embedding)."""
+    return _left_solve(cmap.jacobian(q), ve)
 
 
 def acceleration_to_engine(
@@ -53,9 +63,8 @@ def acceleration_to_engine(
 def acceleration_to_book(
     cmap: CoordinateMap, q: np.ndarray, v: np.ndarray, ae: np.ndarray
 ) -> np.ndarray:
-    """a = J⁻¹ (ā − (∂²x̄/∂x∂x) v v)."""
-    rhs = ae - cmap.hessian_term(q, v)
-    return np.linalg.solve(cmap.jacobian(q), rhs[..., None])[..., 0]
+    """a = J⁻¹ (ā − (∂²x̄/∂x∂x) v v) (least squares for an embedding)."""
+    return _left_solve(cmap.jacobian(q), ae - cmap.hessian_term(q, v))
 
 
 def force_to_book(cmap: CoordinateMap, q: np.ndarray, tau_e: np.ndarray) -> np.ndarray:
@@ -64,9 +73,13 @@ def force_to_book(cmap: CoordinateMap, q: np.ndarray, tau_e: np.ndarray) -> np.n
 
 
 def force_to_engine(cmap: CoordinateMap, q: np.ndarray, tau: np.ndarray) -> np.ndarray:
-    """τ̄ = J⁻ᵀ τ."""
+    """τ̄ = J⁻ᵀ τ; for an embedding the least-norm τ̄ = J (JᵀJ)⁻¹ τ with Jᵀ τ̄ = τ (a force
+    outside J's range — along a constraint or a spin — would change nothing the book sees)."""
     J = cmap.jacobian(q)
-    return np.linalg.solve(np.swapaxes(J, -1, -2), tau[..., None])[..., 0]
+    if J.shape[-1] == J.shape[-2]:
+        return np.linalg.solve(np.swapaxes(J, -1, -2), tau[..., None])[..., 0]
+    Jt = np.swapaxes(J, -1, -2)
+    return _mv(J, np.linalg.solve(Jt @ J, tau[..., None])[..., 0])
 
 
 def mass_matrix_to_book(cmap: CoordinateMap, q: np.ndarray, Me: np.ndarray) -> np.ndarray:

@@ -43,5 +43,9 @@ class EngineNotInstalled(DyncheckError, ImportError):
         )
 
 
+class Unsupported(DyncheckError):
+    """An engine cannot represent a case's model (reported as skipped, with the reason)."""
+
+
 class EngineError(DyncheckError, RuntimeError):
     """An engine call failed or returned a non-finite value."""

@@ -18,6 +18,7 @@ import numpy as np
 from dyncheck import coordinates as co
 from dyncheck.adapters import ENGINE_PACKAGES, Adapter, get_adapter
 from dyncheck.cases import Case, StateSample
+from dyncheck.conventions import from_native, to_native
 from dyncheck.errors import UnknownName
 from dyncheck.reference import particle, pendulum
 from dyncheck.reference.coordinates import cylindrical, spherical
@@ -46,6 +47,7 @@ IMPLEMENTATIONS: tuple[str, ...] = (
 _REFERENCE: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
     "simple_pendulum": (pendulum.simple_pendulum, pendulum.simple_pendulum_printed),
     "compound_pendulum": (pendulum.compound_pendulum, pendulum.compound_pendulum_printed),
+    "spherical_pendulum": (pendulum.spherical_pendulum, pendulum.spherical_pendulum_printed),
     "spherical_coordinates": (
         lambda M, g, inertia: particle.particle(spherical(), M, g, inertia=inertia),
         particle.example5_printed,
@@ -183,6 +185,33 @@ class ReferenceImplementation(_Equations):
         return general_method(case)
 
 
+@dataclass(frozen=True)
+class NativeMap:
+    """The case's map followed by the engine's storage conventions (``dyncheck.conventions``):
+    quaternion order; angular velocities stay in the body frame, where every engine mapped
+    here keeps them."""
+
+    base: Any
+    engine: str
+    spec: Any
+
+    @property
+    def description(self) -> str:
+        return self.base.description
+
+    def to_engine(self, q: np.ndarray) -> np.ndarray:
+        return to_native(self.engine, self.spec, self.base.to_engine(q))
+
+    def to_book(self, qn: np.ndarray) -> np.ndarray:
+        return self.base.to_book(from_native(self.engine, self.spec, qn))
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        return self.base.jacobian(q)
+
+    def hessian_term(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return self.base.hessian_term(q, v)
+
+
 class EngineImplementation(Implementation):
     """An engine adapter seen through the case's coordinate map."""
 
@@ -190,7 +219,7 @@ class EngineImplementation(Implementation):
         super().__init__(case)
         self.name = adapter.name  # type: ignore[misc]
         self.adapter = adapter(case.multibody())
-        self.map = case.engine_map()
+        self.map = NativeMap(case.engine_map(), adapter.name, case.multibody())
         self.integrators = adapter.integrators
 
     def variant(self) -> Variant | None:

@@ -121,3 +121,54 @@ def compound_pendulum_printed(
         T=kinetic,
         V=lambda q: -(m1 + m2) * g * L1 * np.cos(q[:, 0]) - m2 * g * L2 * np.cos(q[:, 1]),
     )
+
+
+@cache
+def spherical_pendulum_symbolic() -> SymbolicSystem:
+    """Exercise 28 from the bob's position ℓ(sin φ sin θ, sin φ cos θ, cos φ) (z down, so
+    V = −m g z), plus ½ I (φ̇² + sin²φ θ̇²): the bob's rotational inertia I about its centre
+    for the swing rotation ω⊥ = r̂ × ṙ̂ (a point mass has no spin degree of freedom)."""
+    ph, th, phd, thd = sp.symbols("phi theta phidot thetadot")
+    m, l, g, inertia = sp.symbols("m l g I", positive=True)
+    r = (l * sp.sin(ph) * sp.sin(th), l * sp.sin(ph) * sp.cos(th), l * sp.cos(ph))
+    rdot = [sp.diff(c, ph) * phd + sp.diff(c, th) * thd for c in r]
+    T = m * sum(c**2 for c in rdot) / 2 + inertia * (phd**2 + sp.sin(ph) ** 2 * thd**2) / 2
+    return SymbolicSystem((ph, th), (phd, thd), (m, l, g, inertia), sp.expand(T), -m * g * r[2])
+
+
+@cache
+def _spherical_numeric(m: float, l: float, g: float, inertia: float) -> LagrangianDynamics:
+    return spherical_pendulum_symbolic().numeric({"m": m, "l": l, "g": g, "I": inertia})
+
+
+def spherical_pendulum(
+    m: float,
+    l: float,
+    g: float,
+    *,
+    inertia: tuple[float] = (0.0,),
+) -> LagrangianDynamics:
+    """General method for exercise 28; ``inertia`` = (I,) about the bob's centre, kg·m²."""
+    return _spherical_numeric(m, l, g, inertia[0])
+
+
+def spherical_pendulum_printed(m: float, l: float, g: float) -> PrintedDynamics:
+    """Exercise 28 as printed, coordinates (φ, θ)::
+
+        d/dt(sin²φ θ̇) = 0        φ̈ − θ̇² sin φ cos φ + (g/ℓ) sin φ = 0
+
+    both Lagrange's equations divided by mℓ² (the first with d/dt expanded); the exercise
+    prints no T or V: T = ½mℓ²(φ̇² + sin²φ θ̇²), V = −mgℓ cos φ, as its Lagrangian implies."""
+
+    def residual(q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        s, c = np.sin(q[:, 0]), np.cos(q[:, 0])
+        e_phi = a[:, 0] - v[:, 1] ** 2 * s * c + (g / l) * s
+        e_theta = 2 * s * c * v[:, 0] * v[:, 1] + s**2 * a[:, 1]
+        return np.stack([e_phi, e_theta], -1)
+
+    return PrintedDynamics(
+        residual=residual,
+        row_factors=np.array([m * l**2, m * l**2]),
+        T=lambda q, v: 0.5 * m * l**2 * (v[:, 0] ** 2 + np.sin(q[:, 0]) ** 2 * v[:, 1] ** 2),
+        V=lambda q: -m * g * l * np.cos(q[:, 0]),
+    )

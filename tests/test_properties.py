@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 from dyncheck.cases import StateSample, get_case
 from dyncheck.comparison import compare_instantaneous
+from dyncheck.errors import Unsupported
 from dyncheck.implementations import IMPLEMENTATIONS, general_method, make_implementation
 from dyncheck.reference.coordinates import NAMED
 
@@ -68,11 +69,17 @@ def test_every_pair_agrees_on_random_states(case_name, data, scale):
     mass_field = next(f for f in ("m", "m1", "M") if hasattr(case, f))
     case = dataclasses.replace(case, **{mass_field: getattr(case, mass_field) * scale})
     s = _states(case, data.draw(st.lists(unit, min_size=8 * case.ndof, max_size=8 * case.ndof)), 2)
-    impls = {n: make_implementation(n, case) for n in IMPLEMENTATIONS}
+    impls = {}
+    for n in IMPLEMENTATIONS:
+        try:
+            impls[n] = make_implementation(n, case)
+        except Unsupported as exc:  # ball joints in Drake and sympy-mechanics: skipped rows
+            impls[n] = exc
     rows = compare_instantaneous(case, impls, s)
     bad = [
         (r.quantity, r.impl_a, r.impl_b, r.note)
         for r in rows
         if r.verdict not in ("passed", "explained")
+        and not (r.verdict == "skipped" and "ball joint" in r.note)
     ]
     assert not bad, bad

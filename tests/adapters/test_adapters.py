@@ -16,7 +16,7 @@ from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases import get_case
 from dyncheck.errors import UnknownName
 
-from ..conftest import CASE_NAMES, ENGINES
+from ..conftest import BALL_CASES, CASE_NAMES, ENGINES
 
 EPS = np.finfo(float).eps
 MJCF_ENGINES = ("mujoco", "pinocchio-mjcf", "drake")
@@ -24,7 +24,8 @@ MJCF_ENGINES = ("mujoco", "pinocchio-mjcf", "drake")
 
 
 @pytest.fixture(
-    params=[(c, e) for c in CASE_NAMES for e in ENGINES], ids=lambda p: f"{p[0]}-{p[1]}"
+    params=[(c, e) for c in CASE_NAMES for e in ENGINES if c not in BALL_CASES],
+    ids=lambda p: f"{p[0]}-{p[1]}",
 )
 def adapter_and_states(request):
     case_name, engine = request.param

@@ -67,7 +67,8 @@ def test_unknown_case_is_usage_error(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert err == (
         "dyncheck: error: unknown case 'nope'; valid: compound_pendulum, "
-        "cylindrical_coordinates, kepler, simple_pendulum, spherical_coordinates"
+        "cylindrical_coordinates, kepler, simple_pendulum, spherical_coordinates, "
+        "spherical_pendulum"
     )
     assert not out.exists()
 

@@ -69,7 +69,10 @@ def test_bad_body(kwargs, message):
 @pytest.mark.parametrize(
     ("joint", "message"),
     [
-        (("j", "ball", Y), r"^j\.type must be one of \('hinge', 'slide'\), got 'ball'$"),
+        (
+            ("j", "universal", Y),
+            r"^j\.type must be one of \('hinge', 'slide', 'ball'\), got 'universal'$",
+        ),
         (("j", "hinge", (0.0, 2.0, 0.0)), r"^j\.axis must be a unit vector"),
         (("j", "hinge", (0.0, 0.0, 0.0)), r"^j\.axis must be a unit vector"),
     ],

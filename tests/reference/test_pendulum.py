@@ -117,3 +117,43 @@ def test_rotational_inertia_variant_adds_diagonal_exactly(states):
     assert_allclose(
         with_inertia - base, np.broadcast_to(np.diag([0.25, 0.5]), base.shape), rtol=0, atol=1e-14
     )
+
+
+SPH = {"m": 1.3, "l": 1.1, "g": 9.81}
+
+
+def test_spherical_pendulum_printed_equals_general(states):
+    """Exercise 28 as printed (both equations ÷ mℓ²) against Lagrange's equations from the
+    bob's position; φ kept off the pole."""
+    q, v, a = states
+    q = np.column_stack([0.3 + np.abs(q[:, 0]) % 2.5, q[:, 1]])
+    printed, general = P.spherical_pendulum_printed(**SPH), P.spherical_pendulum(**SPH)
+    for name, args in (
+        ("mass_matrix", (q,)),
+        ("bias", (q, v)),
+        ("inverse", (q, v, a)),
+        ("kinetic_energy", (q, v)),
+    ):
+        got, want = getattr(printed, name)(*args), getattr(general, name)(*args)
+        assert_allclose(got, want, rtol=0, atol=256 * EPS * np.abs(want).max(), err_msg=name)
+
+
+def test_spherical_pendulum_conserved_quantities():
+    """sin²φ θ̇ (the first printed equation) and T + V are constants of the motion."""
+    dyn = P.spherical_pendulum(**SPH)
+    t = np.linspace(0, 4, 201)
+    q, v = solve(dyn, np.array([0.8, 0.3]), np.array([0.2, 1.5]), t)
+    h = np.sin(q[:, 0]) ** 2 * v[:, 1]
+    assert np.ptp(h) < 1e-11 * abs(h[0])
+    e = dyn.kinetic_energy(q, v) + dyn.potential_energy(q)
+    assert np.ptp(e) < 1e-11 * np.abs(e).max()
+
+
+def test_steady_conical_motion():
+    """φ̈ = 0 in the second printed equation: θ̇² = g/(ℓ cos φ₀) keeps φ = φ₀, θ = θ̇ t."""
+    phi0 = 0.6
+    w = np.sqrt(SPH["g"] / (SPH["l"] * np.cos(phi0)))
+    t = np.linspace(0, 3, 61)
+    q, _ = solve(P.spherical_pendulum(**SPH), np.array([phi0, 0.0]), np.array([0.0, w]), t)
+    assert_allclose(q[:, 0], phi0, atol=1e-10)
+    assert_allclose(q[:, 1], w * t, atol=1e-9)

@@ -1,0 +1,119 @@
+"""Engine state conventions, established by experiment on the installed versions: if an engine
+changes its quaternion order or velocity frame, these fail and say so."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from dyncheck import conventions
+from dyncheck.cases import get_case
+from dyncheck.cases.coordinate_maps import SphericalPendulumMap, quat_to_matrix
+from dyncheck.comparison import compare_instantaneous
+from dyncheck.implementations import make_implementation
+
+ROT = np.array([np.cos(0.35), 0.3 * np.sin(0.35), -0.5 * np.sin(0.35), 0.812404 * np.sin(0.35)])
+ROT /= np.linalg.norm(ROT)  # a generic rotation, (w, x, y, z)
+OMEGA = np.array([0.3, -0.7, 1.1])  # body-frame angular velocity
+
+
+def _mujoco():
+    import mujoco
+
+    case = get_case("spherical_pendulum")
+    impl = make_implementation("mujoco", case)
+    m, d = impl.adapter.model, impl.adapter.data
+    d.qpos[:] = conventions.to_native("mujoco", case.multibody(), ROT[None])[0]
+    d.qvel[:] = OMEGA
+    mujoco.mj_forward(m, d)
+    vel = np.zeros(6)
+    mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, 1, vel, 0)  # world-aligned
+    return d.xmat[1].reshape(3, 3), vel[:3]
+
+
+def _pinocchio(name: str):
+    import pinocchio as pin
+
+    case = get_case("spherical_pendulum")
+    impl = make_implementation(name, case)
+    m, d = impl.adapter.model, impl.adapter.data
+    q = conventions.to_native(name, case.multibody(), ROT[None])[0]
+    pin.forwardKinematics(m, d, q, OMEGA)
+    j = impl.adapter._joint_ids[0]
+    world = pin.getVelocity(m, d, j, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).angular
+    return d.oMi[j].rotation, world
+
+
+@pytest.mark.parametrize("engine", ["mujoco", "pinocchio", "pinocchio-mjcf"])
+def test_quaternion_order_and_velocity_frame(engine):
+    """Feeding the quaternion in the order the table states must give the rotation it means;
+    the angular velocity seen in the world is R ω (ω in the body frame)."""
+    R, omega_world = _mujoco() if engine == "mujoco" else _pinocchio(engine)
+    assert_allclose(R, quat_to_matrix(ROT[None])[0], atol=1e-14)
+    assert_allclose(omega_world, R @ OMEGA, atol=1e-14)
+    assert conventions.ANGULAR_VELOCITY_FRAME[engine] == "local"
+
+
+def test_native_order_round_trip():
+    spec = get_case("spherical_pendulum").multibody()
+    for engine in conventions.QUATERNION_ORDER:
+        q = conventions.to_native(engine, spec, ROT[None])
+        assert_allclose(conventions.from_native(engine, spec, q), ROT[None])
+    assert_allclose(
+        conventions.to_native("pinocchio", spec, ROT[None])[0], [ROT[1], ROT[2], ROT[3], ROT[0]]
+    )
+
+
+@pytest.mark.parametrize(("engine", "wrong"), [("mujoco", "xyzw"), ("pinocchio", "wxyz")])
+def test_wrong_quaternion_order_is_caught(engine, wrong, monkeypatch):
+    """The same engine with the other storage order assumed: its rows fail."""
+    monkeypatch.setitem(conventions.QUATERNION_ORDER, engine, wrong)
+    case = get_case("spherical_pendulum")
+    impls = {
+        "reference": make_implementation("reference", case),
+        engine: make_implementation(engine, case),
+    }
+    rows = compare_instantaneous(case, impls, case.sample_states())
+    failed = {r.quantity for r in rows if r.verdict == "failed"}
+    assert {"bias_forces", "forward_dynamics", "potential_energy"} <= failed
+
+
+def test_world_frame_velocity_would_be_caught():
+    """Giving the engine the world-frame angular velocity instead of the body-frame one."""
+    case = get_case("spherical_pendulum")
+    impl = make_implementation("mujoco", case)
+    base = impl.map.base
+
+    class WorldFrame:
+        description = "wrong: world-frame angular velocity"
+        to_engine, to_book, hessian_term = base.to_engine, base.to_book, base.hessian_term
+
+        def jacobian(self, q):
+            return base._rotation(q) @ base.jacobian(q)
+
+    impl.map = type(impl.map)(WorldFrame(), "mujoco", case.multibody())
+    impls = {"reference": make_implementation("reference", case), "mujoco": impl}
+    rows = compare_instantaneous(case, impls, case.sample_states())
+    assert {r.quantity for r in rows if r.verdict == "failed"} >= {"kinetic_energy"}
+
+
+def test_spherical_pendulum_map_derivatives():
+    """J by central differences of the bob's motion, the (2.2.5)-type term by differences of
+    J along a path; the quaternion round trip."""
+    m = SphericalPendulumMap()
+    rng = np.random.default_rng(4)
+    q = np.column_stack([rng.uniform(0.3, 2.8, 6), rng.uniform(-3, 3, 6)])
+    v = rng.uniform(-1, 1, (6, 2))
+    assert_allclose(m.to_book(m.to_engine(q)), q, atol=1e-14)
+    R = m._rotation(q)
+    h = 1e-6
+    r = lambda x: m._rhat(x)[0]  # noqa: E731
+    rdot = (r(q + h * v) - r(q - h * v)) / (2 * h)
+    omega_world = np.einsum("nij,nj->ni", R, np.einsum("nij,nj->ni", m.jacobian(q), v))
+    assert_allclose(np.cross(omega_world, r(q)), rdot, atol=1e-9)
+    assert_allclose(np.einsum("ni,ni->n", omega_world, r(q)), 0, atol=1e-15)  # no spin
+    Jw = lambda x: np.einsum("nij,njk->nik", m._rotation(x), m.jacobian(x))  # noqa: E731
+    dJ = (Jw(q + h * v) - Jw(q - h * v)) / (2 * h)
+    H_world = np.einsum("nij,nj->ni", dJ, v)
+    assert_allclose(np.einsum("nij,nj->ni", R, m.hessian_term(q, v)), H_world, atol=1e-8)
