@@ -113,6 +113,11 @@ class Adapter(ABC):
             "potential_energy": self.potential_energy(q),
         }
 
+    def definition(self, integrator: str) -> str:
+        """The integrator's definition as a name: two names with the same definition give the
+        same run (dyncheck's own ``implicitfast`` is ``euler`` where nothing is damped)."""
+        return integrator
+
     def solve(self, q0: np.ndarray, v0: np.ndarray, t_eval: np.ndarray, rtol: float) -> Trajectory:
         """Error-controlled integration (scipy's DOP853) of the engine's forward dynamics."""
         raise NotImplementedError(f"{self.name} offers no error-controlled integration")

@@ -29,11 +29,12 @@ from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlan
 from pydrake.multibody.tree import JacobianWrtVariable, MultibodyForces
 from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import LogVectorOutput
 
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Multibody
-from dyncheck.errors import Unsupported
+from dyncheck.errors import EngineError, Unsupported
 
 _INTEGRATORS = {
     "euler": "semi_explicit_euler",
@@ -231,6 +232,46 @@ class DrakeAdapter(Adapter):
             out[k] = self.plant.CalcPotentialEnergy(self.context)
         return self._check("potential energy", out)
 
+    def evaluate_all(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
+    ) -> dict[str, np.ndarray]:
+        """One pass over the states: the state is set once per state for all six quantities."""
+        plant, ctx = self.plant, self.context
+        n, nv = v.shape
+        iv = self._iv
+        M = np.empty((n, nv, nv))
+        bias, fwd, inv = np.empty((n, nv)), np.empty((n, nv)), np.empty((n, nv))
+        kin, pot = np.empty(n), np.empty(n)
+        forces = MultibodyForces(plant)
+        t_full = np.zeros(plant.num_velocities())
+        vdot = np.zeros(plant.num_velocities())
+        field = bool(self.spec.central_mu)
+        for k in range(n):
+            self._set(q[k], v[k])
+            M[k] = plant.CalcMassMatrix(ctx)[np.ix_(iv, iv)]
+            bias[k] = self._h()[iv]
+            t_full[iv] = tau[k]
+            self._tau_port.FixValue(ctx, t_full)
+            self._force_port.FixValue(ctx, self._field_forces(ctx) if field else [])
+            fwd[k] = self._acc_port.Eval(ctx)[iv]
+            forces.SetZero()
+            plant.CalcForceElementsContribution(ctx, forces)
+            vdot[iv] = a[k]
+            inv[k] = plant.CalcInverseDynamics(ctx, vdot, forces)[iv]
+            if field:
+                inv[k] -= self._field_generalized()
+            kin[k] = plant.CalcKineticEnergy(ctx)
+            pot[k] = plant.CalcPotentialEnergy(ctx)
+        out = {
+            "mass_matrix": M,
+            "bias_forces": bias,
+            "forward_dynamics": fwd,
+            "inverse_dynamics": inv,
+            "kinetic_energy": kin,
+            "potential_energy": pot,
+        }
+        return {key: self._check(key, val) for key, val in out.items()}
+
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:
@@ -240,6 +281,7 @@ class DrakeAdapter(Adapter):
             field = builder.AddSystem(_Field(self))
             builder.Connect(plant.get_state_output_port(), field.get_input_port(0))
             builder.Connect(field.get_output_port(0), plant.get_applied_spatial_force_input_port())
+        logger = LogVectorOutput(plant.get_state_output_port(), builder, publish_period=dt)
         diagram = builder.Build()
         simulator = Simulator(diagram)
         root = simulator.get_mutable_context()
@@ -255,11 +297,10 @@ class DrakeAdapter(Adapter):
             integ.set_maximum_step_size(dt)
         simulator.Initialize()
         steps = round(duration / dt)
-        qs = np.empty((steps + 1, len(self._iq)))
-        vs = np.empty((steps + 1, len(self._iv)))
-        qs[0], vs[0] = q0, v0
-        for k in range(1, steps + 1):
-            simulator.AdvanceTo(k * dt)
-            qs[k] = plant.GetPositions(ctx)[self._iq]
-            vs[k] = plant.GetVelocities(ctx)[self._iv]
+        simulator.AdvanceTo(steps * dt)
+        x = logger.FindLog(root).data().T  # one sample per step: the publish period is dt
+        if x.shape[0] != steps + 1:
+            raise EngineError(f"drake logged {x.shape[0]} states for {steps} steps")
+        nq = plant.num_positions()
+        qs, vs = x[:, :nq][:, self._iq], x[:, nq:][:, self._iv]
         return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)

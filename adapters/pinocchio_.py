@@ -174,6 +174,10 @@ class PinocchioAdapter(Adapter):
         out = [pin.computePotentialEnergy(self.model, self.data, q[k]) for k in range(len(q))]
         return self._check("potential energy", np.array(out))
 
+    def definition(self, integrator: str) -> str:
+        """dyncheck's ``implicitfast`` has D = 0 here (no damping, no actuators): ``euler``."""
+        return "euler" if integrator == "implicitfast" else integrator
+
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:

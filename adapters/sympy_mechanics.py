@@ -168,6 +168,10 @@ class SympyMechanicsAdapter(Adapter):
     def potential_energy(self, q: np.ndarray) -> np.ndarray:
         return self._check("potential energy", self._V(*self._args(q))[:, 0])
 
+    def definition(self, integrator: str) -> str:
+        """dyncheck's ``implicitfast`` has D = 0 here (no damping, no actuators): ``euler``."""
+        return "euler" if integrator == "implicitfast" else integrator
+
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:

@@ -86,6 +86,7 @@ class References:
         (2.2.5) (ā = J a + ∂²x̄ v v), so the discrete map is the engines' own, also where the
         coordinate map is non-linear. With ``rk4-held-force`` the field's engine-coordinate
         force J⁻ᵀ Q is frozen at the start of each step."""
+        integrator = "euler" if integrator == "implicitfast" else integrator  # same map, D = 0
         key = (variant, integrator, dt)
         if key not in self._discrete:
             dyn = general_method(self.case, variant)

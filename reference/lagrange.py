@@ -50,6 +50,20 @@ def _vectorize(expr: sp.Expr, args: Sequence[sp.Symbol]) -> Callable[..., np.nda
     return evaluate
 
 
+def _fused(exprs: Sequence[sp.Expr], args: Sequence[sp.Symbol]) -> Callable[..., np.ndarray]:
+    """Many expressions in one numpy function (shared subexpressions computed once); each
+    result broadcast to the batch shape, stacked on the last axis."""
+    f = sp.lambdify(args, list(exprs), modules="numpy", cse=True)
+
+    def evaluate(*values: np.ndarray) -> np.ndarray:
+        shape = np.broadcast(*values).shape
+        return np.stack(
+            [np.broadcast_to(np.asarray(x, dtype=float), shape) for x in f(*values)], -1
+        )
+
+    return evaluate
+
+
 @dataclass(frozen=True)
 class SymbolicSystem:
     """T(x, ẋ) and V(x) with parameter symbols; :meth:`numeric` binds parameter values.
@@ -97,14 +111,16 @@ class SymbolicSystem:
             _vectorize(self.V, args),
             tuple(_vectorize(-sp.diff(self.field, qi), args) for qi in self.q),
             _vectorize(self.field, args),
+            _fused([*M, *h, *(-sp.diff(self.field, qi) for qi in self.q)], args),
         )
 
     def numeric(self, values: dict[str, float]) -> LagrangianDynamics:
         missing = {s.name for s in self.params} - set(values)
         if missing:
             raise KeyError(f"missing parameter values: {sorted(missing)}")
-        M_entries, h_entries, T_fn, V_fn, F_entries, Vf_fn = self.compiled
+        M_entries, h_entries, T_fn, V_fn, F_entries, Vf_fn, fused = self.compiled
         return LagrangianDynamics(
+            fused=fused,
             F_entries=F_entries,
             Vf_fn=Vf_fn,
             ndof=len(self.q),
@@ -128,6 +144,8 @@ class LagrangianDynamics:
     V_fn: Callable[..., np.ndarray]
     F_entries: tuple[Callable[..., np.ndarray], ...] = ()
     Vf_fn: Callable[..., np.ndarray] | None = None
+    fused: Callable[..., np.ndarray] | None = None
+    """M, h and the field's force in one call (the hot path of forward dynamics)."""
 
     def field_force(self, q: np.ndarray) -> np.ndarray:
         """Q_r = −∂V_f/∂xʳ of the external field, shape (n, N) (zero without a field)."""
@@ -159,6 +177,13 @@ class LagrangianDynamics:
 
     def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """ẍ = M⁻¹(τ + Q_field − h), shape (n, N)."""
+        if self.fused is not None:
+            n = self.ndof
+            out = self.fused(*self._args(q, v))
+            M = out[..., : n * n].reshape(-1, n, n)
+            h, Q = out[..., n * n : n * n + n], out[..., n * n + n :]
+            rhs = np.atleast_2d(tau) + Q - h
+            return np.linalg.solve(M, rhs[..., None])[..., 0]
         rhs = np.atleast_2d(tau) + self.field_force(q) - self.bias(q, v)
         return np.linalg.solve(self.mass_matrix(q), rhs[..., None])[..., 0]
 
