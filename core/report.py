@@ -193,7 +193,8 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     ax.set_xlabel("t (s)")
     ax.set_ylabel("max |q - q_ref| (rad)")
     ax.set_title("Error against time (finest step of each integrator)")
-    ax.legend(fontsize=6, ncol=2)
+    if data.errors:
+        ax.legend(fontsize=6, ncol=2)
     fig.tight_layout()
     out["error_time"] = _png(fig)
 
@@ -210,7 +211,8 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     ax.set_xlabel("dt (s)")
     ax.set_ylabel("max error (rad)")
     ax.set_title("Error against step size (dotted: nominal slopes)")
-    ax.legend(fontsize=6, ncol=2)
+    if len(c):
+        ax.legend(fontsize=6, ncol=2)
     fig.tight_layout()
     out["convergence"] = _png(fig)
     return out
@@ -354,8 +356,8 @@ def index_page(result: RunResult, *, date: str) -> str:
     return "\n".join(lines)
 
 
-def write(result: RunResult, out: Path, *, date: str | None = None) -> list[Path]:
-    """Write every file of the report under ``out``; each file atomically."""
+def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Path, str | bytes]:
+    """Every file of the report, in memory (nothing is written)."""
     date = date or datetime.now(UTC).strftime("%Y-%m-%d")
     files: dict[Path, str | bytes] = {
         out / "discrepancies.csv": to_csv(result.discrepancies),
@@ -366,6 +368,40 @@ def write(result: RunResult, out: Path, *, date: str | None = None) -> list[Path
         for kind, png in figures(case, result.figures[case.name], result.convergence).items():
             files[out / "figures" / f"{case.name}_{kind}.png"] = png
     files[out / "README.md"] = index_page(result, date=date)
+    return files
+
+
+VOLATILE = ("| date (UTC)", "| dyncheck commit")
+"""Provenance lines that change with every run without the results changing."""
+
+
+def _stable(content: str | bytes) -> str | bytes:
+    if isinstance(content, bytes):
+        return content
+    return "\n".join(line for line in content.splitlines() if not line.startswith(VOLATILE))
+
+
+def check(result: RunResult, out: Path) -> list[str]:
+    """Files of the committed report that differ from what the code computes now (tables and
+    pages; figures are drawn from the same numbers, and provenance lines that name the date
+    and commit are ignored)."""
+    stale = []
+    for path, content in render(result, out).items():
+        if path.suffix == ".png":
+            continue
+        if not path.exists():
+            stale.append(f"{path} (missing)")
+            continue
+        old = path.read_bytes() if isinstance(content, bytes) else path.read_text()
+        if _stable(old) != _stable(content):
+            stale.append(str(path))
+    return stale
+
+
+def write(result: RunResult, out: Path, *, date: str | None = None) -> list[Path]:
+    """Write every file of the report under ``out``; each file atomically, after all of them
+    are computed (a run killed before this point changes nothing)."""
+    files = render(result, out, date=date)
     for path, content in files.items():
         write_atomic(path, content)
     return list(files)
