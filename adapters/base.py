@@ -122,6 +122,26 @@ class Adapter(ABC):
         """Error-controlled integration (scipy's DOP853) of the engine's forward dynamics."""
         raise NotImplementedError(f"{self.name} offers no error-controlled integration")
 
+    def _outputs(
+        self,
+        M: np.ndarray,
+        bias: np.ndarray,
+        fwd: np.ndarray,
+        inv: np.ndarray,
+        kin: np.ndarray,
+        pot: np.ndarray,
+    ) -> dict[str, np.ndarray]:
+        """The batched quantities under their canonical names, each checked finite."""
+        out = {
+            "mass_matrix": M,
+            "bias_forces": bias,
+            "forward_dynamics": fwd,
+            "inverse_dynamics": inv,
+            "kinetic_energy": kin,
+            "potential_energy": pot,
+        }
+        return {key: self._check(key, val) for key, val in out.items()}
+
     def _check(self, what: str, value: np.ndarray) -> np.ndarray:
         if not np.all(np.isfinite(value)):
             raise EngineError(f"{self.name}: {what} returned a non-finite value")

@@ -262,15 +262,7 @@ class DrakeAdapter(Adapter):
                 inv[k] -= self._field_generalized()
             kin[k] = plant.CalcKineticEnergy(ctx)
             pot[k] = plant.CalcPotentialEnergy(ctx)
-        out = {
-            "mass_matrix": M,
-            "bias_forces": bias,
-            "forward_dynamics": fwd,
-            "inverse_dynamics": inv,
-            "kinetic_energy": kin,
-            "potential_energy": pot,
-        }
-        return {key: self._check(key, val) for key, val in out.items()}
+        return self._outputs(M, bias, fwd, inv, kin, pot)
 
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str

@@ -165,15 +165,7 @@ class MuJoCoAdapter(Adapter):
             mujoco.mj_fullM(m, d, M[k])
             bias[k], fwd[k], energy[k] = d.qfrc_bias, d.qacc, d.energy
             inv[k] = self._inverse_one(a[k])
-        out = {
-            "mass_matrix": M,
-            "bias_forces": bias,
-            "forward_dynamics": fwd,
-            "inverse_dynamics": inv,
-            "kinetic_energy": energy[:, 1],
-            "potential_energy": energy[:, 0],
-        }
-        return {key: self._check(key, val) for key, val in out.items()}
+        return self._outputs(M, bias, fwd, inv, energy[:, 1], energy[:, 0])
 
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str

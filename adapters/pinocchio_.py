@@ -230,15 +230,7 @@ class PinocchioAdapter(Adapter):
             kin[k] = pin.computeKineticEnergy(m, d, qk, vk)
             pot[k] = pin.computePotentialEnergy(m, d, qk)
         M = np.triu(M) + np.swapaxes(np.triu(M, 1), 1, 2)
-        out = {
-            "mass_matrix": M,
-            "bias_forces": bias,
-            "forward_dynamics": fwd,
-            "inverse_dynamics": inv,
-            "kinetic_energy": kin,
-            "potential_energy": pot,
-        }
-        return {key: self._check(key, val) for key, val in out.items()}
+        return self._outputs(M, bias, fwd, inv, kin, pot)
 
     @property
     def _pool(self) -> pin.ModelPool:

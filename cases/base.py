@@ -32,6 +32,17 @@ NOMINAL_ORDER: dict[str, int] = {
 }
 
 
+STEPS: dict[str, tuple[float, ...]] = {
+    "euler": (2e-3, 1e-3, 5e-4, 2.5e-4),
+    "implicitfast": (2e-3, 1e-3, 5e-4, 2.5e-4),
+    "rk2": (1e-2, 5e-3, 2.5e-3, 1.25e-3),
+    "rk3": (1e-2, 5e-3, 2.5e-3, 1.25e-3),
+    "rk4": (1e-2, 5e-3, 2.5e-3, 1.25e-3),
+}
+"""Default halving sequences (s): coarse enough that each integrator's error stands well above
+the reference's (~1e-13), fine enough to be in the asymptotic range on these cases."""
+
+
 @dataclass(frozen=True)
 class StateSample:
     """Book-coordinate states at which every implementation is evaluated.

@@ -14,20 +14,12 @@ from typing import ClassVar
 
 import numpy as np
 
-from dyncheck.cases.base import Case, TrajectorySpec
+from dyncheck.cases.base import STEPS, Case, TrajectorySpec
 from dyncheck.cases.coordinate_maps import LinearMap, SphericalPendulumMap
 from dyncheck.cases.multibody import Body, Joint, Multibody
 from dyncheck.cases.validate import positive
 
 Y_AXIS = (0.0, 1.0, 0.0)
-
-STEPS = {
-    "euler": (2e-3, 1e-3, 5e-4, 2.5e-4),
-    "implicitfast": (2e-3, 1e-3, 5e-4, 2.5e-4),
-    "rk2": (1e-2, 5e-3, 2.5e-3, 1.25e-3),
-    "rk3": (1e-2, 5e-3, 2.5e-3, 1.25e-3),
-    "rk4": (1e-2, 5e-3, 2.5e-3, 1.25e-3),
-}
 
 
 @dataclass(frozen=True)

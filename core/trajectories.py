@@ -266,20 +266,16 @@ def _adaptive(
     )
 
 
-def _unavailable(
-    case: Case, name: str, exc: Exception, integrator: str = "", dt: float = float("nan")
+def _no_numbers(
+    case: Case, a: str, b: str, integrator: str, dt: float, verdict: str, convention: str, note: str
 ) -> Discrepancy:
-    """A skipped (engine not installed) or failed (raised, diverged) trajectory row."""
-    from dyncheck.errors import EngineNotInstalled, Unsupported
-
-    verdict = "skipped" if isinstance(exc, EngineNotInstalled | Unsupported) else "failed"
+    """A trajectory row with no error to show (skipped, or failed before any number)."""
     nan = float("nan")
-    message = str(exc) if verdict == "skipped" else f"{type(exc).__name__}: {exc}"
     return Discrepancy(
         case.name,
         "trajectory",
-        "reference",
-        name,
+        a,
+        b,
         integrator,
         dt,
         nan,
@@ -287,9 +283,23 @@ def _unavailable(
         nan,
         "",
         verdict,
-        "",
-        message,
+        convention,
+        note,
         -1,
+    )
+
+
+def _unavailable(
+    case: Case, name: str, exc: Exception, integrator: str = "", dt: float = float("nan")
+) -> Discrepancy:
+    """A skipped (engine not installed, model unsupported) or failed (raised, diverged)
+    trajectory row against the reference."""
+    from dyncheck.errors import EngineNotInstalled, Unsupported
+
+    if isinstance(exc, EngineNotInstalled | Unsupported):
+        return _no_numbers(case, "reference", name, integrator, dt, "skipped", "", str(exc))
+    return _no_numbers(
+        case, "reference", name, integrator, dt, "failed", "", f"{type(exc).__name__}: {exc}"
     )
 
 
@@ -313,24 +323,17 @@ def _engine_pairs(
                 if integrator == "rk4" and (
                     _naive_group_rk4(case, impls_[a]) != _naive_group_rk4(case, impls_[b])
                 ):
-                    nan = float("nan")
                     rows.append(
-                        Discrepancy(
-                            case.name,
-                            "trajectory",
+                        _no_numbers(
+                            case,
                             a,
                             b,
                             integrator,
                             dt,
-                            nan,
-                            nan,
-                            nan,
-                            "",
                             "skipped",
                             NAIVE_GROUP_RK4,
                             "the two RK4s differ in definition on the rotation group; each is "
                             "judged against the reference in the order study instead",
-                            -1,
                         )
                     )
                     continue
