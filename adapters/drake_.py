@@ -99,6 +99,7 @@ class DrakeAdapter(Adapter):
         self._tau_port = self.plant.get_applied_generalized_force_input_port()
         self._force_port = self.plant.get_applied_spatial_force_input_port()
         self._acc_port = self.plant.get_generalized_acceleration_output_port()
+        self._force_port.FixValue(self.context, [])  # the field, if any, is set per state
 
     @staticmethod
     def _parse(xml: str, time_step: float = 0.0) -> tuple[MultibodyPlant, list[str]]:
@@ -252,7 +253,8 @@ class DrakeAdapter(Adapter):
             bias[k] = self._h()[iv]
             t_full[iv] = tau[k]
             self._tau_port.FixValue(ctx, t_full)
-            self._force_port.FixValue(ctx, self._field_forces(ctx) if field else [])
+            if field:
+                self._force_port.FixValue(ctx, self._field_forces(ctx))
             fwd[k] = self._acc_port.Eval(ctx)[iv]
             forces.SetZero()
             plant.CalcForceElementsContribution(ctx, forces)

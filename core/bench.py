@@ -198,7 +198,7 @@ def ratios(t: pd.DataFrame) -> pd.DataFrame:
         sel = t[(t.part == part) & (t.implementation == impl)]
         return float(sel.us_per_state.iloc[0]) if len(sel) else float("nan")
 
-    engines = [n for n in ("mujoco", "pinocchio", "pinocchio-mjcf") if n in set(t.implementation)]
+    engines = [n for n in RAW if n in set(t[t.part == "raw engine calls"].implementation)]
     raw_sum = sum(us("raw engine calls", e) for e in engines)
     fastest_raw = min(us("raw engine calls", e) for e in engines)
     parts = sum(
