@@ -151,6 +151,21 @@ class Case(ABC):
     def state_scale(self) -> tuple[float, float, float]:
         """Ranges (max |q̇|, max |τ|, max |q̈|) for sampled states."""
 
+    def chart_singularity(self, q: np.ndarray) -> str | None:
+        """Why ``q`` (one state, book coordinates) lies on the chart's singular set, or None.
+        The default chart has none."""
+        return None
+
+    def check_state(self, field: str, q: tuple[float, ...] | np.ndarray) -> None:
+        """InvalidInput when a user-given state sits on the chart's singular set."""
+        why = self.chart_singularity(np.asarray(q, dtype=float))
+        if why:
+            raise InvalidInput(
+                field,
+                tuple(float(x) for x in q),
+                f"off the singular set of the book's chart ({why})",
+            )
+
     def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Sampling box of the book's coordinates, away from the chart's singular set."""
         return np.full(self.ndof, -np.pi), np.full(self.ndof, np.pi)

@@ -35,6 +35,7 @@ class _Particle(Case):
     def __post_init__(self) -> None:
         positive("M", self.M)
         positive("g", self.g)
+        self.check_state("q0", self.trajectory.q0)
 
     def params(self) -> dict[str, float]:
         return {"M": self.M, "g": self.g}
@@ -74,6 +75,15 @@ class SphericalCoordinates(_Particle):
     def rest(self) -> np.ndarray:
         return np.array([1.0, np.pi / 2, 0.0])
 
+    def chart_singularity(self, q: np.ndarray) -> str | None:
+        """Spherical (ρ, θ, φ): singular at ρ = 0 and on the z axis (θ = 0, π)."""
+        if abs(q[0]) < 1e-9:
+            return "ρ = 0, the origin"
+        theta = q[1] % (2 * np.pi)
+        if min(theta, abs(theta - np.pi), 2 * np.pi - theta) < 1e-6:
+            return "θ = 0 or π, the z axis, where φ is undefined"
+        return None
+
     def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """ρ > 0 and θ ∉ {0, π}: the chart is singular on the z axis."""
         return np.array([0.5, 0.3, -np.pi]), np.array([2.0, np.pi - 0.3, np.pi])
@@ -111,6 +121,10 @@ class CylindricalCoordinates(_Particle):
 
     def rest(self) -> np.ndarray:
         return np.array([1.0, 0.0, 0.0])
+
+    def chart_singularity(self, q: np.ndarray) -> str | None:
+        """Cylindrical (r, θ, z): singular on the z axis (r = 0)."""
+        return "r = 0, the z axis, where θ is undefined" if abs(q[0]) < 1e-9 else None
 
     def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """r > 0: the chart is singular on the z axis."""
@@ -173,6 +187,7 @@ class Kepler(Case):
     def __post_init__(self) -> None:
         positive("M", self.M)
         positive("mu", self.mu)
+        self.check_state("q0", self.trajectory.q0)
 
     def params(self) -> dict[str, float]:
         return {"M": self.M, "mu": self.mu}
@@ -187,6 +202,15 @@ class Kepler(Case):
 
     def rest(self) -> np.ndarray:
         return np.array([1.0, np.pi / 2, 0.0])
+
+    def chart_singularity(self, q: np.ndarray) -> str | None:
+        """Spherical (ρ, θ, φ): singular at ρ = 0 and on the z axis (θ = 0, π)."""
+        if abs(q[0]) < 1e-9:
+            return "ρ = 0, the origin"
+        theta = q[1] % (2 * np.pi)
+        if min(theta, abs(theta - np.pi), 2 * np.pi - theta) < 1e-6:
+            return "θ = 0 or π, the z axis, where φ is undefined"
+        return None
 
     def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         return np.array([0.5, 0.3, -np.pi]), np.array([2.0, np.pi - 0.3, np.pi])

@@ -177,6 +177,13 @@ class SphericalPendulum(Case):
     def __post_init__(self) -> None:
         for name in ("m", "l", "g"):
             positive(name, getattr(self, name))
+        self.check_state("q0", self.trajectory.q0)
+
+    def chart_singularity(self, q: np.ndarray) -> str | None:
+        phi = q[0] % (2 * np.pi)
+        if min(phi, abs(phi - np.pi), 2 * np.pi - phi) < 1e-6:
+            return "φ = 0 or π, the vertical, where θ is undefined"
+        return None
 
     def params(self) -> dict[str, float]:
         return {"m": self.m, "l": self.l, "g": self.g}

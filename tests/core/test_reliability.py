@@ -177,3 +177,24 @@ def test_killed_run_leaves_previous_report_intact(tmp_path):
     proc.wait()
     after = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
     assert after == before
+
+
+@pytest.mark.parametrize(
+    ("case", "q0", "message"),
+    [
+        (
+            "spherical_pendulum",
+            (0.0, 0.3),
+            r"^q0 must be off the singular set of the book's chart \(φ = 0",
+        ),
+        ("spherical_coordinates", (1.0, 0.0, 0.2), r"θ = 0 or π, the z axis"),
+        ("kepler", (0.0, 1.0, 0.2), r"ρ = 0, the origin"),
+        ("cylindrical_coordinates", (0.0, 0.3, 0.5), r"r = 0, the z axis"),
+    ],
+)
+def test_state_at_a_chart_singularity(case, q0, message):
+    """A clear message, not a NaN in the table."""
+    c = get_case(case)
+    spec = dataclasses.replace(c.trajectory, q0=q0)
+    with pytest.raises(InvalidInput, match=message):
+        dataclasses.replace(c, trajectory=spec)
