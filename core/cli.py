@@ -1,4 +1,5 @@
-"""The ``dyncheck`` command line: ``list``, ``run``, ``report``, ``baseline`` and ``bench``.
+"""The ``dyncheck`` command line: ``list``, ``run``, ``report``, ``explain``, ``baseline`` and
+``bench``.
 
 Exit status: 0 when nothing failed unexplained, 1 when a check failed (or regressed against a
 baseline, or the committed report is stale), 2 for bad usage or bad input (a one-line message
@@ -64,6 +65,8 @@ def _parser() -> argparse.ArgumentParser:
     )
     c.add_argument("--out", type=Path, default=Path("reports"), help="report folder")
     c.add_argument("--jobs", type=int, default=1, metavar="N")
+    e = sub.add_parser("explain", help="demonstrate a modelling convention (all if none)")
+    e.add_argument("name", nargs="?", default=None, metavar="NAME")
     bl = sub.add_parser("baseline", help="run and write the regression baseline")
     _selection(bl)
     bl.add_argument("--out", type=Path, default=Path("reports/baseline.csv"), metavar="FILE")
@@ -200,7 +203,20 @@ def _bench(args: argparse.Namespace) -> int:
     return 0
 
 
-COMMANDS = {"run": _run, "report": _report, "baseline": _baseline, "bench": _bench}
+def _explain(args: argparse.Namespace) -> int:
+    from dyncheck.catalogue import explain, render
+
+    print(render(explain(args.name)))
+    return 0
+
+
+COMMANDS = {
+    "run": _run,
+    "report": _report,
+    "baseline": _baseline,
+    "bench": _bench,
+    "explain": _explain,
+}
 
 
 def main(argv: Sequence[str] | None = None) -> int:

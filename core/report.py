@@ -346,7 +346,8 @@ def index_page(result: RunResult, *, date: str) -> str:
         "",
         *[f"- **{name}**: {CONVENTIONS.get(name, '')}" for name in used],
         "",
-        "Performance: [benchmark.md](benchmark.md), written by `dyncheck bench`.",
+        "Performance: [benchmark.md](benchmark.md), written by `dyncheck bench`. "
+        "Conventions catalogue: [conventions.md](conventions.md).",
         "",
         "### Case pages",
         "",
@@ -354,6 +355,22 @@ def index_page(result: RunResult, *, date: str) -> str:
         "",
     ]
     return "\n".join(lines)
+
+
+def conventions_page() -> str:
+    """The catalogue's demonstrations, run now (``dyncheck explain`` prints the same)."""
+    from dyncheck.catalogue import explain, render
+
+    head = [
+        "# Conventions catalogue",
+        "",
+        "Each entry is run on the installed engines by `dyncheck explain`: the naive "
+        "mapping's measured error against the correct one's. The conventions the main run "
+        "measures (point-mass inertia floor, MJCF gravity, held forces, RK4 on the rotation "
+        "group) are explained with their numbers in [README.md](README.md).",
+        "",
+    ]
+    return "\n".join(head) + "\n" + render(explain())
 
 
 def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Path, str | bytes]:
@@ -368,6 +385,7 @@ def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Pat
         for kind, png in figures(case, result.figures[case.name], result.convergence).items():
             files[out / "figures" / f"{case.name}_{kind}.png"] = png
     files[out / "README.md"] = index_page(result, date=date)
+    files[out / "conventions.md"] = conventions_page()
     return files
 
 

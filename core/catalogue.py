@@ -1,0 +1,268 @@
+"""The conventions catalogue: why two "identical" models disagree, each entry demonstrated.
+
+Every entry runs inside the suite on the installed engines: the naive mapping's measured error
+against the correct mapping's, or the measured effect of an engine default. ``dyncheck explain
+[NAME]`` prints them; the report's ``conventions.md`` lists them. If an engine changes its
+behaviour, the entry's numbers change and its test fails.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from dyncheck import conventions
+from dyncheck.cases import get_case
+from dyncheck.cases.coordinate_maps import LinearMap
+from dyncheck.comparison import compare_instantaneous
+from dyncheck.errors import UnknownName
+from dyncheck.implementations import EngineImplementation, NativeMap, make_implementation
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One convention: what it is, where the engines stand, and the measured demonstration."""
+
+    name: str
+    what: str
+    engines: str
+    naive: str
+    naive_error: float
+    correct_error: float
+    unit: str = "max relative error"
+
+
+def _worst(case_name: str, engine: str, cmap=None) -> float:
+    """Largest relative error of ``engine`` against the reference over the instantaneous
+    quantities, with the case's map replaced by ``cmap`` (engine storage conventions kept)."""
+    case = get_case(case_name)
+    impl = make_implementation(engine, case)
+    if cmap is not None:
+        assert isinstance(impl, EngineImplementation)
+        impl.map = NativeMap(cmap, engine, case.multibody())
+    impls = {"reference": make_implementation("reference", case), engine: impl}
+    rows = compare_instantaneous(case, impls, case.sample_states())
+    errors = [r.max_rel_err for r in rows if r.verdict != "explained" or cmap is not None]
+    if cmap is not None and any(r.verdict == "failed" and np.isnan(r.max_rel_err) for r in rows):
+        return float("inf")  # the naive map made a quantity fail outright (singular, NaN)
+    return float(np.nanmax(errors))
+
+
+def _map_demo(
+    name: str, case: str, engine: str, naive: LinearMap, what: str, engines: str
+) -> Entry:
+    return Entry(
+        name, what, engines, naive.description, _worst(case, engine, naive), _worst(case, engine)
+    )
+
+
+def relative_angles() -> Entry:
+    return _map_demo(
+        "relative-vs-absolute-angles",
+        "compound_pendulum",
+        "pinocchio",
+        LinearMap(((-1.0, 0.0), (0.0, -1.0)), (0.0, 0.0), "engine angles taken as absolute"),
+        "The book's compound pendulum uses absolute angles θ₁, θ₂ (2.2.28); engines' hinges "
+        "measure each link relative to its parent: α₂ = −(θ₂ − θ₁).",
+        "MuJoCo, Pinocchio, Drake: relative joint angles.",
+    )
+
+
+def hinge_sign() -> Entry:
+    return _map_demo(
+        "hinge-axis-sign",
+        "compound_pendulum",
+        "pinocchio",
+        LinearMap(((-1.0, 0.0), (-1.0, 1.0)), (0.0, 0.0), "elbow sign ignored: α₂ = θ₂ − θ₁"),
+        "The book's θ grows toward +x; a hinge about +y turns the link toward −x, so α = −θ. "
+        "Flipping *every* sign is a mirror symmetry of a pendulum and invisible (measured: "
+        "the simple pendulum cannot tell); one joint's wrong sign is not.",
+        "All engines: right-hand rule about the joint axis.",
+    )
+
+
+def coordinate_order() -> Entry:
+    return _map_demo(
+        "coordinate-order",
+        "spherical_coordinates",
+        "pinocchio",
+        LinearMap(
+            ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)),
+            (0.0, 0.0, 0.0),
+            "book (ρ, θ, φ) fed as joints in order",
+        ),
+        "The book orders spherical coordinates (ρ, θ, φ); a joint chain that realises them "
+        "applies φ, then θ, then ρ.",
+        "All engines: coordinates in joint order, parents first.",
+    )
+
+
+def quaternion_order() -> Entry:
+    case = "spherical_pendulum"
+    correct = _worst(case, "pinocchio")
+    old = conventions.QUATERNION_ORDER["pinocchio"]
+    conventions.QUATERNION_ORDER["pinocchio"] = "wxyz"
+    try:
+        naive = _worst(case, "pinocchio")
+    finally:
+        conventions.QUATERNION_ORDER["pinocchio"] = old
+    return Entry(
+        "quaternion-storage-order",
+        "A ball joint's orientation is a unit quaternion; engines store it in different orders.",
+        "MuJoCo (w, x, y, z); Pinocchio (x, y, z, w); Drake's MJCF parser makes a "
+        "roll-pitch-yaw BallRpyJoint.",
+        "Pinocchio given MuJoCo's (w, x, y, z) order",
+        naive,
+        correct,
+    )
+
+
+def velocity_frame() -> Entry:
+    case_name = "spherical_pendulum"
+    case = get_case(case_name)
+    base = case.engine_map()
+
+    @dataclass(frozen=True)
+    class WorldFrame:
+        description: str = "angular velocity given in the world frame"
+
+        def to_engine(self, q):
+            return base.to_engine(q)
+
+        def to_book(self, qe):
+            return base.to_book(qe)
+
+        def jacobian(self, q):
+            return base._rotation(q) @ base.jacobian(q)
+
+        def hessian_term(self, q, v):
+            return np.einsum("nij,nj->ni", base._rotation(q), base.hessian_term(q, v))
+
+    return Entry(
+        "ball-joint-velocity-frame",
+        "A ball joint's velocity is an angular velocity — expressed in the body "
+        "(local) frame or the world frame.",
+        "MuJoCo qvel and Pinocchio v: body frame (measured).",
+        "world-frame angular velocity",
+        _worst(case_name, "mujoco", WorldFrame()),
+        _worst(case_name, "mujoco"),
+    )
+
+
+def mujoco_defaults() -> Entry:
+    import mujoco
+
+    m = mujoco.MjModel.from_xml_string(
+        "<mujoco><worldbody><body><joint type='hinge'/>"
+        "<inertial pos='0 0 -1' mass='1' diaginertia='1e-8 1e-8 1e-8'/></body></worldbody>"
+        "</mujoco>"
+    )
+    return Entry(
+        "default-integrator-and-timestep",
+        "An MJCF without <option> integrates with MuJoCo's defaults, whatever the "
+        "model was tuned for.",
+        f"MuJoCo {mujoco.__version__}: integrator "
+        f"{mujoco.mjtIntegrator(m.opt.integrator).name}, timestep {m.opt.timestep} s; "
+        "Drake's MJCF parser ignores both (see the report's parser notes).",
+        "timestep assumed 0 (continuous)",
+        float(m.opt.timestep),
+        0.0,
+        "seconds",
+    )
+
+
+def degrees_radians() -> Entry:
+    import mujoco
+
+    xml = (
+        "<mujoco>{c}<worldbody><body euler='0 90 0'><joint type='hinge'/>"
+        "<inertial pos='0 0 -1' mass='1' diaginertia='1e-8 1e-8 1e-8'/></body></worldbody>"
+        "</mujoco>"
+    )
+    turn = []
+    for compiler in ("", "<compiler angle='radian'/>"):
+        m = mujoco.MjModel.from_xml_string(xml.format(c=compiler))
+        w = float(m.body_quat[1][0])
+        turn.append(2 * np.degrees(np.arccos(np.clip(abs(w), 0, 1))))
+    return Entry(
+        "degrees-vs-radians",
+        "MJCF angles are degrees unless <compiler angle='radian'>: euler='0 90 0' "
+        "turns a body 90° by default and 90 rad (mod 360°) with the radian flag.",
+        "MuJoCo: degrees by default; dyncheck writes angle='radian'.",
+        "euler='0 90 0' read as radians",
+        turn[1],
+        turn[0],
+        "degrees turned",
+    )
+
+
+def energy_after_step() -> Entry:
+    import mujoco
+
+    from dyncheck.adapters.mjcf import to_mjcf
+
+    case = get_case("simple_pendulum")
+    m = mujoco.MjModel.from_xml_string(to_mjcf(case.multibody()))
+    d = mujoco.MjData(m)
+    d.qpos[:], d.qvel[:] = 0.5, 0.0
+    m.opt.timestep = 0.01
+    mujoco.mj_step(m, d)
+    readout = float(d.energy.sum())
+    before = mujoco.MjData(m)
+    before.qpos[:], before.qvel[:] = 0.5, 0.0
+    mujoco.mj_forward(m, before)
+    after = mujoco.MjData(m)
+    after.qpos[:], after.qvel[:] = d.qpos, d.qvel
+    mujoco.mj_forward(m, after)
+    return Entry(
+        "energy-readout-after-step",
+        "After mj_step, data.energy holds the energy of the state *before* the step "
+        "(computed in the step's mj_forward), not of the new qpos/qvel.",
+        "MuJoCo: energy is a by-product of mj_forward.",
+        "energy read after mj_step taken as the new state's",
+        abs(readout - float(after.energy.sum())),
+        abs(readout - float(before.energy.sum())),
+        "J (absolute)",
+    )
+
+
+DEMOS: dict[str, Callable[[], Entry]] = {
+    "ball-joint-velocity-frame": velocity_frame,
+    "coordinate-order": coordinate_order,
+    "default-integrator-and-timestep": mujoco_defaults,
+    "degrees-vs-radians": degrees_radians,
+    "energy-readout-after-step": energy_after_step,
+    "hinge-axis-sign": hinge_sign,
+    "quaternion-storage-order": quaternion_order,
+    "relative-vs-absolute-angles": relative_angles,
+}
+"""Conventions demonstrated by a run of their own; the others (point-mass inertia floor,
+MJCF gravity, held forces, RK4 on the rotation group) are measured by ``dyncheck run`` and
+explained in its report."""
+
+
+def explain(name: str | None = None) -> list[Entry]:
+    """Run the demonstration ``name`` (all when None)."""
+    if name is None:
+        return [demo() for demo in DEMOS.values()]
+    if name not in DEMOS:
+        raise UnknownName("convention", name, DEMOS)
+    return [DEMOS[name]()]
+
+
+def render(entries: list[Entry]) -> str:
+    lines = []
+    for e in entries:
+        lines += [
+            f"## {e.name}",
+            "",
+            e.what,
+            "",
+            f"- Where the engines stand: {e.engines}",
+            f"- Naive ({e.naive}): {e.unit} {e.naive_error:.3g}",
+            f"- Correct mapping: {e.unit} {e.correct_error:.3g}",
+            "",
+        ]
+    return "\n".join(lines)

@@ -1,0 +1,61 @@
+"""The conventions catalogue: each demonstration, run on the installed engines, must show the
+naive mapping wrong and the correct one right — if an engine changes, these say which."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from dyncheck import catalogue
+from dyncheck.cases.coordinate_maps import LinearMap
+from dyncheck.cli import main
+from dyncheck.errors import UnknownName
+
+MAP_DEMOS = [
+    "relative-vs-absolute-angles",
+    "hinge-axis-sign",
+    "coordinate-order",
+    "quaternion-storage-order",
+    "ball-joint-velocity-frame",
+]
+
+
+@pytest.mark.parametrize("name", MAP_DEMOS)
+def test_naive_mapping_fails_correct_one_agrees(name):
+    (entry,) = catalogue.explain(name)
+    assert entry.naive_error > 1e-3, entry
+    assert entry.correct_error < 64 * np.finfo(float).eps, entry
+
+
+def test_a_global_sign_flip_is_invisible():
+    """Why the hinge-sign entry flips one joint: the mirror image of a pendulum is a
+    pendulum, so flipping every angle leaves every quantity unchanged."""
+    naive = LinearMap(((1.0,),), (0.0,), "α = θ")
+    assert catalogue._worst("simple_pendulum", "pinocchio", naive) < 1e-14
+
+
+def test_mujoco_defaults():
+    (entry,) = catalogue.explain("default-integrator-and-timestep")
+    assert entry.naive_error == 0.002 and "mjINT_EULER" in entry.engines
+
+
+def test_degrees_by_default():
+    """euler='0 90 0' is 90° by default; read as radians it is 90 rad, a turn of
+    (90 mod 2π) = 116.6° (folded into [0°, 180°])."""
+    (entry,) = catalogue.explain("degrees-vs-radians")
+    assert entry.correct_error == pytest.approx(90.0, abs=1e-9)
+    turn = np.degrees(90.0 % (2 * np.pi))
+    assert entry.naive_error == pytest.approx(min(turn, 360 - turn), abs=1e-6)
+
+
+def test_energy_readout_is_of_the_state_before_the_step():
+    (entry,) = catalogue.explain("energy-readout-after-step")
+    assert entry.correct_error == 0.0
+    assert entry.naive_error > 1e-6
+
+
+def test_explain_cli(capsys):
+    assert main(["explain", "quaternion-storage-order"]) == 0
+    assert "Pinocchio (x, y, z, w)" in capsys.readouterr().out
+    with pytest.raises(UnknownName, match="unknown convention 'nope'"):
+        catalogue.explain("nope")
