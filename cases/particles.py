@@ -25,6 +25,20 @@ reference's accuracy at 1e-2 already: its study starts coarser."""
 PERMUTE_REVERSE = ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0), (1.0, 0.0, 0.0))
 
 
+SPHERICAL_BOUNDS = (np.array([0.5, 0.3, -np.pi]), np.array([2.0, np.pi - 0.3, np.pi]))
+"""Sampling box for spherical (ρ, θ, φ): ρ > 0 and θ ∉ {0, π}, off the chart's singular set."""
+
+
+def spherical_singularity(q: np.ndarray) -> str | None:
+    """Spherical (ρ, θ, φ): singular at ρ = 0 and on the z axis (θ = 0, π)."""
+    if abs(q[0]) < 1e-9:
+        return "ρ = 0, the origin"
+    theta = q[1] % (2 * np.pi)
+    if min(theta, abs(theta - np.pi), 2 * np.pi - theta) < 1e-6:
+        return "θ = 0 or π, the z axis, where φ is undefined"
+    return None
+
+
 @dataclass(frozen=True)
 class _Particle(Case):
     M: float = 1.5
@@ -76,17 +90,10 @@ class SphericalCoordinates(_Particle):
         return np.array([1.0, np.pi / 2, 0.0])
 
     def chart_singularity(self, q: np.ndarray) -> str | None:
-        """Spherical (ρ, θ, φ): singular at ρ = 0 and on the z axis (θ = 0, π)."""
-        if abs(q[0]) < 1e-9:
-            return "ρ = 0, the origin"
-        theta = q[1] % (2 * np.pi)
-        if min(theta, abs(theta - np.pi), 2 * np.pi - theta) < 1e-6:
-            return "θ = 0 or π, the z axis, where φ is undefined"
-        return None
+        return spherical_singularity(q)
 
     def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """ρ > 0 and θ ∉ {0, π}: the chart is singular on the z axis."""
-        return np.array([0.5, 0.3, -np.pi]), np.array([2.0, np.pi - 0.3, np.pi])
+        return SPHERICAL_BOUNDS
 
 
 @dataclass(frozen=True)
@@ -204,16 +211,10 @@ class Kepler(Case):
         return np.array([1.0, np.pi / 2, 0.0])
 
     def chart_singularity(self, q: np.ndarray) -> str | None:
-        """Spherical (ρ, θ, φ): singular at ρ = 0 and on the z axis (θ = 0, π)."""
-        if abs(q[0]) < 1e-9:
-            return "ρ = 0, the origin"
-        theta = q[1] % (2 * np.pi)
-        if min(theta, abs(theta - np.pi), 2 * np.pi - theta) < 1e-6:
-            return "θ = 0 or π, the z axis, where φ is undefined"
-        return None
+        return spherical_singularity(q)
 
     def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        return np.array([0.5, 0.3, -np.pi]), np.array([2.0, np.pi - 0.3, np.pi])
+        return SPHERICAL_BOUNDS
 
     def state_scale(self) -> tuple[float, float, float]:
         return 1.5, 2 * self.M * self.mu, 4 * self.mu

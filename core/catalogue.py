@@ -261,7 +261,12 @@ def render(entries: list[Entry]) -> str:
             e.what,
             "",
             f"- Where the engines stand: {e.engines}",
-            f"- Naive ({e.naive}): {e.unit} {e.naive_error:.3g}",
+            f"- Naive ({e.naive}): "
+            + (
+                f"{e.unit} {e.naive_error:.3g}"
+                if np.isfinite(e.naive_error)
+                else "fails outright (a quantity is singular)"
+            ),
             f"- Correct mapping: {e.unit} {e.correct_error:.3g}",
             "",
         ]
