@@ -59,3 +59,24 @@ def test_explain_cli(capsys):
     assert "Pinocchio (x, y, z, w)" in capsys.readouterr().out
     with pytest.raises(UnknownName, match="unknown convention 'nope'"):
         catalogue.explain("nope")
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "free-body-velocity-frames",
+        "passive-damping",
+        "geometry-derived-inertia",
+        "soft-vs-exact-constraints",
+    ],
+)
+def test_engine_conventions_measured(name):
+    """Naive reading visibly wrong (> 1e-3 relative); the stated mapping exact to round-off."""
+    (entry,) = catalogue.explain(name)
+    assert entry.naive_error > 1e-3, entry
+    assert entry.correct_error < 1e-14, entry
+
+
+def test_pinocchio_mjcf_reads_one_top_level_tree():
+    (entry,) = catalogue.explain("pinocchio-mjcf-top-level-bodies")
+    assert entry.naive_error == 1.0 and entry.correct_error == 0.0
