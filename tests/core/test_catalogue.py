@@ -80,3 +80,11 @@ def test_engine_conventions_measured(name):
 def test_pinocchio_mjcf_reads_one_top_level_tree():
     (entry,) = catalogue.explain("pinocchio-mjcf-top-level-bodies")
     assert entry.naive_error == 1.0 and entry.correct_error == 0.0
+
+
+def test_point_mass_floor_and_pinocchio_options():
+    (floor,) = catalogue.explain("point-mass-inertia-floor")
+    assert "positive" in floor.what and 1e-9 < floor.naive_error < 1e-8
+    (options,) = catalogue.explain("pinocchio-mjcf-options")
+    assert options.naive_error == pytest.approx(9.81 - 1.62)  # gravity option not read
+    assert "differs from MuJoCo's by 0°" in options.engines  # eulerseq is read
