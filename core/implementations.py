@@ -222,6 +222,7 @@ class EngineImplementation(Implementation):
         self.map = NativeMap(case.engine_map(), adapter.name, case.multibody())
         self.integrators = adapter.integrators
         self._runs: dict[tuple[float, str], tuple[np.ndarray, np.ndarray]] = {}
+        self._velocities: dict[tuple[float, str], np.ndarray] = {}
 
     def variant(self) -> Variant | None:
         spec = self.case.multibody()
@@ -277,8 +278,14 @@ class EngineImplementation(Implementation):
         key = (dt, self.adapter.definition(integrator))
         if key not in self._runs:  # two names for one map (implicitfast = euler, D = 0) run once
             traj = self.adapter.simulate(qe0, ve0, spec.duration, dt, integrator)
-            self._runs[key] = (traj.t, self.map.to_book(traj.q))
+            qb = self.map.to_book(traj.q)
+            self._runs[key] = (traj.t, qb)
+            self._velocities[key] = co.velocity_to_book(self.map, qb, traj.v)
         return self._runs[key]
+
+    def velocities(self, dt: float, integrator: str) -> np.ndarray | None:
+        """Book-coordinate velocities of a run :meth:`simulate` made (None if none)."""
+        return self._velocities.get((dt, self.adapter.definition(integrator)))
 
     def solve(self, t: np.ndarray, rtol: float) -> np.ndarray:
         """Book-coordinate configurations of an error-controlled run at times ``t``."""

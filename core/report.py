@@ -107,7 +107,7 @@ def _md(frame: pd.DataFrame) -> str:
 
 def _cell(group: pd.DataFrame) -> str:
     worst = group["max_rel_err"].max()
-    verdicts = sorted(set(group["verdict"]), key=["failed", "skipped", "explained", "passed"].index)
+    verdicts = sorted(set(group["verdict"]), key=["failed", "explained", "passed", "skipped"].index)
     return f"{verdicts[0]} {worst:.1e}" if np.isfinite(worst) else verdicts[0]
 
 
@@ -148,6 +148,56 @@ def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) ->
             }
         )
     return pd.DataFrame(rows)
+
+
+def family_matrix(d: pd.DataFrame, trajectories: bool) -> pd.DataFrame:
+    """Pair × case: the worst verdict and worst relative error over the family's rows
+    (instantaneous quantities, or trajectories)."""
+    rows = d[(d.quantity == "trajectory") == trajectories].copy()
+    if not len(rows):
+        return pd.DataFrame()
+    rows["pair"] = rows["impl_a"] + " vs " + rows["impl_b"]
+    out = rows.groupby(["pair", "case"], sort=True).apply(_cell, include_groups=False)
+    return out.unstack("case", fill_value="").reset_index()
+
+
+def order_matrix(conv: pd.DataFrame, d: pd.DataFrame) -> pd.DataFrame:
+    """Implementation/integrator × case: observed order (verdict)."""
+    t = order_table(conv, d)
+    if not len(t):
+        return t
+    t["run"] = t["implementation"] + " " + t["integrator"]
+    t["cell"] = [
+        f"{p:.3f} ({v})" if np.isfinite(p) else v
+        for p, v in zip(t["observed order"], t["verdict"], strict=True)
+    ]
+    return t.pivot(index="run", columns="case", values="cell").fillna("").reset_index()
+
+
+def conservation_table(result: RunResult) -> pd.DataFrame:
+    """Per case × implementation × integrator: the finest run's max relative energy error."""
+    rows = []
+    for case, fig in result.figures.items():
+        for (impl, integ), drift in sorted(fig.energy.items()):
+            rows.append(
+                {
+                    "case": case,
+                    "impl": impl,
+                    "integrator": integ,
+                    "dt": fig.steps[impl, integ],
+                    "max_energy_drift": float(drift.max()),
+                }
+            )
+    return pd.DataFrame(rows, columns=["case", "impl", "integrator", "dt", "max_energy_drift"])
+
+
+def conservation_matrix(result: RunResult) -> pd.DataFrame:
+    t = conservation_table(result)
+    if not len(t):
+        return t
+    t["run"] = t["impl"] + " " + t["integrator"]
+    t["cell"] = [f"{x:.1e}" for x in t["max_energy_drift"]]
+    return t.pivot(index="run", columns="case", values="cell").fillna("").reset_index()
 
 
 def _summary(d: pd.DataFrame) -> pd.DataFrame:
@@ -215,6 +265,22 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
         ax.legend(fontsize=6, ncol=2)
     fig.tight_layout()
     out["convergence"] = _png(fig)
+
+    fig, ax = plt.subplots(figsize=(7, 3.2))
+    for (impl, integ), drift in sorted(data.energy.items()):
+        ax.semilogy(
+            data.t,
+            np.maximum(drift[:: max(1, len(drift) // len(data.t))][: len(data.t)], 1e-17),
+            lw=1,
+            label=f"{impl} {integ}",
+        )
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("|E(t) − E(0)| / max|E|")
+    ax.set_title("Conservation drift (finest step of each integrator)")
+    if data.energy:
+        ax.legend(fontsize=6, ncol=2)
+    fig.tight_layout()
+    out["energy"] = _png(fig)
     return out
 
 
@@ -262,6 +328,8 @@ def case_page(case: Case, result: RunResult) -> str:
         "",
         f"![error against step](figures/{case.name}_convergence.png)",
         "",
+        f"![conservation drift](figures/{case.name}_energy.png)",
+        "",
     ]
     return "\n".join(lines)
 
@@ -307,9 +375,25 @@ def index_page(result: RunResult, *, date: str) -> str:
         "",
         _md(_summary(d)),
         "",
-        f"### Order of accuracy (finest asymptotic pair of steps, nominal ± {ORDER_SLACK})",
+        "### Instantaneous quantities: worst verdict and relative error, pair × case",
         "",
-        _md(order_table(conv, d)),
+        _md(family_matrix(d, trajectories=False)),
+        "",
+        "### Trajectories: worst verdict and relative error, pair × case",
+        "",
+        _md(family_matrix(d, trajectories=True)),
+        "",
+        f"### Order of accuracy: observed order (verdict), nominal ± {ORDER_SLACK}",
+        "",
+        _md(order_matrix(conv, d)),
+        "",
+        "### Conservation: max |E(t) − E(0)| / max |E| of the finest run (measured)",
+        "",
+        "E = T + V of each implementation's own model (the field's V for Kepler); a "
+        "symplectic Euler keeps it bounded, RK4 lets it drift at its order. Informational: no "
+        "verdict (conservation.csv).",
+        "",
+        _md(conservation_matrix(result)),
         "",
         "### Errata: the book's printed equations against the general method",
         "",
@@ -379,6 +463,7 @@ def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Pat
     files: dict[Path, str | bytes] = {
         out / "discrepancies.csv": to_csv(result.discrepancies),
         out / "convergence.csv": to_csv(result.convergence),
+        out / "conservation.csv": to_csv(conservation_table(result)),
     }
     for case in result.cases:
         files[out / f"{case.name}.md"] = case_page(case, result)

@@ -119,6 +119,26 @@ class References:
         return self._discrete[key]
 
 
+def _energy_drift(
+    case: Case,
+    impl: Implementation,
+    variant: Variant | None,
+    dt: float,
+    integrator: str,
+    q: np.ndarray,
+) -> np.ndarray | None:
+    """Relative energy error along a run (conservation, (2.2.36)'s T + V = h), evaluated with
+    the reference's energy of the implementation's own model."""
+    v = getattr(impl, "velocities", lambda *_: None)(dt, integrator)
+    if v is None or variant is None:
+        return None
+    dyn = general_method(case, variant)
+    energy = dyn.kinetic_energy(q, v) + dyn.potential_energy(q)
+    if hasattr(dyn, "field_potential"):
+        energy = energy + dyn.field_potential(q)
+    return np.abs(energy - energy[0]) / max(float(np.abs(energy).max()), 1e-300)
+
+
 def observed_orders(dts: list[float], errors: list[float]) -> list[float]:
     """p between consecutive steps; NaN for the first."""
     out = [float("nan")]
@@ -137,6 +157,8 @@ class TrajectoryFigures:
     runs: dict[tuple[str, str], np.ndarray] = field(default_factory=dict)
     errors: dict[tuple[str, str], np.ndarray] = field(default_factory=dict)
     steps: dict[tuple[str, str], float] = field(default_factory=dict)
+    energy: dict[tuple[str, str], np.ndarray] = field(default_factory=dict)
+    """|E(t) − E(0)| / max|E| of the finest run, E = T + V (+ the field's V) of its own model."""
 
 
 def study(
@@ -180,6 +202,9 @@ def study(
             figures.runs[name, integrator] = q[:: round(spec.grid_step / dt)]
             figures.errors[name, integrator] = diff
             figures.steps[name, integrator] = dt
+            drift = _energy_drift(case, impl, variant, dt, integrator, q)
+            if drift is not None:
+                figures.energy[name, integrator] = drift
             orders = observed_orders(list(dts), errors)
             asym = [e > REFERENCE_MARGIN * ref_err for e in errors]
             finest = [i for i in range(1, len(dts)) if asym[i] and asym[i - 1]]
