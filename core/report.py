@@ -431,7 +431,8 @@ def index_page(result: RunResult, *, date: str) -> str:
         *[f"- **{name}**: {CONVENTIONS.get(name, '')}" for name in used],
         "",
         "Performance: [benchmark.md](benchmark.md), written by `dyncheck bench`. "
-        "Conventions catalogue: [conventions.md](conventions.md).",
+        "Conventions catalogue: [conventions.md](conventions.md). "
+        "Errata: [errata.md](errata.md).",
         "",
         "### Case pages",
         "",
@@ -471,6 +472,22 @@ def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Pat
             files[out / "figures" / f"{case.name}_{kind}.png"] = png
     files[out / "README.md"] = index_page(result, date=date)
     files[out / "conventions.md"] = conventions_page()
+    lead, table = errata(result.discrepancies)
+    files[out / "errata.md"] = "\n".join(
+        [
+            "# Errata: the book's printed equations against the general method",
+            "",
+            "Each printed equation of motion (and its T and V) is evaluated as `book` and compared "
+            "with the general method (`reference`, Lagrange's equations (2.2.23)-(2.2.26) from the "
+            "particle positions) at the seeded states of every case; a disagreement beyond "
+            "round-off would be an erratum of the book.",
+            "",
+            lead,
+            "",
+            _md(table),
+            "",
+        ]
+    )
     return files
 
 

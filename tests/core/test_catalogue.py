@@ -88,3 +88,11 @@ def test_point_mass_floor_and_pinocchio_options():
     (options,) = catalogue.explain("pinocchio-mjcf-options")
     assert options.naive_error == pytest.approx(9.81 - 1.62)  # gravity option not read
     assert "differs from MuJoCo's by 0°" in options.engines  # eulerseq is read
+
+
+def test_pinocchio_drops_equality_and_group_rk4_order():
+    (eq,) = catalogue.explain("pinocchio-mjcf-equality")
+    assert eq.naive_error == 1.0  # the one tendon equality is not loaded
+    (rk4,) = catalogue.explain("rk4-on-the-rotation-group")
+    assert rk4.naive_error == pytest.approx(2.0, abs=0.1)
+    assert rk4.correct_error == pytest.approx(4.0, abs=0.1)
