@@ -270,7 +270,7 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     for (impl, integ), drift in sorted(data.energy.items()):
         ax.semilogy(
             data.t,
-            np.maximum(drift[:: max(1, len(drift) // len(data.t))][: len(data.t)], 1e-17),
+            np.maximum(drift[:: (len(drift) - 1) // (len(data.t) - 1)], 1e-17),
             lw=1,
             label=f"{impl} {integ}",
         )
