@@ -39,6 +39,19 @@ def spherical_singularity(q: np.ndarray) -> str | None:
     return None
 
 
+class _SphericalChart:
+    """The book's spherical chart (ρ, θ, φ): datum on the equator, singular set, sampling box."""
+
+    def rest(self) -> np.ndarray:
+        return np.array([1.0, np.pi / 2, 0.0])
+
+    def chart_singularity(self, q: np.ndarray) -> str | None:
+        return spherical_singularity(q)
+
+    def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        return SPHERICAL_BOUNDS
+
+
 @dataclass(frozen=True)
 class _Particle(Case):
     M: float = 1.5
@@ -59,7 +72,7 @@ class _Particle(Case):
 
 
 @dataclass(frozen=True)
-class SphericalCoordinates(_Particle):
+class SphericalCoordinates(_SphericalChart, _Particle):
     """Spherical coordinates (ρ, θ, φ) of Example 5 as a joint chain::
 
     hinge φ about z  →  hinge θ about y  →  slide ρ along z  →  ● M
@@ -85,15 +98,6 @@ class SphericalCoordinates(_Particle):
         return LinearMap(
             PERMUTE_REVERSE, (0.0, 0.0, 0.0), "joints (φ, θ, ρ) = book (ρ, θ, φ) reversed"
         )
-
-    def rest(self) -> np.ndarray:
-        return np.array([1.0, np.pi / 2, 0.0])
-
-    def chart_singularity(self, q: np.ndarray) -> str | None:
-        return spherical_singularity(q)
-
-    def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        return SPHERICAL_BOUNDS
 
 
 @dataclass(frozen=True)
@@ -156,7 +160,7 @@ def _kepler_initial_state(mu: float, a: float, e: float, incl: float) -> tuple[t
 
 
 @dataclass(frozen=True)
-class Kepler(Case):
+class Kepler(_SphericalChart, Case):
     """Exercise 25: a particle attracted to the origin by F = −μM r/|r|³, the force applied
     through each engine's external-force input; book coordinates spherical (ρ, θ, φ), engine
     joints three Cartesian slides::
@@ -206,15 +210,6 @@ class Kepler(Case):
 
     def engine_map(self) -> SphericalToCartesian:
         return SphericalToCartesian()
-
-    def rest(self) -> np.ndarray:
-        return np.array([1.0, np.pi / 2, 0.0])
-
-    def chart_singularity(self, q: np.ndarray) -> str | None:
-        return spherical_singularity(q)
-
-    def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        return SPHERICAL_BOUNDS
 
     def state_scale(self) -> tuple[float, float, float]:
         return 1.5, 2 * self.M * self.mu, 4 * self.mu
