@@ -14,6 +14,7 @@ from dyncheck.errors import EngineNotInstalled, UnknownName
 ENGINE_PACKAGES: dict[str, str] = {
     "drake": "drake",
     "mujoco": "mujoco",
+    "mujoco-stiff": "mujoco",
     "pinocchio": "pin",
     "pinocchio-mjcf": "pin",
     "sympy-mechanics": "sympy",
@@ -24,11 +25,12 @@ ADAPTERS: dict[str, type[Adapter]] = {}
 MISSING: dict[str, str] = {}
 
 try:
-    from dyncheck.adapters.mujoco_ import MuJoCoAdapter
+    from dyncheck.adapters.mujoco_ import MuJoCoAdapter, MuJoCoStiffAdapter
 
     ADAPTERS[MuJoCoAdapter.name] = MuJoCoAdapter
+    ADAPTERS[MuJoCoStiffAdapter.name] = MuJoCoStiffAdapter
 except ImportError as exc:  # pragma: no cover - depends on the environment
-    MISSING["mujoco"] = str(exc)
+    MISSING["mujoco"] = MISSING["mujoco-stiff"] = str(exc)
 
 try:
     from dyncheck.adapters.sympy_mechanics import SympyMechanicsAdapter

@@ -57,6 +57,9 @@ class Adapter(ABC):
     """Fixed-step integrators :meth:`simulate` accepts."""
     adaptive: ClassVar[bool] = False
     """Whether :meth:`solve` (error-controlled integration by scipy) is offered."""
+    requires_couplings: ClassVar[bool] = False
+    """An implementation that exists only for models with couplings (it equals another one
+    elsewhere)."""
 
     def __init__(self, model: Multibody) -> None:
         self.spec = model
@@ -98,13 +101,24 @@ class Adapter(ABC):
     ) -> Trajectory:
         """Fixed-step integration from (q0, v0) for ``round(duration / dt)`` steps, τ = 0."""
 
+    def constraint_force(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """The couplings' multipliers f (n, n_couplings) of the forward-dynamics solve at τ,
+        in the sign of ``M v̇ + h = τ + Cᵀ f`` (C = ``spec.coupling_matrix()``)."""
+        raise NotImplementedError(f"{self.name} reports no constraint force")
+
+    def softness(self) -> tuple[float, ...] | None:
+        """How the loaded model enforces couplings: ``None`` for exactly (a KKT solve), or a
+        soft constraint's parameters (MuJoCo: solref + solimp, read back from the model)."""
+        return None
+
     def evaluate_all(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
     ) -> dict[str, np.ndarray]:
         """Every quantity at each state, keyed ``mass_matrix``, ``bias_forces``,
         ``forward_dynamics`` (at τ), ``inverse_dynamics`` (at v̇ = a), ``kinetic_energy``,
-        ``potential_energy``. Engines override this with their cheapest batched path."""
-        return {
+        ``potential_energy`` and, with couplings, ``constraint_force`` (at τ). Engines
+        override this with their cheapest batched path."""
+        out = {
             "mass_matrix": self.mass_matrix(q),
             "bias_forces": self.bias(q, v),
             "forward_dynamics": self.forward(q, v, tau),
@@ -112,6 +126,11 @@ class Adapter(ABC):
             "kinetic_energy": self.kinetic_energy(q, v),
             "potential_energy": self.potential_energy(q),
         }
+        if self.spec.couplings:
+            out["constraint_force"] = self._check(
+                "constraint force", self.constraint_force(q, v, tau)
+            )
+        return out
 
     def definition(self, integrator: str) -> str:
         """The integrator's definition as a name: two names with the same definition give the
@@ -130,6 +149,7 @@ class Adapter(ABC):
         inv: np.ndarray,
         kin: np.ndarray,
         pot: np.ndarray,
+        constraint: np.ndarray | None = None,
     ) -> dict[str, np.ndarray]:
         """The batched quantities under their canonical names, each checked finite."""
         out = {
@@ -140,6 +160,8 @@ class Adapter(ABC):
             "kinetic_energy": kin,
             "potential_energy": pot,
         }
+        if constraint is not None:
+            out["constraint_force"] = constraint
         return {key: self._check(key, val) for key, val in out.items()}
 
     def _check(self, what: str, value: np.ndarray) -> np.ndarray:

@@ -80,6 +80,11 @@ class DrakeAdapter(Adapter):
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
+        if model.couplings:
+            raise Unsupported(
+                "a continuous-time MultibodyPlant enforces no constraints (Drake's coupler "
+                "constraint needs the discrete SAP solver, a different, compliant dynamics)"
+            )
         if any(j.type == "ball" for j in model.joints):
             raise Unsupported(
                 "Drake's MJCF parser turns a ball joint into a BallRpyJoint (roll-pitch-yaw "

@@ -14,11 +14,20 @@ def _fmt(values: object) -> str:
     return " ".join(repr(float(x)) for x in np.ravel(values))
 
 
-def to_mjcf(model: Multibody, *, timestep: float = 0.002, integrator: str = "Euler") -> str:
+def to_mjcf(
+    model: Multibody,
+    *,
+    timestep: float = 0.002,
+    integrator: str = "Euler",
+    solimp: tuple[float, ...] | None = None,
+) -> str:
     """The MJCF document for ``model``: angles in radians, gravity explicit, energy enabled.
 
     A point mass becomes an ``<inertial>`` (never a geom-derived sphere) with diagonal inertia
     ``model.mjcf_point_inertia``: MuJoCo rejects a moving body whose inertia is below mjMINVAL.
+    Several top-level bodies are wrapped in one jointless ``root`` body (welded to the world):
+    Pinocchio's MJCF parser loads only the first top-level body. A coupling becomes a fixed
+    tendon with an ``<equality>`` holding its length (``solimp`` given, or MuJoCo's default).
     """
     root = ET.Element("mujoco", model=model.name)
     ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false", autolimits="true")
@@ -31,6 +40,10 @@ def to_mjcf(model: Multibody, *, timestep: float = 0.002, integrator: str = "Eul
     )
     ET.SubElement(option, "flag", energy="enable", contact="disable")
     parents: dict[str | None, ET.Element] = {None: ET.SubElement(root, "worldbody")}
+    if sum(body.parent is None for body in model.bodies) > 1:
+        parents[None] = ET.SubElement(parents[None], "body", name="root", pos="0 0 0")
+        # welded to the world, so its mass moves nothing; Pinocchio's parser needs one
+        ET.SubElement(parents[None], "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
     for body in model.bodies:
         el = ET.SubElement(parents[body.parent], "body", name=body.name, pos=_fmt(body.joint_pos))
         for joint in body.joints:
@@ -55,5 +68,16 @@ def to_mjcf(model: Multibody, *, timestep: float = 0.002, integrator: str = "Eul
             fullinertia=_fmt(inertia[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]]),
         )
         parents[body.name] = el
+    if model.couplings:
+        tendons = ET.SubElement(root, "tendon")
+        equality = ET.SubElement(root, "equality")
+        for coupling in model.couplings:
+            fixed = ET.SubElement(tendons, "fixed", name=coupling.name)
+            for joint, c in coupling.coefs:
+                ET.SubElement(fixed, "joint", joint=joint, coef=repr(float(c)))
+            attrs = {"tendon1": coupling.name}
+            if solimp is not None:
+                attrs["solimp"] = _fmt(solimp)
+            ET.SubElement(equality, "tendon", attrs)
     ET.indent(root)
     return ET.tostring(root, encoding="unicode") + "\n"

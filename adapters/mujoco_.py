@@ -11,6 +11,11 @@ generalized force, so the field's Jᵀ F (``mj_applyFT``) is subtracted to give 
 simulation, a force written to ``xfrc_applied`` before ``mj_step`` is held over all RK4 stages
 (``rk4-held-force``); evaluating it at every stage needs the passive-force callback
 ``mjcb_passive``, which MuJoCo calls inside every stage's forward pass.
+
+Couplings are tendon equalities, MuJoCo's *soft* constraints: their force is ``efc_force`` of
+the equality rows (``qfrc_constraint = efc_Jᵀ efc_force``), their model the loaded
+``eq_solref`` and ``eq_solimp``. ``mujoco-stiff`` is the same model with the impedance at
+MuJoCo's ceiling (solimp d = 0.9999 everywhere).
 """
 
 from __future__ import annotations
@@ -24,7 +29,7 @@ import numpy as np
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Multibody
-from dyncheck.errors import EngineError
+from dyncheck.errors import EngineError, Unsupported
 
 _DIVERGED = (
     mujoco.mjtWarning.mjWARN_BADQPOS,
@@ -45,9 +50,14 @@ class MuJoCoAdapter(Adapter):
     package: ClassVar[str] = "mujoco"
     integrators: ClassVar[tuple[str, ...]] = tuple(_INTEGRATORS)
 
+    solimp: ClassVar[tuple[float, ...] | None] = None
+    """The equalities' solimp written to the MJCF (None: MuJoCo's default)."""
+
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
-        self.xml = to_mjcf(model)
+        if self.requires_couplings and not model.couplings:
+            raise Unsupported(f"{self.name} differs from mujoco only on couplings; none here")
+        self.xml = to_mjcf(model, solimp=self.solimp)
         self.model = mujoco.MjModel.from_xml_string(self.xml)
         self.data = mujoco.MjData(self.model)
         self._body_ids = [self.model.body(b.name).id for b in model.bodies]
@@ -69,6 +79,30 @@ class MuJoCoAdapter(Adapter):
 
     def loaded_gravity(self) -> np.ndarray:
         return np.array(self.model.opt.gravity)
+
+    def softness(self) -> tuple[float, ...] | None:
+        """(timeconst, dampratio, dmin, dmax, width, mid, power) of the equalities."""
+        if not self.model.neq:
+            return None
+        params = {
+            (*map(float, self.model.eq_solref[i]), *map(float, self.model.eq_solimp[i]))
+            for i in range(self.model.neq)
+        }
+        if len(params) > 1:
+            raise EngineError(f"{self.name}: equalities with different solref/solimp")
+        return params.pop()
+
+    def _equality_force(self, d: mujoco.MjData) -> np.ndarray:
+        """efc_force of the equality rows, in equality order (after ``mj_forward``)."""
+        rows = np.flatnonzero(d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+        order = np.argsort(d.efc_id[rows], kind="stable")
+        return np.array(d.efc_force[rows[order]])
+
+    def constraint_force(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        out = np.empty((q.shape[0], self.model.neq))
+        for k, d in self._eval(q, v, tau):
+            out[k] = self._equality_force(d)
+        return self._check("constraint force", out)
 
     # --- the external field ---------------------------------------------------------------
 
@@ -159,13 +193,16 @@ class MuJoCoAdapter(Adapter):
         M = np.empty((n, nv, nv))
         bias, fwd, inv = np.empty((n, nv)), np.empty((n, nv)), np.empty((n, nv))
         energy = np.empty((n, 2))
+        force = np.empty((n, m.neq)) if self.spec.couplings else None
         for k in range(n):
             self._set(q[k], v[k], tau[k])
             mujoco.mj_forward(m, d)
             mujoco.mj_fullM(m, d, M[k])
             bias[k], fwd[k], energy[k] = d.qfrc_bias, d.qacc, d.energy
+            if force is not None:
+                force[k] = self._equality_force(d)
             inv[k] = self._inverse_one(a[k])
-        return self._outputs(M, bias, fwd, inv, energy[:, 1], energy[:, 0])
+        return self._outputs(M, bias, fwd, inv, energy[:, 1], energy[:, 0], force)
 
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
@@ -205,3 +242,12 @@ class MuJoCoAdapter(Adapter):
         """mjcb_passive: the field's Jᵀ F added at every stage of every step."""
         if m is self.model:
             self._field_generalized(d, d.qfrc_passive)
+
+
+class MuJoCoStiffAdapter(MuJoCoAdapter):
+    """MuJoCo with the equalities' impedance at its ceiling mjMAXIMP = 0.9999 (solimp
+    dmin = dmax): the stiffest soft constraint MuJoCo offers. Only for models with couplings."""
+
+    name: ClassVar[str] = "mujoco-stiff"
+    requires_couplings: ClassVar[bool] = True
+    solimp: ClassVar[tuple[float, ...] | None] = (0.9999, 0.9999, 0.001, 0.5, 2.0)

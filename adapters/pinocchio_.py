@@ -7,6 +7,12 @@ Pinocchio's names: M = ``crba`` (upper triangle filled, mirrored here); h = ``rn
 ``computeKineticEnergy``, ``computePotentialEnergy`` (V = −Σ mᵢ g·cᵢ). Pinocchio has no time
 integrator: :mod:`.integrators` supplies MuJoCo's definitions so integrators compare like for
 like, and :meth:`PinocchioAdapter.solve` integrates with scipy's error-controlled DOP853.
+
+Couplings: Pinocchio's constrained forward dynamics ``forwardDynamics(q, v, τ, C, γ = 0)``
+(an exact KKT solve with the constant constraint Jacobian C; the multipliers in
+``data.lambda_c``, with M v̇ + h = τ + Cᵀ λ). Pinocchio's MJCF parser drops the tendon
+equality (see ``dyncheck explain pinocchio-mjcf-equality``), so ``pinocchio-mjcf`` takes C
+from the engine-neutral model as well.
 """
 
 from __future__ import annotations
@@ -96,6 +102,9 @@ class PinocchioAdapter(Adapter):
         self.__pool: pin.ModelPool | None = None
         # the joint that carries each body's inertia, found through the body's frame
         self._joint_ids = [self._body_joint(b.name) for b in model.bodies]
+        self._C = model.coupling_matrix() if model.couplings else None
+        if self._C is not None and model.central_mu:
+            raise Unsupported(f"{self.name}: couplings together with a field")
 
     def _build(self, model: Multibody) -> pin.Model:
         return build_model(model)
@@ -134,7 +143,21 @@ class PinocchioAdapter(Adapter):
             fext[j] = fext[j] + d.oMi[j].actInv(pin.Force(F, np.cross(c, F)))
         return fext
 
+    def _constrained(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """v̇ of the KKT solve; the multipliers are left in ``data.lambda_c``."""
+        gamma = np.zeros(self._C.shape[0])  # C is constant: no drift term
+        return pin.forwardDynamics(self.model, self.data, q, v, tau, self._C, gamma).copy()
+
+    def constraint_force(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        out = np.empty((q.shape[0], self._C.shape[0]))
+        for k in range(q.shape[0]):
+            self._constrained(q[k], v[k], tau[k])
+            out[k] = self.data.lambda_c
+        return self._check("constraint force", out)
+
     def _aba(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, fext=None) -> np.ndarray:
+        if self._C is not None:
+            return self._constrained(q, v, tau)
         fext = self._fext(q) if fext is None else fext
         if fext is None:
             return pin.aba(self.model, self.data, q, v, tau)
@@ -217,11 +240,17 @@ class PinocchioAdapter(Adapter):
         kin, pot = np.empty(n), np.empty(n)
         crba, rnea, aba = pin.crba, pin.rnea, pin.aba
         field = bool(self.spec.central_mu)
+        coupled = self._C is not None
+        force = np.empty((n, self._C.shape[0])) if coupled else None
         for k in range(n):
             qk, vk = q[k], v[k]
             M[k] = crba(m, d, qk)
             bias[k] = rnea(m, d, qk, vk, zero)
-            if field:
+            if coupled:
+                fwd[k] = self._constrained(qk, vk, tau[k])
+                force[k] = d.lambda_c
+                inv[k] = rnea(m, d, qk, vk, a[k])
+            elif field:
                 fwd[k] = self._aba(qk, vk, tau[k])
                 inv[k] = self._rnea(qk, vk, a[k])
             else:
@@ -230,7 +259,7 @@ class PinocchioAdapter(Adapter):
             kin[k] = pin.computeKineticEnergy(m, d, qk, vk)
             pot[k] = pin.computePotentialEnergy(m, d, qk)
         M = np.triu(M) + np.swapaxes(np.triu(M, 1), 1, 2)
-        return self._outputs(M, bias, fwd, inv, kin, pot)
+        return self._outputs(M, bias, fwd, inv, kin, pot, force)
 
     @property
     def _pool(self) -> pin.ModelPool:

@@ -55,6 +55,8 @@ class SympyMechanicsAdapter(Adapter):
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
+        if model.couplings:
+            raise Unsupported("couplings (LagrangesMethod's hol_coneqs) are not built yet")
         if any(j.type == "ball" for j in model.joints):
             raise Unsupported(
                 "a ball joint needs a three-angle chart in sympy.physics.mechanics; dyncheck "

@@ -5,10 +5,13 @@ from __future__ import annotations
 from dyncheck.cases.base import INTEGRATORS, NOMINAL_ORDER, Case, StateSample, TrajectorySpec
 from dyncheck.cases.particles import CylindricalCoordinates, Kepler, SphericalCoordinates
 from dyncheck.cases.pendulums import CompoundPendulum, SimplePendulum, SphericalPendulum
+from dyncheck.cases.pulleys import Atwood, CompoundPulley
 from dyncheck.errors import UnknownName
 
 CASES: dict[str, type[Case]] = {
+    "atwood": Atwood,
     "compound_pendulum": CompoundPendulum,
+    "compound_pulley": CompoundPulley,
     "cylindrical_coordinates": CylindricalCoordinates,
     "kepler": Kepler,
     "simple_pendulum": SimplePendulum,

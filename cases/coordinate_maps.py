@@ -44,7 +44,12 @@ class LinearMap:
         return q @ self.A.T + np.asarray(self.offset)
 
     def to_book(self, qe: np.ndarray) -> np.ndarray:
-        return np.linalg.solve(self.A, (qe - np.asarray(self.offset)).T).T
+        """x = A⁻¹ (x̄ − c); least squares (AᵀA)⁻¹Aᵀ(x̄ − c) for an embedding (more engine
+        coordinates than book ones: a constraint's), exact on A's range."""
+        A = self.A
+        if A.shape[0] == A.shape[1]:
+            return np.linalg.solve(A, (qe - np.asarray(self.offset)).T).T
+        return np.linalg.solve(A.T @ A, A.T @ (qe - np.asarray(self.offset)).T).T
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         """∂x̄ʳ/∂xʲ of (2.2.4), shape (n, ne, nb)."""

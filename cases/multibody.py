@@ -71,6 +71,25 @@ class Body:
 
 
 @dataclass(frozen=True)
+class Coupling:
+    """A linear holonomic constraint Σⱼ cⱼ qⱼ = 0 on slide or hinge joint coordinates, zero at
+    the model's reference configuration (all joint coordinates 0): an inextensible cord whose
+    length change is Σⱼ cⱼ qⱼ. Its multiplier f enters the joint equations as
+    M v̇ + h = τ + cᵀ f; for a cord pulled taut, f = −(cord tension)."""
+
+    name: str
+    coefs: tuple[tuple[str, float], ...]
+    """(joint name, coefficient) pairs."""
+
+    def __post_init__(self) -> None:
+        if not self.coefs:
+            raise InvalidInput(f"{self.name}.coefs", self.coefs, "at least one joint")
+        for joint, c in self.coefs:
+            if not np.isfinite(c) or c == 0:
+                raise InvalidInput(f"{self.name}.coefs[{joint}]", c, "a finite non-zero number")
+
+
+@dataclass(frozen=True)
 class Multibody:
     """A tree of bodies in parent-before-child order, under uniform gravity.
 
@@ -86,6 +105,8 @@ class Multibody:
     central_mu: float = 0.0
     """μ of an inverse-square attraction F = −μ m r/|r|³ toward the world origin on every
     body's centre of mass (m³/s²), applied through each engine's external-force input."""
+    couplings: tuple[Coupling, ...] = ()
+    """Linear constraints between joint coordinates (cords over pulleys)."""
 
     def __post_init__(self) -> None:
         finite_array("gravity", self.gravity, (3,))
@@ -97,6 +118,27 @@ class Multibody:
             if body.parent not in seen:
                 raise ValueError(f"body {body.name!r}: parent {body.parent!r} must come first")
             seen.add(body.name)
+        types = {j.name: j.type for j in self.joints}
+        for coupling in self.couplings:
+            for joint, _ in coupling.coefs:
+                if types.get(joint) not in ("slide", "hinge"):
+                    raise InvalidInput(
+                        f"{coupling.name}.coefs", joint, "the name of a slide or hinge joint"
+                    )
+
+    def coupling_matrix(self, positions: bool = False) -> np.ndarray:
+        """The constraint rows C: (n_couplings, nv) on velocity coordinates (C v = 0), or with
+        ``positions`` (n_couplings, nq) on position coordinates (C q = 0, the violation)."""
+        size = NQ if positions else NV
+        index, k = {}, 0
+        for j in self.joints:
+            index[j.name] = k
+            k += size[j.type]
+        C = np.zeros((len(self.couplings), k))
+        for i, coupling in enumerate(self.couplings):
+            for joint, c in coupling.coefs:
+                C[i, index[joint]] += c
+        return C
 
     @property
     def joints(self) -> tuple[Joint, ...]:

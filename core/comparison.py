@@ -24,22 +24,26 @@ from dyncheck.implementations import (
     GRAVITY_DEFAULT,
     IMPLEMENTATIONS,
     POINT_INERTIA,
-    QUANTITIES,
     Implementation,
     ReferenceImplementation,
     Variant,
     book_variant,
     general_method,
+    quantities,
 )
 
 __all__ = ["GRAVITY_DEFAULT", "POINT_INERTIA", "compare_instantaneous"]
 from dyncheck.results import Discrepancy
-from dyncheck.tolerances import instantaneous
+from dyncheck.tolerances import instantaneous, soft_condition
 
 
 def describe(v: Variant) -> str:
     """A variant in a few words, for notes."""
-    return f"(point inertia {list(v.point_inertia)} kg m^2, gravity {list(v.gravity)} m/s^2)"
+    soft = ""
+    if v.softness:
+        tc, dr, *imp = v.softness
+        soft = f", soft constraint solref {[tc, dr]} solimp {imp}"
+    return f"(point inertia {list(v.point_inertia)} kg m^2, gravity {list(v.gravity)} m/s^2{soft})"
 
 
 def _per_state(x: np.ndarray) -> np.ndarray:
@@ -146,7 +150,11 @@ class VariantPredictor:
 def _row(
     case: Case, quantity: str, a: Evaluator, b: Evaluator, st: PairStats, condition: float
 ) -> Discrepancy:
-    tol = instantaneous(quantity, condition)
+    soft = max(
+        soft_condition(min(max(v.softness[2:4]), 0.9999)) if v is not None and v.softness else 1.0
+        for v in (a.variant, b.variant)
+    )
+    tol = instantaneous(quantity, condition, soft)
     base = dict(
         case=case.name,
         quantity=quantity,
@@ -208,7 +216,14 @@ def compare_instantaneous(
     names = [n for n in IMPLEMENTATIONS if n in impls]
     evals = {n: Evaluator(n, impls[n]) for n in names}
     pairs = list(combinations(names, 2))
-    stats = {(q, a, b): PairStats() for q in QUANTITIES for a, b in pairs}
+    qs = quantities(case)
+
+    def provides(name: str, q: str) -> bool:
+        impl = impls[name]
+        return impl.provides(q) if isinstance(impl, Implementation) else True
+
+    keys = [(q, a, b) for q in qs for a, b in pairs if provides(a, q) and provides(b, q)]
+    stats = {key: PairStats() for key in keys}
     predict = VariantPredictor(case)
     book = book_variant(case)
     condition, offset = 1.0, 0
@@ -223,12 +238,9 @@ def compare_instantaneous(
                 continue
             differ = ea.variant is not None and eb.variant is not None and ea.variant != eb.variant
             pa, pb = (predict(ea.variant), predict(eb.variant)) if differ else (None, None)
-            for q in QUANTITIES:
-                predicted = pb[q] - pa[q] if differ else None
-                stats[q, a, b].update(offset, s, eb.values[q], ea.values[q], predicted)
+            for q in qs:
+                if (q, a, b) in stats:
+                    predicted = pb[q] - pa[q] if differ else None
+                    stats[q, a, b].update(offset, s, eb.values[q], ea.values[q], predicted)
         offset += len(s)
-    return [
-        _row(case, q, evals[a], evals[b], stats[q, a, b], condition)
-        for q in QUANTITIES
-        for a, b in pairs
-    ]
+    return [_row(case, q, evals[a], evals[b], stats[q, a, b], condition) for q, a, b in keys]

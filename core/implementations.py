@@ -20,7 +20,8 @@ from dyncheck.adapters import ENGINE_PACKAGES, Adapter, get_adapter
 from dyncheck.cases import Case, StateSample
 from dyncheck.conventions import from_native, to_native
 from dyncheck.errors import UnknownName
-from dyncheck.reference import particle, pendulum
+from dyncheck.reference import particle, pendulum, pulley
+from dyncheck.reference.constraints import Softness
 from dyncheck.reference.coordinates import cylindrical, spherical
 from dyncheck.reference.trajectory import solve
 
@@ -31,7 +32,18 @@ QUANTITIES: tuple[str, ...] = (
     "inverse_dynamics",
     "kinetic_energy",
     "potential_energy",
+    "constraint_force",
 )
+"""``constraint_force`` exists only for cases with couplings: the cords' tensions (N), from
+the forward-dynamics solve at the sampled τ."""
+
+
+def quantities(case: Case) -> tuple[str, ...]:
+    """The quantities compared for ``case``."""
+    if case.multibody().couplings:
+        return QUANTITIES
+    return tuple(q for q in QUANTITIES if q != "constraint_force")
+
 
 IMPLEMENTATIONS: tuple[str, ...] = (
     "reference",
@@ -41,8 +53,13 @@ IMPLEMENTATIONS: tuple[str, ...] = (
     "pinocchio-mjcf",
     "drake",
     "mujoco",
+    "mujoco-stiff",
 )
 """All implementation names, most trusted first: in a pair the earlier one is ``desired``."""
+
+COUPLINGS_ONLY: frozenset[str] = frozenset({"mujoco-stiff"})
+"""Implementations that differ from another only in how couplings are held: run on cases
+with couplings only (elsewhere they would repeat ``mujoco`` under a second name)."""
 
 _REFERENCE: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
     "simple_pendulum": (pendulum.simple_pendulum, pendulum.simple_pendulum_printed),
@@ -62,6 +79,19 @@ _REFERENCE: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
         lambda M, g, inertia: particle.particle(cylindrical(), M, g, inertia=inertia),
         lambda M, g: particle.lagrange_form(cylindrical(), M, g),
     ),
+    # the masses ride on slides and never rotate: an inertia floor has no effect
+    "atwood": (
+        lambda m1, m2, a, l, g, inertia, rest, softness: pulley.atwood(
+            m1, m2, a, l, g, rest[0], softness=softness
+        ),
+        lambda m1, m2, a, l, g: pulley.atwood_printed(m1, m2, g),
+    ),
+    "compound_pulley": (
+        lambda m1, m2, m3, a, l1, l2, g, inertia, rest, softness: pulley.compound_pulley(
+            m1, m2, m3, a, l1, l2, g, rest, softness=softness
+        ),
+        lambda m1, m2, m3, a, l1, l2, g: pulley.compound_pulley_printed(m1, m2, m3, g),
+    ),
 }
 """Case name → (general method, the book's printed form). For the cylindrical particle the
 book prints no equations; its "printed" form is (2.2.23) with the closed-form metric and
@@ -74,6 +104,9 @@ def general_method(case: Case, variant: Variant | None = None):
     general, _ = _REFERENCE[case.name]
     variant = variant or book_variant(case)
     params = case.params() | {"g": -variant.gravity[2]}
+    if case.multibody().couplings:
+        params["rest"] = tuple(float(x) for x in case.rest())
+        params["softness"] = Softness(*variant.softness) if variant.softness else None
     return general(**params, inertia=variant.point_inertia)
 
 
@@ -92,6 +125,8 @@ class Variant:
 
     point_inertia: tuple[float, ...]
     gravity: tuple[float, float, float]
+    softness: tuple[float, ...] | None = None
+    """None: couplings held exactly; else a soft constraint's (solref, solimp)."""
 
     def conventions(self, other: Variant) -> list[str]:
         """Names of the conventions in which two variants differ."""
@@ -100,11 +135,14 @@ class Variant:
             out.append(POINT_INERTIA)
         if self.gravity != other.gravity:
             out.append(GRAVITY_DEFAULT)
+        if self.softness != other.softness:
+            out.append(SOFT_CONSTRAINT)
         return out
 
 
 POINT_INERTIA = "point-mass inertia floor"
 GRAVITY_DEFAULT = "MJCF gravity option not read"
+SOFT_CONSTRAINT = "soft constraint (MuJoCo solref/solimp impedance model)"
 
 
 def book_variant(case: Case) -> Variant:
@@ -131,6 +169,10 @@ class Implementation(ABC):
 
     @abstractmethod
     def _potential(self, q: np.ndarray) -> np.ndarray: ...
+
+    def provides(self, quantity: str) -> bool:
+        """Whether this implementation computes ``quantity`` (all of the case's, by default)."""
+        return quantity in quantities(self.case)
 
     def evaluate(self, s: StateSample) -> dict[str, np.ndarray]:
         """Every quantity at every state; potential energy relative to the case's rest state."""
@@ -159,13 +201,16 @@ class _Equations(Implementation):
 
     def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]:
         d = self.dyn
-        return {
+        out = {
             "mass_matrix": d.mass_matrix(q),
             "bias_forces": d.bias(q, s.v),
             "forward_dynamics": d.forward(q, s.v, s.tau),
             "inverse_dynamics": d.inverse(q, s.v, s.a),
             "kinetic_energy": d.kinetic_energy(q, s.v),
         }
+        if self.provides("constraint_force"):
+            out["constraint_force"] = d.constraint_force(q, s.v, s.tau)
+        return out
 
     def _potential(self, q: np.ndarray) -> np.ndarray:
         return self.dyn.potential_energy(q)
@@ -173,6 +218,10 @@ class _Equations(Implementation):
 
 class BookImplementation(_Equations):
     name: ClassVar[str] = "book"
+
+    def provides(self, quantity: str) -> bool:
+        """The book prints no cord tension (Example 6, exercise 17)."""
+        return quantity != "constraint_force" and super().provides(quantity)
 
     def _build(self, case: Case) -> Any:
         return printed_equations(case)
@@ -223,6 +272,7 @@ class EngineImplementation(Implementation):
         self.integrators = adapter.integrators
         self._runs: dict[tuple[float, str], tuple[np.ndarray, np.ndarray]] = {}
         self._velocities: dict[tuple[float, str], np.ndarray] = {}
+        self._engine_q: dict[tuple[float, str], np.ndarray] = {}
 
     def variant(self) -> Variant | None:
         spec = self.case.multibody()
@@ -248,7 +298,7 @@ class EngineImplementation(Implementation):
         gravity = tuple(float(x) for x in self.adapter.loaded_gravity())
         if gravity[0] or gravity[1]:
             return None  # the reference models gravity along −z only
-        return Variant(tuple(out), gravity)
+        return Variant(tuple(out), gravity, self.adapter.softness())
 
     def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]:
         m = self.map
@@ -257,7 +307,7 @@ class EngineImplementation(Implementation):
             qe, ve, co.force_to_engine(m, q, s.tau), co.acceleration_to_engine(m, q, s.v, s.a)
         )
         Me = raw["mass_matrix"]
-        return {
+        out = {
             "mass_matrix": co.mass_matrix_to_book(m, q, Me),
             "bias_forces": co.bias_to_book(m, q, s.v, Me, raw["bias_forces"]),
             "forward_dynamics": co.acceleration_to_book(m, q, s.v, raw["forward_dynamics"]),
@@ -265,6 +315,9 @@ class EngineImplementation(Implementation):
             "kinetic_energy": raw["kinetic_energy"],
             "potential_energy": raw["potential_energy"],
         }
+        if "constraint_force" in raw:  # a coupling's multiplier is minus its cord's tension
+            out["constraint_force"] = -raw["constraint_force"]
+        return out
 
     def _potential(self, q: np.ndarray) -> np.ndarray:
         return self.adapter.potential_energy(self.map.to_engine(q))
@@ -280,8 +333,13 @@ class EngineImplementation(Implementation):
             traj = self.adapter.simulate(qe0, ve0, spec.duration, dt, integrator)
             qb = self.map.to_book(traj.q)
             self._runs[key] = (traj.t, qb)
+            self._engine_q[key] = traj.q
             self._velocities[key] = co.velocity_to_book(self.map, qb, traj.v)
         return self._runs[key]
+
+    def engine_positions(self, dt: float, integrator: str) -> np.ndarray:
+        """Engine-coordinate positions of a run :meth:`simulate` made (native storage)."""
+        return self._engine_q[dt, self.adapter.definition(integrator)]
 
     def velocities(self, dt: float, integrator: str) -> np.ndarray | None:
         """Book-coordinate velocities of a run :meth:`simulate` made (None if none)."""
@@ -316,8 +374,11 @@ def reference_trajectory(
 ) -> np.ndarray:
     """q(t) of the general method for ``variant`` by DOP853 (book coordinates)."""
     spec = case.trajectory
+    dyn = general_method(case, variant)
+    if getattr(dyn, "softness", None) is not None:  # the masses leave the cords: integrate them
+        return dyn.trajectory(np.asarray(spec.q0), np.asarray(spec.v0), t, rtol)
     q, _ = solve(
-        general_method(case, variant),
+        dyn,
         np.asarray(spec.q0),
         np.asarray(spec.v0),
         t,

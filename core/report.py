@@ -18,10 +18,17 @@ import pandas as pd
 
 from dyncheck.cases import Case
 from dyncheck.comparison import GRAVITY_DEFAULT, POINT_INERTIA
+from dyncheck.implementations import SOFT_CONSTRAINT
 from dyncheck.results import to_csv, write_atomic
 from dyncheck.run import RunResult
 from dyncheck.tolerances import ORDER_SLACK
-from dyncheck.trajectories import HELD_FORCE, NAIVE_GROUP_RK4, TRUNCATION, TrajectoryFigures
+from dyncheck.trajectories import (
+    HELD_FORCE,
+    NAIVE_GROUP_RK4,
+    PRE_ASYMPTOTIC,
+    TRUNCATION,
+    TrajectoryFigures,
+)
 
 CONVENTIONS = {
     POINT_INERTIA: (
@@ -58,6 +65,25 @@ CONVENTIONS = {
         "without the dexp⁻¹ correction of Munthe-Kaas is second order) and measured in the "
         "order study. MuJoCo 4.0's own RK4 keeps order 4 on the same ball joint (measured), "
         "so engine-against-engine RK4 rows are skipped there: the definitions differ."
+    ),
+    SOFT_CONSTRAINT: (
+        "MuJoCo's equality constraints are soft (Computation chapter, soft constraints): the "
+        "constraint force f = −(A + R)⁻¹(J a₀ − a_ref) with A = J M⁻¹ Jᵀ, R = (1 − d)/d · A "
+        "and a_ref = −b ṙ − k d(r) r (b = 2/(dmax τ), k = 1/(dmax² τ² ζ²)), where d(r) is "
+        "the solimp impedance and τ, ζ the solref time constant and damping ratio, read back "
+        "from the loaded model. At zero violation the acceleration is the exact one plus "
+        "(1 − d) of the unconstrained excess and the tension d times the exact tension "
+        "(d = 0.9 by default: 10% low); along a run the cords stretch until k d r balances "
+        "the excess. The reference (`reference/constraints.py`) evaluates this model on the "
+        "free masses; a row is `explained` only when MuJoCo's numbers equal its prediction "
+        "within round-off, amplified by the solver's Hessian condition 1 + d/(1 − d)."
+    ),
+    PRE_ASYMPTOTIC: (
+        "A stiff constraint mode (λ ≈ −1/τ = −50 s⁻¹ for MuJoCo's default τ = 0.02 s) keeps "
+        "RK4 pre-asymptotic over the resolvable steps: the observed order exceeds 4 (4.40, "
+        "4.20, 4.13 as the step halves). Explained only where the reference's own equations "
+        "of the same model, stepped by the same integrator, show the same order at the same "
+        "step; an engine with a wrong integrator would not."
     ),
     TRUNCATION: (
         "A fixed-step integrator's error against the exact solution of the same model. Judged "
@@ -101,6 +127,10 @@ def versions() -> dict[str, str]:
     return out
 
 
+TRAJECTORY_QUANTITIES = ("trajectory", "constraint_drift")
+"""Row quantities that come from runs (the rest are instantaneous)."""
+
+
 def _md(frame: pd.DataFrame) -> str:
     return frame.to_markdown(index=False, floatfmt=".3g") if len(frame) else "_(none)_"
 
@@ -112,7 +142,7 @@ def _cell(group: pd.DataFrame) -> str:
 
 
 def instantaneous_matrix(d: pd.DataFrame, case: str) -> pd.DataFrame:
-    rows = d[(d["case"] == case) & (d["quantity"] != "trajectory")].copy()
+    rows = d[(d["case"] == case) & ~d["quantity"].isin(TRAJECTORY_QUANTITIES)].copy()
     rows["pair"] = rows["impl_a"] + " vs " + rows["impl_b"]
     out = rows.groupby(["quantity", "pair"], sort=False).apply(_cell, include_groups=False)
     return out.unstack("pair").reset_index()
@@ -153,7 +183,7 @@ def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) ->
 def family_matrix(d: pd.DataFrame, trajectories: bool) -> pd.DataFrame:
     """Pair × case: the worst verdict and worst relative error over the family's rows
     (instantaneous quantities, or trajectories)."""
-    rows = d[(d.quantity == "trajectory") == trajectories].copy()
+    rows = d[d.quantity.isin(TRAJECTORY_QUANTITIES) == trajectories].copy()
     if not len(rows):
         return pd.DataFrame()
     rows["pair"] = rows["impl_a"] + " vs " + rows["impl_b"]
@@ -293,9 +323,9 @@ def case_page(case: Case, result: RunResult) -> str:
     lines = [
         f"# {case.title}",
         "",
-        f"Book: {case.book_refs}. Coordinates: {', '.join(case.coordinates)} (absolute angles "
-        "from the downward vertical). Engine joint coordinates: "
-        f"{cmap.description}; MJCF point-mass inertia {mb.mjcf_point_inertia:g} kg m^2.",
+        f"Book: {case.book_refs}. Coordinates: {', '.join(case.coordinates)}. Engine joint "
+        f"coordinates: {cmap.description}; MJCF point-mass inertia "
+        f"{mb.mjcf_point_inertia:g} kg m^2.",
         "",
         "### Parameters (SI)",
         "",
@@ -320,6 +350,7 @@ def case_page(case: Case, result: RunResult) -> str:
         "",
         _md(pairs[["impl_a", "impl_b", "integrator", "dt", "max_rel_err", "tolerance", "verdict"]]),
         "",
+        *_constraint_section(case, d),
         "### Figures",
         "",
         f"![trajectory](figures/{case.name}_trajectory.png)",
@@ -332,6 +363,40 @@ def case_page(case: Case, result: RunResult) -> str:
         "",
     ]
     return "\n".join(lines)
+
+
+def _constraint_section(case: Case, d: pd.DataFrame) -> list[str]:
+    """For a case with couplings: how each implementation holds them — the tension and
+    acceleration against the exact solve, and the drift of the constraint along each run."""
+    mb = case.multibody()
+    if not mb.couplings:
+        return []
+    inst = d[
+        (d.case == case.name)
+        & (d.impl_a == "reference")
+        & d.quantity.isin(["forward_dynamics", "constraint_force"])
+    ]
+    drift = d[(d.case == case.name) & (d.quantity == "constraint_drift")]
+    return [
+        "### Constraints: exact (KKT) and soft (MuJoCo's impedance model)",
+        "",
+        "The cords are couplings between the masses' slide joints: a tendon equality in "
+        "MuJoCo (soft: `mujoco` with the default solimp, `mujoco-stiff` with d = 0.9999), "
+        "Pinocchio's constrained `forwardDynamics` with the constraint Jacobian (exact; "
+        "Pinocchio's MJCF parser drops the tendon equality, so `pinocchio-mjcf` takes the "
+        "Jacobian from the model too). The reference predicts the soft solve from MuJoCo's "
+        "documented model: ÿ = ÿ_exact + (1 − d)(a₀ − ÿ_exact) and tension d·T at zero "
+        "violation, and the stretch of the cords along a run "
+        "(`dyncheck explain soft-vs-exact-constraints`). Constraint force = cord tension (N).",
+        "",
+        _md(inst[["quantity", "impl_b", "max_rel_err", "tolerance", "verdict", "note"]]),
+        "",
+        "Drift of the constraint (cord stretch, m) along each run at its coarsest step, "
+        "against the same model stepped by the same integrator:",
+        "",
+        _md(drift[["impl_b", "integrator", "dt", "max_abs_err", "tolerance", "verdict", "note"]]),
+        "",
+    ]
 
 
 def errata(d: pd.DataFrame) -> tuple[str, pd.DataFrame]:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Protocol
 
 import numpy as np
@@ -24,11 +25,25 @@ def solve(
     """q(t), v(t) at ``t_eval`` (shapes (len(t_eval), N)) of M ẍ + h = 0, first-order form
     (x, ẋ)' = (ẋ, ẍ), by DOP853 (8th order) at tight tolerances."""
     q0, v0 = np.asarray(q0, float), np.asarray(v0, float)
+    zero = np.zeros((1, q0.shape[0]))
+    return solve_second_order(
+        lambda q, v: dynamics.forward(q[None], v[None], zero)[0], q0, v0, t_eval, rtol, atol
+    )
+
+
+def solve_second_order(
+    acceleration: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    q0: np.ndarray,
+    v0: np.ndarray,
+    t_eval: np.ndarray,
+    rtol: float,
+    atol: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """q(t), v(t) of q̈ = acceleration(q, q̇) by DOP853, first-order form (q, q̇)' = (q̇, q̈)."""
     n = q0.shape[0]
-    zero = np.zeros((1, n))
 
     def rhs(_t: float, y: np.ndarray) -> np.ndarray:
-        return np.concatenate([y[n:], dynamics.forward(y[None, :n], y[None, n:], zero)[0]])
+        return np.concatenate([y[n:], acceleration(y[:n], y[n:])])
 
     sol = solve_ivp(
         rhs,
