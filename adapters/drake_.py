@@ -82,7 +82,8 @@ class DrakeAdapter(Adapter):
         super().__init__(model)
         if model.couplings:
             raise Unsupported(
-                "a continuous-time MultibodyPlant enforces no constraints (Drake's coupler "
+                "Drake's MJCF parser ignores <tendon> and <equality><tendon> (its own warning), "
+                "and a continuous-time MultibodyPlant enforces no constraints (Drake's coupler "
                 "constraint needs the discrete SAP solver, a different, compliant dynamics)"
             )
         if any(j.type == "ball" for j in model.joints):

@@ -9,7 +9,9 @@ frame (hinge: ``orientnew('Axis')``) or moves the point along the current frame'
 bodies with inertia ``RigidBody``s. Gravity enters as loads; the Lagrangian is T alone, so
 ``LagrangesMethod`` gives M q̈ = F with F = τ_loads − (velocity terms). The canonical h is
 −F without the field's loads; the field's generalized force is F(field) − F(no field).
-Energies: ``kinetic_energy`` and V = −Σ m g·r.
+Energies: ``kinetic_energy`` and V = −Σ m g·r. Couplings (cords) are ``hol_coneqs`` of
+``LagrangesMethod``: its full mass matrix and forcing give q̈ and the multipliers λ together
+(M q̈ = F + τ + Φᵀ λ, the adapters' sign of f).
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ from dyncheck.errors import Unsupported
 
 def _vec(frame: me.ReferenceFrame, xyz) -> me.Vector:
     return sum(
-        (sp.nsimplify(float(c)) * e for c, e in zip(xyz, (frame.x, frame.y, frame.z), strict=True)),
+        (sp.Rational(float(c)) * e for c, e in zip(xyz, (frame.x, frame.y, frame.z), strict=True)),
         me.Vector(0),
     )
 
@@ -55,8 +57,6 @@ class SympyMechanicsAdapter(Adapter):
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
-        if model.couplings:
-            raise Unsupported("couplings (LagrangesMethod's hol_coneqs) are not built yet")
         if any(j.type == "ball" for j in model.joints):
             raise Unsupported(
                 "a ball joint needs a three-angle chart in sympy.physics.mechanics; dyncheck "
@@ -88,7 +88,7 @@ class SympyMechanicsAdapter(Adapter):
             r = com.pos_from(O)
             com.set_vel(N, r.dt(N))
             frame.set_ang_vel(N, frame.ang_vel_in(N))
-            m = sp.nsimplify(float(body.mass))
+            m = sp.Rational(float(body.mass))
             if body.is_point_mass:
                 particles.append(me.Particle(body.name, com, m))
             else:
@@ -96,7 +96,7 @@ class SympyMechanicsAdapter(Adapter):
                 dyad = me.inertia(
                     frame,
                     *(
-                        sp.nsimplify(float(x))
+                        sp.Rational(float(x))
                         for x in (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[1, 2], I[0, 2])
                     ),
                 )
@@ -105,7 +105,7 @@ class SympyMechanicsAdapter(Adapter):
             V -= m * g.dot(r)
             if model.central_mu:
                 dist = sp.sqrt(r.dot(r))
-                field_loads.append((com, -sp.nsimplify(model.central_mu) * m * r / dist**3))
+                field_loads.append((com, -sp.Rational(float(model.central_mu)) * m * r / dist**3))
             frames[body.name], points[body.name] = frame, point
         T = me.kinetic_energy(N, *particles)
         qs, vs = sp.symbols(f"x0:{n}"), sp.symbols(f"v0:{n}")
@@ -118,6 +118,26 @@ class SympyMechanicsAdapter(Adapter):
 
         M, F_free = forcing(gravity_loads)
         args = [*qs, *vs]
+        self._kkt = None
+        if model.couplings and model.central_mu:
+            raise Unsupported(f"{self.name}: couplings together with a field")
+        if model.couplings:
+            # the cords as holonomic constraints: LagrangesMethod adds multipliers λ with
+            # M q̈ − Φᵀ λ = F and the constraints' second derivative Φ q̈ = −Φ̇ q̇
+            index = {j.name: i for i, j in enumerate(model.joints)}
+            cons = [
+                sum(sp.Rational(float(c)) * q[index[j]] for j, c in cp.coefs)
+                for cp in model.couplings
+            ]
+            lm = me.LagrangesMethod(T, q, hol_coneqs=cons, forcelist=gravity_loads, frame=N)
+            lm.form_lagranges_equations()
+            K = lm.mass_matrix_full[n:, n:]
+            rhs = lm.forcing_full[n:, :]
+            self._kkt = (
+                _batched([e.subs(plain) for e in K], args),
+                _batched([e.subs(plain) for e in rhs], args),
+                len(cons),
+            )
         self._M = _batched([sp.simplify(e.subs(plain)) for e in M], args)
         self._h = _batched([(-e).subs(plain) for e in F_free], args)
         if field_loads:
@@ -154,7 +174,25 @@ class SympyMechanicsAdapter(Adapter):
     def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         return self._check("bias forces", self._h(*self._args(q, v)))
 
+    def _constrained(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(q̈, λ) of LagrangesMethod's equations with the cords (M q̈ = F + τ + Φᵀ λ)."""
+        K_fn, rhs_fn, m = self._kkt
+        args = self._args(q, v)
+        n = self._n
+        K = K_fn(*args).reshape(-1, n + m, n + m)
+        rhs = rhs_fn(*args)
+        rhs[:, :n] += tau
+        x = np.linalg.solve(K, rhs[..., None])[..., 0]
+        return x[:, :n], x[:, n:]
+
+    def constraint_force(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        return self._check("constraint force", self._constrained(q, v, tau)[1])
+
     def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        if self._kkt is not None:
+            return self._check("forward dynamics", self._constrained(q, v, tau)[0])
         rhs = tau + self._field_force(q) - self.bias(q, v)
         return self._check(
             "forward dynamics", np.linalg.solve(self.mass_matrix(q), rhs[..., None])[..., 0]

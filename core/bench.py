@@ -31,6 +31,7 @@ from dyncheck.cases import Case, get_case
 from dyncheck.implementations import (
     IMPLEMENTATIONS,
     EngineImplementation,
+    implementations_for,
     make_implementation,
 )
 from dyncheck.results import to_csv, write_atomic
@@ -121,7 +122,7 @@ def _sweep_rss(case_name: str, states: int, queue: mp.Queue) -> None:
     from dyncheck.comparison import compare_instantaneous
 
     case = get_case(case_name)
-    impls = {n: make_implementation(n, case) for n in IMPLEMENTATIONS}
+    impls = {n: make_implementation(n, case) for n in implementations_for(case)}
     compare_instantaneous(case, impls, case.iter_states(states))
     queue.put(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
 
@@ -143,7 +144,7 @@ def bench(case: Case, states: int, repeats: int) -> pd.DataFrame:
     from dyncheck.comparison import compare_instantaneous
 
     sample = case.sample_states(states)
-    impls = {n: make_implementation(n, case) for n in IMPLEMENTATIONS}
+    impls = {n: make_implementation(n, case) for n in implementations_for(case)}
     rows = []
 
     def add(part: str, impl: str, seconds: float) -> None:

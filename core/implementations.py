@@ -61,6 +61,13 @@ COUPLINGS_ONLY: frozenset[str] = frozenset({"mujoco-stiff"})
 """Implementations that differ from another only in how couplings are held: run on cases
 with couplings only (elsewhere they would repeat ``mujoco`` under a second name)."""
 
+
+def implementations_for(case: Case, names: tuple[str, ...] = IMPLEMENTATIONS) -> list[str]:
+    """Of ``names``, those that run on ``case`` (couplings-only ones need couplings)."""
+    coupled = bool(case.multibody().couplings)
+    return [n for n in names if coupled or n not in COUPLINGS_ONLY]
+
+
 _REFERENCE: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
     "simple_pendulum": (pendulum.simple_pendulum, pendulum.simple_pendulum_printed),
     "compound_pendulum": (pendulum.compound_pendulum, pendulum.compound_pendulum_printed),

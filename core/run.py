@@ -13,9 +13,9 @@ from dyncheck.cases import Case, get_case
 from dyncheck.comparison import compare_instantaneous
 from dyncheck.errors import UnknownName
 from dyncheck.implementations import (
-    COUPLINGS_ONLY,
     IMPLEMENTATIONS,
     Implementation,
+    implementations_for,
     make_implementation,
 )
 from dyncheck.results import (
@@ -60,10 +60,7 @@ def _run_case(
     """Everything for one case (a unit of work for a worker process)."""
     impls: dict[str, Implementation | Exception] = {}
     notes: dict[str, set[str]] = {}
-    coupled = bool(case.multibody().couplings)
-    for name in impl_names:
-        if not coupled and name in COUPLINGS_ONLY:
-            continue  # it would be another implementation under a second name
+    for name in implementations_for(case, tuple(impl_names)):
         try:
             impls[name] = make_implementation(name, case)
         except Exception as exc:  # reported as a row, the run goes on

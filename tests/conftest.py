@@ -11,7 +11,8 @@ from dyncheck.implementations import IMPLEMENTATIONS
 from dyncheck.run import RunResult, run
 
 CASE_NAMES = sorted(CASES)
-ENGINES = sorted(ENGINE_PACKAGES)
+ALL_ENGINES = sorted(ENGINE_PACKAGES)
+"""Every engine implementation, including those that exist only for couplings."""
 BALL_CASES = sorted(
     n for n in CASES if any(j.type == "ball" for j in get_case(n).multibody().joints)
 )
@@ -20,8 +21,29 @@ NO_BALL = ("drake", "sympy-mechanics")
 """Engines dyncheck does not map on ball joints (skipped, with the reason)."""
 
 
+COUPLED_CASES = sorted(n for n in CASES if get_case(n).multibody().couplings)
+"""Cases whose masses are held by cords (couplings between joints)."""
+NO_COUPLINGS = ("drake",)
+"""Engines dyncheck does not run with couplings (skipped, with the reason)."""
+COUPLINGS_ONLY_ENGINES = ("mujoco-stiff",)
+"""Engines that exist only for cases with couplings."""
+ENGINES = [e for e in ALL_ENGINES if e not in COUPLINGS_ONLY_ENGINES]
+"""The engines every case runs in (where supported)."""
+
+
 def supported(case: str, engine: str) -> bool:
-    return not (case in BALL_CASES and engine in NO_BALL)
+    return unsupported_reason(case, engine) is None
+
+
+def unsupported_reason(case: str, engine: str) -> str | None:
+    """The words the Unsupported message must contain, or None when supported."""
+    if case in BALL_CASES and engine in NO_BALL:
+        return "ball joint"
+    if case in COUPLED_CASES and engine in NO_COUPLINGS:
+        return "ignores <tendon>"
+    if case not in COUPLED_CASES and engine in COUPLINGS_ONLY_ENGINES:
+        return "couplings"
+    return None
 
 
 @pytest.fixture(scope="session")

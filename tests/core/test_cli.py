@@ -66,7 +66,7 @@ def test_unknown_case_is_usage_error(tmp_path, capsys):
     assert main(["run", "nope", "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip()
     assert err == (
-        "dyncheck: error: unknown case 'nope'; valid: compound_pendulum, "
+        "dyncheck: error: unknown case 'nope'; valid: atwood, compound_pendulum, compound_pulley, "
         "cylindrical_coordinates, kepler, simple_pendulum, spherical_coordinates, "
         "spherical_pendulum"
     )
