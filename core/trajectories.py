@@ -374,7 +374,7 @@ def _drift_row(
         max_rel_err=err / scale,
         verdict="passed" if err / scale <= tol.rtol else "failed",
         convention=SOFT_CONSTRAINT if variant.softness else "",
-        note=f"max |violation| observed {np.abs(observed).max():.3g} m, predicted "
+        note=f"max abs violation observed {np.abs(observed).max():.3g} m, predicted "
         f"{np.abs(predicted).max():.3g} m (the same model stepped by {integrator})",
         worst_state=int(diff.argmax()),
     )
