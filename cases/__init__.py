@@ -6,6 +6,7 @@ from dyncheck.cases.base import INTEGRATORS, NOMINAL_ORDER, Case, StateSample, T
 from dyncheck.cases.particles import CylindricalCoordinates, Kepler, SphericalCoordinates
 from dyncheck.cases.pendulums import CompoundPendulum, SimplePendulum, SphericalPendulum
 from dyncheck.cases.pulleys import Atwood, CompoundPulley
+from dyncheck.cases.rigid import RigidBodyBall, TorqueFree
 from dyncheck.errors import UnknownName
 
 CASES: dict[str, type[Case]] = {
@@ -14,9 +15,11 @@ CASES: dict[str, type[Case]] = {
     "compound_pulley": CompoundPulley,
     "cylindrical_coordinates": CylindricalCoordinates,
     "kepler": Kepler,
+    "rigid_body_ball": RigidBodyBall,
     "simple_pendulum": SimplePendulum,
     "spherical_coordinates": SphericalCoordinates,
     "spherical_pendulum": SphericalPendulum,
+    "torque_free": TorqueFree,
 }
 """Case name → case class with the book's default parameters; kept sorted by name."""
 

@@ -236,3 +236,78 @@ class SphericalPendulumMap:
         second = r_pp * pd**2 + 2 * r_pt * pd * td + r_tt * td**2
         Hw = np.cross(r, second)
         return np.einsum("nji,nj->ni", self._rotation(q), Hw)
+
+
+@dataclass(frozen=True)
+class EulerAngleMap:
+    """Example 9's Euler angles (φ, θ, ψ) to a ball joint's state: the orientation is the
+    direction-cosine matrix ℓ = Aᵀ of (2.2.50) (x = ℓ x̄ takes body components to space
+    components, as an engine's body rotation does), A = R₃(ψ) R₁(θ) R₃(φ) the product of
+    Example 9's rotations of axes; positions are unit quaternions (w, x, y, z). Velocities are
+    the body-frame angular velocity of exercise 23, ω̄ = J(q) q̇ with
+
+        J = [[sin θ sin ψ, cos ψ, 0], [sin θ cos ψ, −sin ψ, 0], [cos θ, 0, 1]],
+
+    and the (2.2.5)-type term J̇ q̇. Singular at θ = 0, π (gimbal lock), where φ and ψ merge.
+    """
+
+    description: str = "ball joint: R = ℓ(φ, θ, ψ) of Example 9, ω̄ of exercise 23 (body frame)"
+
+    @staticmethod
+    def _rotation(q: np.ndarray) -> np.ndarray:
+        """ℓ(q) = (R₃(ψ) R₁(θ) R₃(φ))ᵀ, batched (n, 3, 3)."""
+
+        def r3(a: np.ndarray) -> np.ndarray:
+            c, s, z, o = np.cos(a), np.sin(a), np.zeros_like(a), np.ones_like(a)
+            return np.stack(
+                [np.stack([c, s, z], -1), np.stack([-s, c, z], -1), np.stack([z, z, o], -1)], -2
+            )
+
+        def r1(a: np.ndarray) -> np.ndarray:
+            c, s, z, o = np.cos(a), np.sin(a), np.zeros_like(a), np.ones_like(a)
+            return np.stack(
+                [np.stack([o, z, z], -1), np.stack([z, c, s], -1), np.stack([z, -s, c], -1)], -2
+            )
+
+        phi, theta, psi = q.T
+        return np.swapaxes(r3(psi) @ r1(theta) @ r3(phi), -1, -2)
+
+    def to_engine(self, q: np.ndarray) -> np.ndarray:
+        return _quat_from_matrix(self._rotation(q))
+
+    def to_book(self, qe: np.ndarray) -> np.ndarray:
+        """θ = arccos A₃₃, φ = atan2(A₃₁, −A₃₂), ψ = atan2(A₁₃, A₂₃) with A = ℓᵀ."""
+        A = np.swapaxes(quat_to_matrix(qe), -1, -2)
+        return np.column_stack(
+            [
+                np.arctan2(A[:, 2, 0], -A[:, 2, 1]),
+                np.arccos(np.clip(A[:, 2, 2], -1.0, 1.0)),
+                np.arctan2(A[:, 0, 2], A[:, 1, 2]),
+            ]
+        )
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        _, th, ps = q.T
+        st, ct, sp_, cp = np.sin(th), np.cos(th), np.sin(ps), np.cos(ps)
+        z, o = np.zeros_like(th), np.ones_like(th)
+        return np.stack(
+            [
+                np.stack([st * sp_, cp, z], -1),
+                np.stack([st * cp, -sp_, z], -1),
+                np.stack([ct, z, o], -1),
+            ],
+            -2,
+        )
+
+    def hessian_term(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """J̇ q̇: the time derivative of exercise 23's ω̄ at q̈ = 0."""
+        _, th, ps = q.T
+        dphi, dth, dps = v.T
+        st, ct, sp_, cp = np.sin(th), np.cos(th), np.sin(ps), np.cos(ps)
+        return np.column_stack(
+            [
+                dphi * (ct * dth * sp_ + st * cp * dps) - sp_ * dps * dth,
+                dphi * (ct * dth * cp - st * sp_ * dps) - cp * dps * dth,
+                -st * dth * dphi,
+            ]
+        )

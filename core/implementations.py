@@ -20,7 +20,7 @@ from dyncheck.adapters import ENGINE_PACKAGES, Adapter, get_adapter
 from dyncheck.cases import Case, StateSample
 from dyncheck.conventions import from_native, to_native
 from dyncheck.errors import UnknownName
-from dyncheck.reference import particle, pendulum, pulley
+from dyncheck.reference import particle, pendulum, pulley, rigid
 from dyncheck.reference.constraints import Softness
 from dyncheck.reference.coordinates import cylindrical, spherical
 from dyncheck.reference.trajectory import solve
@@ -85,6 +85,15 @@ _REFERENCE: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
     "cylindrical_coordinates": (
         lambda M, g, inertia: particle.particle(cylindrical(), M, g, inertia=inertia),
         lambda M, g: particle.lagrange_form(cylindrical(), M, g),
+    ),
+    # a body with its own inertia: no point-mass floor to add
+    "rigid_body_ball": (
+        lambda m, g, inertia, **I: rigid.rigid_ball(**I),
+        lambda m, g, **I: rigid.rigid_ball_printed(**I),
+    ),
+    "torque_free": (
+        lambda m, g, inertia, **I: rigid.rigid_ball(**I),
+        lambda m, g, **I: rigid.rigid_ball_printed(**I, principal=True),
     ),
     # the masses ride on slides and never rotate: an inertia floor has no effect
     "atwood": (
@@ -301,7 +310,7 @@ class EngineImplementation(Implementation):
             )
             if np.abs(extra - floor * np.eye(3)).max() > slack:
                 return None  # not an isotropic floor: not a convention we can predict
-            out.append(floor)
+            out.append(0.0 if abs(floor) <= slack else floor)  # round-off of a read-back
         gravity = tuple(float(x) for x in self.adapter.loaded_gravity())
         if gravity[0] or gravity[1]:
             return None  # the reference models gravity along −z only

@@ -127,7 +127,7 @@ def versions() -> dict[str, str]:
     return out
 
 
-TRAJECTORY_QUANTITIES = ("trajectory", "constraint_drift")
+TRAJECTORY_QUANTITIES = ("trajectory", "constraint_drift", "closed_form")
 """Row quantities that come from runs (the rest are instantaneous)."""
 
 

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import pandas as pd
 
 from dyncheck.cases import Case, get_case
+from dyncheck.closed_forms import closed_form_rows
 from dyncheck.comparison import compare_instantaneous
 from dyncheck.errors import UnknownName
 from dyncheck.implementations import (
@@ -69,7 +70,7 @@ def _run_case(
         notes.setdefault(name, set()).update(warnings)
     rows = compare_instantaneous(case, impls, case.iter_states(states))
     points, trajectory_rows, figures = study(case, impls)
-    return rows + trajectory_rows, points, figures, notes
+    return rows + trajectory_rows + closed_form_rows(case), points, figures, notes
 
 
 def run(

@@ -80,16 +80,19 @@ class SymbolicSystem:
     T: sp.Expr
     V: sp.Expr
     field: sp.Expr | int = 0
+    simplify: bool = True
+    """Simplify M and h symbolically (exact either way; off where sympy's simplify is slow)."""
 
     def equations(self) -> tuple[sp.Matrix, sp.Matrix]:
         """(M, h) of the canonical form, from (2.2.22)–(2.2.26)."""
         n = len(self.q)
         p = [sp.diff(self.T, qdi) for qdi in self.qd]  # ∂T/∂ẋʳ
-        M = sp.Matrix(n, n, lambda r, s: sp.simplify(sp.diff(p[r], self.qd[s])))
+        tidy = sp.simplify if self.simplify else sp.expand
+        M = sp.Matrix(n, n, lambda r, s: tidy(sp.diff(p[r], self.qd[s])))
         h = sp.Matrix(
             n,
             1,
-            lambda r, _: sp.simplify(
+            lambda r, _: tidy(
                 sum(sp.diff(p[r], qn) * qdn for qn, qdn in zip(self.q, self.qd, strict=True))
                 - sp.diff(self.T, self.q[r])
                 + sp.diff(self.V, self.q[r])

@@ -354,3 +354,94 @@ class TorqueFree:
     def parameter(self) -> float:
         """m = k² of the elliptic functions (after the swap, if any)."""
         return float(self._setup()[2])
+
+
+# --- a rigid body on a ball joint at its centre of mass, in Euler angles ------------------
+
+INERTIA_NAMES = ("I11", "I22", "I33", "I12", "I13", "I23")
+
+
+def _inertia_matrix(I11, I22, I33, I12, I13, I23):
+    return [[I11, I12, I13], [I12, I22, I23], [I13, I23, I33]]
+
+
+@cache
+def rigid_ball_symbolic():
+    """The general method for a body turning about its fixed centre of mass: T = ½ Ī_ij ω̄_i ω̄_j
+    (2.2.40) with ω̄ of exercise 23 in Example 9's angles (φ, θ, ψ), V = 0 (gravity acts at the
+    fixed point); Lagrange's equations (2.2.26) derived exactly."""
+    from dyncheck.reference.lagrange import SymbolicSystem
+
+    f, t, p = sp.symbols("phi theta psi")
+    df, dt_, dp = sp.symbols("phidot thetadot psidot")
+    params = sp.symbols(" ".join(INERTIA_NAMES), real=True)
+    w = sp.Matrix(
+        [
+            dt_ * sp.cos(p) + df * sp.sin(t) * sp.sin(p),
+            -dt_ * sp.sin(p) + df * sp.sin(t) * sp.cos(p),
+            dp + df * sp.cos(t),
+        ]
+    )
+    I = sp.Matrix(_inertia_matrix(*params))
+    T = sp.expand((w.T * I * w)[0, 0] / 2)
+    return SymbolicSystem((f, t, p), (df, dt_, dp), params, T, sp.Integer(0), simplify=False)
+
+
+def rigid_ball(**inertia: float):
+    """Numeric general method for the body with inertia components ``I11 … I23`` (kg m²)."""
+    return rigid_ball_symbolic().numeric({k: inertia[k] for k in INERTIA_NAMES})
+
+
+def body_angular_velocity(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """ω̄ of exercise 23 at Euler-angle states, batched (n, 3)."""
+    return _ex23(np.atleast_2d(q), np.atleast_2d(v))[0]
+
+
+def _ex23(q: np.ndarray, v: np.ndarray, a: np.ndarray | None = None):
+    """ω̄ (exercise 23) and, given the angle accelerations, dω̄/dt, batched."""
+    _, th, ps = np.moveaxis(q, -1, 0)
+    dphi, dth, dps = np.moveaxis(v, -1, 0)
+    st, ct, sp_, cp = np.sin(th), np.cos(th), np.sin(ps), np.cos(ps)
+    w = np.stack([dth * cp + dphi * st * sp_, -dth * sp_ + dphi * st * cp, dps + dphi * ct], -1)
+    if a is None:
+        return w, None
+    a1, a2, a3 = np.moveaxis(a, -1, 0)
+    dw = np.stack(
+        [
+            a2 * cp - dth * sp_ * dps + a1 * st * sp_ + dphi * (ct * dth * sp_ + st * cp * dps),
+            -a2 * sp_ - dth * cp * dps + a1 * st * cp + dphi * (ct * dth * cp - st * sp_ * dps),
+            a3 + a1 * ct - dphi * st * dth,
+        ],
+        -1,
+    )
+    return w, dw
+
+
+def rigid_ball_printed(*, principal: bool = False, **inertia: float):
+    """Euler's equations as printed — (2.2.71), or (2.2.72) in principal axes — with exercise
+    23's kinematics: the generalized force on (φ, θ, ψ) is Jᵀ M̄ (virtual work of the body
+    moment M̄ through δω̄ = J δq), J = ∂ω̄/∂q̇ of exercise 23; T = ½ Ī ω̄ ω̄ (2.2.40), V = 0."""
+    from dyncheck.reference.printed import PrintedDynamics
+
+    I = np.array(_inertia_matrix(*(inertia[k] for k in INERTIA_NAMES)), float)
+
+    def jacobian(q: np.ndarray) -> np.ndarray:
+        eye = np.eye(3)
+        return np.stack([_ex23(q, np.broadcast_to(e, q.shape))[0] for e in eye], -1)
+
+    def residual(q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        w, dw = _ex23(q, v, a)
+        if principal:
+            if np.any(I - np.diag(np.diag(I))):
+                raise ValueError("(2.2.72) needs principal axes: products of inertia are not 0")
+            moments = euler_residual_principal(np.diag(I), w, dw)
+        else:
+            moments = euler_residual_printed(I, w, dw)
+        return np.einsum("nij,ni->nj", jacobian(q), moments)
+
+    return PrintedDynamics(
+        residual=residual,
+        row_factors=np.ones(3),
+        T=lambda q, v: kinetic_energy(I, _ex23(q, v)[0]),
+        V=lambda q: np.zeros(len(q)),
+    )
