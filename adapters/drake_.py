@@ -86,10 +86,10 @@ class DrakeAdapter(Adapter):
                 "and a continuous-time MultibodyPlant enforces no constraints (Drake's coupler "
                 "constraint needs the discrete SAP solver, a different, compliant dynamics)"
             )
-        if any(j.type == "ball" for j in model.joints):
+        if any(j.type in ("ball", "free") for j in model.joints):
             raise Unsupported(
                 "Drake's MJCF parser turns a ball joint into a BallRpyJoint (roll-pitch-yaw "
-                "chart); dyncheck maps no rpy chart"
+                "chart); dyncheck maps no rpy chart, and no free (floating) body state yet"
             )
         self.xml = to_mjcf(model)
         self.plant, self.parser_warnings = self._parse(self.xml)

@@ -47,6 +47,9 @@ def to_mjcf(
     for body in model.bodies:
         el = ET.SubElement(parents[body.parent], "body", name=body.name, pos=_fmt(body.joint_pos))
         for joint in body.joints:
+            if joint.type == "free":
+                ET.SubElement(el, "freejoint", name=joint.name)
+                continue
             attrs = {
                 "name": joint.name,
                 "type": joint.type,

@@ -47,6 +47,8 @@ _AXIS_JOINTS = {
 def _joint(joint: Joint) -> pin.JointModel:
     if joint.type == "ball":
         return pin.JointModelSpherical()  # q = (x, y, z, w), v = angular velocity, local
+    if joint.type == "free":
+        return pin.JointModelFreeFlyer()  # q = (p, x, y, z, w), v = (v, ω) both local
     axis = tuple(float(x) for x in joint.axis)
     if (joint.type, axis) in _AXIS_JOINTS:
         return _AXIS_JOINTS[joint.type, axis]()

@@ -57,10 +57,10 @@ class SympyMechanicsAdapter(Adapter):
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
-        if any(j.type == "ball" for j in model.joints):
+        if any(j.type in ("ball", "free") for j in model.joints):
             raise Unsupported(
-                "a ball joint needs a three-angle chart in sympy.physics.mechanics; dyncheck "
-                "builds none"
+                "a ball joint (or a free body's rotation) needs a three-angle chart in "
+                "sympy.physics.mechanics; dyncheck builds none"
             )
         n = model.nv
         q = me.dynamicsymbols(f"q0:{n}")

@@ -6,7 +6,7 @@ from dyncheck.cases.base import INTEGRATORS, NOMINAL_ORDER, Case, StateSample, T
 from dyncheck.cases.particles import CylindricalCoordinates, Kepler, SphericalCoordinates
 from dyncheck.cases.pendulums import CompoundPendulum, SimplePendulum, SphericalPendulum
 from dyncheck.cases.pulleys import Atwood, CompoundPulley
-from dyncheck.cases.rigid import RigidBodyBall, TorqueFree
+from dyncheck.cases.rigid import RigidBodyBall, RigidBodyFree, TorqueFree
 from dyncheck.errors import UnknownName
 
 CASES: dict[str, type[Case]] = {
@@ -16,6 +16,7 @@ CASES: dict[str, type[Case]] = {
     "cylindrical_coordinates": CylindricalCoordinates,
     "kepler": Kepler,
     "rigid_body_ball": RigidBodyBall,
+    "rigid_body_free": RigidBodyFree,
     "simple_pendulum": SimplePendulum,
     "spherical_coordinates": SphericalCoordinates,
     "spherical_pendulum": SphericalPendulum,

@@ -311,3 +311,29 @@ class EulerAngleMap:
                 -st * dth * dphi,
             ]
         )
+
+
+@dataclass(frozen=True)
+class FreeBodyMap:
+    """A free body's book coordinates (x₁, x₂, x₃, φ, θ, ψ) — the centre of mass in space axes
+    and Example 9's angles — to a free joint's canonical state: position, then the unit
+    quaternion of ℓ (:class:`EulerAngleMap`); velocity (ẋ in space axes, ω̄ of exercise 23)."""
+
+    description: str = "free joint: position, R = ℓ(φ, θ, ψ); velocity (ẋ world, ω̄ body)"
+
+    def to_engine(self, q: np.ndarray) -> np.ndarray:
+        return np.column_stack([q[:, :3], EulerAngleMap().to_engine(q[:, 3:])])
+
+    def to_book(self, qe: np.ndarray) -> np.ndarray:
+        return np.column_stack([qe[:, :3], EulerAngleMap().to_book(qe[:, 3:])])
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        J = np.zeros((q.shape[0], 6, 6))
+        J[:, :3, :3] = np.eye(3)
+        J[:, 3:, 3:] = EulerAngleMap().jacobian(q[:, 3:])
+        return J
+
+    def hessian_term(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return np.column_stack(
+            [np.zeros((q.shape[0], 3)), EulerAngleMap().hessian_term(q[:, 3:], v[:, 3:])]
+        )

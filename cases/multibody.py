@@ -19,11 +19,15 @@ Mat3 = tuple[Vec3, Vec3, Vec3]
 ZERO3: Mat3 = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
-JOINT_TYPES = ("hinge", "slide", "ball")
-NQ = {"hinge": 1, "slide": 1, "ball": 4}
-"""Position coordinates per joint type: a ball joint's orientation is a unit quaternion."""
-NV = {"hinge": 1, "slide": 1, "ball": 3}
-"""Velocity coordinates per joint type: a ball joint's is an angular velocity."""
+JOINT_TYPES = ("hinge", "slide", "ball", "free")
+NQ = {"hinge": 1, "slide": 1, "ball": 4, "free": 7}
+"""Position coordinates per joint type: a ball joint's orientation is a unit quaternion; a
+free joint's the position of the body frame's origin, then a unit quaternion."""
+NV = {"hinge": 1, "slide": 1, "ball": 3, "free": 6}
+"""Velocity coordinates per joint type: a ball joint's is an angular velocity; a free joint's
+a linear velocity of the body frame's origin, then an angular velocity."""
+ROTATING = ("ball", "free")
+"""Joint types whose orientation is a quaternion."""
 
 
 @dataclass(frozen=True)
@@ -162,6 +166,6 @@ class Multibody:
         """The inertia a model must hold for ``body``: its own, or — for a point mass on a
         ball joint, whose spin about the rod would otherwise have no inertia and make M
         singular — the isotropic floor ``mjcf_point_inertia``."""
-        if body.is_point_mass and any(j.type == "ball" for j in body.joints):
+        if body.is_point_mass and any(j.type in ROTATING for j in body.joints):
             return self.mjcf_point_inertia * np.eye(3)
         return np.asarray(body.inertia, float)

@@ -15,7 +15,7 @@ from typing import ClassVar
 import numpy as np
 
 from dyncheck.cases.base import Case, TrajectorySpec
-from dyncheck.cases.coordinate_maps import EulerAngleMap
+from dyncheck.cases.coordinate_maps import EulerAngleMap, FreeBodyMap
 from dyncheck.cases.multibody import Body, Joint, Multibody
 from dyncheck.cases.validate import inertia_tensor, positive
 
@@ -151,3 +151,49 @@ class TorqueFree(RigidBodyBall):
             q0=(0.3, 1.2, -0.4), v0=(1.4, 0.77, -0.31), duration=4.0, steps=RIGID_STEPS
         )
     )
+
+
+@dataclass(frozen=True)
+class RigidBodyFree(RigidBodyBall):
+    """The body of ``rigid_body_ball`` flying free under gravity: translation of the centre
+    of mass (2.2.48) and rotation about it (2.2.70)–(2.2.71), uncoupled. Engines: a free
+    joint (MuJoCo ``freejoint``: linear velocity in the world frame; Pinocchio free-flyer:
+    in the body frame — the comparison layer maps both)."""
+
+    name: ClassVar[str] = "rigid_body_free"
+    title: ClassVar[str] = "Free rigid body (translation and Euler's equations)"
+    book_refs: ClassVar[str] = "(2.2.44)-(2.2.49), Example 9, exercise 23, (2.2.70)-(2.2.71)"
+    coordinates: ClassVar[tuple[str, ...]] = ("x1", "x2", "x3", "φ", "θ", "ψ")
+    periodic: ClassVar[tuple[bool, ...]] = (False, False, False, True, False, True)
+
+    trajectory: TrajectorySpec = field(
+        default_factory=lambda: TrajectorySpec(
+            q0=(0.1, -0.2, 0.5, 0.3, 1.4, -0.5),
+            v0=(0.4, 0.3, 2.0, 0.2, 0.3, 1.6),
+            duration=2.0,
+            steps=RIGID_STEPS,
+        )
+    )
+
+    def multibody(self) -> Multibody:
+        inertia = tuple(tuple(float(x) for x in row) for row in self.inertia())
+        body = Body(
+            "body", None, (0, 0, 0), (Joint("free", "free"),), self.m, (0.0, 0.0, 0.0), inertia
+        )
+        return Multibody(self.name, (body,), (0.0, 0.0, -self.g))
+
+    def engine_map(self) -> FreeBodyMap:
+        return FreeBodyMap()
+
+    def chart_singularity(self, q: np.ndarray) -> str | None:
+        return super().chart_singularity(q[3:])
+
+    def rest(self) -> np.ndarray:
+        return np.array([0.0, 0.0, 0.0, 0.0, np.pi / 2, 0.0])
+
+    def q_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        low, high = super().q_bounds()
+        return np.concatenate([[-1.0, -1.0, -1.0], low]), np.concatenate([[1.0, 1.0, 1.0], high])
+
+    def state_scale(self) -> tuple[float, float, float]:
+        return 2.0, max(2.0 * self.I33, self.m * self.g), 10.0

@@ -8,6 +8,13 @@ test_conventions.py rotates a body by a known quaternion and reads the result ba
 - MuJoCo: ball-joint qpos (w, x, y, z); qvel the angular velocity in the body frame.
 - Pinocchio (``JointModelSpherical``, programmatic or from MJCF): q (x, y, z, w); v the
   angular velocity in the joint's local frame.
+- Free joints (measured likewise, tests/core/test_conventions.py): MuJoCo qpos (p, w, x, y,
+  z), qvel (v, ω) with the linear velocity of the body origin in the *world* frame and ω in
+  the body frame; Pinocchio's free-flyer q (p, x, y, z, w), v (v, ω) *both* in the body frame.
+  The canonical state is MuJoCo's; for Pinocchio the linear velocity is v_b = Rᵀ v_w, so
+  velocities cross with T = diag(Rᵀ, 1) and accelerations pick up Ṫ v = (−ω × v_b, 0): the
+  engine's v̇ is the derivative of body-frame components (the "spatial" acceleration
+  Rᵀ p̈ − ω × v_b), not the body's acceleration.
 - Drake's MJCF parser turns a ball joint into ``BallRpyJoint`` (roll-pitch-yaw angles, their
   rates as velocities) and sympy.physics.mechanics needs a chart of three angles: neither has
   a quaternion state, so dyncheck does not map ball joints for them (their rows are skipped
@@ -18,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dyncheck.cases.multibody import NQ, Multibody
+from dyncheck.cases.multibody import NQ, NV, Multibody
 
 QUATERNION_ORDER: dict[str, str] = {
     "mujoco": "wxyz",
@@ -32,16 +39,76 @@ ANGULAR_VELOCITY_FRAME: dict[str, str] = {
     "pinocchio": "local",
     "pinocchio-mjcf": "local",
 }
-"""In which frame each engine expresses a ball joint's angular velocity."""
+"""In which frame each engine expresses a ball or free joint's angular velocity."""
+
+LINEAR_VELOCITY_FRAME: dict[str, str] = {
+    "mujoco": "world",
+    "pinocchio": "local",
+    "pinocchio-mjcf": "local",
+}
+"""In which frame each engine expresses a free joint's linear velocity."""
 
 
 def quaternion_slots(spec: Multibody) -> list[int]:
-    """Index of each ball joint's first position coordinate."""
+    """Index of each ball or free joint's quaternion in the position coordinates."""
     out, i = [], 0
     for joint in spec.joints:
         if joint.type == "ball":
             out.append(i)
+        elif joint.type == "free":
+            out.append(i + 3)
         i += NQ[joint.type]
+    return out
+
+
+def _free_slots(spec: Multibody) -> list[tuple[int, int]]:
+    """(position index, velocity index) of each free joint."""
+    out, i, k = [], 0, 0
+    for joint in spec.joints:
+        if joint.type == "free":
+            out.append((i, k))
+        i += NQ[joint.type]
+        k += NV[joint.type]
+    return out
+
+
+def _matrix(quat: np.ndarray) -> np.ndarray:
+    """Rotation matrices of unit quaternions (w, x, y, z), batched."""
+    w, x, y, z = np.moveaxis(quat, -1, 0)
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        -2,
+    )
+
+
+def velocity_frames(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray | None:
+    """T(q) with v_native = T v_canonical (canonical states, batched (n, nv, nv)), or None
+    when the engine's frames are the canonical ones."""
+    slots = _free_slots(spec)
+    if not slots or LINEAR_VELOCITY_FRAME.get(engine, "world") == "world":
+        return None
+    T = np.broadcast_to(np.eye(spec.nv), (qe.shape[0], spec.nv, spec.nv)).copy()
+    for i, k in slots:
+        T[:, k : k + 3, k : k + 3] = np.swapaxes(_matrix(qe[:, i + 3 : i + 7]), -1, -2)
+    return T
+
+
+def velocity_frame_rates(
+    engine: str, spec: Multibody, qe: np.ndarray, ve: np.ndarray
+) -> np.ndarray | None:
+    """Ṫ v for canonical states and velocities: (−ω × Rᵀ v_w, 0) per free joint."""
+    slots = _free_slots(spec)
+    if not slots or LINEAR_VELOCITY_FRAME.get(engine, "world") == "world":
+        return None
+    out = np.zeros_like(ve)
+    for i, k in slots:
+        R = _matrix(qe[:, i + 3 : i + 7])
+        vb = np.einsum("nji,nj->ni", R, ve[:, k : k + 3])
+        out[:, k : k + 3] = -np.cross(ve[:, k + 3 : k + 6], vb)
     return out
 
 

@@ -18,7 +18,12 @@ import numpy as np
 from dyncheck import coordinates as co
 from dyncheck.adapters import ENGINE_PACKAGES, Adapter, get_adapter
 from dyncheck.cases import Case, StateSample
-from dyncheck.conventions import from_native, to_native
+from dyncheck.conventions import (
+    from_native,
+    to_native,
+    velocity_frame_rates,
+    velocity_frames,
+)
 from dyncheck.errors import UnknownName
 from dyncheck.reference import particle, pendulum, pulley, rigid
 from dyncheck.reference.constraints import Softness
@@ -90,6 +95,10 @@ _REFERENCE: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
     "rigid_body_ball": (
         lambda m, g, inertia, **I: rigid.rigid_ball(**I),
         lambda m, g, **I: rigid.rigid_ball_printed(**I),
+    ),
+    "rigid_body_free": (
+        lambda m, g, inertia, **I: rigid.rigid_free(m, g, **I),
+        lambda m, g, **I: rigid.rigid_free_printed(m, g, **I),
     ),
     "torque_free": (
         lambda m, g, inertia, **I: rigid.rigid_ball(**I),
@@ -253,8 +262,8 @@ class ReferenceImplementation(_Equations):
 @dataclass(frozen=True)
 class NativeMap:
     """The case's map followed by the engine's storage conventions (``dyncheck.conventions``):
-    quaternion order; angular velocities stay in the body frame, where every engine mapped
-    here keeps them."""
+    quaternion order, and a free joint's linear velocity in the engine's frame; angular
+    velocities stay in the body frame, where every engine mapped here keeps them."""
 
     base: Any
     engine: str
@@ -271,10 +280,21 @@ class NativeMap:
         return self.base.to_book(from_native(self.engine, self.spec, qn))
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
-        return self.base.jacobian(q)
+        """T J: the case's Jacobian, then the engine's velocity frames (free joints)."""
+        J = self.base.jacobian(q)
+        T = velocity_frames(self.engine, self.spec, self.base.to_engine(q))
+        return J if T is None else T @ J
 
     def hessian_term(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        return self.base.hessian_term(q, v)
+        """T H + Ṫ J v: the frames' rotation adds to the (2.2.5)-type term."""
+        H = self.base.hessian_term(q, v)
+        qe = self.base.to_engine(q)
+        T = velocity_frames(self.engine, self.spec, qe)
+        if T is None:
+            return H
+        ve = np.einsum("nij,nj->ni", self.base.jacobian(q), v)
+        rates = velocity_frame_rates(self.engine, self.spec, qe, ve)
+        return np.einsum("nij,nj->ni", T, H) + rates
 
 
 class EngineImplementation(Implementation):

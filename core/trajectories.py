@@ -28,7 +28,9 @@ import numpy as np
 from dyncheck import coordinates as co
 from dyncheck.adapters.integrators import STEPPERS, integrate
 from dyncheck.cases import NOMINAL_ORDER, Case
+from dyncheck.cases.coordinate_maps import EulerAngleMap
 from dyncheck.comparison import describe
+from dyncheck.conventions import LINEAR_VELOCITY_FRAME
 from dyncheck.implementations import (
     IMPLEMENTATIONS,
     SOFT_CONSTRAINT,
@@ -38,11 +40,13 @@ from dyncheck.implementations import (
     general_method,
     reference_trajectory,
 )
+from dyncheck.reference import rigid
 from dyncheck.results import ConvergencePoint, Discrepancy
 from dyncheck.tolerances import ORDER_SLACK, REFERENCE_MARGIN, accumulated, soft_condition
 
 TRUNCATION = "integrator truncation error"
 PRE_ASYMPTOTIC = "pre-asymptotic step (a fast constraint mode)"
+FREE_VELOCITY_FRAME = "free-body velocity state in different frames (world vs body)"
 HELD_FORCE = "state-dependent force held over RK4 stages"
 NAIVE_GROUP_RK4 = "RK4 tableau summed across tangent spaces of the rotation group"
 
@@ -52,7 +56,7 @@ def _naive_group_rk4(case: Case, impl: Implementation) -> bool:
     angular velocities that live in different frames: on a ball joint its order drops to 2."""
     adapter = getattr(impl, "adapter", None)
     return bool(getattr(adapter, "naive_group_rk4", False)) and any(
-        j.type == "ball" for j in case.multibody().joints
+        j.type in ("ball", "free") for j in case.multibody().joints
     )
 
 
@@ -165,6 +169,21 @@ def _energy_drift(
     return np.abs(energy - energy[0]) / max(float(np.abs(energy).max()), 1e-300)
 
 
+def _momentum_drift(
+    case: Case, impl: Implementation, dt: float, integrator: str, q: np.ndarray
+) -> np.ndarray | None:
+    """|H(t) − H(0)| / |H(0)| along a run of a rigid case (its last three coordinates are
+    Example 9's angles): H = ℓ Ī ω̄ in space axes, conserved by (2.2.49) with M = 0."""
+    v = getattr(impl, "velocities", lambda *_: None)(dt, integrator)
+    if v is None or not hasattr(case, "inertia"):
+        return None
+    angles, rates = q[:, -3:], v[:, -3:]
+    euler = EulerAngleMap()
+    w = np.einsum("nij,nj->ni", euler.jacobian(angles), rates)
+    H = np.einsum("nij,nj->ni", euler._rotation(angles), rigid.angular_momentum(case.inertia(), w))
+    return np.linalg.norm(H - H[0], axis=1) / np.linalg.norm(H[0])
+
+
 def observed_orders(dts: list[float], errors: list[float]) -> list[float]:
     """p between consecutive steps; NaN for the first."""
     out = [float("nan")]
@@ -184,6 +203,9 @@ class TrajectoryFigures:
     errors: dict[tuple[str, str], np.ndarray] = field(default_factory=dict)
     steps: dict[tuple[str, str], float] = field(default_factory=dict)
     energy: dict[tuple[str, str], np.ndarray] = field(default_factory=dict)
+    momentum: dict[tuple[str, str], np.ndarray] = field(default_factory=dict)
+    """|H(t) − H(0)| / |H(0)| of the finest run, H = ℓ Ī ω̄ the angular momentum in space
+    axes ((2.2.42), (2.2.50)), for rigid bodies under no moment about the centre of mass."""
     """|E(t) − E(0)| / max|E| of the finest run, E = T + V (+ the field's V) of its own model."""
 
 
@@ -233,6 +255,9 @@ def study(
             drift = _energy_drift(case, impl, variant, dt, integrator, q)
             if drift is not None:
                 figures.energy[name, integrator] = drift
+            h_drift = _momentum_drift(case, impl, dt, integrator, q)
+            if h_drift is not None:
+                figures.momentum[name, integrator] = h_drift
             orders = observed_orders(list(dts), errors)
             asym = [e > REFERENCE_MARGIN * ref_err for e in errors]
             finest = [i for i in range(1, len(dts)) if asym[i] and asym[i - 1]]
@@ -451,6 +476,53 @@ def _unavailable(
     )
 
 
+def _frames_differ(case: Case, a: str, b: str) -> bool:
+    """Two engines that keep a free body's linear velocity in different frames."""
+    if not any(j.type == "free" for j in case.multibody().joints):
+        return False
+    return LINEAR_VELOCITY_FRAME.get(a, "world") != LINEAR_VELOCITY_FRAME.get(b, "world")
+
+
+def _frame_pair(
+    case: Case,
+    a: str,
+    b: str,
+    integrator: str,
+    dts: tuple[float, ...],
+    runs: dict[tuple[str, str, float], np.ndarray],
+) -> Discrepancy:
+    """A fixed-step method on (v_world, ω) and the same method on (v_body, ω) are different
+    maps: both converge at the integrator's order, so their difference must shrink at that
+    order too. Predicted: the difference's observed order between the two coarsest steps."""
+    nominal = NOMINAL_ORDER[integrator]
+    if integrator == "rk4":
+        nominal = 2  # the body-frame side is the naive group RK4 (see NAIVE_GROUP_RK4)
+    d = []
+    for dt in dts[:2]:
+        qa, qb = runs[a, integrator, dt], runs[b, integrator, dt]
+        d.append(float(difference(case, qb, qa).max()))
+    p = float(np.log(d[0] / d[1]) / np.log(dts[0] / dts[1]))
+    scale_q = float(np.abs(runs[a, integrator, dts[0]]).max())
+    ok = abs(p - nominal) <= ORDER_SLACK
+    return Discrepancy(
+        case.name,
+        "trajectory",
+        a,
+        b,
+        integrator,
+        dts[0],
+        d[0],
+        d[0] / scale_q,
+        float("nan"),
+        f"difference of two order-{nominal} maps: shrinks at order {nominal} ± {ORDER_SLACK}",
+        "explained" if ok else "failed",
+        FREE_VELOCITY_FRAME,
+        f"{a} and {b} step a free body's velocity in different frames; their difference "
+        f"shrinks at order {p:.3f} from dt={dts[0]:g} to {dts[1]:g} (predicted {nominal})",
+        -1,
+    )
+
+
 def _engine_pairs(
     case: Case,
     engines: list[str],
@@ -484,6 +556,9 @@ def _engine_pairs(
                             "judged against the reference in the order study instead",
                         )
                     )
+                    continue
+                if _frames_differ(case, a, b):
+                    rows.append(_frame_pair(case, a, b, integrator, dts, runs))
                     continue
                 qa, qb = runs[a, integrator, dt], runs[b, integrator, dt]
                 steps = qa.shape[0] - 1

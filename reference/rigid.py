@@ -445,3 +445,44 @@ def rigid_ball_printed(*, principal: bool = False, **inertia: float):
         T=lambda q, v: kinetic_energy(I, _ex23(q, v)[0]),
         V=lambda q: np.zeros(len(q)),
     )
+
+
+@cache
+def rigid_free_symbolic():
+    """A free body: T = ½ m ẋ·ẋ + ½ Ī ω̄ ω̄ (translation of the centre of mass (2.2.48) and
+    rotation about it (2.2.40)), V = m g x₃; coordinates (x₁, x₂, x₃, φ, θ, ψ)."""
+    from dyncheck.reference.lagrange import SymbolicSystem
+
+    ball = rigid_ball_symbolic()
+    x = sp.symbols("x1 x2 x3")
+    xd = sp.symbols("x1dot x2dot x3dot")
+    m, g = sp.symbols("m g", positive=True)
+    T = ball.T + m * sum(c**2 for c in xd) / 2
+    return SymbolicSystem(
+        (*x, *ball.q), (*xd, *ball.qd), (*ball.params, m, g), T, m * g * x[2], simplify=False
+    )
+
+
+def rigid_free(m: float, g: float, **inertia: float):
+    """Numeric general method for the free body."""
+    values = {k: inertia[k] for k in INERTIA_NAMES} | {"m": m, "g": g}
+    return rigid_free_symbolic().numeric(values)
+
+
+def rigid_free_printed(m: float, g: float, **inertia: float):
+    """(2.2.48) for the centre of mass, m ẍ = F + m g (gravity −x₃), with Euler's equations
+    (2.2.71) and exercise 23 for the rotation: residual (m ẍ + m g e₃, Jᵀ(Euler))."""
+    from dyncheck.reference.printed import PrintedDynamics
+
+    rot = rigid_ball_printed(**inertia)
+
+    def residual(q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        lin = m * a[:, :3] + np.array([0.0, 0.0, m * g])
+        return np.concatenate([lin, rot.residual(q[:, 3:], v[:, 3:], a[:, 3:])], -1)
+
+    return PrintedDynamics(
+        residual=residual,
+        row_factors=np.ones(6),
+        T=lambda q, v: 0.5 * m * np.sum(v[:, :3] ** 2, -1) + rot.T(q[:, 3:], v[:, 3:]),
+        V=lambda q: m * g * q[:, 2],
+    )

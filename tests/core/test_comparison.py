@@ -210,3 +210,29 @@ def test_drake_parser_reports_what_it_ignores():
 
     drake = get_adapter("drake")(get_case("simple_pendulum").multibody())
     assert any("timestep" in w for w in drake.parser_warnings)
+
+
+def test_free_body_velocity_frame_ignored_is_caught():
+    """Pinocchio's free-flyer velocity is (v_body, ω_body): a map that feeds it MuJoCo's
+    (v_world, ω_body) — the case's canonical state with the quaternion reordered but no
+    frame change — must fail (M and T, rotation-invariant, cannot see it), and the correct
+    map (T = diag(Rᵀ, 1), Ṫ v) must pass."""
+    from dyncheck.implementations import NativeMap
+
+    case = get_case("rigid_body_free")
+
+    class NoFrames(NativeMap):
+        def jacobian(self, q):
+            return self.base.jacobian(q)
+
+        def hessian_term(self, q, v):
+            return self.base.hessian_term(q, v)
+
+    impl = make_implementation("pinocchio", case)
+    naive = NoFrames(impl.map.base, "pinocchio", impl.map.spec)
+    failed = {
+        r.quantity for r in _compare_with(case, "pinocchio", cmap=naive) if r.verdict == "failed"
+    }
+    # M = m 1 and T = ½ m |v|² are blind to a rotation of v; the accelerations are not
+    assert {"bias_forces", "forward_dynamics", "inverse_dynamics"} <= failed
+    assert all(r.verdict == "passed" for r in _compare_with(case, "pinocchio"))
