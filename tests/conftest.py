@@ -14,9 +14,13 @@ CASE_NAMES = sorted(CASES)
 ALL_ENGINES = sorted(ENGINE_PACKAGES)
 """Every engine implementation, including those that exist only for couplings."""
 BALL_CASES = sorted(
-    n for n in CASES if any(j.type == "ball" for j in get_case(n).multibody().joints)
+    n for n in CASES if any(j.type in ("ball", "free") for j in get_case(n).multibody().joints)
 )
-"""Cases with a ball joint: quaternion state, no Drake or sympy-mechanics mapping."""
+"""Cases with a ball or free joint: quaternion state, no Drake or sympy-mechanics mapping."""
+FREE_CASES = sorted(
+    n for n in CASES if any(j.type == "free" for j in get_case(n).multibody().joints)
+)
+"""Cases with a free joint: engines keep its linear velocity in different frames."""
 NO_BALL = ("drake", "sympy-mechanics")
 """Engines dyncheck does not map on ball joints (skipped, with the reason)."""
 

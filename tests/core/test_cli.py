@@ -67,7 +67,7 @@ def test_unknown_case_is_usage_error(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert err == (
         "dyncheck: error: unknown case 'nope'; valid: atwood, compound_pendulum, compound_pulley, "
-        "cylindrical_coordinates, kepler, rigid_body_ball, simple_pendulum, "
+        "cylindrical_coordinates, kepler, rigid_body_ball, rigid_body_free, simple_pendulum, "
         "spherical_coordinates, spherical_pendulum, torque_free"
     )
     assert not out.exists()

@@ -117,3 +117,52 @@ def test_spherical_pendulum_map_derivatives():
     dJ = (Jw(q + h * v) - Jw(q - h * v)) / (2 * h)
     H_world = np.einsum("nij,nj->ni", dJ, v)
     assert_allclose(np.einsum("nij,nj->ni", R, m.hessian_term(q, v)), H_world, atol=1e-8)
+
+
+V_LIN = np.array([0.4, -1.0, 0.6])
+
+
+def test_mujoco_free_joint_linear_velocity_is_world_frame():
+    """MuJoCo's freejoint: qvel[:3] is the body origin's velocity in world axes, qvel[3:] the
+    angular velocity in body axes; with no force the linear qacc is zero (p̈ = 0)."""
+    import mujoco
+
+    case = get_case("rigid_body_free")
+    impl = make_implementation("mujoco", case)
+    m, d = impl.adapter.model, impl.adapter.data
+    m.opt.gravity[:] = 0
+    d.qpos[:] = np.concatenate([[0.1, 0.2, 0.3], ROT])
+    d.qvel[:] = np.concatenate([V_LIN, OMEGA])
+    mujoco.mj_forward(m, d)
+    vel = np.zeros(6)
+    mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, 1, vel, 0)  # (ω, v) world-aligned
+    R = d.xmat[1].reshape(3, 3)
+    assert_allclose(vel[3:], V_LIN, atol=1e-14)
+    assert_allclose(vel[:3], R @ OMEGA, atol=1e-14)
+    assert_allclose(d.qacc[:3], 0, atol=1e-12)
+    assert conventions.LINEAR_VELOCITY_FRAME["mujoco"] == "world"
+
+
+@pytest.mark.parametrize("name", ["pinocchio", "pinocchio-mjcf"])
+def test_pinocchio_free_flyer_velocity_is_body_frame(name):
+    """Pinocchio's free-flyer: v[:3] is the body origin's velocity in body axes; with no force
+    its v̇[:3] is not zero but −ω × v_b (the derivative of body-frame components)."""
+    import pinocchio as pin
+
+    case = get_case("rigid_body_free")
+    impl = make_implementation(name, case)
+    m, d = impl.adapter.model, impl.adapter.data
+    m.gravity.linear[:] = 0
+    q = conventions.to_native(name, case.multibody(), np.concatenate([[0.1, 0.2, 0.3], ROT])[None])[
+        0
+    ]
+    v = np.concatenate([V_LIN, OMEGA])
+    pin.forwardKinematics(m, d, q, v)
+    R = d.oMi[1].rotation
+    assert_allclose(R, quat_to_matrix(ROT[None])[0], atol=1e-14)
+    world = pin.getVelocity(m, d, 1, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+    assert_allclose(world.linear, R @ V_LIN, atol=1e-14)
+    assert_allclose(world.angular, R @ OMEGA, atol=1e-14)
+    a = pin.aba(m, d, q, v, np.zeros(6))
+    assert_allclose(a[:3], -np.cross(OMEGA, V_LIN), atol=1e-12)
+    assert conventions.LINEAR_VELOCITY_FRAME[name] == "local"

@@ -71,7 +71,7 @@ def test_bad_body(kwargs, message):
     [
         (
             ("j", "universal", Y),
-            r"^j\.type must be one of \('hinge', 'slide', 'ball'\), got 'universal'$",
+            r"^j\.type must be one of \('hinge', 'slide', 'ball', 'free'\), got 'universal'$",
         ),
         (("j", "hinge", (0.0, 2.0, 0.0)), r"^j\.axis must be a unit vector"),
         (("j", "hinge", (0.0, 0.0, 0.0)), r"^j\.axis must be a unit vector"),

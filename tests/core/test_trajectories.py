@@ -10,9 +10,17 @@ from dyncheck.adapters import ADAPTERS
 from dyncheck.cases import NOMINAL_ORDER, get_case
 from dyncheck.comparison import GRAVITY_DEFAULT
 from dyncheck.implementations import SOFT_CONSTRAINT
-from dyncheck.trajectories import PRE_ASYMPTOTIC, observed_orders
+from dyncheck.trajectories import FREE_VELOCITY_FRAME, PRE_ASYMPTOTIC, observed_orders
 
-from ..conftest import ALL_ENGINES, BALL_CASES, CASE_NAMES, COUPLED_CASES, ENGINES, supported
+from ..conftest import (
+    ALL_ENGINES,
+    BALL_CASES,
+    CASE_NAMES,
+    COUPLED_CASES,
+    ENGINES,
+    FREE_CASES,
+    supported,
+)
 
 STUDIES = [
     (c, e, i)
@@ -75,6 +83,10 @@ def test_engine_pairs_on_the_same_model_agree_to_roundoff(full_run):
     d = full_run.discrepancies
     rows = d[(d.quantity == "trajectory") & (d.impl_a == "pinocchio-mjcf") & (d.impl_b == "mujoco")]
     assert len(rows) == sum(_common("pinocchio-mjcf", "mujoco", c) for c in CASE_NAMES)
+    frames = rows[rows.case.isin(FREE_CASES)]  # velocity state in world vs body axes
+    assert (frames.verdict.isin(["explained", "skipped"])).all() and len(frames) > 0
+    assert frames[frames.verdict == "explained"].convention.eq(FREE_VELOCITY_FRAME).all()
+    rows = rows[~rows.case.isin(FREE_CASES)]
     soft = rows[rows.case.isin(COUPLED_CASES)]  # MuJoCo's soft cords, Pinocchio's exact ones
     assert (soft.verdict == "explained").all() and len(soft) > 0
     assert soft.convention.str.contains(SOFT_CONSTRAINT, regex=False).all()
