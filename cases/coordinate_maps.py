@@ -13,6 +13,8 @@ from typing import Protocol
 
 import numpy as np
 
+from dyncheck.errors import InvalidInput
+
 
 class CoordinateMap(Protocol):
     """x̄(x) with its Jacobian and second-derivative term, all batched."""
@@ -160,9 +162,23 @@ def _quat_from_matrix(R: np.ndarray) -> np.ndarray:
     return q
 
 
+UNIT_TOLERANCE = 1e-6
+"""How far a quaternion's norm may stray from 1 (engines renormalize every step; a state
+written by hand with 6 digits passes)."""
+
+
 def quat_to_matrix(q: np.ndarray) -> np.ndarray:
-    """Rotation matrices (n, 3, 3) of quaternions (n, 4) in (w, x, y, z) order."""
-    q = q / np.linalg.norm(q, axis=1, keepdims=True)
+    """Rotation matrices (n, 3, 3) of unit quaternions (n, 4) in (w, x, y, z) order; q and −q
+    give the same rotation. A zero, non-finite or non-unit quaternion is refused."""
+    q = np.asarray(q, float)
+    norm = np.linalg.norm(q, axis=1, keepdims=True)
+    bad = ~np.isfinite(norm[:, 0]) | (np.abs(norm[:, 0] - 1.0) > UNIT_TOLERANCE)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise InvalidInput(
+            "quaternion", tuple(float(x) for x in q[k]), "a unit quaternion (w, x, y, z)"
+        )
+    q = q / norm
     w, x, y, z = q.T
     return np.stack(
         [

@@ -85,3 +85,18 @@ def test_closed_form_row_passes(full_run):
     row = d[d.quantity == "closed_form"]
     assert list(row.case) == ["torque_free"]
     assert row.verdict.iloc[0] == "passed" and row.max_rel_err.iloc[0] < 1e-11
+
+
+def test_q_and_minus_q_are_the_same_rotation(states):
+    """Rotations are compared, not quaternion components: −q maps to the same angles."""
+    q, _ = states
+    m = EulerAngleMap()
+    assert_allclose(m.to_book(-m.to_engine(q)), m.to_book(m.to_engine(q)), atol=1e-15)
+
+
+@pytest.mark.parametrize(
+    "quat", [(0.0, 0.0, 0.0, 0.0), (1.0, 0.1, 0.0, 0.0), (float("nan"), 0.0, 0.0, 1.0)]
+)
+def test_non_unit_quaternion_is_refused(quat):
+    with pytest.raises(InvalidInput, match=r"^quaternion must be a unit quaternion \(w, x, y, z\)"):
+        EulerAngleMap().to_book(np.array([quat]))
