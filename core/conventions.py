@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.cases.multibody import NQ, NV, Multibody
 
 QUATERNION_ORDER: dict[str, str] = {
@@ -72,19 +73,6 @@ def _free_slots(spec: Multibody) -> list[tuple[int, int]]:
     return out
 
 
-def _matrix(quat: np.ndarray) -> np.ndarray:
-    """Rotation matrices of unit quaternions (w, x, y, z), batched."""
-    w, x, y, z = np.moveaxis(quat, -1, 0)
-    return np.stack(
-        [
-            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-        ],
-        -2,
-    )
-
-
 def velocity_frames(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray | None:
     """T(q) with v_native = T v_canonical (canonical states, batched (n, nv, nv)), or None
     when the engine's frames are the canonical ones."""
@@ -93,7 +81,7 @@ def velocity_frames(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray 
         return None
     T = np.broadcast_to(np.eye(spec.nv), (qe.shape[0], spec.nv, spec.nv)).copy()
     for i, k in slots:
-        T[:, k : k + 3, k : k + 3] = np.swapaxes(_matrix(qe[:, i + 3 : i + 7]), -1, -2)
+        T[:, k : k + 3, k : k + 3] = np.swapaxes(quat_to_matrix(qe[:, i + 3 : i + 7]), -1, -2)
     return T
 
 
@@ -106,7 +94,7 @@ def velocity_frame_rates(
         return None
     out = np.zeros_like(ve)
     for i, k in slots:
-        R = _matrix(qe[:, i + 3 : i + 7])
+        R = quat_to_matrix(qe[:, i + 3 : i + 7])
         vb = np.einsum("nji,nj->ni", R, ve[:, k : k + 3])
         out[:, k : k + 3] = -np.cross(ve[:, k + 3 : k + 6], vb)
     return out
