@@ -14,6 +14,11 @@ Integrators (Drake's own, fixed step, by ``ResetIntegratorFromFlags``): ``euler`
 ``runge_kutta2`` (order 2), ``rk3`` ``runge_kutta3`` in fixed-step mode (order 3; it is
 error-controlled by default). Drake has no classic RK4.
 The parser's warnings (what it ignores) are kept in :attr:`DrakeAdapter.parser_warnings`.
+
+State (measured, ``dyncheck.conventions``): a ball joint becomes a ``BallRpyJoint`` —
+q = (roll, pitch, yaw), v = ω in *world* axes; a free joint a ``QuaternionFloatingJoint`` —
+q = (w, x, y, z, p), v = (ω, v) both in world axes. Drake integrates the quaternion's
+components (q̇ = ½ q ⊗ ω), so its norm drifts; the comparison layer renormalizes.
 """
 
 from __future__ import annotations
@@ -33,7 +38,7 @@ from pydrake.systems.primitives import LogVectorOutput
 
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
-from dyncheck.cases.multibody import Multibody
+from dyncheck.cases.multibody import Joint, Multibody
 from dyncheck.errors import EngineError, Unsupported
 
 _INTEGRATORS = {
@@ -86,26 +91,34 @@ class DrakeAdapter(Adapter):
                 "and a continuous-time MultibodyPlant enforces no constraints (Drake's coupler "
                 "constraint needs the discrete SAP solver, a different, compliant dynamics)"
             )
-        if any(j.type in ("ball", "free") for j in model.joints):
-            raise Unsupported(
-                "Drake's MJCF parser turns a ball joint into a BallRpyJoint (roll-pitch-yaw "
-                "chart); dyncheck maps no rpy chart, and no free (floating) body state yet"
-            )
         self.xml = to_mjcf(model)
         self.plant, self.parser_warnings = self._parse(self.xml)
         self.context = self.plant.CreateDefaultContext()
         self._bodies = [self.plant.GetBodyByName(b.name) for b in model.bodies]
         # engine coordinates in the spec's joint order; Drake orders its own
-        self._iq = np.array(
-            [self.plant.GetJointByName(j.name).position_start() for j in model.joints]
+        joints = [self._joint(b.name, j) for b in model.bodies for j in b.joints]
+        self._iq = np.concatenate(
+            [np.arange(j.position_start(), j.position_start() + j.num_positions()) for j in joints]
         )
-        self._iv = np.array(
-            [self.plant.GetJointByName(j.name).velocity_start() for j in model.joints]
+        self._iv = np.concatenate(
+            [np.arange(j.velocity_start(), j.velocity_start() + j.num_velocities()) for j in joints]
         )
         self._tau_port = self.plant.get_applied_generalized_force_input_port()
         self._force_port = self.plant.get_applied_spatial_force_input_port()
         self._acc_port = self.plant.get_generalized_acceleration_output_port()
         self._force_port.FixValue(self.context, [])  # the field, if any, is set per state
+
+    def _joint(self, body: str, joint: Joint):
+        """Drake's joint for a spec joint; a free joint is the body's floating joint, which
+        Drake's parser names after the body, not after the MJCF freejoint."""
+        if joint.type != "free":
+            return self.plant.GetJointByName(joint.name)
+        plant = self.plant
+        for index in plant.GetJointIndices():
+            candidate = plant.get_joint(index)
+            if candidate.child_body().name() == body and candidate.num_velocities() == 6:
+                return candidate
+        raise EngineError(f"drake: no floating joint for body {body!r}")
 
     @staticmethod
     def _parse(xml: str, time_step: float = 0.0) -> tuple[MultibodyPlant, list[str]]:

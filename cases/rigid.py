@@ -22,10 +22,12 @@ from dyncheck.cases.validate import inertia_tensor, positive
 RIGID_STEPS = {
     "euler": (2e-3, 1e-3, 5e-4, 2.5e-4),
     "implicitfast": (2e-3, 1e-3, 5e-4, 2.5e-4),
+    "rk2": (2e-2, 1e-2, 5e-3, 2.5e-3),
+    "rk3": (4e-2, 2e-2, 1e-2, 5e-3),
     "rk4": (8e-2, 4e-2, 2e-2, 1e-2),
 }
 """A free rotation is smooth enough that MuJoCo's RK4 reaches the reference's accuracy below
-1e-2: its study starts coarser (Euler keeps the default halving sequence)."""
+1e-2: its study starts coarser; Drake's RK2 and RK3 likewise (Euler keeps the default)."""
 
 
 @dataclass(frozen=True)

@@ -15,10 +15,13 @@ test_conventions.py rotates a body by a known quaternion and reads the result ba
   velocities cross with T = diag(Rᵀ, 1) and accelerations pick up Ṫ v = (−ω × v_b, 0): the
   engine's v̇ is the derivative of body-frame components (the "spatial" acceleration
   Rᵀ p̈ − ω × v_b), not the body's acceleration.
-- Drake's MJCF parser turns a ball joint into ``BallRpyJoint`` (roll-pitch-yaw angles, their
-  rates as velocities) and sympy.physics.mechanics needs a chart of three angles: neither has
-  a quaternion state, so dyncheck does not map ball joints for them (their rows are skipped
-  with this reason).
+- Drake (measured likewise): its MJCF parser turns a ball joint into ``BallRpyJoint``,
+  q = (roll, pitch, yaw) with R = R_z(y) R_y(p) R_x(r) and v = ω in *world* axes (T = R);
+  a free joint into ``QuaternionFloatingJoint``, q = (w, x, y, z, p), v = (ω, v) both in
+  world axes. Drake integrates the quaternion's components, so its norm drifts: the
+  comparison renormalizes.
+- sympy.physics.mechanics needs a chart of three angles for a rotating body: dyncheck builds
+  none, so its ball and free rows are skipped with this reason.
 """
 
 from __future__ import annotations
@@ -32,13 +35,22 @@ QUATERNION_ORDER: dict[str, str] = {
     "mujoco": "wxyz",
     "pinocchio": "xyzw",
     "pinocchio-mjcf": "xyzw",
+    "drake": "wxyz",
 }
-"""How each engine stores a ball joint's quaternion."""
+"""How each engine stores a ball or free joint's quaternion."""
+
+BALL_CHART: dict[str, str] = {"drake": "rpy"}
+"""Engines whose ball joint holds angles, not a quaternion: Drake's MJCF parser makes a
+``BallRpyJoint``, q = (roll, pitch, yaw) with R = R_z(y) R_y(p) R_x(r) (measured)."""
+
+QUATERNION_FIRST: frozenset[str] = frozenset({"drake"})
+"""Engines whose free joint stores (quaternion, position): Drake's QuaternionFloatingJoint."""
 
 ANGULAR_VELOCITY_FRAME: dict[str, str] = {
     "mujoco": "local",
     "pinocchio": "local",
     "pinocchio-mjcf": "local",
+    "drake": "world",
 }
 """In which frame each engine expresses a ball or free joint's angular velocity."""
 
@@ -46,12 +58,16 @@ LINEAR_VELOCITY_FRAME: dict[str, str] = {
     "mujoco": "world",
     "pinocchio": "local",
     "pinocchio-mjcf": "local",
+    "drake": "world",
 }
 """In which frame each engine expresses a free joint's linear velocity."""
 
+ANGULAR_FIRST: frozenset[str] = frozenset({"drake"})
+"""Engines whose free-joint velocity is (ω, v) rather than (v, ω)."""
+
 
 def quaternion_slots(spec: Multibody) -> list[int]:
-    """Index of each ball or free joint's quaternion in the position coordinates."""
+    """Index of each ball or free joint's quaternion in the canonical position coordinates."""
     out, i = [], 0
     for joint in spec.joints:
         if joint.type == "ball":
@@ -62,67 +78,145 @@ def quaternion_slots(spec: Multibody) -> list[int]:
     return out
 
 
-def _free_slots(spec: Multibody) -> list[tuple[int, int]]:
-    """(position index, velocity index) of each free joint."""
-    out, i, k = [], 0, 0
+def _perm(order: str) -> list[int]:
+    return ["wxyz".index(c) for c in order]
+
+
+def _rpy_from_matrix(R: np.ndarray) -> np.ndarray:
+    """(roll, pitch, yaw) with R = R_z(yaw) R_y(pitch) R_x(roll), batched."""
+    return np.stack(
+        [
+            np.arctan2(R[:, 2, 1], R[:, 2, 2]),
+            np.arcsin(np.clip(-R[:, 2, 0], -1.0, 1.0)),
+            np.arctan2(R[:, 1, 0], R[:, 0, 0]),
+        ],
+        -1,
+    )
+
+
+def _quat_from_rpy(rpy: np.ndarray) -> np.ndarray:
+    """Unit quaternion (w, x, y, z) of R_z(y) R_y(p) R_x(r), batched."""
+    r, p, y = (rpy[:, i] / 2 for i in range(3))
+    cr, sr, cp, sp_, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
+    return np.stack(
+        [
+            cr * cp * cy + sr * sp_ * sy,
+            sr * cp * cy - cr * sp_ * sy,
+            cr * sp_ * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp_ * cy,
+        ],
+        -1,
+    )
+
+
+def _unit(quat: np.ndarray) -> np.ndarray:
+    """Engines that integrate quaternion components (Drake) let the norm drift: renormalize."""
+    return quat / np.linalg.norm(quat, axis=-1, keepdims=True)
+
+
+def to_native(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray:
+    """Canonical positions (quaternions (w, x, y, z); a free joint's position first) to the
+    engine's storage (quaternion order, a ball joint's chart, a free joint's layout)."""
+    if not any(j.type in ("ball", "free") for j in spec.joints):
+        return qe
+    perm = _perm(QUATERNION_ORDER[engine])
+    cols, i = [], 0
     for joint in spec.joints:
-        if joint.type == "free":
-            out.append((i, k))
+        chunk = qe[:, i : i + NQ[joint.type]]
+        if joint.type == "ball":
+            if BALL_CHART.get(engine) == "rpy":
+                cols.append(_rpy_from_matrix(quat_to_matrix(chunk)))
+            else:
+                cols.append(chunk[:, perm])
+        elif joint.type == "free":
+            quat = chunk[:, 3:][:, perm]
+            parts = [quat, chunk[:, :3]] if engine in QUATERNION_FIRST else [chunk[:, :3], quat]
+            cols.extend(parts)
+        else:
+            cols.append(chunk)
         i += NQ[joint.type]
-        k += NV[joint.type]
-    return out
+    return np.concatenate(cols, -1)
+
+
+def from_native(engine: str, spec: Multibody, qn: np.ndarray) -> np.ndarray:
+    """The engine's storage back to canonical positions."""
+    if not any(j.type in ("ball", "free") for j in spec.joints):
+        return qn
+    inverse = np.argsort(_perm(QUATERNION_ORDER[engine]))
+    cols, i = [], 0
+    for joint in spec.joints:
+        if joint.type == "ball" and BALL_CHART.get(engine) == "rpy":
+            cols.append(_quat_from_rpy(qn[:, i : i + 3]))
+            i += 3
+            continue
+        chunk = qn[:, i : i + NQ[joint.type]]
+        if joint.type == "ball":
+            cols.append(_unit(chunk[:, inverse]))
+        elif joint.type == "free":
+            quat, pos = (
+                (chunk[:, :4], chunk[:, 4:])
+                if engine in QUATERNION_FIRST
+                else (
+                    chunk[:, 3:],
+                    chunk[:, :3],
+                )
+            )
+            cols.extend([pos, _unit(quat[:, inverse])])
+        else:
+            cols.append(chunk)
+        i += NQ[joint.type]
+    return np.concatenate(cols, -1)
 
 
 def velocity_frames(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray | None:
     """T(q) with v_native = T v_canonical (canonical states, batched (n, nv, nv)), or None
-    when the engine's frames are the canonical ones."""
-    slots = _free_slots(spec)
-    if not slots or LINEAR_VELOCITY_FRAME.get(engine, "world") == "world":
+    when the engine's velocities are the canonical ones: a ball joint's ω in world axes
+    (Drake: R ω̄), a free joint's v in body axes (Pinocchio: Rᵀ v) or (ω_world, v) (Drake)."""
+    rotating = [j for j in spec.joints if j.type in ("ball", "free")]
+    if not rotating:
         return None
-    T = np.broadcast_to(np.eye(spec.nv), (qe.shape[0], spec.nv, spec.nv)).copy()
-    for i, k in slots:
-        T[:, k : k + 3, k : k + 3] = np.swapaxes(quat_to_matrix(qe[:, i + 3 : i + 7]), -1, -2)
+    world_w = ANGULAR_VELOCITY_FRAME.get(engine) == "world"
+    local_v = LINEAR_VELOCITY_FRAME.get(engine) == "local"
+    if not (world_w or (local_v and any(j.type == "free" for j in rotating))):
+        return None
+    n = qe.shape[0]
+    T = np.broadcast_to(np.eye(spec.nv), (n, spec.nv, spec.nv)).copy()
+    i = k = 0
+    for joint in spec.joints:
+        if joint.type == "ball" and world_w:
+            T[:, k : k + 3, k : k + 3] = quat_to_matrix(qe[:, i : i + 4])
+        elif joint.type == "free":
+            R = quat_to_matrix(qe[:, i + 3 : i + 7])
+            lin = np.swapaxes(R, -1, -2) if local_v else np.broadcast_to(np.eye(3), R.shape)
+            ang = R if world_w else np.broadcast_to(np.eye(3), R.shape)
+            T[:, k : k + 6, k : k + 6] = 0.0
+            if engine in ANGULAR_FIRST:
+                T[:, k : k + 3, k + 3 : k + 6] = ang
+                T[:, k + 3 : k + 6, k : k + 3] = lin
+            else:
+                T[:, k : k + 3, k : k + 3] = lin
+                T[:, k + 3 : k + 6, k + 3 : k + 6] = ang
+        i += NQ[joint.type]
+        k += NV[joint.type]
     return T
 
 
 def velocity_frame_rates(
     engine: str, spec: Multibody, qe: np.ndarray, ve: np.ndarray
 ) -> np.ndarray | None:
-    """Ṫ v for canonical states and velocities: (−ω × Rᵀ v_w, 0) per free joint."""
-    slots = _free_slots(spec)
-    if not slots or LINEAR_VELOCITY_FRAME.get(engine, "world") == "world":
+    """Ṫ v for canonical states and velocities: (−ω × Rᵀ v_w, 0) for a free joint whose v is in
+    body axes; R ω̄ in world axes has Ṙ ω̄ = R (ω̄ × ω̄) = 0."""
+    if velocity_frames(engine, spec, qe) is None:
         return None
     out = np.zeros_like(ve)
-    for i, k in slots:
-        R = quat_to_matrix(qe[:, i + 3 : i + 7])
-        vb = np.einsum("nji,nj->ni", R, ve[:, k : k + 3])
-        out[:, k : k + 3] = -np.cross(ve[:, k + 3 : k + 6], vb)
-    return out
-
-
-def _perm(order: str) -> list[int]:
-    return ["wxyz".index(c) for c in order]
-
-
-def to_native(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray:
-    """Canonical (w, x, y, z) quaternions to the engine's storage order."""
-    slots = quaternion_slots(spec)
-    if not slots:
-        return qe
-    perm = _perm(QUATERNION_ORDER[engine])
-    out = qe.copy()
-    for s in slots:
-        out[..., s : s + 4] = qe[..., [s + p for p in perm]]
-    return out
-
-
-def from_native(engine: str, spec: Multibody, qn: np.ndarray) -> np.ndarray:
-    """The engine's storage order back to canonical (w, x, y, z)."""
-    slots = quaternion_slots(spec)
-    if not slots:
-        return qn
-    perm = _perm(QUATERNION_ORDER[engine])
-    out = qn.copy()
-    for s in slots:
-        out[..., [s + p for p in perm]] = qn[..., s : s + 4]
+    if LINEAR_VELOCITY_FRAME.get(engine) != "local":
+        return out
+    i = k = 0
+    for joint in spec.joints:
+        if joint.type == "free":
+            R = quat_to_matrix(qe[:, i + 3 : i + 7])
+            vb = np.einsum("nji,nj->ni", R, ve[:, k : k + 3])
+            out[:, k : k + 3] = -np.cross(ve[:, k + 3 : k + 6], vb)
+        i += NQ[joint.type]
+        k += NV[joint.type]
     return out

@@ -46,7 +46,7 @@ from dyncheck.tolerances import ORDER_SLACK, REFERENCE_MARGIN, accumulated, soft
 
 TRUNCATION = "integrator truncation error"
 PRE_ASYMPTOTIC = "pre-asymptotic step (a fast constraint mode)"
-FREE_VELOCITY_FRAME = "free-body velocity state in different frames (world vs body)"
+FREE_VELOCITY_FRAME = "rotating-body state stepped in different frames or charts"
 HELD_FORCE = "state-dependent force held over RK4 stages"
 NAIVE_GROUP_RK4 = "RK4 tableau summed across tangent spaces of the rotation group"
 
@@ -280,7 +280,7 @@ def study(
                 verdict, note = "failed", "no pair of steps in the asymptotic range"
             else:
                 p = orders[finest[-1]]
-                ok = abs(p - nominal) <= ORDER_SLACK
+                ok = p >= nominal - ORDER_SLACK  # two order-p maps differ by O(hᵖ) or less
                 verdict = "passed" if ok else "failed"
                 if convention and ok:
                     verdict = "explained"  # the predicted (reduced) order, a finding
@@ -477,8 +477,16 @@ def _unavailable(
 
 
 def _frames_differ(case: Case, a: str, b: str) -> bool:
-    """Two engines that keep a free body's linear velocity in different frames."""
-    if not any(j.type == "free" for j in case.multibody().joints):
+    """Two engines whose fixed-step maps differ on a rotating joint: a free body's linear
+    velocity in different frames, or Drake (which integrates roll-pitch-yaw angles or
+    quaternion components, with ω in world axes) against an engine that steps the
+    quaternion by the exponential map."""
+    types = {j.type for j in case.multibody().joints}
+    if not types & {"ball", "free"}:
+        return False
+    if ("drake" in (a, b)) and a != b:
+        return True
+    if "free" not in types:
         return False
     return LINEAR_VELOCITY_FRAME.get(a, "world") != LINEAR_VELOCITY_FRAME.get(b, "world")
 
@@ -491,19 +499,23 @@ def _frame_pair(
     dts: tuple[float, ...],
     runs: dict[tuple[str, str, float], np.ndarray],
 ) -> Discrepancy:
-    """A fixed-step method on (v_world, ω) and the same method on (v_body, ω) are different
-    maps: both converge at the integrator's order, so their difference must shrink at that
-    order too. Predicted: the difference's observed order between the two coarsest steps."""
+    """A fixed-step method on (v_world, ω) and the same method on (v_body, ω) (or on another
+    chart) are different maps: both converge at the integrator's order p, so their difference
+    must shrink at least at order p (faster where the maps agree to higher order). Predicted:
+    the difference's observed order between the two coarsest steps."""
     nominal = NOMINAL_ORDER[integrator]
     if integrator == "rk4":
         nominal = 2  # the body-frame side is the naive group RK4 (see NAIVE_GROUP_RK4)
+    if len(dts) < 2 or any((e, integrator, dt) not in runs for e in (a, b) for dt in dts[:2]):
+        why = "the two maps differ in definition and fewer than two steps ran"
+        return _no_numbers(case, a, b, integrator, dts[0], "skipped", FREE_VELOCITY_FRAME, why)
     d = []
     for dt in dts[:2]:
         qa, qb = runs[a, integrator, dt], runs[b, integrator, dt]
         d.append(float(difference(case, qb, qa).max()))
     p = float(np.log(d[0] / d[1]) / np.log(dts[0] / dts[1]))
     scale_q = float(np.abs(runs[a, integrator, dts[0]]).max())
-    ok = abs(p - nominal) <= ORDER_SLACK
+    ok = p >= nominal - ORDER_SLACK  # two order-p maps differ by O(hᵖ) or less
     return Discrepancy(
         case.name,
         "trajectory",
@@ -514,11 +526,12 @@ def _frame_pair(
         d[0],
         d[0] / scale_q,
         float("nan"),
-        f"difference of two order-{nominal} maps: shrinks at order {nominal} ± {ORDER_SLACK}",
+        f"difference of two order-{nominal} maps: shrinks at order >= {nominal} - {ORDER_SLACK}",
         "explained" if ok else "failed",
         FREE_VELOCITY_FRAME,
-        f"{a} and {b} step a free body's velocity in different frames; their difference "
-        f"shrinks at order {p:.3f} from dt={dts[0]:g} to {dts[1]:g} (predicted {nominal})",
+        f"{a} and {b} step a rotating body's state differently (velocity frames or chart); "
+        f"their difference shrinks at order {p:.3f} from dt={dts[0]:g} to {dts[1]:g} "
+        f"(predicted {nominal})",
         -1,
     )
 
@@ -584,9 +597,20 @@ def _engine_pairs(
                 if err / scale_q <= tol.rtol:
                     rows.append(Discrepancy(**row, verdict="passed", convention="", note=""))
                 elif va is not None and vb is not None and va != vb:
-                    predicted = refs.discrete(vb, integrator, dt) - refs.discrete(
-                        va, integrator, dt
-                    )
+                    try:
+                        predicted = refs.discrete(vb, integrator, dt) - refs.discrete(
+                            va, integrator, dt
+                        )
+                    except Exception as exc:  # no discrete prediction here: a failed row
+                        rows.append(
+                            Discrepancy(
+                                **row,
+                                verdict="failed",
+                                convention="; ".join(va.conventions(vb)),
+                                note=f"no prediction: {type(exc).__name__}: {exc}",
+                            )
+                        )
+                        continue
                     res_rel = float(difference(case, qb - qa, predicted).max()) / scale_q
                     note = (
                         f"predicted by the reference equations of both models, stepped by "

@@ -21,7 +21,7 @@ FREE_CASES = sorted(
     n for n in CASES if any(j.type == "free" for j in get_case(n).multibody().joints)
 )
 """Cases with a free joint: engines keep its linear velocity in different frames."""
-NO_BALL = ("drake", "sympy-mechanics")
+NO_BALL = ("sympy-mechanics",)
 """Engines dyncheck does not map on ball joints (skipped, with the reason)."""
 
 

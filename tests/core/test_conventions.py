@@ -166,3 +166,39 @@ def test_pinocchio_free_flyer_velocity_is_body_frame(name):
     a = pin.aba(m, d, q, v, np.zeros(6))
     assert_allclose(a[:3], -np.cross(OMEGA, V_LIN), atol=1e-12)
     assert conventions.LINEAR_VELOCITY_FRAME[name] == "local"
+
+
+def test_drake_ball_joint_is_rpy_with_world_angular_velocity():
+    """Drake's BallRpyJoint: q = (r, p, y) with R = R_z(y) R_y(p) R_x(r); v = ω in world
+    axes. Checked on the plant Drake's parser builds from the spherical pendulum's MJCF."""
+    case = get_case("spherical_pendulum")
+    adapter = make_implementation("drake", case).adapter
+    plant, ctx = adapter.plant, adapter.context
+    q = conventions.to_native("drake", case.multibody(), ROT[None])[0]
+    assert q.shape == (3,)
+    plant.SetPositions(ctx, q)
+    plant.SetVelocities(ctx, OMEGA)
+    body = plant.GetBodyByName("bob")
+    R = plant.EvalBodyPoseInWorld(ctx, body).rotation().matrix()
+    assert_allclose(R, quat_to_matrix(ROT[None])[0], atol=1e-14)
+    w = plant.EvalBodySpatialVelocityInWorld(ctx, body).rotational()
+    assert_allclose(w, OMEGA, atol=1e-15)  # v is ω in world axes, not body axes
+    back = conventions.from_native("drake", case.multibody(), q[None])[0]
+    assert_allclose(quat_to_matrix(back[None])[0], quat_to_matrix(ROT[None])[0], atol=1e-14)
+
+
+def test_drake_free_joint_is_quaternion_first_world_velocities():
+    """Drake's QuaternionFloatingJoint: q = (w, x, y, z, p), v = (ω, v), both world axes."""
+    case = get_case("rigid_body_free")
+    adapter = make_implementation("drake", case).adapter
+    plant, ctx = adapter.plant, adapter.context
+    canonical = np.concatenate([[0.1, 0.2, 0.3], ROT])
+    q = conventions.to_native("drake", case.multibody(), canonical[None])[0]
+    assert_allclose(q, np.concatenate([ROT, [0.1, 0.2, 0.3]]))
+    plant.SetPositions(ctx, q)
+    plant.SetVelocities(ctx, np.concatenate([OMEGA, V_LIN]))
+    body = plant.GetBodyByName("body")
+    assert_allclose(plant.EvalBodyPoseInWorld(ctx, body).translation(), [0.1, 0.2, 0.3])
+    V = plant.EvalBodySpatialVelocityInWorld(ctx, body)
+    assert_allclose(V.rotational(), OMEGA, atol=1e-15)
+    assert_allclose(V.translational(), V_LIN, atol=1e-15)
