@@ -10,6 +10,7 @@ import pytest
 from dyncheck.adapters import get_adapter
 from dyncheck.cases import CASES, get_case
 from dyncheck.errors import InvalidInput, UnknownName, Unsupported
+from dyncheck.implementations import make_implementation
 
 from ..conftest import ALL_ENGINES, CASE_NAMES, supported, unsupported_reason
 
@@ -28,9 +29,9 @@ def test_case_loads_in_every_adapter(case, engine):
         with pytest.raises(Unsupported, match=unsupported_reason(case, engine)):
             get_adapter(engine)(c.multibody())
         return
-    adapter = get_adapter(engine)(c.multibody())
+    impl = make_implementation(engine, c)  # the case's map and the engine's storage
     nv = c.multibody().nv
-    assert adapter.mass_matrix(c.engine_map().to_engine(c.rest()[None])).shape == (1, nv, nv)
+    assert impl.adapter.mass_matrix(impl.map.to_engine(c.rest()[None])).shape == (1, nv, nv)
 
 
 @pytest.mark.parametrize("case", CASE_NAMES)
