@@ -92,9 +92,11 @@ CONVENTIONS = {
         "Instantaneous quantities cross the difference exactly (v_b = Rᵀ v_w and the "
         "acceleration term −ω × v_b, in `core/conventions.py`); a fixed-step integrator, "
         "though, is a different map on each state: semi-implicit Euler on (v_w, ω) and on "
-        "(v_b, ω) agree only to O(h). Their engine-against-engine row is explained when the "
-        "difference shrinks at the integrators' order (each is judged against the reference "
-        "in the order study)."
+        "(v_b, ω) agree only to O(h). Drake steps a ball joint's roll-pitch-yaw angles and a "
+        "free joint's quaternion components with ω in world axes — again a different map. "
+        "Such an engine-against-engine row is explained when the difference shrinks at least "
+        "at the integrators' order (each engine is judged against the reference in the order "
+        "study)."
     ),
     TRUNCATION: (
         "A fixed-step integrator's error against the exact solution of the same model. Judged "
