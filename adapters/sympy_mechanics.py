@@ -4,8 +4,9 @@ as frames, points and particles, Lagrange's equations by ``LagrangesMethod``, nu
 its agreement is independent evidence.
 
 Construction, per body: the parent's frame and point; each joint in order either rotates the
-frame (hinge: ``orientnew('Axis')``) or moves the point along the current frame's axis
-(slide); the centre of mass is located in the final frame. Point masses are ``Particle``s,
+frame (hinge: ``orientnew('Axis')``; ball: ``orientnew('Body', (φ, θ, ψ), 'ZXZ')``, Example
+9's angles as coordinates) or moves the point (slide: along the frame's axis; free: along
+the parent's axes, then a ball); the centre of mass is located in the final frame. Point masses are ``Particle``s,
 bodies with inertia ``RigidBody``s. Gravity enters as loads; the Lagrangian is T alone, so
 ``LagrangesMethod`` gives M q̈ = F with F = τ_loads − (velocity terms). The canonical h is
 −F without the field's loads; the field's generalized force is F(field) − F(no field).
@@ -49,19 +50,14 @@ def _batched(exprs: list[sp.Expr], args: list[sp.Symbol]) -> Callable[..., np.nd
 class SympyMechanicsAdapter(Adapter):
     name: ClassVar[str] = "sympy-mechanics"
     package: ClassVar[str] = "sympy"
-    naive_group_rk4: ClassVar[bool] = True
-    """dyncheck's RK4 sums stage velocities from different tangent spaces (order 2 on SO(3))."""
+    naive_group_rk4: ClassVar[bool] = False
+    """Rotations are Euler angles (a chart), so dyncheck's RK4 is the classic one (order 4)."""
     integrators: ClassVar[tuple[str, ...]] = ("rk4",)
     """RK4 only: each step costs Python-level evaluations of the lambdified equations, and one
     integrator suffices to show this symbolic peer integrates the same dynamics."""
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
-        if any(j.type in ("ball", "free") for j in model.joints):
-            raise Unsupported(
-                "a ball joint (or a free body's rotation) needs a three-angle chart in "
-                "sympy.physics.mechanics; dyncheck builds none"
-            )
         n = model.nv
         q = me.dynamicsymbols(f"q0:{n}")
         qd = [qi.diff() for qi in q]
@@ -77,22 +73,32 @@ class SympyMechanicsAdapter(Adapter):
             frame = frames[body.parent]
             point = points[body.parent].locatenew(f"{body.name}_j", _vec(frame, body.joint_pos))
             for joint in body.joints:
-                if joint.type == "hinge":
+                if joint.type == "free":  # position in the parent's axes, then a ball
+                    offset = q[k] * frame.x + q[k + 1] * frame.y + q[k + 2] * frame.z
+                    point = point.locatenew(f"{joint.name}_P", offset)
+                    k += 3
+                if joint.type in ("ball", "free"):  # Example 9's angles: body Z, X, Z
+                    frame = frame.orientnew(
+                        f"{joint.name}_F", "Body", (q[k], q[k + 1], q[k + 2]), "ZXZ"
+                    )
+                    k += 3
+                elif joint.type == "hinge":
                     frame = frame.orientnew(
                         f"{joint.name}_F", "Axis", (q[k], _vec(frame, joint.axis))
                     )
+                    k += 1
                 else:
                     point = point.locatenew(f"{joint.name}_P", q[k] * _vec(frame, joint.axis))
-                k += 1
+                    k += 1
             com = point.locatenew(f"{body.name}_c", _vec(frame, body.com))
             r = com.pos_from(O)
             com.set_vel(N, r.dt(N))
             frame.set_ang_vel(N, frame.ang_vel_in(N))
             m = sp.Rational(float(body.mass))
-            if body.is_point_mass:
+            I = model.body_inertia(body)  # a point mass on a ball joint carries the floor
+            if not I.any():
                 particles.append(me.Particle(body.name, com, m))
             else:
-                I = np.asarray(body.inertia, float)
                 dyad = me.inertia(
                     frame,
                     *(
@@ -119,6 +125,14 @@ class SympyMechanicsAdapter(Adapter):
         M, F_free = forcing(gravity_loads)
         args = [*qs, *vs]
         self._kkt = None
+        if any(b.is_point_mass and any(j.type in ("ball", "free") for j in b.joints)
+               for b in model.bodies):  # fmt: skip
+            raise Unsupported(
+                "a point mass on a ball joint: its spin (a degree of freedom the book lacks, "
+                "carried by the inertia floor) is not orthogonal to the book's velocities in "
+                "Euler-angle rates, so least-norm forces would drive it; dyncheck maps ball "
+                "joints in sympy-mechanics only for bodies with inertia"
+            )
         if model.couplings and model.central_mu:
             raise Unsupported(f"{self.name}: couplings together with a field")
         if model.couplings:
@@ -156,7 +170,7 @@ class SympyMechanicsAdapter(Adapter):
         return sp.__version__
 
     def loaded_bodies(self) -> list[LoadedBody]:
-        return [LoadedBody(b.name, b.mass, np.asarray(b.inertia, float)) for b in self.spec.bodies]
+        return [LoadedBody(b.name, b.mass, self.spec.body_inertia(b)) for b in self.spec.bodies]
 
     def loaded_gravity(self) -> np.ndarray:
         return np.asarray(self.spec.gravity, float)

@@ -20,15 +20,16 @@ test_conventions.py rotates a body by a known quaternion and reads the result ba
   a free joint into ``QuaternionFloatingJoint``, q = (w, x, y, z, p), v = (ω, v) both in
   world axes. Drake integrates the quaternion's components, so its norm drifts: the
   comparison renormalizes.
-- sympy.physics.mechanics needs a chart of three angles for a rotating body: dyncheck builds
-  none, so its ball and free rows are skipped with this reason.
+- sympy-mechanics (dyncheck's own model): a rotating body in Example 9's angles (body Z, X,
+  Z), velocities their rates, so v = J⁻¹ ω̄ (exercise 23) and v̇ picks up −J⁻¹ J̇ q̇. Not for
+  a point mass on a ball joint, whose spin the book lacks (skipped with the reason).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from dyncheck.cases.coordinate_maps import quat_to_matrix
+from dyncheck.cases.coordinate_maps import EulerAngleMap, quat_to_matrix
 from dyncheck.cases.multibody import NQ, NV, Multibody
 
 QUATERNION_ORDER: dict[str, str] = {
@@ -36,12 +37,15 @@ QUATERNION_ORDER: dict[str, str] = {
     "pinocchio": "xyzw",
     "pinocchio-mjcf": "xyzw",
     "drake": "wxyz",
+    "sympy-mechanics": "wxyz",
 }
 """How each engine stores a ball or free joint's quaternion."""
 
-BALL_CHART: dict[str, str] = {"drake": "rpy"}
+BALL_CHART: dict[str, str] = {"drake": "rpy", "sympy-mechanics": "euler"}
 """Engines whose ball joint holds angles, not a quaternion: Drake's MJCF parser makes a
-``BallRpyJoint``, q = (roll, pitch, yaw) with R = R_z(y) R_y(p) R_x(r) (measured)."""
+``BallRpyJoint``, q = (roll, pitch, yaw) with R = R_z(y) R_y(p) R_x(r) (measured);
+dyncheck's sympy-mechanics model uses Example 9's angles (body Z, X, Z: R = ℓ(φ, θ, ψ)) with
+their rates as velocities (a free joint likewise, after its position)."""
 
 QUATERNION_FIRST: frozenset[str] = frozenset({"drake"})
 """Engines whose free joint stores (quaternion, position): Drake's QuaternionFloatingJoint."""
@@ -51,14 +55,17 @@ ANGULAR_VELOCITY_FRAME: dict[str, str] = {
     "pinocchio": "local",
     "pinocchio-mjcf": "local",
     "drake": "world",
+    "sympy-mechanics": "euler rates",
 }
-"""In which frame each engine expresses a ball or free joint's angular velocity."""
+"""In which frame each engine expresses a ball or free joint's angular velocity (or, for a
+chart, that its velocities are the angles' rates)."""
 
 LINEAR_VELOCITY_FRAME: dict[str, str] = {
     "mujoco": "world",
     "pinocchio": "local",
     "pinocchio-mjcf": "local",
     "drake": "world",
+    "sympy-mechanics": "world",
 }
 """In which frame each engine expresses a free joint's linear velocity."""
 
@@ -109,6 +116,10 @@ def _quat_from_rpy(rpy: np.ndarray) -> np.ndarray:
     )
 
 
+def _euler(quat: np.ndarray) -> np.ndarray:
+    return EulerAngleMap().to_book(quat)
+
+
 def _unit(quat: np.ndarray) -> np.ndarray:
     """Engines that integrate quaternion components (Drake) let the norm drift: renormalize."""
     return quat / np.linalg.norm(quat, axis=-1, keepdims=True)
@@ -126,8 +137,12 @@ def to_native(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray:
         if joint.type == "ball":
             if BALL_CHART.get(engine) == "rpy":
                 cols.append(_rpy_from_matrix(quat_to_matrix(chunk)))
+            elif BALL_CHART.get(engine) == "euler":
+                cols.append(_euler(chunk))
             else:
                 cols.append(chunk[:, perm])
+        elif joint.type == "free" and BALL_CHART.get(engine) == "euler":
+            cols.extend([chunk[:, :3], _euler(chunk[:, 3:])])
         elif joint.type == "free":
             quat = chunk[:, 3:][:, perm]
             parts = [quat, chunk[:, :3]] if engine in QUATERNION_FIRST else [chunk[:, :3], quat]
@@ -147,6 +162,13 @@ def from_native(engine: str, spec: Multibody, qn: np.ndarray) -> np.ndarray:
     for joint in spec.joints:
         if joint.type == "ball" and BALL_CHART.get(engine) == "rpy":
             cols.append(_quat_from_rpy(qn[:, i : i + 3]))
+            i += 3
+            continue
+        if joint.type in ("ball", "free") and BALL_CHART.get(engine) == "euler":
+            if joint.type == "free":
+                cols.append(qn[:, i : i + 3])
+                i += 3
+            cols.append(EulerAngleMap().to_engine(qn[:, i : i + 3]))
             i += 3
             continue
         chunk = qn[:, i : i + NQ[joint.type]]
@@ -176,14 +198,19 @@ def velocity_frames(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray 
     if not rotating:
         return None
     world_w = ANGULAR_VELOCITY_FRAME.get(engine) == "world"
+    rates = ANGULAR_VELOCITY_FRAME.get(engine) == "euler rates"
     local_v = LINEAR_VELOCITY_FRAME.get(engine) == "local"
-    if not (world_w or (local_v and any(j.type == "free" for j in rotating))):
+    if not (world_w or rates or (local_v and any(j.type == "free" for j in rotating))):
         return None
     n = qe.shape[0]
     T = np.broadcast_to(np.eye(spec.nv), (n, spec.nv, spec.nv)).copy()
     i = k = 0
     for joint in spec.joints:
-        if joint.type == "ball" and world_w:
+        if joint.type in ("ball", "free") and rates:  # q̇ = J⁻¹ ω̄ (exercise 23 inverted)
+            a, b = (i + 3, k + 3) if joint.type == "free" else (i, k)
+            angles = _euler(qe[:, a : a + 4])
+            T[:, b : b + 3, b : b + 3] = np.linalg.inv(EulerAngleMap().jacobian(angles))
+        elif joint.type == "ball" and world_w:
             T[:, k : k + 3, k : k + 3] = quat_to_matrix(qe[:, i : i + 4])
         elif joint.type == "free":
             R = quat_to_matrix(qe[:, i + 3 : i + 7])
@@ -206,9 +233,25 @@ def velocity_frame_rates(
 ) -> np.ndarray | None:
     """Ṫ v for canonical states and velocities: (−ω × Rᵀ v_w, 0) for a free joint whose v is in
     body axes; R ω̄ in world axes has Ṙ ω̄ = R (ω̄ × ω̄) = 0."""
-    if velocity_frames(engine, spec, qe) is None:
+    T = velocity_frames(engine, spec, qe)
+    if T is None:
         return None
     out = np.zeros_like(ve)
+    if ANGULAR_VELOCITY_FRAME.get(engine) == "euler rates":
+        # d/dt (J⁻¹ ω̄) = −J⁻¹ J̇ q̇ with q̇ = J⁻¹ ω̄ (the Euler chart's own (2.2.5) term)
+        i = k = 0
+        for joint in spec.joints:
+            if joint.type in ("ball", "free"):
+                a, b = (i + 3, k + 3) if joint.type == "free" else (i, k)
+                angles = _euler(qe[:, a : a + 4])
+                Tb = T[:, b : b + 3, b : b + 3]
+                qdot = np.einsum("nij,nj->ni", Tb, ve[:, b : b + 3])
+                out[:, b : b + 3] = -np.einsum(
+                    "nij,nj->ni", Tb, EulerAngleMap().hessian_term(angles, qdot)
+                )
+            i += NQ[joint.type]
+            k += NV[joint.type]
+        return out
     if LINEAR_VELOCITY_FRAME.get(engine) != "local":
         return out
     i = k = 0

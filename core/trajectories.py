@@ -30,7 +30,7 @@ from dyncheck.adapters.integrators import STEPPERS, integrate
 from dyncheck.cases import NOMINAL_ORDER, Case
 from dyncheck.cases.coordinate_maps import EulerAngleMap
 from dyncheck.comparison import describe
-from dyncheck.conventions import LINEAR_VELOCITY_FRAME
+from dyncheck.conventions import BALL_CHART, LINEAR_VELOCITY_FRAME
 from dyncheck.implementations import (
     IMPLEMENTATIONS,
     SOFT_CONSTRAINT,
@@ -484,7 +484,8 @@ def _frames_differ(case: Case, a: str, b: str) -> bool:
     types = {j.type for j in case.multibody().joints}
     if not types & {"ball", "free"}:
         return False
-    if ("drake" in (a, b)) and a != b:
+    charted = {e for e in (a, b) if e in BALL_CHART}
+    if charted and a != b:
         return True
     if "free" not in types:
         return False
