@@ -7,9 +7,10 @@ Construction, per body: the parent's frame and point; each joint in order either
 frame (hinge: ``orientnew('Axis')``; ball: ``orientnew('Body', (φ, θ, ψ), 'ZXZ')``, Example
 9's angles as coordinates) or moves the point (slide: along the frame's axis; free: along
 the parent's axes, then a ball); the centre of mass is located in the final frame. Point
-masses are ``Particle``s, bodies with inertia ``RigidBody``s. Gravity enters as loads; the Lagrangian is T alone, so
-``LagrangesMethod`` gives M q̈ = F with F = τ_loads − (velocity terms). The canonical h is
-−F without the field's loads; the field's generalized force is F(field) − F(no field).
+masses are ``Particle``s, bodies with inertia ``RigidBody``s. Gravity enters as loads;
+the Lagrangian is T alone, so ``LagrangesMethod`` gives M q̈ = F with F = τ_loads −
+(velocity terms). The canonical h is −F without the field's loads; the field's generalized
+force is F(field) − F(no field).
 Energies: ``kinetic_energy`` and V = −Σ m g·r. Couplings (cords) are ``hol_coneqs`` of
 ``LagrangesMethod``: its full mass matrix and forcing give q̈ and the multipliers λ together
 (M q̈ = F + τ + Φᵀ λ, the adapters' sign of f).
