@@ -126,14 +126,6 @@ class SympyMechanicsAdapter(Adapter):
         M, F_free = forcing(gravity_loads)
         args = [*qs, *vs]
         self._kkt = None
-        if any(b.is_point_mass and any(j.type in ("ball", "free") for j in b.joints)
-               for b in model.bodies):  # fmt: skip
-            raise Unsupported(
-                "a point mass on a ball joint: its spin (a degree of freedom the book lacks, "
-                "carried by the inertia floor) is not orthogonal to the book's velocities in "
-                "Euler-angle rates, so least-norm forces would drive it; dyncheck maps ball "
-                "joints in sympy-mechanics only for bodies with inertia"
-            )
         if model.couplings and model.central_mu:
             raise Unsupported(f"{self.name}: couplings together with a field")
         if model.couplings:

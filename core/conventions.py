@@ -21,8 +21,9 @@ test_conventions.py rotates a body by a known quaternion and reads the result ba
   world axes. Drake integrates the quaternion's components, so its norm drifts: the
   comparison renormalizes.
 - sympy-mechanics (dyncheck's own model): a rotating body in Example 9's angles (body Z, X,
-  Z), velocities their rates, so v = J⁻¹ ω̄ (exercise 23) and v̇ picks up −J⁻¹ J̇ q̇. Not for
-  a point mass on a ball joint, whose spin the book lacks (skipped with the reason).
+  Z), velocities their rates, so v = J⁻¹ ω̄ (exercise 23) and v̇ picks up −J⁻¹ J̇ q̇. Where
+  the book has fewer coordinates than the engine (a point mass's spin), least squares and
+  least-norm forces are taken in the canonical metric W = T⁻ᵀT⁻¹, not in the angle rates'.
 """
 
 from __future__ import annotations

@@ -38,19 +38,29 @@ def velocity_to_engine(cmap: CoordinateMap, q: np.ndarray, v: np.ndarray) -> np.
     return _mv(cmap.jacobian(q), v)
 
 
-def _left_solve(J: np.ndarray, x: np.ndarray) -> np.ndarray:
+def _weight(cmap: CoordinateMap, q: np.ndarray) -> np.ndarray | None:
+    """The metric W of an embedding's least squares: the identity in the case's canonical
+    engine coordinates; an engine whose velocities are T times them (a chart's rates) weighs
+    by W = T⁻ᵀ T⁻¹, so that what the book cannot see (a spin) is chosen as canonically."""
+    weight = getattr(cmap, "weight", None)
+    return None if weight is None else weight(q)
+
+
+def _left_solve(J: np.ndarray, x: np.ndarray, W: np.ndarray | None = None) -> np.ndarray:
     """y with J y = x: J⁻¹ x for a square J; for an embedding (more engine coordinates than
-    book ones: a constraint, or a ball joint's spin) the least-squares (JᵀJ)⁻¹ Jᵀ x, exact
+    book ones: a constraint, or a ball joint's spin) the least-squares (JᵀWJ)⁻¹ JᵀW x, exact
     when x lies in J's range, as it does for states of the book's model."""
     if J.shape[-1] == J.shape[-2]:
         return np.linalg.solve(J, x[..., None])[..., 0]
     Jt = np.swapaxes(J, -1, -2)
+    if W is not None:
+        Jt = Jt @ W
     return np.linalg.solve(Jt @ J, _mv(Jt, x)[..., None])[..., 0]
 
 
 def velocity_to_book(cmap: CoordinateMap, q: np.ndarray, ve: np.ndarray) -> np.ndarray:
     """v = J⁻¹ v̄ (least squares for an embedding)."""
-    return _left_solve(cmap.jacobian(q), ve)
+    return _left_solve(cmap.jacobian(q), ve, _weight(cmap, q))
 
 
 def acceleration_to_engine(
@@ -64,7 +74,7 @@ def acceleration_to_book(
     cmap: CoordinateMap, q: np.ndarray, v: np.ndarray, ae: np.ndarray
 ) -> np.ndarray:
     """a = J⁻¹ (ā − (∂²x̄/∂x∂x) v v) (least squares for an embedding)."""
-    return _left_solve(cmap.jacobian(q), ae - cmap.hessian_term(q, v))
+    return _left_solve(cmap.jacobian(q), ae - cmap.hessian_term(q, v), _weight(cmap, q))
 
 
 def force_to_book(cmap: CoordinateMap, q: np.ndarray, tau_e: np.ndarray) -> np.ndarray:
@@ -73,13 +83,15 @@ def force_to_book(cmap: CoordinateMap, q: np.ndarray, tau_e: np.ndarray) -> np.n
 
 
 def force_to_engine(cmap: CoordinateMap, q: np.ndarray, tau: np.ndarray) -> np.ndarray:
-    """τ̄ = J⁻ᵀ τ; for an embedding the least-norm τ̄ = J (JᵀJ)⁻¹ τ with Jᵀ τ̄ = τ (a force
-    outside J's range — along a constraint or a spin — would change nothing the book sees)."""
+    """τ̄ = J⁻ᵀ τ; for an embedding the least-norm τ̄ = W J (JᵀWJ)⁻¹ τ with Jᵀ τ̄ = τ (a force
+    outside J's range — along a constraint or a spin — would change nothing the book sees;
+    W as in :func:`_weight`)."""
     J = cmap.jacobian(q)
     if J.shape[-1] == J.shape[-2]:
         return np.linalg.solve(np.swapaxes(J, -1, -2), tau[..., None])[..., 0]
-    Jt = np.swapaxes(J, -1, -2)
-    return _mv(J, np.linalg.solve(Jt @ J, tau[..., None])[..., 0])
+    W = _weight(cmap, q)
+    WJ = J if W is None else W @ J
+    return _mv(WJ, np.linalg.solve(np.swapaxes(J, -1, -2) @ WJ, tau[..., None])[..., 0])
 
 
 def mass_matrix_to_book(cmap: CoordinateMap, q: np.ndarray, Me: np.ndarray) -> np.ndarray:

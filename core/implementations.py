@@ -285,6 +285,14 @@ class NativeMap:
         T = velocity_frames(self.engine, self.spec, self.base.to_engine(q))
         return J if T is None else T @ J
 
+    def weight(self, q: np.ndarray) -> np.ndarray | None:
+        """W = T⁻ᵀ T⁻¹: least squares in the canonical coordinates (None where T = 1)."""
+        T = velocity_frames(self.engine, self.spec, self.base.to_engine(q))
+        if T is None:
+            return None
+        Tinv = np.linalg.inv(T)
+        return np.swapaxes(Tinv, -1, -2) @ Tinv
+
     def hessian_term(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """T H + Ṫ J v: the frames' rotation adds to the (2.2.5)-type term."""
         H = self.base.hessian_term(q, v)

@@ -21,7 +21,7 @@ FREE_CASES = sorted(
     n for n in CASES if any(j.type == "free" for j in get_case(n).multibody().joints)
 )
 """Cases with a free joint: engines keep its linear velocity in different frames."""
-NO_BALL = ("sympy-mechanics",)
+NO_BALL: tuple[str, ...] = ()
 """Engines dyncheck does not map for a point mass on a ball joint (skipped, with the reason)."""
 POINT_BALL_CASES = sorted(
     n
