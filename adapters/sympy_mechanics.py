@@ -27,7 +27,7 @@ import sympy.physics.mechanics as me
 
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.integrators import integrate
-from dyncheck.cases.multibody import Multibody
+from dyncheck.cases.multibody import ROTATING, Multibody
 from dyncheck.errors import Unsupported
 
 
@@ -78,7 +78,7 @@ class SympyMechanicsAdapter(Adapter):
                     offset = q[k] * frame.x + q[k + 1] * frame.y + q[k + 2] * frame.z
                     point = point.locatenew(f"{joint.name}_P", offset)
                     k += 3
-                if joint.type in ("ball", "free"):  # Example 9's angles: body Z, X, Z
+                if joint.type in ROTATING:  # Example 9's angles: body Z, X, Z
                     frame = frame.orientnew(
                         f"{joint.name}_F", "Body", (q[k], q[k + 1], q[k + 2]), "ZXZ"
                     )

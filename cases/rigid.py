@@ -14,14 +14,13 @@ from typing import ClassVar
 
 import numpy as np
 
-from dyncheck.cases.base import Case, TrajectorySpec
+from dyncheck.cases.base import STEPS, Case, TrajectorySpec
 from dyncheck.cases.coordinate_maps import EulerAngleMap, FreeBodyMap
 from dyncheck.cases.multibody import Body, Joint, Multibody
 from dyncheck.cases.validate import inertia_tensor, positive
 
 RIGID_STEPS = {
-    "euler": (2e-3, 1e-3, 5e-4, 2.5e-4),
-    "implicitfast": (2e-3, 1e-3, 5e-4, 2.5e-4),
+    **STEPS,
     "rk2": (2e-2, 1e-2, 5e-3, 2.5e-3),
     "rk3": (4e-2, 2e-2, 1e-2, 5e-3),
     "rk4": (8e-2, 4e-2, 2e-2, 1e-2),

@@ -33,8 +33,17 @@ from dyncheck.implementations import (
 )
 
 __all__ = ["GRAVITY_DEFAULT", "POINT_INERTIA", "compare_instantaneous"]
+from dyncheck.reference.constraints import MAX_IMPEDANCE
 from dyncheck.results import Discrepancy
 from dyncheck.tolerances import instantaneous, soft_condition
+
+
+def soft_factor(v: Variant | None) -> float:
+    """Round-off amplification of a variant's soft-constraint solve (1 without one): the
+    :func:`soft_condition` at its largest impedance, clamped like MuJoCo's."""
+    if v is None or not v.softness:
+        return 1.0
+    return soft_condition(min(max(v.softness[2:4]), MAX_IMPEDANCE))
 
 
 def describe(v: Variant) -> str:
@@ -150,11 +159,7 @@ class VariantPredictor:
 def _row(
     case: Case, quantity: str, a: Evaluator, b: Evaluator, st: PairStats, condition: float
 ) -> Discrepancy:
-    soft = max(
-        soft_condition(min(max(v.softness[2:4]), 0.9999)) if v is not None and v.softness else 1.0
-        for v in (a.variant, b.variant)
-    )
-    tol = instantaneous(quantity, condition, soft)
+    tol = instantaneous(quantity, condition, max(soft_factor(a.variant), soft_factor(b.variant)))
     base = dict(
         case=case.name,
         quantity=quantity,

@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from dyncheck.cases.coordinate_maps import EulerAngleMap, quat_to_matrix
-from dyncheck.cases.multibody import NQ, NV, Multibody
+from dyncheck.cases.multibody import NQ, NV, ROTATING, Multibody
 
 QUATERNION_ORDER: dict[str, str] = {
     "mujoco": "wxyz",
@@ -72,18 +72,6 @@ LINEAR_VELOCITY_FRAME: dict[str, str] = {
 
 ANGULAR_FIRST: frozenset[str] = frozenset({"drake"})
 """Engines whose free-joint velocity is (ω, v) rather than (v, ω)."""
-
-
-def quaternion_slots(spec: Multibody) -> list[int]:
-    """Index of each ball or free joint's quaternion in the canonical position coordinates."""
-    out, i = [], 0
-    for joint in spec.joints:
-        if joint.type == "ball":
-            out.append(i)
-        elif joint.type == "free":
-            out.append(i + 3)
-        i += NQ[joint.type]
-    return out
 
 
 def _perm(order: str) -> list[int]:
@@ -129,7 +117,7 @@ def _unit(quat: np.ndarray) -> np.ndarray:
 def to_native(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray:
     """Canonical positions (quaternions (w, x, y, z); a free joint's position first) to the
     engine's storage (quaternion order, a ball joint's chart, a free joint's layout)."""
-    if not any(j.type in ("ball", "free") for j in spec.joints):
+    if not any(j.type in ROTATING for j in spec.joints):
         return qe
     perm = _perm(QUATERNION_ORDER[engine])
     cols, i = [], 0
@@ -156,7 +144,7 @@ def to_native(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray:
 
 def from_native(engine: str, spec: Multibody, qn: np.ndarray) -> np.ndarray:
     """The engine's storage back to canonical positions."""
-    if not any(j.type in ("ball", "free") for j in spec.joints):
+    if not any(j.type in ROTATING for j in spec.joints):
         return qn
     inverse = np.argsort(_perm(QUATERNION_ORDER[engine]))
     cols, i = [], 0
@@ -165,7 +153,7 @@ def from_native(engine: str, spec: Multibody, qn: np.ndarray) -> np.ndarray:
             cols.append(_quat_from_rpy(qn[:, i : i + 3]))
             i += 3
             continue
-        if joint.type in ("ball", "free") and BALL_CHART.get(engine) == "euler":
+        if joint.type in ROTATING and BALL_CHART.get(engine) == "euler":
             if joint.type == "free":
                 cols.append(qn[:, i : i + 3])
                 i += 3
@@ -176,14 +164,10 @@ def from_native(engine: str, spec: Multibody, qn: np.ndarray) -> np.ndarray:
         if joint.type == "ball":
             cols.append(_unit(chunk[:, inverse]))
         elif joint.type == "free":
-            quat, pos = (
-                (chunk[:, :4], chunk[:, 4:])
-                if engine in QUATERNION_FIRST
-                else (
-                    chunk[:, 3:],
-                    chunk[:, :3],
-                )
-            )
+            if engine in QUATERNION_FIRST:
+                quat, pos = chunk[:, :4], chunk[:, 4:]
+            else:
+                quat, pos = chunk[:, 3:], chunk[:, :3]
             cols.extend([pos, _unit(quat[:, inverse])])
         else:
             cols.append(chunk)
@@ -195,7 +179,7 @@ def velocity_frames(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray 
     """T(q) with v_native = T v_canonical (canonical states, batched (n, nv, nv)), or None
     when the engine's velocities are the canonical ones: a ball joint's ω in world axes
     (Drake: R ω̄), a free joint's v in body axes (Pinocchio: Rᵀ v) or (ω_world, v) (Drake)."""
-    rotating = [j for j in spec.joints if j.type in ("ball", "free")]
+    rotating = [j for j in spec.joints if j.type in ROTATING]
     if not rotating:
         return None
     world_w = ANGULAR_VELOCITY_FRAME.get(engine) == "world"
@@ -207,7 +191,7 @@ def velocity_frames(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray 
     T = np.broadcast_to(np.eye(spec.nv), (n, spec.nv, spec.nv)).copy()
     i = k = 0
     for joint in spec.joints:
-        if joint.type in ("ball", "free") and rates:  # q̇ = J⁻¹ ω̄ (exercise 23 inverted)
+        if joint.type in ROTATING and rates:  # q̇ = J⁻¹ ω̄ (exercise 23 inverted)
             a, b = (i + 3, k + 3) if joint.type == "free" else (i, k)
             angles = _euler(qe[:, a : a + 4])
             T[:, b : b + 3, b : b + 3] = np.linalg.inv(EulerAngleMap().jacobian(angles))
@@ -230,19 +214,17 @@ def velocity_frames(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray 
 
 
 def velocity_frame_rates(
-    engine: str, spec: Multibody, qe: np.ndarray, ve: np.ndarray
-) -> np.ndarray | None:
-    """Ṫ v for canonical states and velocities: (−ω × Rᵀ v_w, 0) for a free joint whose v is in
-    body axes; R ω̄ in world axes has Ṙ ω̄ = R (ω̄ × ω̄) = 0."""
-    T = velocity_frames(engine, spec, qe)
-    if T is None:
-        return None
+    engine: str, spec: Multibody, qe: np.ndarray, ve: np.ndarray, T: np.ndarray
+) -> np.ndarray:
+    """Ṫ v for canonical states and velocities, given T = :func:`velocity_frames` there:
+    (−ω × Rᵀ v_w, 0) for a free joint whose v is in body axes; R ω̄ in world axes has
+    Ṙ ω̄ = R (ω̄ × ω̄) = 0; an Euler chart's −J⁻¹ J̇ q̇."""
     out = np.zeros_like(ve)
     if ANGULAR_VELOCITY_FRAME.get(engine) == "euler rates":
         # d/dt (J⁻¹ ω̄) = −J⁻¹ J̇ q̇ with q̇ = J⁻¹ ω̄ (the Euler chart's own (2.2.5) term)
         i = k = 0
         for joint in spec.joints:
-            if joint.type in ("ball", "free"):
+            if joint.type in ROTATING:
                 a, b = (i + 3, k + 3) if joint.type == "free" else (i, k)
                 angles = _euler(qe[:, a : a + 4])
                 Tb = T[:, b : b + 3, b : b + 3]

@@ -262,8 +262,8 @@ class ReferenceImplementation(_Equations):
 @dataclass(frozen=True)
 class NativeMap:
     """The case's map followed by the engine's storage conventions (``dyncheck.conventions``):
-    quaternion order, and a free joint's linear velocity in the engine's frame; angular
-    velocities stay in the body frame, where every engine mapped here keeps them."""
+    quaternion order or chart, a free joint's layout, and the frames (or angle rates) of a
+    rotating joint's velocities, v_native = T v_canonical."""
 
     base: Any
     engine: str
@@ -279,15 +279,20 @@ class NativeMap:
     def to_book(self, qn: np.ndarray) -> np.ndarray:
         return self.base.to_book(from_native(self.engine, self.spec, qn))
 
+    def _frames(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """The canonical engine state of ``q`` and T there (None where T = 1)."""
+        qe = self.base.to_engine(q)
+        return qe, velocity_frames(self.engine, self.spec, qe)
+
     def jacobian(self, q: np.ndarray) -> np.ndarray:
-        """T J: the case's Jacobian, then the engine's velocity frames (free joints)."""
+        """T J: the case's Jacobian, then the engine's velocity frames."""
         J = self.base.jacobian(q)
-        T = velocity_frames(self.engine, self.spec, self.base.to_engine(q))
+        T = self._frames(q)[1]
         return J if T is None else T @ J
 
     def weight(self, q: np.ndarray) -> np.ndarray | None:
         """W = T⁻ᵀ T⁻¹: least squares in the canonical coordinates (None where T = 1)."""
-        T = velocity_frames(self.engine, self.spec, self.base.to_engine(q))
+        T = self._frames(q)[1]
         if T is None:
             return None
         Tinv = np.linalg.inv(T)
@@ -296,12 +301,11 @@ class NativeMap:
     def hessian_term(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """T H + Ṫ J v: the frames' rotation adds to the (2.2.5)-type term."""
         H = self.base.hessian_term(q, v)
-        qe = self.base.to_engine(q)
-        T = velocity_frames(self.engine, self.spec, qe)
+        qe, T = self._frames(q)
         if T is None:
             return H
         ve = np.einsum("nij,nj->ni", self.base.jacobian(q), v)
-        rates = velocity_frame_rates(self.engine, self.spec, qe, ve)
+        rates = velocity_frame_rates(self.engine, self.spec, qe, ve, T)
         return np.einsum("nij,nj->ni", T, H) + rates
 
 

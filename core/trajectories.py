@@ -29,7 +29,8 @@ from dyncheck import coordinates as co
 from dyncheck.adapters.integrators import STEPPERS, integrate
 from dyncheck.cases import NOMINAL_ORDER, Case
 from dyncheck.cases.coordinate_maps import EulerAngleMap
-from dyncheck.comparison import describe
+from dyncheck.cases.multibody import ROTATING
+from dyncheck.comparison import describe, soft_factor
 from dyncheck.conventions import BALL_CHART, LINEAR_VELOCITY_FRAME
 from dyncheck.implementations import (
     IMPLEMENTATIONS,
@@ -42,7 +43,7 @@ from dyncheck.implementations import (
 )
 from dyncheck.reference import rigid
 from dyncheck.results import ConvergencePoint, Discrepancy
-from dyncheck.tolerances import ORDER_SLACK, REFERENCE_MARGIN, accumulated, soft_condition
+from dyncheck.tolerances import ORDER_SLACK, REFERENCE_MARGIN, accumulated
 
 TRUNCATION = "integrator truncation error"
 PRE_ASYMPTOTIC = "pre-asymptotic step (a fast constraint mode)"
@@ -56,7 +57,7 @@ def _naive_group_rk4(case: Case, impl: Implementation) -> bool:
     angular velocities that live in different frames: on a ball joint its order drops to 2."""
     adapter = getattr(impl, "adapter", None)
     return bool(getattr(adapter, "naive_group_rk4", False)) and any(
-        j.type in ("ball", "free") for j in case.multibody().joints
+        j.type in ROTATING for j in case.multibody().joints
     )
 
 
@@ -346,13 +347,6 @@ def study(
     return points, rows, figures
 
 
-def _soft(variant: Variant | None) -> float:
-    """Round-off amplification of a soft-constraint solve (1 without one)."""
-    if variant is None or not variant.softness:
-        return 1.0
-    return soft_condition(min(max(variant.softness[2:4]), 0.9999))
-
-
 def _drift_row(
     case: Case,
     impl: Implementation,
@@ -367,7 +361,7 @@ def _drift_row(
     C = case.multibody().coupling_matrix(positions=True)
     observed = impl.engine_positions(dt, integrator) @ C.T  # type: ignore[attr-defined]
     steps = observed.shape[0] - 1
-    tol = accumulated(steps, _soft(variant))
+    tol = accumulated(steps, soft_factor(variant))
     base = dict(
         case=case.name,
         quantity="constraint_drift",
@@ -482,7 +476,7 @@ def _frames_differ(case: Case, a: str, b: str) -> bool:
     quaternion components, with ω in world axes) against an engine that steps the
     quaternion by the exponential map."""
     types = {j.type for j in case.multibody().joints}
-    if not types & {"ball", "free"}:
+    if not types & set(ROTATING):
         return False
     charted = {e for e in (a, b) if e in BALL_CHART}
     if charted and a != b:
@@ -576,7 +570,7 @@ def _engine_pairs(
                     continue
                 qa, qb = runs[a, integrator, dt], runs[b, integrator, dt]
                 steps = qa.shape[0] - 1
-                tol = accumulated(steps, max(_soft(variants[a]), _soft(variants[b])))
+                tol = accumulated(steps, max(soft_factor(variants[a]), soft_factor(variants[b])))
                 scale_q = float(np.abs(qa).max())
                 diff = difference(case, qb, qa).max(axis=1)
                 worst = int(diff.argmax())
