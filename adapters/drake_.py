@@ -15,6 +15,19 @@ Integrators (Drake's own, fixed step, by ``ResetIntegratorFromFlags``): ``euler`
 error-controlled by default). Drake has no classic RK4.
 The parser's warnings (what it ignores) are kept in :attr:`DrakeAdapter.parser_warnings`.
 
+Couplings (cords): Drake's MJCF parser ignores ``<tendon>`` and the tendon ``<equality>``
+(its own warning), and a continuous-time plant enforces no constraint (Drake's coupler
+constraint exists only for a discrete plant solved by SAP, and couples two joints, not the
+three of exercise 17). So the cord is closed here, with Drake's own M and h, by the Lagrange
+multiplier of the linear constraint C v = 0 (C constant, from the engine-neutral model, as for
+``pinocchio-mjcf``): the KKT system
+
+    [M  −Cᵀ] [v̇]   [τ − h]
+    [C   0 ] [f ] = [  0  ],
+
+f = −tension; in simulation Cᵀ f enters the plant's applied-generalized-force input, recomputed
+from the state at every stage of Drake's integrators.
+
 State (measured, ``dyncheck.conventions``): a ball joint becomes a ``BallRpyJoint`` —
 q = (roll, pitch, yaw), v = ω in *world* axes; a free joint a ``QuaternionFloatingJoint`` —
 q = (w, x, y, z, p), v = (ω, v) both in world axes. Drake integrates the quaternion's
@@ -78,6 +91,35 @@ class _Field(LeafSystem):
         output.set_value(self._a._field_forces(self._ctx))
 
 
+class _Cords(LeafSystem):
+    """Reads the plant's state, outputs the cords' generalized force Cᵀ f of the KKT solve
+    (τ = 0) as the plant's applied generalized force — at every stage of every step."""
+
+    def __init__(self, adapter: DrakeAdapter) -> None:
+        super().__init__()
+        self._a = adapter
+        plant = adapter.plant
+        self._state = self.DeclareVectorInputPort(
+            "state", plant.num_positions() + plant.num_velocities()
+        )
+        self.DeclareVectorOutputPort("force", plant.num_velocities(), self._calc)
+        self._ctx = plant.CreateDefaultContext()
+        self._zero = np.zeros(plant.num_velocities())
+
+    def _calc(self, context, output) -> None:
+        self._a.plant.SetPositionsAndVelocities(self._ctx, self._state.Eval(context))
+        f = self._a._closed(self._ctx, self._zero)[1]
+        output.SetFromVector(self._a._C.T @ f)
+
+
+def kkt(M: np.ndarray, rhs: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """v̇ and f of M v̇ − Cᵀ f = rhs, C v̇ = 0 (a constant constraint: no drift term)."""
+    n, m = M.shape[0], C.shape[0]
+    K = np.block([[M, -C.T], [C, np.zeros((m, m))]])
+    x = np.linalg.solve(K, np.concatenate([rhs, np.zeros(m)]))
+    return x[:n], x[n:]
+
+
 class DrakeAdapter(Adapter):
     name: ClassVar[str] = "drake"
     package: ClassVar[str] = "drake"
@@ -85,12 +127,8 @@ class DrakeAdapter(Adapter):
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
-        if model.couplings:
-            raise Unsupported(
-                "Drake's MJCF parser ignores <tendon> and <equality><tendon> (its own warning), "
-                "and a continuous-time MultibodyPlant enforces no constraints (Drake's coupler "
-                "constraint needs the discrete SAP solver, a different, compliant dynamics)"
-            )
+        if model.couplings and model.central_mu:
+            raise Unsupported(f"{self.name}: couplings together with a field")
         self.xml = to_mjcf(model)
         self.plant, self.parser_warnings = self._parse(self.xml)
         self.context = self.plant.CreateDefaultContext()
@@ -107,6 +145,10 @@ class DrakeAdapter(Adapter):
         self._force_port = self.plant.get_applied_spatial_force_input_port()
         self._acc_port = self.plant.get_generalized_acceleration_output_port()
         self._force_port.FixValue(self.context, [])  # the field, if any, is set per state
+        self._C = None  # the cords' rows in Drake's velocity order
+        if model.couplings:
+            self._C = np.zeros((len(model.couplings), self.plant.num_velocities()))
+            self._C[:, self._iv] = model.coupling_matrix()
 
     def _joint(self, body: str, joint: Joint):
         """Drake's joint for a spec joint; a free joint is the body's floating joint, which
@@ -194,6 +236,28 @@ class DrakeAdapter(Adapter):
             tau += J.T @ f.F_Bq_W.translational()
         return tau[self._iv]
 
+    # --- the cords ---------------------------------------------------------------------------
+
+    def _closed(self, context, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """v̇ and the multipliers f of the KKT solve at the context's state (Drake's full
+        velocity order): Drake's M and h, the cords' constant C."""
+        return kkt(
+            self.plant.CalcMassMatrix(context),
+            tau
+            - self.plant.CalcBiasTerm(context)
+            + self.plant.CalcGravityGeneralizedForces(context),
+            self._C,
+        )
+
+    def constraint_force(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        out = np.empty((len(q), self._C.shape[0]))
+        t = np.zeros(self.plant.num_velocities())
+        for k in range(len(q)):
+            self._set(q[k], v[k])
+            t[self._iv] = tau[k]
+            out[k] = self._closed(self.context, t)[1]
+        return self._check("constraint force", out)
+
     # --- the canonical form ----------------------------------------------------------------
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
@@ -220,6 +284,9 @@ class DrakeAdapter(Adapter):
             self._set(q[k], v[k])
             t = np.zeros(self.plant.num_velocities())
             t[self._iv] = tau[k]
+            if self._C is not None:
+                out[k] = self._closed(self.context, t)[0][self._iv]
+                continue
             self._tau_port.FixValue(self.context, t)
             self._force_port.FixValue(self.context, self._field_forces(self.context))
             out[k] = self._acc_port.Eval(self.context)[self._iv]
@@ -266,15 +333,21 @@ class DrakeAdapter(Adapter):
         t_full = np.zeros(plant.num_velocities())
         vdot = np.zeros(plant.num_velocities())
         field = bool(self.spec.central_mu)
+        coupled = self._C is not None
+        force = np.empty((n, self._C.shape[0])) if coupled else None
         for k in range(n):
             self._set(q[k], v[k])
             M[k] = plant.CalcMassMatrix(ctx)[np.ix_(iv, iv)]
             bias[k] = self._h()[iv]
             t_full[iv] = tau[k]
-            self._tau_port.FixValue(ctx, t_full)
-            if field:
-                self._force_port.FixValue(ctx, self._field_forces(ctx))
-            fwd[k] = self._acc_port.Eval(ctx)[iv]
+            if coupled:
+                acc, force[k] = self._closed(ctx, t_full)
+                fwd[k] = acc[iv]
+            else:
+                self._tau_port.FixValue(ctx, t_full)
+                if field:
+                    self._force_port.FixValue(ctx, self._field_forces(ctx))
+                fwd[k] = self._acc_port.Eval(ctx)[iv]
             forces.SetZero()
             plant.CalcForceElementsContribution(ctx, forces)
             vdot[iv] = a[k]
@@ -283,7 +356,7 @@ class DrakeAdapter(Adapter):
                 inv[k] -= self._field_generalized()
             kin[k] = plant.CalcKineticEnergy(ctx)
             pot[k] = plant.CalcPotentialEnergy(ctx)
-        return self._outputs(M, bias, fwd, inv, kin, pot)
+        return self._outputs(M, bias, fwd, inv, kin, pot, force)
 
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
@@ -294,6 +367,12 @@ class DrakeAdapter(Adapter):
             field = builder.AddSystem(_Field(self))
             builder.Connect(plant.get_state_output_port(), field.get_input_port(0))
             builder.Connect(field.get_output_port(0), plant.get_applied_spatial_force_input_port())
+        if self._C is not None:
+            cord = builder.AddSystem(_Cords(self))
+            builder.Connect(plant.get_state_output_port(), cord.get_input_port(0))
+            builder.Connect(
+                cord.get_output_port(0), plant.get_applied_generalized_force_input_port()
+            )
         logger = LogVectorOutput(plant.get_state_output_port(), builder, publish_period=dt)
         diagram = builder.Build()
         simulator = Simulator(diagram)

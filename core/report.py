@@ -404,7 +404,11 @@ def _constraint_section(case: Case, d: pd.DataFrame) -> list[str]:
         "MuJoCo (soft: `mujoco` with the default solimp, `mujoco-stiff` with d = 0.9999), "
         "Pinocchio's constrained `forwardDynamics` with the constraint Jacobian (exact; "
         "Pinocchio's MJCF parser drops the tendon equality, so `pinocchio-mjcf` takes the "
-        "Jacobian from the model too). The reference predicts the soft solve from MuJoCo's "
+        "Jacobian from the model too); Drake's parser ignores the tendon equality and a "
+        "continuous-time plant holds no constraint, so the `drake` adapter closes the cords "
+        "with Drake's own M and h by a KKT solve (exact; in simulation its Cᵀf enters the "
+        "plant's applied-generalized-force input at every integrator stage). "
+        "The reference predicts the soft solve from MuJoCo's "
         "documented model: ÿ = ÿ_exact + (1 − d)(a₀ − ÿ_exact) and tension d·T at zero "
         "violation, and the stretch of the cords along a run "
         "(`dyncheck explain soft-vs-exact-constraints`). Constraint force = cord tension (N).",

@@ -36,7 +36,7 @@ POINT_BALL_CASES = sorted(
 
 COUPLED_CASES = sorted(n for n in CASES if get_case(n).multibody().couplings)
 """Cases whose masses are held by cords (couplings between joints)."""
-NO_COUPLINGS = ("drake",)
+NO_COUPLINGS: tuple[str, ...] = ()
 """Engines dyncheck does not run with couplings (skipped, with the reason)."""
 COUPLINGS_ONLY_ENGINES = ("mujoco-stiff",)
 """Engines that exist only for cases with couplings."""

@@ -208,7 +208,8 @@ def test_batched_path_equals_per_quantity_methods(adapter_and_states):
 
 def test_drake_parser_ignores_the_tendon_equality():
     """Measured: Drake's MJCF parser warns that it ignores <tendon> and the tendon equality,
-    and loads no constraint — why dyncheck does not run Drake with couplings."""
+    and loads no constraint — why the Drake adapter closes the cords itself (a KKT solve with
+    Drake's M and h)."""
     from dyncheck.adapters.drake_ import DrakeAdapter
 
     plant, warnings = DrakeAdapter._parse(to_mjcf(get_case("atwood").multibody()))
