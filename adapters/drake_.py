@@ -12,7 +12,8 @@ applied-spatial-force input (``ExternallyAppliedSpatialForce`` at the centre of 
 Integrators (Drake's own, fixed step, by ``ResetIntegratorFromFlags``): ``euler`` is
 ``semi_explicit_euler`` (v first, then q with the new v: MuJoCo's Euler), ``rk2``
 ``runge_kutta2`` (order 2), ``rk3`` ``runge_kutta3`` in fixed-step mode (order 3; it is
-error-controlled by default). Drake has no classic RK4.
+error-controlled by default). Drake has no classic RK4. :meth:`DrakeAdapter.simulate_controlled`
+runs ``runge_kutta3`` error-controlled (Drake's Simulator default) at a target accuracy.
 The parser's warnings (what it ignores) are kept in :attr:`DrakeAdapter.parser_warnings`.
 
 Couplings (cords): Drake's MJCF parser ignores ``<tendon>`` and the tendon ``<equality>``
@@ -361,6 +362,31 @@ class DrakeAdapter(Adapter):
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:
+        steps = round(duration / dt)
+        traj, _ = self._run(q0, v0, steps, dt, _INTEGRATORS[integrator], dt)
+        return traj
+
+    def simulate_controlled(
+        self, q0: np.ndarray, v0: np.ndarray, duration: float, grid: float, accuracy: float
+    ) -> tuple[Trajectory, int]:
+        """Drake's error-controlled ``runge_kutta3`` (its Simulator's default integrator: a
+        3rd-order solution propagated, the embedded 2nd-order midpoint for the error estimate)
+        at ``accuracy``, sampled every ``grid`` seconds; also the number of steps taken."""
+        return self._run(q0, v0, round(duration / grid), grid, "runge_kutta3", None, accuracy)
+
+    def _run(
+        self,
+        q0: np.ndarray,
+        v0: np.ndarray,
+        samples: int,
+        period: float,
+        scheme: str,
+        dt: float | None,
+        accuracy: float | None = None,
+    ) -> tuple[Trajectory, int]:
+        """A Drake simulation from (q0, v0), logged every ``period`` for ``samples`` periods:
+        fixed step ``dt``, or error-controlled at ``accuracy`` (``dt`` None; steps then end at
+        the logging times, so none is longer than ``period``)."""
         builder = DiagramBuilder()
         plant = builder.AddSystem(self._parse(self.xml)[0])
         if self.spec.central_mu:
@@ -373,7 +399,7 @@ class DrakeAdapter(Adapter):
             builder.Connect(
                 cord.get_output_port(0), plant.get_applied_generalized_force_input_port()
             )
-        logger = LogVectorOutput(plant.get_state_output_port(), builder, publish_period=dt)
+        logger = LogVectorOutput(plant.get_state_output_port(), builder, publish_period=period)
         diagram = builder.Build()
         simulator = Simulator(diagram)
         root = simulator.get_mutable_context()
@@ -383,16 +409,18 @@ class DrakeAdapter(Adapter):
         qd[self._iq], vd[self._iv] = q0, v0
         plant.SetPositions(ctx, qd)
         plant.SetVelocities(ctx, vd)
-        integ = ResetIntegratorFromFlags(simulator, _INTEGRATORS[integrator], dt)
-        if integrator == "rk3":  # error-controlled by default: pin it to the step
+        integ = ResetIntegratorFromFlags(simulator, scheme, dt or period)
+        if accuracy is not None:
+            integ.set_target_accuracy(accuracy)
+        elif scheme == "runge_kutta3":  # error-controlled by default: pin it to the step
             integ.set_fixed_step_mode(True)
             integ.set_maximum_step_size(dt)
         simulator.Initialize()
-        steps = round(duration / dt)
-        simulator.AdvanceTo(steps * dt)
-        x = logger.FindLog(root).data().T  # one sample per step: the publish period is dt
-        if x.shape[0] != steps + 1:
-            raise EngineError(f"drake logged {x.shape[0]} states for {steps} steps")
+        simulator.AdvanceTo(samples * period)
+        x = logger.FindLog(root).data().T  # one sample per period
+        if x.shape[0] != samples + 1:
+            raise EngineError(f"drake logged {x.shape[0]} states for {samples} periods")
         nq = plant.num_positions()
         qs, vs = x[:, :nq][:, self._iq], x[:, nq:][:, self._iv]
-        return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)
+        t = np.arange(samples + 1) * period
+        return Trajectory(t, self._check("simulate", qs), vs), integ.get_num_steps_taken()

@@ -370,12 +370,17 @@ class EngineImplementation(Implementation):
     def _potential(self, q: np.ndarray) -> np.ndarray:
         return self.adapter.potential_energy(self.map.to_engine(q))
 
-    def simulate(self, dt: float, integrator: str) -> tuple[np.ndarray, np.ndarray]:
-        """Times and book-coordinate configurations of a fixed-step run, shapes (k,), (k, N)."""
+    def _engine_start(self) -> tuple[np.ndarray, np.ndarray]:
+        """The case's initial state in engine coordinates (q, v)."""
         spec = self.case.trajectory
         q0 = np.asarray(spec.q0)[None]
         qe0 = self.map.to_engine(q0)[0]
-        ve0 = co.velocity_to_engine(self.map, q0, np.asarray(spec.v0)[None])[0]
+        return qe0, co.velocity_to_engine(self.map, q0, np.asarray(spec.v0)[None])[0]
+
+    def simulate(self, dt: float, integrator: str) -> tuple[np.ndarray, np.ndarray]:
+        """Times and book-coordinate configurations of a fixed-step run, shapes (k,), (k, N)."""
+        spec = self.case.trajectory
+        qe0, ve0 = self._engine_start()
         key = (dt, self.adapter.definition(integrator))
         if key not in self._runs:  # two names for one map (implicitfast = euler, D = 0) run once
             traj = self.adapter.simulate(qe0, ve0, spec.duration, dt, integrator)
@@ -393,12 +398,19 @@ class EngineImplementation(Implementation):
         """Book-coordinate velocities of a run :meth:`simulate` made (None if none)."""
         return self._velocities.get((dt, self.adapter.definition(integrator)))
 
+    def simulate_controlled(self, accuracy: float) -> tuple[np.ndarray, int]:
+        """Book-coordinate configurations on the case's comparison grid of a run of the
+        engine's own error-controlled integrator at ``accuracy``, and its number of steps."""
+        spec = self.case.trajectory
+        qe0, ve0 = self._engine_start()
+        traj, steps = self.adapter.simulate_controlled(  # type: ignore[attr-defined]
+            qe0, ve0, spec.duration, spec.grid_step, accuracy
+        )
+        return self.map.to_book(traj.q), steps
+
     def solve(self, t: np.ndarray, rtol: float) -> np.ndarray:
         """Book-coordinate configurations of an error-controlled run at times ``t``."""
-        spec = self.case.trajectory
-        q0 = np.asarray(spec.q0)[None]
-        qe0 = self.map.to_engine(q0)[0]
-        ve0 = co.velocity_to_engine(self.map, q0, np.asarray(spec.v0)[None])[0]
+        qe0, ve0 = self._engine_start()
         return self.map.to_book(self.adapter.solve(qe0, ve0, t, rtol).q)
 
 

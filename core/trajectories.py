@@ -343,6 +343,11 @@ def study(
                 rows.append(_adaptive(case, impl, variant, refs))
             except Exception as exc:  # unsupported (quaternion state) or crashed: a row
                 rows.append(_unavailable(case, name, exc, "dop853"))
+        if hasattr(getattr(impl, "adapter", None), "simulate_controlled"):
+            try:
+                rows += _controlled(case, impl, variant, refs)
+            except Exception as exc:  # crashed or diverged: a row, not a crash
+                rows.append(_unavailable(case, name, exc, CONTROLLED))
     rows += _engine_pairs(case, engines, runs, variants, refs, impls)
     return points, rows, figures
 
@@ -439,6 +444,77 @@ def _adaptive(
         "scipy solve_ivp on the engine's forward dynamics, same model",
         int(diff.argmax()),
     )
+
+
+CONTROLLED = "rk3-controlled"
+CONTROLLED_ACCURACIES = (1e-7, 1e-8, 1e-9, 1e-10)
+"""Target accuracies ε of an engine's error-controlled integrator, a decade apart."""
+
+
+def _controlled(
+    case: Case, impl: Implementation, variant: Variant | None, refs: References
+) -> list[Discrepancy]:
+    """Tolerance proportionality of an engine's error-controlled integrator (Drake's
+    ``runge_kutta3``). Its controller sizes each step so that the embedded 2nd-order estimate
+    of the local error (∝ h³) meets ε, while it propagates the 3rd-order solution (local error
+    ∝ h⁴): h ∝ ε^(1/3), global error ∝ h³ ∝ ε. The observed slope
+    ln(E₁/E₂)/ln(ε₁/ε₂) at the finest pair above the reference's error must be 1 ± ORDER_SLACK;
+    a polynomial q(t) (the cords) is integrated exactly, to accumulated round-off."""
+    ref, ref_err = refs(variant or book_variant(case))
+    scale = float(np.abs(ref).max())
+    errors, steps, worst = [], [], []
+    for eps in CONTROLLED_ACCURACIES:
+        q, n = impl.simulate_controlled(eps)  # type: ignore[attr-defined]
+        diff = difference(case, q, ref).max(axis=1)
+        errors.append(float(diff.max()))
+        steps.append(n)
+        worst.append(int(diff.argmax()))
+    slopes = observed_orders(list(CONTROLLED_ACCURACIES), errors)
+    asym = [e > REFERENCE_MARGIN * ref_err for e in errors]
+    finest = [i for i in range(1, len(errors)) if asym[i] and asym[i - 1]]
+    degree = getattr(general_method(case, variant), "polynomial_degree", None)
+    if variant is None:
+        verdict, basis = "failed", "model differs from the book in an unpredicted way"
+        note = basis
+    elif degree is not None and degree <= 3:
+        tol = accumulated(max(steps))
+        verdict = "passed" if max(errors) <= tol.rtol * scale else "failed"
+        basis = "exact for a polynomial q(t): accumulated round-off"
+        note = (
+            f"q(t) is a polynomial of degree {degree}, which RK3 integrates exactly: max error "
+            f"{max(errors):.2g} within {tol.basis} (x scale {scale:.3g})"
+        )
+    elif not finest:
+        verdict, basis = "failed", "tolerance proportionality"
+        note = "no pair of accuracies in the asymptotic range"
+    else:
+        p = slopes[finest[-1]]
+        verdict = "passed" if abs(p - 1) <= ORDER_SLACK else "failed"
+        basis = f"tolerance proportionality: global error ∝ ε, slope within 1 ± {ORDER_SLACK}"
+        note = (
+            f"observed slope {p:.3f} (nominal 1) between ε = "
+            f"{CONTROLLED_ACCURACIES[finest[-1] - 1]:g} and {CONTROLLED_ACCURACIES[finest[-1]]:g}"
+            f"; reference error estimate {ref_err:.1e}"
+        )
+    return [
+        Discrepancy(
+            case=case.name,
+            quantity="trajectory",
+            impl_a="reference",
+            impl_b=impl.name,
+            integrator=f"{CONTROLLED} eps={eps:g}",
+            dt=float("nan"),
+            max_abs_err=err,
+            max_rel_err=err / scale,
+            tolerance=float("nan"),
+            tolerance_basis=basis,
+            verdict=verdict,
+            convention="",
+            note=f"{n} steps; {note}",
+            worst_state=w,
+        )
+        for eps, err, n, w in zip(CONTROLLED_ACCURACIES, errors, steps, worst, strict=True)
+    ]
 
 
 def _no_numbers(

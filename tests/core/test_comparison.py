@@ -236,3 +236,20 @@ def test_free_body_velocity_frame_ignored_is_caught():
     # M = m 1 and T = ½ m |v|² are blind to a rotation of v; the accelerations are not
     assert {"bias_forces", "forward_dynamics", "inverse_dynamics"} <= failed
     assert all(r.verdict == "passed" for r in _compare_with(case, "pinocchio"))
+
+
+@pytest.mark.parametrize("case_name", COUPLED_CASES)
+def test_drake_with_a_wrong_cord_is_caught(case_name):
+    """Drake's cords are closed by the adapter's KKT solve: a cord with one coefficient
+    doubled (a wrong pulley ratio) must fail forward dynamics and tension against the
+    reference, and the right cord must pass every quantity (M, h and the energies come
+    from Drake's plant unchanged)."""
+    case = get_case(case_name)
+    assert all(r.verdict == "passed" for r in _compare_with(case, "drake"))
+    impl = make_implementation("drake", case)
+    impl.adapter._C[0, impl.adapter._iv[0]] *= 2
+    impls = {"reference": make_implementation("reference", case), "drake": impl}
+    rows = compare_instantaneous(case, impls, case.sample_states())
+    failed = {r.quantity for r in rows if r.verdict == "failed"}
+    assert {"forward_dynamics", "constraint_force"} <= failed
+    assert "mass_matrix" not in failed
