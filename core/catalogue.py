@@ -165,7 +165,7 @@ def mujoco_defaults() -> Entry:
         "model was tuned for.",
         f"MuJoCo {mujoco.__version__}: integrator "
         f"{mujoco.mjtIntegrator(m.opt.integrator).name}, timestep {m.opt.timestep} s; "
-        "Drake's MJCF parser ignores both (see the report's parser notes).",
+        "Drake's MJCF parser ignores both (measured: `drake-mjcf-options`).",
         "timestep assumed 0 (continuous)",
         float(m.opt.timestep),
         0.0,
@@ -462,6 +462,46 @@ def pinocchio_mjcf_options() -> Entry:
     )
 
 
+def drake_mjcf_options() -> Entry:
+    """What Drake's MJCF parser reads of <option> and <compiler>: the same file as the
+    Pinocchio entry plus a timestep and an integrator."""
+    import mujoco
+    from pydrake.math import RigidTransform
+
+    from dyncheck.adapters.drake_ import DrakeAdapter
+
+    xml = (
+        "<mujoco model='m'><compiler eulerseq='zyx'/>"
+        "<option gravity='0 0 -1.62' timestep='0.01' integrator='RK4'/><worldbody>"
+        "<body name='b' euler='30 20 10'><joint name='j' type='hinge' axis='0 1 0'/>"
+        "<inertial pos='0 0 -1' mass='1' diaginertia='1e-8 1e-8 1e-8'/></body>"
+        "</worldbody></mujoco>"
+    )
+    m = mujoco.MjModel.from_xml_string(xml)
+    plant, warnings = DrakeAdapter._parse(xml)
+    joint = plant.GetJointByName("j")
+    X = joint.frame_on_parent().CalcPoseInBodyFrame(plant.CreateDefaultContext())
+    R_dk = RigidTransform(X).rotation().matrix()
+    R_mj = quat_to_matrix(np.asarray(m.body_quat[1])[None])[0]
+    angle = np.degrees(np.arccos(np.clip((np.trace(R_mj.T @ R_dk) - 1) / 2, -1, 1)))
+    gravity = np.asarray(plant.gravity_field().gravity_vector())
+    ignored = sorted({a for a in ("timestep", "integrator") for w in warnings if f"'{a}'" in w})
+    return Entry(
+        "drake-mjcf-options",
+        "What Drake's MJCF parser reads of an MJCF's options: gravity (0, 0, −1.62), "
+        "timestep 0.01 s, integrator RK4, and compiler eulerseq='zyx' with body "
+        "euler='30 20 10' (degrees).",
+        f"Drake keeps gravity {[round(float(x), 3) for x in gravity]} (MuJoCo "
+        f"{[round(float(x), 3) for x in m.opt.gravity]}); its body rotation differs from "
+        f"MuJoCo's by {angle:.3g}°; it warns it ignores {', '.join(ignored)} (measured): the "
+        "plant is continuous and its integrator is chosen by the Simulator, not the file.",
+        "Drake's gravity taken as the file's",
+        float(np.linalg.norm(gravity - m.opt.gravity)),
+        0.0,
+        "gravity difference (m/s²)",
+    )
+
+
 def pinocchio_equality() -> Entry:
     """Example 6's cord as a tendon equality, read by Pinocchio's constraint-aware parser."""
     import os
@@ -559,6 +599,43 @@ def drake_equality() -> Entry:
     )
 
 
+def multiplier_sign() -> Entry:
+    """Example 6 in sympy.physics.mechanics: the cord as ``hol_coneqs`` of LagrangesMethod,
+    lengths measured downward (as in the case), solved exactly in rationals."""
+    import sympy as sp
+    import sympy.physics.mechanics as me
+
+    m1, m2, g = sp.Rational(3, 2), sp.Rational(9, 10), sp.Rational(981, 100)
+    y1, y2 = me.dynamicsymbols("y1 y2")
+    N, O = me.ReferenceFrame("N"), me.Point("O")
+    O.set_vel(N, 0)
+    points = [O.locatenew(f"P{i}", -y * N.z) for i, y in enumerate((y1, y2))]
+    for P in points:
+        P.set_vel(N, P.pos_from(O).dt(N))
+    pairs = list(zip(points, (m1, m2), strict=True))
+    particles = [me.Particle(f"m{i}", P, m) for i, (P, m) in enumerate(pairs)]
+    loads = [(P, -m * g * N.z) for P, m in pairs]
+    lm = me.LagrangesMethod(
+        me.Lagrangian(N, *particles), [y1, y2], hol_coneqs=[y1 + y2], forcelist=loads, frame=N
+    )
+    lm.form_lagranges_equations()
+    lam = lm.mass_matrix_full.LUsolve(lm.forcing_full)[-1]
+    tension = 2 * m1 * m2 * g / (m1 + m2)  # Example 6's cord, from (m₁ + m₂) ÿ₁ = (m₁ − m₂) g
+    return Entry(
+        "lagrange-multiplier-sign",
+        "A cord's Lagrange multiplier is the constraint force along ∂Φ/∂q, not the tension: "
+        "with Φ = y₁ + y₂ and lengths measured downward, λ = −T. Demonstrated on Example 6 "
+        "in sympy.physics.mechanics (exact rationals).",
+        f"sympy {sp.__version__} LagrangesMethod(hol_coneqs): λ = {lam} N, the tension "
+        f"2m₁m₂g/(m₁ + m₂) = {tension} N. Pinocchio's data.lambda_c, the reference and the "
+        "`drake` KKT use the same sign (M v̇ + h = τ + Cᵀ f), so dyncheck compares f = −T.",
+        "λ taken as the tension",
+        float(abs(lam - tension) / tension),
+        float(abs(-lam - tension) / tension),
+        "relative error of the tension",
+    )
+
+
 def group_rk4() -> Entry:
     """The order study of the spherical pendulum (a ball joint), RK4 only."""
     import dataclasses
@@ -602,9 +679,11 @@ DEMOS: dict[str, Callable[[], Entry]] = {
     "coordinate-order": coordinate_order,
     "default-integrator-and-timestep": mujoco_defaults,
     "drake-mjcf-equality": drake_equality,
+    "drake-mjcf-options": drake_mjcf_options,
     "degrees-vs-radians": degrees_radians,
     "energy-readout-after-step": energy_after_step,
     "hinge-axis-sign": hinge_sign,
+    "lagrange-multiplier-sign": multiplier_sign,
     "quaternion-storage-order": quaternion_order,
     "relative-vs-absolute-angles": relative_angles,
     "rk4-on-the-rotation-group": group_rk4,

@@ -106,3 +106,19 @@ def test_drake_drops_equality_and_its_coupler_is_near_rigid():
     assert eq.naive_error == pytest.approx(3.0, rel=1e-12)
     assert "loads 0 constraints" in eq.engines
     assert 1e-8 < eq.correct_error < 1e-2
+
+
+def test_lagrange_multiplier_is_minus_the_tension():
+    """Expected from Example 6 (tension 2m₁m₂g/(m₁ + m₂), exact rationals): sympy's λ along
+    ∂Φ/∂q = (1, 1) with downward lengths is −T, so taking λ as T is off by exactly 2."""
+    (entry,) = catalogue.explain("lagrange-multiplier-sign")
+    assert entry.naive_error == 2.0 and entry.correct_error == 0.0
+
+
+def test_drake_reads_gravity_and_eulerseq_but_not_timestep_or_integrator():
+    """Measured against MuJoCo reading the same file (the other engine): Drake keeps the
+    file's gravity and body rotation, and warns that it ignores timestep and integrator."""
+    (entry,) = catalogue.explain("drake-mjcf-options")
+    assert entry.naive_error < 1e-12
+    assert "differs from MuJoCo's by 0°" in entry.engines
+    assert "ignores integrator, timestep" in entry.engines
