@@ -135,6 +135,15 @@ def versions() -> dict[str, str]:
             cwd=Path(__file__).parent,
             check=True,
         ).stdout.strip()
+        dirty = subprocess.run(  # code changed since that commit (the reports aside)?
+            ["git", "status", "--porcelain", "--untracked-files=no", "--", ":(top,exclude)reports"],
+            capture_output=True,
+            text=True,
+            cwd=Path(__file__).parent,
+            check=True,
+        ).stdout.strip()
+        if dirty:
+            commit += " + uncommitted changes"
     except (OSError, subprocess.CalledProcessError):
         commit = "unknown"
     out["dyncheck commit"] = commit
