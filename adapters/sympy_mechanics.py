@@ -39,11 +39,27 @@ def _vec(frame: me.ReferenceFrame, xyz) -> me.Vector:
 
 
 def _batched(exprs: list[sp.Expr], args: list[sp.Symbol]) -> Callable[..., np.ndarray]:
-    fns = [sp.lambdify(args, e, modules="numpy", cse=True) for e in exprs]
+    """One function for all of ``exprs`` (common subexpressions shared): numpy over a batch
+    of states, Python's ``math`` on scalars for one state (a time step: numpy's per-call
+    overhead would dominate). Constant entries are filled in, not evaluated. Returns
+    (n, len(exprs)) for n states."""
+    symbols = set(args)
+    varying = [i for i, e in enumerate(exprs) if e.free_symbols & symbols]
+    const = [i for i, e in enumerate(exprs) if not e.free_symbols & symbols]
+    values_const = np.array([float(exprs[i]) for i in const])
+    terms = [exprs[i] for i in varying]
+    batch = sp.lambdify(args, terms, modules="numpy", cse=True)
+    scalar = sp.lambdify(args, terms, modules="math", cse=True)
 
     def evaluate(*values: np.ndarray) -> np.ndarray:
         n = np.broadcast(*values).shape[0]
-        return np.stack([np.broadcast_to(np.asarray(f(*values), float), (n,)) for f in fns], -1)
+        out = np.empty((n, len(exprs)))
+        out[:, const] = values_const
+        if varying and n == 1:
+            out[0, varying] = scalar(*(float(x[0]) for x in values))
+        elif varying:
+            out[:, varying] = np.stack(batch(*values), -1)
+        return out
 
     return evaluate
 
@@ -53,9 +69,10 @@ class SympyMechanicsAdapter(Adapter):
     package: ClassVar[str] = "sympy"
     naive_group_rk4: ClassVar[bool] = False
     """Rotations are Euler angles (a chart), so dyncheck's RK4 is the classic one (order 4)."""
-    integrators: ClassVar[tuple[str, ...]] = ("rk4",)
-    """RK4 only: each step costs Python-level evaluations of the lambdified equations, and one
-    integrator suffices to show this symbolic peer integrates the same dynamics."""
+    integrators: ClassVar[tuple[str, ...]] = ("euler", "rk4")
+    """MuJoCo's definitions (:mod:`.integrators`): semi-implicit Euler, shared with every
+    engine including Drake, and RK4. Each step costs Python-level evaluations of the
+    lambdified equations."""
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
@@ -145,7 +162,7 @@ class SympyMechanicsAdapter(Adapter):
                 _batched([e.subs(plain) for e in rhs], args),
                 len(cons),
             )
-        self._M = _batched([sp.simplify(e.subs(plain)) for e in M], args)
+        self._M = _batched([e.subs(plain) for e in M], args)
         self._h = _batched([(-e).subs(plain) for e in F_free], args)
         if field_loads:
             _, F_field = forcing(gravity_loads + field_loads)
