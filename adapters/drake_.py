@@ -38,6 +38,7 @@ components (q̇ = ½ q ⊗ ω), so its norm drifts; the comparison layer renorma
 from __future__ import annotations
 
 import logging
+from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
@@ -90,6 +91,14 @@ class _Field(LeafSystem):
         x = self._state.Eval(context)
         self._a.plant.SetPositionsAndVelocities(self._ctx, x)
         output.set_value(self._a._field_forces(self._ctx))
+
+
+@dataclass(frozen=True)
+class Steps:
+    """A Drake run's step counts: steps taken, and steps shrunk by error control."""
+
+    taken: int
+    shrunk: int
 
 
 class _Cords(LeafSystem):
@@ -367,12 +376,22 @@ class DrakeAdapter(Adapter):
         return traj
 
     def simulate_controlled(
-        self, q0: np.ndarray, v0: np.ndarray, duration: float, grid: float, accuracy: float
-    ) -> tuple[Trajectory, int]:
-        """Drake's error-controlled ``runge_kutta3`` (its Simulator's default integrator: a
-        3rd-order solution propagated, the embedded 2nd-order midpoint for the error estimate)
-        at ``accuracy``, sampled every ``grid`` seconds; also the number of steps taken."""
-        return self._run(q0, v0, round(duration / grid), grid, "runge_kutta3", None, accuracy)
+        self,
+        q0: np.ndarray,
+        v0: np.ndarray,
+        duration: float,
+        grid: float,
+        accuracy: float,
+        scheme: str = "runge_kutta3",
+        caching: bool = True,
+    ) -> tuple[Trajectory, Steps]:
+        """An error-controlled run at ``accuracy``, sampled every ``grid`` seconds, and its
+        step counts. Default: ``runge_kutta3``, the Simulator's default integrator (a
+        3rd-order solution propagated, the embedded 2nd-order midpoint as error estimate);
+        ``caching=False`` disables the context's cache (which must not change results)."""
+        return self._run(
+            q0, v0, round(duration / grid), grid, scheme, None, accuracy, caching=caching
+        )
 
     def _run(
         self,
@@ -383,7 +402,8 @@ class DrakeAdapter(Adapter):
         scheme: str,
         dt: float | None,
         accuracy: float | None = None,
-    ) -> tuple[Trajectory, int]:
+        caching: bool = True,
+    ) -> tuple[Trajectory, Steps]:
         """A Drake simulation from (q0, v0), logged every ``period`` for ``samples`` periods:
         fixed step ``dt``, or error-controlled at ``accuracy`` (``dt`` None; steps then end at
         the logging times, so none is longer than ``period``)."""
@@ -403,6 +423,8 @@ class DrakeAdapter(Adapter):
         diagram = builder.Build()
         simulator = Simulator(diagram)
         root = simulator.get_mutable_context()
+        if not caching:
+            root.DisableCaching()
         ctx = plant.GetMyMutableContextFromRoot(root)
         qd = np.zeros(plant.num_positions())
         vd = np.zeros(plant.num_velocities())
@@ -423,4 +445,7 @@ class DrakeAdapter(Adapter):
         nq = plant.num_positions()
         qs, vs = x[:, :nq][:, self._iq], x[:, nq:][:, self._iv]
         t = np.arange(samples + 1) * period
-        return Trajectory(t, self._check("simulate", qs), vs), integ.get_num_steps_taken()
+        steps = Steps(
+            integ.get_num_steps_taken(), integ.get_num_step_shrinkages_from_error_control()
+        )
+        return Trajectory(t, self._check("simulate", qs), vs), steps

@@ -406,7 +406,7 @@ class EngineImplementation(Implementation):
         traj, steps = self.adapter.simulate_controlled(  # type: ignore[attr-defined]
             qe0, ve0, spec.duration, spec.grid_step, accuracy
         )
-        return self.map.to_book(traj.q), steps
+        return self.map.to_book(traj.q), steps.taken
 
     def solve(self, t: np.ndarray, rtol: float) -> np.ndarray:
         """Book-coordinate configurations of an error-controlled run at times ``t``."""
