@@ -97,7 +97,13 @@ def _list() -> int:
     print("implementations:")
     for name in IMPLEMENTATIONS:
         if name in ADAPTERS:
-            what = f"{ENGINE_PACKAGES[name]} {ADAPTERS[name].version()}"
+            adapter = ADAPTERS[name]
+            steps = list(adapter.integrators)
+            if adapter.adaptive:
+                steps.append("dop853 (scipy, error-controlled)")
+            if hasattr(adapter, "simulate_controlled"):
+                steps.append("rk3-controlled (its own runge_kutta3, error-controlled)")
+            what = f"{ENGINE_PACKAGES[name]} {adapter.version()}; integrators: {', '.join(steps)}"
         elif name in MISSING:
             what = f"not installed: pip install {ENGINE_PACKAGES[name]}"
         elif name == "book":

@@ -91,6 +91,8 @@ def test_list_names_engine_versions(capsys):
     out = capsys.readouterr().out
     assert "simple_pendulum" in out
     assert "mujoco 4" in out or "mujoco 3" in out
+    drake = next(line for line in out.splitlines() if line.split()[:1] == ["drake"])
+    assert "rk3-controlled" in drake and "rk4" not in drake  # Drake has no classic RK4
 
 
 def test_states_option_sweeps_more_states(tmp_path):
