@@ -127,10 +127,12 @@ def test_drake_reads_gravity_and_eulerseq_but_not_timestep_or_integrator():
 def test_drake_fsal_integrators_depend_on_caching():
     """Caching must not change a result (expected: equal errors). Measured on Drake 1.51.1:
     the FSAL runge_kutta5 on a MultibodyPlant is > 100x less accurate with the cache on than
-    off, while the plant's forward dynamics in a plain LeafSystem match the uncached run and
-    the non-FSAL runge_kutta3 (the one dyncheck judges) is bit-identical either way. If a
+    off, while the plant's forward dynamics in a plain LeafSystem match the uncached run, a run
+    with no rejected step and the non-FSAL runge_kutta3 (the one dyncheck judges) are
+    bit-identical either way. If a
     Drake release fixes this, this test fails: update the entry and the pinned version."""
     (entry,) = catalogue.explain("drake-fsal-caching")
     assert entry.naive_error > 100 * entry.correct_error
     assert entry.correct_error < 1e-10
     assert "runge_kutta3 (not FSAL): bit-identical" in entry.engines
+    assert "(0 steps shrunk): bit-identical" in entry.engines  # no rejection, no defect
