@@ -32,6 +32,8 @@ class Entry:
     naive_error: float
     correct_error: float
     unit: str = "max relative error"
+    skipped: str = ""
+    """Why the demonstration did not run (an engine not installed), or empty."""
 
 
 def _worst(case_name: str, engine: str, cmap=None) -> float:
@@ -781,18 +783,42 @@ MJCF gravity, held forces, RK4 on the rotation group) are measured by ``dyncheck
 explained in its report."""
 
 
+REQUIRES: dict[str, tuple[str, ...]] = {
+    "drake-fsal-caching": ("drake",),
+    "drake-mjcf-equality": ("drake",),
+    "drake-mjcf-options": ("drake",),
+}
+"""Demonstrations that need an optional engine (MuJoCo and Pinocchio are core dependencies)."""
+
+
+def _run(name: str) -> Entry:
+    """One demonstration, or a skipped entry naming the engine that is not installed."""
+    from dyncheck.adapters import ENGINE_PACKAGES, MISSING
+
+    for engine in REQUIRES.get(name, ()):
+        if engine in MISSING:
+            why = f"{engine} is not installed (pip install {ENGINE_PACKAGES[engine]})"
+            nan = float("nan")
+            return Entry(name, "", "", "", nan, nan, skipped=why)
+    return DEMOS[name]()
+
+
 def explain(name: str | None = None) -> list[Entry]:
-    """Run the demonstration ``name`` (all when None)."""
+    """Run the demonstration ``name`` (all when None); an entry whose engine is not installed
+    is returned skipped, with the reason."""
     if name is None:
-        return [demo() for demo in DEMOS.values()]
+        return [_run(n) for n in DEMOS]
     if name not in DEMOS:
         raise UnknownName("convention", name, DEMOS)
-    return [DEMOS[name]()]
+    return [_run(name)]
 
 
 def render(entries: list[Entry]) -> str:
     lines = []
     for e in entries:
+        if e.skipped:
+            lines += [f"## {e.name}", "", f"- Skipped: {e.skipped}.", ""]
+            continue
         lines += [
             f"## {e.name}",
             "",

@@ -136,3 +136,16 @@ def test_drake_fsal_integrators_depend_on_caching():
     assert entry.correct_error < 1e-10
     assert "runge_kutta3 (not FSAL): bit-identical" in entry.engines
     assert "(0 steps shrunk): bit-identical" in entry.engines  # no rejection, no defect
+
+
+def test_drake_entries_are_skipped_when_drake_is_missing(monkeypatch):
+    """Drake is an optional extra: without it its entries say so (with the pip hint) and the
+    rest of the catalogue still runs — never a crash of the report."""
+    from dyncheck import adapters
+
+    monkeypatch.setitem(adapters.MISSING, "drake", "No module named 'pydrake'")
+    (entry,) = catalogue.explain("drake-mjcf-options")
+    assert entry.skipped and "pip install drake" in entry.skipped
+    text = catalogue.render([entry, *catalogue.explain("hinge-axis-sign")])
+    assert "- Skipped: drake is not installed (pip install drake)." in text
+    assert "## hinge-axis-sign" in text and "Correct mapping" in text

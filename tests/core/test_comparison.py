@@ -190,9 +190,10 @@ def test_worst_state_is_reported_and_reproducible():
     assert row.worst_state_values.startswith(f"q=[{s.q[k][0]:.6g}, {s.q[k][1]:.6g}]")
 
 
-def test_missing_engine_is_skipped_never_passed(monkeypatch):
-    """An engine that is not installed gives `skipped` rows with the pip hint, never `passed`."""
-    from dyncheck import adapters
+def test_missing_engine_is_skipped_never_passed(monkeypatch, tmp_path):
+    """An engine that is not installed gives `skipped` rows with the pip hint, never `passed`,
+    and the report (with its conventions catalogue) is still written."""
+    from dyncheck import adapters, report
     from dyncheck.run import run
 
     monkeypatch.delitem(adapters.ADAPTERS, "drake")
@@ -203,6 +204,9 @@ def test_missing_engine_is_skipped_never_passed(monkeypatch):
     assert len(rows) > 0 and (rows.verdict == "skipped").all()
     assert rows.note.str.contains("pip install drake").all()
     assert not result.failed
+    report.write(result, tmp_path, date="2026-01-01")
+    assert "| drake           | not installed" in (tmp_path / "README.md").read_text()
+    assert "Skipped: drake is not installed" in (tmp_path / "conventions.md").read_text()
 
 
 def test_drake_parser_reports_what_it_ignores():
