@@ -474,7 +474,9 @@ def _controlled(
     slopes = observed_orders(list(CONTROLLED_ACCURACIES), errors)
     asym = [e > REFERENCE_MARGIN * ref_err for e in errors]
     finest = [i for i in range(1, len(errors)) if asym[i] and asym[i - 1]]
-    degree = getattr(general_method(case, variant), "polynomial_degree", None)
+    degree = None
+    if variant is not None:
+        degree = getattr(general_method(case, variant), "polynomial_degree", None)
     if variant is None:
         verdict, basis = "failed", "model differs from the book in an unpredicted way"
         note = basis
