@@ -21,7 +21,7 @@ from typing import ClassVar
 import numpy as np
 
 from dyncheck.cases.multibody import Multibody
-from dyncheck.errors import EngineError
+from dyncheck.errors import EngineError, Unsupported
 
 DIVERGED = 1e12
 """A coordinate beyond this (rad or m) means a run has blown up: no case here comes near it."""
@@ -60,8 +60,13 @@ class Adapter(ABC):
     requires_couplings: ClassVar[bool] = False
     """An implementation that exists only for models with couplings (it equals another one
     elsewhere)."""
+    couplings_with_field: ClassVar[bool] = False
+    """Whether the adapter holds couplings and an external field in one model (refused, before
+    any work, where it does not)."""
 
     def __init__(self, model: Multibody) -> None:
+        if model.couplings and model.central_mu and not self.couplings_with_field:
+            raise Unsupported(f"{self.name}: couplings together with a field")
         self.spec = model
 
     @staticmethod

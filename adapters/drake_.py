@@ -54,7 +54,7 @@ from pydrake.systems.primitives import LogVectorOutput
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Joint, Multibody
-from dyncheck.errors import EngineError, Unsupported
+from dyncheck.errors import EngineError
 
 _INTEGRATORS = {
     "euler": "semi_explicit_euler",
@@ -137,8 +137,6 @@ class DrakeAdapter(Adapter):
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
-        if model.couplings and model.central_mu:
-            raise Unsupported(f"{self.name}: couplings together with a field")
         self.xml = to_mjcf(model)
         self.plant, self.parser_warnings = self._parse(self.xml)
         self.context = self.plant.CreateDefaultContext()

@@ -49,6 +49,8 @@ class MuJoCoAdapter(Adapter):
     name: ClassVar[str] = "mujoco"
     package: ClassVar[str] = "mujoco"
     integrators: ClassVar[tuple[str, ...]] = tuple(_INTEGRATORS)
+    couplings_with_field: ClassVar[bool] = True
+    """Tendon equalities and xfrc_applied coexist in one MuJoCo model."""
 
     solimp: ClassVar[tuple[float, ...] | None] = None
     """The equalities' solimp written to the MJCF (None: MuJoCo's default)."""

@@ -105,8 +105,6 @@ class PinocchioAdapter(Adapter):
         # the joint that carries each body's inertia, found through the body's frame
         self._joint_ids = [self._body_joint(b.name) for b in model.bodies]
         self._C = model.coupling_matrix() if model.couplings else None
-        if self._C is not None and model.central_mu:
-            raise Unsupported(f"{self.name}: couplings together with a field")
 
     def _build(self, model: Multibody) -> pin.Model:
         return build_model(model)

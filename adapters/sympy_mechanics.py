@@ -28,7 +28,6 @@ import sympy.physics.mechanics as me
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.integrators import integrate
 from dyncheck.cases.multibody import ROTATING, Multibody
-from dyncheck.errors import Unsupported
 
 
 def _vec(frame: me.ReferenceFrame, xyz) -> me.Vector:
@@ -143,8 +142,6 @@ class SympyMechanicsAdapter(Adapter):
         M, F_free = forcing(gravity_loads)
         args = [*qs, *vs]
         self._kkt = None
-        if model.couplings and model.central_mu:
-            raise Unsupported(f"{self.name}: couplings together with a field")
         if model.couplings:
             # the cords as holonomic constraints: LagrangesMethod adds multipliers λ with
             # M q̈ − Φᵀ λ = F and the constraints' second derivative Φ q̈ = −Φ̇ q̇
