@@ -46,6 +46,8 @@ class RigidBodyBall(Case):
     )
     coordinates: ClassVar[tuple[str, ...]] = ("φ", "θ", "ψ")
     periodic: ClassVar[tuple[bool, ...]] = (True, False, True)
+    joint: ClassVar[str] = "ball"
+    """The engine joint at the centre of mass (its type and name)."""
 
     m: float = 2.0
     """mass, kg"""
@@ -99,9 +101,8 @@ class RigidBodyBall(Case):
 
     def multibody(self) -> Multibody:
         inertia = tuple(tuple(float(x) for x in row) for row in self.inertia())
-        body = Body(
-            "body", None, (0, 0, 0), (Joint("ball", "ball"),), self.m, (0.0, 0.0, 0.0), inertia
-        )
+        joint = Joint(self.joint, self.joint)
+        body = Body("body", None, (0, 0, 0), (joint,), self.m, (0.0, 0.0, 0.0), inertia)
         return Multibody(self.name, (body,), (0.0, 0.0, -self.g))
 
     def engine_map(self) -> EulerAngleMap:
@@ -166,6 +167,7 @@ class RigidBodyFree(RigidBodyBall):
     book_refs: ClassVar[str] = "(2.2.44)-(2.2.49), Example 9, exercise 23, (2.2.70)-(2.2.71)"
     coordinates: ClassVar[tuple[str, ...]] = ("x1", "x2", "x3", "φ", "θ", "ψ")
     periodic: ClassVar[tuple[bool, ...]] = (False, False, False, True, False, True)
+    joint: ClassVar[str] = "free"
 
     trajectory: TrajectorySpec = field(
         default_factory=lambda: TrajectorySpec(
@@ -175,13 +177,6 @@ class RigidBodyFree(RigidBodyBall):
             steps=RIGID_STEPS,
         )
     )
-
-    def multibody(self) -> Multibody:
-        inertia = tuple(tuple(float(x) for x in row) for row in self.inertia())
-        body = Body(
-            "body", None, (0, 0, 0), (Joint("free", "free"),), self.m, (0.0, 0.0, 0.0), inertia
-        )
-        return Multibody(self.name, (body,), (0.0, 0.0, -self.g))
 
     def engine_map(self) -> FreeBodyMap:
         return FreeBodyMap()
