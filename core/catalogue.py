@@ -367,22 +367,42 @@ def pinocchio_top_level_bodies() -> Entry:
     )
 
 
-def soft_constraint() -> Entry:
-    """The Atwood machine (Example 6) as two slides held by a tendon equality."""
-    import mujoco
+ATWOOD = (1.5, 0.9, 9.81)
+"""Example 6's m₁, m₂ (kg) and g (m/s²) for the cord demonstrations."""
 
-    m1, m2, g = 1.5, 0.9, 9.81
+
+def _atwood_xml(cord: bool = True) -> str:
+    """Example 6 as MJCF: two slides (lengths measured downward) and, with ``cord``, the
+    cord as a fixed tendon held by an equality."""
+    m1, m2, g = ATWOOD
     xml = (
-        f"<mujoco><option gravity='0 0 -{g}'/><worldbody>"
+        f"<mujoco model='atwood'><option gravity='0 0 -{g}'/><worldbody>"
         f"<body name='a' pos='-0.2 0 -1'><joint name='y1' type='slide' axis='0 0 -1'/>"
         f"<inertial pos='0 0 0' mass='{m1}' diaginertia='1e-8 1e-8 1e-8'/></body>"
         f"<body name='b' pos='0.2 0 -1'><joint name='y2' type='slide' axis='0 0 -1'/>"
         f"<inertial pos='0 0 0' mass='{m2}' diaginertia='1e-8 1e-8 1e-8'/></body>"
-        "</worldbody><tendon><fixed name='cord'><joint joint='y1' coef='1'/>"
-        "<joint joint='y2' coef='1'/></fixed></tendon>"
-        "<equality><tendon tendon1='cord'/></equality></mujoco>"
+        "</worldbody>"
     )
-    m = mujoco.MjModel.from_xml_string(xml)
+    if cord:
+        xml += (
+            "<tendon><fixed name='cord'><joint joint='y1' coef='1'/>"
+            "<joint joint='y2' coef='1'/></fixed></tendon>"
+            "<equality><tendon tendon1='cord'/></equality>"
+        )
+    return xml + "</mujoco>"
+
+
+def _rotation_angle(Ra: np.ndarray, Rb: np.ndarray) -> float:
+    """The angle (degrees) of the rotation between two rotation matrices."""
+    return float(np.degrees(np.arccos(np.clip((np.trace(Ra.T @ Rb) - 1) / 2, -1, 1))))
+
+
+def soft_constraint() -> Entry:
+    """The Atwood machine (Example 6) as two slides held by a tendon equality."""
+    import mujoco
+
+    m1, m2, g = ATWOOD
+    m = mujoco.MjModel.from_xml_string(_atwood_xml())
     d = mujoco.MjData(m)
     mujoco.mj_forward(m, d)
     book = (m1 - m2) * g / (m1 + m2)  # Example 6: (m₁ + m₂) ÿ₁ = (m₁ − m₂) g
@@ -456,7 +476,7 @@ def pinocchio_mjcf_options() -> Entry:
         "(0, 0, −1.62) and compiler eulerseq='zyx' with body euler='30 20 10' (degrees).",
         f"Pinocchio keeps gravity {[round(float(x), 3) for x in pm.gravity.linear]} (MuJoCo "
         f"{[round(float(x), 3) for x in m.opt.gravity]}); its body rotation differs from MuJoCo's "
-        f"by {np.degrees(np.arccos(np.clip((np.trace(R_mj.T @ R_pin) - 1) / 2, -1, 1))):.3g}°.",
+        f"by {_rotation_angle(R_mj, R_pin):.3g}°.",
         "Pinocchio's gravity taken as the file's",
         gravity,
         0.0,
@@ -485,7 +505,7 @@ def drake_mjcf_options() -> Entry:
     X = joint.frame_on_parent().CalcPoseInBodyFrame(plant.CreateDefaultContext())
     R_dk = RigidTransform(X).rotation().matrix()
     R_mj = quat_to_matrix(np.asarray(m.body_quat[1])[None])[0]
-    angle = np.degrees(np.arccos(np.clip((np.trace(R_mj.T @ R_dk) - 1) / 2, -1, 1)))
+    angle = _rotation_angle(R_mj, R_dk)
     gravity = np.asarray(plant.gravity_field().gravity_vector())
     ignored = sorted({a for a in ("timestep", "integrator") for w in warnings if f"'{a}'" in w})
     return Entry(
@@ -640,29 +660,16 @@ def drake_equality() -> Entry:
 
     from dyncheck.adapters.drake_ import DrakeAdapter
 
-    m1, m2, g, h = 1.5, 0.9, 9.81, 1e-3
-    bodies = (
-        f"<mujoco model='atwood'><option gravity='0 0 -{g}'/><worldbody>"
-        f"<body name='a' pos='-0.2 0 -1'><joint name='y1' type='slide' axis='0 0 -1'/>"
-        f"<inertial pos='0 0 0' mass='{m1}' diaginertia='1e-8 1e-8 1e-8'/></body>"
-        f"<body name='b' pos='0.2 0 -1'><joint name='y2' type='slide' axis='0 0 -1'/>"
-        f"<inertial pos='0 0 0' mass='{m2}' diaginertia='1e-8 1e-8 1e-8'/></body>"
-        "</worldbody>"
-    )
-    cord = (
-        "<tendon><fixed name='cord'><joint joint='y1' coef='1'/>"
-        "<joint joint='y2' coef='1'/></fixed></tendon>"
-        "<equality><tendon tendon1='cord'/></equality></mujoco>"
-    )
+    (m1, m2, g), h = ATWOOD, 1e-3
     book = (m1 - m2) * g / (m1 + m2)  # Example 6
-    loaded, warnings = DrakeAdapter._parse(bodies + cord)  # continuous plant
+    loaded, warnings = DrakeAdapter._parse(_atwood_xml())  # continuous plant
     ctx = loaded.CreateDefaultContext()
     free_fall = float(loaded.get_generalized_acceleration_output_port().Eval(ctx)[0])
     ignored = sum("tendon" in w for w in warnings)
 
     plant = MultibodyPlant(h)
     plant.set_discrete_contact_approximation(DiscreteContactApproximation.kSap)
-    Parser(plant).AddModelsFromString(bodies + "</mujoco>", "xml")
+    Parser(plant).AddModelsFromString(_atwood_xml(cord=False), "xml")
     plant.AddCouplerConstraint(plant.GetJointByName("y1"), plant.GetJointByName("y2"), -1.0, 0.0)
     plant.Finalize()
     simulator = Simulator(plant)
