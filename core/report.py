@@ -31,6 +31,7 @@ from dyncheck.trajectories import (
     PRE_ASYMPTOTIC,
     TRUNCATION,
     TrajectoryFigures,
+    finest_pair,
 )
 
 CONVENTIONS = {
@@ -179,9 +180,8 @@ def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) ->
         if case is not None and c != case:
             continue
         g = g.sort_values("dt", ascending=False)
-        ok = g["asymptotic"].to_numpy()
-        idx = [i for i in range(1, len(g)) if ok[i] and ok[i - 1]]
-        p = g["observed_order"].iloc[idx[-1]] if idx else float("nan")
+        i = finest_pair(list(g["asymptotic"]))
+        p = g["observed_order"].iloc[i] if i is not None else float("nan")
         verdict = d[
             (d.case == c)
             & (d.quantity == "trajectory")

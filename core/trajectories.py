@@ -193,6 +193,13 @@ def observed_orders(dts: list[float], errors: list[float]) -> list[float]:
     return out
 
 
+def finest_pair(asymptotic: list[bool]) -> int | None:
+    """The index i of the finest pair of consecutive steps (i − 1, i) both in the asymptotic
+    range, or None: where an observed order is read."""
+    pairs = [i for i in range(1, len(asymptotic)) if asymptotic[i] and asymptotic[i - 1]]
+    return pairs[-1] if pairs else None
+
+
 @dataclass
 class TrajectoryFigures:
     """What the report plots: the book model's reference on the grid, and per engine ×
@@ -261,7 +268,7 @@ def study(
                 figures.momentum[name, integrator] = h_drift
             orders = observed_orders(list(dts), errors)
             asym = [e > REFERENCE_MARGIN * ref_err for e in errors]
-            finest = [i for i in range(1, len(dts)) if asym[i] and asym[i - 1]]
+            finest = finest_pair(asym)
             degree = getattr(general_method(case, variant), "polynomial_degree", None)
             exact = variant is not None and degree is not None and nominal >= degree > 1
             if exact:
@@ -277,16 +284,16 @@ def study(
                 )
             elif variant is None:
                 verdict, note = "failed", "model differs from the book in an unpredicted way"
-            elif not finest:
+            elif finest is None:
                 verdict, note = "failed", "no pair of steps in the asymptotic range"
             else:
-                p = orders[finest[-1]]
+                p = orders[finest]
                 ok = abs(p - nominal) <= ORDER_SLACK
                 verdict = "passed" if ok else "failed"
                 if convention and ok:
                     verdict = "explained"  # the predicted (reduced) order, a finding
                 note = (
-                    f"observed order {p:.3f} (nominal {nominal}) at dt={dts[finest[-1]]:g}; "
+                    f"observed order {p:.3f} (nominal {nominal}) at dt={dts[finest]:g}; "
                     f"reference error estimate {ref_err:.1e}"
                 )
                 if not ok and not convention and integrator in STEPPERS:
@@ -302,7 +309,7 @@ def study(
                         )
                         for h in dts
                     ]
-                    p_pred = observed_orders(list(dts), pred)[finest[-1]]
+                    p_pred = observed_orders(list(dts), pred)[finest]
                     if abs(p - p_pred) <= ORDER_SLACK:
                         verdict, convention = "explained", PRE_ASYMPTOTIC
                         note += (
@@ -473,7 +480,7 @@ def _controlled(
         worst.append(int(diff.argmax()))
     slopes = observed_orders(list(CONTROLLED_ACCURACIES), errors)
     asym = [e > REFERENCE_MARGIN * ref_err for e in errors]
-    finest = [i for i in range(1, len(errors)) if asym[i] and asym[i - 1]]
+    finest = finest_pair(asym)
     degree = None
     if variant is not None:
         degree = getattr(general_method(case, variant), "polynomial_degree", None)
@@ -488,16 +495,16 @@ def _controlled(
             f"q(t) is a polynomial of degree {degree}, which RK3 integrates exactly: max error "
             f"{max(errors):.2g} within {tol.basis} (x scale {scale:.3g})"
         )
-    elif not finest:
+    elif finest is None:
         verdict, basis = "failed", "tolerance proportionality"
         note = "no pair of accuracies in the asymptotic range"
     else:
-        p = slopes[finest[-1]]
+        p = slopes[finest]
         verdict = "passed" if abs(p - 1) <= ORDER_SLACK else "failed"
         basis = f"tolerance proportionality: global error ∝ ε, slope within 1 ± {ORDER_SLACK}"
         note = (
             f"observed slope {p:.3f} (nominal 1) between ε = "
-            f"{CONTROLLED_ACCURACIES[finest[-1] - 1]:g} and {CONTROLLED_ACCURACIES[finest[-1]]:g}"
+            f"{CONTROLLED_ACCURACIES[finest - 1]:g} and {CONTROLLED_ACCURACIES[finest]:g}"
             f"; reference error estimate {ref_err:.1e}"
         )
     return [
