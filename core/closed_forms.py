@@ -38,7 +38,7 @@ def closed_form_rows(case: Case) -> list[Discrepancy]:
     scale = float(np.abs(exact).max())
     err = np.abs(w - exact).max(axis=1)
     estimate = float(np.abs(w - w_tight).max())
-    rate = abs(float(tf._setup()[4]))
+    rate = abs(tf.rate)
     allowed = 4 * estimate + 64 * EPS * (1 + rate * spec.duration) * scale
     return [
         Discrepancy(

@@ -355,6 +355,11 @@ class TorqueFree:
         """m = k² of the elliptic functions (after the swap, if any)."""
         return float(self._setup()[2])
 
+    @property
+    def rate(self) -> float:
+        """u̇, the rate of the elliptic functions' argument u = u₀ + u̇ t."""
+        return float(self._setup()[4])
+
 
 # --- a rigid body on a ball joint at its centre of mass, in Euler angles ------------------
 
