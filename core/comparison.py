@@ -31,11 +31,11 @@ from dyncheck.implementations import (
     general_method,
     quantities,
 )
-
-__all__ = ["GRAVITY_DEFAULT", "POINT_INERTIA", "compare_instantaneous"]
 from dyncheck.reference.constraints import MAX_IMPEDANCE
 from dyncheck.results import Discrepancy
 from dyncheck.tolerances import instantaneous, soft_condition
+
+__all__ = ["GRAVITY_DEFAULT", "POINT_INERTIA", "compare_instantaneous", "soft_factor"]
 
 
 def soft_factor(v: Variant | None) -> float:
