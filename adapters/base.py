@@ -60,6 +60,9 @@ class Adapter(ABC):
     requires_couplings: ClassVar[bool] = False
     """An implementation that exists only for models with couplings (it equals another one
     elsewhere)."""
+    gyroscopic_implicit: ClassVar[bool] = False
+    """Whether the engine's ``implicitfast`` differentiates a free body's gyroscopic force (a
+    different map from semi-implicit Euler there)."""
     couplings_with_field: ClassVar[bool] = False
     """Whether the adapter holds couplings and an external field in one model (refused, before
     any work, where it does not)."""

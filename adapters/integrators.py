@@ -1,56 +1,168 @@
-"""Fixed-step integrators defined as MuJoCo defines them, for engines that have none.
+"""Integrators defined as MuJoCo defines them, for engines that have none (Pinocchio,
+dyncheck's own sympy-mechanics model), and error-controlled integration on the rotation group.
 
-MuJoCo (``mj_Euler``, ``mj_implicit``, ``mj_RungeKutta``; see its Computation chapter):
+States are laid out as MuJoCo lays them out (:class:`Layout`): a hinge or slide one
+coordinate; a ball joint its unit quaternion (w, x, y, z) and its angular velocity ω in the
+body frame; a free joint (p, quaternion) and (v, ω) with the linear velocity v in the *world*
+frame. An engine whose state differs maps to this layout and back (its adapter does).
 
-- ``euler``: semi-implicit Euler, v' = v + h·v̇(q, v), then q' = q + h·v' (new velocity).
+Fixed-step integrators (MuJoCo's ``mj_Euler``, ``mj_implicit``, ``mj_RungeKutta``, read in
+MuJoCo's source and its 4.0.0 changelog, and checked on the installed MuJoCo to round-off in
+one step of a ball and a free joint, tests/adapters/test_integrators.py):
+
+- ``euler``: semi-implicit Euler, v' = v + h·v̇(q, v), then q' = q ⊕ h·v'.
 - ``implicitfast``: v' = v + h·(M − h·D)⁻¹(τ − h(q, v) + f_passive) with D = ∂f/∂v of the
-  passive and actuator forces only (Coriolis derivatives dropped), then q' = q + h·v'. With no
-  damping and no actuators D = 0, and it is the same map as ``euler``.
-- ``rk4``: the classic four-stage Runge–Kutta tableau on x = (q, v), ẋ = (v, v̇).
+  passive and actuator forces; with no damping and no actuators D = 0 and it is ``euler``.
+  (MuJoCo ≥ 3.12 also applies a free body's gyroscopic derivative here; dyncheck's does not.)
+- ``rk4``: the classic four-stage tableau on x = (q, v) with stage positions
+  q₀ ⊕ h·Σⱼ aᵢⱼ kⱼ. On a ball or free joint's rotation the stage velocities kⱼ are the
+  Runge–Kutta–Munthe-Kaas ones, kⱼ = dexp⁻¹(θⱼ) ωⱼ with θⱼ the stage's own increment and
+  dexp⁻¹ the exact inverse right Jacobian of SO(3) — MuJoCo ≥ 4.0.0 (commit 9a7f240f0). Up
+  to MuJoCo 3.x the stage angular velocities were summed as they are (kⱼ = ωⱼ), which is
+  second order on the rotation group; :func:`integrate` keeps that definition only for the
+  conventions catalogue's demonstration (``naive_group=True``).
 - ``rk4-held-force``: the same tableau with a state-dependent external force evaluated once at
   the start of the step and held over the stages — what MuJoCo does with a force written to
-  ``xfrc_applied`` before ``mj_step``. The force's error over a step is O(h²), so the
-  predicted order is 1.
+  ``xfrc_applied`` before ``mj_step``. The force's error over a step is O(h²): order 1.
 
-Nominal orders: 1, 1, 4. Positions are updated by ``integrate_pos(q, v, h)``: q + h·v for
-hinges and slides, and for a ball joint the quaternion times exp(h·ω/2) — MuJoCo's
-``mj_integratePos``, Pinocchio's ``pin.integrate`` — so every stage and step stays on the
-rotation group (the RK4 stage positions are q₀ ⊕ h·Σ aᵢⱼ kⱼ, as in ``mj_RungeKutta``).
+Positions advance by MuJoCo's ``mj_integratePos``: q + h·v for hinges and slides (and a free
+joint's position), the quaternion times exp(h·ω/2), renormalized.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 import numpy as np
+from scipy.integrate import DOP853, solve_ivp
+
+from dyncheck.cases.multibody import NQ, NV, ROTATING
+from dyncheck.errors import EngineError
 
 Acceleration = Callable[..., np.ndarray]
-"""v̇(q, v, held) for one state, shapes (nv,) → (nv,); ``held`` is ``None`` (evaluate every
-state-dependent external force now) or what ``freeze`` returned at the start of the step."""
+"""v̇(q, v, held) for one state in the :class:`Layout`, shapes (nq,), (nv,) → (nv,); ``held``
+is ``None`` (evaluate every state-dependent external force now) or what ``freeze`` returned at
+the start of the step."""
 
 NOMINAL_ORDER = {"euler": 1, "implicitfast": 1, "rk4": 4, "rk4-held-force": 1}
 
 
-def _vector_pos(q: np.ndarray, v: np.ndarray, h: float) -> np.ndarray:
-    return q + h * v
+def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product of quaternions (w, x, y, z)."""
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return np.array(
+        [
+            w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+            w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+            w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+        ]
+    )
 
 
-def _euler(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float, pos=_vector_pos) -> tuple:
+def quat_exp(theta: np.ndarray) -> np.ndarray:
+    """The unit quaternion of the rotation vector θ: (cos |θ|/2, sin(|θ|/2) θ/|θ|)."""
+    angle = float(np.linalg.norm(theta))
+    if angle == 0.0:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    return np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * theta / angle])
+
+
+def dexp_inv(theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """J_r⁻¹(θ) ω: the rate θ̇ of exponential coordinates, q(t) = q₀ exp(θ(t)), whose body
+    angular velocity is ω — θ̇ = ω + ½ θ × ω + (1/|θ|² − (1 + cos|θ|)/(2|θ| sin|θ|)) θ × (θ × ω)
+    (the Bernoulli series ω + ½ θ × ω + θ × (θ × ω)/12 + O(|θ|⁴) below 1e-4 rad)."""
+    angle = float(np.linalg.norm(theta))
+    if angle < 1e-4:
+        k = 1.0 / 12.0 + angle**2 / 720.0
+    else:
+        k = 1.0 / angle**2 - (1.0 + np.cos(angle)) / (2.0 * angle * np.sin(angle))
+    cross = np.cross(theta, omega)
+    return omega + 0.5 * cross + k * np.cross(theta, cross)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Layout:
+    """A state laid out as MuJoCo's: per joint its type and the addresses of its positions
+    (``qadr``) and velocities (``vadr``)."""
+
+    joints: tuple[tuple[str, int, int], ...]
+
+    @classmethod
+    def of(cls, joint_types: Sequence[str]) -> Layout:
+        joints, qa, va = [], 0, 0
+        for jt in joint_types:
+            joints.append((jt, qa, va))
+            qa, va = qa + NQ[jt], va + NV[jt]
+        return cls(joints=tuple(joints))
+
+    @property
+    def rotating(self) -> bool:
+        return any(jt in ROTATING for jt, _, _ in self.joints)
+
+    def rotations(self) -> list[tuple[int, int]]:
+        """(address of the quaternion in q, of ω in v) per ball or free joint."""
+        out = []
+        for jt, qa, va in self.joints:
+            if jt == "ball":
+                out.append((qa, va))
+            elif jt == "free":
+                out.append((qa + 3, va + 3))
+        return out
+
+    def integrate_pos(self, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
+        """q ⊕ dq, MuJoCo's ``mj_integratePos`` with the increment already times h."""
+        if not self.rotating:
+            return q + dq
+        out = np.array(q, float)
+        for jt, qa, va in self.joints:
+            if jt == "free":
+                out[qa : qa + 3] += dq[va : va + 3]
+            elif jt not in ROTATING:
+                out[qa] += dq[va]
+        for qa, va in self.rotations():
+            quat = quat_mul(out[qa : qa + 4], quat_exp(dq[va : va + 3]))
+            out[qa : qa + 4] = quat / np.linalg.norm(quat)
+        return out
+
+    def dexp_inv(self, theta: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """The velocity as the rate of the increment θ: dexp⁻¹(θ) ω on every rotation, v
+        elsewhere."""
+        if not self.rotating:
+            return v
+        out = np.array(v, float)
+        for _, va in self.rotations():
+            out[va : va + 3] = dexp_inv(theta[va : va + 3], v[va : va + 3])
+        return out
+
+
+def _vector(nq: int) -> Layout:
+    return Layout.of(["slide"] * nq)
+
+
+def _euler(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float, layout: Layout, naive):
     v_new = v + h * acc(q, v)
-    return pos(q, v_new, h), v_new
+    return layout.integrate_pos(q, h * v_new), v_new
 
 
-def _rk4(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float, pos=_vector_pos) -> tuple:
-    k1q, k1v = v, acc(q, v)
-    k2q = v + 0.5 * h * k1v
-    k2v = acc(pos(q, k1q, 0.5 * h), k2q)
-    k3q = v + 0.5 * h * k2v
-    k3v = acc(pos(q, k2q, 0.5 * h), k3q)
-    k4q = v + h * k3v
-    k4v = acc(pos(q, k3q, h), k4q)
-    dq = (k1q + 2 * k2q + 2 * k3q + k4q) / 6
-    dv = (k1v + 2 * k2v + 2 * k3v + k4v) / 6
-    return pos(q, dq, h), v + h * dv
+RK4_A = ((0.5,), (0.0, 0.5), (0.0, 0.0, 1.0))
+RK4_B = (1 / 6, 1 / 3, 1 / 3, 1 / 6)
+
+
+def _rk4(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float, layout: Layout, naive):
+    """MuJoCo's ``mj_RungeKutta`` (N = 4): stage positions q₀ ⊕ h Σ aᵢⱼ kⱼ, stage velocities
+    vᵢ = v₀ + h Σ aᵢⱼ v̇ⱼ, and kᵢ = dexp⁻¹(θᵢ) vᵢ on rotations (``naive``: kᵢ = vᵢ)."""
+    ks, fs = [v], [acc(q, v)]
+    for row in RK4_A:
+        theta = h * sum(a * k for a, k in zip(row, ks, strict=False))
+        vi = v + h * sum(a * f for a, f in zip(row, fs, strict=False))
+        fs.append(acc(layout.integrate_pos(q, theta), vi))
+        ks.append(vi if naive else layout.dexp_inv(theta, vi))
+    dq = h * sum(b * k for b, k in zip(RK4_B, ks, strict=True))
+    dv = h * sum(b * f for b, f in zip(RK4_B, fs, strict=True))
+    return layout.integrate_pos(q, dq), v + dv
 
 
 STEPPERS: dict[str, Callable[..., tuple]] = {
@@ -70,14 +182,19 @@ def integrate(
     integrator: str,
     *,
     freeze: Callable[[np.ndarray, np.ndarray], object] | None = None,
-    integrate_pos: Callable[[np.ndarray, np.ndarray, float], np.ndarray] = _vector_pos,
+    layout: Layout | None = None,
+    naive_group: bool = False,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """States after 0..steps steps, shapes (steps + 1, nv). With ``rk4-held-force``,
-    ``freeze(q, v)`` is evaluated at the start of each step and passed to every stage."""
+    """States after 0..steps steps, shapes (steps + 1, nq) and (steps + 1, nv), in ``layout``
+    (default: every coordinate a slide). With ``rk4-held-force``, ``freeze(q, v)`` is
+    evaluated at the start of each step and passed to every stage. ``naive_group`` sums RK4's
+    stage angular velocities without the Munthe-Kaas correction (MuJoCo 3.x; order 2 on the
+    rotation group): for the conventions catalogue only."""
     step = STEPPERS[integrator]
-    qs = np.empty((steps + 1, q0.shape[0]))
-    vs = np.empty((steps + 1, v0.shape[0]))
     q, v = np.array(q0, float), np.array(v0, float)
+    layout = layout or _vector(q.shape[0])
+    qs = np.empty((steps + 1, q.shape[0]))
+    vs = np.empty((steps + 1, v.shape[0]))
     qs[0], vs[0] = q, v
     held = integrator == "rk4-held-force" and freeze is not None
     for k in range(1, steps + 1):
@@ -91,8 +208,84 @@ def integrate(
             def stage(qq: np.ndarray, vv: np.ndarray) -> np.ndarray:
                 return acc(qq, vv, None)
 
-        q, v = step(stage, q, v, dt, integrate_pos)
+        q, v = step(stage, q, v, dt, layout, naive_group)
         qs[k], vs[k] = q, v
         if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
             raise FloatingPointError(f"{integrator} diverged at step {k} (t = {k * dt:g})")
     return qs, vs
+
+
+MAX_CHART_ANGLE = 0.5
+"""Rotation (rad) past which a local exponential chart is re-centred: far from its singularity
+at π, where dexp⁻¹ stays well conditioned."""
+
+
+def solve_on_group(
+    acc: Acceleration,
+    q0: np.ndarray,
+    v0: np.ndarray,
+    t_eval: np.ndarray,
+    rtol: float,
+    *,
+    layout: Layout,
+    label: str,
+) -> tuple[np.ndarray, np.ndarray]:
+    """scipy's DOP853 (rtol = atol = ``rtol``) of (q, v)' = (v, acc(q, v)). On the rotation
+    group in local exponential coordinates θ about a centre q_c — θ̇ = dexp⁻¹(θ) ω,
+    v̇ = acc(q_c ⊕ θ, v) — re-centred (q_c ← q_c ⊕ θ, θ ← 0) at the end of the first accepted
+    step on which a rotation exceeds :data:`MAX_CHART_ANGLE`, and continued from there with the
+    step size it had (never at an interpolated point: the dense output is less accurate than
+    the steps). Samples at ``t_eval`` come from each step's dense output, as in ``solve_ivp``.
+    Returns q, v at ``t_eval``, shapes (n, nq), (n, nv)."""
+    nv = v0.shape[0]
+    if not layout.rotating:  # a vector state is its own global chart: one solve
+        sol = solve_ivp(
+            lambda _t, y: np.concatenate([y[nv:], acc(y[:nv], y[nv:], None)]),
+            (t_eval[0], t_eval[-1]),
+            np.concatenate([q0, v0]),
+            method="DOP853",
+            t_eval=t_eval,
+            rtol=rtol,
+            atol=rtol,
+        )
+        if not sol.success:
+            raise EngineError(f"{label}: solve_ivp failed: {sol.message}")
+        return sol.y[:nv].T, sol.y[nv:].T
+
+    def rhs(_t: float, y: np.ndarray, centre: np.ndarray) -> np.ndarray:
+        theta, vel = y[:nv], y[nv:]
+        return np.concatenate(
+            [layout.dexp_inv(theta, vel), acc(layout.integrate_pos(centre, theta), vel, None)]
+        )
+
+    def start(t: float, centre: np.ndarray, v: np.ndarray, first_step: float | None) -> DOP853:
+        return DOP853(
+            lambda t, y: rhs(t, y, centre),
+            t,
+            np.concatenate([np.zeros(nv), v]),
+            float(t_eval[-1]),
+            rtol=rtol,
+            atol=rtol,
+            first_step=first_step,
+        )
+
+    centre = np.array(q0, float)
+    solver = start(float(t_eval[0]), centre, np.asarray(v0, float), None)
+    qs, vs = [centre], [np.array(v0, float)]
+    k = 1
+    while k < len(t_eval):
+        message = solver.step()
+        if solver.status == "failed":
+            raise EngineError(f"{label}: DOP853 failed: {message}")
+        dense = solver.dense_output()
+        while k < len(t_eval) and t_eval[k] <= solver.t:
+            y = dense(t_eval[k])
+            qs.append(layout.integrate_pos(centre, y[:nv]))
+            vs.append(y[nv:])
+            k += 1
+        turn = max(np.linalg.norm(solver.y[va : va + 3]) for _, va in layout.rotations())
+        if turn > MAX_CHART_ANGLE and solver.status == "running":
+            centre = layout.integrate_pos(centre, solver.y[:nv])
+            step = min(solver.step_size, float(t_eval[-1]) - solver.t)
+            solver = start(solver.t, centre, solver.y[nv:], step)
+    return np.array(qs), np.array(vs)

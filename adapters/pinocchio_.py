@@ -5,8 +5,11 @@ MJCF parser (``pinocchio-mjcf``).
 Pinocchio's names: M = ``crba`` (upper triangle filled, mirrored here); h = ``rnea(q, v, 0)``
 (= ``nonLinearEffects``, gravity included); forward dynamics ``aba``; inverse ``rnea``;
 ``computeKineticEnergy``, ``computePotentialEnergy`` (V = −Σ mᵢ g·cᵢ). Pinocchio has no time
-integrator: :mod:`.integrators` supplies MuJoCo's definitions so integrators compare like for
-like, and :meth:`PinocchioAdapter.solve` integrates with scipy's error-controlled DOP853.
+integrator: :mod:`.integrators` supplies MuJoCo's definitions, run in MuJoCo's state layout
+(a quaternion (w, x, y, z); a free joint's linear velocity in world axes, v_w = R v_b, whose
+rate is R (v̇_b + ω × v_b)), so that the maps compare like for like; and
+:meth:`PinocchioAdapter.solve` integrates with scipy's error-controlled DOP853, on the rotation
+group in re-centred exponential coordinates.
 
 Couplings: Pinocchio's constrained forward dynamics ``forwardDynamics(q, v, τ, C, γ = 0)``
 (an exact KKT solve with the constant constraint Jacobian C; the multipliers in
@@ -23,13 +26,12 @@ from typing import ClassVar
 
 import numpy as np
 import pinocchio as pin
-from scipy.integrate import solve_ivp
 
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
-from dyncheck.adapters.integrators import STEPPERS, integrate
+from dyncheck.adapters.integrators import STEPPERS, Layout, integrate, solve_on_group
 from dyncheck.adapters.mjcf import to_mjcf
+from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.cases.multibody import Joint, Multibody
-from dyncheck.errors import EngineError, Unsupported
 
 THREADS = max(1, min(2, os.cpu_count() or 1))
 """Threads for Pinocchio's batched ABA/RNEA (the machines this runs on have 2 cores)."""
@@ -92,8 +94,6 @@ def load_mjcf(xml: str) -> pin.Model:
 class PinocchioAdapter(Adapter):
     name: ClassVar[str] = "pinocchio"
     package: ClassVar[str] = "pin"
-    naive_group_rk4: ClassVar[bool] = True
-    """dyncheck's RK4 sums stage velocities from different tangent spaces (order 2 on SO(3))."""
     integrators: ClassVar[tuple[str, ...]] = tuple(STEPPERS)
     adaptive: ClassVar[bool] = True
 
@@ -105,6 +105,7 @@ class PinocchioAdapter(Adapter):
         # the joint that carries each body's inertia, found through the body's frame
         self._joint_ids = [self._body_joint(b.name) for b in model.bodies]
         self._C = model.coupling_matrix() if model.couplings else None
+        self.layout = Layout.of([j.type for j in model.joints])
 
     def _build(self, model: Multibody) -> pin.Model:
         return build_model(model)
@@ -201,25 +202,60 @@ class PinocchioAdapter(Adapter):
         """dyncheck's ``implicitfast`` has D = 0 here (no damping, no actuators): ``euler``."""
         return "euler" if integrator == "implicitfast" else integrator
 
+    def _to_mujoco(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Pinocchio's state → MuJoCo's layout: quaternions (x, y, z, w) → (w, x, y, z), a
+        free joint's body-frame linear velocity v_b → v_w = R v_b."""
+        q, v = np.array(q, float), np.array(v, float)
+        for jt, qa, va in self.layout.joints:
+            if jt in ("ball", "free"):
+                k = qa + (3 if jt == "free" else 0)
+                q[k : k + 4] = np.roll(q[k : k + 4], 1)
+            if jt == "free":
+                v[va : va + 3] = quat_to_matrix(q[None, qa + 3 : qa + 7])[0] @ v[va : va + 3]
+        return q, v
+
+    def _from_mujoco(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The inverse of :meth:`_to_mujoco`."""
+        q, v = np.array(q, float), np.array(v, float)
+        for jt, qa, va in self.layout.joints:
+            if jt == "free":
+                v[va : va + 3] = quat_to_matrix(q[None, qa + 3 : qa + 7])[0].T @ v[va : va + 3]
+            if jt in ("ball", "free"):
+                k = qa + (3 if jt == "free" else 0)
+                q[k : k + 4] = np.roll(q[k : k + 4], -1)
+        return q, v
+
+    def _mujoco_acceleration(self, q: np.ndarray, v: np.ndarray, held=None) -> np.ndarray:
+        """v̇ in MuJoCo's layout: Pinocchio's ABA, a free joint's v̇_b turned into
+        R (v̇_b + ω × v_b), the rate of v_w = R v_b."""
+        qp, vp = self._from_mujoco(q, v)
+        a = self._aba(qp, vp, np.zeros(self.model.nv), held)
+        for jt, qa, va in self.layout.joints:
+            if jt == "free":
+                R = quat_to_matrix(q[None, qa + 3 : qa + 7])[0]
+                lin, ang = slice(va, va + 3), slice(va + 3, va + 6)
+                a[lin] = R @ (a[lin] + np.cross(vp[ang], vp[lin]))
+        return a
+
+    def _states_from_mujoco(self, qs: np.ndarray, vs: np.ndarray) -> tuple:
+        pairs = [self._from_mujoco(q, v) for q, v in zip(qs, vs, strict=True)]
+        return np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
+
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:
-        zero = np.zeros(self.model.nv)
-
-        def acc(q: np.ndarray, v: np.ndarray, held=None) -> np.ndarray:
-            return self._aba(q, v, zero, held)
-
+        """MuJoCo's definition of ``integrator`` (:mod:`.integrators`), in MuJoCo's layout."""
         steps = round(duration / dt)
         qs, vs = integrate(
-            acc,
-            np.asarray(q0),
-            np.asarray(v0),
+            self._mujoco_acceleration,
+            *self._to_mujoco(q0, v0),
             dt,
             steps,
             integrator,
-            freeze=lambda q, v: self._fext(q),
-            integrate_pos=lambda q, v, h: pin.integrate(self.model, q, h * v),
+            freeze=lambda q, v: self._fext(self._from_mujoco(q, v)[0]),
+            layout=self.layout,
         )
+        qs, vs = self._states_from_mujoco(qs, vs)
         return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)
 
     def evaluate_all(
@@ -268,29 +304,17 @@ class PinocchioAdapter(Adapter):
         return self.__pool
 
     def solve(self, q0: np.ndarray, v0: np.ndarray, t_eval: np.ndarray, rtol: float) -> Trajectory:
-        """scipy's DOP853 on (q, v)' = (v, aba(q, v, 0)), rtol = atol = ``rtol``."""
-        if self.model.nq != self.model.nv:
-            raise Unsupported(
-                f"{self.name}: scipy's DOP853 integrates q' = v only where "
-                "positions and velocities match; a quaternion state needs a chart"
-            )
-        nv, zero = self.model.nv, np.zeros(self.model.nv)
-
-        def rhs(_t: float, y: np.ndarray) -> np.ndarray:
-            return np.concatenate([y[nv:], self._aba(y[:nv], y[nv:], zero)])
-
-        sol = solve_ivp(
-            rhs,
-            (t_eval[0], t_eval[-1]),
-            np.concatenate([q0, v0]),
-            method="DOP853",
-            t_eval=t_eval,
-            rtol=rtol,
-            atol=rtol,
+        """scipy's DOP853 at rtol = atol = ``rtol`` (:func:`.integrators.solve_on_group`)."""
+        qs, vs = solve_on_group(
+            self._mujoco_acceleration,
+            *self._to_mujoco(q0, v0),
+            t_eval,
+            rtol,
+            layout=self.layout,
+            label=self.name,
         )
-        if not sol.success:
-            raise EngineError(f"{self.name}: solve_ivp failed: {sol.message}")
-        return Trajectory(t_eval, self._check("solve", sol.y[:nv].T), sol.y[nv:].T)
+        qs, vs = self._states_from_mujoco(qs, vs)
+        return Trajectory(t_eval, self._check("solve", qs), vs)
 
 
 class PinocchioMJCFAdapter(PinocchioAdapter):

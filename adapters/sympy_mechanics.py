@@ -66,8 +66,6 @@ def _batched(exprs: list[sp.Expr], args: list[sp.Symbol]) -> Callable[..., np.nd
 class SympyMechanicsAdapter(Adapter):
     name: ClassVar[str] = "sympy-mechanics"
     package: ClassVar[str] = "sympy"
-    naive_group_rk4: ClassVar[bool] = False
-    """Rotations are Euler angles (a chart), so dyncheck's RK4 is the classic one (order 4)."""
     integrators: ClassVar[tuple[str, ...]] = ("euler", "rk4")
     """MuJoCo's definitions (:mod:`.integrators`): semi-implicit Euler, shared with every
     engine including Drake, and RK4. Each step costs Python-level evaluations of the

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.errors import InvalidInput
-from dyncheck.results import DISCREPANCY_KEY, to_csv, write_atomic
+from dyncheck.results import DISCREPANCY_KEY, VERDICTS, to_csv, write_atomic
 
 COLUMNS = [*DISCREPANCY_KEY, "max_rel_err", "tolerance", "verdict"]
 FACTOR = 10.0
@@ -26,27 +26,67 @@ def baseline_table(discrepancies: pd.DataFrame) -> pd.DataFrame:
     return discrepancies[COLUMNS].sort_values(DISCREPANCY_KEY, kind="stable").reset_index(drop=True)
 
 
-def write(discrepancies: pd.DataFrame, path: Path) -> None:
-    write_atomic(path, to_csv(baseline_table(discrepancies)))
+def write(discrepancies: pd.DataFrame, path: Path, versions: dict[str, str] | None = None) -> None:
+    """The baseline CSV, headed by ``# versions:`` (what made it) so that a later mismatch
+    says whether the code or an engine changed."""
+    head = ""
+    if versions:
+        head = "# versions: " + " ".join(f"{k}={v}" for k, v in versions.items()) + "\n"
+    write_atomic(path, head + to_csv(baseline_table(discrepancies)))
 
 
-def load(path: Path) -> pd.DataFrame:
-    """The baseline at ``path``; a one-line InvalidInput for a missing or malformed file."""
+def versions_of(path: Path) -> dict[str, str]:
+    """The ``# versions:`` header of a baseline (empty when it has none)."""
+    with path.open(encoding="utf-8", errors="replace") as f:
+        first = f.readline()
+    if not first.startswith("# versions: "):
+        return {}
+    return dict(item.split("=", 1) for item in first[12:].split() if "=" in item)
+
+
+def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
+    """The baseline at ``path``, validated before any work: a one-line InvalidInput for a
+    missing, unreadable or malformed file (columns, types, verdicts, a number wherever a
+    verdict needs one, no duplicate keys)."""
+    if path.is_dir():
+        raise InvalidInput(flag, str(path), "a baseline CSV file, not a folder")
     try:
-        frame = pd.read_csv(path, keep_default_na=False, na_values=[""])
+        frame = pd.read_csv(path, keep_default_na=False, na_values=[""], comment="#")
     except FileNotFoundError:
-        raise InvalidInput("--baseline", str(path), "an existing baseline CSV file") from None
+        raise InvalidInput(flag, str(path), "an existing baseline CSV file") from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        raise InvalidInput("--baseline", str(path), f"a CSV file ({exc})") from None
+        reason = str(exc).splitlines()[0]
+        raise InvalidInput(flag, str(path), f"a CSV file ({reason})") from None
+    except OSError as exc:
+        raise InvalidInput(flag, str(path), f"a readable file ({exc.strerror})") from None
     missing = [c for c in COLUMNS if c not in frame.columns]
     if missing:
-        raise InvalidInput("--baseline", str(path), f"a dyncheck baseline (missing {missing})")
+        raise InvalidInput(flag, str(path), f"a dyncheck baseline (missing {missing})")
     try:
-        frame["max_rel_err"] = frame["max_rel_err"].astype(float)
-        frame["dt"] = frame["dt"].astype(float)
+        for col in ("max_rel_err", "dt", "tolerance"):
+            frame[col] = frame[col].astype(float)
     except ValueError as exc:
-        raise InvalidInput("--baseline", str(path), f"numeric errors and steps ({exc})") from None
+        raise InvalidInput(flag, str(path), f"numeric errors and steps ({exc})") from None
+    bad = ~frame["verdict"].isin(VERDICTS)
+    if bad.any():
+        row = int(np.flatnonzero(bad.to_numpy())[0]) + 1
+        raise InvalidInput(
+            flag, str(path), f"verdicts in {VERDICTS} (data row {row}: truncated or edited?)"
+        )
+    judged = frame["verdict"].isin(["passed", "explained"])
+    nan = judged & ~np.isfinite(frame["max_rel_err"].to_numpy())
+    if nan.any():
+        row = int(np.flatnonzero(nan.to_numpy())[0]) + 1
+        raise InvalidInput(
+            flag,
+            str(path),
+            f"a finite max_rel_err on every passed or explained row (data row {row})",
+        )
     frame["integrator"] = frame["integrator"].fillna("").astype(str)
+    dup = _key(frame).duplicated()
+    if dup.any():
+        row = int(np.flatnonzero(dup.to_numpy())[0]) + 1
+        raise InvalidInput(flag, str(path), f"one row per key (data row {row} repeats a key)")
     return frame
 
 
@@ -87,3 +127,10 @@ def compare(
         if ratio > FACTOR and max(eb, ec) > tol:
             out.append((k, f"error moved x{ratio:.3g}", f"{eb:.3e}", f"{ec:.3e}"))
     return pd.DataFrame(out, columns=["row", "change", "baseline", "current"])
+
+
+def version_changes(path: Path, current: dict[str, str]) -> list[str]:
+    """Engines and libraries whose version differs from the baseline's header."""
+    old = versions_of(path)
+    keys = [k for k in old if k not in ("date (UTC)", "dyncheck commit")]
+    return [f"{k} {old[k]} -> {current.get(k, 'absent')}" for k in keys if old[k] != current.get(k)]

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import multiprocessing as mp
 import platform
+import queue as queue_module
 import resource
 import statistics
 import time
@@ -28,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.cases import Case, get_case
+from dyncheck.errors import EngineError
 from dyncheck.implementations import (
     IMPLEMENTATIONS,
     EngineImplementation,
@@ -133,7 +135,16 @@ def peak_memory_kib(case_name: str, states: int) -> int:
     queue = ctx.Queue()
     proc = ctx.Process(target=_sweep_rss, args=(case_name, states, queue))
     proc.start()
-    rss = queue.get()
+    while True:  # never wait on a child that has died: poll its queue and its life
+        try:
+            rss = queue.get(timeout=1.0)
+            break
+        except queue_module.Empty:
+            if not proc.is_alive():
+                raise EngineError(
+                    f"bench --memory {states}: the sweep process died (exit code "
+                    f"{proc.exitcode}) before reporting its memory"
+                ) from None
     proc.join()
     return int(rss)
 

@@ -8,6 +8,7 @@ behaviour, the entry's numbers change and its test fails.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -17,7 +18,8 @@ from dyncheck import conventions
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import LinearMap, quat_to_matrix
 from dyncheck.comparison import compare_instantaneous
-from dyncheck.errors import UnknownName
+from dyncheck.errors import EngineNotInstalled, UnknownName
+from dyncheck.explanations import Origin
 from dyncheck.implementations import EngineImplementation, NativeMap, make_implementation
 
 
@@ -34,6 +36,8 @@ class Entry:
     unit: str = "max relative error"
     skipped: str = ""
     """Why the demonstration did not run (an engine not installed), or empty."""
+    origin: Origin | None = None
+    """Whose property the convention is (set from :data:`DEMOS`)."""
 
 
 def _worst(case_name: str, engine: str, cmap=None) -> float:
@@ -733,61 +737,78 @@ def multiplier_sign() -> Entry:
 
 
 def group_rk4() -> Entry:
-    """The order study of the spherical pendulum (a ball joint), RK4 only."""
-    import dataclasses
+    """RK4 on a ball joint with and without the Munthe-Kaas correction of the stage angular
+    velocities (MuJoCo 4.0's ``mj_RungeKutta`` and MuJoCo 3.x's), on Pinocchio's dynamics of
+    the rigid body of Example 9 on a ball joint: self-convergence orders
+    p = log2(|q_h − q_{h/2}| / |q_{h/2} − q_{h/4}|) at the finest steps."""
+    from dyncheck.adapters.integrators import integrate
 
-    from dyncheck.trajectories import study
+    case = get_case("rigid_body_ball")
+    impl = make_implementation("pinocchio", case)
+    adapter = impl.adapter  # type: ignore[attr-defined]
+    q0, v0 = adapter._to_mujoco(*impl._engine_start())  # type: ignore[attr-defined]
+    duration = case.trajectory.duration
+    dts = case.trajectory.steps["rk4"][1:]
 
-    case = get_case("spherical_pendulum")
-    rk4 = {"rk4": case.trajectory.steps["rk4"]}
-    case = dataclasses.replace(case, trajectory=dataclasses.replace(case.trajectory, steps=rk4))
-    impls = {n: make_implementation(n, case) for n in ("mujoco", "pinocchio")}
-    points, _, _ = study(case, impls)
-
-    def order(impl: str) -> float:
-        ps = [p for p in points if p.impl == impl and p.asymptotic]
-        return float(ps[-1].observed_order)
+    def order(naive: bool) -> float:
+        ends = []
+        for dt in dts:
+            qs, _ = integrate(
+                adapter._mujoco_acceleration,
+                q0,
+                v0,
+                dt,
+                round(duration / dt),
+                "rk4",
+                layout=adapter.layout,
+                naive_group=naive,
+            )
+            ends.append(qs[-1])
+        e1, e2 = np.abs(ends[0] - ends[1]).max(), np.abs(ends[1] - ends[2]).max()
+        return float(np.log2(e1 / e2))
 
     return Entry(
         "rk4-on-the-rotation-group",
-        "RK4 on a ball joint: MuJoCo's mj_RungeKutta keeps order 4; the same tableau "
-        "with stage positions q₀ ⊕ h·Σaᵢⱼkᵢ and stage angular velocities summed across "
-        "body frames (dyncheck's integrator for Pinocchio) keeps order 2 (measured on "
-        "the spherical pendulum).",
-        "MuJoCo RK4: order 4; naive group RK4: order 2.",
-        "naive RK4 on the rotation group: observed order",
-        order("pinocchio"),
-        order("mujoco"),
-        "observed order (correct: MuJoCo's)",
+        "RK4 on a ball joint: the stage angular velocities ωⱼ live in different body frames. "
+        "Summed as they are (q₀ ⊕ h Σ bⱼ ωⱼ: MuJoCo ≤ 3.x's mj_RungeKutta) the method keeps only "
+        "order 2 on the rotation group; with the Runge–Kutta–Munthe-Kaas correction "
+        "kⱼ = dexp⁻¹(θⱼ) ωⱼ (MuJoCo 4.0.0's, and dyncheck's integrators for Pinocchio) it "
+        "keeps order 4. Measured on Example 9's body on a ball joint (Pinocchio's dynamics, "
+        "self-convergence at h = " + ", ".join(f"{h:g}" for h in dts) + " s).",
+        "MuJoCo 4.0.0: RKMK, order 4 (changelog 9a7f240f0); MuJoCo 3.x: naive sum, order 2.",
+        "stage angular velocities summed across tangent spaces: observed order",
+        order(True),
+        order(False),
+        "observed order (correct: with dexp⁻¹)",
     )
 
 
-DEMOS: dict[str, Callable[[], Entry]] = {
-    "ball-joint-velocity-frame": velocity_frame,
-    "free-body-velocity-frames": free_body_velocity,
-    "geometry-derived-inertia": geometry_inertia,
-    "passive-damping": passive_damping,
-    "pinocchio-mjcf-equality": pinocchio_equality,
-    "pinocchio-mjcf-options": pinocchio_mjcf_options,
-    "pinocchio-mjcf-top-level-bodies": pinocchio_top_level_bodies,
-    "point-mass-inertia-floor": point_mass_floor,
-    "soft-vs-exact-constraints": soft_constraint,
-    "coordinate-order": coordinate_order,
-    "default-integrator-and-timestep": mujoco_defaults,
-    "drake-fsal-caching": drake_fsal_caching,
-    "drake-mjcf-equality": drake_equality,
-    "drake-mjcf-options": drake_mjcf_options,
-    "degrees-vs-radians": degrees_radians,
-    "energy-readout-after-step": energy_after_step,
-    "hinge-axis-sign": hinge_sign,
-    "lagrange-multiplier-sign": multiplier_sign,
-    "quaternion-storage-order": quaternion_order,
-    "relative-vs-absolute-angles": relative_angles,
-    "rk4-on-the-rotation-group": group_rk4,
+DEMOS: dict[str, tuple[Callable[[], Entry], Origin]] = {
+    "ball-joint-velocity-frame": (velocity_frame, Origin.ENGINE),
+    "free-body-velocity-frames": (free_body_velocity, Origin.ENGINE),
+    "geometry-derived-inertia": (geometry_inertia, Origin.ENGINE),
+    "passive-damping": (passive_damping, Origin.ENGINE),
+    "pinocchio-mjcf-equality": (pinocchio_equality, Origin.ENGINE),
+    "pinocchio-mjcf-options": (pinocchio_mjcf_options, Origin.ENGINE),
+    "pinocchio-mjcf-top-level-bodies": (pinocchio_top_level_bodies, Origin.ENGINE),
+    "point-mass-inertia-floor": (point_mass_floor, Origin.ENGINE),
+    "soft-vs-exact-constraints": (soft_constraint, Origin.ENGINE),
+    "coordinate-order": (coordinate_order, Origin.ENGINE),
+    "default-integrator-and-timestep": (mujoco_defaults, Origin.ENGINE),
+    "drake-fsal-caching": (drake_fsal_caching, Origin.ENGINE),
+    "drake-mjcf-equality": (drake_equality, Origin.ENGINE),
+    "drake-mjcf-options": (drake_mjcf_options, Origin.ENGINE),
+    "degrees-vs-radians": (degrees_radians, Origin.ENGINE),
+    "energy-readout-after-step": (energy_after_step, Origin.ENGINE),
+    "hinge-axis-sign": (hinge_sign, Origin.ENGINE),
+    "lagrange-multiplier-sign": (multiplier_sign, Origin.ENGINE),
+    "quaternion-storage-order": (quaternion_order, Origin.ENGINE),
+    "relative-vs-absolute-angles": (relative_angles, Origin.BOOK),
+    "rk4-on-the-rotation-group": (group_rk4, Origin.MATHEMATICS),
 }
-"""Conventions demonstrated by a run of their own; the others (point-mass inertia floor,
-MJCF gravity, held forces, RK4 on the rotation group) are measured by ``dyncheck run`` and
-explained in its report."""
+"""Conventions demonstrated by a run of their own, with whose property each is; the others
+(point-mass inertia floor, MJCF gravity, held forces, soft constraints: :mod:`.explanations`)
+are measured by ``dyncheck run`` and explained in its report."""
 
 
 REQUIRES: dict[str, tuple[str, ...]] = {
@@ -802,12 +823,19 @@ def _run(name: str) -> Entry:
     """One demonstration, or a skipped entry naming the engine that is not installed."""
     from dyncheck.adapters import ENGINE_PACKAGES, MISSING
 
+    nan = float("nan")
     for engine in REQUIRES.get(name, ()):
         if engine in MISSING:
             why = f"{engine} is not installed (pip install {ENGINE_PACKAGES[engine]})"
-            nan = float("nan")
             return Entry(name, "", "", "", nan, nan, skipped=why)
-    return DEMOS[name]()
+    demo, origin = DEMOS[name]
+    try:
+        entry = demo()
+    except EngineNotInstalled as exc:  # a core engine missing: only this entry is lost
+        return Entry(name, "", "", "", nan, nan, skipped=str(exc))
+    except ImportError as exc:
+        return Entry(name, "", "", "", nan, nan, skipped=f"an engine is not installed ({exc})")
+    return dataclasses.replace(entry, origin=origin)
 
 
 def explain(name: str | None = None) -> list[Entry]:
@@ -831,6 +859,7 @@ def render(entries: list[Entry]) -> str:
             "",
             e.what,
             "",
+            f"- Whose property: {e.origin.value if e.origin else 'unknown'}",
             f"- Where the engines stand: {e.engines}",
             f"- Naive ({e.naive}): "
             + (

@@ -9,12 +9,28 @@ naming the argument and the value).
 from __future__ import annotations
 
 import argparse
-import os
 import sys
+import tempfile
 from collections.abc import Sequence
 from pathlib import Path
+from typing import NoReturn
 
 from dyncheck.errors import DyncheckError, InvalidInput
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (``dyncheck: error: …``, exit 2), no usage dump."""
+
+    def error(self, message: str) -> NoReturn:
+        print(f"dyncheck: error: {self.prog}: {message}", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def _path(text: str) -> Path:
+    """A path argument; an empty one is refused (it would silently mean this folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path is not a folder or file name")
+    return Path(text)
 
 
 def _selection(p: argparse.ArgumentParser) -> None:
@@ -36,12 +52,12 @@ def _selection(p: argparse.ArgumentParser) -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="dyncheck", description=__doc__.splitlines()[0])
-    sub = p.add_subparsers(dest="command", required=True)
+    p = _Parser(prog="dyncheck", description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     sub.add_parser("list", help="cases and implementations, with installed engine versions")
     r = sub.add_parser("run", help="compare implementations on cases and write the report")
     _selection(r)
-    r.add_argument("--out", type=Path, default=Path("reports"), help="report folder")
+    r.add_argument("--out", type=_path, default=Path("reports"), help="report folder")
     r.add_argument(
         "--states",
         type=int,
@@ -51,7 +67,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     r.add_argument(
         "--baseline",
-        type=Path,
+        type=_path,
         default=None,
         metavar="FILE",
         help="report every row that regressed against this baseline (exit 1)",
@@ -63,13 +79,21 @@ def _parser() -> argparse.ArgumentParser:
         required=True,
         help="recompute every case and compare with the report folder",
     )
-    c.add_argument("--out", type=Path, default=Path("reports"), help="report folder")
+    c.add_argument("--out", type=_path, default=Path("reports"), help="report folder")
     c.add_argument("--jobs", type=int, default=1, metavar="N")
+    c.add_argument(
+        "--from",
+        dest="run_dir",
+        type=_path,
+        default=None,
+        metavar="DIR",
+        help="compare with the output folder of a finished `dyncheck run` instead of running",
+    )
     e = sub.add_parser("explain", help="demonstrate a modelling convention (all if none)")
     e.add_argument("name", nargs="?", default=None, metavar="NAME")
     bl = sub.add_parser("baseline", help="run and write the regression baseline")
     _selection(bl)
-    bl.add_argument("--out", type=Path, default=Path("reports/baseline.csv"), metavar="FILE")
+    bl.add_argument("--out", type=_path, default=Path("reports/baseline.csv"), metavar="FILE")
     b = sub.add_parser("bench", help="time the engines, adapters, reference and a sweep")
     b.add_argument("case", nargs="?", default="compound_pendulum", metavar="CASE")
     b.add_argument("--states", type=int, default=100_000, metavar="N")
@@ -82,7 +106,7 @@ def _parser() -> argparse.ArgumentParser:
         metavar="N",
         help="sweep sizes whose peak memory is measured in fresh processes",
     )
-    b.add_argument("--out", type=Path, default=Path("reports"), help="report folder")
+    b.add_argument("--out", type=_path, default=Path("reports"), help="report folder")
     return p
 
 
@@ -115,15 +139,26 @@ def _list() -> int:
 
 
 def _check_out(out: Path) -> None:
-    """--out must be a directory, or creatable: its nearest existing ancestor a writable
-    directory (checked before any work, so bad usage changes nothing)."""
+    """--out must be a directory, or creatable, and writable — tried for real (a probe file
+    created and removed, any folder made for it removed again) before any work, so bad usage
+    changes nothing."""
     if out.exists() and not out.is_dir():
         raise InvalidInput("--out", str(out), "a directory")
-    probe = out if out.exists() else next((p for p in out.parents if p.exists()), Path("."))
-    if not probe.is_dir():
-        raise InvalidInput("--out", str(out), f"a directory path ({probe} is a file)")
-    if not os.access(probe, os.W_OK):
-        raise InvalidInput("--out", str(out), "a writable directory")
+    missing = [p for p in (out, *out.parents) if not p.exists()]
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=out, prefix=".dyncheck-probe-"):
+            pass
+    except OSError as exc:
+        raise InvalidInput("--out", str(out), f"a writable directory ({exc.strerror})") from None
+    finally:
+        for p in missing:  # innermost first: leave no trace of the probe
+            if p.is_dir() and not any(p.iterdir()):
+                p.rmdir()
+
+
+MAX_STATES = 10**9
+"""More sampled states than this would take days at ~50 µs per state: refused up front."""
 
 
 def _positive(name: str, value: int | None) -> None:
@@ -137,6 +172,8 @@ def _run(args: argparse.Namespace) -> int:
 
     _check_out(args.out)
     _positive("--states", args.states)
+    if args.states is not None and args.states > MAX_STATES:
+        raise InvalidInput("--states", args.states, f"at most {MAX_STATES} (~50 µs per state)")
     _positive("--jobs", args.jobs)
     reference = baseline.load(args.baseline) if args.baseline is not None else None
     cases, impls = resolve(args.cases, args.impl)
@@ -156,43 +193,63 @@ def _run(args: argparse.Namespace) -> int:
             if regressed
             else f"no regression against {args.baseline}"
         )
+        moved = baseline.version_changes(args.baseline, report.versions())
+        print(
+            "versions changed since the baseline: " + ", ".join(moved)
+            if moved
+            else "same engine versions as the baseline (a regression is a change of code)"
+        )
         if regressed:
             print(changes.to_string(index=False))
     return 1 if result.failed or regressed else 0
 
 
+SHOWN = 20
+"""Moved results listed by `report --check` (the rest counted)."""
+
+
 def _report(args: argparse.Namespace) -> int:
-    from dyncheck import report
+    from dyncheck import freshness, report
     from dyncheck.run import resolve, run
 
     _positive("--jobs", args.jobs)
-    cases, impls = resolve([], [])
-    stale = report.check(run(cases, impls, jobs=args.jobs), args.out)
-    for line in stale:
-        print(f"stale: {line}")
+    for flag, folder in (("--out", args.out), ("--from", args.run_dir)):
+        if folder is not None and not folder.is_dir():
+            raise InvalidInput(flag, str(folder), "an existing report folder")
+    committed = freshness.read_report(args.out)
+    if args.run_dir is not None:
+        moved = freshness.compare(committed, freshness.read_report(args.run_dir))
+    else:
+        cases, impls = resolve([], [])
+        moved = report.check(run(cases, impls, jobs=args.jobs), args.out)
+    for m in moved[:SHOWN]:
+        print(f"moved: {m}")
+    if len(moved) > SHOWN:
+        print(f"moved: ... and {len(moved) - SHOWN} more")
     print(
-        "report up to date"
-        if not stale
-        else f"{len(stale)} stale files: run `dyncheck run --out {args.out}` and commit"
+        "report up to date (results equal beyond round-off)"
+        if not moved
+        else f"{len(moved)} results moved: run `dyncheck run --out {args.out}` and commit"
     )
-    return 1 if stale else 0
+    return 1 if moved else 0
 
 
 def _baseline(args: argparse.Namespace) -> int:
     """Write the baseline; show what changed against the previous one."""
-    from dyncheck import baseline
+    from dyncheck import baseline, report
     from dyncheck.run import resolve, run
 
+    if args.out.is_dir():
+        raise InvalidInput("--out", str(args.out), "a file path, not a folder")
     _check_out(args.out.parent)
     _positive("--jobs", args.jobs)
     cases, impls = resolve(args.cases, args.impl)
+    previous = baseline.load(args.out, "--out") if args.out.exists() else None  # validated first
     result = run(cases, impls, jobs=args.jobs)
-    if args.out.exists():
-        changes = baseline.compare(
-            result.discrepancies, baseline.load(args.out), cases=[c.name for c in cases]
-        )
+    if previous is not None:
+        changes = baseline.compare(result.discrepancies, previous, cases=[c.name for c in cases])
         print(changes.to_string(index=False) if len(changes) else "no change")
-    baseline.write(result.discrepancies, args.out)
+    baseline.write(result.discrepancies, args.out, versions=report.versions())
     print(f"baseline written to {args.out} ({len(result.discrepancies)} rows)")
     return 0
 
@@ -205,6 +262,8 @@ def _bench(args: argparse.Namespace) -> int:
     get_case(args.case)
     _positive("--states", args.states)
     _positive("--repeats", args.repeats)
+    for n in args.memory:
+        _positive("--memory", n)
     print(bench.main(args.case, args.states, args.repeats, args.memory, args.out))
     return 0
 
@@ -232,8 +291,19 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _list()
         return COMMANDS[args.command](args)
     except DyncheckError as exc:
-        print(f"dyncheck: error: {exc}", file=sys.stderr)
+        print(f"dyncheck: error: {_one_line(str(exc))}", file=sys.stderr)
         return 2
+    except OSError as exc:  # a write that failed mid-way (disk full, file-size limit)
+        where = exc.filename or "output"
+        print(f"dyncheck: error: cannot write {where}: {exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("dyncheck: interrupted (nothing half-written)", file=sys.stderr)
+        return 130
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
 
 
 if __name__ == "__main__":

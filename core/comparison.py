@@ -33,7 +33,7 @@ from dyncheck.implementations import (
 )
 from dyncheck.reference.constraints import MAX_IMPEDANCE
 from dyncheck.results import Discrepancy
-from dyncheck.tolerances import instantaneous, soft_condition
+from dyncheck.tolerances import EPS, ROUNDOFF_FACTOR, first_near_max, instantaneous, soft_condition
 
 __all__ = ["GRAVITY_DEFAULT", "POINT_INERTIA", "compare_instantaneous", "soft_factor"]
 
@@ -84,13 +84,17 @@ class PairStats:
         predicted: np.ndarray | None,
     ) -> None:
         diff = _per_state(actual - desired)
-        k = int(np.argmax(diff))
-        if diff[k] > self.max_abs or self.worst < 0:
-            self.max_abs, self.worst = float(diff[k]), offset + k
+        self.scale = max(self.scale, float(np.abs(desired).max()))
+        # ties at round-off go to the first state, so that the worst state does not flip
+        # between machines whose round-off differs
+        band = ROUNDOFF_FACTOR * EPS * self.scale
+        k = first_near_max(diff, band)
+        if diff[k] > self.max_abs + band or self.worst < 0:
+            self.worst = offset + k
             self.worst_values = (
                 f"q={_fmt(s.q[k])} v={_fmt(s.v[k])} tau={_fmt(s.tau[k])} a={_fmt(s.a[k])}"
             )
-        self.scale = max(self.scale, float(np.abs(desired).max()))
+        self.max_abs = max(self.max_abs, float(diff.max()))
         if predicted is not None:
             self.predicted = max(self.predicted, float(np.abs(predicted).max()))
             self.residual = max(self.residual, float(np.abs(actual - desired - predicted).max()))

@@ -17,96 +17,18 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.cases import Case
-from dyncheck.comparison import GRAVITY_DEFAULT, POINT_INERTIA
-from dyncheck.implementations import SOFT_CONSTRAINT
+from dyncheck.explanations import EXPLANATIONS
+from dyncheck.freshness import Moved, compare, read_report
 from dyncheck.results import to_csv, write_atomic
 from dyncheck.run import RunResult
 from dyncheck.tolerances import ORDER_SLACK
 from dyncheck.trajectories import (
     CONTROLLED,
     CONTROLLED_ACCURACIES,
-    FREE_VELOCITY_FRAME,
-    HELD_FORCE,
-    NAIVE_GROUP_RK4,
-    PRE_ASYMPTOTIC,
     TRUNCATION,
     TrajectoryFigures,
     finest_pair,
 )
-
-CONVENTIONS = {
-    POINT_INERTIA: (
-        "MuJoCo's compiler rejects a moving body whose mass or inertia is below mjMINVAL "
-        "(1e-15), so the MJCF gives each of the book's point masses a small isotropic inertia "
-        "(`Multibody.mjcf_point_inertia`). MuJoCo and `pinocchio-mjcf` read it; `pinocchio` "
-        "(built programmatically) holds exact point masses. The reference predicts the "
-        "difference exactly: the general method with ½ I |ω|² added per body (from (2.2.40); "
-        "ω = θ̇ for a pendulum bob with θ absolute, the rotation of the coordinate triad for a "
-        "particle carried by coordinate joints). A row is `explained` only when observed − "
-        "predicted is within round-off."
-    ),
-    GRAVITY_DEFAULT: (
-        "Pinocchio's MJCF parser (`pin.buildModelFromMJCF`, Pinocchio 4.1) does not read "
-        "`<option gravity>`: the loaded model keeps Pinocchio's default (0, 0, −9.81) m/s² "
-        "whatever the file says (measured: the loaded `model.gravity` is read back). It is "
-        "invisible where the case's gravity is the default and a failure of the model "
-        "elsewhere; the reference predicts it exactly by evaluating the general method with "
-        "the gravity the engine actually holds."
-    ),
-    HELD_FORCE: (
-        "A state-dependent external force written to MuJoCo's `xfrc_applied` before `mj_step` "
-        "is held over the four RK4 stages; the force then errs by O(h) over a step and RK4 "
-        "drops to order 1 (predicted, and measured in the order study). Evaluating the force "
-        "at every stage (MuJoCo's `mjcb_passive` callback, or the stage function of "
-        "dyncheck's integrators for Pinocchio) restores order 4."
-    ),
-    NAIVE_GROUP_RK4: (
-        "dyncheck's RK4 for engines without an integrator (Pinocchio) applies MuJoCo's "
-        "published tableau with stage positions q₀ ⊕ h·Σaᵢⱼkᵢ (`pin.integrate`), summing "
-        "stage angular velocities that live in different body frames. On hinges and slides "
-        "this is classic RK4 (order 4); on a ball joint the frames rotate between stages and "
-        "the method keeps only order 2 — predicted (a Runge–Kutta method on a Lie group "
-        "without the dexp⁻¹ correction of Munthe-Kaas is second order) and measured in the "
-        "order study. MuJoCo 4.0's own RK4 keeps order 4 on the same ball joint (measured), "
-        "so engine-against-engine RK4 rows are skipped there: the definitions differ."
-    ),
-    SOFT_CONSTRAINT: (
-        "MuJoCo's equality constraints are soft (Computation chapter, soft constraints): the "
-        "constraint force f = −(A + R)⁻¹(J a₀ − a_ref) with A = J M⁻¹ Jᵀ, R = (1 − d)/d · A "
-        "and a_ref = −b ṙ − k d(r) r (b = 2/(dmax τ), k = 1/(dmax² τ² ζ²)), where d(r) is "
-        "the solimp impedance and τ, ζ the solref time constant and damping ratio, read back "
-        "from the loaded model. At zero violation the acceleration is the exact one plus "
-        "(1 − d) of the unconstrained excess and the tension d times the exact tension "
-        "(d = 0.9 by default: 10% low); along a run the cords stretch until k d r balances "
-        "the excess. The reference (`reference/constraints.py`) evaluates this model on the "
-        "free masses; a row is `explained` only when MuJoCo's numbers equal its prediction "
-        "within round-off, amplified by the solver's Hessian condition 1 + d/(1 − d)."
-    ),
-    PRE_ASYMPTOTIC: (
-        "A stiff constraint mode (λ ≈ −1/τ = −50 s⁻¹ for MuJoCo's default τ = 0.02 s) keeps "
-        "RK4 pre-asymptotic over the resolvable steps: the observed order exceeds 4 (4.40, "
-        "4.20, 4.13 as the step halves). Explained only where the reference's own equations "
-        "of the same model, stepped by the same integrator, show the same order at the same "
-        "step; an engine with a wrong integrator would not."
-    ),
-    FREE_VELOCITY_FRAME: (
-        "MuJoCo's free joint keeps the linear velocity in the world frame, Pinocchio's "
-        "free-flyer in the body frame (measured; `dyncheck explain free-body-velocity-frames`). "
-        "Instantaneous quantities cross the difference exactly (v_b = Rᵀ v_w and the "
-        "acceleration term −ω × v_b, in `core/conventions.py`); a fixed-step integrator, "
-        "though, is a different map on each state: semi-implicit Euler on (v_w, ω) and on "
-        "(v_b, ω) agree only to O(h). Drake steps a ball joint's roll-pitch-yaw angles and a "
-        "free joint's quaternion components with ω in world axes — again a different map. "
-        "Such an engine-against-engine row is explained when the difference shrinks at least "
-        "at the integrators' order (each engine is judged against the reference in the order "
-        "study)."
-    ),
-    TRUNCATION: (
-        "A fixed-step integrator's error against the exact solution of the same model. Judged "
-        "by the order study: the error must shrink at the nominal order (1 for `euler` and "
-        "`implicitfast`, 4 for `rk4`) within ±0.1 in the asymptotic range."
-    ),
-}
 
 
 def versions() -> dict[str, str]:
@@ -529,7 +451,8 @@ def index_page(result: RunResult, *, date: str) -> str:
         f"Drake's `runge_kutta3` at ε = {', '.join(f'{e:g}' for e in CONTROLLED_ACCURACIES)} "
         "passes when its global error shrinks in proportion to ε (slope 1 ± "
         f"{ORDER_SLACK}; case pages); `dop853` is scipy's DOP853 on Pinocchio's forward "
-        "dynamics within 4× the reference's error estimate.",
+        "dynamics (on the rotation group in re-centred exponential coordinates) within twice "
+        "the sum of its own and the reference's error estimates.",
         "",
         _md(controlled_matrix(d)),
         "",
@@ -576,7 +499,7 @@ def index_page(result: RunResult, *, date: str) -> str:
         "",
         "### Conventions that explain differences",
         "",
-        *[f"- **{name}**: {CONVENTIONS.get(name, '')}" for name in used],
+        *[f"- **{name}**: {EXPLANATIONS[name].text}" for name in used],
         "",
         "Performance: [benchmark.md](benchmark.md), written by `dyncheck bench`. "
         "Conventions catalogue: [conventions.md](conventions.md). "
@@ -599,8 +522,9 @@ def conventions_page() -> str:
         "",
         "Each entry is run on the installed engines by `dyncheck explain`: the naive "
         "mapping's measured error against the correct one's. The conventions the main run "
-        "measures (point-mass inertia floor, MJCF gravity, held forces, RK4 on the rotation "
-        "group) are explained with their numbers in [README.md](README.md).",
+        "measures (point-mass inertia floor, MJCF gravity, held forces, soft constraints, "
+        "charts, MuJoCo's gyroscopic implicitfast) are explained with their numbers in "
+        "[README.md](README.md).",
         "",
     ]
     return "\n".join(head) + "\n" + render(explain())
@@ -639,31 +563,19 @@ def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Pat
     return files
 
 
-VOLATILE = ("| date (UTC)", "| dyncheck commit")
-"""Provenance lines that change with every run without the results changing."""
+def rendered_text(result: RunResult, out: Path) -> dict[str, str]:
+    """The tables and pages a run writes (figures left out), file name → text."""
+    return {
+        path.name: content
+        for path, content in render(result, out).items()
+        if isinstance(content, str) and path.parent == out
+    }
 
 
-def _stable(content: str | bytes) -> str | bytes:
-    if isinstance(content, bytes):
-        return content
-    return "\n".join(line for line in content.splitlines() if not line.startswith(VOLATILE))
-
-
-def check(result: RunResult, out: Path) -> list[str]:
-    """Files of the committed report that differ from what the code computes now (tables and
-    pages; figures are drawn from the same numbers, and provenance lines that name the date
-    and commit are ignored)."""
-    stale = []
-    for path, content in render(result, out).items():
-        if path.suffix == ".png":
-            continue
-        if not path.exists():
-            stale.append(f"{path} (missing)")
-            continue
-        old = path.read_bytes() if isinstance(content, bytes) else path.read_text()
-        if _stable(old) != _stable(content):
-            stale.append(str(path))
-    return stale
+def check(result: RunResult, out: Path) -> list[Moved]:
+    """What moved between the committed report in ``out`` and what the code computes now,
+    compared on results, not bytes (:mod:`dyncheck.freshness`)."""
+    return compare(read_report(out), rendered_text(result, out))
 
 
 def write(result: RunResult, out: Path, *, date: str | None = None) -> list[Path]:

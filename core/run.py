@@ -47,7 +47,7 @@ def resolve(case_names: Sequence[str], impl_names: Sequence[str]) -> tuple[list[
     """Validate names before any work: UnknownName lists the valid ones."""
     from dyncheck.cases import CASES
 
-    cases = [get_case(n) for n in (case_names or list(CASES))]
+    cases = [get_case(n) for n in dict.fromkeys(case_names or list(CASES))]  # once each
     for name in impl_names:
         if name not in IMPLEMENTATIONS:
             raise UnknownName("implementation", name, IMPLEMENTATIONS)

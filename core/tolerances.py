@@ -60,6 +60,12 @@ def accumulated(steps: int, soft: float = 1.0) -> Tolerance:
     return Tolerance(ROUNDOFF_FACTOR * EPS * steps * soft, basis)
 
 
+def first_near_max(errors: np.ndarray, band: float) -> int:
+    """The first index whose error is within ``band`` (round-off) of the largest: where
+    several errors tie at round-off, the same index on every machine."""
+    return int(np.argmax(errors >= errors.max() - band))
+
+
 ORDER_SLACK = 0.1
 """Observed order must lie within nominal ± this, in the asymptotic range."""
 

@@ -36,7 +36,10 @@ def test_stale_report_is_detected(tmp_path):
     assert report.check(result, tmp_path) == []
     csv = tmp_path / "discrepancies.csv"
     csv.write_text(csv.read_text().replace("passed", "failed", 1))
-    assert report.check(result, tmp_path) == [str(csv)]
+    moved = report.check(result, tmp_path)
+    assert [(m.file, m.field, m.old, m.new) for m in moved] == [
+        ("discrepancies.csv", "verdict", "failed", "passed")
+    ]
 
 
 @dataclass(frozen=True)

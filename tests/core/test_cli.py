@@ -108,6 +108,8 @@ def test_states_option_sweeps_more_states(tmp_path):
                 "reference",
                 "--impl",
                 "pinocchio",
+                "--impl",
+                "mujoco",
                 "--out",
                 str(out),
             ]
@@ -116,8 +118,11 @@ def test_states_option_sweeps_more_states(tmp_path):
     )
     d = pd.read_csv(out / "discrepancies.csv")
     inst = d[d.quantity != "trajectory"]
-    assert inst.worst_state.max() >= 16  # states beyond the default 16 were visited
-    assert (inst.verdict == "passed").all()
+    assert set(inst.verdict) <= {"passed", "explained"}
+    # MuJoCo's inertia floor is a real difference (explained): where it peaks is located, and
+    # it peaks beyond the default 16 states (ties at round-off would all go to state 0)
+    real = inst[inst.verdict == "explained"]
+    assert len(real) and real.worst_state.max() >= 16
 
 
 def test_bad_states_option(tmp_path, capsys):

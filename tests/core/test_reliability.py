@@ -110,7 +110,7 @@ def test_out_below_a_file_is_usage_error(tmp_path, capsys):
     f = tmp_path / "file"
     f.write_text("keep")
     assert main(["run", "simple_pendulum", "--out", str(f / "sub")]) == 2
-    assert "--out must be a directory path" in capsys.readouterr().err
+    assert "--out must be a writable directory (Not a directory)" in capsys.readouterr().err
     assert f.read_text() == "keep"
 
 

@@ -1,0 +1,121 @@
+"""Every label that can explain a row, with its text and its origin — one home.
+
+A difference is ``explained`` only by a property of an engine, of the book or of the
+mathematics, with its predicted size — never by a defect of dyncheck's own code (those are
+fixed). :class:`Origin` says which; ``tests/core/test_explanations.py`` fails if any explained
+row of a run carries a label that is missing here or whose origin is dyncheck itself.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+from dyncheck.implementations import GRAVITY_DEFAULT, POINT_INERTIA, SOFT_CONSTRAINT
+from dyncheck.trajectories import (
+    CHARTS_DIFFER,
+    GYROSCOPIC_IMPLICIT,
+    HELD_FORCE,
+    PRE_ASYMPTOTIC,
+    TRUNCATION,
+)
+
+
+class Origin(Enum):
+    """Whose property a difference is."""
+
+    ENGINE = "engine"
+    """A definition, default or parser behaviour of an engine (documented or measured)."""
+    BOOK = "book"
+    """How the book writes a system (its coordinates, its idealizations)."""
+    MATHEMATICS = "mathematics"
+    """A property of the numerical method or of the equations themselves."""
+    DYNCHECK = "dyncheck"
+    """dyncheck's own code: never a valid explanation (fix the code)."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class Explanation:
+    origin: Origin
+    text: str
+
+
+EXPLANATIONS: dict[str, Explanation] = {
+    POINT_INERTIA: Explanation(
+        origin=Origin.ENGINE,
+        text="MuJoCo's compiler rejects a moving body whose mass or inertia is below mjMINVAL "
+        "(1e-15), so the MJCF gives each of the book's point masses a small isotropic inertia "
+        "(`Multibody.mjcf_point_inertia`). MuJoCo and `pinocchio-mjcf` read it; `pinocchio` "
+        "(built programmatically) holds exact point masses. The reference predicts the "
+        "difference exactly: the general method with ½ I |ω|² added per body (from (2.2.40); "
+        "ω = θ̇ for a pendulum bob with θ absolute, the rotation of the coordinate triad for a "
+        "particle carried by coordinate joints). A row is `explained` only when observed − "
+        "predicted is within round-off.",
+    ),
+    GRAVITY_DEFAULT: Explanation(
+        origin=Origin.ENGINE,
+        text="Pinocchio's MJCF parser (`pin.buildModelFromMJCF`, Pinocchio 4.1) does not read "
+        "`<option gravity>`: the loaded model keeps Pinocchio's default (0, 0, −9.81) m/s² "
+        "whatever the file says (measured: the loaded `model.gravity` is read back). It is "
+        "invisible where the case's gravity is the default and a failure of the model "
+        "elsewhere; the reference predicts it exactly by evaluating the general method with "
+        "the gravity the engine actually holds.",
+    ),
+    HELD_FORCE: Explanation(
+        origin=Origin.ENGINE,
+        text="A state-dependent external force written to MuJoCo's `xfrc_applied` before "
+        "`mj_step` is held over the four RK4 stages; the force then errs by O(h) over a step "
+        "and RK4 drops to order 1 (predicted, and measured in the order study). Evaluating "
+        "the force at every stage (MuJoCo's `mjcb_passive` callback, or the stage function of "
+        "dyncheck's integrators for Pinocchio) restores order 4.",
+    ),
+    SOFT_CONSTRAINT: Explanation(
+        origin=Origin.ENGINE,
+        text="MuJoCo's equality constraints are soft (Computation chapter, soft constraints): "
+        "the constraint force f = −(A + R)⁻¹(J a₀ − a_ref) with A = J M⁻¹ Jᵀ, "
+        "R = (1 − d)/d · A and a_ref = −b ṙ − k d(r) r (b = 2/(dmax τ), "
+        "k = 1/(dmax² τ² ζ²)), where d(r) is the solimp impedance and τ, ζ the solref time "
+        "constant and damping ratio, read back from the loaded model. At zero violation the "
+        "acceleration is the exact one plus (1 − d) of the unconstrained excess and the "
+        "tension d times the exact tension (d = 0.9 by default: 10% low); along a run the "
+        "cords stretch until k d r balances the excess. The reference "
+        "(`reference/constraints.py`) evaluates this model on the free masses; a row is "
+        "`explained` only when MuJoCo's numbers equal its prediction within round-off, "
+        "amplified by the solver's Hessian condition 1 + d/(1 − d).",
+    ),
+    PRE_ASYMPTOTIC: Explanation(
+        origin=Origin.MATHEMATICS,
+        text="A stiff constraint mode (λ ≈ −1/τ = −50 s⁻¹ for MuJoCo's default τ = 0.02 s) "
+        "keeps RK4 pre-asymptotic over the resolvable steps: the observed order exceeds 4 "
+        "(4.40, 4.20, 4.13 as the step halves). Explained only where the reference's own "
+        "equations of the same model, stepped by the same integrator, show the same order at "
+        "the same step; an engine with a wrong integrator would not.",
+    ),
+    CHARTS_DIFFER: Explanation(
+        origin=Origin.ENGINE,
+        text="Drake steps a ball joint's roll-pitch-yaw angles and a free joint's quaternion "
+        "components (ω in world axes); sympy.physics.mechanics models a rotating body in "
+        "generalized coordinates (Example 9's angles) and steps their rates; MuJoCo — and "
+        "dyncheck's integrators for Pinocchio, which are MuJoCo's — apply the exponential "
+        "map to the quaternion. The same fixed-step method in two charts is two different "
+        "maps of the same dynamics: both converge at the method's order p, so they differ by "
+        "O(hᵖ) or less. Explained when the difference shrinks at least at order p (each "
+        "engine is also judged against the reference in the order study).",
+    ),
+    GYROSCOPIC_IMPLICIT: Explanation(
+        origin=Origin.ENGINE,
+        text="Since MuJoCo 3.12 (changelog, commit f0fa3d82) `implicitfast` applies the "
+        "gyroscopic bias-force derivative of a standalone free body through a local solve, so "
+        "on a free joint it is no longer semi-implicit Euler (measured on `rigid_body_free`: "
+        "the two differ by 5.6e-4 rad at h = 2 ms, halving with h). Engines without it (and "
+        "dyncheck's `implicitfast`, which has nothing damped to differentiate) step Euler's "
+        "map; both are order 1, so they differ by O(h): explained when the difference shrinks "
+        "at least at order 1.",
+    ),
+    TRUNCATION: Explanation(
+        origin=Origin.MATHEMATICS,
+        text="A fixed-step integrator's error against the exact solution of the same model. "
+        "Judged by the order study: the error must shrink at the nominal order (1 for `euler` "
+        "and `implicitfast`, 4 for `rk4`) within ±0.1 in the asymptotic range.",
+    ),
+}
