@@ -26,22 +26,30 @@ def baseline_table(discrepancies: pd.DataFrame) -> pd.DataFrame:
     return discrepancies[COLUMNS].sort_values(DISCREPANCY_KEY, kind="stable").reset_index(drop=True)
 
 
+HEADER = "# dyncheck baseline"
+
+
 def write(discrepancies: pd.DataFrame, path: Path, versions: dict[str, str] | None = None) -> None:
-    """The baseline CSV, headed by ``# versions:`` (what made it) so that a later mismatch
-    says whether the code or an engine changed."""
-    head = ""
-    if versions:
-        head = "# versions: " + " ".join(f"{k}={v}" for k, v in versions.items()) + "\n"
-    write_atomic(path, head + to_csv(baseline_table(discrepancies)))
+    """The baseline CSV under a header line naming its row count (a file cut short at a line
+    end is still found truncated) and the versions that made it (so that a later mismatch
+    says whether the code or an engine changed)."""
+    table = baseline_table(discrepancies)
+    items = {"rows": str(len(table)), **(versions or {})}
+    head = HEADER + " " + " ".join(f"{k}={v.replace(' ', '_')}" for k, v in items.items())
+    write_atomic(path, head + "\n" + to_csv(table))
+
+
+def _header(path: Path) -> dict[str, str]:
+    with path.open(encoding="utf-8", errors="replace") as f:
+        first = f.readline()
+    if not first.startswith(HEADER):
+        return {}
+    return dict(item.split("=", 1) for item in first[len(HEADER) :].split() if "=" in item)
 
 
 def versions_of(path: Path) -> dict[str, str]:
-    """The ``# versions:`` header of a baseline (empty when it has none)."""
-    with path.open(encoding="utf-8", errors="replace") as f:
-        first = f.readline()
-    if not first.startswith("# versions: "):
-        return {}
-    return dict(item.split("=", 1) for item in first[12:].split() if "=" in item)
+    """The versions a baseline was made with (empty when its header names none)."""
+    return {k: v for k, v in _header(path).items() if k != "rows"}
 
 
 def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
@@ -81,6 +89,11 @@ def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
             flag,
             str(path),
             f"a finite max_rel_err on every passed or explained row (data row {row})",
+        )
+    expected = _header(path).get("rows")
+    if expected is not None and expected != str(len(frame)):
+        raise InvalidInput(
+            flag, str(path), f"{expected} rows as its header says ({len(frame)} found: truncated?)"
         )
     frame["integrator"] = frame["integrator"].fillna("").astype(str)
     dup = _key(frame).duplicated()
@@ -132,5 +145,6 @@ def compare(
 def version_changes(path: Path, current: dict[str, str]) -> list[str]:
     """Engines and libraries whose version differs from the baseline's header."""
     old = versions_of(path)
-    keys = [k for k in old if k not in ("date (UTC)", "dyncheck commit")]
-    return [f"{k} {old[k]} -> {current.get(k, 'absent')}" for k in keys if old[k] != current.get(k)]
+    keys = [k for k in old if k not in ("date_(UTC)", "dyncheck_commit")]
+    now = {k.replace(" ", "_"): v.replace(" ", "_") for k, v in current.items()}
+    return [f"{k} {old[k]} -> {now.get(k, 'absent')}" for k in keys if old[k] != now.get(k)]

@@ -9,8 +9,10 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from dyncheck.adapters import get_adapter
@@ -21,6 +23,8 @@ from dyncheck.errors import EngineError, InvalidInput
 from dyncheck.run import run
 
 from ..conftest import ENGINES
+
+REPORTS = Path(__file__).resolve().parents[2] / "reports"
 
 Y = (0.0, 1.0, 0.0)
 
@@ -198,3 +202,169 @@ def test_state_at_a_chart_singularity(case, q0, message):
     spec = dataclasses.replace(c.trajectory, q0=q0)
     with pytest.raises(InvalidInput, match=message):
         dataclasses.replace(c, trajectory=spec)
+
+
+# --- issue 23: each found fault, a test that failed before the fix -------------------------
+
+
+def test_bench_memory_sizes_are_validated(tmp_path, capsys):
+    assert main(["bench", "simple_pendulum", "--memory", "-3", "--out", str(tmp_path)]) == 2
+    assert "--memory must be a positive integer, got -3" in capsys.readouterr().err
+
+
+def test_memory_probe_does_not_wait_on_a_dead_child():
+    """The child dies (an unknown case raises in it) before reporting: an error, not a hang."""
+    from dyncheck.bench import peak_memory_kib
+    from dyncheck.errors import EngineError
+
+    with pytest.raises(EngineError, match="died"):
+        peak_memory_kib("no_such_case", 5)
+
+
+def test_missing_engine_costs_only_its_rows(tmp_path):
+    """Pinocchio not importable: its rows are skipped with the pip hint, the rest of the
+    report (the conventions page included) is written, exit 0."""
+    out = tmp_path / "rep"
+    code = (
+        "import sys; sys.modules['pinocchio'] = None\n"
+        "from dyncheck.cli import main\n"
+        f"raise SystemExit(main(['run', 'simple_pendulum', '--out', {str(out)!r}]))"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr
+    d = pd.read_csv(out / "discrepancies.csv")
+    pin = d[d.impl_a.str.startswith("pinocchio") | d.impl_b.str.startswith("pinocchio")]
+    assert len(pin) and (pin.verdict == "skipped").all()
+    assert pin.note.str.contains("pip install pin").all()
+    others = d.drop(pin.index)
+    assert (others.verdict.isin(["passed", "explained"])).all() and len(others)
+    assert "pip install pin" in (out / "conventions.md").read_text()
+
+
+def _baseline_file(tmp_path, edit) -> Path:
+    text = (REPORTS / "baseline.csv").read_text()
+    path = tmp_path / "base.csv"
+    path.write_text(edit(text))
+    return path
+
+
+def _all_nan(text: str) -> str:
+    lines = text.splitlines()
+    head = lines[0].split(",")
+    k = head.index("max_rel_err")
+    rows = [",".join(f if i != k else "nan" for i, f in enumerate(r.split(","))) for r in lines[1:]]
+    return "\n".join([lines[0], *rows]) + "\n"
+
+
+def _headed(text: str) -> str:
+    """The committed baseline rewritten with a row-count header, then cut at a line end."""
+    from dyncheck import baseline
+
+    lines = text.splitlines()
+    body = [ln for ln in lines if not ln.startswith("#")]
+    head = f"{baseline.HEADER} rows={len(body) - 1}"
+    return "\n".join([head, *body[: len(body) // 2]]) + "\n"
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (_all_nan, "finite"),
+        (lambda t: t + t.splitlines()[-1] + "\n", "repeats a key"),
+        (lambda t: t[: len(t) // 2 - 7], "truncated or edited"),
+        (_headed, "truncated?"),
+    ],
+    ids=["nan-errors", "duplicated-row", "truncated-mid-line", "truncated-at-line-end"],
+)
+def test_corrupted_baseline_is_refused_before_any_work(tmp_path, edit, message, capsys):
+    from dyncheck import baseline
+
+    path = _baseline_file(tmp_path, edit)
+    with pytest.raises(InvalidInput, match=message):
+        baseline.load(path)
+    out = tmp_path / "rep"
+    assert main(["run", "simple_pendulum", "--baseline", str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_baseline_folder_and_baseline_out_folder_are_refused(tmp_path, capsys):
+    assert (
+        main(["run", "simple_pendulum", "--baseline", str(tmp_path), "--out", str(tmp_path / "r")])
+        == 2
+    )
+    assert "--baseline must be a baseline CSV file, not a folder" in capsys.readouterr().err
+    assert main(["baseline", "simple_pendulum", "--out", str(tmp_path)]) == 2
+    assert "--out must be a file path, not a folder" in capsys.readouterr().err
+
+
+def test_same_case_twice_runs_once():
+    from dyncheck.run import resolve
+
+    cases, _ = resolve(["simple_pendulum", "simple_pendulum"], [])
+    assert [c.name for c in cases] == ["simple_pendulum"]
+
+
+def test_empty_out_is_refused(capsys):
+    assert main(["run", "simple_pendulum", "--out", ""]) == 2
+    err = capsys.readouterr().err
+    assert "an empty path" in err and len(err.strip().splitlines()) == 1
+
+
+def test_unwritable_out_is_refused_before_any_work(capsys):
+    assert main(["run", "simple_pendulum", "--out", "/proc/dyncheck-nope"]) == 2
+    assert "--out must be a writable directory" in capsys.readouterr().err
+
+
+def test_write_failure_midway_is_one_line(tmp_path, monkeypatch, capsys):
+    """A full disk or a file-size limit while the report is written: one line, exit 2."""
+    import errno
+
+    from dyncheck import report
+
+    def full(*_args, **_kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device", str(tmp_path / "r" / "x.csv"))
+
+    monkeypatch.setattr(report, "write", full)
+    assert (
+        main(
+            [
+                "run",
+                "simple_pendulum",
+                "--impl",
+                "reference",
+                "--impl",
+                "book",
+                "--out",
+                str(tmp_path / "r"),
+            ]
+        )
+        == 2
+    )
+    err = capsys.readouterr().err
+    assert err.startswith("dyncheck: error: cannot write") and "No space left" in err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_interrupt_is_one_line_and_exit_130(tmp_path, monkeypatch, capsys):
+    from dyncheck import run as run_module
+
+    def interrupted(*_args, **_kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(run_module, "run", interrupted)
+    assert main(["run", "simple_pendulum", "--out", str(tmp_path / "r")]) == 130
+    assert capsys.readouterr().err.strip() == "dyncheck: interrupted (nothing half-written)"
+    assert not (tmp_path / "r").exists()
+
+
+def test_absurd_state_count_is_refused(tmp_path, capsys):
+    assert main(["run", "--states", str(10**11), "--out", str(tmp_path / "r")]) == 2
+    assert "--states must be at most" in capsys.readouterr().err
+
+
+def test_unknown_subcommand_is_one_line(capsys):
+    assert main(["frobnicate"]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
