@@ -35,8 +35,12 @@ def write(discrepancies: pd.DataFrame, path: Path, versions: dict[str, str] | No
     says whether the code or an engine changed)."""
     table = baseline_table(discrepancies)
     items = {"rows": str(len(table)), **(versions or {})}
-    head = HEADER + " " + " ".join(f"{k}={v.replace(' ', '_')}" for k, v in items.items())
+    head = HEADER + " " + " ".join(f"{_word(k)}={_word(v)}" for k, v in items.items())
     write_atomic(path, head + "\n" + to_csv(table))
+
+
+def _word(text: str) -> str:
+    return text.replace(" ", "_")
 
 
 def _header(path: Path) -> dict[str, str]:
@@ -146,5 +150,5 @@ def version_changes(path: Path, current: dict[str, str]) -> list[str]:
     """Engines and libraries whose version differs from the baseline's header."""
     old = versions_of(path)
     keys = [k for k in old if k not in ("date_(UTC)", "dyncheck_commit")]
-    now = {k.replace(" ", "_"): v.replace(" ", "_") for k, v in current.items()}
+    now = {_word(k): _word(v) for k, v in current.items()}
     return [f"{k} {old[k]} -> {now.get(k, 'absent')}" for k in keys if old[k] != now.get(k)]
