@@ -94,16 +94,16 @@ def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
             str(path),
             f"a finite max_rel_err on every passed or explained row (data row {row})",
         )
-    expected = _header(path).get("rows")
-    if expected is not None and expected != str(len(frame)):
-        raise InvalidInput(
-            flag, str(path), f"{expected} rows as its header says ({len(frame)} found: truncated?)"
-        )
     frame["integrator"] = frame["integrator"].fillna("").astype(str)
     dup = _key(frame).duplicated()
     if dup.any():
         row = int(np.flatnonzero(dup.to_numpy())[0]) + 1
         raise InvalidInput(flag, str(path), f"one row per key (data row {row} repeats a key)")
+    expected = _header(path).get("rows")
+    if expected is not None and expected != str(len(frame)):
+        raise InvalidInput(
+            flag, str(path), f"{expected} rows as its header says ({len(frame)} found: truncated?)"
+        )
     return frame
 
 

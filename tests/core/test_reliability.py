@@ -250,9 +250,8 @@ def _baseline_file(tmp_path, edit) -> Path:
 
 
 def _all_nan(text: str) -> str:
-    lines = text.splitlines()
-    head = lines[0].split(",")
-    k = head.index("max_rel_err")
+    lines = [ln for ln in text.splitlines() if not ln.startswith("#")]
+    k = lines[0].split(",").index("max_rel_err")
     rows = [",".join(f if i != k else "nan" for i, f in enumerate(r.split(","))) for r in lines[1:]]
     return "\n".join([lines[0], *rows]) + "\n"
 
