@@ -1,0 +1,69 @@
+"""The layers' import rules, read from the source (every import statement, module level or
+inside a function): ``reference/`` uses numpy, scipy, sympy and the standard library only —
+never an engine; ``adapters/`` never sees the reference (nor the comparison layer);
+``cases/`` holds models, not engines; only the comparison layer (``dyncheck/``) sees both."""
+
+from __future__ import annotations
+
+import ast
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+THIRD_PARTY = {"numpy", "scipy", "sympy"}
+ENGINES = {"mujoco", "pinocchio", "pydrake", "mujoco_warp", "jax"}
+
+
+def _imports(path: Path) -> set[str]:
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            names |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names.add(node.module)
+    return names
+
+
+def _modules(folder: str) -> list[Path]:
+    return sorted((ROOT / folder).glob("*.py"))
+
+
+def _top(name: str) -> str:
+    return name.split(".")[0]
+
+
+@pytest.mark.parametrize("path", _modules("reference"), ids=lambda p: p.name)
+def test_reference_imports_numpy_scipy_sympy_only(path):
+    for name in _imports(path):
+        top = _top(name)
+        if name.startswith("dyncheck."):
+            assert name.startswith("dyncheck.reference"), f"{path.name} imports {name}"
+        else:
+            assert top in THIRD_PARTY | sys.stdlib_module_names, f"{path.name} imports {name}"
+
+
+@pytest.mark.parametrize("path", _modules("adapters"), ids=lambda p: p.name)
+def test_adapters_never_import_the_reference_or_the_comparison_layer(path):
+    for name in _imports(path):
+        if name.startswith("dyncheck."):
+            allowed = ("dyncheck.adapters", "dyncheck.cases", "dyncheck.errors")
+            assert name.startswith(allowed), f"{path.name} imports {name}"
+
+
+@pytest.mark.parametrize("path", _modules("cases"), ids=lambda p: p.name)
+def test_cases_import_no_engine_no_adapter_no_reference(path):
+    for name in _imports(path):
+        assert _top(name) not in ENGINES, f"{path.name} imports {name}"
+        if name.startswith("dyncheck."):
+            assert name.startswith(("dyncheck.cases", "dyncheck.errors")), (
+                f"{path.name} imports {name}"
+            )
+
+
+def test_the_rule_reader_sees_function_level_imports(tmp_path):
+    """The check can fail: an import hidden in a function body is found."""
+    module = tmp_path / "m.py"
+    module.write_text("def f():\n    import mujoco\n    from dyncheck.reference import rigid\n")
+    assert _imports(module) == {"mujoco", "dyncheck.reference"}
