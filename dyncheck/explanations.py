@@ -2,7 +2,7 @@
 
 A difference is ``explained`` only by a property of an engine, of the book or of the
 mathematics, with its predicted size — never by a defect of dyncheck's own code (those are
-fixed). :class:`Origin` says which; ``tests/core/test_explanations.py`` fails if any explained
+fixed). :class:`Origin` says which; ``tests/dyncheck/test_explanations.py`` fails if any explained
 row of a run carries a label that is missing here or whose origin is dyncheck itself.
 """
 

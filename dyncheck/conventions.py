@@ -2,13 +2,13 @@
 
 A case's coordinate map produces a canonical engine state: unit quaternions stored
 (w, x, y, z) and a ball joint's angular velocity in the body (local) frame. Each engine then
-differs only in storage order — measured on the installed versions (tests/core/
+differs only in storage order — measured on the installed versions (tests/dyncheck/
 test_conventions.py rotates a body by a known quaternion and reads the result back):
 
 - MuJoCo: ball-joint qpos (w, x, y, z); qvel the angular velocity in the body frame.
 - Pinocchio (``JointModelSpherical``, programmatic or from MJCF): q (x, y, z, w); v the
   angular velocity in the joint's local frame.
-- Free joints (measured likewise, tests/core/test_conventions.py): MuJoCo qpos (p, w, x, y,
+- Free joints (measured likewise, tests/dyncheck/test_conventions.py): MuJoCo qpos (p, w, x, y,
   z), qvel (v, ω) with the linear velocity of the body origin in the *world* frame and ω in
   the body frame; Pinocchio's free-flyer q (p, x, y, z, w), v (v, ω) *both* in the body frame.
   The canonical state is MuJoCo's; for Pinocchio the linear velocity is v_b = Rᵀ v_w, so
