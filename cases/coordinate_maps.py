@@ -117,7 +117,7 @@ class SphericalToCartesian:
         return np.column_stack([hx, hy, hz])
 
 
-def _quat_from_matrix(R: np.ndarray) -> np.ndarray:
+def quat_from_matrix(R: np.ndarray) -> np.ndarray:
     """Unit quaternions (w, x, y, z), w ≥ 0, of rotation matrices (n, 3, 3) (Shepperd's
     method, the branch on the largest of w², x², y², z²)."""
     n = R.shape[0]
@@ -234,7 +234,7 @@ class SphericalPendulumMap:
         return r, r_p, r_t, -r, r_pt, r_tt
 
     def to_engine(self, q: np.ndarray) -> np.ndarray:
-        return _quat_from_matrix(self._rotation(q))
+        return quat_from_matrix(self._rotation(q))
 
     def to_book(self, qe: np.ndarray) -> np.ndarray:
         """(φ, θ) of the bob's direction r̂ = R (0, 0, −1), whatever the spin."""
@@ -289,7 +289,7 @@ class EulerAngleMap:
         return np.swapaxes(r3(psi) @ r1(theta) @ r3(phi), -1, -2)
 
     def to_engine(self, q: np.ndarray) -> np.ndarray:
-        return _quat_from_matrix(self._rotation(q))
+        return quat_from_matrix(self._rotation(q))
 
     def to_book(self, qe: np.ndarray) -> np.ndarray:
         """θ = arccos A₃₃, φ = atan2(A₃₁, −A₃₂), ψ = atan2(A₁₃, A₂₃) with A = ℓᵀ."""

@@ -1,0 +1,129 @@
+"""The engine-neutral description of a loaded model, read back from each engine.
+
+A tree of *joints*: each joint carries the rigid body that moves with it and with no joint
+below it (an engine's fused or welded links lumped in), so that engines which fuse fixed links
+(MuJoCo's URDF compiler, Pinocchio) and engines which keep them (Drake) describe the same
+thing. Where one body carries several joints, its inertia goes to the last of them and the
+others carry none (as Pinocchio models it). Every vector and tensor is in world axes at the
+engine's reference configuration (hinges and slides at 0, ball joints at identity, free joints
+at the pose the file gives), the inertia tensor about the lumped centre of mass (§2.2,
+(2.2.37)–(2.2.38)). The state layout — where a joint's coordinates sit in the engine's q and
+v, quaternion order, the axes of a free joint's velocities — is declared with each joint, so
+that the comparison layer maps states without knowing the engine.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import StrEnum
+
+import numpy as np
+
+
+class JointType(StrEnum):
+    HINGE = "hinge"
+    SLIDE = "slide"
+    BALL = "ball"
+    FREE = "free"
+
+
+class Axes(StrEnum):
+    """The axes a velocity (or a generalized force) is resolved in."""
+
+    WORLD = "world"
+    LOCAL = "local"
+
+
+NQ = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 4, JointType.FREE: 7}
+NV = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 3, JointType.FREE: 6}
+
+
+@dataclass(frozen=True, kw_only=True)
+class Layout:
+    """Where one joint's coordinates sit in an engine's q and v, and in which convention.
+
+    ``quat`` is ``"wxyz"`` or ``"xyzw"``; a free joint's q is ``(p, quat)`` unless
+    ``quat_first``; its v is ``(linear, angular)`` unless ``angular_first``, each resolved in
+    ``linear_axes`` / ``angular_axes``. ``cos_sin``: a hinge stored as (cos θ, sin θ) (an
+    unbounded revolute joint)."""
+
+    q_start: int
+    v_start: int
+    nq: int
+    nv: int
+    quat: str = "wxyz"
+    quat_first: bool = False
+    angular_first: bool = False
+    linear_axes: Axes = Axes.WORLD
+    angular_axes: Axes = Axes.LOCAL
+    cos_sin: bool = False
+    zero: float = 0.0  # hinge, slide: the coordinate's value at the reference configuration
+    placement: np.ndarray = field(default_factory=lambda: np.eye(4))  # free: world ← q's frame
+
+
+@dataclass(frozen=True, kw_only=True)
+class TreeJoint:
+    """One joint and the rigid body it alone moves (world axes, reference configuration)."""
+
+    name: str
+    type: JointType
+    parent: str | None
+    body: str
+    axis: np.ndarray  # unit axis (hinge, slide); zeros otherwise
+    anchor: np.ndarray  # a point on the axis / the ball's centre / the free body's origin
+    frame: np.ndarray  # 3×3 orientation of the joint's child frame (ball, free)
+    mass: float
+    com: np.ndarray
+    inertia: np.ndarray  # about the centre of mass
+    armature: tuple[float, ...]
+    damping: tuple[float, ...]
+    range: tuple[float, float] | None  # (lower, upper) where the joint is limited
+    layout: Layout
+
+
+@dataclass(frozen=True, kw_only=True)
+class ModelTree:
+    """What one engine holds after reading a file."""
+
+    engine: str
+    joints: tuple[TreeJoint, ...]
+    gravity: np.ndarray
+    nq: int
+    nv: int
+    notes: tuple[str, ...] = field(default=())
+
+    def joint(self, name: str) -> TreeJoint:
+        for j in self.joints:
+            if j.name == name:
+                return j
+        raise KeyError(name)
+
+
+def lump(
+    masses: list[float], coms: list[np.ndarray], inertias: list[np.ndarray]
+) -> tuple[float, np.ndarray, np.ndarray]:
+    """Mass, centre of mass and inertia about it of rigidly joined bodies (world axes):
+    the parallel-axis theorem, I = Σ (Iᵢ + mᵢ (|dᵢ|² 1 − dᵢ dᵢᵀ)), dᵢ = cᵢ − c."""
+    mass = float(sum(masses))
+    if mass <= 0.0:
+        return mass, np.zeros(3), sum(inertias, np.zeros((3, 3)))
+    com = sum(m * c for m, c in zip(masses, coms, strict=True)) / mass
+    total = np.zeros((3, 3))
+    for m, c, inertia in zip(masses, coms, inertias, strict=True):
+        d = c - com
+        total += inertia + m * (d @ d * np.eye(3) - np.outer(d, d))
+    return mass, np.asarray(com, float), total
+
+
+@dataclass(frozen=True, kw_only=True)
+class Dynamics:
+    """An engine's smooth dynamics at a batch of states, in its own layout: M (n, nv, nv),
+    h = C v + g (n, nv), forward dynamics at τ = 0 (n, nv), inverse dynamics at the given
+    accelerations (n, nv), kinetic and potential energy (n,)."""
+
+    mass_matrix: np.ndarray
+    bias: np.ndarray
+    forward: np.ndarray
+    inverse: np.ndarray
+    kinetic: np.ndarray
+    potential: np.ndarray

@@ -1,0 +1,195 @@
+"""A user's model in MuJoCo, through MuJoCo's own parsers (MJCF, or its URDF compiler).
+
+Smooth dynamics only: constraints (contacts, limits, equalities), actuation and passive forces
+(springs, dampers) are disabled in ``opt.disableflags``; damping and armature are read back as
+model fields. M = ``mj_fullM`` (armature included), h = ``qfrc_bias``, forward
+dynamics ``qacc`` at zero applied force, inverse ``mj_inverse``, energies ``mjENBL_ENERGY``.
+State layout: a quaternion (w, x, y, z); a free joint q = (p, quat), v = (linear in world
+axes, angular in local axes); a ball joint v = angular velocity in local axes.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from dyncheck.adapters.model_files import Format, ModelFile
+from dyncheck.adapters.model_tree import (
+    NQ,
+    NV,
+    Axes,
+    Dynamics,
+    JointType,
+    Layout,
+    ModelTree,
+    TreeJoint,
+    lump,
+)
+from dyncheck.errors import EngineError
+
+ENGINE = "mujoco"
+_TYPES = {
+    mujoco.mjtJoint.mjJNT_HINGE: JointType.HINGE,
+    mujoco.mjtJoint.mjJNT_SLIDE: JointType.SLIDE,
+    mujoco.mjtJoint.mjJNT_BALL: JointType.BALL,
+    mujoco.mjtJoint.mjJNT_FREE: JointType.FREE,
+}
+_SMOOTH_ONLY = (
+    mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    | mujoco.mjtDisableBit.mjDSBL_ACTUATION
+    | mujoco.mjtDisableBit.mjDSBL_SPRING
+    | mujoco.mjtDisableBit.mjDSBL_DAMPER
+)
+FLOATING_NAME = "root_joint"
+"""The free joint added to a URDF's root link with ``--floating`` (Pinocchio's name)."""
+
+
+def version() -> str:
+    return mujoco.__version__
+
+
+def _compile(source: ModelFile) -> tuple[mujoco.MjModel, tuple[str, ...]]:
+    notes: list[str] = []
+    try:
+        if source.format is Format.MJCF:
+            spec = mujoco.MjSpec.from_file(str(source.path))
+        else:
+            spec = mujoco.MjSpec.from_string(source.text)
+        if source.floating and source.format is Format.URDF:
+            root = spec.worldbody.first_body()
+            root.add_freejoint(name=FLOATING_NAME)
+            notes.append(f"mujoco: free joint {FLOATING_NAME!r} added to root link {root.name!r}")
+        model = spec.compile()
+    except Exception as exc:  # MuJoCo raises ValueError with its compiler's message
+        raise EngineError(f"mujoco refused {source.path}: {str(exc).strip().splitlines()[0]}")
+    return model, tuple(notes)
+
+
+def _joint_body_groups(m: mujoco.MjModel) -> dict[int, list[int]]:
+    """Each body with joints → itself and the joint-less bodies rigidly attached below it."""
+    owner = {0: -1}
+    groups: dict[int, list[int]] = {}
+    for b in range(1, m.nbody):
+        parent = int(m.body_parentid[b])
+        owner[b] = b if m.body_jntnum[b] > 0 else owner[parent]
+        if owner[b] >= 0:
+            groups.setdefault(owner[b], []).append(b)
+    return groups
+
+
+def _layouts(m: mujoco.MjModel) -> list[Layout]:
+    out = []
+    for j in range(m.njnt):
+        kind = _TYPES[int(m.jnt_type[j])]
+        out.append(
+            Layout(
+                q_start=int(m.jnt_qposadr[j]), v_start=int(m.jnt_dofadr[j]),
+                nq=NQ[kind], nv=NV[kind], quat="wxyz", linear_axes=Axes.WORLD,
+                angular_axes=Axes.LOCAL, zero=float(m.qpos0[m.jnt_qposadr[j]]),
+            )
+        )
+    return out
+
+
+class MujocoModel:
+    """A compiled model and its neutral tree."""
+
+    engine = ENGINE
+
+    def __init__(self, source: ModelFile) -> None:
+        self.model, notes = _compile(source)
+        m = self.model
+        m.opt.disableflags |= int(_SMOOTH_ONLY)
+        m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
+        self.data = mujoco.MjData(m)
+        if np.any(m.body_gravcomp != 0):
+            notes += ("mujoco: gravity compensation (gravcomp) left out of the dynamics",)
+        self.tree = self._tree(notes)
+
+    def _tree(self, notes: tuple[str, ...]) -> ModelTree:
+        m, d = self.model, self.data
+        d.qpos[:] = m.qpos0
+        mujoco.mj_kinematics(m, d)
+        groups = _joint_body_groups(m)
+        layouts = _layouts(m)
+        last_joint: dict[int, int] = {}  # body → its last joint
+        joints = []
+        for j in range(m.njnt):
+            b = int(m.jnt_bodyid[j])
+            kind = _TYPES[int(m.jnt_type[j])]
+            first = int(m.body_jntadr[b])
+            if j > first:
+                parent: int | None = j - 1
+            else:
+                a = int(m.body_parentid[b])
+                while a > 0 and a not in last_joint:
+                    a = int(m.body_parentid[a])
+                parent = last_joint.get(a)
+            last_joint[b] = j
+            is_last = j == first + int(m.body_jntnum[b]) - 1
+            if is_last:
+                members = groups[b]
+                mass, com, inertia = lump(
+                    [float(m.body_mass[i]) for i in members],
+                    [d.xipos[i].copy() for i in members],
+                    [
+                        d.ximat[i].reshape(3, 3) @ np.diag(m.body_inertia[i])
+                        @ d.ximat[i].reshape(3, 3).T
+                        for i in members
+                    ],
+                )
+            else:
+                mass, com, inertia = 0.0, np.zeros(3), np.zeros((3, 3))
+            dofs = slice(int(m.jnt_dofadr[j]), int(m.jnt_dofadr[j]) + NV[kind])
+            axis = d.xaxis[j].copy() if kind in (JointType.HINGE, JointType.SLIDE) else np.zeros(3)
+            limited = bool(m.jnt_limited[j]) and kind in (JointType.HINGE, JointType.SLIDE)
+            joints.append(
+                TreeJoint(
+                    name=m.joint(j).name or f"{m.body(b).name}:{kind}",
+                    type=kind,
+                    parent=None if parent is None else (
+                        m.joint(parent).name
+                        or f"{m.body(int(m.jnt_bodyid[parent])).name}:"
+                        f"{_TYPES[int(m.jnt_type[parent])]}"
+                    ),
+                    body=m.body(b).name,
+                    axis=axis,
+                    anchor=d.xanchor[j].copy() if kind is not JointType.FREE else d.xpos[b].copy(),
+                    frame=d.xmat[b].reshape(3, 3).copy(),
+                    mass=mass, com=com, inertia=inertia,
+                    armature=tuple(float(x) for x in m.dof_armature[dofs]),
+                    damping=tuple(float(x) for x in m.dof_damping[dofs]),
+                    range=(float(m.jnt_range[j, 0]), float(m.jnt_range[j, 1])) if limited else None,
+                    layout=layouts[j],
+                )
+            )
+        return ModelTree(
+            engine=ENGINE, joints=tuple(joints), gravity=m.opt.gravity.copy(),
+            nq=m.nq, nv=m.nv, notes=notes,
+        )
+
+    def reference_q(self) -> np.ndarray:
+        return self.model.qpos0.copy()
+
+    def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
+        m, d = self.model, self.data
+        n, nv = len(q), m.nv
+        out = {k: np.empty((n, nv)) for k in ("bias", "forward", "inverse")}
+        mass = np.empty((n, nv, nv))
+        kinetic, potential = np.empty(n), np.empty(n)
+        for i in range(n):
+            d.qpos[:], d.qvel[:] = q[i], v[i]
+            d.qfrc_applied[:] = 0.0
+            mujoco.mj_forward(m, d)
+            mujoco.mj_fullM(m, d, mass[i])
+            out["bias"][i] = d.qfrc_bias
+            out["forward"][i] = d.qacc
+            kinetic[i], potential[i] = d.energy[1], d.energy[0]
+            d.qacc[:] = a[i]
+            mujoco.mj_inverse(m, d)
+            out["inverse"][i] = d.qfrc_inverse
+        result = Dynamics(mass_matrix=mass, kinetic=kinetic, potential=potential, **out)
+        for name, value in vars(result).items():
+            if not np.all(np.isfinite(value)):
+                raise EngineError(f"mujoco returned a non-finite {name}")
+        return result

@@ -1,0 +1,151 @@
+"""A user's model in Pinocchio, through Pinocchio's own parsers (``buildModelFromMJCF``,
+``buildModelFromXML`` for URDF text; ``--floating`` gives the URDF root a
+``JointModelFreeFlyer``, as Pinocchio's users do).
+
+M = ``crba`` (armature included; upper triangle mirrored), h = ``rnea(q, v, 0)``, forward
+dynamics ``aba`` at τ = 0, inverse ``rnea``, ``computeKineticEnergy`` (the bodies' energy:
+armature *not* included), ``computePotentialEnergy``. Pinocchio applies no damping: its
+``model.damping`` is read back as a field only. State layout: quaternions (x, y, z, w); a free
+joint v = (linear, angular), both in local axes; an unbounded revolute joint q = (cos θ, sin θ).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from dyncheck.adapters.model_files import Format, ModelFile
+from dyncheck.adapters.model_tree import (
+    Axes,
+    Dynamics,
+    JointType,
+    Layout,
+    ModelTree,
+    TreeJoint,
+)
+from dyncheck.errors import EngineError, Unsupported
+
+ENGINE = "pinocchio"
+_HINGE = ("JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned")
+_HINGE_UNBOUNDED = (
+    "JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned",
+)
+_SLIDE = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned")
+
+
+def version() -> str:
+    return pin.__version__
+
+
+def _type(shortname: str) -> JointType:
+    if shortname in _HINGE or shortname in _HINGE_UNBOUNDED:
+        return JointType.HINGE
+    if shortname in _SLIDE:
+        return JointType.SLIDE
+    if shortname == "JointModelSpherical":
+        return JointType.BALL
+    if shortname == "JointModelFreeFlyer":
+        return JointType.FREE
+    raise Unsupported(f"pinocchio joint type {shortname} is not checked")
+
+
+def _load(source: ModelFile) -> pin.Model:
+    try:
+        if source.format is Format.MJCF:
+            return pin.buildModelFromMJCF(str(source.path))
+        if source.floating:
+            return pin.buildModelFromXML(source.text, pin.JointModelFreeFlyer())
+        return pin.buildModelFromXML(source.text)
+    except Exception as exc:
+        message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise EngineError(f"pinocchio refused {source.path}: {message}")
+
+
+class PinocchioModel:
+    """A Pinocchio model and its neutral tree."""
+
+    engine = ENGINE
+
+    def __init__(self, source: ModelFile) -> None:
+        self.model = _load(source)
+        self.data = self.model.createData()
+        notes = ()
+        if source.floating and source.format is Format.URDF:
+            notes = ("pinocchio: JointModelFreeFlyer 'root_joint' at the URDF root",)
+        self.tree = self._tree(notes)
+
+    def _tree(self, notes: tuple[str, ...]) -> ModelTree:
+        m, d = self.model, self.data
+        q0 = pin.neutral(m)
+        pin.forwardKinematics(m, d, q0)
+        joints = []
+        for i in range(1, m.njoints):
+            jm = m.joints[i]
+            short = jm.shortname()
+            kind = _type(short)
+            placement = d.oMi[i]
+            rotation, origin = placement.rotation, placement.translation
+            subspace = np.asarray(d.joints[i].S).reshape(6, -1)
+            if kind is JointType.HINGE:
+                axis = rotation @ subspace[3:, 0]
+            elif kind is JointType.SLIDE:
+                axis = rotation @ subspace[:3, 0]
+            else:
+                axis = np.zeros(3)
+            inertia = m.inertias[i]
+            dofs = slice(jm.idx_v, jm.idx_v + jm.nv)
+            lower, upper = m.lowerPositionLimit[jm.idx_q], m.upperPositionLimit[jm.idx_q]
+            limited = (
+                kind in (JointType.HINGE, JointType.SLIDE) and jm.nq == 1
+                and np.isfinite(lower) and np.isfinite(upper)
+                and abs(lower) < 1e10 and abs(upper) < 1e10  # Pinocchio's "no limit" is ±max
+            )
+            parent = int(m.parents[i])
+            joints.append(
+                TreeJoint(
+                    name=m.names[i], type=kind,
+                    parent=None if parent == 0 else m.names[parent],
+                    body=m.names[i],
+                    axis=np.asarray(axis, float), anchor=origin.copy(), frame=rotation.copy(),
+                    mass=float(inertia.mass),
+                    com=placement.act(inertia.lever).copy(),
+                    inertia=rotation @ inertia.inertia @ rotation.T,
+                    armature=tuple(float(x) for x in m.armature[dofs]),
+                    damping=tuple(float(x) for x in m.damping[dofs]),
+                    range=(float(lower), float(upper)) if limited else None,
+                    layout=Layout(
+                        q_start=jm.idx_q, v_start=jm.idx_v, nq=jm.nq, nv=jm.nv, quat="xyzw",
+                        linear_axes=Axes.LOCAL, angular_axes=Axes.LOCAL,
+                        cos_sin=short in _HINGE_UNBOUNDED,
+                        placement=np.asarray(m.jointPlacements[i].homogeneous, float),
+                    ),
+                )
+            )
+        return ModelTree(
+            engine=ENGINE, joints=tuple(joints), gravity=np.asarray(m.gravity.linear, float),
+            nq=m.nq, nv=m.nv, notes=notes,
+        )
+
+    def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
+        m, d = self.model, self.data
+        n, nv = len(q), m.nv
+        mass = np.empty((n, nv, nv))
+        bias, forward, inverse = (np.empty((n, nv)) for _ in range(3))
+        kinetic, potential = np.empty(n), np.empty(n)
+        zero = np.zeros(nv)
+        for i in range(n):
+            upper = pin.crba(m, d, q[i])
+            mass[i] = np.triu(upper) + np.triu(upper, 1).T
+            bias[i] = pin.rnea(m, d, q[i], v[i], zero)
+            forward[i] = pin.aba(m, d, q[i], v[i], zero)
+            inverse[i] = pin.rnea(m, d, q[i], v[i], a[i])
+            kinetic[i] = pin.computeKineticEnergy(m, d, q[i], v[i])
+            potential[i] = pin.computePotentialEnergy(m, d, q[i])
+        result = Dynamics(
+            mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
+            kinetic=kinetic, potential=potential,
+        )
+        for name, value in vars(result).items():
+            if not np.all(np.isfinite(value)):
+                raise EngineError(f"pinocchio returned a non-finite {name}")
+        return result

@@ -1,0 +1,133 @@
+"""Canonical states ↔ an engine's own layout, joint by joint, matched by name.
+
+The canonical layout is MuJoCo's convention in the canonical joint order: a hinge or slide its
+coordinate; a quaternion (w, x, y, z); a free joint q = (p, quat) as the world pose of its body,
+v = (linear velocity in world axes, angular velocity in local axes); a ball joint v = angular
+velocity in local axes. Each engine declares its own (:class:`~dyncheck.adapters.model_tree.Layout`).
+
+Velocities map linearly, v_e = T(q) v_c, with T orthogonal (a permutation of the joints'
+blocks, and on a free joint's blocks R or Rᵀ or 1), so that — the kinetic energy and the power
+τ·v being invariant — M_c = Tᵀ M_e T, τ_c = Tᵀ τ_e, and accelerations a_e = T a_c + Ṫ v_c, with
+Ṫ v_c = −ω × (Rᵀ v_w) on a free joint's linear velocity held in local axes (the only block
+whose T depends on q: d(Rᵀ)/dt = −ω̂ Rᵀ, ω in local axes).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from dyncheck.adapters.model_tree import NQ, NV, Axes, Dynamics, JointType, ModelTree, TreeJoint
+from dyncheck.cases.coordinate_maps import quat_from_matrix, quat_to_matrix
+
+
+@dataclass(frozen=True, kw_only=True)
+class Canonical:
+    """The canonical joint order and where each joint's coordinates sit in it."""
+
+    names: tuple[str, ...]
+    types: tuple[JointType, ...]
+    q_start: tuple[int, ...]
+    v_start: tuple[int, ...]
+    nq: int
+    nv: int
+
+
+def canonical(tree: ModelTree) -> Canonical:
+    q_start, v_start, nq, nv = [], [], 0, 0
+    for j in tree.joints:
+        q_start.append(nq)
+        v_start.append(nv)
+        nq, nv = nq + NQ[j.type], nv + NV[j.type]
+    return Canonical(
+        names=tuple(j.name for j in tree.joints), types=tuple(j.type for j in tree.joints),
+        q_start=tuple(q_start), v_start=tuple(v_start), nq=nq, nv=nv,
+    )
+
+
+def _quat_out(quat_wxyz: np.ndarray, order: str) -> np.ndarray:
+    return quat_wxyz if order == "wxyz" else np.concatenate([quat_wxyz[1:], quat_wxyz[:1]])
+
+
+def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    w1, v1, w2, v2 = a[0], a[1:], b[0], b[1:]
+    return np.concatenate([[w1 * w2 - v1 @ v2], w1 * v2 + w2 * v1 + np.cross(v1, v2)])
+
+
+@dataclass(frozen=True)
+class StateMap:
+    """One state's map: the engine's q, and T, Ṫ v_c for the velocities."""
+
+    q: np.ndarray
+    t: np.ndarray
+    tdot_v: np.ndarray
+
+
+def state_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray, v_c: np.ndarray) -> StateMap:
+    q_e = np.zeros(tree.nq)
+    t = np.zeros((tree.nv, canon.nv))
+    tdot_v = np.zeros(tree.nv)
+    for name, kind, qs, vs in zip(
+        canon.names, canon.types, canon.q_start, canon.v_start, strict=True
+    ):
+        joint: TreeJoint = tree.joint(name)
+        lay = joint.layout
+        qe, ve = lay.q_start, lay.v_start
+        if kind in (JointType.HINGE, JointType.SLIDE):
+            value = q_c[qs]
+            if lay.cos_sin:
+                q_e[qe : qe + 2] = np.cos(value), np.sin(value)
+            else:
+                q_e[qe] = value
+            t[ve, vs] = 1.0
+        elif kind is JointType.BALL:
+            q_e[qe : qe + 4] = _quat_out(q_c[qs : qs + 4], lay.quat)
+            t[ve : ve + 3, vs : vs + 3] = np.eye(3)
+        else:
+            p_w, quat_w = q_c[qs : qs + 3], q_c[qs + 3 : qs + 7]
+            place_r, place_p = lay.placement[:3, :3], lay.placement[:3, 3]
+            p_e = place_r.T @ (p_w - place_p)
+            quat_e = _quat_mul(quat_from_matrix(place_r.T[None])[0], quat_w)
+            quat_e = _quat_out(quat_e, lay.quat)
+            q_e[qe : qe + 7] = (
+                np.concatenate([quat_e, p_e]) if lay.quat_first else np.concatenate([p_e, quat_e])
+            )
+            rot = quat_to_matrix(quat_w[None])[0]
+            lin_rows = slice(ve + 3, ve + 6) if lay.angular_first else slice(ve, ve + 3)
+            ang_rows = slice(ve, ve + 3) if lay.angular_first else slice(ve + 3, ve + 6)
+            v_lin, omega = v_c[vs : vs + 3], v_c[vs + 3 : vs + 6]
+            if lay.linear_axes is Axes.LOCAL:
+                t[lin_rows, vs : vs + 3] = rot.T
+                tdot_v[lin_rows] = -np.cross(omega, rot.T @ v_lin)
+            else:
+                t[lin_rows, vs : vs + 3] = np.eye(3)
+            t[ang_rows, vs + 3 : vs + 6] = rot if lay.angular_axes is Axes.WORLD else np.eye(3)
+    return StateMap(q=q_e, t=t, tdot_v=tdot_v)
+
+
+def engine_states(
+    canon: Canonical, tree: ModelTree, q: np.ndarray, v: np.ndarray, a: np.ndarray
+) -> tuple[list[StateMap], np.ndarray, np.ndarray, np.ndarray]:
+    """The batch in the engine's layout: maps, q_e, v_e, a_e."""
+    maps = [state_map(canon, tree, qi, vi) for qi, vi in zip(q, v, strict=True)]
+    q_e = np.array([s.q for s in maps])
+    v_e = np.array([s.t @ vi for s, vi in zip(maps, v, strict=True)])
+    a_e = np.array([s.t @ ai + s.tdot_v for s, ai in zip(maps, a, strict=True)])
+    return maps, q_e, v_e, a_e
+
+
+def to_canonical(maps: list[StateMap], dyn: Dynamics) -> Dynamics:
+    """An engine's dynamics in the canonical layout (see the module's docstring)."""
+    mass, bias, forward, inverse = [], [], [], []
+    for s, m_e, h_e, a_e, tau_e in zip(
+        maps, dyn.mass_matrix, dyn.bias, dyn.forward, dyn.inverse, strict=True
+    ):
+        mass.append(s.t.T @ m_e @ s.t)
+        bias.append(s.t.T @ (h_e + m_e @ s.tdot_v))
+        forward.append(s.t.T @ (a_e - s.tdot_v))
+        inverse.append(s.t.T @ tau_e)
+    return Dynamics(
+        mass_matrix=np.array(mass), bias=np.array(bias), forward=np.array(forward),
+        inverse=np.array(inverse), kinetic=dyn.kinetic, potential=dyn.potential,
+    )
