@@ -109,6 +109,9 @@ class MujocoModel:
     def _tree(self, notes: tuple[str, ...]) -> ModelTree:
         m, d = self.model, self.data
         d.qpos[:] = m.qpos0
+        for j in range(m.njnt):  # free bodies at the reference pose: the origin, unrotated
+            if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE:
+                d.qpos[m.jnt_qposadr[j] : m.jnt_qposadr[j] + 7] = (0, 0, 0, 1, 0, 0, 0)
         mujoco.mj_kinematics(m, d)
         groups = _joint_body_groups(m)
         layouts = _layouts(m)

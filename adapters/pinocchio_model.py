@@ -76,7 +76,13 @@ class PinocchioModel:
 
     def _tree(self, notes: tuple[str, ...]) -> ModelTree:
         m, d = self.model, self.data
-        q0 = pin.neutral(m)
+        configurations = {c.key(): c.data() for c in m.referenceConfigurations}
+        # MJCF: the file's pose (a joint's ``ref`` included) is Pinocchio's "qpos0".
+        q0 = np.array(configurations.get("qpos0", pin.neutral(m)), float)
+        for i in range(1, m.njoints):  # free bodies at the reference pose: origin, unrotated
+            if m.joints[i].shortname() == "JointModelFreeFlyer":
+                place = m.jointPlacements[i]
+                q0[m.joints[i].idx_q : m.joints[i].idx_q + 7] = pin.SE3ToXYZQUAT(place.inverse())
         pin.forwardKinematics(m, d, q0)
         joints = []
         for i in range(1, m.njoints):
@@ -117,6 +123,7 @@ class PinocchioModel:
                         q_start=jm.idx_q, v_start=jm.idx_v, nq=jm.nq, nv=jm.nv, quat="xyzw",
                         linear_axes=Axes.LOCAL, angular_axes=Axes.LOCAL,
                         cos_sin=short in _HINGE_UNBOUNDED,
+                        zero=float(q0[jm.idx_q]) if jm.nq == 1 else 0.0,
                         placement=np.asarray(m.jointPlacements[i].homogeneous, float),
                     ),
                 )

@@ -112,6 +112,14 @@ class TreeDynamics:
         self.v_start = np.cumsum([0] + [NV[b.kind] for b in bodies])[:-1]
         self.nv = int(sum(NV[b.kind] for b in bodies))
         self.armature = np.concatenate([np.asarray(b.armature, float) for b in bodies])
+        chains: list[list[int]] = []
+        for j, b in enumerate(bodies):
+            chains.append([*(chains[b.parent] if b.parent >= 0 else []), j])
+        self.ancestor_columns = [
+            np.concatenate([np.arange(self.v_start[i], self.v_start[i] + NV[bodies[i].kind])
+                            for i in chain])
+            for chain in chains
+        ]
 
     def _kinematics(
         self, q: np.ndarray, x: np.ndarray
@@ -185,31 +193,34 @@ class TreeDynamics:
         dg = np.zeros((nv, nv, nv))  # dg[k] = ∂_k g
         dv = np.zeros(nv)
         potential = 0.0
+        # All joints' columns at once: angular (B, 3, nv) with their pivots, linear (B, 3, nv).
+        angular = np.zeros((nv + 1, 3, nv), complex)
+        pivots = np.zeros((nv + 1, 3, nv), complex)
+        linear = np.zeros((nv + 1, 3, nv), complex)
+        for joint_columns in columns:
+            for span, w, pivot in joint_columns:
+                if pivot is None:
+                    linear[:, :, span] = w
+                else:
+                    angular[:, :, span] = w
+                    pivots[:, :, span] = pivot[:, :, None]
         for b, body in enumerate(self.bodies):
             if body.mass == 0.0 and not np.any(body.inertia):
                 continue
-            cols = np.concatenate(
-                [np.arange(nv)[c] for j in ancestors[b] for c, _, _ in columns[j]]
-            )
+            cols = self.ancestor_columns[b]
             rows = np.append(cols, nv)
-            position = {int(c): i for i, c in enumerate(cols)}
-            k = len(cols)
             r, t = rot[b][rows], trans[b][rows]
             c = np.einsum("bij,j->bi", r, body.com) + t
-            jc = np.zeros((len(rows), 3, k), complex)
-            jw = np.zeros((len(rows), 3, k), complex)
-            for j in ancestors[b]:
-                for span, w, pivot in columns[j]:
-                    local = slice(position[span.start], position[span.start] + span.stop
-                                  - span.start)
-                    ws = w[rows]
-                    if pivot is None:  # translation
-                        jc[:, :, local] = ws
-                    else:  # rotation about the pivot: ω × (c − p)
-                        jw[:, :, local] = ws
-                        jc[:, :, local] = np.cross(
-                            ws, (c - pivot[rows])[:, :, None], axisa=1, axisb=1, axisc=1
-                        )
+            jw = angular[np.ix_(rows, range(3), cols)]
+            arm = c[:, :, None] - pivots[np.ix_(rows, range(3), cols)]
+            jc = linear[np.ix_(rows, range(3), cols)] + np.stack(  # ω × (c − p)
+                [
+                    jw[:, 1] * arm[:, 2] - jw[:, 2] * arm[:, 1],
+                    jw[:, 2] * arm[:, 0] - jw[:, 0] * arm[:, 2],
+                    jw[:, 0] * arm[:, 1] - jw[:, 1] * arm[:, 0],
+                ],
+                1,
+            )
             inertia = r @ body.inertia @ np.swapaxes(r, 1, 2)
             gb = body.mass * np.swapaxes(jc, 1, 2) @ jc + np.swapaxes(jw, 1, 2) @ inertia @ jw
             mass[np.ix_(cols, cols)] += gb[-1].real

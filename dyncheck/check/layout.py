@@ -22,6 +22,10 @@ from dyncheck.adapters.model_tree import NQ, NV, Axes, Dynamics, JointType, Mode
 from dyncheck.cases.coordinate_maps import quat_from_matrix, quat_to_matrix
 
 
+def tree_zero(canon: Canonical, name: str) -> float:
+    return canon.zeros[canon.names.index(name)]
+
+
 @dataclass(frozen=True, kw_only=True)
 class Canonical:
     """The canonical joint order and where each joint's coordinates sit in it."""
@@ -32,6 +36,7 @@ class Canonical:
     v_start: tuple[int, ...]
     nq: int
     nv: int
+    zeros: tuple[float, ...]  # a hinge's or slide's coordinate at the reference configuration
 
 
 def canonical(tree: ModelTree) -> Canonical:
@@ -43,6 +48,7 @@ def canonical(tree: ModelTree) -> Canonical:
     return Canonical(
         names=tuple(j.name for j in tree.joints), types=tuple(j.type for j in tree.joints),
         q_start=tuple(q_start), v_start=tuple(v_start), nq=nq, nv=nv,
+        zeros=tuple(j.layout.zero for j in tree.joints),
     )
 
 
@@ -75,7 +81,7 @@ def state_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray, v_c: np.ndarra
         lay = joint.layout
         qe, ve = lay.q_start, lay.v_start
         if kind in (JointType.HINGE, JointType.SLIDE):
-            value = q_c[qs]
+            value = q_c[qs] - tree_zero(canon, name) + lay.zero
             if lay.cos_sin:
                 q_e[qe : qe + 2] = np.cos(value), np.sin(value)
             else:

@@ -1,0 +1,177 @@
+"""Step 3 and 4 of a model check: what each engine read (the neutral trees compared field by
+field, joints matched by name) and whether it is physically possible (§2.2: the inertia
+tensor (2.2.39) of real matter is positive semi-definite and its principal moments obey the
+triangle inequality, Iₐ + I_b ≥ I_c, because each is a sum of m (r² − rᵢ²) ≥ 0 terms).
+
+Tolerances: every field is the file's numbers carried through a chain of rigid transforms
+(one per joint and fused link above it), so two parsers of the same text differ by round-off
+growing with the chain: 64 ε × the tree's depth, relative to the field's scale (the body's
+mass; the model's size for positions; the larger inertia, or m·size², for inertia tensors).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+
+from dyncheck.adapters.model_tree import JointType, ModelTree, TreeJoint
+from dyncheck.check.rows import CheckRow, Section, Verdict
+
+EPS = float(np.finfo(float).eps)
+ROUNDOFF = 64
+
+
+def depth(tree: ModelTree) -> int:
+    """The number of joints on the longest chain from the world."""
+    level: dict[str | None, int] = {None: 0}
+    for j in tree.joints:  # parents come first in every engine's order
+        level[j.name] = level.get(j.parent, 0) + 1
+    return max(level.values())
+
+
+def size(tree: ModelTree) -> float:
+    """The model's length scale: the largest distance of a joint or centre of mass from the
+    origin (at least 1 mm)."""
+    points = [j.anchor for j in tree.joints] + [j.com for j in tree.joints if j.mass > 0]
+    return max([1e-3, *(float(np.linalg.norm(p)) for p in points)])
+
+
+def _fmt(value: object) -> str:
+    if isinstance(value, np.ndarray):
+        return np.array2string(value, precision=6, separator=" ", max_line_width=10**6)
+    if isinstance(value, float):
+        return f"{value:.9g}"
+    return str(value)
+
+
+def _compare(a: TreeJoint, b: TreeJoint, length: float) -> Iterator[tuple[str, object, object,
+                                                                           float, float]]:
+    """(field, value_a, value_b, error, scale) for every numeric field of a joint."""
+    if a.type in (JointType.HINGE, JointType.SLIDE):
+        yield "axis", a.axis, b.axis, float(np.abs(a.axis - b.axis).max()), 1.0
+    if a.type is JointType.HINGE:  # any point of the axis line: distance of b's from a's line
+        off = float(np.linalg.norm(np.cross(b.anchor - a.anchor, a.axis)))
+        yield "anchor", a.anchor, b.anchor, off, length
+    elif a.type in (JointType.BALL, JointType.FREE):
+        yield "anchor", a.anchor, b.anchor, float(np.abs(a.anchor - b.anchor).max()), length
+    mass_scale = max(a.mass, b.mass, 1e-300)
+    yield "mass", a.mass, b.mass, abs(a.mass - b.mass), mass_scale
+    if max(a.mass, b.mass) > 0:
+        yield "com", a.com, b.com, float(np.abs(a.com - b.com).max()), length
+    inertia_scale = max(
+        float(np.abs(a.inertia).max()), float(np.abs(b.inertia).max()),
+        mass_scale * length**2 * 1e-6, 1e-300,
+    )
+    yield "inertia", a.inertia, b.inertia, float(np.abs(a.inertia - b.inertia).max()), \
+        inertia_scale
+    for name in ("armature", "damping"):
+        va, vb = np.asarray(getattr(a, name)), np.asarray(getattr(b, name))
+        scale = max(float(np.abs(va).max(initial=0)), float(np.abs(vb).max(initial=0)), 1e-300)
+        yield name, va, vb, float(np.abs(va - vb).max(initial=0)), scale
+
+
+def diff(model: str, a: ModelTree, b: ModelTree) -> list[CheckRow]:
+    """Every difference between two engines' trees (one row each), or one passed row."""
+    rtol = ROUNDOFF * EPS * max(depth(a), depth(b))
+    basis = f"round-off: {ROUNDOFF} eps x tree depth {max(depth(a), depth(b))}"
+    length = size(a)
+    rows: list[CheckRow] = []
+
+    def row(subject: str, field: str, va: object, vb: object, err: float, tol: float,
+            verdict: Verdict, note: str = "") -> None:
+        rows.append(
+            CheckRow(
+                model=model, section=Section.DESCRIPTION, subject=subject, field=field,
+                impl_a=a.engine, impl_b=b.engine, value_a=_fmt(va), value_b=_fmt(vb),
+                error=err, tolerance=tol, basis=basis if tol else "", verdict=verdict, note=note,
+            )
+        )
+
+    names_a, names_b = [j.name for j in a.joints], [j.name for j in b.joints]
+    for name in names_a:
+        if name not in names_b:
+            row(name, "joint", "present", "absent", np.inf, 0.0, Verdict.FAILED,
+                f"{b.engine} has no joint {name!r}")
+    for name in names_b:
+        if name not in names_a:
+            row(name, "joint", "absent", "present", np.inf, 0.0, Verdict.FAILED,
+                f"{a.engine} has no joint {name!r}")
+    compared = 0
+    for ja in a.joints:
+        if ja.name not in names_b:
+            continue
+        jb = b.joint(ja.name)
+        if ja.type is not jb.type:
+            row(ja.name, "type", ja.type, jb.type, np.inf, 0.0, Verdict.FAILED)
+            continue
+        if ja.parent != jb.parent:
+            row(ja.name, "parent", ja.parent, jb.parent, np.inf, 0.0, Verdict.FAILED)
+        if (ja.range is None) != (jb.range is None) or (
+            ja.range is not None and jb.range is not None
+            and np.abs(np.subtract(ja.range, jb.range)).max() > rtol * max(1.0, *map(abs, ja.range))
+        ):
+            row(ja.name, "range", ja.range, jb.range, np.inf, 0.0, Verdict.FAILED,
+                "joint limits read differently (the dynamics leave limits out; states are "
+                f"sampled within {a.engine}'s)")
+        for field, va, vb, err, scale in _compare(ja, jb, length):
+            compared += 1
+            if err > rtol * scale:
+                row(ja.name, field, va, vb, err / scale, rtol, Verdict.FAILED,
+                    f"{a.engine} and {b.engine} read {ja.name!r} ({ja.body}) differently")
+    gravity_err = float(np.abs(a.gravity - b.gravity).max())
+    if gravity_err > rtol * max(1.0, float(np.abs(a.gravity).max())):
+        row("model", "gravity", a.gravity, b.gravity, gravity_err, rtol, Verdict.FAILED)
+    if names_a != names_b and set(names_a) == set(names_b):
+        row("model", "joint order", " ".join(names_a), " ".join(names_b), 0.0, 0.0,
+            Verdict.PASSED, "the engines order the joints differently; matched by name")
+    if not any(r.verdict is Verdict.FAILED for r in rows):
+        row("model", "all fields", f"{len(a.joints)} joints", f"{len(b.joints)} joints", 0.0,
+            rtol, Verdict.PASSED, f"{compared} fields agree to round-off")
+    return rows
+
+
+def validity(model: str, tree: ModelTree) -> list[CheckRow]:
+    """Positive mass, positive semi-definite inertia, triangle inequality — for every rigid
+    group an engine holds (a failed row per violation, else one passed row per check)."""
+    failures: dict[str, list[CheckRow]] = {"mass": [], "inertia": [], "triangle": []}
+    checked = 0
+
+    def fail(joint: TreeJoint, field: str, value: object, err: float, tol: float,
+             note: str) -> None:
+        failures[field].append(
+            CheckRow(
+                model=model, section=Section.VALIDITY, subject=joint.body, field=field,
+                impl_a=tree.engine, impl_b="", value_a=_fmt(value), value_b="", error=err,
+                tolerance=tol, basis=f"round-off: {ROUNDOFF} eps x trace(I)" if tol else "",
+                verdict=Verdict.FAILED, note=note,
+            )
+        )
+
+    for j in tree.joints:
+        if j.mass == 0.0 and not np.any(j.inertia):
+            continue  # a massless link between joints
+        checked += 1
+        if not j.mass > 0.0:
+            fail(j, "mass", j.mass, abs(j.mass), 0.0,
+                 f"joint {j.name!r} moves a body of mass {j.mass:g} (must be > 0)")
+        moments = np.linalg.eigvalsh(0.5 * (j.inertia + j.inertia.T))
+        tol = ROUNDOFF * EPS * max(float(np.abs(moments).sum()), 1e-300)
+        if moments[0] < -tol:
+            fail(j, "inertia", moments, -moments[0], tol,
+                 f"principal moments {_fmt(moments)}: not positive semi-definite (2.2.39)")
+        elif moments[0] + moments[1] < moments[2] - tol:
+            fail(j, "triangle", moments, moments[2] - moments[0] - moments[1], tol,
+                 f"principal moments {_fmt(moments)} break I1 + I2 >= I3 (2.2.39)")
+    rows: list[CheckRow] = []
+    for field, found in failures.items():
+        rows.extend(found)
+        if not found:
+            rows.append(
+                CheckRow(
+                    model=model, section=Section.VALIDITY, subject="model", field=field,
+                    impl_a=tree.engine, impl_b="", value_a=f"{checked} bodies", value_b="",
+                    error=0.0, tolerance=0.0, basis="", verdict=Verdict.PASSED, note="",
+                )
+            )
+    return rows

@@ -1,0 +1,121 @@
+"""What ``dyncheck check`` is given, validated before any engine runs: every fault is one line
+naming the file (and the element, line or engine where known)."""
+
+from __future__ import annotations
+
+import importlib.metadata
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from dyncheck.errors import InvalidInput, UnknownName
+
+URDF_JOINTS = ("revolute", "continuous", "prismatic", "fixed")
+"""The URDF joint types every engine here reads alike (``floating`` and ``planar`` are not:
+Pinocchio's parser maps them, MuJoCo's refuses or changes them)."""
+MAX_STATES = 100_000
+ROBOTS_EXTRA = "example-robot-data"
+
+
+class ModelFileError(InvalidInput):
+    """A model file that cannot be checked: one line naming the file."""
+
+    def __init__(self, path: Path | str, problem: str) -> None:
+        self.field, self.value, self.expected = "model", str(path), problem
+        Exception.__init__(self, f"{path}: {problem}")
+
+
+def model_path(text: str) -> Path:
+    """An existing, readable MJCF (``<mujoco>``) or URDF (``<robot>``) file."""
+    path = Path(text)
+    if not path.exists():
+        raise ModelFileError(path, "no such file")
+    if not path.is_file():
+        raise ModelFileError(path, "not a file")
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ModelFileError(path, f"cannot be read ({exc.strerror})") from None
+    try:
+        root = ET.fromstring(raw)
+    except ET.ParseError as exc:
+        line, column = exc.position
+        raise ModelFileError(path, f"not XML (line {line}, column {column})") from None
+    if root.tag == "robot":
+        _check_urdf(path, root)
+    elif root.tag != "mujoco":
+        raise ModelFileError(path, f"root element <{root.tag}> is neither <mujoco> nor <robot>")
+    return path
+
+
+def _check_urdf(path: Path, root: ET.Element) -> None:
+    for joint in root.iter("joint"):
+        kind = joint.get("type", "")
+        if kind not in URDF_JOINTS:
+            raise ModelFileError(
+                path,
+                f"joint {joint.get('name')!r} has type {kind!r}, which is not checked "
+                f"(checked: {', '.join(URDF_JOINTS)})",
+            )
+    for mesh in root.iter("mesh"):
+        name = mesh.get("filename", "")
+        target = _mesh_file(path, name)
+        if target is not None and not target.is_file():
+            raise ModelFileError(path, f"mesh {name!r} not found (looked for {target})")
+
+
+def _mesh_file(urdf: Path, name: str) -> Path | None:
+    """The file a mesh reference names, where it can be resolved: relative or absolute paths,
+    ``file://``, and ``package://NAME/...`` when a folder NAME is an ancestor of the URDF."""
+    if name.startswith("file://"):
+        return Path(name[len("file://") :])
+    if name.startswith("package://"):
+        package, _, rest = name[len("package://") :].partition("/")
+        for ancestor in urdf.resolve().parents:
+            if ancestor.name == package:
+                return ancestor / rest
+        return None
+    return urdf.parent / name if not Path(name).is_absolute() else Path(name)
+
+
+def states(value: int) -> int:
+    if not 1 <= value <= MAX_STATES:
+        raise InvalidInput("--states", value, f"an integer in [1, {MAX_STATES}]")
+    return value
+
+
+def robots_folder() -> Path | None:
+    """example-robot-data's ``robots`` folder, or None when the ``robots`` extra is absent."""
+    try:
+        dist = importlib.metadata.distribution(ROBOTS_EXTRA)
+    except importlib.metadata.PackageNotFoundError:
+        return None
+    folder = Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data/robots")))
+    return folder if folder.is_dir() else None
+
+
+def robots() -> dict[str, Path]:
+    """Every URDF of example-robot-data by name: the file's stem, or ``folder/stem`` where
+    two folders hold the same stem."""
+    folder = robots_folder()
+    if folder is None:
+        return {}
+    files = sorted(folder.rglob("*.urdf"))
+    stems: dict[str, int] = {}
+    for f in files:
+        stems[f.stem] = stems.get(f.stem, 0) + 1
+    out = {}
+    for f in files:
+        top = f.relative_to(folder).parts[0].removesuffix("_description")
+        out[f.stem if stems[f.stem] == 1 else f"{top}/{f.stem}"] = f
+    return out
+
+
+def robot(name: str) -> Path:
+    available = robots()
+    if not available:
+        raise InvalidInput(
+            "--robot", name, "a robot of example-robot-data: pip install 'dyncheck[robots]'"
+        )
+    if name not in available:
+        raise UnknownName("robot", name, available)
+    return available[name]

@@ -1,0 +1,206 @@
+"""``check_model``: do the engines read a user's MJCF or URDF alike, is what they read
+physically possible, and do they compute the same smooth dynamics — with the book's general
+method (:mod:`dyncheck.reference.tree`) as the referee.
+
+Usable from a user's own test suite::
+
+    from dyncheck import check_model
+
+    def test_my_robot():
+        result = check_model("robot.urdf", floating=True)
+        assert result.ok, result.failures()
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from dyncheck.adapters.model_files import ModelFile, read
+from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.check import describe, inputs, layout
+from dyncheck.check.dynamics import Explanation, compare, sample
+from dyncheck.check.engines import ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded, load
+from dyncheck.check.referee import ReferenceModel
+from dyncheck.check.rows import COLUMNS, CheckRow, Section, Verdict
+from dyncheck.errors import InvalidInput, UnknownName
+
+SMOOTH_NOTE = (
+    "smooth dynamics only: contacts, joint limits, equality constraints, actuators and passive "
+    "forces (springs, damping) are left out of M, h, forward and inverse dynamics; damping and "
+    "armature are compared as fields of the model"
+)
+KINETIC_WITHOUT_ARMATURE = {"pinocchio"}
+"""Engines whose kinetic-energy function sums the bodies' energy only (no rotor inertia),
+while their M includes the armature: T differs by ½ Σ aᵢ vᵢ² (measured, Pinocchio 4)."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class CheckResult:
+    """The rows of one model's check (a DataFrame, :data:`~dyncheck.check.rows.COLUMNS`)."""
+
+    model: str
+    path: Path
+    rows: pd.DataFrame
+    notes: tuple[str, ...]
+    seconds: dict[str, float] = field(default_factory=dict)
+    states: int = 0
+
+    @property
+    def ok(self) -> bool:
+        return not (self.rows["verdict"] == Verdict.FAILED).any()
+
+    def failures(self) -> str:
+        failed = self.rows[self.rows["verdict"] == Verdict.FAILED]
+        return "\n".join(
+            f"{r.section} {r.subject} {r.field} {r.impl_a}/{r.impl_b}: {r.value_a} vs "
+            f"{r.value_b} (error {r.error:.3g}) {r.note}"
+            for r in failed.itertuples()
+        )
+
+
+def _impls(impls: tuple[str, ...] | None) -> tuple[str, ...]:
+    if impls is None:
+        return IMPLEMENTATIONS
+    for name in impls:
+        if name not in IMPLEMENTATIONS:
+            raise UnknownName("implementation", name, IMPLEMENTATIONS)
+    return tuple(dict.fromkeys(impls))
+
+
+def _row(model: str, section: Section, engine: str, verdict: Verdict, note: str,
+         subject: str = "model", field: str = "load") -> CheckRow:
+    return CheckRow(
+        model=model, section=section, subject=subject, field=field, impl_a=engine, impl_b="",
+        value_a="", value_b="", error=0.0, tolerance=0.0, basis="", verdict=verdict, note=note,
+    )
+
+
+def check_model(
+    path: str | Path,
+    *,
+    impls: tuple[str, ...] | None = None,
+    states: int = 100,
+    seed: int = 0,
+    floating: bool = False,
+    against: str | Path | None = None,
+    name: str | None = None,
+) -> CheckResult:
+    """Check one model file (see the module's docstring); bad input raises
+    :class:`~dyncheck.errors.InvalidInput` before any engine runs."""
+    source_path = inputs.model_path(str(path))
+    against_path = inputs.model_path(str(against)) if against is not None else None
+    inputs.states(states)
+    chosen = _impls(impls)
+    if not any(i in ENGINES for i in chosen):
+        raise InvalidInput("--impl", ",".join(chosen), "at least one engine (the referee "
+                           "checks an engine's tree)")
+    model = name or source_path.stem
+    source = read(source_path, floating=floating)
+    rows: list[CheckRow] = []
+    notes = list(source.notes) + [SMOOTH_NOTE]
+    seconds: dict[str, float] = {}
+    loaded = {}
+    for engine in (i for i in chosen if i in ENGINES):
+        t0 = time.perf_counter()
+        result = load(engine, source)
+        seconds[engine] = time.perf_counter() - t0
+        if isinstance(result, NotLoaded):
+            verdict = Verdict.SKIPPED if result.missing else Verdict.FAILED
+            rows.append(_row(model, Section.LOAD, engine, verdict, result.message))
+            if engine == "mujoco" and not result.missing and source.format.value == "mjcf":
+                raise inputs.ModelFileError(source_path, result.message)
+            continue
+        loaded[engine] = result
+        notes.extend(result.tree.notes)
+        rows.append(_row(model, Section.LOAD, engine, Verdict.PASSED,
+                         f"nq={result.tree.nq} nv={result.tree.nv}"))
+    if not loaded:
+        raise inputs.ModelFileError(
+            source_path, "no engine could load it: " + "; ".join(r.note for r in rows)
+        )
+    first = next(iter(loaded.values()))
+    canonical_tree: ModelTree = first.tree
+    if canonical_tree.nv == 0:
+        raise inputs.ModelFileError(source_path, "has no degrees of freedom (nothing moves)")
+    notes.append(
+        f"canonical layout and joint order: {first.engine}'s; the reference reads "
+        f"{first.engine}'s tree"
+    )
+    # Step 3: what each engine read; step 4: is it physically possible.
+    differing: dict[str, str] = {}
+    for engine, m in loaded.items():
+        rows.extend(describe.validity(model, m.tree))
+        if m is first:
+            continue
+        found = describe.diff(model, canonical_tree, m.tree)
+        rows.extend(found)
+        fields = sorted({r.field for r in found if r.verdict is Verdict.FAILED})
+        if fields:
+            differing[engine] = ", ".join(fields)
+    if against_path is not None:
+        rows.extend(_against(model, canonical_tree, read(against_path, floating=floating)))
+    # Step 5 and 6: dynamics at the same states, every pair.
+    canon = layout.canonical(canonical_tree)
+    unmatched = [e for e, m in loaded.items()
+                 if {j.name for j in m.tree.joints} != set(canon.names)
+                 or any(m.tree.joint(n).type is not t for n, t in zip(canon.names, canon.types,
+                                                                      strict=True))]
+    batch = sample(canon, canonical_tree, states, seed)
+    results = {}
+    if REFEREE in chosen:
+        t0 = time.perf_counter()
+        results[REFEREE] = ReferenceModel(canonical_tree).dynamics(batch.q, batch.v, batch.a)
+        seconds[REFEREE] = time.perf_counter() - t0
+    for engine, m in loaded.items():
+        if engine in unmatched:
+            rows.append(_row(model, Section.DYNAMICS, engine, Verdict.SKIPPED,
+                             "its joints do not match the canonical engine's (description rows)",
+                             field="dynamics"))
+            continue
+        t0 = time.perf_counter()
+        maps, q_e, v_e, a_e = layout.engine_states(canon, m.tree, batch.q, batch.v, batch.a)
+        try:
+            results[engine] = layout.to_canonical(maps, m.dynamics(q_e, v_e, a_e))
+        except Exception as exc:  # an engine failing mid-way costs its own rows
+            rows.append(_row(model, Section.DYNAMICS, engine, Verdict.FAILED,
+                             f"{type(exc).__name__}: {exc}", field="dynamics"))
+        seconds[engine] = seconds.get(engine, 0.0) + time.perf_counter() - t0
+    armature = np.concatenate([np.asarray(j.armature) for j in canonical_tree.joints])
+    rotor = 0.5 * np.einsum("i,ni,ni->n", armature, batch.v, batch.v)
+    order = list(results)
+    for i, a in enumerate(order):
+        for b in order[i + 1 :]:
+            explanations = {}
+            if (a in KINETIC_WITHOUT_ARMATURE) != (b in KINETIC_WITHOUT_ARMATURE):
+                explanations["kinetic_energy"] = Explanation(
+                    rotor, "the rotor inertia's energy ½ Σ aᵢ vᵢ² is in M but not in "
+                    f"{a if a in KINETIC_WITHOUT_ARMATURE else b}'s kinetic energy "
+                    "(computeKineticEnergy sums the bodies)",
+                )
+            cause = ", ".join(differing[e] for e in (a, b) if e in differing)
+            rows.extend(compare(model, canonical_tree, a, results[a], b, results[b],
+                                explanations, cause))
+    frame = pd.DataFrame([vars(r) for r in rows], columns=COLUMNS)
+    for column in ("section", "verdict"):
+        frame[column] = frame[column].astype(str)
+    return CheckResult(model=model, path=source_path, rows=frame, notes=tuple(notes),
+                       seconds=seconds, states=states)
+
+
+def _against(model: str, mine: ModelTree, other: ModelFile) -> list[CheckRow]:
+    """The description diff against another file (the previous version of the model), both
+    read by the same engine."""
+    from dyncheck.adapters.mujoco_model import MujocoModel
+
+    theirs = MujocoModel(other).tree
+    label = f"against:{other.path.name}"
+    renamed = ModelTree(engine=label, joints=theirs.joints, gravity=theirs.gravity,
+                        nq=theirs.nq, nv=theirs.nv)
+    mine_renamed = ModelTree(engine=f"{mine.engine}:{model}", joints=mine.joints,
+                             gravity=mine.gravity, nq=mine.nq, nv=mine.nv)
+    return describe.diff(model, renamed, mine_renamed)
