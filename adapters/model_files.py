@@ -46,3 +46,39 @@ def read(path: Path, *, floating: bool = False) -> ModelFile:
         path=path, format=Format.MJCF, text=path.read_text(encoding="utf-8"),
         floating=floating, notes=(),
     )
+
+
+@dataclass(frozen=True, kw_only=True)
+class Inertial:
+    """A link's ``<inertial>`` as the URDF file states it (mass, inertia about the centre of
+    mass in the inertial frame)."""
+
+    link: str
+    mass: float
+    inertia: tuple[tuple[float, float, float], ...]
+
+
+def urdf_inertials(source: ModelFile) -> list[Inertial]:
+    """Every URDF link's stated inertial (none for MJCF: MuJoCo's compiler validates those)."""
+    if source.format is not Format.URDF:
+        return []
+    out = []
+    for link in ET.fromstring(source.text).findall("link"):
+        inertial = link.find("inertial")
+        if inertial is None:
+            continue
+        mass_el, inertia_el = inertial.find("mass"), inertial.find("inertia")
+        mass = float(mass_el.get("value", "0")) if mass_el is not None else 0.0
+        e = {k: float(inertia_el.get(k, "0")) if inertia_el is not None else 0.0
+             for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+        out.append(
+            Inertial(
+                link=link.get("name", ""), mass=mass,
+                inertia=(
+                    (e["ixx"], e["ixy"], e["ixz"]),
+                    (e["ixy"], e["iyy"], e["iyz"]),
+                    (e["ixz"], e["iyz"], e["izz"]),
+                ),
+            )
+        )
+    return out

@@ -131,47 +131,55 @@ def diff(model: str, a: ModelTree, b: ModelTree) -> list[CheckRow]:
     return rows
 
 
-def validity(model: str, tree: ModelTree) -> list[CheckRow]:
-    """Positive mass, positive semi-definite inertia, triangle inequality — for every rigid
-    group an engine holds (a failed row per violation, else one passed row per check)."""
-    failures: dict[str, list[CheckRow]] = {"mass": [], "inertia": [], "triangle": []}
-    checked = 0
+def _violation(mass: float, inertia: np.ndarray) -> tuple[str, object, float, float, str] | None:
+    """(field, value, error, tolerance, note) of the first violated condition, or None."""
+    if not mass > 0.0:
+        return "mass", mass, abs(mass), 0.0, f"mass {mass:g} (must be > 0)"
+    moments = np.linalg.eigvalsh(0.5 * (inertia + inertia.T))
+    tol = ROUNDOFF * EPS * max(float(np.abs(moments).sum()), 1e-300)
+    if moments[0] < -tol:
+        return ("inertia", moments, -float(moments[0]), tol,
+                f"principal moments {_fmt(moments)}: not positive semi-definite (2.2.39)")
+    if moments[0] + moments[1] < moments[2] - tol:
+        return ("triangle", moments, float(moments[2] - moments[0] - moments[1]), tol,
+                f"principal moments {_fmt(moments)} break I1 + I2 >= I3 (2.2.39)")
+    return None
 
-    def fail(joint: TreeJoint, field: str, value: object, err: float, tol: float,
-             note: str) -> None:
-        failures[field].append(
-            CheckRow(
-                model=model, section=Section.VALIDITY, subject=joint.body, field=field,
-                impl_a=tree.engine, impl_b="", value_a=_fmt(value), value_b="", error=err,
-                tolerance=tol, basis=f"round-off: {ROUNDOFF} eps x trace(I)" if tol else "",
-                verdict=Verdict.FAILED, note=note,
-            )
-        )
 
-    for j in tree.joints:
-        if j.mass == 0.0 and not np.any(j.inertia):
-            continue  # a massless link between joints
-        checked += 1
-        if not j.mass > 0.0:
-            fail(j, "mass", j.mass, abs(j.mass), 0.0,
-                 f"joint {j.name!r} moves a body of mass {j.mass:g} (must be > 0)")
-        moments = np.linalg.eigvalsh(0.5 * (j.inertia + j.inertia.T))
-        tol = ROUNDOFF * EPS * max(float(np.abs(moments).sum()), 1e-300)
-        if moments[0] < -tol:
-            fail(j, "inertia", moments, -moments[0], tol,
-                 f"principal moments {_fmt(moments)}: not positive semi-definite (2.2.39)")
-        elif moments[0] + moments[1] < moments[2] - tol:
-            fail(j, "triangle", moments, moments[2] - moments[0] - moments[1], tol,
-                 f"principal moments {_fmt(moments)} break I1 + I2 >= I3 (2.2.39)")
+def validity(model: str, holder: str, bodies: list[tuple[str, float, np.ndarray]]) -> list[CheckRow]:
+    """Positive mass, positive semi-definite inertia, triangle inequality for each
+    ``(name, mass, inertia)`` an engine holds (its rigid groups) or the file states (a URDF's
+    links): a failed row per violation, else one passed row. Massless, inertia-less links
+    (frames) are not bodies and are skipped."""
     rows: list[CheckRow] = []
-    for field, found in failures.items():
-        rows.extend(found)
-        if not found:
+    checked = 0
+    for name, mass, inertia in bodies:
+        if mass == 0.0 and not np.any(inertia):
+            continue
+        checked += 1
+        found = _violation(mass, inertia)
+        if found is not None:
+            field, value, err, tol, note = found
             rows.append(
                 CheckRow(
-                    model=model, section=Section.VALIDITY, subject="model", field=field,
-                    impl_a=tree.engine, impl_b="", value_a=f"{checked} bodies", value_b="",
-                    error=0.0, tolerance=0.0, basis="", verdict=Verdict.PASSED, note="",
+                    model=model, section=Section.VALIDITY, subject=name, field=field,
+                    impl_a=holder, impl_b="", value_a=_fmt(value), value_b="", error=err,
+                    tolerance=tol, basis=f"round-off: {ROUNDOFF} eps x trace(I)" if tol else "",
+                    verdict=Verdict.FAILED, note=note,
                 )
             )
+    if not rows:
+        rows.append(
+            CheckRow(
+                model=model, section=Section.VALIDITY, subject="model",
+                field="mass, inertia, triangle", impl_a=holder, impl_b="",
+                value_a=f"{checked} bodies", value_b="", error=0.0, tolerance=0.0, basis="",
+                verdict=Verdict.PASSED, note="positive mass, positive semi-definite inertia, "
+                "triangle inequality",
+            )
+        )
     return rows
+
+
+def tree_bodies(tree: ModelTree) -> list[tuple[str, float, np.ndarray]]:
+    return [(j.body, j.mass, j.inertia) for j in tree.joints]

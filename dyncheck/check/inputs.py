@@ -48,7 +48,7 @@ def model_path(text: str) -> Path:
 
 
 def _check_urdf(path: Path, root: ET.Element) -> None:
-    for joint in root.iter("joint"):
+    for joint in root.findall("joint"):  # not <transmission>'s <joint> references
         kind = joint.get("type", "")
         if kind not in URDF_JOINTS:
             raise ModelFileError(
@@ -69,7 +69,7 @@ def _mesh_file(urdf: Path, name: str) -> Path | None:
     if name.startswith("file://"):
         return Path(name[len("file://") :])
     if name.startswith("package://"):
-        package, _, rest = name[len("package://") :].partition("/")
+        package, _, rest = name[len("package://") :].lstrip("/").partition("/")
         for ancestor in urdf.resolve().parents:
             if ancestor.name == package:
                 return ancestor / rest

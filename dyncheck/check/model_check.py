@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from dyncheck.adapters.model_files import ModelFile, read
+from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials
 from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.check import describe, inputs, layout
 from dyncheck.check.dynamics import Explanation, compare, sample
@@ -132,9 +132,13 @@ def check_model(
         f"{first.engine}'s tree"
     )
     # Step 3: what each engine read; step 4: is it physically possible.
+    stated = urdf_inertials(source)
+    if stated:
+        rows.extend(describe.validity(model, "file", [
+            (i.link, i.mass, np.array(i.inertia)) for i in stated]))
     differing: dict[str, str] = {}
     for engine, m in loaded.items():
-        rows.extend(describe.validity(model, m.tree))
+        rows.extend(describe.validity(model, engine, describe.tree_bodies(m.tree)))
         if m is first:
             continue
         found = describe.diff(model, canonical_tree, m.tree)
