@@ -61,7 +61,7 @@ def _compile(source: ModelFile) -> tuple[mujoco.MjModel, tuple[str, ...]]:
             notes.append(f"mujoco: free joint {FLOATING_NAME!r} added to root link {root.name!r}")
         model = spec.compile()
     except Exception as exc:  # MuJoCo raises ValueError with its compiler's message
-        raise EngineError(f"mujoco refused {source.path}: {str(exc).strip().splitlines()[0]}")
+        raise EngineError(f"mujoco refused {source.path}: {' '.join(str(exc).split())}")
     return model, tuple(notes)
 
 

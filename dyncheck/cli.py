@@ -1,5 +1,5 @@
-"""The ``dyncheck`` command line: ``list``, ``run``, ``report``, ``explain``, ``baseline`` and
-``bench``.
+"""The ``dyncheck`` command line: ``list``, ``run``, ``check``, ``report``, ``explain``,
+``baseline`` and ``bench``.
 
 Exit status: 0 when nothing failed unexplained, 1 when a check failed (or regressed against a
 baseline, or the committed report is stale), 2 for bad usage or bad input (a one-line message
@@ -72,6 +72,19 @@ def _parser() -> argparse.ArgumentParser:
         metavar="FILE",
         help="report every row that regressed against this baseline (exit 1)",
     )
+    k = sub.add_parser("check", help="do the engines read and simulate YOUR model alike?")
+    k.add_argument("paths", nargs="*", type=_path, metavar="PATH", help="MJCF (.xml) or URDF")
+    k.add_argument("--robot", action="append", default=[], metavar="NAME",
+                   help="a robot of example-robot-data (extra 'robots'; see `dyncheck list`)")
+    k.add_argument("--impl", action="append", default=[], metavar="NAME",
+                   help="reference, mujoco, pinocchio, drake (repeatable; default: all)")
+    k.add_argument("--states", type=int, default=100, metavar="N", help="sampled states")
+    k.add_argument("--seed", type=int, default=0, metavar="S")
+    k.add_argument("--floating", action="store_true",
+                   help="a URDF's root link is a free body (a free joint in every engine)")
+    k.add_argument("--against", type=_path, default=None, metavar="PATH",
+                   help="also compare what MuJoCo reads with this other file (a previous version)")
+    k.add_argument("--out", type=_path, default=Path("reports/check"), help="output folder")
     c = sub.add_parser("report", help="check that the committed report matches the code")
     c.add_argument(
         "--check",
@@ -135,6 +148,15 @@ def _list() -> int:
         else:
             what = "dyncheck.reference (general method, (2.2.23)-(2.2.26))"
         print(f"  {name:24s} {what}")
+    from dyncheck.check.inputs import robots
+
+    found = robots()
+    if found:
+        print(f"robots (example-robot-data, for `dyncheck check --robot NAME`): {len(found)}")
+        for name, path in found.items():
+            print(f"  {name:32s} {path.name}")
+    else:
+        print("robots: the 'robots' extra is not installed (pip install 'dyncheck[robots]')")
     return 0
 
 
@@ -275,8 +297,40 @@ def _explain(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check(args: argparse.Namespace) -> int:
+    from dyncheck.check import inputs
+    from dyncheck.check.model_check import check_model
+    from dyncheck.check.page import summary_line, write
+
+    targets = [(str(p), None) for p in args.paths]
+    targets += [(str(inputs.robot(name)), name) for name in args.robot]
+    if not targets:
+        raise InvalidInput("PATH", "", "at least one model file or --robot NAME")
+    for text, _ in targets:  # every input validated before any engine runs
+        inputs.model_path(text)
+    if args.against is not None:
+        inputs.model_path(str(args.against))
+    inputs.states(args.states)
+    if args.seed < 0:
+        raise InvalidInput("--seed", args.seed, "a non-negative integer")
+    _check_out(args.out)
+    failed = False
+    for text, robot in targets:
+        result = check_model(
+            text, impls=tuple(args.impl) or None, states=args.states, seed=args.seed,
+            floating=args.floating, against=args.against, name=robot,
+        )
+        written = write(result, args.out)
+        print(f"{summary_line(result)} -> {written[1]}")
+        if not result.ok:
+            failed = True
+            print(result.failures())
+    return 1 if failed else 0
+
+
 COMMANDS = {
     "run": _run,
+    "check": _check,
     "report": _report,
     "baseline": _baseline,
     "bench": _bench,

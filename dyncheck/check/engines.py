@@ -11,7 +11,7 @@ import numpy as np
 
 from dyncheck.adapters.model_files import ModelFile
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
-from dyncheck.errors import DyncheckError
+from dyncheck.errors import DyncheckError, Unsupported
 
 
 class ModelEngine(Protocol):
@@ -41,10 +41,11 @@ IMPLEMENTATIONS = (REFEREE, *ENGINES)
 
 @dataclass(frozen=True)
 class NotLoaded:
-    """Why an engine has no model: ``missing`` (not installed) or ``refused`` (its message)."""
+    """Why an engine has no model: not installed or cannot represent the model (``skip``:
+    a skipped row naming why), or it refused the file or failed (a failed row, its message)."""
 
     engine: str
-    missing: bool
+    skip: bool
     message: str
 
 
@@ -56,7 +57,10 @@ def load(name: str, source: ModelFile) -> ModelEngine | NotLoaded:
         return NotLoaded(name, True, f"needs the '{spec.extra}' extra ({exc.name} not installed)")
     try:
         return getattr(module, spec.cls)(source)  # type: ignore[no-any-return]
+    except Unsupported as exc:
+        return NotLoaded(name, True, str(exc))
     except DyncheckError as exc:
         return NotLoaded(name, False, str(exc))
     except Exception as exc:  # an engine's own failure: its message, on its own rows
-        return NotLoaded(name, False, f"{name} failed: {type(exc).__name__}: {exc}")
+        message = " ".join(str(exc).split())
+        return NotLoaded(name, False, f"{name} failed: {type(exc).__name__}: {message}")

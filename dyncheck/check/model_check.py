@@ -14,14 +14,14 @@ Usable from a user's own test suite::
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials
-from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.adapters.model_tree import JointType, ModelTree
 from dyncheck.check import describe, inputs, layout
 from dyncheck.check.dynamics import Explanation, compare, sample
 from dyncheck.check.engines import ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded, load
@@ -110,11 +110,15 @@ def check_model(
         result = load(engine, source)
         seconds[engine] = time.perf_counter() - t0
         if isinstance(result, NotLoaded):
-            verdict = Verdict.SKIPPED if result.missing else Verdict.FAILED
+            verdict = Verdict.SKIPPED if result.skip else Verdict.FAILED
             rows.append(_row(model, Section.LOAD, engine, verdict, result.message))
-            if engine == "mujoco" and not result.missing and source.format.value == "mjcf":
+            if engine == "mujoco" and not result.skip and source.format.value == "mjcf":
                 raise inputs.ModelFileError(source_path, result.message)
             continue
+        if loaded:
+            result.tree, renamed = _align_free_joints(next(iter(loaded.values())).tree,
+                                                      result.tree)
+            notes.extend(renamed)
         loaded[engine] = result
         notes.extend(result.tree.notes)
         rows.append(_row(model, Section.LOAD, engine, Verdict.PASSED,
@@ -194,6 +198,29 @@ def check_model(
         frame[column] = frame[column].astype(str)
     return CheckResult(model=model, path=source_path, rows=frame, notes=tuple(notes),
                        seconds=seconds, states=states)
+
+
+def _align_free_joints(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree, list[str]]:
+    """Free joints matched by their body where an engine names them otherwise (Drake names an
+    MJCF ``<freejoint>`` after its body)."""
+    names = {j.name for j in tree.joints}
+    by_body = {j.body: j.name for j in canonical.joints if j.type is JointType.FREE}
+    renames = {
+        j.name: by_body[j.body] for j in tree.joints
+        if j.type is JointType.FREE and j.name not in {c.name for c in canonical.joints}
+        and j.body in by_body and by_body[j.body] not in names
+    }
+    if not renames:
+        return tree, []
+    joints = tuple(
+        replace(j, name=renames.get(j.name, j.name),
+                parent=renames.get(j.parent, j.parent) if j.parent else None)
+        for j in tree.joints
+    )
+    notes = [f"{tree.engine}: free joint {old!r} (body {old_body!r}) matched to {new!r} by its "
+             "body" for old, new, old_body in
+             ((o, n, tree.joint(o).body) for o, n in renames.items())]
+    return replace(tree, joints=joints), notes
 
 
 def _against(model: str, mine: ModelTree, other: ModelFile) -> list[CheckRow]:

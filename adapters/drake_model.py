@@ -1,0 +1,197 @@
+"""A user's model in Drake (optional extra ``drake``), through Drake's own parsers, in a
+continuous-time ``MultibodyPlant``.
+
+Drake keeps a URDF's fixed links as welded bodies (lumped here into the moving body they are
+welded to) and leaves a URDF's root link floating unless welded: the root is welded to the
+world, or with ``--floating`` given a ``QuaternionFloatingJoint`` named ``root_joint``. Drake
+names the floating joint of an MJCF ``<freejoint>`` after its body. Joint damping is read back
+as a field, then zeroed before ``Finalize`` (Drake applies it in every dynamics call; the check
+compares damping-free dynamics in every engine). Drake has no joint armature (rotor inertia
+belongs to its actuators). M = ``CalcMassMatrix``, h = ``CalcBiasTerm`` −
+``CalcGravityGeneralizedForces``, forward dynamics the plant's generalized-acceleration
+output, inverse ``CalcInverseDynamics`` with gravity from ``CalcForceElementsContribution``.
+State layout: a floating joint q = (w, x, y, z, p), v = (ω, v), both in world axes. A ball
+joint is a ``BallRpyJoint`` (roll-pitch-yaw coordinates): not mapped here (its rows skipped).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import BodyIndex, MultibodyForces, QuaternionFloatingJoint
+
+from dyncheck.adapters.model_files import Format, ModelFile
+from dyncheck.adapters.model_tree import (
+    Axes,
+    Dynamics,
+    JointType,
+    Layout,
+    ModelTree,
+    TreeJoint,
+    lump,
+)
+from dyncheck.errors import EngineError, Unsupported
+
+ENGINE = "drake"
+_TYPES = {
+    "revolute": JointType.HINGE,
+    "prismatic": JointType.SLIDE,
+    "quaternion_floating": JointType.FREE,
+}
+
+
+def version() -> str:
+    from importlib.metadata import version as _version
+
+    return _version("drake")
+
+
+def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str, tuple]]:
+    plant = MultibodyPlant(0.0)
+    notes: list[str] = []
+    try:
+        if source.format is Format.MJCF:
+            Parser(plant).AddModels(str(source.path))
+        else:
+            Parser(plant).AddModelsFromString(source.text, "urdf")
+    except Exception as exc:
+        raise EngineError(f"drake refused {source.path}: {' '.join(str(exc).split())}")
+    if source.format is Format.URDF:
+        root = _urdf_root(plant)
+        if source.floating:
+            plant.AddJoint(QuaternionFloatingJoint("root_joint", plant.world_frame(),
+                                                   root.body_frame()))
+            notes.append("drake: QuaternionFloatingJoint 'root_joint' at the URDF root")
+        else:
+            plant.WeldFrames(plant.world_frame(), root.body_frame())
+    damping = {}
+    for index in plant.GetJointIndices():
+        joint = plant.get_joint(index)
+        if joint.num_velocities() > 0:
+            damping[joint.name()] = tuple(float(x) for x in joint.default_damping_vector())
+            joint.set_default_damping_vector(np.zeros(joint.num_velocities()))
+    plant.Finalize()
+    return plant, tuple(notes), damping
+
+
+def _urdf_root(plant: MultibodyPlant):
+    """The link no joint points to (URDF: exactly one)."""
+    children = {plant.get_joint(i).child_body().index() for i in plant.GetJointIndices()}
+    candidates = [
+        plant.get_body(BodyIndex(b)) for b in range(1, plant.num_bodies())
+        if BodyIndex(b) not in children
+    ]
+    if len(candidates) != 1:
+        raise EngineError(f"drake: expected one URDF root link, found {len(candidates)}")
+    return candidates[0]
+
+
+class DrakeModel:
+    """A Drake plant and its neutral tree."""
+
+    engine = ENGINE
+
+    def __init__(self, source: ModelFile) -> None:
+        self.plant, notes, self._damping = _plant(source)
+        self.context = self.plant.CreateDefaultContext()
+        actuation = self.plant.get_actuation_input_port()
+        if self.plant.num_actuated_dofs() > 0:
+            actuation.FixValue(self.context, np.zeros(self.plant.num_actuated_dofs()))
+        self._acc = self.plant.get_generalized_acceleration_output_port()
+        self.tree = self._tree(notes)
+
+    def _tree(self, notes: tuple[str, ...]) -> ModelTree:
+        plant, ctx = self.plant, self.context
+        q0 = plant.GetPositions(ctx).copy()
+        moving = [plant.get_joint(i) for i in plant.GetJointIndices()
+                  if plant.get_joint(i).num_velocities() > 0]
+        for joint in moving:
+            if joint.type_name() not in _TYPES:
+                raise Unsupported(
+                    f"drake holds joint {joint.name()!r} as a {joint.type_name()} joint, which "
+                    "the model check does not map"
+                )
+        for joint in moving:  # free bodies at the reference pose: the origin, unrotated
+            if _TYPES[joint.type_name()] is JointType.FREE:
+                q0[joint.position_start() : joint.position_start() + 7] = (1, 0, 0, 0, 0, 0, 0)
+        plant.SetPositions(ctx, q0)
+        owner_of = {}  # body index → the moving joint whose child group holds it
+        for joint in moving:
+            for body in plant.GetBodiesWeldedTo(joint.child_body()):
+                owner_of[body.index()] = joint
+        joints = []
+        for joint in moving:
+            kind = _TYPES[joint.type_name()]
+            group = plant.GetBodiesWeldedTo(joint.child_body())
+            masses, coms, inertias = [], [], []
+            for body in group:
+                m = body.default_mass()
+                p = np.asarray(body.default_com())  # from the body origin, body axes
+                pose = body.EvalPoseInWorld(ctx)
+                rot = pose.rotation().matrix()
+                i_origin = body.default_rotational_inertia().CopyToFullMatrix3()  # about Bo
+                i_com = i_origin - m * (p @ p * np.eye(3) - np.outer(p, p))  # parallel axis
+                masses.append(m)
+                coms.append(pose.translation() + rot @ p)
+                inertias.append(rot @ i_com @ rot.T)
+            mass, com, inertia = lump(masses, coms, inertias)
+            parent_joint = owner_of.get(joint.parent_body().index())
+            child_pose = joint.frame_on_child().CalcPoseInWorld(ctx)
+            if kind is JointType.HINGE:
+                axis = joint.frame_on_parent().CalcPoseInWorld(ctx).rotation().matrix() @ \
+                    joint.revolute_axis()
+            elif kind is JointType.SLIDE:
+                axis = joint.frame_on_parent().CalcPoseInWorld(ctx).rotation().matrix() @ \
+                    joint.translation_axis()
+            else:
+                axis = np.zeros(3)
+            lower, upper = joint.position_lower_limits(), joint.position_upper_limits()
+            limited = kind is not JointType.FREE and np.isfinite(lower[0]) and \
+                np.isfinite(upper[0])
+            nv = joint.num_velocities()
+            joints.append(
+                TreeJoint(
+                    name=joint.name(), type=kind,
+                    parent=None if parent_joint is None else parent_joint.name(),
+                    body=joint.child_body().name(), axis=np.asarray(axis, float),
+                    anchor=np.asarray(child_pose.translation(), float),
+                    frame=child_pose.rotation().matrix(), mass=mass, com=com, inertia=inertia,
+                    armature=(0.0,) * nv, damping=self._damping.get(joint.name(), (0.0,) * nv),
+                    range=(float(lower[0]), float(upper[0])) if limited else None,
+                    layout=Layout(
+                        q_start=joint.position_start(), v_start=joint.velocity_start(),
+                        nq=joint.num_positions(), nv=nv, quat="wxyz", quat_first=True,
+                        angular_first=True, linear_axes=Axes.WORLD, angular_axes=Axes.WORLD,
+                        zero=float(q0[joint.position_start()]) if nv == 1 else 0.0,
+                    ),
+                )
+            )
+        gravity = np.asarray(plant.gravity_field().gravity_vector(), float)
+        return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
+                         nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes)
+
+    def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
+        plant, ctx = self.plant, self.context
+        n, nv = len(q), plant.num_velocities()
+        mass = np.empty((n, nv, nv))
+        bias, forward, inverse = (np.empty((n, nv)) for _ in range(3))
+        kinetic, potential = np.empty(n), np.empty(n)
+        forces = MultibodyForces(plant)
+        for i in range(n):
+            plant.SetPositions(ctx, q[i])
+            plant.SetVelocities(ctx, v[i])
+            mass[i] = plant.CalcMassMatrix(ctx)
+            bias[i] = plant.CalcBiasTerm(ctx) - plant.CalcGravityGeneralizedForces(ctx)
+            forward[i] = self._acc.Eval(ctx)
+            forces.SetZero()
+            plant.CalcForceElementsContribution(ctx, forces)
+            inverse[i] = plant.CalcInverseDynamics(ctx, a[i], forces)
+            kinetic[i] = plant.CalcKineticEnergy(ctx)
+            potential[i] = plant.CalcPotentialEnergy(ctx)
+        result = Dynamics(mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
+                          kinetic=kinetic, potential=potential)
+        for name, value in vars(result).items():
+            if not np.all(np.isfinite(value)):
+                raise EngineError(f"drake returned a non-finite {name}")
+        return result

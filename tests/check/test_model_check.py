@@ -1,0 +1,137 @@
+"""``check_model`` on small models written for these tests: every installed engine and the
+reference must agree (the expected values are the other engines' and the book's general
+method's — three independent computations); corrupted copies must fail, naming the body and
+the field; engines that order the joints differently must still agree."""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+from pathlib import Path
+
+import pytest
+
+from dyncheck.check.model_check import check_model
+
+MODELS = Path(__file__).parent / "models"
+CASES = [
+    ("mixed.xml", False),
+    ("floating_arm.xml", False),
+    ("branches.urdf", True),
+    ("branches.urdf", False),
+]
+DRAKE = importlib.util.find_spec("pydrake") is not None
+
+
+def _rows(result, **where):
+    frame = result.rows
+    for key, value in where.items():
+        frame = frame[frame[key] == value]
+    return frame
+
+
+@pytest.fixture(scope="module", params=CASES, ids=lambda c: f"{c[0]}-floating{c[1]}")
+def agreeing(request):
+    name, floating = request.param
+    return check_model(MODELS / name, floating=floating, states=40)
+
+
+def test_engines_and_reference_agree(agreeing):
+    assert agreeing.ok, agreeing.failures()
+    dynamics = _rows(agreeing, section="dynamics")
+    pairs = set(zip(dynamics["impl_a"], dynamics["impl_b"], strict=True))
+    assert ("reference", "mujoco") in pairs and ("reference", "pinocchio") in pairs
+    assert ("mujoco", "pinocchio") in pairs
+    if DRAKE and agreeing.path.name != "mixed.xml":
+        assert ("reference", "drake") in pairs and ("mujoco", "drake") in pairs
+    assert set(dynamics["subject"]) == {
+        "mass_matrix", "bias_forces", "forward_dynamics", "inverse_dynamics",
+        "kinetic_energy", "potential_energy",
+    }
+
+
+def test_missing_engine_is_skipped_not_passed(monkeypatch):
+    """An engine whose extra is not installed (simulated: its module cannot be imported)
+    gives a skipped row naming the extra, and no dynamics rows."""
+    from dyncheck.check import engines
+
+    missing = engines.Engine("dyncheck.adapters.no_such_module", "X", "drake")
+    monkeypatch.setitem(engines.ENGINES, "drake", missing)
+    result = check_model(MODELS / "branches.urdf", states=5)
+    load = _rows(result, section="load", impl_a="drake")
+    assert list(load["verdict"]) == ["skipped"] and "'drake' extra" in load["note"].iloc[0]
+    assert _rows(result, section="dynamics", impl_b="drake").empty
+    assert result.ok
+
+
+@pytest.mark.skipif(not DRAKE, reason="needs the 'drake' extra")
+def test_drake_ball_joint_is_skipped_naming_the_joint_type():
+    result = check_model(MODELS / "mixed.xml", states=5)
+    load = _rows(result, section="load", impl_a="drake")
+    assert list(load["verdict"]) == ["skipped"] and "ball_rpy" in load["note"].iloc[0]
+    assert _rows(result, section="dynamics", impl_b="drake").empty
+
+
+def test_engines_ordering_joints_differently_still_agree():
+    """MuJoCo's URDF compiler follows the file's joint order, Pinocchio's parser the links'
+    (measured): the two order this tree differently, and the check matches by name."""
+    result = check_model(MODELS / "branches.urdf", floating=True, states=20)
+    order = _rows(result, field="joint order", impl_b="pinocchio")
+    assert len(order) == 1 and order["value_a"].iloc[0] != order["value_b"].iloc[0]
+    assert result.ok, result.failures()
+
+
+def test_armature_kinetic_energy_is_explained_with_its_size():
+    """Pinocchio's computeKineticEnergy leaves out the rotor inertia that its M includes."""
+    result = check_model(MODELS / "mixed.xml", states=20)
+    row = _rows(result, subject="kinetic_energy", impl_a="mujoco", impl_b="pinocchio")
+    assert row["verdict"].iloc[0] == "explained" and "rotor" in row["note"].iloc[0]
+
+
+def _corrupt(tmp_path: Path, old: str, new: str) -> Path:
+    text = (MODELS / "branches.urdf").read_text()
+    assert old in text
+    path = tmp_path / "corrupted.urdf"
+    path.write_text(text.replace(old, new, 1))
+    return path
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "subject", "field"),
+    [
+        ('<mass value="1.5"/>', '<mass value="1.515"/>', "leg_joint", "mass"),
+        ('<axis xyz="0 1 0"/>', '<axis xyz="0 -1 0"/>', "leg_joint", "axis"),
+    ],
+    ids=["mass-x1.01", "axis-flipped"],
+)
+def test_corrupted_copy_fails_naming_body_and_field(tmp_path, old, new, subject, field):
+    corrupted = _corrupt(tmp_path, old, new)
+    result = check_model(corrupted, floating=True, states=10, against=MODELS / "branches.urdf")
+    assert not result.ok
+    failed = _rows(result, verdict="failed")
+    assert ((failed["subject"] == subject) & (failed["field"] == field)).any(), failed
+
+
+def test_indefinite_inertia_fails_naming_the_link(tmp_path):
+    corrupted = _corrupt(
+        tmp_path,
+        '<inertia ixx="0.03" ixy="0.001" ixz="0" iyy="0.03" iyz="0" izz="0.01"/>',
+        '<inertia ixx="0.03" ixy="0.001" ixz="0" iyy="0.03" iyz="0" izz="-0.01"/>',
+    )
+    result = check_model(corrupted, floating=True, states=10)
+    failed = _rows(result, verdict="failed", section="validity")
+    assert ((failed["subject"] == "aa_leg") & (failed["field"] == "inertia")).any(), failed
+    # MuJoCo refuses the file; Pinocchio accepts it silently (its rigid group is indefinite).
+    assert _rows(result, section="load", impl_a="mujoco")["verdict"].iloc[0] == "failed"
+    assert ((failed["impl_a"] == "pinocchio") & (failed["field"] == "inertia")).any()
+
+
+def test_check_model_is_deterministic():
+    a = check_model(MODELS / "mixed.xml", states=10, impls=("reference", "mujoco"))
+    b = check_model(MODELS / "mixed.xml", states=10, impls=("reference", "mujoco"))
+    assert a.rows.equals(b.rows)
+
+
+def test_readme_pytest_recipe_names_the_api():
+    readme = (Path(__file__).parents[2] / "README.md").read_text()
+    assert re.search(r"from dyncheck import check_model", readme)
