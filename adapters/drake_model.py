@@ -16,6 +16,8 @@ joint is a ``BallRpyJoint`` (roll-pitch-yaw coordinates): not mapped here (its r
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
@@ -50,6 +52,10 @@ def version() -> str:
 def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str, tuple]]:
     plant = MultibodyPlant(0.0)
     notes: list[str] = []
+    capture = _Capture()
+    log = logging.getLogger("drake")
+    log.addHandler(capture)
+    propagate, log.propagate = log.propagate, False
     try:
         if source.format is Format.MJCF:
             Parser(plant).AddModels(str(source.path))
@@ -57,9 +63,15 @@ def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str
             Parser(plant).AddModelsFromString(source.text, "urdf")
     except Exception as exc:
         raise EngineError(f"drake refused {source.path}: {' '.join(str(exc).split())}")
+    finally:
+        log.removeHandler(capture)
+        log.propagate = propagate
+    notes.extend(capture.summary())
     if source.format is Format.URDF:
         root = _urdf_root(plant)
-        if source.floating:
+        if root is None:
+            notes.append("drake: the URDF's root link is 'world' (already welded)")
+        elif source.floating:
             plant.AddJoint(QuaternionFloatingJoint("root_joint", plant.world_frame(),
                                                    root.body_frame()))
             notes.append("drake: QuaternionFloatingJoint 'root_joint' at the URDF root")
@@ -75,16 +87,36 @@ def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str
     return plant, tuple(notes), damping
 
 
+class _Capture(logging.Handler):
+    """Drake's parser warnings (what it ignores or changes), kept for the report."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.messages.append(" ".join(record.getMessage().split("warning: ", 1)[-1].split()))
+
+    def summary(self) -> list[str]:
+        counts: dict[str, int] = {}
+        for message in self.messages:
+            key = message.split(":", 1)[0] if "MakeFromMomentsAndProducts" in message else \
+                message
+            counts[key] = counts.get(key, 0) + 1
+        return [f"drake parser warning ({n}x): {m[:300]}" for m, n in counts.items()]
+
+
 def _urdf_root(plant: MultibodyPlant):
-    """The link no joint points to (URDF: exactly one)."""
+    """The link no joint points to (URDF: one, or none when a link named ``world`` welds the
+    model to Drake's world)."""
     children = {plant.get_joint(i).child_body().index() for i in plant.GetJointIndices()}
     candidates = [
         plant.get_body(BodyIndex(b)) for b in range(1, plant.num_bodies())
         if BodyIndex(b) not in children
     ]
-    if len(candidates) != 1:
+    if len(candidates) > 1:
         raise EngineError(f"drake: expected one URDF root link, found {len(candidates)}")
-    return candidates[0]
+    return candidates[0] if candidates else None
 
 
 class DrakeModel:

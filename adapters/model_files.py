@@ -16,6 +16,10 @@ class Format(StrEnum):
 
 
 GEOMETRY_NOTE = "URDF geometry (<visual>, <collision>) removed before loading: the check is inertial"
+MIMIC_NOTE = (
+    "URDF <mimic> couplings removed before loading: they are constraints, left out of the "
+    "smooth dynamics in every engine (Drake's continuous plant refuses them outright)"
+)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -38,9 +42,15 @@ def read(path: Path, *, floating: bool = False) -> ModelFile:
             for tag in ("visual", "collision"):
                 for element in link.findall(tag):
                     link.remove(element)
+        notes = [GEOMETRY_NOTE]
+        mimics = [(j, m) for j in root.findall("joint") for m in j.findall("mimic")]
+        for joint, mimic in mimics:
+            joint.remove(mimic)
+        if mimics:
+            notes.append(MIMIC_NOTE + f" ({len(mimics)} joints)")
         text = ET.tostring(root, encoding="unicode")
         return ModelFile(
-            path=path, format=Format.URDF, text=text, floating=floating, notes=(GEOMETRY_NOTE,)
+            path=path, format=Format.URDF, text=text, floating=floating, notes=tuple(notes)
         )
     return ModelFile(
         path=path, format=Format.MJCF, text=path.read_text(encoding="utf-8"),

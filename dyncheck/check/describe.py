@@ -39,7 +39,8 @@ def size(tree: ModelTree) -> float:
 
 def _fmt(value: object) -> str:
     if isinstance(value, np.ndarray):
-        return np.array2string(value, precision=6, separator=" ", max_line_width=10**6)
+        text = np.array2string(value, precision=6, separator=" ", max_line_width=10**6)
+        return " ".join(text.split())
     if isinstance(value, float):
         return f"{value:.9g}"
     return str(value)
