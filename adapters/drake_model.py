@@ -62,7 +62,9 @@ def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str
         else:
             Parser(plant).AddModelsFromString(source.text, "urdf")
     except Exception as exc:
-        raise EngineError(f"drake refused {source.path}: {' '.join(str(exc).split())}")
+        raise EngineError(
+            f"drake refused {source.path}: {' '.join(str(exc).split())}"
+        ) from None
     finally:
         log.removeHandler(capture)
         log.propagate = propagate

@@ -15,7 +15,9 @@ class Format(StrEnum):
     URDF = "urdf"
 
 
-GEOMETRY_NOTE = "URDF geometry (<visual>, <collision>) removed before loading: the check is inertial"
+GEOMETRY_NOTE = (
+    "URDF geometry (<visual>, <collision>) removed before loading: the check is inertial"
+)
 MIMIC_NOTE = (
     "URDF <mimic> couplings removed before loading: they are constraints, left out of the "
     "smooth dynamics in every engine (Drake's continuous plant refuses them outright)"

@@ -5,11 +5,12 @@ below it (an engine's fused or welded links lumped in), so that engines which fu
 (MuJoCo's URDF compiler, Pinocchio) and engines which keep them (Drake) describe the same
 thing. Where one body carries several joints, its inertia goes to the last of them and the
 others carry none (as Pinocchio models it). Every vector and tensor is in world axes at the
-engine's reference configuration (hinges and slides at 0 — MuJoCo: at ``ref`` —, ball joints
-at identity, free bodies at the world origin, unrotated), the inertia tensor about the lumped centre of mass (§2.2,
-(2.2.37)–(2.2.38)). The state layout — where a joint's coordinates sit in the engine's q and
-v, quaternion order, the axes of a free joint's velocities — is declared with each joint, so
-that the comparison layer maps states without knowing the engine.
+engine's reference configuration (hinges and slides at 0 — MuJoCo: at ``ref`` —,
+ball joints at identity, free bodies at the world origin, unrotated), the inertia tensor
+about the lumped centre of mass (§2.2, (2.2.39)). The state layout — where a joint's
+coordinates sit in the engine's q and v, quaternion order, the axes of a free joint's
+velocities — is declared with each joint, so that the comparison layer maps states without
+knowing the engine.
 """
 
 from __future__ import annotations

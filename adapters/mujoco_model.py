@@ -61,7 +61,9 @@ def _compile(source: ModelFile) -> tuple[mujoco.MjModel, tuple[str, ...]]:
             notes.append(f"mujoco: free joint {FLOATING_NAME!r} added to root link {root.name!r}")
         model = spec.compile()
     except Exception as exc:  # MuJoCo raises ValueError with its compiler's message
-        raise EngineError(f"mujoco refused {source.path}: {' '.join(str(exc).split())}")
+        raise EngineError(
+            f"mujoco refused {source.path}: {' '.join(str(exc).split())}"
+        ) from None
     return model, tuple(notes)
 
 

@@ -58,7 +58,7 @@ def _load(source: ModelFile) -> pin.Model:
         return pin.buildModelFromXML(source.text)
     except Exception as exc:
         message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise EngineError(f"pinocchio refused {source.path}: {message}")
+        raise EngineError(f"pinocchio refused {source.path}: {message}") from None
 
 
 class PinocchioModel:

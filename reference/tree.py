@@ -127,7 +127,7 @@ class TreeDynamics:
         """At the state q (chart centre) displaced by chart coordinates x (B, nv), complex:
         the metric g (B, nv, nv), the centres of mass (B, nb, 3) and the translational
         Jacobians (B, nb, 3, nv)."""
-        nb, nv, batch = len(self.bodies), self.nv, x.shape[0]
+        nb, batch = len(self.bodies), x.shape[0]
         dtype = x.dtype
         rot = np.empty((nb, batch, 3, 3), dtype)
         trans = np.empty((nb, batch, 3), dtype)
@@ -188,7 +188,7 @@ class TreeDynamics:
         nv = self.nv
         x = np.zeros((nv + 1, nv), complex)
         x[np.arange(nv), np.arange(nv)] = 1j * STEP
-        rot, trans, columns, ancestors = self._kinematics(np.asarray(q, float), x)
+        rot, trans, columns, _ = self._kinematics(np.asarray(q, float), x)
         mass = np.diag(self.armature).astype(float)
         dg = np.zeros((nv, nv, nv))  # dg[k] = ∂_k g
         dv = np.zeros(nv)

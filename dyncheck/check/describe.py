@@ -147,7 +147,9 @@ def _violation(mass: float, inertia: np.ndarray) -> tuple[str, object, float, fl
     return None
 
 
-def validity(model: str, holder: str, bodies: list[tuple[str, float, np.ndarray]]) -> list[CheckRow]:
+def validity(
+    model: str, holder: str, bodies: list[tuple[str, float, np.ndarray]]
+) -> list[CheckRow]:
     """Positive mass, positive semi-definite inertia, triangle inequality for each
     ``(name, mass, inertia)`` an engine holds (its rigid groups) or the file states (a URDF's
     links): a failed row per violation, else one passed row. Massless, inertia-less links

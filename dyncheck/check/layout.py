@@ -3,7 +3,8 @@
 The canonical layout is MuJoCo's convention in the canonical joint order: a hinge or slide its
 coordinate; a quaternion (w, x, y, z); a free joint q = (p, quat) as the world pose of its body,
 v = (linear velocity in world axes, angular velocity in local axes); a ball joint v = angular
-velocity in local axes. Each engine declares its own (:class:`~dyncheck.adapters.model_tree.Layout`).
+velocity in local axes. Each engine declares its own
+(:class:`~dyncheck.adapters.model_tree.Layout`).
 
 Velocities map linearly, v_e = T(q) v_c, with T orthogonal (a permutation of the joints'
 blocks, and on a free joint's blocks R or Rᵀ or 1), so that — the kinetic energy and the power

@@ -102,7 +102,7 @@ def check_model(
     model = name or source_path.stem
     source = read(source_path, floating=floating)
     rows: list[CheckRow] = []
-    notes = list(source.notes) + [SMOOTH_NOTE]
+    notes = [*source.notes, SMOOTH_NOTE]
     seconds: dict[str, float] = {}
     loaded = {}
     for engine in (i for i in chosen if i in ENGINES):
