@@ -38,6 +38,8 @@ components (q̇ = ½ q ⊗ ω), so its norm drifts; the comparison layer renorma
 from __future__ import annotations
 
 import logging
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -70,7 +72,22 @@ class _Capture(logging.Handler):
         self.messages: list[str] = []
 
     def emit(self, record: logging.LogRecord) -> None:
-        self.messages.append(record.getMessage())
+        self.messages.append(record.getMessage().split("warning: ", 1)[-1])
+
+
+@contextmanager
+def parser_warnings() -> Iterator[list[str]]:
+    """Drake's log messages while the block runs (its parser's warnings: what it ignores or
+    changes), kept in the yielded list instead of printed."""
+    capture = _Capture()
+    log = logging.getLogger("drake")
+    log.addHandler(capture)
+    propagate, log.propagate = log.propagate, False
+    try:
+        yield capture.messages
+    finally:
+        log.removeHandler(capture)
+        log.propagate = propagate
 
 
 class _Field(LeafSystem):
@@ -173,17 +190,10 @@ class DrakeAdapter(Adapter):
     @staticmethod
     def _parse(xml: str, time_step: float = 0.0) -> tuple[MultibodyPlant, list[str]]:
         plant = MultibodyPlant(time_step)
-        capture = _Capture()
-        log = logging.getLogger("drake")
-        log.addHandler(capture)
-        propagate, log.propagate = log.propagate, False
-        try:
+        with parser_warnings() as warnings:
             Parser(plant).AddModelsFromString(xml, "xml")
-        finally:
-            log.removeHandler(capture)
-            log.propagate = propagate
         plant.Finalize()
-        return plant, [m.split("warning: ", 1)[-1] for m in capture.messages]
+        return plant, warnings
 
     @staticmethod
     def version() -> str:

@@ -16,13 +16,12 @@ joint is a ``BallRpyJoint`` (roll-pitch-yaw coordinates): not mapped here (its r
 
 from __future__ import annotations
 
-import logging
-
 import numpy as np
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, MultibodyForces, QuaternionFloatingJoint
 
+from dyncheck.adapters.drake_ import parser_warnings
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -43,32 +42,20 @@ _TYPES = {
 }
 
 
-def version() -> str:
-    from importlib.metadata import version as _version
-
-    return _version("drake")
-
-
 def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str, tuple]]:
     plant = MultibodyPlant(0.0)
     notes: list[str] = []
-    capture = _Capture()
-    log = logging.getLogger("drake")
-    log.addHandler(capture)
-    propagate, log.propagate = log.propagate, False
-    try:
-        if source.format is Format.MJCF:
-            Parser(plant).AddModels(str(source.path))
-        else:
-            Parser(plant).AddModelsFromString(source.text, "urdf")
-    except Exception as exc:
-        raise EngineError(
-            f"drake refused {source.path}: {' '.join(str(exc).split())}"
-        ) from None
-    finally:
-        log.removeHandler(capture)
-        log.propagate = propagate
-    notes.extend(capture.summary())
+    with parser_warnings() as warnings:
+        try:
+            if source.format is Format.MJCF:
+                Parser(plant).AddModels(str(source.path))
+            else:
+                Parser(plant).AddModelsFromString(source.text, "urdf")
+        except Exception as exc:
+            raise EngineError(
+                f"drake refused {source.path}: {' '.join(str(exc).split())}"
+            ) from None
+    notes.extend(_summary(warnings))
     if source.format is Format.URDF:
         root = _urdf_root(plant)
         if root is None:
@@ -89,23 +76,16 @@ def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str
     return plant, tuple(notes), damping
 
 
-class _Capture(logging.Handler):
-    """Drake's parser warnings (what it ignores or changes), kept for the report."""
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.messages: list[str] = []
-
-    def emit(self, record: logging.LogRecord) -> None:
-        self.messages.append(" ".join(record.getMessage().split("warning: ", 1)[-1].split()))
-
-    def summary(self) -> list[str]:
-        counts: dict[str, int] = {}
-        for message in self.messages:
-            key = message.split(":", 1)[0] if "MakeFromMomentsAndProducts" in message else \
-                message
-            counts[key] = counts.get(key, 0) + 1
-        return [f"drake parser warning ({n}x): {m[:300]}" for m, n in counts.items()]
+def _summary(warnings: list[str]) -> list[str]:
+    """Drake's parser warnings for the report, each distinct one once with its count (an
+    inertia warning by its first line: the rest is the matrix)."""
+    counts: dict[str, int] = {}
+    for message in warnings:
+        key = " ".join(message.split())
+        if "MakeFromMomentsAndProducts" in key:
+            key = key.split(":", 1)[0]
+        counts[key] = counts.get(key, 0) + 1
+    return [f"drake parser warning ({n}x): {m[:300]}" for m, n in counts.items()]
 
 
 def _urdf_root(plant: MultibodyPlant):
@@ -223,9 +203,5 @@ class DrakeModel:
             inverse[i] = plant.CalcInverseDynamics(ctx, a[i], forces)
             kinetic[i] = plant.CalcKineticEnergy(ctx)
             potential[i] = plant.CalcPotentialEnergy(ctx)
-        result = Dynamics(mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
+        return Dynamics(mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
                           kinetic=kinetic, potential=potential)
-        for name, value in vars(result).items():
-            if not np.all(np.isfinite(value)):
-                raise EngineError(f"drake returned a non-finite {name}")
-        return result

@@ -33,10 +33,6 @@ _HINGE_UNBOUNDED = (
 _SLIDE = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned")
 
 
-def version() -> str:
-    return pin.__version__
-
-
 def _type(shortname: str) -> JointType:
     if shortname in _HINGE or shortname in _HINGE_UNBOUNDED:
         return JointType.HINGE
@@ -148,11 +144,7 @@ class PinocchioModel:
             inverse[i] = pin.rnea(m, d, q[i], v[i], a[i])
             kinetic[i] = pin.computeKineticEnergy(m, d, q[i], v[i])
             potential[i] = pin.computePotentialEnergy(m, d, q[i])
-        result = Dynamics(
+        return Dynamics(
             mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
             kinetic=kinetic, potential=potential,
         )
-        for name, value in vars(result).items():
-            if not np.all(np.isfinite(value)):
-                raise EngineError(f"pinocchio returned a non-finite {name}")
-        return result

@@ -6,11 +6,22 @@ import os
 import tempfile
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, fields
+from enum import StrEnum
 from pathlib import Path
 
 import pandas as pd
 
-VERDICTS = ("passed", "explained", "failed", "skipped")
+
+class Verdict(StrEnum):
+    """What a row concluded (a ``str``: compares equal to its value, in tables and CSV)."""
+
+    PASSED = "passed"
+    EXPLAINED = "explained"
+    FAILED = "failed"
+    SKIPPED = "skipped"
+
+
+VERDICTS = tuple(v.value for v in Verdict)
 
 
 @dataclass(frozen=True)

@@ -123,28 +123,25 @@ class TreeDynamics:
 
     def _kinematics(
         self, q: np.ndarray, x: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    ) -> tuple[np.ndarray, np.ndarray, list[list[tuple[slice, np.ndarray, np.ndarray | None]]]]:
         """At the state q (chart centre) displaced by chart coordinates x (B, nv), complex:
-        the metric g (B, nv, nv), the centres of mass (B, nb, 3) and the translational
-        Jacobians (B, nb, 3, nv)."""
+        each body's rigid transform x ↦ R x + t (R (nb, B, 3, 3), t (nb, B, 3)) and each
+        joint's Jacobian columns (angular about a pivot, or linear: pivot None)."""
         nb, batch = len(self.bodies), x.shape[0]
         dtype = x.dtype
         rot = np.empty((nb, batch, 3, 3), dtype)
         trans = np.empty((nb, batch, 3), dtype)
         # Per joint: its Jacobian columns — angular (B, 3, d) about a pivot (B, 3), or linear.
         columns: list[list[tuple[slice, np.ndarray, np.ndarray | None]]] = []
-        ancestors: list[list[int]] = []
         for j, body in enumerate(self.bodies):
             qs, vs = int(self.q_start[j]), int(self.v_start[j])
             cols = slice(vs, vs + NV[body.kind])
             xj = x[:, cols]
             if body.parent >= 0:
                 rp, tp = rot[body.parent], trans[body.parent]
-                ancestors.append([*ancestors[body.parent], j])
             else:
                 rp = np.broadcast_to(np.eye(3, dtype=dtype), (batch, 3, 3))
                 tp = np.zeros((batch, 3), dtype)
-                ancestors.append([j])
             anchor = np.asarray(body.anchor, float)
             pivot = np.einsum("bij,j->bi", rp, anchor) + tp
             if body.kind == "hinge":
@@ -179,7 +176,7 @@ class TreeDynamics:
             trans[j] = pivot - np.einsum("bij,j->bi", rot[j], anchor)
             if body.kind == "slide":
                 trans[j] = trans[j] + np.einsum("bij,bj->bi", rp, disp)
-        return rot, trans, columns, ancestors
+        return rot, trans, columns
 
     def at(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
         """M, h, T, V at one state (MuJoCo layout). A body's energy depends only on its
@@ -188,7 +185,7 @@ class TreeDynamics:
         nv = self.nv
         x = np.zeros((nv + 1, nv), complex)
         x[np.arange(nv), np.arange(nv)] = 1j * STEP
-        rot, trans, columns, _ = self._kinematics(np.asarray(q, float), x)
+        rot, trans, columns = self._kinematics(np.asarray(q, float), x)
         mass = np.diag(self.armature).astype(float)
         dg = np.zeros((nv, nv, nv))  # dg[k] = ∂_k g
         dv = np.zeros(nv)

@@ -16,7 +16,8 @@ from collections.abc import Iterator
 import numpy as np
 
 from dyncheck.adapters.model_tree import JointType, ModelTree, TreeJoint
-from dyncheck.check.rows import CheckRow, Section, Verdict
+from dyncheck.check.rows import CheckRow, Section
+from dyncheck.results import Verdict
 
 EPS = float(np.finfo(float).eps)
 ROUNDOFF = 64

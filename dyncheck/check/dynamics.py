@@ -22,7 +22,8 @@ import numpy as np
 from dyncheck.adapters.model_tree import Dynamics, JointType, ModelTree
 from dyncheck.check.describe import EPS, ROUNDOFF, depth
 from dyncheck.check.layout import Canonical
-from dyncheck.check.rows import CheckRow, Section, Verdict
+from dyncheck.check.rows import CheckRow, Section
+from dyncheck.results import Verdict
 
 QUANTITIES = {
     "mass_matrix": "mass_matrix",

@@ -19,12 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dyncheck.adapters.integrators import quat_mul
 from dyncheck.adapters.model_tree import NQ, NV, Axes, Dynamics, JointType, ModelTree, TreeJoint
 from dyncheck.cases.coordinate_maps import quat_from_matrix, quat_to_matrix
-
-
-def tree_zero(canon: Canonical, name: str) -> float:
-    return canon.zeros[canon.names.index(name)]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -57,11 +54,6 @@ def _quat_out(quat_wxyz: np.ndarray, order: str) -> np.ndarray:
     return quat_wxyz if order == "wxyz" else np.concatenate([quat_wxyz[1:], quat_wxyz[:1]])
 
 
-def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    w1, v1, w2, v2 = a[0], a[1:], b[0], b[1:]
-    return np.concatenate([[w1 * w2 - v1 @ v2], w1 * v2 + w2 * v1 + np.cross(v1, v2)])
-
-
 @dataclass(frozen=True)
 class StateMap:
     """One state's map: the engine's q, and T, Ṫ v_c for the velocities."""
@@ -71,18 +63,22 @@ class StateMap:
     tdot_v: np.ndarray
 
 
-def state_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray, v_c: np.ndarray) -> StateMap:
+def _state_map(
+    canon: Canonical, joints: list[TreeJoint], placements: list[np.ndarray | None],
+    tree: ModelTree, q_c: np.ndarray, v_c: np.ndarray,
+) -> StateMap:
+    """One state; ``joints`` are the engine's joints in canonical order, ``placements`` the
+    quaternion of each free joint's placement inverse (None for other joints)."""
     q_e = np.zeros(tree.nq)
     t = np.zeros((tree.nv, canon.nv))
     tdot_v = np.zeros(tree.nv)
-    for name, kind, qs, vs in zip(
-        canon.names, canon.types, canon.q_start, canon.v_start, strict=True
+    for joint, place_quat, kind, qs, vs, zero in zip(
+        joints, placements, canon.types, canon.q_start, canon.v_start, canon.zeros, strict=True
     ):
-        joint: TreeJoint = tree.joint(name)
         lay = joint.layout
         qe, ve = lay.q_start, lay.v_start
         if kind in (JointType.HINGE, JointType.SLIDE):
-            value = q_c[qs] - tree_zero(canon, name) + lay.zero
+            value = q_c[qs] - zero + lay.zero
             if lay.cos_sin:
                 q_e[qe : qe + 2] = np.cos(value), np.sin(value)
             else:
@@ -95,8 +91,7 @@ def state_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray, v_c: np.ndarra
             p_w, quat_w = q_c[qs : qs + 3], q_c[qs + 3 : qs + 7]
             place_r, place_p = lay.placement[:3, :3], lay.placement[:3, 3]
             p_e = place_r.T @ (p_w - place_p)
-            quat_e = _quat_mul(quat_from_matrix(place_r.T[None])[0], quat_w)
-            quat_e = _quat_out(quat_e, lay.quat)
+            quat_e = _quat_out(quat_mul(place_quat, quat_w), lay.quat)
             q_e[qe : qe + 7] = (
                 np.concatenate([quat_e, p_e]) if lay.quat_first else np.concatenate([p_e, quat_e])
             )
@@ -117,7 +112,14 @@ def engine_states(
     canon: Canonical, tree: ModelTree, q: np.ndarray, v: np.ndarray, a: np.ndarray
 ) -> tuple[list[StateMap], np.ndarray, np.ndarray, np.ndarray]:
     """The batch in the engine's layout: maps, q_e, v_e, a_e."""
-    maps = [state_map(canon, tree, qi, vi) for qi, vi in zip(q, v, strict=True)]
+    joints = [tree.joint(name) for name in canon.names]
+    placements = [
+        quat_from_matrix(j.layout.placement[:3, :3].T[None])[0]
+        if kind is JointType.FREE else None
+        for j, kind in zip(joints, canon.types, strict=True)
+    ]
+    maps = [_state_map(canon, joints, placements, tree, qi, vi)
+            for qi, vi in zip(q, v, strict=True)]
     q_e = np.array([s.q for s in maps])
     v_e = np.array([s.t @ vi for s, vi in zip(maps, v, strict=True)])
     a_e = np.array([s.t @ ai + s.tdot_v for s, ai in zip(maps, a, strict=True)])

@@ -26,8 +26,9 @@ from dyncheck.check import describe, inputs, layout
 from dyncheck.check.dynamics import Explanation, compare, sample
 from dyncheck.check.engines import ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded, load
 from dyncheck.check.referee import ReferenceModel
-from dyncheck.check.rows import COLUMNS, CheckRow, Section, Verdict
+from dyncheck.check.rows import COLUMNS, CheckRow, Section
 from dyncheck.errors import InvalidInput, UnknownName
+from dyncheck.results import Verdict
 
 SMOOTH_NOTE = (
     "smooth dynamics only: contacts, joint limits, equality constraints, actuators and passive "
@@ -178,6 +179,12 @@ def check_model(
             rows.append(_row(model, Section.DYNAMICS, engine, Verdict.FAILED,
                              f"{type(exc).__name__}: {exc}", field="dynamics"))
         seconds[engine] = seconds.get(engine, 0.0) + time.perf_counter() - t0
+    for name in list(results):
+        bad = [f for f, value in vars(results[name]).items() if not np.all(np.isfinite(value))]
+        if bad:
+            rows.append(_row(model, Section.DYNAMICS, name, Verdict.FAILED,
+                             f"{name} returned a non-finite {', '.join(bad)}", field="dynamics"))
+            del results[name]
     armature = np.concatenate([np.asarray(j.armature) for j in canonical_tree.joints])
     rotor = 0.5 * np.einsum("i,ni,ni->n", armature, batch.v, batch.v)
     order = list(results)
@@ -230,8 +237,5 @@ def _against(model: str, mine: ModelTree, other: ModelFile) -> list[CheckRow]:
 
     theirs = MujocoModel(other).tree
     label = f"against:{other.path.name}"
-    renamed = ModelTree(engine=label, joints=theirs.joints, gravity=theirs.gravity,
-                        nq=theirs.nq, nv=theirs.nv)
-    mine_renamed = ModelTree(engine=f"{mine.engine}:{model}", joints=mine.joints,
-                             gravity=mine.gravity, nq=mine.nq, nv=mine.nv)
-    return describe.diff(model, renamed, mine_renamed)
+    return describe.diff(model, replace(theirs, engine=label),
+                         replace(mine, engine=f"{mine.engine}:{model}"))

@@ -9,8 +9,8 @@ from pathlib import Path
 import pandas as pd
 
 from dyncheck.check.model_check import CheckResult
-from dyncheck.check.rows import Section, Verdict
-from dyncheck.results import to_csv, write_atomic
+from dyncheck.check.rows import Section
+from dyncheck.results import Verdict, to_csv, write_atomic
 
 
 def _versions() -> dict[str, str]:

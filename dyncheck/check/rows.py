@@ -5,6 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import StrEnum
 
+from dyncheck.results import Verdict
+
 
 class Section(StrEnum):
     """Where a row comes from, in the order a report shows them."""
@@ -13,13 +15,6 @@ class Section(StrEnum):
     DESCRIPTION = "description"
     VALIDITY = "validity"
     DYNAMICS = "dynamics"
-
-
-class Verdict(StrEnum):
-    PASSED = "passed"
-    EXPLAINED = "explained"
-    FAILED = "failed"
-    SKIPPED = "skipped"
 
 
 @dataclass(frozen=True, kw_only=True)
