@@ -28,6 +28,7 @@ import numpy as np
 
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
+from dyncheck.adapters.mujoco_api import full_inertia
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import EngineError, Unsupported
 
@@ -149,7 +150,7 @@ class MuJoCoAdapter(Adapter):
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         out = np.empty((q.shape[0], self.model.nv, self.model.nv))
         for k, d in self._eval(q):
-            mujoco.mj_fullM(self.model, d, out[k])
+            full_inertia(self.model, d, out[k])
         return self._check("mass matrix", out)
 
     def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -205,7 +206,7 @@ class MuJoCoAdapter(Adapter):
         for k in range(n):
             self._set(q[k], v[k], tau[k])
             mujoco.mj_forward(m, d)
-            mujoco.mj_fullM(m, d, M[k])
+            full_inertia(m, d, M[k])
             bias[k], fwd[k], energy[k] = d.qfrc_bias, d.qacc, d.energy
             if force is not None:
                 force[k] = self._equality_force(d)

@@ -25,6 +25,7 @@ from dyncheck.adapters.model_tree import (
     TreeJoint,
     lump,
 )
+from dyncheck.adapters.mujoco_api import full_inertia
 from dyncheck.errors import EngineError
 
 ENGINE = "mujoco"
@@ -182,7 +183,7 @@ class MujocoModel:
             d.qpos[:], d.qvel[:] = q[i], v[i]
             d.qfrc_applied[:] = 0.0
             mujoco.mj_forward(m, d)
-            mujoco.mj_fullM(m, d, mass[i])
+            full_inertia(m, d, mass[i])
             out["bias"][i] = d.qfrc_bias
             out["forward"][i] = d.qacc
             kinetic[i], potential[i] = d.energy[1], d.energy[0]

@@ -14,11 +14,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from dyncheck import diff
 from dyncheck.errors import InvalidInput
 from dyncheck.results import DISCREPANCY_KEY, VERDICTS, to_csv, write_atomic
 
 COLUMNS = [*DISCREPANCY_KEY, "max_rel_err", "tolerance", "verdict"]
-FACTOR = 10.0
+FACTOR = diff.FACTOR
 """An error that grows or shrinks by more than this factor is reported."""
 
 
@@ -95,7 +96,7 @@ def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
             f"a finite max_rel_err on every passed or explained row (data row {row})",
         )
     frame["integrator"] = frame["integrator"].fillna("").astype(str)
-    dup = _key(frame).duplicated()
+    dup = diff.keys(frame, DISCREPANCY_KEY).duplicated()
     if dup.any():
         row = int(np.flatnonzero(dup.to_numpy())[0]) + 1
         raise InvalidInput(flag, str(path), f"one row per key (data row {row} repeats a key)")
@@ -107,43 +108,30 @@ def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
     return frame
 
 
-def _key(frame: pd.DataFrame) -> pd.Series:
-    dt = frame["dt"].map(lambda x: "" if pd.isna(x) else f"{x:.6e}")
-    parts = [frame[c].astype(str) for c in DISCREPANCY_KEY if c != "dt"]
-    out = parts[0]
-    for p in parts[1:]:
-        out = out + "|" + p
-    return out + "|" + dt
-
-
 def compare(
     current: pd.DataFrame, baseline: pd.DataFrame, *, cases: list[str] | None = None
 ) -> pd.DataFrame:
-    """Rows that regressed: columns ``key, change, baseline, current``. ``cases`` restricts
-    the baseline to the cases that were run."""
+    """Rows that moved (:func:`dyncheck.diff.diff` at :data:`FACTOR`): columns ``row`` (its
+    key), ``change`` (the move and why), ``baseline`` and ``current`` (verdict and error).
+    ``cases`` restricts the baseline to the cases that were run."""
     if cases is not None:
         baseline = baseline[baseline["case"].isin(cases)]
-    cur = current.assign(_k=_key(current)).set_index("_k")
-    base = baseline.assign(_k=_key(baseline)).set_index("_k")
-    out = []
-    for k in sorted(set(base.index) - set(cur.index)):
-        out.append((k, "vanished", base.loc[k, "verdict"], ""))
-    for k in sorted(set(cur.index) - set(base.index)):
-        out.append((k, "appeared", "", cur.loc[k, "verdict"]))
-    for k in sorted(set(cur.index) & set(base.index)):
-        b, c = base.loc[k], cur.loc[k]
-        if b["verdict"] != c["verdict"]:
-            out.append((k, "verdict changed", b["verdict"], c["verdict"]))
-            continue
-        eb, ec = float(b["max_rel_err"]), float(c["max_rel_err"])
-        if not (np.isfinite(eb) and np.isfinite(ec)):
-            continue
-        tol = float(c["tolerance"]) if pd.notna(c["tolerance"]) else 0.0
-        tiny = np.finfo(float).tiny
-        ratio = max(eb, ec, tiny) / max(min(eb, ec), tiny)
-        if ratio > FACTOR and max(eb, ec) > tol:
-            out.append((k, f"error moved x{ratio:.3g}", f"{eb:.3e}", f"{ec:.3e}"))
-    return pd.DataFrame(out, columns=["row", "change", "baseline", "current"])
+    here = Path("current run")
+    old = diff.tables(baseline[COLUMNS], diff.RunKind.RUN, path=here, flag="--baseline")
+    new = diff.tables(current[COLUMNS], diff.RunKind.RUN, path=here)
+    table = diff.moved(diff.diff(old, new, factor=FACTOR))
+    def side(s: str) -> pd.Series:
+        err = table[f"error_{s}"].map(lambda x: f" {x:.3e}" if pd.notna(x) else "")
+        return table[f"verdict_{s}"] + err
+
+    return pd.DataFrame(
+        {
+            "row": diff.keys(table, DISCREPANCY_KEY).to_numpy(),
+            "change": (table["move"].astype(str) + ": " + table["note"]).to_numpy(),
+            "baseline": side("a").to_numpy(),
+            "current": side("b").to_numpy(),
+        }
+    )
 
 
 def version_changes(path: Path, current: dict[str, str]) -> list[str]:

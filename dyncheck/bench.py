@@ -51,6 +51,8 @@ def _median_time(fn: Callable[[], object], repeats: int) -> float:
 def _raw_mujoco(adapter, qe, ve, te, ae) -> Callable[[], None]:
     import mujoco
 
+    from dyncheck.adapters.mujoco_api import full_inertia
+
     m, d = adapter.model, adapter.data
     M = np.empty((m.nv, m.nv))
 
@@ -58,7 +60,7 @@ def _raw_mujoco(adapter, qe, ve, te, ae) -> Callable[[], None]:
         for k in range(len(qe)):
             d.qpos[:], d.qvel[:], d.qfrc_applied[:] = qe[k], ve[k], te[k]
             mujoco.mj_forward(m, d)
-            mujoco.mj_fullM(m, d, M)
+            full_inertia(m, d, M)
             d.qacc[:] = ae[k]
             mujoco.mj_inverse(m, d)
 

@@ -321,6 +321,8 @@ def passive_damping() -> Entry:
 def geometry_inertia() -> Entry:
     import mujoco
 
+    from dyncheck.adapters.mujoco_api import full_inertia
+
     xml = (
         "<mujoco><worldbody><body name='b'><joint type='hinge' axis='0 1 0'/>"
         "<geom type='sphere' size='0.1' pos='0 0 -1' mass='1'/></body></worldbody></mujoco>"
@@ -329,7 +331,7 @@ def geometry_inertia() -> Entry:
     d = mujoco.MjData(m)
     mujoco.mj_forward(m, d)
     M = np.zeros((1, 1))
-    mujoco.mj_fullM(m, d, M)
+    full_inertia(m, d, M)
     point = 1.0 * 1.0**2  # m ℓ²
     solid = point + 0.4 * 1.0 * 0.1**2  # + (2/5) m r², a solid sphere about its centre
     return Entry(

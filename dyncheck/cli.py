@@ -85,6 +85,26 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--against", type=_path, default=None, metavar="PATH",
                    help="also compare what MuJoCo reads with this other file (a previous version)")
     k.add_argument("--out", type=_path, default=Path("reports/check"), help="output folder")
+    d = sub.add_parser("diff", help="what moved between two runs (engine upgrade, code change)")
+    d.add_argument("run_a", type=_path, metavar="RUN_A",
+                   help="output folder of `run` or `check` (or a baseline CSV): the old side")
+    d.add_argument("run_b", type=_path, metavar="RUN_B", help="the new side, same kind")
+    d.add_argument("--tolerance", type=float, default=None, metavar="FACTOR",
+                   help="an error above its tolerance moved when it changed by more than this "
+                        "factor (default 10)")
+    d.add_argument("--markdown", type=_path, default=None, metavar="FILE",
+                   help="also write the diff as a Markdown page")
+    d.add_argument("--all", action="store_true", help="list unchanged rows too")
+    v = sub.add_parser(
+        "versions", help="the version matrix: each engine release in its own environment")
+    v.add_argument("--engine", action="append", default=[], metavar="NAME",
+                   help="mujoco, pinocchio, drake (repeatable; default: all)")
+    v.add_argument("--case", action="append", default=[], metavar="CASE",
+                   help="cases to run (repeatable; default: all)")
+    v.add_argument("--jobs", type=int, default=2, metavar="N")
+    v.add_argument("--bisect", nargs=3, default=None, metavar=("ENGINE", "GOOD", "BAD"),
+                   help="name the first release between GOOD and BAD whose results moved")
+    v.add_argument("--out", type=_path, default=Path("reports/versions.md"), metavar="FILE")
     c = sub.add_parser("report", help="check that the committed report matches the code")
     c.add_argument(
         "--check",
@@ -290,6 +310,67 @@ def _bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _diff(args: argparse.Namespace) -> int:
+    """Exit 1 when any row moved; 0 when every row is unchanged."""
+    import dataclasses
+
+    from dyncheck import baseline, diff
+    from dyncheck.results import write_atomic
+
+    factor = diff.FACTOR if args.tolerance is None else args.tolerance
+    if not factor > 1.0:
+        raise InvalidInput("--tolerance", args.tolerance, "a factor > 1")
+    if args.markdown is not None:
+        if args.markdown.is_dir():
+            raise InvalidInput("--markdown", str(args.markdown), "a file path, not a folder")
+        _check_out(args.markdown.parent)
+    sides = []
+    for flag, path in (("RUN_A", args.run_a), ("RUN_B", args.run_b)):
+        side = diff.load(path, flag)
+        if path.is_file() and not side.versions:
+            side = dataclasses.replace(side, versions=baseline.versions_of(path))
+        sides.append(side)
+    a, b = sides
+    table = diff.diff(a, b, factor=factor)
+    counts = diff.summary(table)
+    print(diff.text(a, b, table, factor=factor, every=args.all).rstrip())
+    if args.markdown is not None:
+        write_atomic(args.markdown, diff.markdown(a, b, table, factor=factor, every=args.all))
+    return 0 if counts[diff.Move.UNCHANGED] == len(table) else 1
+
+
+def _versions(args: argparse.Namespace) -> int:
+    """Exit 0 (the matrix reports moves; it does not judge them)."""
+    from dyncheck import matrix
+    from dyncheck.cases import get_case
+    from dyncheck.results import write_atomic
+
+    _positive("--jobs", args.jobs)
+    for name in args.case:
+        get_case(name)
+    if args.bisect is not None:
+        name, good, bad = args.bisect
+        first, moved = matrix.bisect(name, good, bad, cases=args.case, jobs=args.jobs,
+                                     log=_log)
+        print(f"first release that moved: {name} {first} ({len(moved)} rows)")
+        print(moved.to_string(index=False))
+        return 0
+    names = args.engine or list(matrix.ENGINES)
+    for name in names:
+        matrix.engine(name)
+    if args.out.is_dir():
+        raise InvalidInput("--out", str(args.out), "a file path, not a folder")
+    _check_out(args.out.parent)
+    steps = matrix.matrix(names, cases=args.case, jobs=args.jobs, log=_log)
+    write_atomic(args.out, matrix.page(steps, notes=matrix.EXPLANATIONS))
+    print(f"version matrix written to {args.out}")
+    return 0
+
+
+def _log(message: str) -> None:
+    print(f"dyncheck: {message}", file=sys.stderr, flush=True)
+
+
 def _explain(args: argparse.Namespace) -> int:
     from dyncheck.catalogue import explain, render
 
@@ -332,6 +413,8 @@ COMMANDS = {
     "run": _run,
     "check": _check,
     "report": _report,
+    "diff": _diff,
+    "versions": _versions,
     "baseline": _baseline,
     "bench": _bench,
     "explain": _explain,

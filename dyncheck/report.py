@@ -19,7 +19,7 @@ import pandas as pd
 from dyncheck.cases import Case
 from dyncheck.explanations import EXPLANATIONS
 from dyncheck.freshness import Moved, compare, read_report
-from dyncheck.results import to_csv, write_atomic
+from dyncheck.results import PROVENANCE, provenance_json, to_csv, write_atomic
 from dyncheck.run import RunResult
 from dyncheck.tolerances import ORDER_SLACK
 from dyncheck.trajectories import (
@@ -544,6 +544,7 @@ def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Pat
             files[out / "figures" / f"{case.name}_{kind}.png"] = png
     files[out / "README.md"] = index_page(result, date=date)
     files[out / "conventions.md"] = conventions_page()
+    files[out / PROVENANCE] = provenance_json({"date (UTC)": date, **versions()})
     lead, table = errata(result.discrepancies)
     files[out / "errata.md"] = "\n".join(
         [
@@ -568,7 +569,7 @@ def rendered_text(result: RunResult, out: Path) -> dict[str, str]:
     return {
         path.name: content
         for path, content in render(result, out).items()
-        if isinstance(content, str) and path.parent == out
+        if isinstance(content, str) and path.parent == out and path.suffix in (".csv", ".md")
     }
 
 

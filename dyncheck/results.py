@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import tempfile
 from collections.abc import Iterable
@@ -70,6 +71,16 @@ class ConvergencePoint:
     nominal_order: int
     reference_error: float
     asymptotic: bool
+
+
+PROVENANCE = "provenance.json"
+"""The file ``run`` and ``check`` write beside their tables: the versions that made them, for
+``dyncheck diff`` (the pages show the same as a table)."""
+
+
+def provenance_json(versions: dict[str, str]) -> str:
+    """``versions`` as the text of :data:`PROVENANCE`."""
+    return json.dumps(versions, indent=2, ensure_ascii=False) + "\n"
 
 
 DISCREPANCY_KEY = ["case", "quantity", "impl_a", "impl_b", "integrator", "dt"]

@@ -10,7 +10,7 @@ import pandas as pd
 
 from dyncheck.check.model_check import CheckResult
 from dyncheck.check.rows import Section
-from dyncheck.results import Verdict, to_csv, write_atomic
+from dyncheck.results import PROVENANCE, Verdict, provenance_json, to_csv, write_atomic
 
 
 def _versions() -> dict[str, str]:
@@ -85,4 +85,5 @@ def write(result: CheckResult, out: Path) -> list[Path]:
     csv_path, md_path = out / f"{name}.csv", out / f"{name}.md"
     write_atomic(csv_path, to_csv(result.rows))
     write_atomic(md_path, page(result))
-    return [csv_path, md_path]
+    write_atomic(out / PROVENANCE, provenance_json(_versions()))
+    return [csv_path, md_path, out / PROVENANCE]

@@ -1,0 +1,30 @@
+"""MuJoCo's API differences between releases, in one place (each with the release that made it).
+
+Every adapter and study calls MuJoCo through these where the API changed within the range
+``pyproject.toml`` states; the version matrix (``dyncheck versions``) runs them on each release.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+
+def _release(text: str) -> tuple[int, ...]:
+    return tuple(int(p) for p in text.split(".")[:3] if p.isdigit())
+
+
+RELEASE = _release(mujoco.__version__)
+
+FULLM_READS_DATA = RELEASE >= (3, 10, 0)
+"""MuJoCo 3.10.0 changed ``mj_fullM(m, dst, M)`` (M: ``d.qM``) to ``mj_fullM(m, d, dst)``
+(changelog 3.10.0, item 14, commit 7b9b8806)."""
+
+
+def full_inertia(m: mujoco.MjModel, d: mujoco.MjData, dst: np.ndarray) -> None:
+    """The dense joint-space inertia matrix (armature included) into ``dst`` (nv × nv), after
+    ``mj_forward`` or ``mj_kinematics`` + ``mj_crb`` have filled ``d``."""
+    if FULLM_READS_DATA:
+        mujoco.mj_fullM(m, d, dst)
+    else:
+        mujoco.mj_fullM(m, dst, d.qM)

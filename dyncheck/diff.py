@@ -1,0 +1,342 @@
+"""What moved between two runs: ``dyncheck diff RUN_A RUN_B``.
+
+Two output folders of ``dyncheck run`` (their ``discrepancies.csv``) or of ``dyncheck check``
+(one CSV per model) are joined on their keys. Each row's error is compared *relative to the
+row's own tolerance*: two errors below the tolerance are the same result whatever their
+digits (round-off differs between builds and machines); above it, an error that grew or shrank
+by more than the factor (``--tolerance``, default 10) moved. Each row gets one :class:`Move`:
+
+- ``regressed`` / ``improved``: the verdict got worse / better, or the error moved beyond the
+  factor above the tolerance;
+- ``definition changed``: a trajectory row whose change *vanishes with the step* — over the
+  steps of one (case, quantity, pair, integrator) group the difference of the two errors falls
+  as dt^p with p ≥ :data:`SCHEME_SLOPE`; a model or parser change would not vanish as dt → 0,
+  a change of integration scheme (its truncation error is O(dt^p)) does;
+- ``appeared`` / ``vanished``: a row present on one side only;
+- ``unchanged``: everything else.
+
+The exit status of the command is 1 when any row moved (``unchanged`` is the only quiet
+answer: an improvement is a change a maintainer must see and accept as a new baseline).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import dataclass, field
+from enum import StrEnum
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from dyncheck.errors import InvalidInput
+from dyncheck.results import DISCREPANCY_KEY, PROVENANCE, VERDICTS
+
+FACTOR = 10.0
+"""Default factor an error must grow or shrink by, above its tolerance, to count as moved."""
+SCHEME_SLOPE = 0.5
+"""Least log-log slope of |Δerror| against dt that makes a change one of the scheme (a change
+of definition of an order-p integrator gives slope ≈ p ≥ 1; a model change gives ≈ 0)."""
+
+
+class RunKind(StrEnum):
+    """Which command wrote a folder."""
+
+    RUN = "run"
+    CHECK = "check"
+
+
+class Move(StrEnum):
+    """How one row changed from run A to run B."""
+
+    UNCHANGED = "unchanged"
+    IMPROVED = "improved"
+    REGRESSED = "regressed"
+    DEFINITION_CHANGED = "definition changed"
+    APPEARED = "appeared"
+    VANISHED = "vanished"
+
+
+KEYS = {
+    RunKind.RUN: DISCREPANCY_KEY,
+    RunKind.CHECK: ["model", "section", "subject", "field", "impl_a", "impl_b"],
+}
+ERROR = {RunKind.RUN: "max_rel_err", RunKind.CHECK: "error"}
+_RANK = {"passed": 0, "explained": 1, "skipped": 2, "failed": 3}
+"""Verdicts from best to worst: a verdict that moves right regressed."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunTables:
+    """One folder's rows (key columns, ``error``, ``tolerance``, ``verdict``) and versions."""
+
+    path: Path
+    kind: RunKind
+    rows: pd.DataFrame
+    versions: dict[str, str] = field(default_factory=dict)
+
+
+def load(path: Path, flag: str) -> RunTables:
+    """The rows of a ``run`` or ``check`` output folder (or one of their CSV files), validated:
+    a one-line InvalidInput naming ``flag`` and the path for anything that is not one."""
+    if not path.exists():
+        raise InvalidInput(flag, str(path), "an existing output folder of `run` or `check`")
+    if path.is_dir():
+        disc = path / "discrepancies.csv"
+        files = [disc] if disc.is_file() else sorted(path.glob("*.csv"))
+        folder = path
+    else:
+        files, folder = [path], path.parent
+    if not files:
+        raise InvalidInput(flag, str(path), "a folder holding discrepancies.csv or check CSVs")
+    frames = [_read_csv(f, flag) for f in files]
+    kinds = {_kind(f, frame, flag) for f, frame in zip(files, frames, strict=True)}
+    if len(kinds) != 1:
+        raise InvalidInput(flag, str(path), "the output of one command (run and check mixed)")
+    kind = kinds.pop()
+    rows = pd.concat(frames, ignore_index=True)
+    return tables(rows, kind, path=path, flag=flag, versions=read_versions(folder))
+
+
+def tables(
+    rows: pd.DataFrame,
+    kind: RunKind,
+    *,
+    path: Path,
+    flag: str = "RUN",
+    versions: dict[str, str] | None = None,
+) -> RunTables:
+    """A table of ``kind``'s columns (a run's discrepancies, a baseline, a check's rows) as
+    :class:`RunTables`; InvalidInput naming ``flag`` for bad types, verdicts or keys."""
+    normal = _normalise(rows, kind, flag, path)
+    return RunTables(path=path, kind=kind, rows=normal, versions=versions or {})
+
+
+def _read_csv(path: Path, flag: str) -> pd.DataFrame:
+    try:
+        return pd.read_csv(path, keep_default_na=False, na_values=[""], comment="#")
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise InvalidInput(flag, str(path), f"a CSV file ({reason})") from None
+    except OSError as exc:
+        raise InvalidInput(flag, str(path), f"a readable file ({exc.strerror})") from None
+
+
+def _kind(path: Path, frame: pd.DataFrame, flag: str) -> RunKind:
+    for kind in RunKind:
+        if {*KEYS[kind], ERROR[kind], "tolerance", "verdict"} <= set(frame.columns):
+            return kind
+    raise InvalidInput(flag, str(path), "a discrepancies.csv of `run` or a CSV of `check`")
+
+
+def _normalise(rows: pd.DataFrame, kind: RunKind, flag: str, path: Path) -> pd.DataFrame:
+    key = KEYS[kind]
+    out = rows[key].copy()
+    for col in key:
+        if col == "dt":
+            out[col] = pd.to_numeric(out[col], errors="coerce")
+        else:
+            out[col] = out[col].fillna("").astype(str)
+    try:
+        out["error"] = rows[ERROR[kind]].astype(float)
+        out["tolerance"] = rows["tolerance"].astype(float).fillna(0.0)
+    except ValueError as exc:
+        raise InvalidInput(flag, str(path), f"numeric errors and tolerances ({exc})") from None
+    out["verdict"] = rows["verdict"].astype(str)
+    bad = ~out["verdict"].isin(VERDICTS)
+    if bad.any():
+        row = int(np.flatnonzero(bad.to_numpy())[0]) + 1
+        raise InvalidInput(flag, str(path), f"verdicts in {VERDICTS} (data row {row})")
+    out["_k"] = keys(out, key)
+    dup = out["_k"].duplicated()
+    if dup.any():
+        row = int(np.flatnonzero(dup.to_numpy())[0]) + 1
+        raise InvalidInput(flag, str(path), f"one row per key (data row {row} repeats a key)")
+    return out.set_index("_k")
+
+
+def keys(frame: pd.DataFrame, key: list[str]) -> pd.Series:
+    """One string per row joining its key columns (steps to 7 digits)."""
+    parts = []
+    for col in key:
+        if col == "dt":
+            parts.append(frame[col].map(lambda x: "" if pd.isna(x) else f"{x:.6e}"))
+        else:
+            parts.append(frame[col].astype(str))
+    out = parts[0]
+    for p in parts[1:]:
+        out = out + "|" + p
+    return out
+
+
+def read_versions(folder: Path) -> dict[str, str]:
+    """The versions recorded in a folder's ``provenance.json`` (empty when it has none)."""
+    path = folder / PROVENANCE
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        return {}
+    return {str(k): str(v) for k, v in data.items()} if isinstance(data, dict) else {}
+
+
+def version_changes(a: dict[str, str], b: dict[str, str]) -> list[str]:
+    """``name old -> new`` for every library whose version differs (dates and commits left
+    out; names and values compared with spaces as underscores, as a baseline's header has
+    them)."""
+
+    def norm(d: dict[str, str]) -> dict[str, str]:
+        return {k.replace(" ", "_"): v.replace(" ", "_") for k, v in d.items()}
+
+    na, nb = norm(a), norm(b)
+    skip = {"date_(UTC)", "dyncheck_commit"}
+    names = [k for k in dict.fromkeys([*na, *nb]) if k not in skip]
+    return [
+        f"{k} {na.get(k, 'absent')} -> {nb.get(k, 'absent')}"
+        for k in names
+        if na.get(k) != nb.get(k)
+    ]
+
+
+def diff(a: RunTables, b: RunTables, *, factor: float = FACTOR) -> pd.DataFrame:
+    """One row per key of either side: its key columns, ``error_a``, ``error_b``, ``ratio``
+    (b / a), ``tolerance``, ``verdict_a``, ``verdict_b``, ``move`` and a ``note``."""
+    if a.kind != b.kind:
+        raise InvalidInput("RUN_B", str(b.path), f"the output of `{a.kind}`, like RUN_A")
+    if not factor > 1.0:
+        raise InvalidInput("--tolerance", factor, "a factor > 1")
+    key = KEYS[a.kind]
+    joined = a.rows.add_suffix("_a").join(b.rows.add_suffix("_b"), how="outer")
+    for col in key:
+        joined[col] = joined[f"{col}_a"].combine_first(joined[f"{col}_b"])
+    tol = np.fmax(joined["tolerance_a"].to_numpy(), joined["tolerance_b"].to_numpy())
+    ea, eb = joined["error_a"].to_numpy(), joined["error_b"].to_numpy()
+    tiny = np.finfo(float).tiny
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.fmax(eb, tiny) / np.fmax(ea, tiny)
+    moves, notes = [], []
+    for i, (_, row) in enumerate(joined.iterrows()):
+        move, note = _move(row, ea[i], eb[i], ratio[i], tol[i], factor)
+        moves.append(move)
+        notes.append(note)
+    out = joined[key].copy()
+    out["error_a"], out["error_b"], out["ratio"], out["tolerance"] = ea, eb, ratio, tol
+    out["verdict_a"] = joined["verdict_a"].fillna("")
+    out["verdict_b"] = joined["verdict_b"].fillna("")
+    out["move"], out["note"] = moves, notes
+    if a.kind is RunKind.RUN:
+        out = _schemes(out, factor)
+    return out.sort_values(key, kind="stable").reset_index(drop=True)
+
+
+def _move(
+    row: pd.Series, ea: float, eb: float, ratio: float, tol: float, factor: float
+) -> tuple[Move, str]:
+    va, vb = row["verdict_a"], row["verdict_b"]
+    if pd.isna(va):
+        return Move.APPEARED, f"new row ({vb})"
+    if pd.isna(vb):
+        return Move.VANISHED, f"row gone (was {va})"
+    if _RANK[va] != _RANK[vb]:
+        move = Move.REGRESSED if _RANK[vb] > _RANK[va] else Move.IMPROVED
+        return move, f"verdict {va} -> {vb}"
+    if not (np.isfinite(ea) and np.isfinite(eb)):
+        if np.isfinite(ea) == np.isfinite(eb):
+            return Move.UNCHANGED, ""
+        return (Move.REGRESSED, "error no longer finite") if np.isfinite(ea) else (
+            Move.IMPROVED, "error finite again")
+    if max(ea, eb) <= tol:
+        return Move.UNCHANGED, ""
+    if ratio > factor:
+        return Move.REGRESSED, f"error x{ratio:.3g}"
+    if ratio < 1.0 / factor:
+        return Move.IMPROVED, f"error x{ratio:.3g}"
+    return Move.UNCHANGED, ""
+
+
+def _schemes(out: pd.DataFrame, factor: float) -> pd.DataFrame:
+    """Trajectory groups whose moved errors differ as dt^p, p ≥ SCHEME_SLOPE: a changed scheme."""
+    traj = out["integrator"].astype(str).ne("") & out["dt"].notna()
+    group = ["case", "quantity", "impl_a", "impl_b", "integrator"]
+    for _, idx in out[traj].groupby(group, sort=False).groups.items():
+        rows = out.loc[idx]
+        if not rows["move"].isin([Move.REGRESSED, Move.IMPROVED]).any():
+            continue
+        delta = (rows["error_b"] - rows["error_a"]).abs().to_numpy()
+        dt = rows["dt"].to_numpy(dtype=float)
+        ok = np.isfinite(delta) & (delta > 0) & (dt > 0)
+        if ok.sum() < 2 or np.unique(dt[ok]).size < 2:
+            continue
+        slope = float(np.polyfit(np.log(dt[ok]), np.log(delta[ok]), 1)[0])
+        if slope >= SCHEME_SLOPE:
+            moved = idx[out.loc[idx, "move"].ne(Move.UNCHANGED).to_numpy()]
+            out.loc[moved, "move"] = Move.DEFINITION_CHANGED
+            out.loc[moved, "note"] = (
+                f"difference of errors ∝ dt^{slope:.2f} over {int(ok.sum())} steps: the "
+                "integration scheme changed, not the model"
+            )
+    return out
+
+
+def moved(table: pd.DataFrame) -> pd.DataFrame:
+    """The rows that moved (everything but ``unchanged``)."""
+    return table[table["move"].ne(Move.UNCHANGED)]
+
+
+def summary(table: pd.DataFrame) -> dict[str, int]:
+    """Rows per move, every move named (zeros included), in :class:`Move` order."""
+    counts = table["move"].value_counts()
+    return {m.value: int(counts.get(m, 0)) for m in Move}
+
+
+def markdown(
+    a: RunTables, b: RunTables, table: pd.DataFrame, *, factor: float, every: bool = False
+) -> str:
+    """The diff as a Markdown page: versions that changed, counts, then every moved row
+    (``every``: every row)."""
+    unrecorded = [f"`{t.path}`" for t in (a, b) if not t.versions]
+    changes = version_changes(a.versions, b.versions) if not unrecorded else []
+    versions = (
+        f"not recorded in {' and '.join(unrecorded)}"
+        if unrecorded
+        else "; ".join(changes) or "none (a move is a change of dyncheck's code or inputs)"
+    )
+    counts = summary(table)
+    shown = _display(table if every else moved(table), a.kind)
+    lines = [
+        f"# dyncheck diff: `{a.path}` → `{b.path}`",
+        "",
+        f"{len(table)} rows joined ({a.kind}); a row moved when its verdict changed or its "
+        f"error, above its tolerance, changed by more than x{factor:g}.",
+        "",
+        f"**Versions changed:** {versions}",
+        "",
+        " · ".join(f"**{n}** {m}" for m, n in counts.items()),
+        "",
+    ]
+    if shown.empty:
+        lines.append("_nothing moved_")
+    else:
+        lines.append(shown.to_markdown(index=False))
+    return "\n".join(lines) + "\n"
+
+
+def _display(table: pd.DataFrame, kind: RunKind) -> pd.DataFrame:
+    show = table.copy()
+    show["pair"] = show["impl_a"] + " vs " + show["impl_b"]
+    for col in ("error_a", "error_b", "ratio", "tolerance"):
+        show[col] = show[col].map(lambda x: "" if pd.isna(x) else f"{x:.3e}")
+    if kind is RunKind.RUN:
+        show["dt"] = show["dt"].map(lambda x: "" if pd.isna(x) else f"{x:g}")
+        cols = ["case", "quantity", "pair", "integrator", "dt"]
+    else:
+        cols = ["model", "section", "subject", "field", "pair"]
+    return show[[*cols, "error_a", "error_b", "ratio", "move", "note"]]
+
+
+def text(
+    a: RunTables, b: RunTables, table: pd.DataFrame, *, factor: float, every: bool = False
+) -> str:
+    """The same as :func:`markdown`, for a terminal (Markdown reads as plain text)."""
+    page = markdown(a, b, table, factor=factor, every=every)
+    return re.sub(r"\*\*(.+?)\*\*", r"\1", page)

@@ -1,0 +1,333 @@
+"""The version matrix: ``dyncheck versions`` — the same cases under each release of an engine.
+
+Each release gets its own virtual environment (the standard library's :mod:`venv`, populated
+by pip) under the user's cache folder, kept across runs: the engine at that release, every
+other library at the version of ``constraints.txt``, dyncheck itself installed from this
+checkout without its dependency ranges (so that releases outside the stated range can be
+tried — that is how the range is proved). In each, ``dyncheck run`` on the engine's
+implementations (and the book's) writes a run folder, also cached (keyed by the release and
+dyncheck's commit). Consecutive releases are then compared with :mod:`dyncheck.diff`, and
+``reports/versions.md`` says, per engine, what moved between which releases and by how much.
+
+``--bisect ENGINE GOOD BAD``: the releases published between two (``pip index versions``) are
+run by bisection until the first release whose run differs from GOOD's is named.
+
+Not part of CI (it installs engines); CI tests the pieces that do not install anything.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import os
+import subprocess
+import sys
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from dyncheck import diff
+from dyncheck.errors import DyncheckError, InvalidInput, UnknownName
+
+ROOT = Path(__file__).resolve().parents[1]
+CORE = ("numpy", "scipy", "sympy", "pandas", "tabulate", "matplotlib", "mujoco", "pin")
+"""What every environment installs (dyncheck's own dependencies, without their ranges)."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class Engine:
+    """One engine of the matrix: its PyPI package, the packages released with it (left out of
+    the constraints so that they follow the engine), its implementations and the releases
+    the committed matrix runs."""
+
+    name: str
+    package: str
+    family: tuple[str, ...]
+    impls: tuple[str, ...]
+    releases: tuple[str, ...]
+    extra: tuple[str, ...] = ()
+
+
+ENGINES = {
+    e.name: e
+    for e in (
+        Engine(
+            name="mujoco",
+            package="mujoco",
+            family=("mujoco", "glfw", "pyopengl"),
+            impls=("mujoco", "mujoco-stiff"),
+            releases=("3.2.7", "3.3.7", "3.6.0", "3.10.0", "3.14.0", "3.17.0", "4.0.0"),
+        ),
+        Engine(
+            name="pinocchio",
+            package="pin",
+            family=("pin", "libpinocchio", "cmeel", "coal", "libcoal", "eigenpy",
+                    "jrl-cmakemodules"),
+            impls=("pinocchio", "pinocchio-mjcf"),
+            releases=("3.4.0", "3.7.0", "3.9.0", "4.0.0", "4.1.0"),
+        ),
+        Engine(
+            name="drake",
+            package="drake",
+            family=("drake", "mosek"),
+            impls=("drake",),
+            releases=("1.40.0", "1.45.0", "1.51.1"),
+            extra=("drake",),
+        ),
+    )
+}
+
+
+EXPLANATIONS: dict[tuple[str, str, str], str] = {}
+"""What the engine's changelog says about a step where rows moved: (engine, old, new) → text."""
+
+
+def engine(name: str) -> Engine:
+    if name not in ENGINES:
+        raise UnknownName("engine", name, ENGINES)
+    return ENGINES[name]
+
+
+def cache_root() -> Path:
+    """``$DYNCHECK_CACHE`` or ``$XDG_CACHE_HOME/dyncheck`` or ``~/.cache/dyncheck``."""
+    if os.environ.get("DYNCHECK_CACHE"):
+        return Path(os.environ["DYNCHECK_CACHE"])
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "dyncheck"
+
+
+def constraints(eng: Engine, text: str) -> str:
+    """``constraints.txt`` without the lines of the engine's family (they follow the release
+    under test)."""
+
+    def name(line: str) -> str:
+        return line.split("==")[0].strip().lower().replace("_", "-")
+
+    keep = [
+        line
+        for line in text.splitlines()
+        if line.strip() and not any(name(line).startswith(f) for f in eng.family)
+    ]
+    return "\n".join(keep) + "\n"
+
+
+SOURCES = ("reference", "adapters", "cases", "dyncheck", ":(exclude)dyncheck/matrix.py",
+           ":(exclude)dyncheck/cli.py", ":(exclude)dyncheck/diff.py")
+"""The code whose content keys the cached runs (the matrix's own code and pages left out)."""
+
+
+def _code_key() -> str:
+    """A hash of the committed content of :data:`SOURCES`, ``+dirty`` when the working tree
+    differs from it (runs are then not reused)."""
+
+    def git(*args: str) -> str:
+        return subprocess.run(["git", *args], capture_output=True, text=True, cwd=ROOT,
+                              check=False).stdout
+
+    listing = git("ls-files", "-s", "--", *SOURCES)
+    key = hashlib.sha1(listing.encode(), usedforsecurity=False).hexdigest()[:12]
+    dirty = git("status", "--porcelain", "--untracked-files=no", "--", *SOURCES).strip()
+    return key + ("+dirty" if dirty else "")
+
+
+Log = Callable[[str], None]
+
+
+def environment(eng: Engine, release: str, *, log: Log) -> Path:
+    """The Python of the release's virtual environment, created once (cached)."""
+    folder = cache_root() / "venvs" / f"{eng.name}-{release}"
+    python = folder / "bin" / "python"
+    done = folder / ".installed"
+    if done.exists():
+        return python
+    log(f"creating {folder} ({eng.package}=={release})")
+    subprocess.run([sys.executable, "-m", "venv", "--clear", str(folder)], check=True)
+    pins = folder / "constraints.txt"
+    pins.write_text(constraints(eng, (ROOT / "constraints.txt").read_text()))
+    wanted = [p for p in (*CORE, *eng.extra) if p != eng.package]
+    pip = [str(python), "-m", "pip", "install", "-q", "--disable-pip-version-check"]
+    result = subprocess.run(
+        [*pip, "-c", str(pins), *wanted, f"{eng.package}=={release}"],
+        capture_output=True, text=True, check=False,
+    )
+    if result.returncode != 0:
+        raise ReleaseUnavailable(eng.name, release, _last_line(result.stderr))
+    subprocess.run([*pip, "--no-deps", "-e", str(ROOT)], check=True, capture_output=True)
+    done.write_text(release + "\n")
+    return python
+
+
+class ReleaseUnavailable(DyncheckError):
+    """A release that pip cannot install here (no wheel for this Python or platform)."""
+
+    def __init__(self, engine: str, release: str, reason: str) -> None:
+        super().__init__(f"{engine} {release} cannot be installed: {reason}")
+
+
+def _last_line(text: str) -> str:
+    lines = [ln for ln in text.splitlines() if ln.strip() and "WARNING" not in ln]
+    return lines[-1] if lines else "pip failed"
+
+
+def run_release(
+    eng: Engine, release: str, *, cases: Sequence[str] = (), jobs: int = 2, log: Log
+) -> Path:
+    """The run folder of one release (computed once per release and content of dyncheck's code)."""
+    key = _code_key()
+    out = cache_root() / "runs" / key / f"{eng.name}-{release}"
+    if (out / "discrepancies.csv").exists() and not key.endswith("+dirty"):
+        return out
+    python = environment(eng, release, log=log)
+    impls = [x for i in ("reference", "book", *eng.impls) for x in ("--impl", i)]
+    log(f"running {eng.name} {release}")
+    result = subprocess.run(
+        [str(python), "-m", "dyncheck.cli", "run", *cases, *impls, "--jobs", str(jobs),
+         "--out", str(out)],
+        capture_output=True, text=True, check=False,
+    )
+    if result.returncode not in (0, 1) or not (out / "discrepancies.csv").exists():
+        raise ReleaseFailed(eng.name, release, _last_line(result.stderr))
+    return out
+
+
+class ReleaseFailed(DyncheckError):
+    """dyncheck could not run under a release (an API it does not handle)."""
+
+    def __init__(self, engine: str, release: str, reason: str) -> None:
+        super().__init__(f"dyncheck does not run under {engine} {release}: {reason}")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Step:
+    """Two consecutive releases of one engine and what moved between them."""
+
+    engine: str
+    old: str
+    new: str
+    table: pd.DataFrame | None
+    problem: str = ""
+
+
+def matrix(
+    names: Sequence[str], *, cases: Sequence[str] = (), jobs: int = 2, log: Log
+) -> list[Step]:
+    """Every consecutive pair of each engine's releases, diffed (a release that cannot be
+    installed or run is a step with its ``problem`` stated, not an abort)."""
+    steps = []
+    for name in names:
+        eng = engine(name)
+        runs: list[tuple[str, Path | None, str]] = []
+        for release in eng.releases:
+            try:
+                runs.append((release, run_release(eng, release, cases=cases, jobs=jobs,
+                                                  log=log), ""))
+            except (ReleaseUnavailable, ReleaseFailed) as exc:
+                log(str(exc))
+                runs.append((release, None, str(exc)))
+        for (old, a, pa), (new, b, pb) in itertools.pairwise(runs):
+            if a is None or b is None:
+                steps.append(Step(engine=name, old=old, new=new, table=None,
+                                  problem=pa or pb))
+                continue
+            table = diff.diff(diff.load(a, "RUN_A"), diff.load(b, "RUN_B"))
+            steps.append(Step(engine=name, old=old, new=new, table=table))
+    return steps
+
+
+def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None = None) -> str:
+    """``reports/versions.md``: per engine, per consecutive pair, the counts of each move and
+    every moved row grouped by (case, quantity, pair, integrator), with its largest ratio.
+    ``notes`` (engine, old, new) → the explanation found for that step."""
+    notes = notes or {}
+    lines = [
+        "# Engine versions: what moved between releases",
+        "",
+        "Generated by `dyncheck versions`; do not edit. Each release ran `dyncheck run` on the "
+        "engine's implementations (every other library at `constraints.txt`); consecutive "
+        "releases are compared with `dyncheck diff` (a row moved when its verdict changed or "
+        f"its error, above its tolerance, changed by more than x{diff.FACTOR:g}; `definition "
+        "changed` when the change vanishes with the step like dt^p).",
+        "",
+    ]
+    for name in dict.fromkeys(s.engine for s in steps):
+        lines += [f"## {name}", ""]
+        for s in (s for s in steps if s.engine == name):
+            lines += [f"### {s.old} → {s.new}", ""]
+            if s.table is None:
+                lines += [f"_not compared_: {s.problem}", ""]
+                continue
+            counts = diff.summary(s.table)
+            lines += [" · ".join(f"**{n}** {m}" for m, n in counts.items()), ""]
+            if (name, s.old, s.new) in notes:
+                lines += [f"**Explanation.** {notes[(name, s.old, s.new)]}", ""]
+            grouped = _grouped(diff.moved(s.table))
+            lines += [grouped.to_markdown(index=False) if len(grouped) else "_nothing moved_", ""]
+    return "\n".join(lines)
+
+
+def _grouped(moved: pd.DataFrame) -> pd.DataFrame:
+    if moved.empty:
+        return moved
+    moved = moved.assign(pair=moved["impl_a"] + " vs " + moved["impl_b"])
+    keys = ["case", "quantity", "pair", "integrator", "move"]
+    g = moved.groupby(keys, sort=True, dropna=False)
+    out = g.agg(rows=("move", "size"), old=("error_a", "max"), new=("error_b", "max"),
+                note=("note", "first")).reset_index()
+    for col in ("old", "new"):
+        out[col] = out[col].map(lambda x: f"{x:.2e}")
+    return out
+
+
+def bisect(
+    name: str, good: str, bad: str, *, cases: Sequence[str] = (), jobs: int = 2, log: Log,
+    releases: Sequence[str] | None = None,
+) -> tuple[str, pd.DataFrame]:
+    """The first release after ``good`` whose run differs from ``good``'s (``bad`` must), and
+    what moved there. ``releases``: the candidates in order (default: ``pip index``)."""
+    eng = engine(name)
+    ordered = list(releases) if releases is not None else published(eng)
+    for r in (good, bad):
+        if r not in ordered:
+            raise InvalidInput("--bisect", r, f"a published release of {eng.package}")
+    lo, hi = ordered.index(good), ordered.index(bad)
+    if lo >= hi:
+        raise InvalidInput("--bisect", f"{good} {bad}", "GOOD older than BAD")
+
+    def moves(release: str) -> pd.DataFrame:
+        a = diff.load(run_release(eng, good, cases=cases, jobs=jobs, log=log), "GOOD")
+        b = diff.load(run_release(eng, release, cases=cases, jobs=jobs, log=log), release)
+        return diff.moved(diff.diff(a, b))
+
+    if moves(bad).empty:
+        raise InvalidInput("--bisect", f"{good} {bad}", "two releases whose runs differ")
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        log(f"bisect: {ordered[lo]} .. {ordered[mid]} .. {ordered[hi]}")
+        if moves(ordered[mid]).empty:
+            lo = mid
+        else:
+            hi = mid
+    first = ordered[hi]
+    a = diff.load(run_release(eng, ordered[lo], cases=cases, jobs=jobs, log=log), "A")
+    b = diff.load(run_release(eng, first, cases=cases, jobs=jobs, log=log), "B")
+    return first, diff.moved(diff.diff(a, b))
+
+
+def published(eng: Engine) -> list[str]:
+    """The releases pip can install here, oldest first (``pip index versions``)."""
+    result = subprocess.run(
+        [sys.executable, "-m", "pip", "index", "versions", eng.package,
+         "--disable-pip-version-check"],
+        capture_output=True, text=True, check=False,
+    )
+    for line in result.stdout.splitlines():
+        if line.startswith("Available versions:"):
+            found = [v.strip() for v in line.split(":", 1)[1].split(",")]
+            return sorted(found, key=_release_key)
+    raise ReleaseUnavailable(eng.name, "*", _last_line(result.stderr or result.stdout))
+
+
+def _release_key(text: str) -> tuple[int, ...]:
+    return tuple(int(p) if p.isdigit() else -1 for p in text.split("."))
