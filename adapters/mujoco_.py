@@ -51,13 +51,13 @@ class MuJoCoAdapter(Adapter):
     package: ClassVar[str] = "mujoco"
     integrators: ClassVar[tuple[str, ...]] = tuple(_INTEGRATORS)
     couplings_with_field: ClassVar[bool] = True
+    """Tendon equalities and xfrc_applied coexist in one MuJoCo model."""
     gyroscopic_implicit: ClassVar[bool] = tuple(
         int(x) for x in mujoco.__version__.split(".")[:2]
     ) >= (3, 12)
     """``implicitfast`` applies a free body's gyroscopic bias-force derivative (MuJoCo ≥ 3.12,
     changelog f0fa3d82): on a free joint it is no longer semi-implicit Euler (measured: the two
     differ by O(h) on ``rigid_body_free``)."""
-    """Tendon equalities and xfrc_applied coexist in one MuJoCo model."""
 
     solimp: ClassVar[tuple[float, ...] | None] = None
     """The equalities' solimp written to the MJCF (None: MuJoCo's default)."""

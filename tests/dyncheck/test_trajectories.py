@@ -205,3 +205,37 @@ def test_pinocchio_under_solve_ivp_matches_reference(full_run):
     assert len(rows) == 2 * len(CASE_NAMES)
     assert rows.case.isin(BALL_CASES).any()
     assert (rows.verdict == "passed").all() and (rows.max_rel_err <= rows.tolerance).all()
+
+
+@pytest.mark.parametrize("case_name", ["rigid_body_ball", "torque_free"])
+def test_discrete_prediction_steps_quaternion_states_at_order_four(case_name):
+    """The reference's equations stepped by RK4 in the engine's coordinates (a unit quaternion
+    for the ball joint, on the rotation group) converge to the reference trajectory at order 4
+    (the classical RK4 order; an additive update of the quaternion could not even run: nq = 4,
+    nv = 3). Needed wherever an engine's rows fail their order and the prediction is asked."""
+    from dyncheck.implementations import book_variant
+    from dyncheck.trajectories import References, difference
+
+    case = get_case(case_name)
+    refs = References(case)
+    variant = book_variant(case)
+    ref, _ = refs(variant)
+    grid = case.trajectory.grid_step
+    errors = []
+    for h in (grid / 4, grid / 8):
+        on_grid = refs.discrete(variant, "rk4", h)[:: round(grid / h)]
+        errors.append(float(difference(case, on_grid, ref).max()))
+    assert 16 / 1.5 < errors[0] / errors[1] < 16 * 1.5
+
+
+def test_discrete_prediction_refused_where_the_book_coordinates_lose_the_spin():
+    """The spherical pendulum's (φ, θ) fix the rod, not the spin about it, which a ball joint
+    stepped on the rotation group acquires: the prediction is refused (the row keeps its
+    verdict, with the reason), never made from the wrong body frame."""
+    from dyncheck.implementations import book_variant
+    from dyncheck.trajectories import References
+
+    case = get_case("spherical_pendulum")
+    refs = References(case)
+    with pytest.raises(ValueError, match="do not determine the engine state"):
+        refs.discrete(book_variant(case), "rk4", case.trajectory.grid_step / 4)
