@@ -813,6 +813,18 @@ DEMOS: dict[str, tuple[Callable[[], Entry], Origin]] = {
 are measured by ``dyncheck run`` and explained in its report."""
 
 
+TUTORIALS: dict[str, str] = {
+    "quaternion-storage-order": "01_quaternion_order",
+    "free-body-velocity-frames": "02_free_joint_velocity_frames",
+    "relative-vs-absolute-angles": "03_absolute_vs_relative_angles",
+    "soft-vs-exact-constraints": "05_soft_constraints",
+    "pinocchio-mjcf-options": "06_what_parsers_read",
+    "drake-mjcf-options": "06_what_parsers_read",
+    "rk4-on-the-rotation-group": "07_integrators_on_rotations",
+}
+"""The executed tutorial (``reports/tutorials/NAME.md``) that teaches an entry step by step."""
+
+
 REQUIRES: dict[str, tuple[str, ...]] = {
     "drake-fsal-caching": ("drake",),
     "drake-mjcf-equality": ("drake",),
@@ -870,6 +882,8 @@ def render(entries: list[Entry]) -> str:
                 else "fails outright (a quantity is singular)"
             ),
             f"- Correct mapping: {e.unit} {e.correct_error:.3g}",
-            "",
         ]
+        if e.name in TUTORIALS:
+            lines.append(f"- Tutorial: reports/tutorials/{TUTORIALS[e.name]}.md")
+        lines.append("")
     return "\n".join(lines)

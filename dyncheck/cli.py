@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
 
-from dyncheck.errors import DyncheckError, InvalidInput
+from dyncheck.errors import DyncheckError, InvalidInput, UnknownName
 
 
 class _Parser(argparse.ArgumentParser):
@@ -105,6 +105,9 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--bisect", nargs=3, default=None, metavar=("ENGINE", "GOOD", "BAD"),
                    help="name the first release between GOOD and BAD whose results moved")
     v.add_argument("--out", type=_path, default=Path("reports/versions.md"), metavar="FILE")
+    t = sub.add_parser("tutorials", help="execute the tutorials and render them to Markdown")
+    t.add_argument("names", nargs="*", metavar="NAME", help="tutorials (default: all)")
+    t.add_argument("--out", type=_path, default=Path("reports/tutorials"), help="output folder")
     c = sub.add_parser("report", help="check that the committed report matches the code")
     c.add_argument(
         "--check",
@@ -371,6 +374,31 @@ def _log(message: str) -> None:
     print(f"dyncheck: {message}", file=sys.stderr, flush=True)
 
 
+def _tutorials(args: argparse.Namespace) -> int:
+    """Execute each tutorial (its own checks must hold) and render it; exit 1 if one fails."""
+    from dyncheck import tutorials
+
+    known = tutorials.available()
+    names = args.names or list(known)
+    for name in names:
+        if name not in known:
+            raise UnknownName("tutorial", name, known)
+    _check_out(args.out)
+    failed = 0
+    for name in names:
+        try:
+            nb = tutorials.execute(name)
+        except tutorials.TutorialFailed as exc:
+            print(f"dyncheck: {exc}", file=sys.stderr)
+            failed += 1
+            continue
+        written = tutorials.render(name, nb, args.out)
+        print(f"{name}: executed -> {written[0]}")
+    if not args.names:
+        tutorials.index(args.out)
+    return 1 if failed else 0
+
+
 def _explain(args: argparse.Namespace) -> int:
     from dyncheck.catalogue import explain, render
 
@@ -415,6 +443,7 @@ COMMANDS = {
     "report": _report,
     "diff": _diff,
     "versions": _versions,
+    "tutorials": _tutorials,
     "baseline": _baseline,
     "bench": _bench,
     "explain": _explain,

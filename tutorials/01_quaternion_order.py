@@ -8,14 +8,17 @@
 # of `q` instead of the rotation they mean reports a difference that does not exist.
 #
 # **The book.** The kinetic energy of a rigid body is T = ½ ωᵢ Iᵢⱼ ωⱼ (2.2.40), with the
-# inertia tensor (2.2.39) in the body's axes; the mass matrix M(q) is the Hessian of T in
-# the velocities, so it depends on the orientation only through the gravity-free geometry
-# of the pendulum below: an offset bob on a ball joint.
+# inertia tensor (2.2.39) in the body's axes. The bias forces h(q, v) of the equations of
+# motion (2.2.24) — gyroscopic and gravity terms — depend on the orientation q; an offset
+# bob on a ball joint makes that dependence strong, so a wrong orientation cannot hide.
 #
 # The code of the convention in dyncheck: `dyncheck/conventions.py` (`QUATERNION_ORDER`)
 # and `cases/coordinate_maps.py` (`quat_from_matrix`, `quat_to_matrix`).
 
 # %%
+import tempfile
+from pathlib import Path
+
 import matplotlib.pyplot as plt
 import mujoco
 import numpy as np
@@ -34,7 +37,10 @@ XML = """
 """
 mj_model = mujoco.MjModel.from_xml_string(XML)
 mj_data = mujoco.MjData(mj_model)
-pin_model = pin.buildModelFromMJCF(XML)
+with tempfile.TemporaryDirectory() as tmp:  # Pinocchio's MJCF parser reads a file
+    path = Path(tmp) / "ball.xml"
+    path.write_text(XML)
+    pin_model = pin.buildModelFromMJCF(str(path))
 pin_data = pin_model.createData()
 
 
