@@ -152,3 +152,15 @@ def test_bench_writes_its_tables(tmp_path, capsys):
     assert {"raw engine calls", "adapter batched", "whole sweep"} <= set(b.part.dropna())
     assert "whole sweep / sum of raw engine calls" in set(b.ratio.dropna())
     assert (tmp_path / "benchmark.md").exists()
+
+
+def test_help_lists_every_command_in_full_with_an_example(capsys):
+    from dyncheck.cli import COMMANDS, EXAMPLES
+
+    assert main(["--help"]) == 0
+    top = capsys.readouterr().out
+    for command in [*COMMANDS, "list"]:
+        assert command in top
+        assert command in EXAMPLES
+        assert main([command, "--help"]) == 0
+        assert "example: dyncheck " + command in " ".join(capsys.readouterr().out.split())
