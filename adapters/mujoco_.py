@@ -26,6 +26,7 @@ from typing import ClassVar
 import mujoco
 import numpy as np
 
+from dyncheck.adapters import mujoco_api
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.mujoco_api import full_inertia
@@ -52,12 +53,12 @@ class MuJoCoAdapter(Adapter):
     integrators: ClassVar[tuple[str, ...]] = tuple(_INTEGRATORS)
     couplings_with_field: ClassVar[bool] = True
     """Tendon equalities and xfrc_applied coexist in one MuJoCo model."""
-    gyroscopic_implicit: ClassVar[bool] = tuple(
-        int(x) for x in mujoco.__version__.split(".")[:2]
-    ) >= (3, 12)
-    """``implicitfast`` applies a free body's gyroscopic bias-force derivative (MuJoCo ≥ 3.12,
-    changelog f0fa3d82): on a free joint it is no longer semi-implicit Euler (measured: the two
-    differ by O(h) on ``rigid_body_free``)."""
+    gyroscopic_implicit: ClassVar[bool] = mujoco_api.GYROSCOPIC_IMPLICIT
+    """``implicitfast`` applies a free body's gyroscopic bias-force derivative (MuJoCo ≥ 3.11):
+    on a free joint it is no longer semi-implicit Euler (measured: the two differ by O(h) on
+    ``rigid_body_free``)."""
+    rk4_group_order: ClassVar[int] = 4 if mujoco_api.RK4_ON_GROUP else 2
+    """RK4's order on ball and free joints (2 before MuJoCo 4.0: stages summed naively)."""
 
     solimp: ClassVar[tuple[float, ...] | None] = None
     """The equalities' solimp written to the MJCF (None: MuJoCo's default)."""

@@ -28,3 +28,14 @@ def full_inertia(m: mujoco.MjModel, d: mujoco.MjData, dst: np.ndarray) -> None:
         mujoco.mj_fullM(m, d, dst)
     else:
         mujoco.mj_fullM(m, dst, d.qM)
+
+
+GYROSCOPIC_IMPLICIT = RELEASE >= (3, 11, 0)
+"""``implicitfast`` applies a free body's gyroscopic bias-force derivative since MuJoCo 3.11.0
+(changelog 3.11.0, commit f0fa3d82): on a free joint it is no longer semi-implicit Euler."""
+
+RK4_ON_GROUP = RELEASE >= (4, 0, 0)
+"""MuJoCo 4.0.0's RK4 combines its stages on the rotation group (Runge-Kutta-Munthe-Kaas with
+dexp⁻¹, commit 9a7f240f0): order 4 on ball and free joints. Before, the stages' angular
+velocities were summed as if in one tangent space: order 2 there (measured by the version
+matrix, ``reports/versions.md``)."""

@@ -48,6 +48,7 @@ from dyncheck.tolerances import ORDER_SLACK, REFERENCE_MARGIN, accumulated, firs
 TRUNCATION = "integrator truncation error"
 PRE_ASYMPTOTIC = "pre-asymptotic step (a fast constraint mode)"
 CHARTS_DIFFER = "rotating-body state stepped in different charts"
+NAIVE_GROUP_RK4 = "RK4 stages summed across the rotation group's tangent spaces (order 2)"
 HELD_FORCE = "state-dependent force held over RK4 stages"
 GYROSCOPIC_IMPLICIT = "MuJoCo's implicitfast applies a free body's gyroscopic derivative"
 
@@ -240,6 +241,7 @@ def study(
     runs: dict[tuple[str, str, float], np.ndarray] = {}
     variants: dict[str, Variant | None] = {}
     engines = [n for n in IMPLEMENTATIONS if n in impls and n not in ("book", "reference")]
+    rotating = any(j.type in ROTATING for j in case.multibody().joints)
     for name in engines:
         impl = impls[name]
         if isinstance(impl, Exception):
@@ -251,6 +253,9 @@ def study(
                 continue
             nominal = NOMINAL_ORDER[integrator]
             convention = HELD_FORCE if integrator == "rk4-held-force" else ""
+            group_order = getattr(getattr(impl, "adapter", None), "rk4_group_order", nominal)
+            if integrator.startswith("rk4") and rotating and group_order < nominal:
+                nominal, convention = group_order, NAIVE_GROUP_RK4
             ref, ref_err = refs(variant or book_variant(case))
             errors, worst = [], []
             try:
