@@ -167,7 +167,16 @@ class ReleaseUnavailable(DyncheckError):
 
 
 def _last_line(text: str) -> str:
-    lines = [ln for ln in text.splitlines() if ln.strip() and "WARNING" not in ln]
+    """pip's reason in one line: the dependency that conflicts with a pinned version, else
+    its last line."""
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip() and "WARNING" not in ln]
+    pinned = [ln for ln in lines if "The user requested (constraint)" in ln]
+    if pinned:
+        pin = pinned[0].split("(constraint)", 1)[1].strip()
+        name = pin.split("=")[0].strip()
+        cause = [ln for ln in lines if f"depends on {name}" in ln and "<" in ln]
+        if cause:
+            return f"{cause[0]}, but constraints.txt pins {pin}"
     return lines[-1] if lines else "pip failed"
 
 

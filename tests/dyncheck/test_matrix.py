@@ -1,0 +1,114 @@
+"""The version matrix's pieces that install nothing (the matrix itself is not run in CI):
+constraints per engine, pip's reason, bisection over synthetic runs, the page; and the
+adapters' release branches."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from dyncheck import diff, matrix
+from dyncheck.errors import InvalidInput, UnknownName
+from dyncheck.results import PROVENANCE, to_csv
+
+CONSTRAINTS = "numpy==2.4.6\nmujoco==4.0.0\nmujoco-core==4.0.0\nPyOpenGL==3.1.10\npin==4.1.0\n" \
+    "cmeel-boost==1.90.0\neigenpy==3.13.0\ndrake==1.51.1\nMosek==11.1.2\npillow==13.0.0\n"
+
+
+@pytest.mark.parametrize(
+    ("engine", "dropped", "kept"),
+    [
+        ("mujoco", {"mujoco", "mujoco-core", "PyOpenGL"}, {"pin", "drake", "numpy", "pillow"}),
+        ("pinocchio", {"pin", "cmeel-boost", "eigenpy"}, {"mujoco", "pillow", "numpy"}),
+        ("drake", {"drake", "Mosek"}, {"mujoco", "pin", "numpy"}),
+    ],
+)
+def test_constraints_leave_out_the_engine_family_only(engine, dropped, kept):
+    names = {ln.split("==")[0] for ln in matrix.constraints(matrix.ENGINES[engine],
+                                                            CONSTRAINTS).split()}
+    assert not (names & dropped)
+    assert kept <= names
+
+
+def test_pip_conflict_is_named_in_one_line():
+    stderr = (
+        "WARNING: Location 'x' is ignored\n"
+        "    cmeel-boost 1.89.0 depends on numpy<2.4 and >=2.3\n"
+        "    The user requested (constraint) numpy==2.4.6\n"
+        "ERROR: ResolutionImpossible: for help visit https://pip.pypa.io\n"
+    )
+    assert matrix._last_line(stderr) == (
+        "cmeel-boost 1.89.0 depends on numpy<2.4 and >=2.3, but constraints.txt pins numpy==2.4.6"
+    )
+
+
+def test_unknown_engine():
+    with pytest.raises(UnknownName, match="unknown engine 'bullet'"):
+        matrix.engine("bullet")
+
+
+def _run(folder: Path, error: float, release: str) -> Path:
+    folder.mkdir(parents=True)
+    frame = pd.DataFrame([dict(case="c", quantity="mass_matrix", impl_a="reference",
+                               impl_b="mujoco", integrator="", dt=np.nan, max_rel_err=error,
+                               tolerance=1e-14, verdict="passed" if error < 1e-14 else "failed")])
+    (folder / "discrepancies.csv").write_text(to_csv(frame))
+    (folder / PROVENANCE).write_text(json.dumps({"mujoco": release}))
+    return folder
+
+
+RELEASES = ["1.0", "1.1", "1.2", "1.3", "1.4", "1.5"]
+
+
+def test_bisect_names_the_first_release_that_moved(tmp_path, monkeypatch):
+    """Releases 1.0–1.2 agree with 1.0; from 1.3 on an error of 1e-9 appears."""
+    runs = {r: _run(tmp_path / r, 1e-16 if r < "1.3" else 1e-9, r) for r in RELEASES}
+    monkeypatch.setattr(matrix, "run_release", lambda eng, r, **kw: runs[r])
+    first, moved = matrix.bisect("mujoco", "1.0", "1.5", releases=RELEASES, log=lambda m: None)
+    assert first == "1.3"
+    assert list(moved["move"]) == [diff.Move.REGRESSED]
+
+
+def test_bisect_refuses_equal_or_reversed_releases(tmp_path, monkeypatch):
+    runs = {r: _run(tmp_path / r, 1e-16, r) for r in RELEASES}
+    monkeypatch.setattr(matrix, "run_release", lambda eng, r, **kw: runs[r])
+    with pytest.raises(InvalidInput, match="two releases whose runs differ"):
+        matrix.bisect("mujoco", "1.0", "1.5", releases=RELEASES, log=lambda m: None)
+    with pytest.raises(InvalidInput, match="GOOD older than BAD"):
+        matrix.bisect("mujoco", "1.5", "1.0", releases=RELEASES, log=lambda m: None)
+    with pytest.raises(InvalidInput, match="a published release"):
+        matrix.bisect("mujoco", "0.9", "1.0", releases=RELEASES, log=lambda m: None)
+
+
+def test_page_counts_moves_and_states_problems(tmp_path):
+    a = diff.load(_run(tmp_path / "a", 1e-16, "1.0"), "A")
+    b = diff.load(_run(tmp_path / "b", 1e-9, "1.1"), "B")
+    steps = [
+        matrix.Step(engine="mujoco", old="1.0", new="1.1", table=diff.diff(a, b)),
+        matrix.Step(engine="mujoco", old="1.1", new="1.2", table=None, problem="no wheel"),
+    ]
+    page = matrix.page(steps, notes={("mujoco", "1.0", "1.1"): "a changed compiler"})
+    assert "### 1.0 → 1.1" in page and "**1** regressed" in page
+    assert "**Explanation.** a changed compiler" in page
+    assert "_not compared_: no wheel" in page
+
+
+def test_full_inertia_calls_the_signature_of_the_installed_release(monkeypatch):
+    """MuJoCo 3.10.0 changed mj_fullM(m, dst, qM) to mj_fullM(m, d, dst): both branches."""
+    import mujoco
+
+    from dyncheck.adapters import mujoco_api
+
+    calls = []
+    monkeypatch.setattr(mujoco, "mj_fullM", lambda *args: calls.append(args))
+    m, d, dst = object(), type("D", (), {"qM": "qM"})(), "dst"
+    monkeypatch.setattr(mujoco_api, "FULLM_READS_DATA", False)
+    mujoco_api.full_inertia(m, d, dst)
+    monkeypatch.setattr(mujoco_api, "FULLM_READS_DATA", True)
+    mujoco_api.full_inertia(m, d, dst)
+    assert calls == [(m, dst, "qM"), (m, d, dst)]
+
