@@ -111,6 +111,8 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--jobs", type=int, default=2, metavar="N")
     v.add_argument("--bisect", nargs=3, default=None, metavar=("ENGINE", "GOOD", "BAD"),
                    help="name the first release between GOOD and BAD whose results moved")
+    v.add_argument("--reuse", action="store_true",
+                   help="reuse each release's newest cached run, whatever code made it")
     v.add_argument("--out", type=_path, default=Path("reports/versions.md"), metavar="FILE")
     t = sub.add_parser("tutorials", help="execute the tutorials and render them to Markdown")
     t.add_argument("names", nargs="*", metavar="NAME", help="tutorials (default: all)")
@@ -389,7 +391,7 @@ def _versions(args: argparse.Namespace) -> int:
     if args.out.is_dir():
         raise InvalidInput("--out", str(args.out), "a file path, not a folder")
     _check_out(args.out.parent)
-    steps = matrix.matrix(names, cases=args.case, jobs=args.jobs, log=_log)
+    steps = matrix.matrix(names, cases=args.case, jobs=args.jobs, log=_log, reuse=args.reuse)
     write_atomic(args.out, matrix.page(steps, notes=matrix.EXPLANATIONS))
     print(f"version matrix written to {args.out}")
     return 0

@@ -80,7 +80,29 @@ ENGINES = {
 }
 
 
-EXPLANATIONS: dict[tuple[str, str, str], str] = {}
+EXPLANATIONS: dict[tuple[str, str, str], str] = {
+    ("mujoco", "3.2.7", "3.3.7"): "MuJoCo 3.3.7 cannot evaluate the compound pulley: every call "
+    "on its model (two tendon equalities sharing a body) raises `addEdge: edge array too small` "
+    "(the constraint-island graph's edge array is sized too small), so every row of that case "
+    "fails with the engine's message — an engine defect, reported as failed rows, not hidden. "
+    "MuJoCo 3.2.7 and 3.6.0 evaluate it.",
+    ("mujoco", "3.3.7", "3.6.0"): "The compound-pulley defect of 3.3.7 is gone: its rows are "
+    "back to the values of 3.2.7.",
+    ("mujoco", "3.10.0", "3.14.0"): "Rigid bodies with a full (non-diagonal) inertia tensor "
+    "(`rigid_body_ball`, `rigid_body_free`): M, h, forward and inverse dynamics and T differ "
+    "from the book by ~2e-9 relative up to 3.10.0 and agree to round-off (1e-14) from 3.14.0 "
+    "on. MuJoCo's compiler turns `fullinertia` into principal moments and a frame (an "
+    "iterative eigen-decomposition); 2e-9 is the accuracy of that step in the older releases, "
+    "not of dyncheck's model (the same MJCF; Pinocchio and the book agree to round-off). "
+    "Name the release with `dyncheck versions --bisect mujoco 3.10.0 3.14.0`.",
+    ("mujoco", "3.17.0", "4.0.0"): "RK4 on ball and free joints: the difference between the "
+    "two releases' errors shrinks as dt² — `diff` classifies it `definition changed`. MuJoCo "
+    "4.0.0 combines RK4's stages on the rotation group (Runge-Kutta-Munthe-Kaas, dexp⁻¹): "
+    "order 4; before, the stages' angular velocities were summed as vectors: order 2 "
+    "(declared by the adapter, `adapters/mujoco_api.py` `RK4_ON_GROUP`; tutorial 07). The "
+    "runs of the earlier releases predate that declaration: their rk4 rows on these cases "
+    "show `failed` (observed order 2.000); with it they are `explained`.",
+}
 """What the engine's changelog says about a step where rows moved: (engine, old, new) → text."""
 
 
@@ -181,9 +203,19 @@ def _last_line(text: str) -> str:
 
 
 def run_release(
-    eng: Engine, release: str, *, cases: Sequence[str] = (), jobs: int = 2, log: Log
+    eng: Engine, release: str, *, cases: Sequence[str] = (), jobs: int = 2, log: Log,
+    reuse: bool = False,
 ) -> Path:
-    """The run folder of one release (computed once per release and content of dyncheck's code)."""
+    """The run folder of one release (computed once per release and content of dyncheck's
+    code; ``reuse``: the newest cached run of the release, whatever code made it — its
+    ``provenance.json`` names the commit)."""
+    if reuse:
+        cached = sorted(
+            (cache_root() / "runs").glob(f"*/{eng.name}-{release}/discrepancies.csv"),
+            key=lambda p: p.stat().st_mtime,
+        )
+        if cached:
+            return cached[-1].parent
     key = _code_key()
     out = cache_root() / "runs" / key / f"{eng.name}-{release}"
     if (out / "discrepancies.csv").exists() and not key.endswith("+dirty"):
@@ -217,10 +249,13 @@ class Step:
     new: str
     table: pd.DataFrame | None
     problem: str = ""
+    made_by: str = ""
+    """The dyncheck commits of the two runs (from their provenance)."""
 
 
 def matrix(
-    names: Sequence[str], *, cases: Sequence[str] = (), jobs: int = 2, log: Log
+    names: Sequence[str], *, cases: Sequence[str] = (), jobs: int = 2, log: Log,
+    reuse: bool = False,
 ) -> list[Step]:
     """Every consecutive pair of each engine's releases, diffed (a release that cannot be
     installed or run is a step with its ``problem`` stated, not an abort)."""
@@ -230,8 +265,8 @@ def matrix(
         runs: list[tuple[str, Path | None, str]] = []
         for release in eng.releases:
             try:
-                runs.append((release, run_release(eng, release, cases=cases, jobs=jobs,
-                                                  log=log), ""))
+                path = run_release(eng, release, cases=cases, jobs=jobs, log=log, reuse=reuse)
+                runs.append((release, path, ""))
             except (ReleaseUnavailable, ReleaseFailed) as exc:
                 log(str(exc))
                 runs.append((release, None, str(exc)))
@@ -240,8 +275,11 @@ def matrix(
                 steps.append(Step(engine=name, old=old, new=new, table=None,
                                   problem=pa or pb))
                 continue
-            table = diff.diff(diff.load(a, "RUN_A"), diff.load(b, "RUN_B"))
-            steps.append(Step(engine=name, old=old, new=new, table=table))
+            ta, tb = diff.load(a, "RUN_A"), diff.load(b, "RUN_B")
+            made_by = " and ".join(dict.fromkeys(
+                t.versions.get("dyncheck commit", "?") for t in (ta, tb)))
+            steps.append(Step(engine=name, old=old, new=new, table=diff.diff(ta, tb),
+                              made_by=made_by))
     return steps
 
 
@@ -268,7 +306,8 @@ def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None
                 lines += [f"_not compared_: {s.problem}", ""]
                 continue
             counts = diff.summary(s.table)
-            lines += [" · ".join(f"**{n}** {m}" for m, n in counts.items()), ""]
+            lines += [" · ".join(f"**{n}** {m}" for m, n in counts.items())
+                      + f" (runs by dyncheck {s.made_by})", ""]
             if (name, s.old, s.new) in notes:
                 lines += [f"**Explanation.** {notes[(name, s.old, s.new)]}", ""]
             grouped = _grouped(diff.moved(s.table))
