@@ -191,3 +191,24 @@ def test_bad_input_is_one_line_exit_2(tmp_path, capsys, argv, message):
     assert main([arg.format(**paths) for arg in argv]) == 2
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1, err
+
+
+RUNS = Path(__file__).parent / "diff_runs"
+
+
+def test_two_real_runs_under_mujoco_3_17_and_4_0(capsys):
+    """Runs made by `dyncheck versions` (rigid_body_free and spherical_pendulum kept): MuJoCo
+    4.0.0 changed RK4 on ball and free joints (stages combined on the rotation group, changelog
+    9a7f240f0). The diff must name the version change and classify exactly those rows as a
+    changed definition — their difference shrinks as dt², the order-2 scheme's error — and
+    leave the instantaneous quantities (M, h, dynamics: no change of model) unchanged."""
+    assert main(["diff", str(RUNS / "mujoco-3.17.0"), str(RUNS / "mujoco-4.0.0")]) == 1
+    out = capsys.readouterr().out
+    assert "mujoco 3.17.0 -> 4.0.0" in out
+    table = diff.diff(diff.load(RUNS / "mujoco-3.17.0", "A"), diff.load(RUNS / "mujoco-4.0.0", "B"))
+    moved = diff.moved(table)
+    assert set(moved["move"]) == {diff.Move.DEFINITION_CHANGED}
+    assert set(moved["integrator"]) == {"rk4"}
+    assert set(moved["case"]) == {"rigid_body_free", "spherical_pendulum"}
+    instantaneous = table[table["integrator"] == ""]
+    assert set(instantaneous["move"]) == {diff.Move.UNCHANGED}
