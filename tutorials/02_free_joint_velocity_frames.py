@@ -13,7 +13,7 @@
 # ω × v term. The kinetic energy (2.2.38)–(2.2.40) must be the same in every convention — a
 # first check of any velocity mapping.
 #
-# The code in dyncheck: `cases/coordinate_maps.py` (`FreeBodyMap`) and
+# The code in dyncheck: [`cases/coordinate_maps.py`](../../cases/coordinate_maps.py) (`FreeBodyMap`) and
 # `dyncheck explain free-body-velocity`.
 
 # %%

@@ -11,7 +11,7 @@
 # **The book.** T (2.2.29) = ½(m₁+m₂)L₁²θ̇₁² + m₂L₁L₂θ̇₁θ̇₂cos(θ₁−θ₂) + ½m₂L₂²θ̇₂², so
 # M_θ = [[(m₁+m₂)L₁², m₂L₁L₂cos(θ₁−θ₂)], [·, m₂L₂²]].
 #
-# The code in dyncheck: `cases/pendulums.py` (`CompoundPendulum`) and
+# The code in dyncheck: [`cases/pendulums.py`](../../cases/pendulums.py) (`CompoundPendulum`) and
 # `dyncheck explain relative-vs-absolute-angles`.
 
 # %%

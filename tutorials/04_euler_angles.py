@@ -10,8 +10,8 @@
 # **The book.** L = R_z(ψ)ᵀ… written out in (2.2.50), with ϕ (ascending node) about x₃,
 # θ (inclination) about the new x₁, ψ (argument of perigee) about the new x₃.
 #
-# The code in dyncheck: `cases/coordinate_maps.py` (`EulerAngleMap`) and
-# `reference/rigid.py`.
+# The code in dyncheck: [`cases/coordinate_maps.py`](../../cases/coordinate_maps.py) (`EulerAngleMap`) and
+# [`reference/rigid.py`](../../reference/rigid.py).
 
 # %%
 import matplotlib.pyplot as plt

@@ -13,7 +13,7 @@
 #
 # **The referee** is `dyncheck check` (the book's general method, (2.2.23)–(2.2.24), on the
 # tree each engine read): it compares what each parser *read*, field by field, before it
-# compares any dynamics. The code: `dyncheck/check/describe.py`.
+# compares any dynamics. The code: [`dyncheck/check/describe.py`](../../dyncheck/check/describe.py).
 
 # %%
 import warnings

@@ -12,7 +12,7 @@
 # **The book.** Euler's equations, the torque-free case of (2.2.41)–(2.2.45):
 # I ω̇ = −ω × I ω in body axes, with the orientation q̇ = ½ q ⊗ (0, ω).
 #
-# The code: `adapters/integrators.py` (`integrate`, `Layout`, `dexp_inv`).
+# The code: [`adapters/integrators.py`](../../adapters/integrators.py) (`integrate`, `Layout`, `dexp_inv`).
 
 # %%
 import matplotlib.pyplot as plt

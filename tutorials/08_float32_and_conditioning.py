@@ -12,7 +12,7 @@
 # Thm 7.2 and §9.4): ‖δa‖/‖a‖ ≤ c · n · ε · κ(M) to first order, with c a small constant
 # (we state c = 4 and check it is not violated).
 #
-# The code: `dyncheck/tolerances.py` (the float64 round-off bounds dyncheck derives).
+# The code: [`dyncheck/tolerances.py`](../../dyncheck/tolerances.py) (the float64 round-off bounds dyncheck derives).
 
 # %%
 import matplotlib.pyplot as plt
