@@ -73,7 +73,7 @@ ENGINES = {
             package="drake",
             family=("drake", "mosek"),
             impls=("drake",),
-            releases=("1.40.0", "1.45.0", "1.51.1"),
+            releases=("1.40.0", "1.51.1"),
             extra=("drake",),
         ),
     )

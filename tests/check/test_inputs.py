@@ -89,7 +89,13 @@ def test_bad_options(tmp_path, capsys, args, words):
 def test_good_model_writes_page_and_csv_and_exits_0(tmp_path, capsys):
     out = tmp_path / "o"
     assert main(["check", str(MODELS / "branches.urdf"), "--states", "10", "--out", str(out)]) == 0
-    assert sorted(p.name for p in out.iterdir()) == ["branches.csv", "branches.md"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        "branches.csv", "branches.md", "provenance.json"]
+    import json
+
+    import mujoco
+
+    assert json.loads((out / "provenance.json").read_text())["mujoco"] == mujoco.__version__
     assert "branches:" in capsys.readouterr().out
 
 
