@@ -64,8 +64,8 @@ PROSE_FLOOR = 1e-10
 two such numbers agree whatever their digits."""
 VOLATILE = ("| date (UTC)", "| dyncheck commit")
 """Provenance lines that change with every run without the results changing."""
-PAGES_NOT_COMPARED = ("benchmark.md",)
-"""Pages of the report folder that a run does not write (``dyncheck bench`` does)."""
+PAGES_NOT_COMPARED = ("benchmark.md", "versions.md")
+"""Pages of the report folder that a run does not write (``dyncheck bench``, ``versions`` do)."""
 TABLES_NOT_COMPARED = ("benchmark.csv", "baseline.csv")
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?|\bnan\b|\binf\b")

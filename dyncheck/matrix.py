@@ -169,7 +169,8 @@ def environment(eng: Engine, release: str, *, log: Log) -> Path:
     pins = folder / "constraints.txt"
     pins.write_text(constraints(eng, (ROOT / "constraints.txt").read_text()))
     wanted = [p for p in (*CORE, *eng.extra) if p != eng.package]
-    pip = [str(python), "-m", "pip", "install", "-q", "--disable-pip-version-check"]
+    pip = [str(python), "-m", "pip", "install", "--disable-pip-version-check"]  # not -q: the
+    # resolver explains a conflict only when not quiet (read by _last_line)
     result = subprocess.run(
         [*pip, "-c", str(pins), *wanted, f"{eng.package}=={release}"],
         capture_output=True, text=True, check=False,
