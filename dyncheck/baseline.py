@@ -16,7 +16,7 @@ import pandas as pd
 
 from dyncheck import diff
 from dyncheck.errors import InvalidInput
-from dyncheck.results import DISCREPANCY_KEY, VERDICTS, to_csv, write_atomic
+from dyncheck.results import DISCREPANCY_KEY, to_csv, write_atomic
 
 COLUMNS = [*DISCREPANCY_KEY, "max_rel_err", "tolerance", "verdict"]
 FACTOR = diff.FACTOR
@@ -63,15 +63,9 @@ def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
     verdict needs one, no duplicate keys)."""
     if path.is_dir():
         raise InvalidInput(flag, str(path), "a baseline CSV file, not a folder")
-    try:
-        frame = pd.read_csv(path, keep_default_na=False, na_values=[""], comment="#")
-    except FileNotFoundError:
-        raise InvalidInput(flag, str(path), "an existing baseline CSV file") from None
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        reason = str(exc).splitlines()[0]
-        raise InvalidInput(flag, str(path), f"a CSV file ({reason})") from None
-    except OSError as exc:
-        raise InvalidInput(flag, str(path), f"a readable file ({exc.strerror})") from None
+    if not path.exists():
+        raise InvalidInput(flag, str(path), "an existing baseline CSV file")
+    frame = diff.read_csv(path, flag)
     missing = [c for c in COLUMNS if c not in frame.columns]
     if missing:
         raise InvalidInput(flag, str(path), f"a dyncheck baseline (missing {missing})")
@@ -80,12 +74,8 @@ def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
             frame[col] = frame[col].astype(float)
     except ValueError as exc:
         raise InvalidInput(flag, str(path), f"numeric errors and steps ({exc})") from None
-    bad = ~frame["verdict"].isin(VERDICTS)
-    if bad.any():
-        row = int(np.flatnonzero(bad.to_numpy())[0]) + 1
-        raise InvalidInput(
-            flag, str(path), f"verdicts in {VERDICTS} (data row {row}: truncated or edited?)"
-        )
+    frame["integrator"] = frame["integrator"].fillna("").astype(str)
+    diff.checked_keys(frame, DISCREPANCY_KEY, flag=flag, path=path)
     judged = frame["verdict"].isin(["passed", "explained"])
     nan = judged & ~np.isfinite(frame["max_rel_err"].to_numpy())
     if nan.any():
@@ -95,11 +85,6 @@ def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
             str(path),
             f"a finite max_rel_err on every passed or explained row (data row {row})",
         )
-    frame["integrator"] = frame["integrator"].fillna("").astype(str)
-    dup = diff.keys(frame, DISCREPANCY_KEY).duplicated()
-    if dup.any():
-        row = int(np.flatnonzero(dup.to_numpy())[0]) + 1
-        raise InvalidInput(flag, str(path), f"one row per key (data row {row} repeats a key)")
     expected = _header(path).get("rows")
     if expected is not None and expected != str(len(frame)):
         raise InvalidInput(
@@ -120,6 +105,7 @@ def compare(
     old = diff.tables(baseline[COLUMNS], diff.RunKind.RUN, path=here, flag="--baseline")
     new = diff.tables(current[COLUMNS], diff.RunKind.RUN, path=here)
     table = diff.moved(diff.diff(old, new, factor=FACTOR))
+
     def side(s: str) -> pd.Series:
         err = table[f"error_{s}"].map(lambda x: f" {x:.3e}" if pd.notna(x) else "")
         return table[f"verdict_{s}"] + err
@@ -135,8 +121,7 @@ def compare(
 
 
 def version_changes(path: Path, current: dict[str, str]) -> list[str]:
-    """Engines and libraries whose version differs from the baseline's header."""
+    """Engines and libraries whose version differs from the baseline's header (none when the
+    header records no versions)."""
     old = versions_of(path)
-    keys = [k for k in old if k not in ("date_(UTC)", "dyncheck_commit")]
-    now = {_word(k): _word(v) for k, v in current.items()}
-    return [f"{k} {old[k]} -> {now.get(k, 'absent')}" for k in keys if old[k] != now.get(k)]
+    return diff.version_changes(old, current) if old else []

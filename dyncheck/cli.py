@@ -348,8 +348,7 @@ def _diff(args: argparse.Namespace) -> int:
     from dyncheck.results import write_atomic
 
     factor = diff.FACTOR if args.tolerance is None else args.tolerance
-    if not factor > 1.0:
-        raise InvalidInput("--tolerance", args.tolerance, "a factor > 1")
+    diff.check_factor(factor)
     if args.markdown is not None:
         if args.markdown.is_dir():
             raise InvalidInput("--markdown", str(args.markdown), "a file path, not a folder")

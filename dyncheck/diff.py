@@ -90,7 +90,7 @@ def load(path: Path, flag: str) -> RunTables:
         files, folder = [path], path.parent
     if not files:
         raise InvalidInput(flag, str(path), "a folder holding discrepancies.csv or check CSVs")
-    frames = [_read_csv(f, flag) for f in files]
+    frames = [read_csv(f, flag) for f in files]
     kinds = {_kind(f, frame, flag) for f, frame in zip(files, frames, strict=True)}
     if len(kinds) != 1:
         raise InvalidInput(flag, str(path), "the output of one command (run and check mixed)")
@@ -113,7 +113,9 @@ def tables(
     return RunTables(path=path, kind=kind, rows=normal, versions=versions or {})
 
 
-def _read_csv(path: Path, flag: str) -> pd.DataFrame:
+def read_csv(path: Path, flag: str) -> pd.DataFrame:
+    """A CSV table of dyncheck's (``#`` lines are comments, empty cells NaN); a one-line
+    InvalidInput naming ``flag`` and the path when it cannot be read or parsed."""
     try:
         return pd.read_csv(path, keep_default_na=False, na_values=[""], comment="#")
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
@@ -144,16 +146,25 @@ def _normalise(rows: pd.DataFrame, kind: RunKind, flag: str, path: Path) -> pd.D
     except ValueError as exc:
         raise InvalidInput(flag, str(path), f"numeric errors and tolerances ({exc})") from None
     out["verdict"] = rows["verdict"].astype(str)
-    bad = ~out["verdict"].isin(VERDICTS)
+    out["_k"] = checked_keys(out, key, flag=flag, path=path)
+    return out.set_index("_k")
+
+
+def checked_keys(frame: pd.DataFrame, key: list[str], *, flag: str, path: Path) -> pd.Series:
+    """:func:`keys` of a table whose verdicts are all known and whose keys are unique; else a
+    one-line InvalidInput naming the first bad data row."""
+    bad = ~frame["verdict"].isin(VERDICTS)
     if bad.any():
         row = int(np.flatnonzero(bad.to_numpy())[0]) + 1
-        raise InvalidInput(flag, str(path), f"verdicts in {VERDICTS} (data row {row})")
-    out["_k"] = keys(out, key)
-    dup = out["_k"].duplicated()
+        raise InvalidInput(
+            flag, str(path), f"verdicts in {VERDICTS} (data row {row}: truncated or edited?)"
+        )
+    out = keys(frame, key)
+    dup = out.duplicated()
     if dup.any():
         row = int(np.flatnonzero(dup.to_numpy())[0]) + 1
         raise InvalidInput(flag, str(path), f"one row per key (data row {row} repeats a key)")
-    return out.set_index("_k")
+    return out
 
 
 def keys(frame: pd.DataFrame, key: list[str]) -> pd.Series:
@@ -198,13 +209,18 @@ def version_changes(a: dict[str, str], b: dict[str, str]) -> list[str]:
     ]
 
 
+def check_factor(factor: float) -> None:
+    """``--tolerance`` must be a factor > 1 (NaN is not)."""
+    if not factor > 1.0:
+        raise InvalidInput("--tolerance", factor, "a factor > 1")
+
+
 def diff(a: RunTables, b: RunTables, *, factor: float = FACTOR) -> pd.DataFrame:
     """One row per key of either side: its key columns, ``error_a``, ``error_b``, ``ratio``
     (b / a), ``tolerance``, ``verdict_a``, ``verdict_b``, ``move`` and a ``note``."""
     if a.kind != b.kind:
         raise InvalidInput("RUN_B", str(b.path), f"the output of `{a.kind}`, like RUN_A")
-    if not factor > 1.0:
-        raise InvalidInput("--tolerance", factor, "a factor > 1")
+    check_factor(factor)
     key = KEYS[a.kind]
     joined = a.rows.add_suffix("_a").join(b.rows.add_suffix("_b"), how="outer")
     for col in key:

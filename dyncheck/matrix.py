@@ -344,10 +344,13 @@ def bisect(
     if lo >= hi:
         raise InvalidInput("--bisect", f"{good} {bad}", "GOOD older than BAD")
 
+    def load(release: str) -> diff.RunTables:
+        return diff.load(run_release(eng, release, cases=cases, jobs=jobs, log=log), release)
+
+    reference = load(good)
+
     def moves(release: str) -> pd.DataFrame:
-        a = diff.load(run_release(eng, good, cases=cases, jobs=jobs, log=log), "GOOD")
-        b = diff.load(run_release(eng, release, cases=cases, jobs=jobs, log=log), release)
-        return diff.moved(diff.diff(a, b))
+        return diff.moved(diff.diff(reference, load(release)))
 
     if moves(bad).empty:
         raise InvalidInput("--bisect", f"{good} {bad}", "two releases whose runs differ")
@@ -359,9 +362,7 @@ def bisect(
         else:
             hi = mid
     first = ordered[hi]
-    a = diff.load(run_release(eng, ordered[lo], cases=cases, jobs=jobs, log=log), "A")
-    b = diff.load(run_release(eng, first, cases=cases, jobs=jobs, log=log), "B")
-    return first, diff.moved(diff.diff(a, b))
+    return first, diff.moved(diff.diff(load(ordered[lo]), load(first)))
 
 
 def published(eng: Engine) -> list[str]:

@@ -413,8 +413,9 @@ def errata(d: pd.DataFrame) -> tuple[str, pd.DataFrame]:
 
 def index_page(result: RunResult, *, date: str) -> str:
     d, conv = result.discrepancies, result.convergence
+    made_with = versions()
     prov = pd.DataFrame(
-        {"item": ["date (UTC)", *versions()], "value": [date, *versions().values()]}
+        {"item": ["date (UTC)", *made_with], "value": [date, *made_with.values()]}
     )
     failed = d[d.verdict.isin(["failed", "skipped"])]
     explained = d.loc[d.verdict == "explained", "convention"]

@@ -39,7 +39,9 @@ def _table(frame: pd.DataFrame, columns: list[str]) -> str:
     return shown.to_markdown(index=False)
 
 
-def page(result: CheckResult) -> str:
+def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
+    """The Markdown page (``versions``: the provenance, read now when not given)."""
+    versions = _versions() if versions is None else versions
     rows = result.rows
     c = counts(result)
     lines = [
@@ -74,7 +76,7 @@ def page(result: CheckResult) -> str:
     lines += ["## Time (seconds on this machine, loading and evaluating)", "",
               pd.DataFrame([result.seconds]).to_markdown(index=False, floatfmt=".3f"), "",
               "## Versions", ""]
-    lines += [f"- {k}: {v}" for k, v in _versions().items()]
+    lines += [f"- {k}: {v}" for k, v in versions.items()]
     lines += [f"- machine: {platform.processor() or platform.machine()}", ""]
     return "\n".join(lines)
 
@@ -84,6 +86,7 @@ def write(result: CheckResult, out: Path) -> list[Path]:
     name = result.model.replace("/", "__")
     csv_path, md_path = out / f"{name}.csv", out / f"{name}.md"
     write_atomic(csv_path, to_csv(result.rows))
-    write_atomic(md_path, page(result))
-    write_atomic(out / PROVENANCE, provenance_json(_versions()))
+    versions = _versions()
+    write_atomic(md_path, page(result, versions))
+    write_atomic(out / PROVENANCE, provenance_json(versions))
     return [csv_path, md_path, out / PROVENANCE]
