@@ -9,6 +9,12 @@ import numpy as np
 
 from dyncheck.errors import InvalidInput
 
+MAGNITUDE = 1e77
+"""Largest (and 1/MAGNITUDE the smallest) size of a parameter: the dynamics multiply up to
+four of them (m l² ω², m g l, …), and (1e77)⁴ = 1e308 is float64's largest finite number,
+(1e-77)⁴ = 1e-308 its smallest normal one (so 1e308 or 1e-300 is refused naming the field,
+not met as an OverflowError or a silent underflow to zero)."""
+
 
 def positive(field: str, value: float) -> float:
     """A finite, strictly positive number (mass, length, gravity, step size, duration)."""
@@ -16,6 +22,9 @@ def positive(field: str, value: float) -> float:
         raise InvalidInput(field, value, "a positive finite number")
     if not math.isfinite(value) or value <= 0:
         raise InvalidInput(field, value, "a positive finite number")
+    if not 1 / MAGNITUDE <= value <= MAGNITUDE:
+        raise InvalidInput(field, value, f"in [{1 / MAGNITUDE:g}, {MAGNITUDE:g}] (products of "
+                           "four parameters must stay finite and normal in float64)")
     return float(value)
 
 
@@ -26,6 +35,9 @@ def finite_array(field: str, value: Sequence[float] | np.ndarray, shape: tuple[i
         raise InvalidInput(field, value, f"of shape {shape}, not {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise InvalidInput(field, value, "finite (no NaN or inf)")
+    if np.any(np.abs(arr) > MAGNITUDE):
+        raise InvalidInput(field, value, f"at most {MAGNITUDE:g} in size (products of four "
+                           "parameters must stay finite in float64)")
 
 
 def inertia_tensor(field: str, value: np.ndarray, *, allow_zero: bool = False) -> None:

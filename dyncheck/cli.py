@@ -92,6 +92,9 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--against", type=_path, default=None, metavar="PATH",
                    help="also compare what MuJoCo reads with this other file (a previous version)")
     k.add_argument("--out", type=_path, default=Path("reports/check"), help="output folder")
+    k.add_argument("--in-process", action="store_true",
+                   help="load the engines in this process (faster start; an engine that "
+                   "crashes on the file then ends the check)")
     d = sub.add_parser("diff", help="what moved between two runs (engine upgrade, code change)")
     d.add_argument("run_a", type=_path, metavar="RUN_A",
                    help="output folder of `run` or `check` (or a baseline CSV): the old side")
@@ -454,6 +457,7 @@ def _check(args: argparse.Namespace) -> int:
         result = check_model(
             text, impls=tuple(args.impl) or None, states=args.states, seed=args.seed,
             floating=args.floating, against=args.against, name=robot,
+            isolate=not args.in_process,
         )
         written = write(result, args.out)
         print(f"{summary_line(result)} -> {written[1]}")

@@ -23,8 +23,9 @@ import pandas as pd
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials
 from dyncheck.adapters.model_tree import JointType, ModelTree
 from dyncheck.check import describe, inputs, layout
+from dyncheck.check import engines as engine_processes
 from dyncheck.check.dynamics import Explanation, compare, sample
-from dyncheck.check.engines import ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded, load
+from dyncheck.check.engines import ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
 from dyncheck.check.referee import ReferenceModel
 from dyncheck.check.rows import COLUMNS, CheckRow, Section
 from dyncheck.errors import InvalidInput, UnknownName
@@ -90,9 +91,12 @@ def check_model(
     floating: bool = False,
     against: str | Path | None = None,
     name: str | None = None,
+    isolate: bool = True,
 ) -> CheckResult:
     """Check one model file (see the module's docstring); bad input raises
-    :class:`~dyncheck.errors.InvalidInput` before any engine runs."""
+    :class:`~dyncheck.errors.InvalidInput` before any engine runs. With ``isolate`` (the
+    default) each engine runs in its own process, so that one crashing on the file costs only
+    its rows (:mod:`dyncheck.check.engines`)."""
     source_path = inputs.model_path(str(path))
     against_path = inputs.model_path(str(against)) if against is not None else None
     inputs.states(states)
@@ -102,18 +106,30 @@ def check_model(
                            "checks an engine's tree)")
     model = name or source_path.stem
     source = read(source_path, floating=floating)
+    t0 = time.perf_counter()
+    engines = engine_processes.start([i for i in chosen if i in ENGINES], source,
+                                     isolate=isolate)
+    try:
+        return _check(model, source_path, source, engines, chosen, states, seed, floating,
+                      against_path, time.perf_counter() - t0)
+    finally:
+        engine_processes.stop(engines)
+
+
+def _check(model: str, source_path: Path, source: ModelFile,
+           engines: dict[str, engine_processes.ModelEngine | NotLoaded], chosen: tuple[str, ...],
+           states: int, seed: int, floating: bool, against_path: Path | None,
+           load_seconds: float) -> CheckResult:
     rows: list[CheckRow] = []
     notes = [*source.notes, SMOOTH_NOTE]
     seconds: dict[str, float] = {}
     loaded = {}
-    for engine in (i for i in chosen if i in ENGINES):
-        t0 = time.perf_counter()
-        result = load(engine, source)
-        seconds[engine] = time.perf_counter() - t0
+    seconds["load"] = load_seconds
+    for engine, result in engines.items():
         if isinstance(result, NotLoaded):
             verdict = Verdict.SKIPPED if result.skip else Verdict.FAILED
             rows.append(_row(model, Section.LOAD, engine, verdict, result.message))
-            if engine == "mujoco" and not result.skip and source.format.value == "mjcf":
+            if engine == "mujoco" and result.refused and source.format.value == "mjcf":
                 raise inputs.ModelFileError(source_path, result.message)
             continue
         if loaded:

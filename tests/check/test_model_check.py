@@ -135,3 +135,32 @@ def test_check_model_is_deterministic():
 def test_readme_pytest_recipe_names_the_api():
     readme = (Path(__file__).parents[2] / "README.md").read_text()
     assert re.search(r"from dyncheck import check_model", readme)
+
+
+@pytest.mark.parametrize(
+    ("engine_class", "words"),
+    [
+        ("CrashOnLoad", "crashed while loading the model (killed by SIGSEGV)"),
+        ("CrashOnDynamics", "crashed while computing the dynamics (killed by SIGSEGV)"),
+        ("HangOnDynamics", "gave no answer within 2 s while computing the dynamics (stopped)"),
+    ],
+)
+def test_an_engine_that_crashes_or_hangs_costs_only_its_rows(monkeypatch, engine_class, words):
+    """A segfault or a hang in one engine (tests/check/crashing_engine.py) fails that engine's
+    rows; the other engines' rows are those of a check without it (all pass on this model)."""
+    from dyncheck.check import engines, model_check
+
+    monkeypatch.setitem(engines.ENGINES, "crashing",
+                        engines.Engine("tests.check.crashing_engine", engine_class, None))
+    monkeypatch.setattr(model_check, "IMPLEMENTATIONS", (*engines.IMPLEMENTATIONS, "crashing"))
+    monkeypatch.setattr(engines, "TIMEOUT_S", 2.0)
+    result = check_model(MODELS / "mixed.xml", impls=("reference", "mujoco", "pinocchio",
+                                                      "crashing"), states=5)
+    rows = result.rows
+    mine = rows[(rows.impl_a == "crashing") | (rows.impl_b == "crashing")]
+    failed = mine[mine.verdict == "failed"]
+    assert len(failed) == 1 and words in failed.note.iloc[0], mine
+    assert not ((mine.section == "dynamics") & (mine.verdict == "passed")).any()
+    others = rows.drop(mine.index)
+    assert {"mujoco", "pinocchio", "reference"} <= set(others.impl_a) | set(others.impl_b)
+    assert not (others.verdict == "failed").any(), others[others.verdict == "failed"]

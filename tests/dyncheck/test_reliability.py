@@ -367,3 +367,26 @@ def test_absurd_state_count_is_refused(tmp_path, capsys):
 def test_unknown_subcommand_is_one_line(capsys):
     assert main(["frobnicate"]) == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    ("case", "field", "value"),
+    [
+        ("simple_pendulum", "m", 1e308),
+        ("simple_pendulum", "l", 1e-300),
+        ("atwood", "g", 1e78),
+        ("torque_free", "m", 5e-78),
+    ],
+)
+def test_case_parameter_out_of_float64_range_names_the_field(case, field, value):
+    """Products of four parameters must stay finite and normal in float64 ((1e77)⁴ = 1e308):
+    a parameter beyond is refused by name, not met later as an OverflowError."""
+    base = get_case(case)
+    assert field in base.params()
+    with pytest.raises(InvalidInput, match=rf"^{field} must be in \[1e-77, 1e\+77\]"):
+        dataclasses.replace(base, **{field: value})
+
+
+def test_case_parameters_at_the_range_edge_are_accepted():
+    """1e77 and 1e-77 themselves are allowed (the bound is inclusive)."""
+    assert dataclasses.replace(get_case("simple_pendulum"), m=1e77, l=1e-77).m == 1e77
