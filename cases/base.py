@@ -73,7 +73,10 @@ class TrajectorySpec:
     def __post_init__(self) -> None:
         positive("duration", self.duration)
         finite_array("q0", self.q0, (len(self.q0),))
-        finite_array("v0", self.v0, (len(self.q0),))
+        finite_array("v0", self.v0, (len(self.v0),))
+        if len(self.v0) != len(self.q0):
+            n = len(self.q0)
+            raise InvalidInput("v0", self.v0, f"{n} value{'s' * (n != 1)}, as many as q0")
         for integrator, dts in self.steps.items():
             if integrator not in INTEGRATORS:
                 raise InvalidInput("integrator", integrator, f"one of {', '.join(INTEGRATORS)}")
@@ -122,6 +125,19 @@ class Case(ABC):
     n_states: int = 16
     seed: int = 20261122
     trajectory: TrajectorySpec = field(default=None)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        """What every case shares: a positive sample count, a seed numpy accepts, an initial
+        state with one value per coordinate."""
+        if isinstance(self.n_states, bool) or not isinstance(self.n_states, int) \
+                or self.n_states < 1:
+            raise InvalidInput("n_states", self.n_states, "a positive integer")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
+            raise InvalidInput("seed", self.seed, "a non-negative integer")
+        if self.trajectory is not None and len(self.trajectory.q0) != self.ndof:
+            raise InvalidInput("trajectory.q0", self.trajectory.q0,
+                               f"{self.ndof} value{'s' * (self.ndof != 1)}, one per "
+                               f"coordinate {self.coordinates}")
 
     @property
     def ndof(self) -> int:

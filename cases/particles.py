@@ -60,6 +60,7 @@ class _Particle(Case):
     """gravity along −z, m/s²"""
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         positive("M", self.M)
         positive("g", self.g)
         self.check_state("q0", self.trajectory.q0)
@@ -196,6 +197,7 @@ class Kepler(_SphericalChart, Case):
     )
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         positive("M", self.M)
         positive("mu", self.mu)
         self.check_state("q0", self.trajectory.q0)

@@ -48,6 +48,7 @@ class SimplePendulum(Case):
     )
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         for name in ("m", "l", "g"):
             positive(name, getattr(self, name))
 
@@ -105,6 +106,7 @@ class CompoundPendulum(Case):
     )
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         for name in ("m1", "m2", "L1", "L2", "g"):
             positive(name, getattr(self, name))
 
@@ -175,6 +177,7 @@ class SphericalPendulum(Case):
     )
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         for name in ("m", "l", "g"):
             positive(name, getattr(self, name))
         self.check_state("q0", self.trajectory.q0)

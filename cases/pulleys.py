@@ -61,6 +61,7 @@ class Atwood(Case):
     )
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         for name in ("m1", "m2", "a", "l", "g"):
             positive(name, getattr(self, name))
         self.check_state("q0", self.trajectory.q0)
@@ -139,6 +140,7 @@ class CompoundPulley(Case):
     )
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         for name in ("m1", "m2", "m3", "a", "l1", "l2", "g"):
             positive(name, getattr(self, name))
         for name, length in (("l1", self.l1), ("l2", self.l2)):

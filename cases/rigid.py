@@ -72,6 +72,7 @@ class RigidBodyBall(Case):
     )
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         positive("m", self.m)
         positive("g", self.g)
         inertia_tensor("inertia", self.inertia())

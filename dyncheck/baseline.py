@@ -75,6 +75,7 @@ def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
     except ValueError as exc:
         raise InvalidInput(flag, str(path), f"numeric errors and steps ({exc})") from None
     frame["integrator"] = frame["integrator"].fillna("").astype(str)
+    diff.checked_signs(frame, ["max_rel_err", "tolerance"], flag=flag, path=path)
     diff.checked_keys(frame, DISCREPANCY_KEY, flag=flag, path=path)
     judged = frame["verdict"].isin(["passed", "explained"])
     nan = judged & ~np.isfinite(frame["max_rel_err"].to_numpy())

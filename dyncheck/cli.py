@@ -22,7 +22,8 @@ class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors (``dyncheck: error: …``, exit 2), no usage dump."""
 
     def error(self, message: str) -> NoReturn:
-        print(f"dyncheck: error: {self.prog}: {message}", file=sys.stderr)
+        where = self.prog.removeprefix("dyncheck").strip()
+        print(f"dyncheck: error: {where + ': ' if where else ''}{message}", file=sys.stderr)
         raise SystemExit(2)
 
 
@@ -291,6 +292,9 @@ def _report(args: argparse.Namespace) -> int:
     for flag, folder in (("--out", args.out), ("--from", args.run_dir)):
         if folder is not None and not folder.is_dir():
             raise InvalidInput(flag, str(folder), "an existing report folder")
+        if folder is not None and not (folder / "discrepancies.csv").is_file():
+            raise InvalidInput(flag, str(folder), "a report folder written by `dyncheck run` "
+                               "(it has no discrepancies.csv)")
     committed = freshness.read_report(args.out)
     if args.run_dir is not None:
         moved = freshness.compare(committed, freshness.read_report(args.run_dir))

@@ -145,9 +145,21 @@ def _normalise(rows: pd.DataFrame, kind: RunKind, flag: str, path: Path) -> pd.D
         out["tolerance"] = rows["tolerance"].astype(float).fillna(0.0)
     except ValueError as exc:
         raise InvalidInput(flag, str(path), f"numeric errors and tolerances ({exc})") from None
+    checked_signs(out, ["error", "tolerance"], flag=flag, path=path)
     out["verdict"] = rows["verdict"].astype(str)
     out["_k"] = checked_keys(out, key, flag=flag, path=path)
     return out.set_index("_k")
+
+
+def checked_signs(frame: pd.DataFrame, columns: list[str], *, flag: str, path: Path) -> None:
+    """Errors and tolerances are sizes: a negative one (an edited file) would make every
+    comparison pass, so it is refused naming the column and the first data row."""
+    for col in columns:
+        negative = frame[col].to_numpy() < 0
+        if negative.any():
+            row = int(np.flatnonzero(negative)[0]) + 1
+            raise InvalidInput(flag, str(path), f"a {col} >= 0 on every row (data row {row}: "
+                               "edited?)")
 
 
 def checked_keys(frame: pd.DataFrame, key: list[str], *, flag: str, path: Path) -> pd.Series:
@@ -156,8 +168,10 @@ def checked_keys(frame: pd.DataFrame, key: list[str], *, flag: str, path: Path) 
     bad = ~frame["verdict"].isin(VERDICTS)
     if bad.any():
         row = int(np.flatnonzero(bad.to_numpy())[0]) + 1
+        value = frame["verdict"].iloc[row - 1]
         raise InvalidInput(
-            flag, str(path), f"verdicts in {VERDICTS} (data row {row}: truncated or edited?)"
+            flag, str(path),
+            f"verdicts in {VERDICTS} (data row {row} has {value!r}: truncated or edited?)",
         )
     out = keys(frame, key)
     dup = out.duplicated()

@@ -21,12 +21,19 @@ class InvalidInput(DyncheckError, ValueError):
         super().__init__(f"{field} must be {expected}, got {value!r}")
 
 
+SHOWN_NAMES = 25
+"""Valid names an UnknownName lists (the rest counted): the error stays one readable line."""
+
+
 class UnknownName(DyncheckError, KeyError):
     """A case, implementation, integrator or quantity name that does not exist."""
 
     def __init__(self, kind: str, name: str, valid: Iterable[str]) -> None:
         self.kind, self.name, self.valid = kind, name, sorted(valid)
-        super().__init__(f"unknown {kind} {name!r}; valid: {', '.join(self.valid)}")
+        shown = self.valid[:SHOWN_NAMES]
+        more = len(self.valid) - len(shown)
+        listed = ", ".join(shown) + (f", … and {more} more" if more else "")
+        super().__init__(f"unknown {kind} {name!r}; valid: {listed}")
 
     def __str__(self) -> str:  # KeyError would quote the message
         return self.args[0]

@@ -137,6 +137,9 @@ def _violation(mass: float, inertia: np.ndarray) -> tuple[str, object, float, fl
     """(field, value, error, tolerance, note) of the first violated condition, or None."""
     if not mass > 0.0:
         return "mass", mass, abs(mass), 0.0, f"mass {mass:g} (must be > 0)"
+    if not np.isfinite(mass) or not np.all(np.isfinite(inertia)):
+        return ("finite", mass, float("inf"), 0.0,
+                f"mass {mass:g} or inertia {_fmt(np.asarray(inertia).ravel())} not finite")
     moments = np.linalg.eigvalsh(0.5 * (inertia + inertia.T))
     tol = ROUNDOFF * EPS * max(float(np.abs(moments).sum()), 1e-300)
     if moments[0] < -tol:

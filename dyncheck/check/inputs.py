@@ -13,6 +13,7 @@ URDF_JOINTS = ("revolute", "continuous", "prismatic", "fixed")
 """The URDF joint types every engine here reads alike (``floating`` and ``planar`` are not:
 Pinocchio's parser maps them, MuJoCo's refuses or changes them)."""
 MAX_STATES = 100_000
+INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 ROBOTS_EXTRA = "example-robot-data"
 
 
@@ -56,6 +57,16 @@ def _check_urdf(path: Path, root: ET.Element) -> None:
                 f"joint {joint.get('name')!r} has type {kind!r}, which is not checked "
                 f"(checked: {', '.join(URDF_JOINTS)})",
             )
+    for link in root.findall("link"):  # the inertials the check reads itself, as numbers
+        for tag, keys in (("mass", ("value",)), ("inertia", INERTIA_KEYS)):
+            element = link.find(f"inertial/{tag}")
+            for key in keys if element is not None else ():
+                text = element.get(key, "0")  # type: ignore[union-attr]
+                try:
+                    float(text)
+                except ValueError:
+                    raise ModelFileError(path, f"link {link.get('name')!r}: <{tag} {key}="
+                                         f"{text!r}> is not a number") from None
     for mesh in root.iter("mesh"):
         name = mesh.get("filename", "")
         target = _mesh_file(path, name)

@@ -179,7 +179,11 @@ def _check(model: str, source_path: Path, source: ModelFile,
     results = {}
     if REFEREE in chosen:
         t0 = time.perf_counter()
-        results[REFEREE] = ReferenceModel(canonical_tree).dynamics(batch.q, batch.v, batch.a)
+        try:
+            results[REFEREE] = ReferenceModel(canonical_tree).dynamics(batch.q, batch.v, batch.a)
+        except Exception as exc:  # the referee failing on a tree costs its own rows too
+            rows.append(_row(model, Section.DYNAMICS, REFEREE, Verdict.FAILED,
+                             f"{type(exc).__name__}: {exc}", field="dynamics"))
         seconds[REFEREE] = time.perf_counter() - t0
     for engine, m in loaded.items():
         if engine in unmatched:

@@ -37,10 +37,14 @@ class ReferenceModel:
         mass = np.empty((n, nv, nv))
         bias, forward, inverse = (np.empty((n, nv)) for _ in range(3))
         kinetic, potential = np.empty(n), np.empty(n)
-        for i in range(n):
-            mass[i], bias[i], kinetic[i], potential[i] = self.solver.at(q[i], v[i])
-            forward[i] = np.linalg.solve(mass[i], -bias[i])
-            inverse[i] = mass[i] @ a[i] + bias[i]
+        with np.errstate(all="ignore"):  # an overflow shows as a non-finite result: a row
+            for i in range(n):
+                mass[i], bias[i], kinetic[i], potential[i] = self.solver.at(q[i], v[i])
+                try:
+                    forward[i] = np.linalg.solve(mass[i], -bias[i])
+                except np.linalg.LinAlgError:  # M singular (a joint moving no mass, a NaN):
+                    forward[i] = np.nan  # no forward dynamics — a failed row (non-finite)
+                inverse[i] = mass[i] @ a[i] + bias[i]
         return Dynamics(
             mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
             kinetic=kinetic, potential=potential,

@@ -1,0 +1,621 @@
+"""Every kind of bad input and fault a user has met or could meet, with the answer dyncheck
+gives — each one asserted (exit status, one line, no traceback, the words that name the field
+or path and the value, nothing written) and the table of observed answers kept in
+``reports/reliability.md`` (this module renders it; ``DYNCHECK_WRITE_PAGES=1`` rewrites it).
+
+Faults that need a real run, a killed process or a crashing engine have their own tests
+(:data:`DEDICATED`); they are listed on the same page.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import errno
+import io
+import os
+import re
+from collections.abc import Callable
+from contextlib import redirect_stderr, redirect_stdout
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+from dyncheck.cases import get_case
+from dyncheck.cases.multibody import Body, Joint
+from dyncheck.cli import main
+from dyncheck.errors import DyncheckError
+
+ROOT = Path(__file__).resolve().parents[2]
+REPORTS = ROOT / "reports"
+PAGE = REPORTS / "reliability.md"
+MODELS = ROOT / "tests" / "check" / "models"
+URDF = (MODELS / "branches.urdf").read_text()
+Y = (0.0, 1.0, 0.0)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Fault:
+    """One kind of bad input or fault: a ``dyncheck`` command (``{tmp}`` and ``{models}``
+    filled in) or a Python call that must raise; what is set up first; the answer expected."""
+
+    kind: str
+    area: str
+    answer: str
+    """A regular expression the one line of the answer must match."""
+    argv: tuple[str, ...] = ()
+    call: Callable[[Path], object] | None = None
+    prepare: Callable[[Path], object] | None = None
+    patch: Callable[[pytest.MonkeyPatch, Path], None] | None = None
+    exit: int = 2
+
+
+def _file(name: str, content: str | bytes) -> Callable[[Path], Path]:
+    def make(tmp: Path) -> Path:
+        path = tmp / name
+        if isinstance(content, bytes):
+            path.write_bytes(content)
+        else:
+            path.write_text(content)
+        return path
+
+    return make
+
+
+def _folder(name: str) -> Callable[[Path], Path]:
+    def make(tmp: Path) -> Path:
+        (tmp / name).mkdir()
+        return tmp / name
+
+    return make
+
+
+def _baseline(edit: Callable[[str], str]) -> Callable[[Path], Path]:
+    return lambda tmp: _file("base.csv", edit((REPORTS / "baseline.csv").read_text()))(tmp)
+
+
+def _data_lines(text: str) -> list[str]:
+    return [ln for ln in text.splitlines() if not ln.startswith("#")]
+
+
+def _column(text: str, name: str, value: str) -> str:
+    lines = _data_lines(text)
+    k = lines[0].split(",").index(name)
+    rows = [",".join(value if i == k else f for i, f in enumerate(r.split(","))) for r in lines[1:]]
+    return "\n".join([lines[0], *rows]) + "\n"
+
+
+def _headed_half(text: str) -> str:
+    from dyncheck import baseline
+
+    body = _data_lines(text)
+    return "\n".join([f"{baseline.HEADER} rows={len(body) - 1}", *body[: len(body) // 2]]) + "\n"
+
+
+def _drop_column(text: str, name: str) -> str:
+    lines = _data_lines(text)
+    k = lines[0].split(",").index(name)
+    return "\n".join(",".join(f for i, f in enumerate(r.split(",")) if i != k)
+                     for r in lines) + "\n"
+
+
+def _raise(exc: BaseException) -> Callable[..., object]:
+    def raiser(*_args: object, **_kwargs: object) -> object:
+        raise exc
+
+    return raiser
+
+
+def _patch_run_then_write(error: OSError) -> Callable[[pytest.MonkeyPatch, Path], None]:
+    """The run itself replaced (its cost is not the point); the report's write fails."""
+
+    def patch(mp: pytest.MonkeyPatch, tmp: Path) -> None:
+        from dyncheck import report, run
+
+        mp.setattr(run, "run", lambda *a, **k: None)
+        mp.setattr(report, "write", _raise(error))
+
+    return patch
+
+
+def _interrupt(module: str, name: str) -> Callable[[pytest.MonkeyPatch, Path], None]:
+    def patch(mp: pytest.MonkeyPatch, tmp: Path) -> None:
+        import importlib
+
+        mp.setattr(importlib.import_module(module), name, _raise(KeyboardInterrupt()))
+
+    return patch
+
+
+def _body(**kw: object) -> Body:
+    args: dict[str, object] = dict(name="b", parent=None, joint_pos=(0, 0, 0),
+                                   joints=(Joint("j", "hinge", Y),), mass=1.0, com=(0, 0, -1))
+    return Body(**(args | kw))  # type: ignore[arg-type]
+
+
+def _case(name: str, **change: object) -> Callable[[Path], object]:
+    return lambda tmp: dataclasses.replace(get_case(name), **change)
+
+
+def _trajectory(name: str, **change: object) -> Callable[[Path], object]:
+    def call(tmp: Path) -> object:
+        case = get_case(name)
+        return dataclasses.replace(case, trajectory=dataclasses.replace(case.trajectory, **change))
+
+    return call
+
+
+OUT = "{tmp}/out"
+BRANCHES = "{models}/branches.urdf"
+SMALL_MJCF = "<mujoco><worldbody><body><joint type='hinge'/><geom size='0.1'/></body>" \
+    "</worldbody></mujoco>"
+
+FAULTS: tuple[Fault, ...] = (
+    # --- the command line itself
+    Fault(kind="no command", area="dyncheck", argv=(),
+          answer=r"^dyncheck: error: the following arguments are required: command$"),
+    Fault(kind="unknown command", area="dyncheck", argv=("frobnicate",),
+          answer=r"invalid choice: 'frobnicate'"),
+    Fault(kind="unknown option", area="dyncheck", argv=("run", "--frob"),
+          answer=r"unrecognized arguments: --frob"),
+    # --- run
+    Fault(kind="unknown case", area="run", argv=("run", "no_such_case", "--out", OUT),
+          answer=r"unknown case 'no_such_case'; valid: atwood, "),
+    Fault(kind="unknown implementation", area="run",
+          argv=("run", "simple_pendulum", "--impl", "bullet", "--out", OUT),
+          answer=r"unknown implementation 'bullet'; valid: "),
+    Fault(kind="--jobs 0", area="run", argv=("run", "--jobs", "0", "--out", OUT),
+          answer=r"--jobs must be a positive integer, got 0$"),
+    Fault(kind="--jobs negative", area="run", argv=("run", "--jobs", "-2", "--out", OUT),
+          answer=r"--jobs must be a positive integer, got -2$"),
+    Fault(kind="--jobs not a number", area="run", argv=("run", "--jobs", "two", "--out", OUT),
+          answer=r"argument --jobs: invalid int value: 'two'$"),
+    Fault(kind="--states 0", area="run", argv=("run", "--states", "0", "--out", OUT),
+          answer=r"--states must be a positive integer, got 0$"),
+    Fault(kind="--states negative", area="run", argv=("run", "--states", "-5", "--out", OUT),
+          answer=r"--states must be a positive integer, got -5$"),
+    Fault(kind="--states 1e11 (days of work)", area="run",
+          argv=("run", "--states", str(10**11), "--out", OUT),
+          answer=r"--states must be at most 1000000000 \(.*\), got 100000000000$"),
+    Fault(kind="--states in float notation", area="run", argv=("run", "--states", "1e3"),
+          answer=r"argument --states: invalid int value: '1e3'$"),
+    Fault(kind="--out empty", area="run", argv=("run", "simple_pendulum", "--out", ""),
+          answer=r"argument --out: an empty path is not a folder or file name$"),
+    Fault(kind="--out below a file", area="run", prepare=_file("file", "keep"),
+          argv=("run", "simple_pendulum", "--out", "{tmp}/file/sub"),
+          answer=r"--out must be a writable directory \(Not a directory\), got '<tmp>/file/sub'"),
+    Fault(kind="--out an existing file", area="run", prepare=_file("file", "keep"),
+          argv=("run", "simple_pendulum", "--out", "{tmp}/file"),
+          answer=r"--out must be a directory, got '<tmp>/file'$"),
+    Fault(kind="--out in a read-only system folder", area="run",
+          argv=("run", "simple_pendulum", "--out", "/proc/dyncheck-nope"),
+          answer=r"--out must be a writable directory \(.+\), got '/proc/dyncheck-nope'$"),
+    Fault(kind="--baseline missing", area="run",
+          argv=("run", "simple_pendulum", "--baseline", "{tmp}/none.csv", "--out", OUT),
+          answer=r"--baseline .*'<tmp>/none.csv'"),
+    Fault(kind="--baseline a folder", area="run", prepare=_folder("base"),
+          argv=("run", "simple_pendulum", "--baseline", "{tmp}/base", "--out", OUT),
+          answer=r"--baseline must be a baseline CSV file, not a folder, got '<tmp>/base'$"),
+    Fault(kind="--baseline binary, not UTF-8", area="run",
+          prepare=_file("base.csv", b"\x89PNG\r\n\x1a\n\xff\xfe\x00\x00"),
+          argv=("run", "simple_pendulum", "--baseline", "{tmp}/base.csv", "--out", OUT),
+          answer=r"--baseline .*'<tmp>/base.csv'"),
+    Fault(kind="--baseline empty file", area="run", prepare=_file("base.csv", ""),
+          argv=("run", "simple_pendulum", "--baseline", "{tmp}/base.csv", "--out", OUT),
+          answer=r"--baseline .*'<tmp>/base.csv'"),
+    Fault(kind="--baseline all errors NaN", area="run",
+          prepare=_baseline(lambda t: _column(t, "max_rel_err", "nan")),
+          argv=("run", "simple_pendulum", "--baseline", "{tmp}/base.csv", "--out", OUT),
+          answer=r"--baseline .*finite"),
+    Fault(kind="--baseline a tolerance negative", area="run",
+          prepare=_baseline(lambda t: _column(t, "tolerance", "-1")),
+          argv=("run", "simple_pendulum", "--baseline", "{tmp}/base.csv", "--out", OUT),
+          answer=r"--baseline .*tolerance"),
+    Fault(kind="--baseline a duplicated row", area="run",
+          prepare=_baseline(lambda t: t + t.splitlines()[-1] + "\n"),
+          argv=("run", "simple_pendulum", "--baseline", "{tmp}/base.csv", "--out", OUT),
+          answer=r"--baseline .*repeats a key"),
+    Fault(kind="--baseline truncated mid-line", area="run",
+          prepare=_baseline(lambda t: t[: len(t) // 2 - 7]),
+          argv=("run", "simple_pendulum", "--baseline", "{tmp}/base.csv", "--out", OUT),
+          answer=r"--baseline .*truncated or edited"),
+    Fault(kind="--baseline truncated at a line end", area="run", prepare=_baseline(_headed_half),
+          argv=("run", "simple_pendulum", "--baseline", "{tmp}/base.csv", "--out", OUT),
+          answer=r"--baseline .*truncated\?"),
+    Fault(kind="--baseline a column missing", area="run",
+          prepare=_baseline(lambda t: _drop_column(t, "verdict")),
+          argv=("run", "simple_pendulum", "--baseline", "{tmp}/base.csv", "--out", OUT),
+          answer=r"--baseline .*verdict"),
+    Fault(kind="--baseline an unknown verdict", area="run",
+          prepare=_baseline(lambda t: _column(t, "verdict", "fine")),
+          argv=("run", "simple_pendulum", "--baseline", "{tmp}/base.csv", "--out", OUT),
+          answer=r"--baseline .*'fine'"),
+    Fault(kind="disk full while the report is written", area="run",
+          patch=_patch_run_then_write(OSError(errno.ENOSPC, "No space left on device",
+                                              "out/x.csv")),
+          argv=("run", "simple_pendulum", "--impl", "reference", "--out", OUT),
+          answer=r"^dyncheck: error: cannot write out/x.csv: No space left on device$"),
+    Fault(kind="file-size limit while the report is written", area="run",
+          patch=_patch_run_then_write(OSError(errno.EFBIG, "File too large", "out/x.csv")),
+          argv=("run", "simple_pendulum", "--impl", "reference", "--out", OUT),
+          answer=r"^dyncheck: error: cannot write out/x.csv: File too large$"),
+    Fault(kind="Ctrl-C during the run", area="run", patch=_interrupt("dyncheck.run", "run"),
+          argv=("run", "simple_pendulum", "--out", OUT), exit=130,
+          answer=r"^dyncheck: interrupted \(nothing half-written\)$"),
+    # --- check
+    Fault(kind="no model given", area="check", argv=("check", "--out", OUT),
+          answer=r"PATH must be at least one model file or --robot NAME"),
+    Fault(kind="model file missing", area="check", argv=("check", "{tmp}/nope.xml"),
+          answer=r"<tmp>/nope.xml: no such file$"),
+    Fault(kind="model path a folder", area="check", prepare=_folder("m"),
+          argv=("check", "{tmp}/m", "--out", OUT), answer=r"<tmp>/m: not a file$"),
+    Fault(kind="model not XML", area="check", prepare=_file("bad.xml", "<mujoco><worldbody>"),
+          argv=("check", "{tmp}/bad.xml", "--out", OUT),
+          answer=r"<tmp>/bad.xml: not XML \(line 1"),
+    Fault(kind="model binary, not UTF-8", area="check",
+          prepare=_file("bin.xml", b"\xff\xfe<\x00m\x00\x00\x01\x02"),
+          argv=("check", "{tmp}/bin.xml", "--out", OUT), answer=r"<tmp>/bin.xml: not XML"),
+    Fault(kind="model file empty", area="check", prepare=_file("empty.urdf", ""),
+          argv=("check", "{tmp}/empty.urdf", "--out", OUT),
+          answer=r"<tmp>/empty.urdf: not XML"),
+    Fault(kind="XML that is neither MJCF nor URDF", area="check", prepare=_file("x.xml", "<svg/>"),
+          argv=("check", "{tmp}/x.xml", "--out", OUT),
+          answer=r"root element <svg> is neither <mujoco> nor <robot>$"),
+    Fault(kind="MJCF MuJoCo refuses (negative geom size)", area="check",
+          prepare=_file("r.xml", "<mujoco><worldbody><body><joint type='hinge'/>"
+                        "<geom size='-1'/></body></worldbody></mujoco>"),
+          argv=("check", "{tmp}/r.xml", "--out", OUT), answer=r"<tmp>/r.xml: mujoco refused"),
+    Fault(kind="MJCF include of a missing file", area="check",
+          prepare=_file("inc.xml", "<mujoco><include file='gone.xml'/></mujoco>"),
+          argv=("check", "{tmp}/inc.xml", "--out", OUT), answer=r"<tmp>/inc.xml: mujoco refused"),
+    Fault(kind="MJCF with an unknown element", area="check",
+          prepare=_file("u.xml", "<mujoco><worldbody><gizmo/></worldbody></mujoco>"),
+          argv=("check", "{tmp}/u.xml", "--out", OUT), answer=r"<tmp>/u.xml: mujoco refused"),
+    Fault(kind="URDF mesh missing", area="check",
+          prepare=_file("m.urdf", URDF.replace(
+              '<link name="base">', '<link name="base"><visual><geometry><mesh filename='
+              '"meshes/base.stl"/></geometry></visual>')),
+          argv=("check", "{tmp}/m.urdf", "--out", OUT),
+          answer=r"mesh 'meshes/base.stl' not found"),
+    Fault(kind="model with no degree of freedom", area="check",
+          prepare=_file("z.xml", "<mujoco><worldbody><body><geom size='0.1'/></body>"
+                        "</worldbody></mujoco>"),
+          argv=("check", "{tmp}/z.xml", "--out", OUT),
+          answer=r"<tmp>/z.xml: has no degrees of freedom"),
+    Fault(kind="URDF joint type no engine maps (planar)", area="check",
+          prepare=_file("p.urdf", URDF.replace('type="continuous"', 'type="planar"')),
+          argv=("check", "{tmp}/p.urdf", "--out", OUT),
+          answer=r"joint 'leg_joint' has type 'planar'"),
+    Fault(kind="URDF with a negative mass", area="check", exit=1,
+          prepare=_file("neg.urdf", URDF.replace('<mass value="1.5"/>', '<mass value="-1.5"/>')),
+          argv=("check", "{tmp}/neg.urdf", "--states", "5", "--out", OUT),
+          answer=r"^neg: \d+ passed, \d+ explained, [1-9]\d* failed"),
+    Fault(kind="URDF inertia breaking the triangle inequality", area="check", exit=1,
+          prepare=_file("tri.urdf", URDF.replace('ixx="0.02"', 'ixx="2.0"', 1)),
+          argv=("check", "{tmp}/tri.urdf", "--states", "5", "--out", OUT),
+          answer=r"^tri: \d+ passed, \d+ explained, [1-9]\d* failed"),
+    Fault(kind="--states 0", area="check", argv=("check", BRANCHES, "--states", "0",
+                                                 "--out", OUT),
+          answer=r"--states must be an integer in \[1, 100000\], got 0$"),
+    Fault(kind="--states too many", area="check",
+          argv=("check", BRANCHES, "--states", str(10**11), "--out", OUT),
+          answer=r"--states must be an integer in \[1, 100000\], got 100000000000$"),
+    Fault(kind="--seed negative", area="check",
+          argv=("check", BRANCHES, "--seed", "-1", "--out", OUT),
+          answer=r"--seed must be a non-negative integer, got -1$"),
+    Fault(kind="--seed not a number", area="check",
+          argv=("check", BRANCHES, "--seed", "x", "--out", OUT),
+          answer=r"argument --seed: invalid int value: 'x'$"),
+    Fault(kind="unknown robot", area="check", argv=("check", "--robot", "no_such_robot",
+                                                    "--out", OUT),
+          answer=r"no_such_robot"),
+    Fault(kind="unknown implementation", area="check",
+          argv=("check", BRANCHES, "--impl", "bullet", "--out", OUT),
+          answer=r"unknown implementation 'bullet'; valid: drake, mujoco, pinocchio, reference$"),
+    Fault(kind="only the referee chosen", area="check",
+          argv=("check", BRANCHES, "--impl", "reference", "--out", OUT),
+          answer=r"--impl must be at least one engine"),
+    Fault(kind="--against missing", area="check",
+          argv=("check", BRANCHES, "--against", "{tmp}/old.urdf", "--out", OUT),
+          answer=r"<tmp>/old.urdf: no such file$"),
+    Fault(kind="--out below a file", area="check", prepare=_file("file", "keep"),
+          argv=("check", BRANCHES, "--out", "{tmp}/file/sub"),
+          answer=r"--out must be a writable directory \(Not a directory\)"),
+    # --- diff
+    Fault(kind="RUN_A missing", area="diff", argv=("diff", "{tmp}/a", "{tmp}/b"),
+          answer=r"RUN_A must be an existing output folder of `run` or `check`, got '<tmp>/a'$"),
+    Fault(kind="RUN_A an empty folder", area="diff", prepare=_folder("a"),
+          argv=("diff", "{tmp}/a", str(REPORTS)), answer=r"RUN_A .*'<tmp>/a'"),
+    Fault(kind="a run against a check", area="diff",
+          argv=("diff", str(REPORTS), str(REPORTS / "check")),
+          answer=r"RUN_B must be the output of `run`, like RUN_A"),
+    Fault(kind="--tolerance below 1", area="diff",
+          argv=("diff", str(REPORTS), str(REPORTS), "--tolerance", "0.5"),
+          answer=r"--tolerance must be a factor > 1, got 0.5$"),
+    Fault(kind="--tolerance NaN", area="diff",
+          argv=("diff", str(REPORTS), str(REPORTS), "--tolerance", "nan"),
+          answer=r"--tolerance must be a factor > 1, got nan$"),
+    Fault(kind="--markdown a folder", area="diff", prepare=_folder("md"),
+          argv=("diff", str(REPORTS), str(REPORTS), "--markdown", "{tmp}/md"),
+          answer=r"--markdown must be a file path, not a folder, got '<tmp>/md'$"),
+    Fault(kind="a run whose CSV is corrupted", area="diff",
+          prepare=lambda tmp: _file("discrepancies.csv", "case,quantity\n\x00\x01,2,3\n")(
+              _folder("a")(tmp)),
+          argv=("diff", "{tmp}/a", str(REPORTS)), answer=r"RUN_A .*<tmp>/a"),
+    # --- versions
+    Fault(kind="unknown engine", area="versions", argv=("versions", "--engine", "bullet"),
+          answer=r"unknown engine 'bullet'; valid: drake, mujoco, pinocchio$"),
+    Fault(kind="unknown case", area="versions", argv=("versions", "--case", "nope"),
+          answer=r"unknown case 'nope'"),
+    Fault(kind="--jobs 0", area="versions", argv=("versions", "--jobs", "0"),
+          answer=r"--jobs must be a positive integer, got 0$"),
+    Fault(kind="--bisect with GOOD equal to BAD", area="versions",
+          argv=("versions", "--bisect", "mujoco", "3.2.7", "3.2.7"),
+          answer=r"--bisect must be GOOD older than BAD, got '3.2.7 3.2.7'$"),
+    Fault(kind="--bisect an unknown engine", area="versions",
+          argv=("versions", "--bisect", "bullet", "1", "2"),
+          answer=r"unknown engine 'bullet'"),
+    Fault(kind="--out a folder", area="versions", prepare=_folder("v"),
+          argv=("versions", "--engine", "mujoco", "--out", "{tmp}/v"),
+          answer=r"--out must be a file path, not a folder, got '<tmp>/v'$"),
+    # --- report
+    Fault(kind="--check on a missing folder", area="report",
+          argv=("report", "--check", "--out", "{tmp}/none"),
+          answer=r"--out must be an existing report folder, got '<tmp>/none'$"),
+    Fault(kind="--check on a folder with no report", area="report", prepare=_folder("r"),
+          argv=("report", "--check", "--out", "{tmp}/r"),
+          answer=r"--out must be a report folder written by `dyncheck run` \(it has no "
+                 r"discrepancies.csv\), got '<tmp>/r'$"),
+    Fault(kind="--jobs 0", area="report", argv=("report", "--check", "--jobs", "0"),
+          answer=r"--jobs must be a positive integer, got 0$"),
+    Fault(kind="--check missing", area="report", argv=("report",),
+          answer=r"^dyncheck: error: report: the following arguments are required: --check$"),
+    # --- explain, tutorials
+    Fault(kind="unknown convention", area="explain", argv=("explain", "nope"),
+          answer=r"unknown convention 'nope'; valid: "),
+    Fault(kind="unknown tutorial", area="tutorials", argv=("tutorials", "nope", "--out", OUT),
+          answer=r"unknown tutorial 'nope'; valid: 01_quaternion_order"),
+    Fault(kind="--out below a file", area="tutorials", prepare=_file("file", "keep"),
+          argv=("tutorials", "01_quaternion_order", "--out", "{tmp}/file/sub"),
+          answer=r"--out must be a writable directory \(Not a directory\)"),
+    # --- baseline
+    Fault(kind="--out an existing folder", area="baseline", prepare=_folder("b"),
+          argv=("baseline", "simple_pendulum", "--out", "{tmp}/b"),
+          answer=r"--out must be a file path, not a folder, got '<tmp>/b'$"),
+    Fault(kind="--out below a file", area="baseline", prepare=_file("file", "keep"),
+          argv=("baseline", "simple_pendulum", "--out", "{tmp}/file/b.csv"),
+          answer=r"--out must be a directory, got '<tmp>/file'$"),
+    Fault(kind="the baseline to replace is corrupted", area="baseline",
+          prepare=_file("b.csv", "# dyncheck baseline rows=3\ncase,quantity\n"),
+          argv=("baseline", "simple_pendulum", "--out", "{tmp}/b.csv"),
+          answer=r"--out .*'<tmp>/b.csv'"),
+    Fault(kind="unknown case", area="baseline", argv=("baseline", "nope", "--out", "{tmp}/b.csv"),
+          answer=r"unknown case 'nope'"),
+    # --- bench
+    Fault(kind="unknown case", area="bench", argv=("bench", "nope", "--out", OUT),
+          answer=r"unknown case 'nope'"),
+    Fault(kind="--states 0", area="bench", argv=("bench", "--states", "0", "--out", OUT),
+          answer=r"--states must be a positive integer, got 0$"),
+    Fault(kind="--repeats 0", area="bench", argv=("bench", "--repeats", "0", "--out", OUT),
+          answer=r"--repeats must be a positive integer, got 0$"),
+    Fault(kind="--memory negative (hung before)", area="bench",
+          argv=("bench", "simple_pendulum", "--memory", "-3", "--out", OUT),
+          answer=r"--memory must be a positive integer, got -3$"),
+    Fault(kind="--memory not a number", area="bench", argv=("bench", "--memory", "abc"),
+          answer=r"argument --memory: invalid int value: 'abc'$"),
+    # --- the Python API: a case or a model built with impossible values
+    Fault(kind="body mass negative", area="Python API", call=lambda t: _body(mass=-1.0),
+          answer=r"^b\.mass must be a positive finite number, got -1\.0$"),
+    Fault(kind="body mass infinite", area="Python API", call=lambda t: _body(mass=float("inf")),
+          answer=r"^b\.mass must be a positive finite number, got inf$"),
+    Fault(kind="inertia not positive definite", area="Python API",
+          call=lambda t: _body(inertia=((1, 0, 0), (0, 1, 0), (0, 0, -1))),
+          answer=r"^b\.inertia must be positive definite"),
+    Fault(kind="inertia not symmetric", area="Python API",
+          call=lambda t: _body(inertia=((1, 0.5, 0), (0, 1, 0), (0, 0, 1))),
+          answer=r"^b\.inertia must be a symmetric"),
+    Fault(kind="inertia breaking I1 + I2 >= I3", area="Python API",
+          call=lambda t: _body(inertia=((1, 0, 0), (0, 1, 0), (0, 0, 3))),
+          answer=r"^b\.inertia must be an inertia whose principal moments obey I1 \+ I2 >= I3"),
+    Fault(kind="centre of mass NaN", area="Python API",
+          call=lambda t: _body(com=(0, float("nan"), 0)),
+          answer=r"^b\.com must be finite \(no NaN or inf\)"),
+    Fault(kind="joint position of the wrong shape", area="Python API",
+          call=lambda t: _body(joint_pos=(0, 0)), answer=r"^b\.joint_pos must be of shape"),
+    Fault(kind="joint type unknown", area="Python API",
+          call=lambda t: Joint("j", "universal", Y),  # type: ignore[arg-type]
+          answer=r"^j\.type must be one of \('hinge', 'slide', 'ball', 'free'\), got 'universal'$"),
+    Fault(kind="joint axis not a unit vector", area="Python API",
+          call=lambda t: Joint("j", "hinge", (0.0, 2.0, 0.0)),
+          answer=r"^j\.axis must be a unit vector"),
+    Fault(kind="joint axis zero", area="Python API",
+          call=lambda t: Joint("j", "hinge", (0.0, 0.0, 0.0)),
+          answer=r"^j\.axis must be a unit vector"),
+    Fault(kind="initial state NaN", area="Python API",
+          call=_trajectory("simple_pendulum", q0=(float("nan"),)),
+          answer=r"^q0 must be finite \(no NaN or inf\)"),
+    Fault(kind="initial velocity infinite", area="Python API",
+          call=_trajectory("simple_pendulum", v0=(float("inf"),)), answer=r"^v0 must be finite"),
+    Fault(kind="initial state of the wrong length", area="Python API",
+          call=_trajectory("simple_pendulum", q0=(0.1, 0.2), v0=(0.0, 0.0)),
+          answer=r"^trajectory\.q0 must be 1 value, one per coordinate \('θ',\), "
+                 r"got \(0\.1, 0\.2\)$"),
+    Fault(kind="initial velocity shorter than the state", area="Python API",
+          call=_trajectory("simple_pendulum", v0=()),
+          answer=r"^v0 must be 1 value, as many as q0, got \(\)$"),
+    Fault(kind="case seed negative (accepted silently before)", area="Python API",
+          call=_case("simple_pendulum", seed=-1),
+          answer=r"^seed must be a non-negative integer, got -1$"),
+    Fault(kind="case sample count zero", area="Python API",
+          call=_case("simple_pendulum", n_states=0),
+          answer=r"^n_states must be a positive integer, got 0$"),
+    Fault(kind="duration zero", area="Python API",
+          call=_trajectory("simple_pendulum", duration=0.0),
+          answer=r"^duration must be a positive finite number, got 0\.0$"),
+    Fault(kind="integrator unknown", area="Python API",
+          call=_trajectory("simple_pendulum", steps={"leapfrog": (0.1, 0.05)}),
+          answer=r"^integrator must be one of euler, implicitfast"),
+    Fault(kind="step size negative", area="Python API",
+          call=_trajectory("simple_pendulum", steps={"euler": (-0.1, -0.05)}),
+          answer=r"^steps\[euler\] dt must be a positive finite"),
+    Fault(kind="one step size (no convergence order)", area="Python API",
+          call=_trajectory("simple_pendulum", steps={"euler": (0.1,)}),
+          answer=r"^steps\[euler\] must be at least two step sizes"),
+    Fault(kind="state on the chart's singular set (spherical pendulum)", area="Python API",
+          call=_trajectory("spherical_pendulum", q0=(0.0, 0.3)),
+          answer=r"^q0 must be off the singular set of the book's chart \(φ = 0"),
+    Fault(kind="state on the z axis (spherical coordinates)", area="Python API",
+          call=_trajectory("spherical_coordinates", q0=(1.0, 0.0, 0.2)),
+          answer=r"θ = 0 or π, the z axis"),
+    Fault(kind="state at the origin (Kepler)", area="Python API",
+          call=_trajectory("kepler", q0=(0.0, 1.0, 0.2)), answer=r"ρ = 0, the origin"),
+    Fault(kind="state on the axis (cylindrical coordinates)", area="Python API",
+          call=_trajectory("cylindrical_coordinates", q0=(0.0, 0.3, 0.5)),
+          answer=r"r = 0, the z axis"),
+    Fault(kind="case parameter 1e308 (OverflowError before)", area="Python API",
+          call=_case("simple_pendulum", m=1e308),
+          answer=r"^m must be in \[1e-77, 1e\+77\] .*, got 1e\+308$"),
+    Fault(kind="case parameter 1e-300 (silent underflow before)", area="Python API",
+          call=_case("simple_pendulum", l=1e-300),
+          answer=r"^l must be in \[1e-77, 1e\+77\] .*, got 1e-300$"),
+    Fault(kind="case parameter zero", area="Python API", call=_case("atwood", g=0.0),
+          answer=r"^g must be a positive finite number, got 0\.0$"),
+)
+
+DEDICATED = (
+    ("a run killed with SIGKILL", "the previous report byte-identical, no temp file",
+     "tests/dyncheck/test_reliability.py::test_killed_run_leaves_previous_report_intact"),
+    ("Pinocchio not importable", "its rows skipped naming `pip install pin`, the rest kept, "
+     "exit 0", "tests/dyncheck/test_reliability.py::test_missing_engine_costs_only_its_rows"),
+    ("an engine raising inside a simulation", "its trajectory rows failed with the message, "
+     "exit 1",
+     "tests/dyncheck/test_reliability.py::test_a_crashing_simulation_becomes_failed_rows"),
+    ("a simulation that diverges", "an error, not a hang or a silent reset",
+     "tests/dyncheck/test_reliability.py::test_divergence_is_an_error_not_a_hang"),
+    ("the memory probe's child dies", "an error naming it, not a wait forever",
+     "tests/dyncheck/test_reliability.py::test_memory_probe_does_not_wait_on_a_dead_child"),
+    ("an engine segfaults loading a user's model", "that engine's rows failed "
+     "(`crashed while loading the model (killed by SIGSEGV)`), the others kept",
+     "tests/check/test_model_check.py::test_an_engine_that_crashes_or_hangs_costs_only_its_rows"),
+    ("an engine segfaults computing the dynamics", "that engine's rows failed, the others kept",
+     "tests/check/test_model_check.py::test_an_engine_that_crashes_or_hangs_costs_only_its_rows"),
+    ("an engine never answers", "stopped after the time limit, its rows failed",
+     "tests/check/test_model_check.py::test_an_engine_that_crashes_or_hangs_costs_only_its_rows"),
+    ("a model file unreadable (permissions)", "`cannot be read (Permission denied)`, exit 2",
+     "tests/check/test_inputs.py::test_unreadable_file"),
+    ("1000 mutated MJCF and URDF files", "each a one-line error or a report, within a time "
+     "limit", "tests/check/test_fuzz.py::test_mutated_models_never_traceback_or_hang"),
+)
+
+OBSERVED: dict[int, tuple[int, str]] = {}
+"""The answers seen in this session, by index in :data:`FAULTS` (the page is made of them)."""
+
+
+def _files(tmp: Path) -> set[Path]:
+    return {p for p in tmp.rglob("*")}
+
+
+def _normalise(text: str, tmp: Path) -> str:
+    return text.replace(str(tmp), "<tmp>").replace(str(MODELS), "<models>")
+
+
+def observe(fault: Fault, tmp: Path) -> tuple[int, str, bool]:
+    """Run ``fault``: its exit status, its answer (every line), whether tmp was left as set
+    up (nothing written, nothing half-written)."""
+    if fault.prepare is not None:
+        fault.prepare(tmp)
+    before = _files(tmp)
+    if fault.call is not None:
+        try:
+            fault.call(tmp)
+        except DyncheckError as exc:
+            return 2, _normalise(str(exc), tmp), _files(tmp) == before
+        return 0, "(accepted)", _files(tmp) == before
+    argv = [a.format(tmp=tmp, models=MODELS) for a in fault.argv]
+    out, err = io.StringIO(), io.StringIO()
+    cwd = Path.cwd()
+    os.chdir(tmp)  # a relative default --out lands in tmp, never in the repository
+    try:
+        with pytest.MonkeyPatch.context() as mp, redirect_stdout(out), redirect_stderr(err):
+            if fault.patch is not None:
+                fault.patch(mp, tmp)
+            code = main(argv)
+    finally:
+        os.chdir(cwd)
+    answer = err.getvalue() if code not in (0, 1) else out.getvalue()
+    after = _files(tmp)
+    untouched = after == before if code not in (0, 1) else True
+    return code, _normalise(answer, tmp), untouched
+
+
+def _line(fault: Fault, answer: str) -> str:
+    """The answer's line: the only one, or for a check's report (exit 1) its summary line."""
+    lines = answer.strip().splitlines() or [""]
+    return next((ln for ln in lines if re.search(fault.answer, ln)), lines[0])
+
+
+@pytest.mark.parametrize("index", range(len(FAULTS)),
+                         ids=[f"{f.area}: {f.kind}" for f in FAULTS])
+def test_fault_gets_one_line_and_its_exit_status(index, tmp_path):
+    """The observed exit status is the one promised (2 for bad input and I/O faults, 130 for
+    an interrupt, 1 for a model the check finds wrong), the answer is one line naming the
+    field or path, no traceback, and a refused command wrote nothing."""
+    fault = FAULTS[index]
+    code, answer, untouched = observe(fault, tmp_path)
+    lines = answer.strip().splitlines()
+    line = _line(fault, answer)
+    OBSERVED[index] = (code, line)
+    assert "Traceback" not in answer
+    assert code == fault.exit, answer
+    if fault.exit != 1:
+        assert len(lines) == 1, answer
+    assert re.search(fault.answer, line), line
+    assert untouched, "a refused command changed files"
+
+
+def render(observed: dict[int, tuple[int, str]]) -> str:
+    import pandas as pd
+
+    rows = [{"area": f.area, "input or fault": f.kind, "exit": observed[i][0],
+             "answer": f"`{observed[i][1]}`"} for i, f in enumerate(FAULTS)]
+    dedicated = pd.DataFrame(DEDICATED, columns=["fault", "answer", "test"])
+    kinds = len(FAULTS) + len(DEDICATED)
+    return "\n".join([
+        "# Reliability: every bad input and fault tried, and the answer",
+        "",
+        f"{kinds} kinds, none answered with a traceback, a hang or a silent pass. Generated "
+        "by `tests/dyncheck/test_faults.py` from the answers dyncheck gave "
+        "(`DYNCHECK_WRITE_PAGES=1 pytest tests/dyncheck/test_faults.py` rewrites it); the test "
+        "fails when an answer here is no longer the one given. `<tmp>` is the test's "
+        "temporary folder. Exit 2: bad input or an I/O fault, found before any long work, "
+        "nothing written; 1: the check found the model wrong (a report is written); "
+        "130: interrupted.",
+        "",
+        "## Commands and the Python API",
+        "",
+        pd.DataFrame(rows).to_markdown(index=False),
+        "",
+        "## Faults with their own tests (a run, a killed process, a crashing engine)",
+        "",
+        dedicated.to_markdown(index=False),
+        "",
+    ])
+
+
+def test_reliability_page_lists_the_answers_given(tmp_path):
+    """``reports/reliability.md`` is the table of the answers observed (faults not run yet in
+    this session are run here); every dedicated fault names a test that exists."""
+    for index, fault in enumerate(FAULTS):
+        if index not in OBSERVED:
+            tmp = tmp_path / str(index)
+            tmp.mkdir()
+            code, answer, _ = observe(fault, tmp)
+            OBSERVED[index] = (code, _line(fault, answer))
+    for _kind, _answer, test in DEDICATED:
+        path, name = test.split("::")
+        assert f"def {name}(" in (ROOT / path).read_text(), test
+    page = render(OBSERVED)
+    if os.environ.get("DYNCHECK_WRITE_PAGES") == "1":
+        PAGE.write_text(page)
+    assert len(FAULTS) + len(DEDICATED) >= 80
+    assert PAGE.read_text() == page, "reports/reliability.md is stale: DYNCHECK_WRITE_PAGES=1"
