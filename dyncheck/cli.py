@@ -140,6 +140,9 @@ def _parser() -> argparse.ArgumentParser:
     )
     e = sub.add_parser("explain", help="demonstrate a modelling convention (all if none)")
     e.add_argument("name", nargs="?", default=None, metavar="NAME")
+    er = sub.add_parser("errata", help="check every formula of §2.2 and write the errata page")
+    er.add_argument("--out", type=_path, default=Path("reports/errata-inventory.md"),
+                    metavar="FILE")
     bl = sub.add_parser("baseline", help="run and write the regression baseline")
     _selection(bl)
     bl.add_argument("--out", type=_path, default=Path("reports/baseline.csv"), metavar="FILE")
@@ -162,6 +165,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 EXAMPLES = {
+    "errata": "dyncheck errata && dyncheck explain erratum-action-integral.d5",
     "list": "dyncheck list",
     "run": "dyncheck run simple_pendulum --impl reference --impl mujoco --out /tmp/report",
     "check": "dyncheck check my_robot.urdf --floating --states 1000",
@@ -435,7 +439,24 @@ def _tutorials(args: argparse.Namespace) -> int:
 def _explain(args: argparse.Namespace) -> int:
     from dyncheck.catalogue import explain, render
 
+    if args.name is not None and args.name.startswith("erratum-"):
+        from dyncheck.errata import page
+
+        print(page.explain(args.name.removeprefix("erratum-")))
+        return 0
     print(render(explain(args.name)))
+    return 0
+
+
+def _errata(args: argparse.Namespace) -> int:
+    from dyncheck.errata import page
+    from dyncheck.results import write_atomic
+
+    if args.out.is_dir():
+        raise InvalidInput("--out", str(args.out), "a file path, not a folder")
+    _check_out(args.out.parent)
+    write_atomic(args.out, page.page())
+    print(f"errata page written to {args.out}")
     return 0
 
 
@@ -481,6 +502,7 @@ COMMANDS = {
     "baseline": _baseline,
     "bench": _bench,
     "explain": _explain,
+    "errata": _errata,
 }
 
 
