@@ -53,8 +53,10 @@ ENGINES = {
 }
 REFEREE = "reference"
 IMPLEMENTATIONS = (REFEREE, *ENGINES)
+LOAD_TIMEOUT_S = 600.0
+"""Longest an isolated engine may take to load a model."""
 TIMEOUT_S = 600.0
-"""Longest an isolated engine may take to load a model or to answer one batch of states."""
+"""Longest an isolated engine may take to answer one batch of states."""
 
 
 @dataclass(frozen=True)
@@ -120,21 +122,22 @@ class Isolated:
         ctx = mp.get_context("fork" if sys.platform == "linux" else "spawn")
         self.engine = name
         self._timeout = TIMEOUT_S if timeout is None else timeout
+        self._load_timeout = LOAD_TIMEOUT_S if timeout is None else timeout
         self._conn, child = ctx.Pipe()
         self._proc = ctx.Process(target=_serve, args=(name, spec or ENGINES[name], source, child),
                                  daemon=True)
         self._proc.start()
         child.close()
 
-    def _receive(self, doing: str) -> object:
-        deadline = time.monotonic() + self._timeout
+    def _receive(self, doing: str, timeout: float) -> object:
+        deadline = time.monotonic() + timeout
         while not self._conn.poll(0.02):
             if not self._proc.is_alive() and not self._conn.poll(0):
                 raise EngineError(f"{self.engine} crashed while {doing} "
                                   f"({_death(self._proc.exitcode)})")
             if time.monotonic() > deadline:
                 self.close()
-                raise EngineError(f"{self.engine} gave no answer within {self._timeout:g} s "
+                raise EngineError(f"{self.engine} gave no answer within {timeout:g} s "
                                   f"while {doing} (stopped)")
         try:
             return self._conn.recv()
@@ -146,7 +149,7 @@ class Isolated:
     def loaded(self) -> Isolated | NotLoaded:
         """Wait for the load: this proxy with the engine's tree, or why it has none."""
         try:
-            answer = self._receive("loading the model")
+            answer = self._receive("loading the model", self._load_timeout)
         except EngineError as exc:
             return NotLoaded(self.engine, False, str(exc))
         if isinstance(answer, NotLoaded):
@@ -161,7 +164,7 @@ class Isolated:
         except OSError:
             raise EngineError(f"{self.engine} crashed earlier "
                               f"({_death(self._proc.exitcode)})") from None
-        answer = self._receive("computing the dynamics")
+        answer = self._receive("computing the dynamics", self._timeout)
         if isinstance(answer, Exception):
             raise answer
         return answer  # type: ignore[return-value]

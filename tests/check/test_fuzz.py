@@ -108,6 +108,7 @@ def _alarm(_signum: int, _frame: object) -> None:
 @pytest.mark.slow
 def test_mutated_models_never_traceback_or_hang(tmp_path, monkeypatch):
     monkeypatch.setattr(engines, "TIMEOUT_S", float(LIMIT_S))
+    monkeypatch.setattr(engines, "LOAD_TIMEOUT_S", float(LIMIT_S))
     codes: Counter[int] = Counter()
     previous = signal.signal(signal.SIGALRM, _alarm)
     try:
