@@ -99,3 +99,11 @@ def test_explain_an_unknown_formula_is_one_line(capsys):
 
 def test_committed_errata_page_is_current():
     assert (ROOT / "reports" / "errata-inventory.md").read_text() == page.page()
+
+
+def test_frenet_check_rejects_a_wrong_sign():
+    """Negative control: the numeric Frenet check fails on δB/δs = +τN (the sign flipped)
+    and on δT/δs = 2κN, so its 'holds' verdicts could have failed."""
+    f = checks._frenet()
+    assert not checks._vanishes(f["dB"] - f["tau"] * f["N"])
+    assert not checks._vanishes(f["dT"] - 2 * f["kappa"] * f["N"])
