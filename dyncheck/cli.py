@@ -238,7 +238,19 @@ def _check_out(out: Path) -> None:
 
 
 MAX_STATES = 10**9
-"""More sampled states than this would take days at ~50 µs per state: refused up front."""
+"""More sampled states than this would take over half a day at ~50 µs per state: refused."""
+STATE_SECONDS = 50e-6
+"""Measured cost of one sampled state through every implementation (reports/benchmark.md)."""
+
+
+def _warn_cost(states: int, jobs: int) -> None:
+    """Say up front what a large sweep will cost (more than a minute), before it starts."""
+    seconds = states * STATE_SECONDS / jobs
+    if seconds > 60:
+        took = f"{seconds / 3600:.1f} h" if seconds >= 3600 else f"{seconds / 60:.0f} min"
+        print(f"dyncheck: {states} sampled states: about {took} on this machine with --jobs "
+              f"{jobs} (~50 µs per state); the states are drawn and compared in chunks, so "
+              "memory stays flat", file=sys.stderr, flush=True)
 
 
 def _positive(name: str, value: int | None) -> None:
@@ -257,6 +269,8 @@ def _run(args: argparse.Namespace) -> int:
     _positive("--jobs", args.jobs)
     reference = baseline.load(args.baseline) if args.baseline is not None else None
     cases, impls = resolve(args.cases, args.impl)
+    if args.states is not None:
+        _warn_cost(args.states * len(cases), args.jobs)
     result = run(cases, impls, states=args.states, jobs=args.jobs, progress=report.stderr_progress)
     report.write(result, args.out)
     counts = result.discrepancies["verdict"].value_counts()

@@ -133,3 +133,16 @@ def test_same_case_twice_runs_once():
 def test_case_parameters_at_the_range_edge_are_accepted():
     """1e77 and 1e-77 themselves are allowed (the bound is inclusive)."""
     assert dataclasses.replace(get_case("simple_pendulum"), m=1e77, l=1e-77).m == 1e77
+
+
+def test_a_large_sweep_says_its_cost_before_it_starts(tmp_path, monkeypatch, capsys):
+    """--states 10⁸ over one case: the estimate (50 µs × 10⁸ = 1.4 h) is said before the
+    run (here interrupted at once), not discovered after hours."""
+    from dyncheck import run as run_module
+
+    monkeypatch.setattr(run_module, "run", lambda *a, **k: (_ for _ in ()).throw(
+        KeyboardInterrupt))
+    assert main(["run", "simple_pendulum", "--states", str(10**8), "--out", str(tmp_path)]) == 130
+    first = capsys.readouterr().err.splitlines()[0]
+    assert first.startswith("dyncheck: 100000000 sampled states: about 1.4 h") and \
+        "memory stays flat" in first
