@@ -516,7 +516,8 @@ def _files(tmp: Path) -> set[Path]:
 
 
 def _normalise(text: str, tmp: Path) -> str:
-    return text.replace(str(tmp), "<tmp>").replace(str(MODELS), "<models>")
+    return (text.replace(str(tmp), "<tmp>").replace(str(MODELS), "<models>")
+            .replace(str(ROOT), "<repository>"))
 
 
 def observe(fault: Fault, tmp: Path) -> tuple[int, str, bool]:
@@ -587,7 +588,8 @@ def render(observed: dict[int, tuple[int, str]]) -> str:
         "by `tests/dyncheck/test_faults.py` from the answers dyncheck gave "
         "(`DYNCHECK_WRITE_PAGES=1 pytest tests/dyncheck/test_faults.py` rewrites it); the test "
         "fails when an answer here is no longer the one given. `<tmp>` is the test's "
-        "temporary folder. Exit 2: bad input or an I/O fault, found before any long work, "
+        "temporary folder, `<repository>` the clone's root. Exit 2: bad input or an I/O "
+        "fault, found before any long work, "
         "nothing written; 1: the check found the model wrong (a report is written); "
         "130: interrupted.",
         "",
