@@ -60,6 +60,10 @@ def read(path: Path, *, floating: bool = False) -> ModelFile:
     )
 
 
+INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+"""The attributes of a URDF ``<inertia>`` (absent ones read as 0)."""
+
+
 @dataclass(frozen=True, kw_only=True)
 class Inertial:
     """A link's ``<inertial>`` as the URDF file states it (mass, inertia about the centre of
@@ -82,7 +86,7 @@ def urdf_inertials(source: ModelFile) -> list[Inertial]:
         mass_el, inertia_el = inertial.find("mass"), inertial.find("inertia")
         mass = float(mass_el.get("value", "0")) if mass_el is not None else 0.0
         e = {k: float(inertia_el.get(k, "0")) if inertia_el is not None else 0.0
-             for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+             for k in INERTIA_KEYS}
         out.append(
             Inertial(
                 link=link.get("name", ""), mass=mass,

@@ -13,7 +13,7 @@ import numpy as np
 
 from dyncheck.cases.coordinate_maps import CoordinateMap
 from dyncheck.cases.multibody import Multibody
-from dyncheck.cases.validate import finite_array, positive
+from dyncheck.cases.validate import finite_array, integer, positive
 from dyncheck.errors import InvalidInput
 
 INTEGRATORS: tuple[str, ...] = ("euler", "implicitfast", "rk2", "rk3", "rk4", "rk4-held-force")
@@ -129,11 +129,8 @@ class Case(ABC):
     def __post_init__(self) -> None:
         """What every case shares: a positive sample count, a seed numpy accepts, an initial
         state with one value per coordinate."""
-        if isinstance(self.n_states, bool) or not isinstance(self.n_states, int) \
-                or self.n_states < 1:
-            raise InvalidInput("n_states", self.n_states, "a positive integer")
-        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
-            raise InvalidInput("seed", self.seed, "a non-negative integer")
+        integer("n_states", self.n_states, 1)
+        integer("seed", self.seed, 0)
         if self.trajectory is not None and len(self.trajectory.q0) != self.ndof:
             raise InvalidInput("trajectory.q0", self.trajectory.q0,
                                f"{self.ndof} value{'s' * (self.ndof != 1)}, one per "

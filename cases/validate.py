@@ -28,6 +28,14 @@ def positive(field: str, value: float) -> float:
     return float(value)
 
 
+def integer(field: str, value: int, minimum: int) -> int:
+    """An int (not a bool) of at least ``minimum`` (0: a seed; 1: a count)."""
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        words = {0: "a non-negative integer", 1: "a positive integer"}
+        raise InvalidInput(field, value, words.get(minimum, f"an integer >= {minimum}"))
+    return value
+
+
 def finite_array(field: str, value: Sequence[float] | np.ndarray, shape: tuple[int, ...]) -> None:
     """An array of the given shape with no NaN or inf."""
     arr = np.asarray(value, dtype=float)

@@ -237,6 +237,13 @@ def _check_out(out: Path) -> None:
                 p.rmdir()
 
 
+def _check_out_file(flag: str, path: Path) -> None:
+    """A file to write: not a folder, and its folder writable (:func:`_check_out`)."""
+    if path.is_dir():
+        raise InvalidInput(flag, str(path), "a file path, not a folder")
+    _check_out(path.parent)
+
+
 MAX_STATES = 10**9
 """More sampled states than this would take over half a day at ~50 µs per state: refused."""
 STATE_SECONDS = 50e-6
@@ -336,9 +343,7 @@ def _baseline(args: argparse.Namespace) -> int:
     from dyncheck import baseline, report
     from dyncheck.run import resolve, run
 
-    if args.out.is_dir():
-        raise InvalidInput("--out", str(args.out), "a file path, not a folder")
-    _check_out(args.out.parent)
+    _check_out_file("--out", args.out)
     _positive("--jobs", args.jobs)
     cases, impls = resolve(args.cases, args.impl)
     previous = baseline.load(args.out, "--out") if args.out.exists() else None  # validated first
@@ -375,9 +380,7 @@ def _diff(args: argparse.Namespace) -> int:
     factor = diff.FACTOR if args.tolerance is None else args.tolerance
     diff.check_factor(factor)
     if args.markdown is not None:
-        if args.markdown.is_dir():
-            raise InvalidInput("--markdown", str(args.markdown), "a file path, not a folder")
-        _check_out(args.markdown.parent)
+        _check_out_file("--markdown", args.markdown)
     sides = []
     for flag, path in (("RUN_A", args.run_a), ("RUN_B", args.run_b)):
         side = diff.load(path, flag)
@@ -412,9 +415,7 @@ def _versions(args: argparse.Namespace) -> int:
     names = args.engine or list(matrix.ENGINES)
     for name in names:
         matrix.engine(name)
-    if args.out.is_dir():
-        raise InvalidInput("--out", str(args.out), "a file path, not a folder")
-    _check_out(args.out.parent)
+    _check_out_file("--out", args.out)
     steps = matrix.matrix(names, cases=args.case, jobs=args.jobs, log=_log, reuse=args.reuse)
     write_atomic(args.out, matrix.page(steps, notes=matrix.EXPLANATIONS))
     print(f"version matrix written to {args.out}")
@@ -466,9 +467,7 @@ def _errata(args: argparse.Namespace) -> int:
     from dyncheck.errata import page
     from dyncheck.results import write_atomic
 
-    if args.out.is_dir():
-        raise InvalidInput("--out", str(args.out), "a file path, not a folder")
-    _check_out(args.out.parent)
+    _check_out_file("--out", args.out)
     write_atomic(args.out, page.page())
     print(f"errata page written to {args.out}")
     return 0

@@ -117,14 +117,12 @@ class Isolated:
     """An engine in its own process (see the module's docstring): its ``tree`` and
     ``dynamics`` as :class:`ModelEngine`, a crash or a hang an :class:`EngineError`."""
 
-    def __init__(self, name: str, source: ModelFile, spec: Engine | None = None,
-                 timeout: float | None = None) -> None:
+    def __init__(self, name: str, source: ModelFile) -> None:
         ctx = mp.get_context("fork" if sys.platform == "linux" else "spawn")
         self.engine = name
-        self._timeout = TIMEOUT_S if timeout is None else timeout
-        self._load_timeout = LOAD_TIMEOUT_S if timeout is None else timeout
         self._conn, child = ctx.Pipe()
-        self._proc = ctx.Process(target=_serve, args=(name, spec or ENGINES[name], source, child),
+        # the spec travels with the call: a spawned child would not see a patched ENGINES
+        self._proc = ctx.Process(target=_serve, args=(name, ENGINES[name], source, child),
                                  daemon=True)
         self._proc.start()
         child.close()
@@ -149,7 +147,7 @@ class Isolated:
     def loaded(self) -> Isolated | NotLoaded:
         """Wait for the load: this proxy with the engine's tree, or why it has none."""
         try:
-            answer = self._receive("loading the model", self._load_timeout)
+            answer = self._receive("loading the model", LOAD_TIMEOUT_S)
         except EngineError as exc:
             return NotLoaded(self.engine, False, str(exc))
         if isinstance(answer, NotLoaded):
@@ -164,7 +162,7 @@ class Isolated:
         except OSError:
             raise EngineError(f"{self.engine} crashed earlier "
                               f"({_death(self._proc.exitcode)})") from None
-        answer = self._receive("computing the dynamics", self._timeout)
+        answer = self._receive("computing the dynamics", TIMEOUT_S)
         if isinstance(answer, Exception):
             raise answer
         return answer  # type: ignore[return-value]

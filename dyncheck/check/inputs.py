@@ -7,13 +7,13 @@ import importlib.metadata
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from dyncheck.adapters.model_files import INERTIA_KEYS
 from dyncheck.errors import InvalidInput, UnknownName
 
 URDF_JOINTS = ("revolute", "continuous", "prismatic", "fixed")
 """The URDF joint types every engine here reads alike (``floating`` and ``planar`` are not:
 Pinocchio's parser maps them, MuJoCo's refuses or changes them)."""
 MAX_STATES = 100_000
-INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 ROBOTS_EXTRA = "example-robot-data"
 
 

@@ -175,9 +175,6 @@ def _action_euler_lagrange() -> Finding:
     )
 
 
-DIMENSIONS = {"m": "M", "h": "M L**2 T**-2", "V": "M L**2 T**-2", "xdot": "L Θ**-1"}
-
-
 def _dims() -> dict[str, sp.Expr]:
     M, L, T, Th = sp.symbols("M L T Θ", positive=True)
     energy = M * L**2 / T**2
@@ -366,8 +363,8 @@ def _lagrange_derivatives() -> Finding:
     for r in range(2):
         p_r = _d(c.T, c.xd[r])
         ok &= zero(p_r - c.M * sum(c.g[r, m] * c.xd[m] for m in range(2)))
-        dg = [[sum(_d(c.g[r, m], c.x[n]) * c.xd[n] for n in range(2)) for m in range(2)]]
-        ok &= zero(p_r.diff(c.t) - c.M * sum(c.g[r, m] * c.xdd[m] + dg[0][m] * c.xd[m]
+        dg = [sum(_d(c.g[r, m], c.x[n]) * c.xd[n] for n in range(2)) for m in range(2)]
+        ok &= zero(p_r.diff(c.t) - c.M * sum(c.g[r, m] * c.xdd[m] + dg[m] * c.xd[m]
                                              for m in range(2)))
         ok &= zero(_d(c.T, c.x[r]) - c.M / 2 * sum(_d(c.g[m, n], c.x[r]) * c.xd[m] * c.xd[n]
                                                     for m in range(2) for n in range(2)))
@@ -526,9 +523,7 @@ def _lagrange_lhs(T: sp.Expr, q: sp.Expr, t: sp.Symbol) -> sp.Expr:
 @cache
 def _spherical() -> tuple[sp.Symbol, sp.Symbol, list[sp.Expr], sp.Expr, sp.Expr]:
     t, M = sp.symbols("t M", positive=True)
-    rho, th, ph = (sp.Function(n)(t) for n in ("rho", "theta", "phi"))
-    x = sp.Matrix([rho * sp.sin(th) * sp.cos(ph), rho * sp.sin(th) * sp.sin(ph),
-                   rho * sp.cos(th)])
+    (rho, th, ph), x = _spherical_map(t)
     v2 = sp.simplify((x.diff(t).T * x.diff(t))[0])
     printed_v2 = rho.diff(t) ** 2 + rho**2 * th.diff(t) ** 2 + rho**2 * sp.sin(th) ** 2 \
         * ph.diff(t) ** 2

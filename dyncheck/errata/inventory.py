@@ -42,7 +42,6 @@ HEADINGS = {
 DISPLAY = re.compile(r"\$\$(.+?)\$\$")
 INLINE = re.compile(r"(?<!\$)\$([^$]+?)\$(?!\$)")
 NUMBER = re.compile(r"\\(?:quad|tag)\s*\{?\(?(2\.2\.\d+)\)?\}?\s*$")
-RANGE = re.compile(r"^\s*[a-z](?:\s*=\s*[\d\\].*)$")
 EXAMPLE = re.compile(r"^EXAMPLE (\d+)")
 EXERCISE = re.compile(r"^\W*(?:►|▶)?\s*\**\s*(\d+)\.\**\s")
 
@@ -65,10 +64,15 @@ class Formula:
 
     @property
     def in_exercise(self) -> bool:
-        return re.fullmatch(r"ex\d+", self.part) is not None
+        return is_exercise(self.part)
 
 
 RANGES = re.compile(r"(?:^|,)\s*[a-z]\s*=\s*1\s*,\s*(?:2\s*,\s*3|\\dots\s*,\s*N)")
+
+
+def is_exercise(part: str) -> bool:
+    """A part that is one exercise (``ex18``), not an example (``example-8``)."""
+    return re.fullmatch(r"ex\d+", part) is not None
 
 
 def _is_relation(text: str) -> bool:
@@ -89,7 +93,7 @@ def parse(text: str) -> list[Formula]:
             part = heading  # the example ended: back to the text around it
         elif m := EXAMPLE.match(stripped):
             part = f"example-{m.group(1)}"
-        elif part.startswith(("exercises", "ex")) and (m := EXERCISE.match(stripped)):
+        elif (part == "exercises" or is_exercise(part)) and (m := EXERCISE.match(stripped)):
             part = f"ex{m.group(1)}"
         for kind, found in ((Kind.DISPLAYED, DISPLAY.findall(line)),
                             (Kind.INLINE, INLINE.findall(DISPLAY.sub("", line)))):
