@@ -10,7 +10,7 @@ import pytest
 import sympy as sp
 
 from dyncheck.cli import main
-from dyncheck.errata import checks, inventory, page
+from dyncheck.errata import checks, frenet, inventory, page
 
 ROOT = inventory.STORED.parents[2]
 BOOK_PRESENT = inventory.BOOK.is_file()
@@ -104,6 +104,6 @@ def test_committed_errata_page_is_current():
 def test_frenet_check_rejects_a_wrong_sign():
     """Negative control: the numeric Frenet check fails on δB/δs = +τN (the sign flipped)
     and on δT/δs = 2κN, so its 'holds' verdicts could have failed."""
-    f = checks._frenet()
-    assert not checks._vanishes(f["dB"] - f["tau"] * f["N"])
-    assert not checks._vanishes(f["dT"] - 2 * f["kappa"] * f["N"])
+    f = frenet.frenet_frame()
+    assert not frenet.vanishes(f["dB"] - f["tau"] * f["N"])
+    assert not frenet.vanishes(f["dT"] - 2 * f["kappa"] * f["N"])
