@@ -141,7 +141,7 @@ def _parser() -> argparse.ArgumentParser:
     e = sub.add_parser("explain", help="demonstrate a modelling convention (all if none)")
     e.add_argument("name", nargs="?", default=None, metavar="NAME")
     er = sub.add_parser("errata", help="check every formula of §2.2 and write the errata page")
-    er.add_argument("--out", type=_path, default=Path("reports/errata-inventory.md"),
+    er.add_argument("--out", type=_path, default=Path("reports/errata.md"),
                     metavar="FILE")
     bl = sub.add_parser("baseline", help="run and write the regression baseline")
     _selection(bl)

@@ -404,7 +404,8 @@ def errata(d: pd.DataFrame) -> tuple[str, pd.DataFrame]:
         )
     else:
         lead = (
-            f"No erratum: all {len(rows)} printed quantities (equations of motion, T, V of "
+            f"No erratum in the printed equations of motion: all {len(rows)} printed "
+            "quantities (equations of motion, T, V of "
             f"{', '.join(sorted(set(rows.case)))}) agree with the general method at "
             "round-off."
         )
@@ -467,7 +468,10 @@ def index_page(result: RunResult, *, date: str) -> str:
         "",
         _md(conservation_matrix(result)),
         "",
-        "### Errata: the book's printed equations against the general method",
+        "### The book's printed equations of motion against the general method",
+        "",
+        "(The errata of §2.2 formula by formula, derivation steps and exercises included: "
+        "[errata.md](errata.md).)",
         "",
         errata(d)[0],
         "",
@@ -504,7 +508,9 @@ def index_page(result: RunResult, *, date: str) -> str:
         "",
         "Performance: [benchmark.md](benchmark.md), written by `dyncheck bench`. "
         "Conventions catalogue: [conventions.md](conventions.md). "
-        "Errata: [errata.md](errata.md).",
+        "Errata: [errata.md](errata.md) (every formula of §2.2, `dyncheck errata`); the printed "
+        "equations of motion against the general method: "
+        "[printed-equations.md](printed-equations.md).",
         "",
         "### Case pages",
         "",
@@ -547,9 +553,13 @@ def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Pat
     files[out / "conventions.md"] = conventions_page()
     files[out / PROVENANCE] = provenance_json({"date (UTC)": date, **versions()})
     lead, table = errata(result.discrepancies)
-    files[out / "errata.md"] = "\n".join(
+    files[out / "printed-equations.md"] = "\n".join(
         [
-            "# Errata: the book's printed equations against the general method",
+            "# The book's printed equations of motion against the general method",
+            "",
+            "The errata of §2.2, formula by formula (every derivation step, identity and "
+            "exercise), are in [errata.md](errata.md); this page is the numeric check of the "
+            "equations of motion the cases implement.",
             "",
             "Each printed equation of motion (and its T and V) is evaluated as `book` and compared "
             "with the general method (`reference`, Lagrange's equations (2.2.23)-(2.2.26) from the "

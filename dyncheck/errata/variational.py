@@ -9,7 +9,7 @@ import sympy as sp
 from dyncheck.errata.registry import Finding, Method, Verdict, check, derived, zero
 
 
-@check("2.2.19", "2.2.20", "conservative.i1")
+@check("2.2.19", "2.2.20", "conservative.i1", "example-8.i3")
 def _work() -> Finding:
     t = sp.Symbol("t", positive=True)
     x, y = sp.symbols("x y")

@@ -10,7 +10,7 @@ import pytest
 import sympy as sp
 
 from dyncheck.cli import main
-from dyncheck.errata import checks, frenet, inventory, page
+from dyncheck.errata import checks, frenet, inventory, page, rotation
 
 ROOT = inventory.STORED.parents[2]
 BOOK_PRESENT = inventory.BOOK.is_file()
@@ -98,7 +98,7 @@ def test_explain_an_unknown_formula_is_one_line(capsys):
 
 
 def test_committed_errata_page_is_current():
-    assert (ROOT / "reports" / "errata-inventory.md").read_text() == page.page()
+    assert (ROOT / "reports" / "errata.md").read_text() == page.page()
 
 
 def test_frenet_check_rejects_a_wrong_sign():
@@ -107,3 +107,35 @@ def test_frenet_check_rejects_a_wrong_sign():
     f = frenet.frenet_frame()
     assert not frenet.vanishes(f["dB"] - f["tau"] * f["N"])
     assert not frenet.vanishes(f["dT"] - 2 * f["kappa"] * f["N"])
+
+
+def test_every_formula_has_a_verdict():
+    """No formula of the inventory is left without a check (the page's 'not yet checked' is
+    empty)."""
+    _, formulas = inventory.stored()
+    assert [f.id for f in formulas if f.id not in checks.CHECKS] == []
+
+
+def test_rotation_checks_reject_a_wrong_sign():
+    """Negative controls for the exact machinery of the rotation checks: ω_z = ψ̇ − ϕ̇ cosθ
+    (exercise 23 with a sign flipped) is not an identity; the velocity of a body point is not
+    +ω_mk x_k (relative-motion.i5 with its sign flipped); and ω = αê₃ − βê₁ does not give a
+    body point's velocity (the ex30 erratum's printed residual is not small)."""
+    (t, ph, th, ps), _, product = rotation._euler()
+    ell = product.T
+    body = rotation._vee(ell.diff(t).T * ell)
+    assert not rotation._trig_nil(sp.Matrix([body[2] - (ps.diff(t) - ph.diff(t) * sp.cos(th))]))
+    ell = rotation._generic()
+    x = ell * sp.Matrix(sp.symbols("c1:4"))
+    assert not rotation._nil(x.diff(t) - ell * ell.diff(t).T * x)
+    assert rotation._nil(x.diff(t) + ell * ell.diff(t).T * x)
+    assert checks.CHECKS["ex30.i16"]().printed_residual() > 0.1
+
+
+def test_the_exercise_18_erratum_is_dimensional():
+    """Derived by hand: the Euler–Lagrange equations of φ = ds/dt give ẋⁱ s̈/ṡ on the right;
+    a straight line run at speed 2√5 t, x = (t², 2t²), satisfies that and not ẋⁱ s̈."""
+    finding = checks.CHECKS["ex18.i3"]()
+    assert finding.verdict is checks.Verdict.ERRATUM
+    assert r"\frac{d^2s/dt^2}{ds/dt}" in finding.corrected
+    assert sp.simplify(finding.printed_residual() - (420 - 80 * sp.sqrt(5))) == 0
