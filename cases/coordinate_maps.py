@@ -19,7 +19,8 @@ from dyncheck.errors import InvalidInput
 class CoordinateMap(Protocol):
     """x̄(x) with its Jacobian and second-derivative term, all batched."""
 
-    description: str
+    @property
+    def description(self) -> str: ...
 
     def to_engine(self, q: np.ndarray) -> np.ndarray: ...
     def to_book(self, qe: np.ndarray) -> np.ndarray: ...

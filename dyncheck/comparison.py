@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from itertools import combinations
+from typing import Any
 
 import numpy as np
 
@@ -164,7 +165,7 @@ def _row(
     case: Case, quantity: str, a: Evaluator, b: Evaluator, st: PairStats, condition: float
 ) -> Discrepancy:
     tol = instantaneous(quantity, condition, max(soft_factor(a.variant), soft_factor(b.variant)))
-    base = dict(
+    base: dict[str, Any] = dict(
         case=case.name,
         quantity=quantity,
         impl_a=a.name,

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from itertools import combinations
+from typing import Any
 
 import numpy as np
 
@@ -386,7 +387,7 @@ def _drift_row(
     observed = impl.engine_positions(dt, integrator) @ C.T  # type: ignore[attr-defined]
     steps = observed.shape[0] - 1
     tol = accumulated(steps, soft_factor(variant))
-    base = dict(
+    base: dict[str, Any] = dict(
         case=case.name,
         quantity="constraint_drift",
         impl_a="reference",
@@ -692,7 +693,7 @@ def _engine_pairs(
                 diff = difference(case, qb, qa).max(axis=1)
                 worst = first_near_max(diff, tol.rtol * scale_q)
                 err = float(diff[worst])
-                row = dict(
+                row: dict[str, Any] = dict(
                     case=case.name,
                     quantity="trajectory",
                     impl_a=a,
