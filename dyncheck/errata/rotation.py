@@ -588,7 +588,9 @@ def _triad_is_not_the_body() -> Finding:
                   r"\quad \lambda = \vec{\omega}_b\cdot\hat{e}_1 + \beta "
                   r"\text{ (}\lambda = 0\text{ when } \hat{e}_2, \hat{e}_3 \text{ are fixed in "
                   r"the body)}",
-        effect="a body point's velocity from the printed ω misses the spin about ê₁: here "
-               "|dr/dt − ω × r| is of the order of |dr/dt| itself",
+        effect="a body point's velocity from the printed ω misses the spin about ê₁: for the "
+               "point (½, 2, −1) of the rotating ℓ(t) at t = 1, |dr/dt − ω × r| = "
+               f"{sp.N(sp.sqrt(printed()), 3)} against |dr/dt| = "
+               f"{sp.N(sp.sqrt(_small(r.diff(t), sp.Integer(1))), 3)}",
         printed_residual=printed, corrected_residual=corrected,
     )
