@@ -9,7 +9,7 @@ reference and the engines.
 __version__ = "0.1.0"
 
 
-def check_model(*args, **kwargs):  # type: ignore[no-untyped-def]
+def check_model(*args, **kwargs):
     """:func:`dyncheck.check.model_check.check_model` (imported on first use: the engines load
     only when a model is checked)."""
     from dyncheck.check.model_check import check_model as _check_model

@@ -9,6 +9,7 @@ from collections.abc import Iterable
 from dataclasses import asdict, dataclass, fields
 from enum import StrEnum
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
@@ -87,10 +88,10 @@ DISCREPANCY_KEY = ["case", "quantity", "impl_a", "impl_b", "integrator", "dt"]
 CONVERGENCE_KEY = ["case", "impl", "integrator", "dt"]
 
 
-def table(records: Iterable[object], record_type: type, key: list[str]) -> pd.DataFrame:
+def table(records: Iterable[Any], record_type: type, key: list[str]) -> pd.DataFrame:
     """Records as a DataFrame with the record's columns, sorted by ``key``."""
     columns = [f.name for f in fields(record_type)]
-    frame = pd.DataFrame([asdict(r) for r in records], columns=columns)  # type: ignore[arg-type]
+    frame = pd.DataFrame([asdict(r) for r in records], columns=columns)
     return frame.sort_values(key, kind="stable").reset_index(drop=True)
 
 

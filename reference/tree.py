@@ -208,9 +208,9 @@ class TreeDynamics:
             rows = np.append(cols, nv)
             r, t = rot[b][rows], trans[b][rows]
             c = np.einsum("bij,j->bi", r, body.com) + t
-            jw = angular[np.ix_(rows, range(3), cols)]
-            arm = c[:, :, None] - pivots[np.ix_(rows, range(3), cols)]
-            jc = linear[np.ix_(rows, range(3), cols)] + np.stack(  # ω × (c − p)
+            jw = angular[np.ix_(rows, np.arange(3), cols)]
+            arm = c[:, :, None] - pivots[np.ix_(rows, np.arange(3), cols)]
+            jc = linear[np.ix_(rows, np.arange(3), cols)] + np.stack(  # ω × (c − p)
                 [
                     jw[:, 1] * arm[:, 2] - jw[:, 2] * arm[:, 1],
                     jw[:, 2] * arm[:, 0] - jw[:, 0] * arm[:, 2],

@@ -79,7 +79,7 @@ def load(name: str, source: ModelFile, spec: Engine | None = None) -> ModelEngin
     except ImportError as exc:
         return NotLoaded(name, True, f"needs the '{spec.extra}' extra ({exc.name} not installed)")
     try:
-        return getattr(module, spec.cls)(source)  # type: ignore[no-any-return]
+        return getattr(module, spec.cls)(source)
     except Unsupported as exc:
         return NotLoaded(name, True, str(exc))
     except DyncheckError as exc:
