@@ -12,7 +12,7 @@ prediction, and the state where the error peaked), so memory stays flat however 
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from itertools import combinations
 from typing import Any
@@ -216,7 +216,7 @@ def _row(
 
 def compare_instantaneous(
     case: Case,
-    impls: dict[str, Implementation | Exception],
+    impls: Mapping[str, Implementation | Exception],
     chunks: StateSample | Iterable[StateSample],
 ) -> list[Discrepancy]:
     """Rows for every pair (trusted first, in IMPLEMENTATIONS order) and quantity, over all

@@ -62,6 +62,21 @@ def test_cases_import_no_engine_no_adapter_no_reference(path):
             )
 
 
+@pytest.mark.parametrize("path", _modules("dyncheck/errata"), ids=lambda p: p.name)
+def test_errata_checks_are_engine_free(path):
+    """The book's formulas are checked by derivation alone: sympy (pandas for the page's
+    table), no engine, no reference, nothing of dyncheck but the errata package and the
+    errors at the bottom of the import graph."""
+    for name in _imports(path):
+        top = _top(name)
+        if name.startswith("dyncheck"):
+            assert name.startswith(("dyncheck.errata", "dyncheck.errors")), (
+                f"{path.name} imports {name}")
+        else:
+            assert top in {"sympy", "pandas"} | sys.stdlib_module_names, (
+                f"{path.name} imports {name}")
+
+
 def test_the_rule_reader_sees_function_level_imports(tmp_path):
     """The check can fail: an import hidden in a function body is found."""
     module = tmp_path / "m.py"

@@ -1,0 +1,62 @@
+"""A catalogue entry (:class:`Entry`) and the measurements the demonstrations share: the
+worst error of an engine against the reference under a coordinate map, and Pinocchio's MJCF
+loader."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from dyncheck.cases import get_case
+from dyncheck.cases.coordinate_maps import LinearMap
+from dyncheck.comparison import compare_instantaneous
+from dyncheck.explanations import Origin
+from dyncheck.implementations import EngineImplementation, NativeMap, make_implementation
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One convention: what it is, where the engines stand, and the measured demonstration."""
+
+    name: str
+    what: str
+    engines: str
+    naive: str
+    naive_error: float
+    correct_error: float
+    unit: str = "max relative error"
+    skipped: str = ""
+    """Why the demonstration did not run (an engine not installed), or empty."""
+    origin: Origin | None = None
+    """Whose property the convention is (set from :data:`DEMOS`)."""
+
+
+def worst(case_name: str, engine: str, cmap=None) -> float:
+    """Largest relative error of ``engine`` against the reference over the instantaneous
+    quantities, with the case's map replaced by ``cmap`` (engine storage conventions kept)."""
+    case = get_case(case_name)
+    impl = make_implementation(engine, case)
+    if cmap is not None:
+        assert isinstance(impl, EngineImplementation)
+        impl.map = NativeMap(cmap, engine, case.multibody())
+    impls = {"reference": make_implementation("reference", case), engine: impl}
+    rows = compare_instantaneous(case, impls, case.sample_states())
+    errors = [r.max_rel_err for r in rows if r.verdict != "explained" or cmap is not None]
+    if cmap is not None and any(r.verdict == "failed" and np.isnan(r.max_rel_err) for r in rows):
+        return float("inf")  # the naive map made a quantity fail outright (singular, NaN)
+    return float(np.nanmax(errors))
+
+
+def map_demo(
+    name: str, case: str, engine: str, naive: LinearMap, what: str, engines: str
+) -> Entry:
+    return Entry(
+        name, what, engines, naive.description, worst(case, engine, naive), worst(case, engine)
+    )
+
+
+def pin_mjcf(xml: str):
+    from dyncheck.adapters.pinocchio_ import load_mjcf
+
+    return load_mjcf(xml)
