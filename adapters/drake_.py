@@ -53,7 +53,7 @@ from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import LogVectorOutput
 
-from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.base import Adapter, Chart, Frame, LoadedBody, StateLayout, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Joint, Multibody
 from dyncheck.errors import EngineError
@@ -149,6 +149,11 @@ def kkt(M: np.ndarray, rhs: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.n
 
 class DrakeAdapter(Adapter):
     name: ClassVar[str] = "drake"
+    layout: ClassVar[StateLayout] = StateLayout(
+        ball_chart=Chart.RPY, quaternion_first=True, angular_velocity_frame=Frame.WORLD,
+        angular_first=True)
+    """Its MJCF parser makes a ball joint a ``BallRpyJoint`` (ω in world axes) and a free
+    joint a ``QuaternionFloatingJoint``, q = (w, x, y, z, p), v = (ω, v) in world axes."""
     package: ClassVar[str] = "drake"
     integrators: ClassVar[tuple[str, ...]] = tuple(_INTEGRATORS)
 

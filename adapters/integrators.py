@@ -45,8 +45,6 @@ Acceleration = Callable[..., np.ndarray]
 is ``None`` (evaluate every state-dependent external force now) or what ``freeze`` returned at
 the start of the step."""
 
-NOMINAL_ORDER = {"euler": 1, "implicitfast": 1, "rk4": 4, "rk4-held-force": 1}
-
 
 def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Hamilton product of quaternions (w, x, y, z)."""

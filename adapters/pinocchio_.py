@@ -27,7 +27,7 @@ from typing import ClassVar
 import numpy as np
 import pinocchio as pin
 
-from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.base import Adapter, Frame, LoadedBody, StateLayout, Trajectory
 from dyncheck.adapters.integrators import STEPPERS, Layout, integrate, solve_on_group
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.coordinate_maps import quat_to_matrix
@@ -93,6 +93,10 @@ def load_mjcf(xml: str) -> pin.Model:
 
 class PinocchioAdapter(Adapter):
     name: ClassVar[str] = "pinocchio"
+    layout: ClassVar[StateLayout] = StateLayout(
+        quaternion_order="xyzw", linear_velocity_frame=Frame.LOCAL)
+    """``JointModelSpherical``: q (x, y, z, w), ω in the joint's local frame; free-flyer q
+    (p, x, y, z, w), v (v, ω) both in the body frame (programmatic or from MJCF)."""
     package: ClassVar[str] = "pin"
     integrators: ClassVar[tuple[str, ...]] = tuple(STEPPERS)
     adaptive: ClassVar[bool] = True

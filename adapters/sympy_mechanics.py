@@ -25,7 +25,7 @@ import numpy as np
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.base import Adapter, Chart, Frame, LoadedBody, StateLayout, Trajectory
 from dyncheck.adapters.integrators import integrate
 from dyncheck.cases.multibody import ROTATING, Multibody
 
@@ -65,6 +65,9 @@ def _batched(exprs: list[sp.Expr], args: list[sp.Symbol]) -> Callable[..., np.nd
 
 class SympyMechanicsAdapter(Adapter):
     name: ClassVar[str] = "sympy-mechanics"
+    layout: ClassVar[StateLayout] = StateLayout(
+        ball_chart=Chart.EULER, angular_velocity_frame=Frame.EULER_RATES)
+    """dyncheck's own model: a rotating body in Example 9's angles, velocities their rates."""
     package: ClassVar[str] = "sympy"
     integrators: ClassVar[tuple[str, ...]] = ("euler", "rk4")
     """MuJoCo's definitions (:mod:`.integrators`): semi-implicit Euler, shared with every

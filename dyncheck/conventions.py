@@ -1,4 +1,6 @@
-"""Engine state conventions, found by experiment and written once (tests hold them).
+"""Engine state conventions, found by experiment (tests hold them): each adapter declares its
+engine's :class:`~dyncheck.adapters.base.StateLayout` (``Adapter.layout``); this module maps
+canonical states to and from it.
 
 A case's coordinate map produces a canonical engine state: unit quaternions stored
 (w, x, y, z) and a ball joint's angular velocity in the body (local) frame. Each engine then
@@ -30,48 +32,21 @@ from __future__ import annotations
 
 import numpy as np
 
+from dyncheck.adapters import ADAPTERS, get_adapter
+from dyncheck.adapters.base import Chart, Frame, StateLayout
 from dyncheck.cases.coordinate_maps import EulerAngleMap, quat_to_matrix
 from dyncheck.cases.multibody import NQ, NV, ROTATING, Multibody
 
-QUATERNION_ORDER: dict[str, str] = {
-    "mujoco": "wxyz",
-    "pinocchio": "xyzw",
-    "pinocchio-mjcf": "xyzw",
-    "drake": "wxyz",
-    "sympy-mechanics": "wxyz",
-}
-"""How each engine stores a ball or free joint's quaternion."""
 
-BALL_CHART: dict[str, str] = {"drake": "rpy", "sympy-mechanics": "euler"}
-"""Engines whose ball joint holds angles, not a quaternion: Drake's MJCF parser makes a
-``BallRpyJoint``, q = (roll, pitch, yaw) with R = R_z(y) R_y(p) R_x(r) (measured);
-dyncheck's sympy-mechanics model uses Example 9's angles (body Z, X, Z: R = ℓ(φ, θ, ψ)) with
-their rates as velocities (a free joint likewise, after its position)."""
+def layout(engine: str) -> StateLayout:
+    """The state layout the engine's adapter declares (:class:`StateLayout`)."""
+    return get_adapter(engine).layout
 
-QUATERNION_FIRST: frozenset[str] = frozenset({"drake"})
-"""Engines whose free joint stores (quaternion, position): Drake's QuaternionFloatingJoint."""
 
-ANGULAR_VELOCITY_FRAME: dict[str, str] = {
-    "mujoco": "local",
-    "pinocchio": "local",
-    "pinocchio-mjcf": "local",
-    "drake": "world",
-    "sympy-mechanics": "euler rates",
-}
-"""In which frame each engine expresses a ball or free joint's angular velocity (or, for a
-chart, that its velocities are the angles' rates)."""
-
-LINEAR_VELOCITY_FRAME: dict[str, str] = {
-    "mujoco": "world",
-    "pinocchio": "local",
-    "pinocchio-mjcf": "local",
-    "drake": "world",
-    "sympy-mechanics": "world",
-}
-"""In which frame each engine expresses a free joint's linear velocity."""
-
-ANGULAR_FIRST: frozenset[str] = frozenset({"drake"})
-"""Engines whose free-joint velocity is (ω, v) rather than (v, ω)."""
+def is_chart(implementation: str) -> bool:
+    """Whether an implementation holds a ball joint as angles (a chart), not a quaternion."""
+    adapter = ADAPTERS.get(implementation)
+    return adapter is not None and adapter.layout.ball_chart is not Chart.QUATERNION
 
 
 def _perm(order: str) -> list[int]:
@@ -119,22 +94,23 @@ def to_native(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray:
     engine's storage (quaternion order, a ball joint's chart, a free joint's layout)."""
     if not any(j.type in ROTATING for j in spec.joints):
         return qe
-    perm = _perm(QUATERNION_ORDER[engine])
+    lay = layout(engine)
+    perm = _perm(lay.quaternion_order)
     cols, i = [], 0
     for joint in spec.joints:
         chunk = qe[:, i : i + NQ[joint.type]]
         if joint.type == "ball":
-            if BALL_CHART.get(engine) == "rpy":
+            if lay.ball_chart is Chart.RPY:
                 cols.append(_rpy_from_matrix(quat_to_matrix(chunk)))
-            elif BALL_CHART.get(engine) == "euler":
+            elif lay.ball_chart is Chart.EULER:
                 cols.append(_euler(chunk))
             else:
                 cols.append(chunk[:, perm])
-        elif joint.type == "free" and BALL_CHART.get(engine) == "euler":
+        elif joint.type == "free" and lay.ball_chart is Chart.EULER:
             cols.extend([chunk[:, :3], _euler(chunk[:, 3:])])
         elif joint.type == "free":
             quat = chunk[:, 3:][:, perm]
-            parts = [quat, chunk[:, :3]] if engine in QUATERNION_FIRST else [chunk[:, :3], quat]
+            parts = [quat, chunk[:, :3]] if lay.quaternion_first else [chunk[:, :3], quat]
             cols.extend(parts)
         else:
             cols.append(chunk)
@@ -146,14 +122,15 @@ def from_native(engine: str, spec: Multibody, qn: np.ndarray) -> np.ndarray:
     """The engine's storage back to canonical positions."""
     if not any(j.type in ROTATING for j in spec.joints):
         return qn
-    inverse = np.argsort(_perm(QUATERNION_ORDER[engine]))
+    lay = layout(engine)
+    inverse = np.argsort(_perm(lay.quaternion_order))
     cols, i = [], 0
     for joint in spec.joints:
-        if joint.type == "ball" and BALL_CHART.get(engine) == "rpy":
+        if joint.type == "ball" and lay.ball_chart is Chart.RPY:
             cols.append(_quat_from_rpy(qn[:, i : i + 3]))
             i += 3
             continue
-        if joint.type in ROTATING and BALL_CHART.get(engine) == "euler":
+        if joint.type in ROTATING and lay.ball_chart is Chart.EULER:
             if joint.type == "free":
                 cols.append(qn[:, i : i + 3])
                 i += 3
@@ -164,7 +141,7 @@ def from_native(engine: str, spec: Multibody, qn: np.ndarray) -> np.ndarray:
         if joint.type == "ball":
             cols.append(_unit(chunk[:, inverse]))
         elif joint.type == "free":
-            if engine in QUATERNION_FIRST:
+            if lay.quaternion_first:
                 quat, pos = chunk[:, :4], chunk[:, 4:]
             else:
                 quat, pos = chunk[:, 3:], chunk[:, :3]
@@ -182,9 +159,10 @@ def velocity_frames(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray 
     rotating = [j for j in spec.joints if j.type in ROTATING]
     if not rotating:
         return None
-    world_w = ANGULAR_VELOCITY_FRAME.get(engine) == "world"
-    rates = ANGULAR_VELOCITY_FRAME.get(engine) == "euler rates"
-    local_v = LINEAR_VELOCITY_FRAME.get(engine) == "local"
+    lay = layout(engine)
+    world_w = lay.angular_velocity_frame is Frame.WORLD
+    rates = lay.angular_velocity_frame is Frame.EULER_RATES
+    local_v = lay.linear_velocity_frame is Frame.LOCAL
     if not (world_w or rates or (local_v and any(j.type == "free" for j in rotating))):
         return None
     n = qe.shape[0]
@@ -202,7 +180,7 @@ def velocity_frames(engine: str, spec: Multibody, qe: np.ndarray) -> np.ndarray 
             lin = np.swapaxes(R, -1, -2) if local_v else np.broadcast_to(np.eye(3), R.shape)
             ang = R if world_w else np.broadcast_to(np.eye(3), R.shape)
             T[:, k : k + 6, k : k + 6] = 0.0
-            if engine in ANGULAR_FIRST:
+            if lay.angular_first:
                 T[:, k : k + 3, k + 3 : k + 6] = ang
                 T[:, k + 3 : k + 6, k : k + 3] = lin
             else:
@@ -220,7 +198,8 @@ def velocity_frame_rates(
     (−ω × Rᵀ v_w, 0) for a free joint whose v is in body axes; R ω̄ in world axes has
     Ṙ ω̄ = R (ω̄ × ω̄) = 0; an Euler chart's −J⁻¹ J̇ q̇."""
     out = np.zeros_like(ve)
-    if ANGULAR_VELOCITY_FRAME.get(engine) == "euler rates":
+    lay = layout(engine)
+    if lay.angular_velocity_frame is Frame.EULER_RATES:
         # d/dt (J⁻¹ ω̄) = −J⁻¹ J̇ q̇ with q̇ = J⁻¹ ω̄ (the Euler chart's own (2.2.5) term)
         i = k = 0
         for joint in spec.joints:
@@ -235,7 +214,7 @@ def velocity_frame_rates(
             i += NQ[joint.type]
             k += NV[joint.type]
         return out
-    if LINEAR_VELOCITY_FRAME.get(engine) != "local":
+    if lay.linear_velocity_frame is not Frame.LOCAL:
         return out
     i = k = 0
     for joint in spec.joints:

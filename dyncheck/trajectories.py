@@ -32,7 +32,7 @@ from dyncheck.cases import NOMINAL_ORDER, Case
 from dyncheck.cases.coordinate_maps import CoordinateMap, EulerAngleMap
 from dyncheck.cases.multibody import ROTATING
 from dyncheck.comparison import describe, soft_factor
-from dyncheck.conventions import BALL_CHART
+from dyncheck.conventions import is_chart
 from dyncheck.implementations import (
     IMPLEMENTATIONS,
     SOFT_CONSTRAINT,
@@ -609,7 +609,7 @@ def _maps_differ(
     types = {j.type for j in case.multibody().joints}
     if not types & set(ROTATING):
         return None
-    if {e for e in (a, b) if e in BALL_CHART} and a != b:
+    if any(is_chart(e) for e in (a, b)) and a != b:
         return CHARTS_DIFFER
     if integrator == "implicitfast" and "free" in types:
         facts = {

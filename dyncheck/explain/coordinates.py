@@ -3,11 +3,12 @@ quaternion order, the velocity frames of ball and free joints, degrees against r
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
-from dyncheck import conventions
+from dyncheck.adapters import get_adapter
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.explain.entry import Entry, map_demo, pin_mjcf, worst
@@ -57,12 +58,13 @@ def coordinate_order() -> Entry:
 def quaternion_order() -> Entry:
     case = "spherical_pendulum"
     correct = worst(case, "pinocchio")
-    old = conventions.QUATERNION_ORDER["pinocchio"]
-    conventions.QUATERNION_ORDER["pinocchio"] = "wxyz"
+    adapter = get_adapter("pinocchio")
+    old = adapter.layout
+    adapter.layout = dataclasses.replace(old, quaternion_order="wxyz")
     try:
         naive = worst(case, "pinocchio")
     finally:
-        conventions.QUATERNION_ORDER["pinocchio"] = old
+        adapter.layout = old
     return Entry(
         "quaternion-storage-order",
         "A ball joint's orientation is a unit quaternion; engines store it in different orders.",

@@ -3,11 +3,15 @@ changes its quaternion order or velocity frame, these fail and say so."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
 from dyncheck import conventions
+from dyncheck.adapters import ADAPTERS, get_adapter
+from dyncheck.adapters.base import Frame
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import SphericalPendulumMap, quat_to_matrix
 from dyncheck.comparison import compare_instantaneous
@@ -52,12 +56,12 @@ def test_quaternion_order_and_velocity_frame(engine):
     R, omega_world = _mujoco() if engine == "mujoco" else _pinocchio(engine)
     assert_allclose(R, quat_to_matrix(ROT[None])[0], atol=1e-14)
     assert_allclose(omega_world, R @ OMEGA, atol=1e-14)
-    assert conventions.ANGULAR_VELOCITY_FRAME[engine] == "local"
+    assert conventions.layout(engine).angular_velocity_frame is Frame.LOCAL
 
 
 def test_native_order_round_trip():
     spec = get_case("spherical_pendulum").multibody()
-    for engine in conventions.QUATERNION_ORDER:
+    for engine in ADAPTERS:  # every installed engine declares a layout
         q = conventions.to_native(engine, spec, ROT[None])
         assert_allclose(conventions.from_native(engine, spec, q), ROT[None])
     assert_allclose(
@@ -68,7 +72,9 @@ def test_native_order_round_trip():
 @pytest.mark.parametrize(("engine", "wrong"), [("mujoco", "xyzw"), ("pinocchio", "wxyz")])
 def test_wrong_quaternion_order_is_caught(engine, wrong, monkeypatch):
     """The same engine with the other storage order assumed: its rows fail."""
-    monkeypatch.setitem(conventions.QUATERNION_ORDER, engine, wrong)
+    adapter = get_adapter(engine)
+    monkeypatch.setattr(adapter, "layout",
+                        dataclasses.replace(adapter.layout, quaternion_order=wrong))
     case = get_case("spherical_pendulum")
     impls = {
         "reference": make_implementation("reference", case),
@@ -140,7 +146,7 @@ def test_mujoco_free_joint_linear_velocity_is_world_frame():
     assert_allclose(vel[3:], V_LIN, atol=1e-14)
     assert_allclose(vel[:3], R @ OMEGA, atol=1e-14)
     assert_allclose(d.qacc[:3], 0, atol=1e-12)
-    assert conventions.LINEAR_VELOCITY_FRAME["mujoco"] == "world"
+    assert conventions.layout("mujoco").linear_velocity_frame is Frame.WORLD
 
 
 @pytest.mark.parametrize("name", ["pinocchio", "pinocchio-mjcf"])
@@ -165,7 +171,7 @@ def test_pinocchio_free_flyer_velocity_is_body_frame(name):
     assert_allclose(world.angular, R @ OMEGA, atol=1e-14)
     a = pin.aba(m, d, q, v, np.zeros(6))
     assert_allclose(a[:3], -np.cross(OMEGA, V_LIN), atol=1e-12)
-    assert conventions.LINEAR_VELOCITY_FRAME[name] == "local"
+    assert conventions.layout(name).linear_velocity_frame is Frame.LOCAL
 
 
 def test_drake_ball_joint_is_rpy_with_world_angular_velocity():
