@@ -88,7 +88,7 @@ class StateLayout:
 class Adapter(ABC):
     """One engine behind the canonical form ``M(q) v̇ + h(q, v) = τ``."""
 
-    layout: ClassVar[StateLayout] = StateLayout()
+    state_layout: ClassVar[StateLayout] = StateLayout()
     """How the engine stores rotations and their velocities (the canonical layout unless the
     adapter declares otherwise)."""
 

@@ -149,7 +149,7 @@ def kkt(M: np.ndarray, rhs: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.n
 
 class DrakeAdapter(Adapter):
     name: ClassVar[str] = "drake"
-    layout: ClassVar[StateLayout] = StateLayout(
+    state_layout: ClassVar[StateLayout] = StateLayout(
         ball_chart=Chart.RPY, quaternion_first=True, angular_velocity_frame=Frame.WORLD,
         angular_first=True)
     """Its MJCF parser makes a ball joint a ``BallRpyJoint`` (ω in world axes) and a free

@@ -93,7 +93,7 @@ def load_mjcf(xml: str) -> pin.Model:
 
 class PinocchioAdapter(Adapter):
     name: ClassVar[str] = "pinocchio"
-    layout: ClassVar[StateLayout] = StateLayout(
+    state_layout: ClassVar[StateLayout] = StateLayout(
         quaternion_order="xyzw", linear_velocity_frame=Frame.LOCAL)
     """``JointModelSpherical``: q (x, y, z, w), ω in the joint's local frame; free-flyer q
     (p, x, y, z, w), v (v, ω) both in the body frame (programmatic or from MJCF)."""

@@ -65,7 +65,7 @@ def _batched(exprs: list[sp.Expr], args: list[sp.Symbol]) -> Callable[..., np.nd
 
 class SympyMechanicsAdapter(Adapter):
     name: ClassVar[str] = "sympy-mechanics"
-    layout: ClassVar[StateLayout] = StateLayout(
+    state_layout: ClassVar[StateLayout] = StateLayout(
         ball_chart=Chart.EULER, angular_velocity_frame=Frame.EULER_RATES)
     """dyncheck's own model: a rotating body in Example 9's angles, velocities their rates."""
     package: ClassVar[str] = "sympy"

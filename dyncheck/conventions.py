@@ -1,5 +1,5 @@
 """Engine state conventions, found by experiment (tests hold them): each adapter declares its
-engine's :class:`~dyncheck.adapters.base.StateLayout` (``Adapter.layout``); this module maps
+engine's :class:`~dyncheck.adapters.base.StateLayout` (``Adapter.state_layout``); this module maps
 canonical states to and from it.
 
 A case's coordinate map produces a canonical engine state: unit quaternions stored
@@ -40,13 +40,13 @@ from dyncheck.cases.multibody import NQ, NV, ROTATING, Multibody
 
 def layout(engine: str) -> StateLayout:
     """The state layout the engine's adapter declares (:class:`StateLayout`)."""
-    return get_adapter(engine).layout
+    return get_adapter(engine).state_layout
 
 
 def is_chart(implementation: str) -> bool:
     """Whether an implementation holds a ball joint as angles (a chart), not a quaternion."""
     adapter = ADAPTERS.get(implementation)
-    return adapter is not None and adapter.layout.ball_chart is not Chart.QUATERNION
+    return adapter is not None and adapter.state_layout.ball_chart is not Chart.QUATERNION
 
 
 def _perm(order: str) -> list[int]:

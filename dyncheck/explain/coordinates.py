@@ -59,12 +59,12 @@ def quaternion_order() -> Entry:
     case = "spherical_pendulum"
     correct = worst(case, "pinocchio")
     adapter = get_adapter("pinocchio")
-    old = adapter.layout
-    adapter.layout = dataclasses.replace(old, quaternion_order="wxyz")
+    old = adapter.state_layout
+    adapter.state_layout = dataclasses.replace(old, quaternion_order="wxyz")
     try:
         naive = worst(case, "pinocchio")
     finally:
-        adapter.layout = old
+        adapter.state_layout = old
     return Entry(
         "quaternion-storage-order",
         "A ball joint's orientation is a unit quaternion; engines store it in different orders.",

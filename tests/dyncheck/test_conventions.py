@@ -73,8 +73,8 @@ def test_native_order_round_trip():
 def test_wrong_quaternion_order_is_caught(engine, wrong, monkeypatch):
     """The same engine with the other storage order assumed: its rows fail."""
     adapter = get_adapter(engine)
-    monkeypatch.setattr(adapter, "layout",
-                        dataclasses.replace(adapter.layout, quaternion_order=wrong))
+    monkeypatch.setattr(adapter, "state_layout",
+                        dataclasses.replace(adapter.state_layout, quaternion_order=wrong))
     case = get_case("spherical_pendulum")
     impls = {
         "reference": make_implementation("reference", case),
