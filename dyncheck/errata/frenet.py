@@ -7,11 +7,16 @@ from functools import cache
 
 import sympy as sp
 
-from dyncheck.errata.registry import Finding, Method, Verdict, check, derived
-
-FRENET_POINTS = (sp.Rational(1, 3), sp.Integer(1), sp.Integer(2))
-"""Parameter values of the twisted cubic (t, t², t³) where the identities are evaluated."""
-DIGITS = 50
+from dyncheck.errata.registry import (
+    DIGITS,
+    POINTS,
+    Finding,
+    Method,
+    Verdict,
+    check,
+    derived,
+    negligible,
+)
 
 
 @cache
@@ -35,11 +40,11 @@ def frenet_frame(plane: bool = False) -> dict[str, sp.Matrix | sp.Expr]:
 
 
 def vanishes(expr: sp.Expr | sp.Matrix, plane: bool = False) -> bool:
-    """|expr| < 10⁻⁴⁰ at every point of FRENET_POINTS, evaluated to DIGITS digits."""
+    """Every entry is negligible at each of POINTS on the twisted cubic (the parabola if
+    ``plane``)."""
     f = frenet_frame(plane)
     values = expr if isinstance(expr, sp.MatrixBase) else sp.Matrix([expr])
-    return all(abs(sp.N(v.subs(f["t"], p), DIGITS)) < sp.Float(10) ** -40
-               for p in FRENET_POINTS for v in values)
+    return all(negligible(v.subs(f["t"], p)) for p in POINTS for v in values)
 
 
 def _dot(a: sp.Matrix, b: sp.Matrix) -> sp.Expr:

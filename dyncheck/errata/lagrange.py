@@ -4,6 +4,7 @@ and potential (the results are identities in N)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
 
@@ -26,6 +27,14 @@ class _Lagrange:
     """Christoffel symbols of the second kind {i; m n} of g."""
 
 
+def christoffel(g: sp.Matrix, p: Sequence[sp.Symbol]) -> list[list[list[sp.Expr]]]:
+    """{i; m n} = ½ g^{ir} (∂g_rm/∂pⁿ + ∂g_rn/∂pᵐ − ∂g_mn/∂pʳ) of the metric g in the
+    coordinates p."""
+    ginv, dim = g.inv(), range(len(p))
+    return [[[sum(ginv[i, r] * (g[r, m].diff(p[n]) + g[r, n].diff(p[m]) - g[m, n].diff(p[r]))
+                  for r in dim) / 2 for n in dim] for m in dim] for i in dim]
+
+
 @cache
 def general_lagrange() -> _Lagrange:
     t, M = sp.symbols("t M", positive=True)
@@ -35,13 +44,10 @@ def general_lagrange() -> _Lagrange:
     p = sp.symbols("p1 p2")
     g11, g12, g22, V = (sp.Function(n)(*p) for n in ("g11", "g12", "g22", "V"))
     g_p = sp.Matrix([[g11, g12], [g12, g22]])
-    ginv = g_p.inv()
-    gamma_p = tuple(tuple(tuple(
-        sum(ginv[i, r] * (g_p[r, m].diff(p[n]) + g_p[r, n].diff(p[m]) - g_p[m, n].diff(p[r]))
-            for r in range(2)) / 2 for n in range(2)) for m in range(2)) for i in range(2))
     at = dict(zip(p, x, strict=True))
     g = g_p.subs(at)
-    gamma = tuple(tuple(tuple(c.subs(at) for c in row) for row in mat) for mat in gamma_p)
+    gamma = tuple(tuple(tuple(c.subs(at) for c in row) for row in mat)
+                  for mat in christoffel(g_p, p))
     T = M / 2 * sum(g[m, n] * xd[m] * xd[n] for m in range(2) for n in range(2))
     return _Lagrange(t, M, x, xd, xdd, g, V.subs(at), T, gamma)
 
@@ -105,10 +111,7 @@ def _acceleration_is_a_vector() -> Finding:
                       p[0] * sp.cos(p[1])])
     J = cart.jacobian(p)
     g = sp.simplify(J.T * J)
-    ginv = g.inv()
-    gamma = [[[sp.simplify(sum(ginv[i, r] * (g[r, m].diff(p[n]) + g[r, n].diff(p[m])
-                                             - g[m, n].diff(p[r])) for r in range(3)) / 2)
-               for n in range(3)] for m in range(3)] for i in range(3)]
+    gamma = [[[sp.simplify(c) for c in row] for row in mat] for mat in christoffel(g, p)]
     at = dict(zip(p, q, strict=True))
     qd = [qi.diff(t) for qi in q]
     f = sp.Matrix([q[i].diff(t, 2) + sum(gamma[i][m][n].subs(at) * qd[m] * qd[n]

@@ -69,6 +69,19 @@ def zero(expr: sp.Expr) -> bool:
     return sp.simplify(expr) == 0
 
 
+POINTS = (sp.Rational(1, 3), sp.Integer(1), sp.Integer(2))
+"""Parameter values (a curve's t, a motion's instant) where an identity in one variable is
+decided: exactly where its terms are rational there, else to DIGITS digits."""
+DIGITS = 50
+TINY = sp.Float(10) ** -40
+"""What counts as zero in a DIGITS-digit evaluation (10 digits of margin)."""
+
+
+def negligible(value: sp.Expr) -> bool:
+    """|value| < TINY, evaluated to DIGITS digits."""
+    return bool(abs(sp.N(value, DIGITS)) < TINY)
+
+
 def findings(ids: list[str]) -> dict[str, Finding]:
     """Each id's finding (PENDING where no check is written yet)."""
     out = {}

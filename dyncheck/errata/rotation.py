@@ -15,21 +15,29 @@ from functools import cache
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
-from dyncheck.errata.registry import Finding, Method, Verdict, check, derived, zero
+from dyncheck.errata.registry import (
+    DIGITS,
+    POINTS,
+    Finding,
+    Method,
+    Verdict,
+    check,
+    derived,
+    negligible,
+    zero,
+)
 from dyncheck.errata.rigid import levi_civita
 
 R3 = range(3)
-TIMES = (sp.Rational(1, 3), sp.Integer(1), sp.Integer(2))
-"""Instants where identities of algebraic (not rational) functions are evaluated exactly."""
 
 
 def _nil(m: sp.Matrix | sp.Expr) -> bool:
-    """Every entry is 0 at each instant of TIMES, exactly: ℓ and its rates take the Cayley
+    """Every entry is 0 at each instant of POINTS, exactly: ℓ and its rates take the Cayley
     frame's values there; a path's values x_i(t) and rates ẋ_i(t) are free (independent
     symbols). The differentiation before it is symbolic."""
     entries = list(m) if isinstance(m, sp.MatrixBase) else [m]
     t = _frame()[0]
-    for at in TIMES:
+    for at in POINTS:
         for e in entries:
             e = e.xreplace(_instant(at))
             e = e.xreplace({d: sp.Dummy() for d in e.atoms(sp.Derivative)})
@@ -421,7 +429,7 @@ def _body_axes() -> Finding:
     dwbar = wbar.diff(t)
     delta = sp.KroneckerDelta
     ok = True
-    for at in TIMES:
+    for at in POINTS:
         L, dL, W, dW, inner_at, rate_at = (m.xreplace(_instant(at)) for m in (
             ell, dell, wbar, dwbar, inner, rate))
         w = L * dL.T  # ω_mj = ℓ_mi ℓ̇_ji
@@ -534,11 +542,11 @@ def _triad() -> dict[str, sp.Expr | sp.Matrix]:
 
 
 def _small(vec: sp.Matrix | sp.Expr, at: sp.Expr) -> sp.Expr:
-    """|vec|² at t = ``at`` to 50 digits, 0 when below 10⁻⁴⁰ (the entries are algebraic)."""
+    """|vec|² at t = ``at`` to DIGITS digits, 0 when negligible (the entries are algebraic)."""
     k = _triad()
     entries = vec if isinstance(vec, sp.MatrixBase) else sp.Matrix([vec])
-    value = sp.N(sum(e**2 for e in entries.subs(k["t"], at)), 50)
-    return sp.Integer(0) if abs(value) < sp.Float(10) ** -40 else value
+    value = sp.N(sum(e**2 for e in entries.subs(k["t"], at)), DIGITS)
+    return sp.Integer(0) if negligible(value) else value
 
 
 @check("ex30.i6", "ex30.i8", "ex30.i9", "ex30.i10", "ex30.i12", "ex30.i13", "ex30.i14")
@@ -548,9 +556,9 @@ def _moving_triad() -> Finding:
     relations = [e1.diff(t) - k["alpha"] * e2, e3.diff(t) - k["beta"] * e2,
                  e2 - e3.cross(e1), e2.diff(t) - (k["alpha"] * e3 - k["beta"] * e1).cross(e2),
                  e1.diff(t) - w.cross(e1), e2.diff(t) - w.cross(e2), e3.diff(t) - w.cross(e3)]
-    ok = all(_small(rel, at) == 0 for rel in relations for at in TIMES)
-    alphas = [sp.N(k["alpha"].subs(t, at), 4) for at in TIMES]
-    betas = [sp.N(k["beta"].subs(t, at), 4) for at in TIMES]
+    ok = all(_small(rel, at) == 0 for rel in relations for at in POINTS)
+    alphas = [sp.N(k["alpha"].subs(t, at), 4) for at in POINTS]
+    betas = [sp.N(k["beta"].subs(t, at), 4) for at in POINTS]
     return derived(
         ok, method=Method.NUMERIC,
         evidence="ê₁ a body axis of the rotating ℓ(t), ê₂ = (dê₁/dt)/α, ê₃ = ê₁ × ê₂: each "
