@@ -106,6 +106,8 @@ class Adapter(ABC):
     gyroscopic_implicit: ClassVar[bool] = False
     """Whether the engine's ``implicitfast`` differentiates a free body's gyroscopic force (a
     different map from semi-implicit Euler there)."""
+    dtype: ClassVar[type[np.floating]] = np.float64
+    """The floating-point type the engine computes in."""
     couplings_with_field: ClassVar[bool] = False
     """Whether the adapter holds couplings and an external field in one model (refused, before
     any work, where it does not)."""
@@ -114,6 +116,11 @@ class Adapter(ABC):
         if model.couplings and model.central_mu and not self.couplings_with_field:
             raise Unsupported(f"{self.name}: couplings together with a field")
         self.spec = model
+
+    @property
+    def eps(self) -> float:
+        """The engine's unit round-off (ε of its floating-point type)."""
+        return float(np.finfo(self.dtype).eps)
 
     @staticmethod
     @abstractmethod

@@ -29,6 +29,7 @@ from dyncheck.implementations import (
     ReferenceImplementation,
     Variant,
     book_variant,
+    compared,
     general_method,
     quantities,
 )
@@ -112,6 +113,11 @@ class Evaluator:
     skipped: bool = False
     values: dict[str, np.ndarray] | None = field(default=None, repr=False)
 
+    @property
+    def eps(self) -> float:
+        """Unit round-off of the implementation's arithmetic (float64's when it failed)."""
+        return EPS if isinstance(self.impl, Exception) else self.impl.eps
+
     def __post_init__(self) -> None:
         if isinstance(self.impl, Exception):
             self.error = str(self.impl)
@@ -164,7 +170,8 @@ class VariantPredictor:
 def _row(
     case: Case, quantity: str, a: Evaluator, b: Evaluator, st: PairStats, condition: float
 ) -> Discrepancy:
-    tol = instantaneous(quantity, condition, max(soft_factor(a.variant), soft_factor(b.variant)))
+    soft = max(soft_factor(a.variant), soft_factor(b.variant))
+    tol = instantaneous(quantity, condition, soft, max(a.eps, b.eps))
     base: dict[str, Any] = dict(
         case=case.name,
         quantity=quantity,
@@ -225,7 +232,7 @@ def compare_instantaneous(
         chunks = [chunks]
     names = [n for n in IMPLEMENTATIONS if n in impls]
     evals = {n: Evaluator(n, impls[n]) for n in names}
-    pairs = list(combinations(names, 2))
+    pairs = [(a, b) for a, b in combinations(names, 2) if compared(a, b)]
     qs = quantities(case)
 
     def provides(name: str, q: str) -> bool:

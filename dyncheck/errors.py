@@ -42,11 +42,14 @@ class UnknownName(DyncheckError, KeyError):
 class EngineNotInstalled(DyncheckError, ImportError):
     """An implementation whose engine package cannot be imported."""
 
-    def __init__(self, implementation: str, package: str, reason: str) -> None:
-        self.implementation, self.package = implementation, package
+    def __init__(
+        self, implementation: str, package: str, reason: str, extra: str | None = None
+    ) -> None:
+        self.implementation, self.package, self.extra = implementation, package, extra
+        hint = f"the extra {extra!r}: pip install 'dyncheck[{extra}]'" if extra else package
         super().__init__(
             f"implementation {implementation!r} needs {package!r}, which is not installed "
-            f"({reason}); pip install {package}"
+            f"({reason}); install {hint}"
         )
 
 

@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from dyncheck import coordinates as co
-from dyncheck.adapters import ENGINE_PACKAGES, Adapter, get_adapter
+from dyncheck.adapters import ENGINE_PACKAGES, ENGINE_PORTS, Adapter, get_adapter
 from dyncheck.cases import Case, StateSample
 from dyncheck.conventions import (
     from_native,
@@ -59,6 +59,9 @@ IMPLEMENTATIONS: tuple[str, ...] = (
     "drake",
     "mujoco",
     "mujoco-stiff",
+    "mjx-f64",
+    "mjx",
+    "mujoco-warp",
 )
 """All implementation names, most trusted first: in a pair the earlier one is ``desired``."""
 
@@ -71,6 +74,18 @@ def implementations_for(case: Case, names: tuple[str, ...] = IMPLEMENTATIONS) ->
     """Of ``names``, those that run on ``case`` (couplings-only ones need couplings)."""
     coupled = bool(case.multibody().couplings)
     return [n for n in names if coupled or n not in COUPLINGS_ONLY]
+
+
+def compared(a: str, b: str) -> bool:
+    """Whether the pair (a, b) is compared: every pair, except that a port (MJX, MuJoCo Warp)
+    meets only the reference, the engine it ports and its own package's other builds."""
+    for port, other in ((a, b), (b, a)):
+        if port in ENGINE_PORTS and not (
+            other in ("reference", ENGINE_PORTS[port])
+            or ENGINE_PACKAGES.get(other) == ENGINE_PACKAGES[port]
+        ):
+            return False
+    return True
 
 
 _REFERENCE: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
@@ -181,6 +196,8 @@ class Implementation(ABC):
 
     name: ClassVar[str]
     integrators: tuple[str, ...] = ()
+    eps: float = float(np.finfo(float).eps)
+    """Unit round-off of the arithmetic the implementation computes in."""
 
     def __init__(self, case: Case) -> None:
         self.case = case
@@ -318,6 +335,7 @@ class EngineImplementation(Implementation):
         self.adapter = adapter(case.multibody())
         self.map = NativeMap(case.engine_map(), adapter.name, case.multibody())
         self.integrators = adapter.integrators
+        self.eps = self.adapter.eps
         self._runs: dict[tuple[float, str], tuple[np.ndarray, np.ndarray]] = {}
         self._velocities: dict[tuple[float, str], np.ndarray] = {}
         self._engine_q: dict[tuple[float, str], np.ndarray] = {}

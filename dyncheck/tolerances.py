@@ -7,6 +7,12 @@ round-off is a few ε; 64 ε (1.4e-14) leaves room for the coordinate map (a few
 without admitting any modelling difference (the smallest one dyncheck explains is ~1e-9).
 Forward dynamics solves M v̇ = τ − h, whose relative error is amplified by κ(M) (the
 2-norm condition number, the largest over the sampled states).
+
+A pair with a float32 implementation (MJX, MuJoCo Warp) is held to the same bounds with
+ε₃₂ = 1.2e-7 in place of ε₆₄: the port rounds the state itself to float32 (a relative
+perturbation ε₃₂ of q, v, τ, whose effect on M, h and τ is a few ε₃₂ at these states' scales)
+and evaluates in float32; c = 64 covers both, as it covers the float64 evaluations. Forward
+dynamics keeps its factor κ(M) (the solve amplifies the relative error of M and of τ − h).
 """
 
 from __future__ import annotations
@@ -18,7 +24,12 @@ import numpy as np
 from dyncheck.implementations import QUANTITIES
 
 EPS = float(np.finfo(float).eps)
+EPS32 = float(np.finfo(np.float32).eps)
 ROUNDOFF_FACTOR = 64
+
+
+def _unit(eps: float) -> str:
+    return "eps" if eps == EPS else ("float32 eps" if eps == EPS32 else f"eps {eps:.3g}")
 
 
 @dataclass(frozen=True)
@@ -37,27 +48,32 @@ def soft_condition(impedance: float) -> float:
     return 1.0 + impedance / (1.0 - impedance)
 
 
-def instantaneous(quantity: str, condition: float, soft: float = 1.0) -> Tolerance:
+def instantaneous(
+    quantity: str, condition: float, soft: float = 1.0, eps: float = EPS
+) -> Tolerance:
     """The tolerance for ``quantity``; ``condition`` = max κ(M) over the states, ``soft``
-    the :func:`soft_condition` of a soft-constraint solve in the pair (1 if none)."""
+    the :func:`soft_condition` of a soft-constraint solve in the pair (1 if none), ``eps``
+    the unit round-off of the pair's less precise implementation."""
     if quantity not in QUANTITIES:
         raise KeyError(quantity)
+    unit = _unit(eps)
     if quantity in ("forward_dynamics", "constraint_force"):
-        basis = f"round-off: {ROUNDOFF_FACTOR} eps x cond(M) = {condition:.3g}"
+        basis = f"round-off: {ROUNDOFF_FACTOR} {unit} x cond(M) = {condition:.3g}"
         if soft > 1.0:
             basis += f" x soft-constraint Hessian 1 + d/(1-d) = {soft:.3g}"
-        return Tolerance(ROUNDOFF_FACTOR * EPS * condition * soft, basis)
-    return Tolerance(ROUNDOFF_FACTOR * EPS, f"round-off: {ROUNDOFF_FACTOR} eps")
+        return Tolerance(ROUNDOFF_FACTOR * eps * condition * soft, basis)
+    return Tolerance(ROUNDOFF_FACTOR * eps, f"round-off: {ROUNDOFF_FACTOR} {unit}")
 
 
-def accumulated(steps: int, soft: float = 1.0) -> Tolerance:
+def accumulated(steps: int, soft: float = 1.0, eps: float = EPS) -> Tolerance:
     """Two runs of the same integrator on the same model: round-off accumulates at most
     linearly over the steps (no exponential growth on these regular orbits); ``soft`` as in
-    :func:`instantaneous`, for runs through a soft-constraint solve."""
-    basis = f"accumulated round-off: {ROUNDOFF_FACTOR} eps x {steps} steps"
+    :func:`instantaneous`, for runs through a soft-constraint solve; ``eps`` the unit
+    round-off of the less precise run."""
+    basis = f"accumulated round-off: {ROUNDOFF_FACTOR} {_unit(eps)} x {steps} steps"
     if soft > 1.0:
         basis += f" x soft-constraint Hessian {soft:.3g}"
-    return Tolerance(ROUNDOFF_FACTOR * EPS * steps * soft, basis)
+    return Tolerance(ROUNDOFF_FACTOR * eps * steps * soft, basis)
 
 
 def first_near_max(errors: np.ndarray, band: float) -> int:

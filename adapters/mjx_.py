@@ -1,0 +1,156 @@
+"""MJX (MuJoCo in JAX) behind the canonical form: ``mjx`` in float32 (JAX's default) and
+``mjx-f64`` with JAX's 64-bit mode, both from the MJCF and ``MjModel`` of ``mujoco``.
+
+MJX's names: ``mjx.forward`` (``qfrc_bias``, ``qacc`` with ``qfrc_applied`` = τ), M from
+``mjx.full_m``, ``mjx.inverse`` (``qfrc_inverse``), the equality rows' ``efc_force``; all
+``jax.vmap``-ed over a chunk of states and compiled once per model. A simulation is
+``mjx.step`` under ``jax.lax.scan``. 64-bit mode is scoped to this adapter's calls
+(``jax.enable_x64``), so the two precisions coexist in one process and neither changes JAX's
+global default.
+
+MJX's integrators differ in definition from MuJoCo C 4.0's, read from its source
+(``mujoco/mjx/_src/forward.py``, mujoco-mjx 3.17.0): ``rungekutta4`` integrates every stage's
+position from q₀ with the stage's combined velocity and sums the stages' angular velocities as
+if in one tangent space (MuJoCo C before 4.0; order 2 on ball and free joints), and
+``implicit`` (implicitfast) differentiates only actuator and damping forces ("TODO: rne
+derivative") — no gyroscopic derivative on a free body (MuJoCo C ≥ 3.11 has one).
+
+JAX's persistent compilation cache is switched on (under the user's cache directory, or
+``DYNCHECK_JAX_CACHE``), so a second run does not compile again.
+"""
+
+from __future__ import annotations
+
+import os
+from contextlib import AbstractContextManager
+from pathlib import Path
+from typing import Any, ClassVar
+
+import jax
+import jax.numpy as jnp
+import mujoco
+import numpy as np
+from mujoco import mjx
+
+from dyncheck.adapters.mujoco_port import CHUNK, STEPS, PortAdapter
+from dyncheck.cases.multibody import Multibody
+
+_CACHE = Path(os.environ.get("DYNCHECK_JAX_CACHE", Path.home() / ".cache" / "dyncheck" / "jax"))
+jax.config.update("jax_compilation_cache_dir", str(_CACHE))
+jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
+
+_INTEGRATORS = {
+    "euler": mujoco.mjtIntegrator.mjINT_EULER,
+    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+}
+
+
+def _evaluate(mx: Any, q: Any, v: Any, tau: Any, a: Any) -> dict[str, Any]:
+    """Every quantity at one state (vmapped over the chunk)."""
+    d = mjx.make_data(mx).replace(qpos=q, qvel=v, qfrc_applied=tau)
+    d = mjx.forward(mx, d)
+    inv = mjx.inverse(mx, d.replace(qacc=a, qfrc_applied=jnp.zeros_like(tau)))
+    return {
+        "M": mjx.full_m(mx, d),
+        "bias": d.qfrc_bias,
+        "qacc": d.qacc,
+        "qfrc_inverse": inv.qfrc_inverse,
+        "xipos": d.xipos,
+        "efc_force": d._impl.efc_force,
+    }
+
+
+def _stretch(mx: Any, d: Any) -> tuple[Any, tuple[Any, Any]]:
+    """STEPS steps of ``mjx.step``, every state recorded."""
+
+    def one(d: Any, _: Any) -> tuple[Any, tuple[Any, Any]]:
+        d = mjx.step(mx, d)
+        return d, (d.qpos, d.qvel)
+
+    return jax.lax.scan(one, d, None, length=STEPS)
+
+
+class MJXAdapter(PortAdapter):
+    """MJX in float32."""
+
+    name: ClassVar[str] = "mjx"
+    package: ClassVar[str] = "mujoco-mjx"
+    integrators: ClassVar[tuple[str, ...]] = tuple(_INTEGRATORS)
+    rk4_group_order: ClassVar[int] = 2
+    gyroscopic_implicit: ClassVar[bool] = False
+    dtype: ClassVar[type[np.floating]] = np.float32
+
+    def __init__(self, model: Multibody) -> None:
+        super().__init__(model)
+        # MJX has no energy flag (put_model refuses it): energies come from M and xipos
+        self.model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_ENERGY)
+        with self._precision():
+            self.mx = self._cast(mjx.put_model(self.model))
+            self._eval = jax.jit(jax.vmap(_evaluate, in_axes=(None, 0, 0, 0, 0)))
+        self._steppers: dict[str, Any] = {}
+
+    @staticmethod
+    def version() -> str:
+        from importlib.metadata import version
+
+        return f"mujoco-mjx {version('mujoco-mjx')}, jax {jax.__version__}"
+
+    def _precision(self) -> AbstractContextManager[Any]:
+        return jax.enable_x64(self.dtype == np.float64)
+
+    def _cast(self, tree: Any) -> Any:
+        """Every floating array of a model or data in the adapter's precision."""
+        return jax.tree_util.tree_map(
+            lambda x: x.astype(self.dtype)
+            if isinstance(x, jax.Array | np.ndarray) and jnp.issubdtype(x.dtype, jnp.floating)
+            else x,
+            tree,
+        )
+
+    def _loaded(self, field: str) -> np.ndarray:
+        obj: Any = self.mx
+        for part in field.split("."):
+            obj = getattr(obj, part)
+        return np.asarray(obj, dtype=float)
+
+    def _batch(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
+    ) -> dict[str, np.ndarray]:
+        assert q.shape[0] == CHUNK
+        with self._precision():
+            args = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, tau, a))
+            out = self._eval(self.mx, *args)
+            return {k: np.asarray(x) for k, x in out.items()}
+
+    def _run(
+        self, q0: np.ndarray, v0: np.ndarray, steps: int, dt: float, integrator: str
+    ) -> tuple[np.ndarray, np.ndarray]:
+        with self._precision():
+            opt = self.mx.opt.replace(
+                integrator=mjx.IntegratorType(int(_INTEGRATORS[integrator])),
+                timestep=jnp.asarray(dt, dtype=self.dtype),
+            )
+            mx = self.mx.replace(opt=opt)
+            if integrator not in self._steppers:
+                self._steppers[integrator] = jax.jit(_stretch)
+            stretch = self._steppers[integrator]
+            d = self._cast(mjx.make_data(mx))
+            d = d.replace(
+                qpos=jnp.asarray(q0, dtype=self.dtype), qvel=jnp.asarray(v0, dtype=self.dtype)
+            )
+            qs = [np.asarray(q0, dtype=self.dtype)[None]]
+            vs = [np.asarray(v0, dtype=self.dtype)[None]]
+            for _ in range(-(-steps // STEPS)):
+                d, (q, v) = stretch(mx, d)
+                qs.append(np.asarray(q))
+                vs.append(np.asarray(v))
+        return np.concatenate(qs)[: steps + 1], np.concatenate(vs)[: steps + 1]
+
+
+class MJXF64Adapter(MJXAdapter):
+    """MJX with JAX's 64-bit mode: the same code in float64, which must agree with MuJoCo C
+    to round-off."""
+
+    name: ClassVar[str] = "mjx-f64"
+    dtype: ClassVar[type[np.floating]] = np.float64

@@ -1,0 +1,151 @@
+"""MuJoCo Warp (NVIDIA Warp) behind the canonical form, float32, from the MJCF and ``MjModel``
+of ``mujoco``; a chunk of states is a batch of Warp "worlds" (``nworld``).
+
+MuJoCo Warp's names: ``mujoco_warp.forward`` (``qfrc_bias``, ``qacc`` with ``qfrc_applied`` =
+τ), ``mujoco_warp.inverse`` (``qfrc_inverse``), M column by column from ``mul_m`` (M eⱼ; the
+port offers no dense M), the equality rows of ``efc.force``. Its integrators, read from its
+source (``mujoco_warp/_src/forward.py``, 4.0.0), share MuJoCo C 4.0's definitions: RK4
+combines its stages on the rotation group (``_rk_correct_velocity``, Runge–Kutta–Munthe-Kaas)
+and ``implicitfast`` applies a free body's gyroscopic derivative (``implicit_free_body``).
+
+The device is Warp's: ``cpu`` unless ``DYNCHECK_DEVICE`` (or ``--device``) names a CUDA device.
+On the CPU every kernel launch costs ~0.1 ms, so a step costs ~10 ms (Euler) to ~40 ms (RK4)
+even on a pendulum (measured); runs longer than ``CPU_STEPS`` are left to a GPU, where one
+step is a captured CUDA graph. Warp's kernel cache (``~/.cache/warp``) keeps compiled kernels
+across runs.
+"""
+
+from __future__ import annotations
+
+import os
+from importlib.metadata import version as _version
+from typing import Any, ClassVar
+
+import mujoco
+import numpy as np
+import warp as wp
+
+wp.config.quiet = True
+import mujoco_warp as mjw  # noqa: E402  (after silencing Warp's start-up banner)
+
+from dyncheck.adapters.mujoco_port import CHUNK, PortAdapter  # noqa: E402
+from dyncheck.cases.multibody import Multibody  # noqa: E402
+from dyncheck.errors import Unsupported  # noqa: E402
+
+_INTEGRATORS = {
+    "euler": mujoco.mjtIntegrator.mjINT_EULER,
+    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+}
+
+CPU_STEPS = 400
+"""The longest run the adapter makes on Warp's CPU device (~16 s of RK4 steps)."""
+
+
+def device() -> str:
+    """Warp's device for this process: ``DYNCHECK_DEVICE`` if set (``cpu``, ``cuda``,
+    ``cuda:0``, …), else ``cpu``."""
+    return os.environ.get("DYNCHECK_DEVICE", "cpu")
+
+
+class MuJoCoWarpAdapter(PortAdapter):
+    """MuJoCo Warp in float32 (Warp's ``float``)."""
+
+    name: ClassVar[str] = "mujoco-warp"
+    package: ClassVar[str] = "mujoco-warp"
+    integrators: ClassVar[tuple[str, ...]] = tuple(_INTEGRATORS)
+    rk4_group_order: ClassVar[int] = 4
+    gyroscopic_implicit: ClassVar[bool] = True
+    dtype: ClassVar[type[np.floating]] = np.float32
+
+    def __init__(self, model: Multibody) -> None:
+        super().__init__(model)
+        self.model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_ENERGY)
+        self.device = device()
+        with wp.ScopedDevice(self.device):
+            self.mw = mjw.put_model(self.model)
+            self.dw = mjw.make_data(self.model, nworld=CHUNK)
+
+    @staticmethod
+    def version() -> str:
+        return f"mujoco-warp {_version('mujoco-warp')}, warp-lang {wp.__version__}"
+
+    def _loaded(self, field: str) -> np.ndarray:
+        obj: Any = self.mw
+        for part in field.split("."):
+            obj = getattr(obj, part)
+        values = obj.numpy() if hasattr(obj, "numpy") else np.asarray(obj)
+        values = np.asarray(values, dtype=float)
+        # batched model fields carry a leading world axis of length one
+        per_model = {"body_mass": 1, "opt.gravity": 1, "body_inertia": 2, "body_iquat": 2}
+        per_model |= {"eq_solref": 2, "eq_solimp": 2}
+        while values.ndim > per_model.get(field, values.ndim):
+            values = values[0]
+        return values
+
+    def _set(self, name: str, values: np.ndarray) -> None:
+        getattr(self.dw, name).assign(wp.array(values.astype(np.float32), device=self.device))
+
+    def _batch(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
+    ) -> dict[str, np.ndarray]:
+        m, d, nv = self.mw, self.dw, self.model.nv
+        with wp.ScopedDevice(self.device):
+            self._set("qpos", q)
+            self._set("qvel", v)
+            self._set("qfrc_applied", tau)
+            mjw.forward(m, d)
+            out = {
+                "bias": d.qfrc_bias.numpy().copy(),
+                "qacc": d.qacc.numpy().copy(),
+                "xipos": d.xipos.numpy().copy(),
+            }
+            M = np.empty((CHUNK, nv, nv))
+            res = wp.zeros((CHUNK, nv), dtype=float)
+            for j in range(nv):
+                e = np.zeros((CHUNK, nv), np.float32)
+                e[:, j] = 1.0
+                mjw.mul_m(m, d, res, wp.array(e))
+                M[:, :, j] = res.numpy()
+            out["M"] = M
+            out["efc_force"] = self._equality_force()
+            self._set("qacc", a)
+            mjw.inverse(m, d)
+            out["qfrc_inverse"] = d.qfrc_inverse.numpy().copy()
+        return out
+
+    def _equality_force(self) -> np.ndarray:
+        """efc.force of the equality rows, in equality order, per world."""
+        neq = self.model.neq
+        out = np.zeros((CHUNK, neq))
+        if not neq:
+            return out
+        kind, ident, force = (x.numpy() for x in (self.dw.efc.type, self.dw.efc.id, self.dw.efc.force))
+        nefc = self.dw.nefc.numpy()
+        for w in range(CHUNK):
+            rows = np.flatnonzero(kind[w, : nefc[w]] == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY))
+            out[w] = force[w, rows[np.argsort(ident[w, rows], kind="stable")]]
+        return out
+
+    def _run(
+        self, q0: np.ndarray, v0: np.ndarray, steps: int, dt: float, integrator: str
+    ) -> tuple[np.ndarray, np.ndarray]:
+        if self.device == "cpu" and steps > CPU_STEPS:
+            raise Unsupported(
+                f"{self.name} on the CPU: {steps} steps at ~10-40 ms each (Warp's kernel "
+                f"launches) exceed the CPU budget of {CPU_STEPS}; run with --device cuda"
+            )
+        self.model.opt.timestep = dt
+        self.model.opt.integrator = _INTEGRATORS[integrator]
+        with wp.ScopedDevice(self.device):
+            m = mjw.put_model(self.model)
+            d = mjw.make_data(self.model, nworld=1)
+            d.qpos.assign(wp.array(np.asarray(q0, np.float32)[None]))
+            d.qvel.assign(wp.array(np.asarray(v0, np.float32)[None]))
+            qs = np.empty((steps + 1, self.model.nq))
+            vs = np.empty((steps + 1, self.model.nv))
+            qs[0], vs[0] = d.qpos.numpy()[0], d.qvel.numpy()[0]
+            for k in range(1, steps + 1):
+                mjw.step(m, d)
+                qs[k], vs[k] = d.qpos.numpy()[0], d.qvel.numpy()[0]
+        return qs, vs
