@@ -117,6 +117,10 @@ class Adapter(ABC):
             raise Unsupported(f"{self.name}: couplings together with a field")
         self.spec = model
 
+    max_steps: int | None = None
+    """The longest fixed-step run the engine makes here (None: no limit); a study whose runs
+    are longer is refused before any of them starts."""
+
     @property
     def eps(self) -> float:
         """The engine's unit round-off (ε of its floating-point type)."""

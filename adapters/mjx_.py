@@ -39,6 +39,9 @@ _CACHE = Path(os.environ.get("DYNCHECK_JAX_CACHE", Path.home() / ".cache" / "dyn
 jax.config.update("jax_compilation_cache_dir", str(_CACHE))
 jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
 
+_MODE: bool | None = None
+"""The 64-bit mode of the last call into JAX (None before the first)."""
+
 _INTEGRATORS = {
     "euler": mujoco.mjtIntegrator.mjINT_EULER,
     "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
@@ -94,17 +97,33 @@ class MJXAdapter(PortAdapter):
     def version() -> str:
         from importlib.metadata import version
 
-        return f"mujoco-mjx {version('mujoco-mjx')}, jax {jax.__version__}"
+        device = jax.devices()[0]
+        return (
+            f"{version('mujoco-mjx')} (jax {jax.__version__}, "
+            f"device {device.platform}: {device.device_kind})"
+        )
 
     def _precision(self) -> AbstractContextManager[Any]:
-        return jax.enable_x64(self.dtype == np.float64)
+        """JAX's 64-bit mode on or off for this adapter's calls. JAX 0.10 cannot lower a
+        function that calls an inner ``jit`` on a NumPy constant (MJX's RK4 tableau through
+        ``jnp.tril``) in one mode once another function has done so in the other mode (a
+        minimal reproducer: ``jnp.tril`` of a NumPy array in two jitted functions, one under
+        each mode); its caches are cleared when the mode changes, so the two coexist."""
+        global _MODE
+        x64 = self.dtype == np.float64
+        if _MODE is not None and _MODE != x64:
+            jax.clear_caches()
+        _MODE = x64
+        return jax.enable_x64(x64)
 
     def _cast(self, tree: Any) -> Any:
         """Every floating array of a model or data in the adapter's precision."""
         return jax.tree_util.tree_map(
-            lambda x: x.astype(self.dtype)
-            if isinstance(x, jax.Array | np.ndarray) and jnp.issubdtype(x.dtype, jnp.floating)
-            else x,
+            lambda x: (
+                x.astype(self.dtype)
+                if isinstance(x, jax.Array | np.ndarray) and jnp.issubdtype(x.dtype, jnp.floating)
+                else x
+            ),
             tree,
         )
 

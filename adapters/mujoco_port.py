@@ -76,8 +76,20 @@ class PortAdapter(MuJoCoAdapter):
 
     # --- the model as the port holds it -----------------------------------------------------
 
+    def _held(self, field: str) -> np.ndarray:
+        """A model array as the port holds it, where it differs from the C model's float64
+        value by more than the port's rounding (|Δ| > ε|x|); within it, the C model's value:
+        rounding the parameters to float32 is part of the float32 round-off the tolerances
+        bound, not a different model (a mass changed by 1e-4 in the port is)."""
+        port = self._loaded(field)
+        obj: object = self.model
+        for part in field.split("."):
+            obj = getattr(obj, part)
+        c = np.asarray(obj, dtype=float).reshape(port.shape)
+        return np.where(np.abs(port - c) <= self.eps * np.abs(c), c, port)
+
     def loaded_bodies(self) -> list[LoadedBody]:
-        mass, inertia, iquat = (self._loaded(f) for f in ("body_mass", "body_inertia", "body_iquat"))
+        mass, inertia, iquat = (self._held(f) for f in ("body_mass", "body_inertia", "body_iquat"))
         out = []
         for body, i in zip(self.spec.bodies, self._body_ids, strict=True):
             w, x, y, z = iquat[i] / np.linalg.norm(iquat[i])
@@ -92,12 +104,12 @@ class PortAdapter(MuJoCoAdapter):
         return out
 
     def loaded_gravity(self) -> np.ndarray:
-        return self._loaded("opt.gravity")
+        return self._held("opt.gravity")
 
     def softness(self) -> tuple[float, ...] | None:
         if not self.model.neq:
             return None
-        solref, solimp = self._loaded("eq_solref"), self._loaded("eq_solimp")
+        solref, solimp = self._held("eq_solref"), self._held("eq_solimp")
         params = {(*map(float, r), *map(float, i)) for r, i in zip(solref, solimp, strict=True)}
         if len(params) > 1:
             raise EngineError(f"{self.name}: equalities with different solref/solimp")

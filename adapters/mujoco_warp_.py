@@ -25,8 +25,8 @@ import mujoco
 import numpy as np
 import warp as wp
 
-wp.config.quiet = True
-import mujoco_warp as mjw  # noqa: E402  (after silencing Warp's start-up banner)
+wp.config.log_level = wp.LOG_ERROR  # no banner, no line per kernel module, no CUDA notice
+import mujoco_warp as mjw  # noqa: E402  (after silencing Warp's log)
 
 from dyncheck.adapters.mujoco_port import CHUNK, PortAdapter  # noqa: E402
 from dyncheck.cases.multibody import Multibody  # noqa: E402
@@ -40,6 +40,13 @@ _INTEGRATORS = {
 
 CPU_STEPS = 400
 """The longest run the adapter makes on Warp's CPU device (~16 s of RK4 steps)."""
+
+
+def too_long(steps: int) -> str:
+    return (
+        f"mujoco-warp on the CPU: {steps} steps at ~10-40 ms each (Warp's kernel launches) "
+        f"exceed the CPU budget of {CPU_STEPS} steps a run; run with --device cuda"
+    )
 
 
 def device() -> str:
@@ -62,13 +69,16 @@ class MuJoCoWarpAdapter(PortAdapter):
         super().__init__(model)
         self.model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_ENERGY)
         self.device = device()
+        self.max_steps = CPU_STEPS if self.device == "cpu" else None
         with wp.ScopedDevice(self.device):
             self.mw = mjw.put_model(self.model)
             self.dw = mjw.make_data(self.model, nworld=CHUNK)
 
     @staticmethod
     def version() -> str:
-        return f"mujoco-warp {_version('mujoco-warp')}, warp-lang {wp.__version__}"
+        where = wp.get_device(device())
+        warp = f"warp-lang {wp.__version__}"
+        return f"{_version('mujoco-warp')} ({warp}, device {where.alias}: {where.name})"
 
     def _loaded(self, field: str) -> np.ndarray:
         obj: Any = self.mw
@@ -120,7 +130,9 @@ class MuJoCoWarpAdapter(PortAdapter):
         out = np.zeros((CHUNK, neq))
         if not neq:
             return out
-        kind, ident, force = (x.numpy() for x in (self.dw.efc.type, self.dw.efc.id, self.dw.efc.force))
+        kind, ident, force = (
+            x.numpy() for x in (self.dw.efc.type, self.dw.efc.id, self.dw.efc.force)
+        )
         nefc = self.dw.nefc.numpy()
         for w in range(CHUNK):
             rows = np.flatnonzero(kind[w, : nefc[w]] == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY))
@@ -130,11 +142,8 @@ class MuJoCoWarpAdapter(PortAdapter):
     def _run(
         self, q0: np.ndarray, v0: np.ndarray, steps: int, dt: float, integrator: str
     ) -> tuple[np.ndarray, np.ndarray]:
-        if self.device == "cpu" and steps > CPU_STEPS:
-            raise Unsupported(
-                f"{self.name} on the CPU: {steps} steps at ~10-40 ms each (Warp's kernel "
-                f"launches) exceed the CPU budget of {CPU_STEPS}; run with --device cuda"
-            )
+        if self.max_steps is not None and steps > self.max_steps:
+            raise Unsupported(too_long(steps))
         self.model.opt.timestep = dt
         self.model.opt.integrator = _INTEGRATORS[integrator]
         with wp.ScopedDevice(self.device):

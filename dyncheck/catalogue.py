@@ -37,7 +37,7 @@ from dyncheck.explain.engine_defaults import (
     point_mass_floor,
 )
 from dyncheck.explain.entry import Entry
-from dyncheck.explain.integrators import drake_fsal_caching, group_rk4
+from dyncheck.explain.integrators import drake_fsal_caching, group_rk4, port_integrators
 from dyncheck.explain.parsers import (
     drake_mjcf_options,
     pinocchio_mjcf_options,
@@ -70,6 +70,7 @@ DEMOS: dict[str, tuple[Callable[[], Entry], Origin]] = {
     "quaternion-storage-order": (quaternion_order, Origin.ENGINE),
     "relative-vs-absolute-angles": (relative_angles, Origin.BOOK),
     "rk4-on-the-rotation-group": (group_rk4, Origin.MATHEMATICS),
+    "mjx-integrator-definitions": (port_integrators, Origin.ENGINE),
 }
 """Conventions demonstrated by a run of their own, with whose property each is; the others
 (point-mass inertia floor, MJCF gravity, held forces, soft constraints: :mod:`.explanations`)
@@ -92,18 +93,22 @@ REQUIRES: dict[str, tuple[str, ...]] = {
     "drake-fsal-caching": ("drake",),
     "drake-mjcf-equality": ("drake",),
     "drake-mjcf-options": ("drake",),
+    "mjx-integrator-definitions": ("mjx-f64",),
 }
 """Demonstrations that need an optional engine (MuJoCo and Pinocchio are core dependencies)."""
 
 
 def _run(name: str) -> Entry:
     """One demonstration, or a skipped entry naming the engine that is not installed."""
-    from dyncheck.adapters import ENGINE_PACKAGES, MISSING
+    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES, MISSING
 
     nan = float("nan")
     for engine in REQUIRES.get(name, ()):
         if engine in MISSING:
             why = f"{engine} is not installed (pip install {ENGINE_PACKAGES[engine]})"
+            if engine in ENGINE_EXTRAS:
+                extra = ENGINE_EXTRAS[engine]
+                why = f"{engine} is not installed (pip install 'dyncheck[{extra}]')"
             return Entry(name, "", "", "", nan, nan, skipped=why)
     demo, origin = DEMOS[name]
     try:

@@ -352,7 +352,7 @@ class EngineImplementation(Implementation):
             # of mass by the parallel-axis theorem, rounding at the scale of m·|c|²
             slack = (
                 64
-                * np.finfo(float).eps
+                * self.eps
                 * (
                     body.mass * float(np.dot(body.com, body.com))
                     + float(np.abs(loaded.inertia).max())

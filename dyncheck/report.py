@@ -47,7 +47,14 @@ def versions() -> dict[str, str]:
         "sympy": sympy.__version__,
         "pandas": pd.__version__,
     }
-    for name, pkg in (("mujoco", "mujoco"), ("pinocchio", "pinocchio"), ("drake", "drake")):
+    engines = (
+        ("mujoco", "mujoco"),
+        ("pinocchio", "pinocchio"),
+        ("drake", "drake"),
+        ("mjx", "mujoco-mjx"),  # with JAX's version and device
+        ("mujoco-warp", "mujoco-warp"),  # with Warp's version and device
+    )
+    for name, pkg in engines:
         out[pkg] = ADAPTERS[name].version() if name in ADAPTERS else "not installed"
     out["dyncheck"] = __version__
     try:

@@ -48,8 +48,16 @@ def supported(case: str, engine: str) -> bool:
     return unsupported_reason(case, engine) is None
 
 
+PORTS = ("mjx", "mjx-f64", "mujoco-warp")
+"""MuJoCo's ports: no passive-force callback, so no external field evaluated per stage."""
+FIELD_CASES = sorted(n for n in CASES if get_case(n).multibody().central_mu)
+"""Cases with an external (central) field."""
+
+
 def unsupported_reason(case: str, engine: str) -> str | None:
     """The words the Unsupported message must contain, or None when supported."""
+    if case in FIELD_CASES and engine in PORTS:
+        return "mjcb_passive"
     if case in POINT_BALL_CASES and engine in NO_BALL:
         return "point mass on a ball joint"
     if case in COUPLED_CASES and engine in NO_COUPLINGS:

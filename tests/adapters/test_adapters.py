@@ -7,6 +7,8 @@ hand derivation of the simple pendulum in engine coordinates (α = −θ about +
 
 from __future__ import annotations
 
+from functools import cache
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
@@ -32,6 +34,7 @@ MJCF_ENGINES = ("mujoco", "pinocchio-mjcf", "drake")
 def adapter_and_states(request):
     case_name, engine = request.param
     case = get_case(case_name)
+    adapter = _adapter(case_name, engine)
     rng = np.random.default_rng(11)
     n, d = 12, case.multibody().nv
     states = rng.uniform(-3, 3, (n, d)), rng.uniform(-3, 3, (n, d)), rng.uniform(-5, 5, (n, d))
@@ -40,7 +43,19 @@ def adapter_and_states(request):
         qb = rng.uniform(*case.q_bounds(), (n, case.ndof))
         vb = rng.uniform(-3, 3, (n, case.ndof))
         states = cmap.to_engine(qb), vb @ cmap.A.T, states[2]
-    return get_adapter(engine)(case.multibody()), states
+    return adapter, states
+
+
+@cache
+def _adapter(case_name: str, engine: str):
+    """One adapter per case and engine for the whole module (a port compiles per adapter)."""
+    return get_adapter(engine)(get_case(case_name).multibody())
+
+
+def ulps(adapter, bound: float) -> float:
+    """A float64 bound as the same multiple of the adapter's unit round-off (ε₃₂ for a
+    float32 port: the bound scales with the precision, nothing else changes)."""
+    return bound * adapter.eps / EPS
 
 
 def test_mass_matrix_symmetric_positive_definite(adapter_and_states):
@@ -58,7 +73,8 @@ def test_forward_inverts_inverse(adapter_and_states):
         C = adapter.spec.coupling_matrix()
         a = a - (a @ C.T) @ np.linalg.solve(C @ C.T, C)
     tau = adapter.inverse(q, v, a)
-    assert_allclose(adapter.forward(q, v, tau), a, rtol=0, atol=1e-12 * np.abs(a).max())
+    atol = ulps(adapter, 1e-12) * np.abs(a).max()
+    assert_allclose(adapter.forward(q, v, tau), a, rtol=0, atol=atol)
 
 
 @pytest.mark.parametrize("case_name", COUPLED_CASES)
@@ -100,10 +116,11 @@ def test_kinetic_energy_is_half_vMv(adapter_and_states):
 
 
 def test_gravity_is_gradient_of_potential(adapter_and_states):
-    """h(q, 0) = ∂V/∂q (2.2.20), by central differences of the engine's own V."""
+    """h(q, 0) = ∂V/∂q (2.2.20), by central differences of the engine's own V (a float32
+    port: step ε^(1/3), error ~ε^(2/3), the optimum for central differences)."""
     adapter, (q, _, _) = adapter_and_states
     h0 = adapter.bias(q, np.zeros_like(q))
-    step = 1e-6
+    step = 1e-6 if adapter.eps == EPS else adapter.eps ** (1 / 3)
     grad = np.stack(
         [
             (adapter.potential_energy(q + step * e) - adapter.potential_energy(q - step * e))
@@ -112,7 +129,8 @@ def test_gravity_is_gradient_of_potential(adapter_and_states):
         ],
         -1,
     )
-    assert_allclose(h0, grad, rtol=0, atol=1e-7 * np.abs(h0).max())
+    rtol = 1e-7 if adapter.eps == EPS else 100 * adapter.eps ** (2 / 3)
+    assert_allclose(h0, grad, rtol=0, atol=rtol * np.abs(h0).max())
 
 
 @pytest.mark.parametrize("engine", [e for e in ENGINES if supported("simple_pendulum", e)])
@@ -120,17 +138,17 @@ def test_simple_pendulum_in_engine_coordinates(engine):
     """By hand: hinge about +y, bob at R_y(α)(0, 0, −ℓ), gravity −z ⇒
     M = mℓ² (+ the MJCF's point inertia), h = mgℓ sin α."""
     case = get_case("simple_pendulum")
-    adapter = get_adapter(engine)(case.multibody())
+    adapter = _adapter("simple_pendulum", engine)
     inertia = case.multibody().mjcf_point_inertia if engine in MJCF_ENGINES else 0.0
     alpha = np.linspace(-3, 3, 13)[:, None]
     assert_allclose(
-        adapter.mass_matrix(alpha)[:, 0, 0], case.m * case.l**2 + inertia, rtol=16 * EPS
+        adapter.mass_matrix(alpha)[:, 0, 0], case.m * case.l**2 + inertia, rtol=16 * adapter.eps
     )
     assert_allclose(
         adapter.bias(alpha, np.zeros_like(alpha))[:, 0],
         case.m * case.g * case.l * np.sin(alpha[:, 0]),
         rtol=0,
-        atol=1e-14,
+        atol=ulps(adapter, 1e-14),
     )
 
 
@@ -146,8 +164,7 @@ def test_simple_pendulum_in_engine_coordinates(engine):
 def test_one_step_matches_integrator_definition(engine, integrator):
     """One step against the definition, computed here from the adapter's own forward():
     semi-implicit Euler (v then q with the new v) and the classic RK4 tableau."""
-    case = get_case("compound_pendulum")
-    adapter = get_adapter(engine)(case.multibody())
+    adapter = _adapter("compound_pendulum", engine)
     q0, v0, h = np.array([0.4, -0.3]), np.array([0.7, 0.2]), 0.01
     zero = np.zeros((1, 2))
 
@@ -165,8 +182,8 @@ def test_one_step_matches_integrator_definition(engine, integrator):
         q1 = q0 + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
         v1 = v0 + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
     traj = adapter.simulate(q0, v0, h, h, integrator)
-    assert_allclose(traj.q[-1], q1, rtol=0, atol=1e-15)
-    assert_allclose(traj.v[-1], v1, rtol=0, atol=1e-14)
+    assert_allclose(traj.q[-1], q1, rtol=0, atol=ulps(adapter, 1e-15))
+    assert_allclose(traj.v[-1], v1, rtol=0, atol=ulps(adapter, 1e-14))
 
 
 def test_mjcf_point_mass_is_an_inertial_not_a_geom():
@@ -201,9 +218,8 @@ def test_batched_path_equals_per_quantity_methods(adapter_and_states):
         single["constraint_force"] = adapter.constraint_force(q, v, tau)
     assert set(batched) == set(single)
     for key, value in single.items():
-        assert_allclose(
-            batched[key], value, rtol=0, atol=1e-13 * max(1, np.abs(value).max()), err_msg=key
-        )
+        atol = ulps(adapter, 1e-13) * max(1, np.abs(value).max())
+        assert_allclose(batched[key], value, rtol=0, atol=atol, err_msg=key)
 
 
 def test_drake_parser_ignores_the_tendon_equality():

@@ -1,0 +1,166 @@
+"""MuJoCo's ports (MJX, MuJoCo Warp) against MuJoCo C, the engine they port.
+
+Expected values come from another engine — MuJoCo C 4.0 on the same MJCF — and from the
+float32 bound of :mod:`dyncheck.tolerances` (c = 64, ε₃₂, κ(M) for forward dynamics), whose
+tightness is proved by a defect planted in the port alone.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
+import pytest
+
+from dyncheck.adapters import ADAPTERS, MISSING, get_adapter
+from dyncheck.cases import get_case
+from dyncheck.comparison import compare_instantaneous
+from dyncheck.implementations import EngineImplementation, make_implementation
+from dyncheck.tolerances import EPS, EPS32, ROUNDOFF_FACTOR
+
+from ..conftest import BALL_CASES, CASE_NAMES, PORTS, supported
+
+PORT_CASES = [c for c in CASE_NAMES if supported(c, "mjx")]
+
+
+@cache
+def _pair(case_name: str, port: str):
+    mb = get_case(case_name).multibody()
+    return get_adapter("mujoco")(mb), get_adapter(port)(mb)
+
+
+def _states(case_name: str, n: int = 16):
+    case = get_case(case_name)
+    s = case.sample_states(n)
+    impl = make_implementation("mujoco", case)
+    from dyncheck import coordinates as co
+
+    m = impl.map
+    q = m.to_engine(s.q)
+    return (
+        q,
+        co.velocity_to_engine(m, s.q, s.v),
+        co.force_to_engine(m, s.q, s.tau),
+        co.acceleration_to_engine(m, s.q, s.v, s.a),
+    )
+
+
+@pytest.mark.parametrize("case_name", PORT_CASES)
+def test_mjx_f64_equals_mujoco_to_float64_round_off(case_name):
+    """MJX in 64-bit mode is MuJoCo C's arithmetic in another language: every quantity within
+    64 ε₆₄ of the quantity's scale (× κ(M) for forward dynamics and cord forces)."""
+    c, port = _pair(case_name, "mjx-f64")
+    args = _states(case_name)
+    want, got = c.evaluate_all(*args), port.evaluate_all(*args)
+    kappa = float(np.linalg.cond(want["mass_matrix"]).max())
+    for key, value in want.items():
+        factor = kappa if key in ("forward_dynamics", "constraint_force") else 1.0
+        scale = max(np.abs(value).max(), 1e-300)
+        err = np.abs(got[key] - value).max() / scale
+        assert err <= ROUNDOFF_FACTOR * EPS * factor, (key, err)
+
+
+@pytest.mark.parametrize("port", ["mjx", "mujoco-warp"])
+@pytest.mark.parametrize("case_name", ["simple_pendulum", "compound_pendulum", "rigid_body_ball"])
+def test_float32_port_within_its_bound_and_not_at_float64(case_name, port):
+    """A float32 port differs from MuJoCo C by more than float64 round-off (it is float32) and
+    by less than the derived bound 64 ε₃₂ (× κ(M) for forward dynamics)."""
+    c, p = _pair(case_name, port)
+    args = _states(case_name)
+    want, got = c.evaluate_all(*args), p.evaluate_all(*args)
+    kappa = float(np.linalg.cond(want["mass_matrix"]).max())
+    errs = {}
+    for key, value in want.items():
+        factor = kappa if key == "forward_dynamics" else 1.0
+        errs[key] = np.abs(got[key] - value).max() / np.abs(value).max()
+        assert errs[key] <= ROUNDOFF_FACTOR * EPS32 * factor, (key, errs[key])
+    assert max(errs.values()) > ROUNDOFF_FACTOR * EPS, errs
+
+
+def _plant_mass_defect(impl: EngineImplementation, factor: float) -> None:
+    """Scale the pendulum bob's mass in the port's own model only, while the model the port
+    reports (its loaded bodies) stays the book's: a defect inside the port's dynamics, which
+    only the tolerance can catch."""
+    adapter = impl.adapter
+    i = adapter._body_ids[0]
+    if impl.name.startswith("mjx"):
+        mass = adapter.mx.body_mass.at[i].multiply(factor)
+        adapter.mx = adapter.mx.replace(body_mass=mass)
+    else:
+        values = adapter.mw.body_mass.numpy()
+        values[..., i] *= factor
+        adapter.mw.body_mass.assign(values)
+    honest = adapter.loaded_bodies()
+    adapter.loaded_bodies = lambda: honest  # the port claims the book's mass
+
+
+@pytest.mark.parametrize("port", ["mjx", "mujoco-warp"])
+@pytest.mark.parametrize(("factor", "verdict"), [(1.0, "passed"), (1.0 + 1e-4, "failed")])
+def test_float32_bound_catches_a_mass_off_by_1e_4(port, factor, verdict):
+    """The float32 bound is tight enough to catch a real defect: the bob's mass changed by
+    1e-4 in the port only fails the port's rows against MuJoCo C (M, forward and inverse
+    dynamics, kinetic energy); unchanged, every row passes."""
+    case = get_case("simple_pendulum")
+    impls = {n: make_implementation(n, case) for n in ("mujoco", port)}
+    _plant_mass_defect(impls[port], factor)
+    rows = compare_instantaneous(case, impls, case.sample_states())
+    verdicts = {r.quantity: r.verdict for r in rows}
+    assert verdicts["mass_matrix"] == verdict, rows
+    assert verdicts["kinetic_energy"] == verdict
+    if factor == 1.0:
+        assert set(verdicts.values()) == {"passed"}, rows
+
+
+@pytest.mark.parametrize("port", PORTS)
+def test_missing_extra_gives_skipped_rows_naming_it(monkeypatch, port):
+    """Without its extra a port's rows are skipped — never passed — and say what to install."""
+    extra = "warp" if port == "mujoco-warp" else "mjx"
+    monkeypatch.delitem(ADAPTERS, port)
+    monkeypatch.setitem(MISSING, port, "No module named 'jax'")
+    case = get_case("simple_pendulum")
+    impls = {}
+    for n in ("reference", "mujoco", port):
+        try:
+            impls[n] = make_implementation(n, case)
+        except Exception as exc:
+            impls[n] = exc
+    rows = [
+        r
+        for r in compare_instantaneous(case, impls, case.sample_states())
+        if port in (r.impl_a, r.impl_b)
+    ]
+    assert rows and {r.verdict for r in rows} == {"skipped"}
+    assert all(f"dyncheck[{extra}]" in r.note for r in rows)
+
+
+@pytest.mark.parametrize("port", PORTS)
+def test_field_refused_with_the_reason(port):
+    """An external field is evaluated at every RK4 stage through MuJoCo C's mjcb_passive; the
+    ports have no such callback: refused at load, before any work."""
+    from dyncheck.errors import Unsupported
+
+    with pytest.raises(Unsupported, match="mjcb_passive"):
+        get_adapter(port)(get_case("kepler").multibody())
+
+
+@pytest.mark.parametrize("case_name", [c for c in BALL_CASES if supported(c, "mjx")])
+def test_declared_rk4_definitions_match_the_measured_orders(full_run, case_name):
+    """MJX's RK4 sums its stages' angular velocities in one tangent space (order 2 on a
+    rotating body, read from its source), MuJoCo C 4.0 and MuJoCo Warp combine them on the
+    group (order 4): the order study of the full run measures what each adapter declares."""
+    rows = [
+        r
+        for r in full_run.rows
+        if r.case == case_name and r.quantity == "trajectory" and r.integrator == "rk4"
+    ]
+    mjx = [r for r in rows if r.impl_a == "reference" and r.impl_b == "mjx-f64"]
+    assert mjx and all(r.verdict == "explained" for r in mjx)
+    assert "observed order 2.0" in mjx[0].note or "observed order 1.9" in mjx[0].note
+    pair = [r for r in rows if {r.impl_a, r.impl_b} == {"mujoco", "mjx-f64"}]
+    assert pair and pair[0].verdict == "explained" and "rotation group" in pair[0].convention
+
+
+def test_ports_are_registered_with_their_extras():
+    for port in PORTS:
+        assert port in ADAPTERS, MISSING.get(port)
+        assert ADAPTERS[port].dtype == (np.float64 if port == "mjx-f64" else np.float32)
