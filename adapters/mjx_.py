@@ -68,10 +68,18 @@ def _stretch(mx: Any, d: Any) -> tuple[Any, tuple[Any, Any]]:
     """STEPS steps of ``mjx.step``, every state recorded."""
 
     def one(d: Any, _: Any) -> tuple[Any, tuple[Any, Any]]:
-        d = mjx.step(mx, d)
-        return d, (d.qpos, d.qvel)
+        new = mjx.step(mx, d)
+        # in 64-bit mode a step returns some index arrays as int64 that make_data made int32
+        new = jax.tree_util.tree_map(lambda x, old: x.astype(old.dtype), new, d)
+        return new, (new.qpos, new.qvel)
 
     return jax.lax.scan(one, d, None, length=STEPS)
+
+
+_EVALUATE = jax.jit(jax.vmap(_evaluate, in_axes=(None, 0, 0, 0, 0)))
+_STRETCH = jax.jit(_stretch)
+"""Compiled once per model structure and precision, shared by every adapter: the model is an
+argument, so a second adapter of the same structure (other masses, other step) reuses it."""
 
 
 class MJXAdapter(PortAdapter):
@@ -90,8 +98,6 @@ class MJXAdapter(PortAdapter):
         self.model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_ENERGY)
         with self._precision():
             self.mx = self._cast(mjx.put_model(self.model))
-            self._eval = jax.jit(jax.vmap(_evaluate, in_axes=(None, 0, 0, 0, 0)))
-        self._steppers: dict[str, Any] = {}
 
     @staticmethod
     def version() -> str:
@@ -139,7 +145,7 @@ class MJXAdapter(PortAdapter):
         assert q.shape[0] == CHUNK
         with self._precision():
             args = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, tau, a))
-            out = self._eval(self.mx, *args)
+            out = _EVALUATE(self.mx, *args)
             return {k: np.asarray(x) for k, x in out.items()}
 
     def _run(
@@ -151,9 +157,6 @@ class MJXAdapter(PortAdapter):
                 timestep=jnp.asarray(dt, dtype=self.dtype),
             )
             mx = self.mx.replace(opt=opt)
-            if integrator not in self._steppers:
-                self._steppers[integrator] = jax.jit(_stretch)
-            stretch = self._steppers[integrator]
             d = self._cast(mjx.make_data(mx))
             d = d.replace(
                 qpos=jnp.asarray(q0, dtype=self.dtype), qvel=jnp.asarray(v0, dtype=self.dtype)
@@ -161,7 +164,7 @@ class MJXAdapter(PortAdapter):
             qs = [np.asarray(q0, dtype=self.dtype)[None]]
             vs = [np.asarray(v0, dtype=self.dtype)[None]]
             for _ in range(-(-steps // STEPS)):
-                d, (q, v) = stretch(mx, d)
+                d, (q, v) = _STRETCH(mx, d)
                 qs.append(np.asarray(q))
                 vs.append(np.asarray(v))
         return np.concatenate(qs)[: steps + 1], np.concatenate(vs)[: steps + 1]

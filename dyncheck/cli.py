@@ -9,6 +9,7 @@ naming the argument and the value).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import tempfile
 from collections.abc import Sequence
@@ -66,6 +67,9 @@ def _parser() -> argparse.ArgumentParser:
     r = sub.add_parser("run", help="compare implementations on cases and write the report")
     _selection(r)
     r.add_argument("--out", type=_path, default=Path("reports"), help="report folder")
+    r.add_argument("--device", choices=("cpu", "cuda"), default=None,
+                   help="where MuJoCo's ports (MJX, MuJoCo Warp) compute (default: the CPU "
+                   "for Warp, JAX's default device for MJX); named in the provenance")
     r.add_argument(
         "--states",
         type=int,
@@ -265,11 +269,22 @@ def _positive(name: str, value: int | None) -> None:
         raise InvalidInput(name, value, "a positive integer")
 
 
+def _use_device(device: str) -> None:
+    """The ports' device, for this process and the workers it starts: Warp reads
+    ``DYNCHECK_DEVICE``, JAX its platform (set before its first computation)."""
+    os.environ["DYNCHECK_DEVICE"] = device
+    os.environ["JAX_PLATFORMS"] = device
+    if "jax" in sys.modules:
+        sys.modules["jax"].config.update("jax_platforms", device)
+
+
 def _run(args: argparse.Namespace) -> int:
     from dyncheck import baseline, report
     from dyncheck.run import resolve, run
 
     _check_out(args.out)
+    if args.device is not None:
+        _use_device(args.device)
     _positive("--states", args.states)
     if args.states is not None and args.states > MAX_STATES:
         raise InvalidInput("--states", args.states, f"at most {MAX_STATES} (~50 µs per state)")

@@ -13,7 +13,7 @@ from dyncheck.cases import get_case
 from dyncheck.implementations import make_implementation
 from dyncheck.reference.coordinates import cylindrical, spherical
 
-from ..conftest import ENGINES
+from ..conftest import ENGINES, PORTS
 
 SYSTEMS = {"spherical_coordinates": spherical, "cylindrical_coordinates": cylindrical}
 
@@ -24,9 +24,10 @@ def test_engine_mass_matrix_is_metric_and_bias_is_christoffel(case_name, engine)
     case = get_case(case_name)
     cs = SYSTEMS[case_name]()
     s = case.sample_states(64)
-    out = make_implementation(engine, case).evaluate(s)
+    impl = make_implementation(engine, case)
+    out = impl.evaluate(s)
     g = cs.numeric.metric(s.q)
-    reads_mjcf = engine in ("mujoco", "pinocchio-mjcf", "drake")
+    reads_mjcf = engine in ("mujoco", "pinocchio-mjcf", "drake", *PORTS)
     floor = case.multibody().mjcf_point_inertia if reads_mjcf else 0.0
     # the MJCF floor adds I |ω|² / 2: diag over the rotating coordinates (predicted, see report)
     rot = {"spherical_coordinates": [0, 1, 1], "cylindrical_coordinates": [0, 1, 0]}[case_name]
@@ -34,7 +35,7 @@ def test_engine_mass_matrix_is_metric_and_bias_is_christoffel(case_name, engine)
         out["mass_matrix"],
         case.M * g + floor * np.diag(rot),
         rtol=0,
-        atol=64 * np.finfo(float).eps * case.M * np.abs(g).max(),
+        atol=64 * impl.eps * case.M * np.abs(g).max(),
     )
     gravity = case.M * case.g * cs.numeric.jacobian(s.q)[:, 2, :]  # ∂V/∂q, V = M g z
     velocity_terms = case.M * np.einsum(
@@ -42,5 +43,5 @@ def test_engine_mass_matrix_is_metric_and_bias_is_christoffel(case_name, engine)
     )
     scale = np.abs(velocity_terms).max() + np.abs(gravity).max()
     assert_allclose(
-        out["bias_forces"] - gravity, velocity_terms, rtol=0, atol=64 * np.finfo(float).eps * scale
+        out["bias_forces"] - gravity, velocity_terms, rtol=0, atol=64 * impl.eps * scale
     )

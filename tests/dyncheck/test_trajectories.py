@@ -63,6 +63,16 @@ def test_observed_order(full_run, case, engine, integrator):
         assert row.verdict == "passed" and "polynomial of degree 2" in row.note
         assert g.error.max() <= 1e-13 * 10
         return
+    if row.verdict == "skipped":
+        # Warp's CPU device: ~10-40 ms a step; longer runs are left to a GPU, said up front
+        assert engine == "mujoco-warp" and "more than the 400 this engine makes" in row.note
+        return
+    if "cannot be observed in this precision" in row.note:
+        # a float32 port whose truncation error is below its own accumulated round-off
+        assert engine in ("mjx", "mujoco-warp") and row.verdict == "passed", row.note
+        return
+    if engine.startswith("mjx") and integrator == "rk4" and case in BALL_CASES:
+        expected = 2  # MJX 3.17's RK4 sums the stages' ω in one tangent space (its source)
     if engine == "mujoco-stiff" and integrator == "rk4":
         # a fast constraint mode: orders above 4, falling toward 4 as dt halves, and the
         # reference's own equations stepped by RK4 show the same
@@ -122,9 +132,10 @@ def test_observed_orders_formula():
     assert observed_orders(dts, [3 * h**2 for h in dts])[1:] == pytest.approx([2, 2], rel=1e-12)
 
 
-@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("engine", [e for e in ENGINES if e != "mujoco-warp"])
 def test_an_error_that_does_not_shrink_fails(engine, monkeypatch):
-    """A run with a constant error offset (a wrong model, not a truncation error) fails."""
+    """A run with a constant error offset (a wrong model, not a truncation error) fails.
+    (mujoco-warp makes no run this long on the CPU: test_observed_order checks the refusal.)"""
     from dyncheck import trajectories
     from dyncheck.cases import get_case
     from dyncheck.implementations import make_implementation
