@@ -22,6 +22,7 @@ JAX's persistent compilation cache is switched on (under the user's cache direct
 from __future__ import annotations
 
 import os
+import re
 from contextlib import AbstractContextManager
 from pathlib import Path
 from typing import Any, ClassVar
@@ -38,6 +39,23 @@ from dyncheck.cases.multibody import Multibody
 _CACHE = Path(os.environ.get("DYNCHECK_JAX_CACHE", Path.home() / ".cache" / "dyncheck" / "jax"))
 jax.config.update("jax_compilation_cache_dir", str(_CACHE))
 jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
+
+def _clear_trace_caches() -> None:
+    """Clear the two tracing caches that keep a NumPy constant's 64-bit-mode type across a
+    change of mode (found by bisecting JAX 0.10's caches: partial_eval's ``trace_to_jaxpr``
+    and pjit's ``_infer_params_cached``); compiled executables stay cached (their keys carry
+    the mode). Any other JAX: all caches."""
+    from jax._src import util
+
+    stale = [c for c, what in list(util._caches.items()) if _STALE.search(str(what))]
+    if len(stale) != 2:
+        jax.clear_caches()
+        return
+    for cache in stale:
+        cache.cache_clear()
+
+
+_STALE = re.compile(r"function (trace_to_jaxpr|_infer_params_cached) ")
 
 _MODE: bool | None = None
 """The 64-bit mode of the last call into JAX (None before the first)."""
@@ -118,7 +136,7 @@ class MJXAdapter(PortAdapter):
         global _MODE
         x64 = self.dtype == np.float64
         if _MODE is not None and _MODE != x64:
-            jax.clear_caches()
+            _clear_trace_caches()
         _MODE = x64
         return jax.enable_x64(x64)
 

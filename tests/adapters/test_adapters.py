@@ -18,10 +18,10 @@ from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases import get_case
 from dyncheck.errors import UnknownName
 
-from ..conftest import ALL_ENGINES, BALL_CASES, CASE_NAMES, COUPLED_CASES, ENGINES, supported
+from ..conftest import ALL_ENGINES, BALL_CASES, CASE_NAMES, COUPLED_CASES, ENGINES, PORTS, supported
 
 EPS = np.finfo(float).eps
-MJCF_ENGINES = ("mujoco", "pinocchio-mjcf", "drake")
+MJCF_ENGINES = ("mujoco", "pinocchio-mjcf", "drake", *PORTS)
 """Engines that read the MJCF file, and with it the point-mass inertia floor."""
 
 
