@@ -33,7 +33,7 @@ import mujoco
 import numpy as np
 from mujoco import mjx
 
-from dyncheck.adapters.mujoco_port import CHUNK, STEPS, PortAdapter
+from dyncheck.adapters.mujoco_port import STEPS, PortAdapter
 from dyncheck.cases.multibody import Multibody
 
 _CACHE = Path(os.environ.get("DYNCHECK_JAX_CACHE", Path.home() / ".cache" / "dyncheck" / "jax"))
@@ -160,7 +160,6 @@ class MJXAdapter(PortAdapter):
     def _batch(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
     ) -> dict[str, np.ndarray]:
-        assert q.shape[0] == CHUNK
         with self._precision():
             args = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, tau, a))
             out = _EVALUATE(self.mx, *args)

@@ -43,6 +43,8 @@ class PortAdapter(MuJoCoAdapter):
     dtype: ClassVar[type[np.floating]] = np.float32
     device: ClassVar[str] = "cpu"
     """The device the port computes on (set from ``--device`` or the environment)."""
+    chunk: int = CHUNK
+    """States per batched call (a GPU wants more: ``benchmarks/ports.py`` sets it)."""
 
     def __init__(self, model: Multibody) -> None:
         if model.central_mu:
@@ -65,7 +67,7 @@ class PortAdapter(MuJoCoAdapter):
     def _batch(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
     ) -> dict[str, np.ndarray]:
-        """One padded chunk (CHUNK states): ``M`` (n, nv, nv), ``bias``, ``qacc``,
+        """One padded chunk (``chunk`` states): ``M`` (n, nv, nv), ``bias``, ``qacc``,
         ``qfrc_inverse`` (n, nv), ``xipos`` (n, nbody, 3), ``efc_force`` (n, neq)."""
 
     @abstractmethod
@@ -124,8 +126,8 @@ class PortAdapter(MuJoCoAdapter):
         its first state), concatenated and cut back to the n states."""
         n = q.shape[0]
         parts: list[dict[str, np.ndarray]] = []
-        for start in range(0, n, CHUNK):
-            idx = np.arange(start, start + CHUNK)
+        for start in range(0, n, self.chunk):
+            idx = np.arange(start, start + self.chunk)
             idx[idx >= n] = start
             parts.append(self._batch(q[idx], v[idx], tau[idx], a[idx]))
         return {k: np.concatenate([p[k] for p in parts])[:n].astype(float) for k in parts[0]}

@@ -18,6 +18,8 @@ across runs.
 from __future__ import annotations
 
 import os
+import sys
+import tempfile
 from importlib.metadata import version as _version
 from typing import Any, ClassVar
 
@@ -25,7 +27,7 @@ import mujoco
 import numpy as np
 import warp as wp
 
-wp.config.log_level = wp.LOG_ERROR  # no banner, no line per kernel module, no CUDA notice
+wp.config.log_level = wp.LOG_ERROR  # no banner, no line per kernel module loaded
 import mujoco_warp as mjw  # noqa: E402  (after silencing Warp's log)
 
 from dyncheck.adapters.mujoco_port import CHUNK, PortAdapter  # noqa: E402
@@ -40,6 +42,29 @@ _INTEGRATORS = {
 
 CPU_STEPS = 400
 """The longest run the adapter makes on Warp's CPU device (~16 s of RK4 steps)."""
+
+
+def _init_quietly() -> None:
+    """``wp.init()`` with its native library's stderr held back: on a machine without a CUDA
+    driver it prints a warning line on every start, which says nothing here (the CPU is
+    Warp's device unless ``--device cuda``); shown if initialisation fails."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as held:
+        os.dup2(held.fileno(), 2)
+        try:
+            wp.init()
+        except Exception:
+            os.dup2(saved, 2)
+            held.seek(0)
+            sys.stderr.write(held.read().decode(errors="replace"))
+            raise
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+
+
+_init_quietly()
 
 
 def too_long(steps: int) -> str:

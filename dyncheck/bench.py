@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from dyncheck.adapters import ENGINE_PORTS
 from dyncheck.cases import Case, get_case
 from dyncheck.errors import EngineError
 from dyncheck.implementations import (
@@ -192,6 +193,26 @@ def bench(case: Case, states: int, repeats: int) -> pd.DataFrame:
                     repeats,
                 ),
             )
+        elif isinstance(impl, EngineImplementation) and name in ENGINE_PORTS:
+            # a port: its first call traces and compiles (JAX, Warp), reported apart from the
+            # steady per-state time of the compiled path
+            cmap, q = impl.map, sample.q
+            qe, ve = cmap.to_engine(q), co.velocity_to_engine(cmap, q, sample.v)
+            te = co.force_to_engine(cmap, q, sample.tau)
+            ae = co.acceleration_to_engine(cmap, q, sample.v, sample.a)
+            t0 = time.perf_counter()
+            impl.adapter.evaluate_all(qe, ve, te, ae)
+            add("first call (compile included)", name, time.perf_counter() - t0)
+            add(
+                "adapter batched",
+                name,
+                _median_time(
+                    lambda impl=impl, qe=qe, ve=ve, te=te, ae=ae: impl.adapter.evaluate_all(
+                        qe, ve, te, ae
+                    ),
+                    repeats,
+                ),
+            )
         add(
             "implementation (book coordinates)",
             name,
@@ -226,6 +247,14 @@ def ratios(t: pd.DataFrame) -> pd.DataFrame:
             "value": us("adapter batched", e) / us("raw engine calls", e),
         }
         for e in engines
+    ]
+    ports = [n for n in ENGINE_PORTS if n in set(t[t.part == "adapter batched"].implementation)]
+    out += [
+        {
+            "ratio": f"{p} batched / MuJoCo C raw calls (per state)",
+            "value": us("adapter batched", p) / us("raw engine calls", ENGINE_PORTS[p]),
+        }
+        for p in ports
     ]
     out += [
         {
