@@ -118,7 +118,7 @@ class MuJoCoWarpAdapter(PortAdapter):
             values = values[0]
         return values
 
-    def _set(self, name: str, values: np.ndarray) -> None:
+    def _assign(self, name: str, values: np.ndarray) -> None:
         getattr(self.dw, name).assign(wp.array(values.astype(np.float32), device=self.device))
 
     def _batch(
@@ -126,9 +126,9 @@ class MuJoCoWarpAdapter(PortAdapter):
     ) -> dict[str, np.ndarray]:
         m, d, nv = self.mw, self.dw, self.model.nv
         with wp.ScopedDevice(self.device):
-            self._set("qpos", q)
-            self._set("qvel", v)
-            self._set("qfrc_applied", tau)
+            self._assign("qpos", q)
+            self._assign("qvel", v)
+            self._assign("qfrc_applied", tau)
             mjw.forward(m, d)
             out = {
                 "bias": d.qfrc_bias.numpy().copy(),
@@ -143,13 +143,13 @@ class MuJoCoWarpAdapter(PortAdapter):
                 mjw.mul_m(m, d, res, wp.array(e))
                 M[:, :, j] = res.numpy()
             out["M"] = M
-            out["efc_force"] = self._equality_force()
-            self._set("qacc", a)
+            out["efc_force"] = self._efc_equality()
+            self._assign("qacc", a)
             mjw.inverse(m, d)
             out["qfrc_inverse"] = d.qfrc_inverse.numpy().copy()
         return out
 
-    def _equality_force(self) -> np.ndarray:
+    def _efc_equality(self) -> np.ndarray:
         """efc.force of the equality rows, in equality order, per world."""
         neq = self.model.neq
         out = np.zeros((CHUNK, neq))

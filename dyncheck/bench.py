@@ -23,6 +23,7 @@ import resource
 import statistics
 import time
 from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -203,16 +204,8 @@ def bench(case: Case, states: int, repeats: int) -> pd.DataFrame:
             t0 = time.perf_counter()
             impl.adapter.evaluate_all(qe, ve, te, ae)
             add("first call (compile included)", name, time.perf_counter() - t0)
-            add(
-                "adapter batched",
-                name,
-                _median_time(
-                    lambda impl=impl, qe=qe, ve=ve, te=te, ae=ae: impl.adapter.evaluate_all(
-                        qe, ve, te, ae
-                    ),
-                    repeats,
-                ),
-            )
+            batched = partial(impl.adapter.evaluate_all, qe, ve, te, ae)
+            add("adapter batched", name, _median_time(batched, repeats))
         add(
             "implementation (book coordinates)",
             name,
