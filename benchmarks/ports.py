@@ -19,8 +19,6 @@ import statistics
 import time
 from pathlib import Path
 
-import numpy as np
-
 
 def _states(case, n: int):
     from dyncheck import coordinates as co
@@ -37,19 +35,12 @@ def _states(case, n: int):
 
 
 def _raw_c(adapter, qe, ve, te, ae) -> float:
-    import mujoco
+    """Seconds per state of the loop ``dyncheck bench`` times for MuJoCo C."""
+    from dyncheck.bench import _raw_mujoco
 
-    from dyncheck.adapters.mujoco_api import full_inertia
-
-    m, d = adapter.model, adapter.data
-    M = np.empty((m.nv, m.nv))
+    loop = _raw_mujoco(adapter, qe, ve, te, ae)
     t0 = time.perf_counter()
-    for k in range(len(qe)):
-        d.qpos[:], d.qvel[:], d.qfrc_applied[:] = qe[k], ve[k], te[k]
-        mujoco.mj_forward(m, d)
-        full_inertia(m, d, M)
-        d.qacc[:] = ae[k]
-        mujoco.mj_inverse(m, d)
+    loop()
     return (time.perf_counter() - t0) / len(qe)
 
 
