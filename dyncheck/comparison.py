@@ -116,7 +116,7 @@ class Evaluator:
     @property
     def eps(self) -> float:
         """Unit round-off of the implementation's arithmetic (float64's when it failed)."""
-        return EPS if isinstance(self.impl, Exception) else self.impl.eps
+        return EPS if isinstance(self.impl, Exception) else getattr(self.impl, "eps", EPS)
 
     def __post_init__(self) -> None:
         if isinstance(self.impl, Exception):

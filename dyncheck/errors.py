@@ -46,10 +46,10 @@ class EngineNotInstalled(DyncheckError, ImportError):
         self, implementation: str, package: str, reason: str, extra: str | None = None
     ) -> None:
         self.implementation, self.package, self.extra = implementation, package, extra
-        hint = f"the extra {extra!r}: pip install 'dyncheck[{extra}]'" if extra else package
+        hint = f"pip install 'dyncheck[{extra}]' (the extra {extra!r})" if extra else ""
         super().__init__(
             f"implementation {implementation!r} needs {package!r}, which is not installed "
-            f"({reason}); install {hint}"
+            f"({reason}); {hint or f'pip install {package}'}"
         )
 
 

@@ -193,7 +193,8 @@ def test_mjcf_point_mass_is_an_inertial_not_a_geom():
 
 
 def test_unknown_engine_lists_valid_names():
-    with pytest.raises(UnknownName, match="unknown implementation 'bullet'; valid: drake, mujoco"):
+    valid = "valid: drake, mjx, mjx-f64, mujoco"
+    with pytest.raises(UnknownName, match=f"unknown implementation 'bullet'; {valid}"):
         get_adapter("bullet")
 
 

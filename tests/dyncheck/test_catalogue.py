@@ -146,9 +146,9 @@ def test_drake_entries_are_skipped_when_drake_is_missing(monkeypatch):
 
     monkeypatch.setitem(adapters.MISSING, "drake", "No module named 'pydrake'")
     (entry,) = catalogue.explain("drake-mjcf-options")
-    assert entry.skipped and "pip install drake" in entry.skipped
+    assert entry.skipped and "pip install 'dyncheck[drake]'" in entry.skipped
     text = catalogue.render([entry, *catalogue.explain("hinge-axis-sign")])
-    assert "- Skipped: drake is not installed (pip install drake)." in text
+    assert "- Skipped: drake is not installed (pip install 'dyncheck[drake]')." in text
     assert "## hinge-axis-sign" in text and "Correct mapping" in text
 
 

@@ -75,7 +75,8 @@ def test_unknown_case_is_usage_error(tmp_path, capsys):
 
 def test_unknown_implementation_is_usage_error(tmp_path, capsys):
     assert main(["run", "--impl", "bullet", "--out", str(tmp_path / "r")]) == 2
-    assert "unknown implementation 'bullet'; valid: book, drake, mujoco" in capsys.readouterr().err
+    valid = "valid: book, drake, mjx, mjx-f64, mujoco"
+    assert f"unknown implementation 'bullet'; {valid}" in capsys.readouterr().err
 
 
 def test_out_that_is_a_file_is_usage_error(tmp_path, capsys):

@@ -119,6 +119,9 @@ def test_missing_engine_costs_only_its_rows(tmp_path):
     assert len(pin) and (pin.verdict == "skipped").all()
     assert pin.note.str.contains("pip install pin").all()
     others = d.drop(pin.index)
+    # MuJoCo Warp's stated CPU step budget aside (skipped with that reason in every run)
+    budget = (others.verdict == "skipped") & others.note.str.contains("this engine makes here")
+    others = others[~budget]
     assert (others.verdict.isin(["passed", "explained"])).all() and len(others)
     assert "pip install pin" in (out / "conventions.md").read_text()
 
