@@ -66,7 +66,8 @@ def test_killed_run_leaves_previous_report_intact(tmp_path):
     and no temporary file is left (files are written to a temp name, then renamed, after
     all the computing)."""
     out = tmp_path / "rep"
-    assert main(["run", "simple_pendulum", "--out", str(out)]) == 0
+    impls = ["--impl", "reference", "--impl", "mujoco"]
+    assert main(["run", "simple_pendulum", *impls, "--out", str(out)]) == 0
     before = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
     proc = subprocess.Popen(
         [
@@ -109,7 +110,9 @@ def test_missing_engine_costs_only_its_rows(tmp_path):
     code = (
         "import sys; sys.modules['pinocchio'] = None\n"
         "from dyncheck.cli import main\n"
-        f"raise SystemExit(main(['run', 'simple_pendulum', '--out', {str(out)!r}]))"
+        "impls = ['--impl', 'reference', '--impl', 'mujoco', '--impl', 'pinocchio',"
+        " '--impl', 'pinocchio-mjcf']\n"
+        f"raise SystemExit(main(['run', 'simple_pendulum', *impls, '--out', {str(out)!r}]))"
     )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
