@@ -1,14 +1,15 @@
 """Time per state of MuJoCo's ports against MuJoCo C's per-state call, on this machine's
 device (JAX's default device; Warp's from ``DYNCHECK_DEVICE``), compile time apart.
 
-    python benchmarks/ports.py [--out FILE] [--batches 256 4096 65536] [--case NAME …]
+    python benchmarks/ports.py [--out reports/benchmark-ports.md] [--batches 256 4096 65536]
 
 For each case: MuJoCo C's plainest loop (``mj_forward`` + ``mj_fullM`` + ``mj_inverse`` per
 state); each installed port's batched path (every quantity dyncheck compares) at each batch
 size — its first call (tracing and compilation included; JAX's persistent cache is off here,
 so the number is the cold cost) and the median of five calls after it. Writes a Markdown table
-(to stdout and ``--out``). The GPU figures in ``reports/benchmark.md`` come from this script
-run on a lent GPU machine (the device is named in the output).
+(to stdout and ``--out``, by default ``reports/benchmark-ports.md``, linked from
+``reports/benchmark.md``'s reader in the README); on a GPU machine write it elsewhere
+(``--out /tmp/ports-gpu.md``): the device is named in the output.
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ def _raw_c(adapter, qe, ve, te, ae) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=None)
+    parser.add_argument("--out", type=Path, default=Path("reports/benchmark-ports.md"))
     parser.add_argument("--batches", type=int, nargs="+", default=[256, 4096, 65536])
     parser.add_argument("--case", action="append", default=[])
     args = parser.parse_args()
