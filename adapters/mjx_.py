@@ -24,6 +24,7 @@ from __future__ import annotations
 import os
 import re
 from contextlib import AbstractContextManager
+from operator import attrgetter
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -152,10 +153,7 @@ class MJXAdapter(PortAdapter):
         )
 
     def _loaded(self, field: str) -> np.ndarray:
-        obj: Any = self.mx
-        for part in field.split("."):
-            obj = getattr(obj, part)
-        return np.asarray(obj, dtype=float)
+        return np.asarray(attrgetter(field)(self.mx), dtype=float)
 
     def _batch(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray

@@ -17,6 +17,7 @@ returned as float64 arrays, so that the comparison sees exactly what the port co
 from __future__ import annotations
 
 from abc import abstractmethod
+from operator import attrgetter
 from typing import ClassVar
 
 import numpy as np
@@ -84,10 +85,7 @@ class PortAdapter(MuJoCoAdapter):
         rounding the parameters to float32 is part of the float32 round-off the tolerances
         bound, not a different model (a mass changed by 1e-4 in the port is)."""
         port = self._loaded(field)
-        obj: object = self.model
-        for part in field.split("."):
-            obj = getattr(obj, part)
-        c = np.asarray(obj, dtype=float).reshape(port.shape)
+        c = np.asarray(attrgetter(field)(self.model), dtype=float).reshape(port.shape)
         return np.where(np.abs(port - c) <= self.eps * np.abs(c), c, port)
 
     def loaded_bodies(self) -> list[LoadedBody]:

@@ -21,7 +21,8 @@ import os
 import sys
 import tempfile
 from importlib.metadata import version as _version
-from typing import Any, ClassVar
+from operator import attrgetter
+from typing import ClassVar
 
 import mujoco
 import numpy as np
@@ -106,9 +107,7 @@ class MuJoCoWarpAdapter(PortAdapter):
         return f"{_version('mujoco-warp')} ({warp}, device {where.alias}: {where.name})"
 
     def _loaded(self, field: str) -> np.ndarray:
-        obj: Any = self.mw
-        for part in field.split("."):
-            obj = getattr(obj, part)
+        obj = attrgetter(field)(self.mw)
         values = obj.numpy() if hasattr(obj, "numpy") else np.asarray(obj)
         values = np.asarray(values, dtype=float)
         # batched model fields carry a leading world axis of length one
