@@ -100,11 +100,13 @@ REQUIRES: dict[str, tuple[str, ...]] = {
 
 def _run(name: str) -> Entry:
     """One demonstration, or a skipped entry naming the engine that is not installed."""
-    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES, MISSING
+    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES, get_adapter
 
     nan = float("nan")
     for engine in REQUIRES.get(name, ()):
-        if engine in MISSING:
+        try:
+            get_adapter(engine)
+        except EngineNotInstalled:
             why = f"{engine} is not installed (pip install {ENGINE_PACKAGES[engine]})"
             if engine in ENGINE_EXTRAS:
                 extra = ENGINE_EXTRAS[engine]

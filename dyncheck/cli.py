@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
 
-from dyncheck.errors import DyncheckError, InvalidInput, UnknownName
+from dyncheck.errors import DyncheckError, EngineNotInstalled, InvalidInput, UnknownName
 
 
 class _Parser(argparse.ArgumentParser):
@@ -51,6 +51,17 @@ def _selection(p: argparse.ArgumentParser) -> None:
         metavar="N",
         help="cases in N parallel processes (same results)",
     )
+    _dask(p)
+
+def _dask(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--dask",
+        default=None,
+        metavar="ADDRESS",
+        help="run the units of work on a dask.distributed cluster: a scheduler address "
+        "(tcp://HOST:8786) or 'local' for a LocalCluster of --jobs workers (same results; "
+        "the extra 'dask')",
+    )
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -63,7 +74,13 @@ def _parser() -> argparse.ArgumentParser:
         "`dyncheck COMMAND --help` shows an example of each command.",
     )
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    sub.add_parser("list", help="cases and implementations, with installed engine versions")
+    ls = sub.add_parser("list", help="cases and implementations, with installed engine versions")
+    ls.add_argument(
+        "--integrators",
+        action="store_true",
+        help="import each engine: its integrators and, for the ports, the device (slower: "
+        "JAX and Warp take seconds to import)",
+    )
     r = sub.add_parser("run", help="compare implementations on cases and write the report")
     _selection(r)
     r.add_argument("--out", type=_path, default=Path("reports"), help="report folder")
@@ -134,6 +151,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     c.add_argument("--out", type=_path, default=Path("reports"), help="report folder")
     c.add_argument("--jobs", type=int, default=1, metavar="N")
+    _dask(c)
     c.add_argument(
         "--from",
         dest="run_dir",
@@ -170,7 +188,7 @@ def _parser() -> argparse.ArgumentParser:
 
 EXAMPLES = {
     "errata": "dyncheck errata && dyncheck explain erratum-action-integral.d5",
-    "list": "dyncheck list",
+    "list": "dyncheck list --integrators",
     "run": "dyncheck run simple_pendulum --impl reference --impl mujoco --out /tmp/report",
     "check": "dyncheck check my_robot.urdf --floating --states 1000",
     "diff": "dyncheck diff reports /tmp/report_after_upgrade --markdown /tmp/diff.md",
@@ -185,30 +203,56 @@ EXAMPLES = {
 """One example per subcommand, printed under its --help."""
 
 
-def _list() -> int:
-    from dyncheck.adapters import ADAPTERS, ENGINE_PACKAGES, MISSING
+def _installed(package: str) -> str | None:
+    """An installed distribution's version, read from its metadata (nothing imported)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version(package)
+    except PackageNotFoundError:
+        return None
+
+
+def _engine_line(name: str) -> str:
+    """An engine imported: its version (and device, for a port) and its integrators."""
+    from dyncheck.adapters import ENGINE_PACKAGES, get_adapter
+
+    try:
+        adapter = get_adapter(name)
+    except EngineNotInstalled as exc:  # the hint names the package or the extra
+        return f"not installed: {exc.hint}"
+    steps = list(adapter.integrators)
+    if adapter.adaptive:
+        steps.append("dop853 (scipy, error-controlled)")
+    if hasattr(adapter, "simulate_controlled"):
+        steps.append("rk3-controlled (its own runge_kutta3, error-controlled)")
+    return f"{ENGINE_PACKAGES[name]} {adapter.version()}; integrators: {', '.join(steps)}"
+
+
+def _list(*, integrators: bool = False) -> int:
+    """Cases, implementations and robots. Engines are named with their installed version from
+    the package metadata — fast, nothing imported — or, with ``integrators``, imported."""
+    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES
     from dyncheck.cases import CASES
-    from dyncheck.implementations import IMPLEMENTATIONS
+    from dyncheck.roster import IMPLEMENTATIONS
 
     print("cases:")
     for name, cls in CASES.items():
         print(f"  {name:24s} {cls.title}")
     print("implementations:")
     for name in IMPLEMENTATIONS:
-        if name in ADAPTERS:
-            adapter = ADAPTERS[name]
-            steps = list(adapter.integrators)
-            if adapter.adaptive:
-                steps.append("dop853 (scipy, error-controlled)")
-            if hasattr(adapter, "simulate_controlled"):
-                steps.append("rk3-controlled (its own runge_kutta3, error-controlled)")
-            what = f"{ENGINE_PACKAGES[name]} {adapter.version()}; integrators: {', '.join(steps)}"
-        elif name in MISSING:
-            what = f"not installed: pip install {ENGINE_PACKAGES[name]}"
-        elif name == "book":
+        if name == "book":
             what = "dyncheck.reference (book printed equations)"
-        else:
+        elif name not in ENGINE_PACKAGES:
             what = "dyncheck.reference (general method, (2.2.23)-(2.2.26))"
+        elif integrators:
+            what = _engine_line(name)
+        elif (version := _installed(ENGINE_PACKAGES[name])) is not None:
+            what = f"{ENGINE_PACKAGES[name]} {version}"
+        elif name in ENGINE_EXTRAS:
+            what = f"not installed: pip install 'dyncheck[{ENGINE_EXTRAS[name]}]'"
+        else:
+            what = f"not installed: pip install {ENGINE_PACKAGES[name]}"
         print(f"  {name:24s} {what}")
     from dyncheck.check.inputs import robots
 
@@ -293,7 +337,8 @@ def _run(args: argparse.Namespace) -> int:
     cases, impls = resolve(args.cases, args.impl)
     if args.states is not None:
         _warn_cost(args.states * len(cases), args.jobs)
-    result = run(cases, impls, states=args.states, jobs=args.jobs, progress=report.stderr_progress)
+    result = run(cases, impls, states=args.states, jobs=args.jobs, dask=args.dask,
+                 conventions=True, progress=report.stderr_progress)
     report.write(result, args.out)
     counts = result.discrepancies["verdict"].value_counts()
     print(
@@ -340,7 +385,8 @@ def _report(args: argparse.Namespace) -> int:
         moved = freshness.compare(committed, freshness.read_report(args.run_dir))
     else:
         cases, impls = resolve([], [])
-        moved = report.check(run(cases, impls, jobs=args.jobs), args.out)
+        result = run(cases, impls, jobs=args.jobs, dask=args.dask, conventions=True)
+        moved = report.check(result, args.out)
     for m in moved[:SHOWN]:
         print(f"moved: {m}")
     if len(moved) > SHOWN:
@@ -362,7 +408,7 @@ def _baseline(args: argparse.Namespace) -> int:
     _positive("--jobs", args.jobs)
     cases, impls = resolve(args.cases, args.impl)
     previous = baseline.load(args.out, "--out") if args.out.exists() else None  # validated first
-    result = run(cases, impls, jobs=args.jobs)
+    result = run(cases, impls, jobs=args.jobs, dask=args.dask)
     if previous is not None:
         changes = baseline.compare(result.discrepancies, previous, cases=[c.name for c in cases])
         print(changes.to_string(index=False) if len(changes) else "no change")
@@ -541,7 +587,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return int(exc.code or 0)
     try:
         if args.command == "list":
-            return _list()
+            return _list(integrators=args.integrators)
         return COMMANDS[args.command](args)
     except DyncheckError as exc:
         print(f"dyncheck: error: {_one_line(str(exc))}", file=sys.stderr)

@@ -32,10 +32,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from dyncheck.adapters import ADAPTERS, get_adapter
+from dyncheck.adapters import get_adapter
 from dyncheck.adapters.base import Chart, Frame, StateLayout
 from dyncheck.cases.coordinate_maps import EulerAngleMap, quat_to_matrix
 from dyncheck.cases.multibody import NQ, NV, ROTATING, Multibody
+from dyncheck.errors import DyncheckError
 
 
 def layout(engine: str) -> StateLayout:
@@ -45,8 +46,11 @@ def layout(engine: str) -> StateLayout:
 
 def is_chart(implementation: str) -> bool:
     """Whether an implementation holds a ball joint as angles (a chart), not a quaternion."""
-    adapter = ADAPTERS.get(implementation)
-    return adapter is not None and adapter.state_layout.ball_chart is not Chart.QUATERNION
+    try:
+        adapter = get_adapter(implementation)
+    except DyncheckError:  # the reference, the book, an engine that is not installed
+        return False
+    return adapter.state_layout.ball_chart is not Chart.QUATERNION
 
 
 def _perm(order: str) -> list[int]:

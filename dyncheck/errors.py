@@ -46,10 +46,14 @@ class EngineNotInstalled(DyncheckError, ImportError):
         self, implementation: str, package: str, reason: str, extra: str | None = None
     ) -> None:
         self.implementation, self.package, self.extra = implementation, package, extra
-        hint = f"pip install 'dyncheck[{extra}]' (the extra {extra!r})" if extra else ""
+        self.hint = (
+            f"pip install 'dyncheck[{extra}]' (the extra {extra!r})"
+            if extra
+            else f"pip install {package}"
+        )
         super().__init__(
             f"implementation {implementation!r} needs {package!r}, which is not installed "
-            f"({reason}); {hint or f'pip install {package}'}"
+            f"({reason}); {self.hint}"
         )
 
 

@@ -29,6 +29,7 @@ from dyncheck.reference import particle, pendulum, pulley, rigid
 from dyncheck.reference.constraints import Softness
 from dyncheck.reference.coordinates import cylindrical, spherical
 from dyncheck.reference.trajectory import solve
+from dyncheck.roster import IMPLEMENTATIONS
 
 QUANTITIES: tuple[str, ...] = (
     "mass_matrix",
@@ -50,20 +51,6 @@ def quantities(case: Case) -> tuple[str, ...]:
     return tuple(q for q in QUANTITIES if q != "constraint_force")
 
 
-IMPLEMENTATIONS: tuple[str, ...] = (
-    "reference",
-    "book",
-    "sympy-mechanics",
-    "pinocchio",
-    "pinocchio-mjcf",
-    "drake",
-    "mujoco",
-    "mujoco-stiff",
-    "mjx-f64",
-    "mjx",
-    "mujoco-warp",
-)
-"""All implementation names, most trusted first: in a pair the earlier one is ``desired``."""
 
 COUPLINGS_ONLY: frozenset[str] = frozenset({"mujoco-stiff"})
 """Implementations that differ from another only in how couplings are held: run on cases

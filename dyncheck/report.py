@@ -17,6 +17,8 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.cases import Case
+from dyncheck.catalogue import Entry
+from dyncheck.errors import EngineNotInstalled
 from dyncheck.explanations import EXPLANATIONS
 from dyncheck.freshness import Moved, compare, read_report
 from dyncheck.results import PROVENANCE, provenance_json, to_csv, write_atomic
@@ -38,7 +40,7 @@ def versions() -> dict[str, str]:
     import sympy
 
     from dyncheck import __version__
-    from dyncheck.adapters import ADAPTERS
+    from dyncheck.adapters import get_adapter
 
     out = {
         "python": platform.python_version(),
@@ -55,7 +57,10 @@ def versions() -> dict[str, str]:
         ("mujoco-warp", "mujoco-warp"),  # with Warp's version and device
     )
     for name, pkg in engines:
-        out[pkg] = ADAPTERS[name].version() if name in ADAPTERS else "not installed"
+        try:
+            out[pkg] = get_adapter(name).version()
+        except EngineNotInstalled:
+            out[pkg] = "not installed"
     out["dyncheck"] = __version__
     try:
         commit = subprocess.run(
@@ -527,8 +532,9 @@ def index_page(result: RunResult, *, date: str) -> str:
     return "\n".join(lines)
 
 
-def conventions_page() -> str:
-    """The catalogue's demonstrations, run now (``dyncheck explain`` prints the same)."""
+def conventions_page(entries: list[Entry] | None = None) -> str:
+    """The catalogue's demonstrations (``dyncheck explain`` prints the same): those the run
+    made, or all of them run now."""
     from dyncheck.catalogue import explain, render
 
     head = [
@@ -541,7 +547,7 @@ def conventions_page() -> str:
         "[README.md](README.md).",
         "",
     ]
-    return "\n".join(head) + "\n" + render(explain())
+    return "\n".join(head) + "\n" + render(entries or explain())
 
 
 def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Path, str | bytes]:
@@ -557,7 +563,7 @@ def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Pat
         for kind, png in figures(case, result.figures[case.name], result.convergence).items():
             files[out / "figures" / f"{case.name}_{kind}.png"] = png
     files[out / "README.md"] = index_page(result, date=date)
-    files[out / "conventions.md"] = conventions_page()
+    files[out / "conventions.md"] = conventions_page(result.conventions)
     files[out / PROVENANCE] = provenance_json({"date (UTC)": date, **versions()})
     lead, table = errata(result.discrepancies)
     files[out / "printed-equations.md"] = "\n".join(

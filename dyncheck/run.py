@@ -2,14 +2,15 @@
 
 from __future__ import annotations
 
-import multiprocessing
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import pandas as pd
 
 from dyncheck.cases import Case, get_case
+from dyncheck.catalogue import DEMOS, Entry
+from dyncheck.catalogue import explain as explain_convention
 from dyncheck.closed_forms import closed_form_rows
 from dyncheck.comparison import compare_instantaneous
 from dyncheck.errors import UnknownName
@@ -27,6 +28,7 @@ from dyncheck.results import (
     table,
 )
 from dyncheck.trajectories import TrajectoryFigures, study
+from dyncheck.workers import executor
 
 
 @dataclass
@@ -37,6 +39,8 @@ class RunResult:
     figures: dict[str, TrajectoryFigures]
     parser_notes: dict[str, list[str]]
     """Per implementation, what its MJCF parser said it ignores (its own warnings)."""
+    conventions: list[Entry] = field(default_factory=list)
+    """The conventions catalogue's demonstrations, run with the cases (its report page)."""
 
     @property
     def failed(self) -> bool:
@@ -79,25 +83,35 @@ def run(
     *,
     states: int | None = None,
     jobs: int = 1,
+    dask: str | None = None,
+    conventions: bool = False,
     progress: Callable[[str], None] = lambda _msg: None,
 ) -> RunResult:
     """Evaluate, compare and study every case (``states`` sampled states each, default the
-    case's own), in ``jobs`` processes; results do not depend on ``jobs``. An implementation
-    that cannot be built (not installed, unsupported, raising) becomes skipped or failed rows,
-    never an aborted run."""
-    if jobs > 1 and len(cases) > 1:
-        ctx = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
-            futures = [pool.submit(_run_case, c, list(impl_names), states) for c in cases]
-            outputs = []
-            for case, future in zip(cases, futures, strict=True):
-                outputs.append(future.result())
-                progress(f"{case.name}: done")
-    else:
-        outputs = []
-        for case in cases:
-            progress(f"{case.name}: running")
-            outputs.append(_run_case(case, impl_names, states))
+    case's own) and, with ``conventions``, run the conventions catalogue — as units of work in
+    this process, ``jobs`` local processes or on a Dask cluster (``dask``:
+    :func:`dyncheck.workers.executor`); results do not depend on where they ran. An
+    implementation that cannot be built (not installed, unsupported, raising) becomes skipped
+    or failed rows, never an aborted run."""
+    units: list[tuple[str, Callable[..., Any], tuple[Any, ...]]] = [
+        (case.name, _run_case, (case, list(impl_names), states)) for case in cases
+    ]
+    if conventions:
+        units += [(f"conventions: {name}", explain_convention, (name,)) for name in DEMOS]
+    with executor(jobs if len(units) > 1 else 1, dask) as pool:
+        if pool is None:
+            done = []
+            for what, fn, args in units:
+                progress(f"{what}: running")
+                done.append(fn(*args))
+        else:
+            futures = [pool.submit(fn, *args) for _what, fn, args in units]
+            done = []
+            for (what, _fn, _args), future in zip(units, futures, strict=True):
+                done.append(future.result())
+                progress(f"{what}: done")
+    outputs = done[: len(cases)]
+    entries = [entry for (entry,) in done[len(cases) :]]
     rows: list[Discrepancy] = []
     points: list[ConvergencePoint] = []
     figures: dict[str, TrajectoryFigures] = {}
@@ -114,4 +128,5 @@ def run(
         table(points, ConvergencePoint, CONVERGENCE_KEY),
         figures,
         {k: sorted(v) for k, v in notes.items() if v},
+        entries,
     )

@@ -7,6 +7,7 @@ hand derivation of the simple pendulum in engine coordinates (α = −θ about +
 
 from __future__ import annotations
 
+import importlib.metadata
 from functools import cache
 
 import numpy as np
@@ -200,6 +201,18 @@ def test_unknown_engine_lists_valid_names():
 
 def test_every_engine_is_installed_here():
     assert sorted(ADAPTERS) == ALL_ENGINES
+
+
+@pytest.mark.parametrize("engine", ALL_ENGINES)
+def test_registration_names_the_class_that_calls_itself_so(engine):
+    """One registration line per engine: the class it names is the adapter of that name, and
+    the package it is listed under is the one the adapter reports the version of."""
+    from dyncheck.adapters import ENGINE_PACKAGES, REGISTRY
+
+    assert get_adapter(engine).name == engine
+    assert set(REGISTRY) == set(ENGINE_PACKAGES)
+    assert get_adapter(engine).version().startswith(importlib.metadata.version(
+        ENGINE_PACKAGES[engine]))
 
 
 def test_batched_path_equals_per_quantity_methods(adapter_and_states):

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import pandas as pd
 
 from dyncheck.cli import main
@@ -90,12 +93,30 @@ def test_out_that_is_a_file_is_usage_error(tmp_path, capsys):
 
 
 def test_list_names_engine_versions(capsys):
-    assert main(["list"]) == 0
+    assert main(["list", "--integrators"]) == 0
     out = capsys.readouterr().out
     assert "simple_pendulum" in out
     assert "mujoco 4" in out or "mujoco 3" in out
     drake = next(line for line in out.splitlines() if line.split()[:1] == ["drake"])
     assert "rk3-controlled" in drake and "rk4" not in drake  # Drake has no classic RK4
+
+
+def test_list_imports_no_engine():
+    """Plain `list` reads versions from package metadata: no engine, JAX, Warp or sympy is
+    imported (each costs up to seconds), and the versions are the installed ones."""
+    import importlib.metadata
+
+    code = (
+        "import sys; from dyncheck.cli import main; main(['list']); "
+        "print(sorted(m for m in ('jax', 'warp', 'pydrake', 'pinocchio', 'mujoco', 'sympy') "
+        "if m in sys.modules))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          check=True)
+    *lines, imported = done.stdout.splitlines()
+    assert imported == "[]"
+    pin = next(line for line in lines if line.split()[:1] == ["pinocchio"])
+    assert pin.split()[1:] == ["pin", importlib.metadata.version("pin")]
 
 
 def test_states_option_sweeps_more_states(tmp_path):

@@ -1,0 +1,69 @@
+"""Where the units of work run (dyncheck.workers): here, a local pool, or a Dask cluster.
+
+Expected values come from another execution path: the same run in this process (``jobs=1``),
+which shares no scheduling code with the pool or the cluster.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import pandas as pd
+import pytest
+
+from dyncheck import workers
+from dyncheck.cases import get_case
+from dyncheck.errors import InvalidInput
+from dyncheck.results import to_csv
+from dyncheck.run import run
+
+CASES = ("simple_pendulum", "atwood")
+IMPLS = ["reference", "book", "mujoco", "pinocchio"]
+
+
+def test_one_job_runs_here():
+    with workers.executor(1) as pool:
+        assert pool is None
+
+
+def test_dask_local_cluster_gives_the_same_csv_bytes_as_one_process():
+    pytest.importorskip("distributed", reason="the extra 'dask' (pip install 'dyncheck[dask]')")
+    cases = [get_case(n) for n in CASES]
+    here = run(cases, IMPLS, jobs=1, conventions=True)
+    cluster = run(cases, IMPLS, jobs=2, dask=workers.LOCAL, conventions=True)
+    assert to_csv(here.discrepancies) == to_csv(cluster.discrepancies)
+    assert to_csv(here.convergence) == to_csv(cluster.convergence)
+    assert [e.name for e in here.conventions] == [e.name for e in cluster.conventions]
+    # the catalogue's numbers too (NaN where an entry has none)
+    pd.testing.assert_frame_equal(
+        pd.DataFrame(here.conventions), pd.DataFrame(cluster.conventions)
+    )
+    assert len(here.conventions) > 10 and not here.discrepancies.empty
+
+
+def test_unreachable_scheduler_is_a_one_line_error_naming_the_flag(monkeypatch):
+    pytest.importorskip("distributed", reason="the extra 'dask' (pip install 'dyncheck[dask]')")
+    monkeypatch.setattr(workers, "CONNECT_SECONDS", 1)
+    with pytest.raises(InvalidInput, match=r"--dask must be a reachable dask scheduler"):
+        with workers.executor(2, "tcp://127.0.0.1:9"):  # the discard port: nobody listens
+            pytest.fail("no executor without a scheduler")
+
+
+def test_dask_without_the_extra_names_the_extra(monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed → ImportError
+    with pytest.raises(InvalidInput, match=r"pip install 'dyncheck\[dask\]'"):
+        with workers.executor(2, workers.LOCAL):
+            pytest.fail("no executor without dask")
+
+
+def test_cli_refuses_an_unreachable_scheduler_before_any_work(tmp_path, monkeypatch, capsys):
+    pytest.importorskip("distributed", reason="the extra 'dask' (pip install 'dyncheck[dask]')")
+    from dyncheck.cli import main
+
+    monkeypatch.setattr(workers, "CONNECT_SECONDS", 1)
+    out = tmp_path / "rep"
+    code = main(["run", "simple_pendulum", "--dask", "tcp://127.0.0.1:9", "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert len(err.splitlines()) == 1 and "--dask" in err and "tcp://127.0.0.1:9" in err
+    assert not (out / "discrepancies.csv").exists()
