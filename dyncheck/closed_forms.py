@@ -17,7 +17,7 @@ from dyncheck.cases import Case
 from dyncheck.implementations import general_method
 from dyncheck.reference import rigid
 from dyncheck.reference.trajectory import solve
-from dyncheck.results import Discrepancy
+from dyncheck.results import Discrepancy, Verdict
 from dyncheck.tolerances import EPS, first_near_max
 
 
@@ -41,21 +41,21 @@ def closed_form_rows(case: Case) -> list[Discrepancy]:
     allowed = 4 * estimate + 64 * EPS * (1 + rate * spec.duration) * scale
     return [
         Discrepancy(
-            case.name,
-            "closed_form",
-            "book",
-            "reference",
-            "dop853",
-            float("nan"),
-            float(err.max()),
-            float(err.max()) / scale,
-            allowed / scale,
-            f"4 x DOP853 error estimate {estimate:.1e} + closed form round-off "
+            case=case.name,
+            quantity="closed_form",
+            impl_a="book",
+            impl_b="reference",
+            integrator="dop853",
+            dt=float("nan"),
+            max_abs_err=float(err.max()),
+            max_rel_err=float(err.max()) / scale,
+            tolerance=allowed / scale,
+            tolerance_basis=f"4 x DOP853 error estimate {estimate:.1e} + closed form round-off "
             "64 eps (1 + abs(du/dt) T)",
-            "passed" if err.max() <= allowed else "failed",
-            "",
-            f"body angular velocity: Jacobi elliptic closed form (m = {tf.parameter:.4f}) "
+            verdict=Verdict.PASSED if err.max() <= allowed else Verdict.FAILED,
+            convention="",
+            note=f"body angular velocity: Jacobi elliptic closed form (m = {tf.parameter:.4f}) "
             "against Lagrange's equations in Euler angles integrated by DOP853",
-            first_near_max(err, 64 * EPS * (1 + rate * spec.duration) * scale),
+            worst_state=first_near_max(err, 64 * EPS * (1 + rate * spec.duration) * scale),
         )
     ]

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from enum import Enum
 
 from dyncheck.implementations import GRAVITY_DEFAULT, POINT_INERTIA, SOFT_CONSTRAINT
-from dyncheck.trajectories import (
+from dyncheck.studies import (
     CHARTS_DIFFER,
     GYROSCOPIC_IMPLICIT,
     HELD_FORCE,

@@ -23,14 +23,14 @@ from dyncheck.explanations import EXPLANATIONS
 from dyncheck.freshness import Moved, compare, read_report
 from dyncheck.results import PROVENANCE, provenance_json, to_csv, write_atomic
 from dyncheck.run import RunResult
-from dyncheck.tolerances import ORDER_SLACK
-from dyncheck.trajectories import (
+from dyncheck.studies import (
     CONTROLLED,
     CONTROLLED_ACCURACIES,
     TRUNCATION,
     TrajectoryFigures,
     finest_pair,
 )
+from dyncheck.tolerances import ORDER_SLACK
 
 
 def versions() -> dict[str, str]:

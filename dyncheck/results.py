@@ -26,7 +26,7 @@ class Verdict(StrEnum):
 VERDICTS = tuple(v.value for v in Verdict)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Discrepancy:
     """One case × quantity × pair of implementations (× integrator × step for trajectories).
 
@@ -58,7 +58,7 @@ class Discrepancy:
             raise ValueError(f"verdict must be one of {VERDICTS}, got {self.verdict!r}")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class ConvergencePoint:
     """One step of an order-of-accuracy study: the max configuration error (rad) over the
     comparison grid against the reference of the implementation's own model."""

@@ -27,7 +27,7 @@ from dyncheck.results import (
     Discrepancy,
     table,
 )
-from dyncheck.trajectories import TrajectoryFigures, study
+from dyncheck.studies import TrajectoryFigures, study
 from dyncheck.workers import executor
 
 

@@ -81,3 +81,11 @@ def full_run() -> RunResult:
 settings.register_profile("ci", max_examples=8, deadline=None, derandomize=True)
 settings.register_profile("nightly", max_examples=300, deadline=None)
 settings.load_profile("ci")
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Every test that needs the full run is ``slow`` (``pytest -m "not slow"`` is the quick
+    loop; the README's test command runs everything)."""
+    for item in items:
+        if "full_run" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.slow)

@@ -40,7 +40,7 @@ def leaf_system_run(
 def drake_fsal_caching() -> Entry:
     """Drake's error-controlled integrators on the compound pendulum's MultibodyPlant with the
     context's cache on (Drake's default) and off: caching must never change a result."""
-    from dyncheck.trajectories import References
+    from dyncheck.studies import References
 
     case = get_case("compound_pendulum")
     impl = make_implementation("drake", case)

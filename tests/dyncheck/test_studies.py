@@ -10,7 +10,7 @@ from dyncheck.adapters import ADAPTERS
 from dyncheck.cases import NOMINAL_ORDER, get_case
 from dyncheck.comparison import GRAVITY_DEFAULT
 from dyncheck.implementations import SOFT_CONSTRAINT
-from dyncheck.trajectories import (
+from dyncheck.studies import (
     CONTROLLED,
     CONTROLLED_ACCURACIES,
     GYROSCOPIC_IMPLICIT,
@@ -138,7 +138,7 @@ def test_observed_orders_formula():
 def test_an_error_that_does_not_shrink_fails(engine, monkeypatch):
     """A run with a constant error offset (a wrong model, not a truncation error) fails.
     (mujoco-warp makes no run this long on the CPU: test_observed_order checks the refusal.)"""
-    from dyncheck import trajectories
+    from dyncheck import studies
     from dyncheck.cases import get_case
     from dyncheck.implementations import make_implementation
 
@@ -151,7 +151,7 @@ def test_an_error_that_does_not_shrink_fails(engine, monkeypatch):
         return t, q + 1e-3
 
     impl.simulate = offset
-    _, rows, _ = trajectories.study(case, {engine: impl})
+    _, rows, _ = studies.study(case, {engine: impl})
     study_rows = [
         r
         for r in rows
@@ -191,7 +191,7 @@ def test_drake_error_controlled_rk3_is_tolerance_proportional(full_run, case):
 
 def test_error_controlled_run_with_an_offset_fails(monkeypatch):
     """An error that does not shrink with ε (a wrong model) fails the tolerance study."""
-    from dyncheck import trajectories
+    from dyncheck import studies
     from dyncheck.implementations import make_implementation
 
     case = get_case("simple_pendulum")
@@ -203,7 +203,7 @@ def test_error_controlled_run_with_an_offset_fails(monkeypatch):
         return q + 1e-6, n
 
     impl.simulate_controlled = offset
-    _, rows, _ = trajectories.study(case, {"drake": impl})
+    _, rows, _ = studies.study(case, {"drake": impl})
     controlled = [r for r in rows if r.integrator.startswith(CONTROLLED)]
     assert len(controlled) == len(CONTROLLED_ACCURACIES)
     assert all(r.verdict == "failed" for r in controlled)
@@ -227,7 +227,7 @@ def test_discrete_prediction_steps_quaternion_states_at_order_four(case_name):
     (the classical RK4 order; an additive update of the quaternion could not even run: nq = 4,
     nv = 3). Needed wherever an engine's rows fail their order and the prediction is asked."""
     from dyncheck.implementations import book_variant
-    from dyncheck.trajectories import References, difference
+    from dyncheck.studies import References, difference
 
     case = get_case(case_name)
     refs = References(case)
@@ -246,7 +246,7 @@ def test_discrete_prediction_refused_where_the_book_coordinates_lose_the_spin():
     stepped on the rotation group acquires: the prediction is refused (the row keeps its
     verdict, with the reason), never made from the wrong body frame."""
     from dyncheck.implementations import book_variant
-    from dyncheck.trajectories import References
+    from dyncheck.studies import References
 
     case = get_case("spherical_pendulum")
     refs = References(case)
@@ -260,7 +260,7 @@ def test_declared_rk4_order_on_the_rotation_group_is_checked(monkeypatch):
     rows fail (observed 4, predicted 2) instead of passing or being explained."""
     from dyncheck.adapters.mujoco_ import MuJoCoAdapter
     from dyncheck.implementations import make_implementation
-    from dyncheck.trajectories import study
+    from dyncheck.studies import study
 
     if not MuJoCoAdapter.rk4_group_order == 4:
         pytest.skip("installed MuJoCo predates 4.0 (its RK4 is order 2 on the group)")

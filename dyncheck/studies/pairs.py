@@ -1,0 +1,261 @@
+"""Engine against engine: the same integrator and step on two engines — equal to accumulated
+round-off, differing by the predicted effect of their model variants, or two different maps
+of the same dynamics whose difference shrinks at the integrator's order."""
+
+from __future__ import annotations
+
+from itertools import combinations
+from typing import Any
+
+import numpy as np
+
+from dyncheck.cases import NOMINAL_ORDER, Case
+from dyncheck.cases.multibody import ROTATING
+from dyncheck.comparison import soft_factor
+from dyncheck.conventions import is_chart
+from dyncheck.errors import EngineNotInstalled, Unsupported
+from dyncheck.implementations import Implementation, Variant, compared
+from dyncheck.results import Discrepancy, Verdict
+from dyncheck.studies.labels import CHARTS_DIFFER, GYROSCOPIC_IMPLICIT, NAIVE_GROUP_RK4
+from dyncheck.studies.references import References, difference
+from dyncheck.tolerances import (
+    EPS,
+    ORDER_SLACK,
+    ROUNDOFF_MARGIN,
+    accumulated,
+    first_near_max,
+    roundoff_floor,
+)
+
+
+def _no_numbers(
+    case: Case, a: str, b: str, integrator: str, dt: float, verdict: str, convention: str, note: str
+) -> Discrepancy:
+    """A trajectory row with no error to show (skipped, or failed before any number)."""
+    nan = float("nan")
+    return Discrepancy(
+        case=case.name,
+        quantity="trajectory",
+        impl_a=a,
+        impl_b=b,
+        integrator=integrator,
+        dt=dt,
+        max_abs_err=nan,
+        max_rel_err=nan,
+        tolerance=nan,
+        tolerance_basis="",
+        verdict=verdict,
+        convention=convention,
+        note=note,
+        worst_state=-1,
+    )
+
+
+def unavailable(
+    case: Case, name: str, exc: Exception, integrator: str = "", dt: float = float("nan")
+) -> Discrepancy:
+    """A skipped (engine not installed, model unsupported) or failed (raised, diverged)
+    trajectory row against the reference."""
+    if isinstance(exc, EngineNotInstalled | Unsupported):
+        return _no_numbers(case, "reference", name, integrator, dt, Verdict.SKIPPED, "", str(exc))
+    return _no_numbers(
+        case, "reference", name, integrator, dt, Verdict.FAILED, "", f"{type(exc).__name__}: {exc}"
+    )
+
+
+def _maps_differ(
+    case: Case, a: str, b: str, integrator: str, impls: dict[str, Implementation | Exception]
+) -> str | None:
+    """Why two engines' fixed-step runs are different maps of the same dynamics, or None:
+    Drake and sympy-mechanics step a rotating body in their own chart (roll-pitch-yaw or
+    Example 9's angles, a free joint's quaternion components) where the others apply the
+    exponential map; MuJoCo's ``implicitfast`` adds a free body's gyroscopic derivative (MuJoCo
+    ≥ 3.12, changelog f0fa3d82), which semi-implicit Euler does not."""
+    types = {j.type for j in case.multibody().joints}
+    if not types & set(ROTATING):
+        return None
+    if any(is_chart(e) for e in (a, b)) and a != b:
+        return CHARTS_DIFFER
+    if integrator.startswith("rk4") and len({_group_order(impls[e]) for e in (a, b)}) == 2:
+        return NAIVE_GROUP_RK4
+    if integrator == "implicitfast" and "free" in types:
+        facts = {
+            getattr(getattr(impls[e], "adapter", None), "gyroscopic_implicit", False)
+            for e in (a, b)
+        }
+        if len(facts) == 2:
+            return GYROSCOPIC_IMPLICIT
+    return None
+
+
+def _group_order(impl: Implementation | Exception) -> int:
+    """RK4's order on the rotation group as the engine defines it (4 unless it says less)."""
+    return int(getattr(getattr(impl, "adapter", None), "rk4_group_order", NOMINAL_ORDER["rk4"]))
+
+
+def _frame_pair(
+    case: Case,
+    a: str,
+    b: str,
+    integrator: str,
+    dts: tuple[float, ...],
+    runs: dict[tuple[str, str, float], np.ndarray],
+    convention: str,
+    nominal: int | None = None,
+    eps: float = EPS,
+) -> Discrepancy:
+    """Two different fixed-step maps of the same dynamics (:func:`_maps_differ`): both
+    converge at the integrator's order p, so their difference must shrink at least at order p
+    (faster where the maps agree to higher order). Predicted: the difference's observed order
+    between the two coarsest steps. ``nominal``: the lower of the two maps' orders (default:
+    the integrator's)."""
+    nominal = nominal or NOMINAL_ORDER[integrator]
+    if len(dts) < 2 or any((e, integrator, dt) not in runs for e in (a, b) for dt in dts[:2]):
+        why = "the two maps differ in definition and fewer than two steps ran"
+        return _no_numbers(case, a, b, integrator, dts[0], Verdict.FAILED, convention, why)
+    d = []
+    for dt in dts[:2]:
+        qa, qb = runs[a, integrator, dt], runs[b, integrator, dt]
+        d.append(float(difference(case, qb, qa).max()))
+    scale_q = float(np.abs(runs[a, integrator, dts[0]]).max())
+    if eps > EPS:
+        steps = round(case.trajectory.duration / dts[1])
+        if d[1] <= ROUNDOFF_MARGIN * roundoff_floor(eps, steps) * scale_q:
+            # the finer difference is round-off: no order to measure in this precision; the
+            # difference must then lie within the pair's accumulated round-off
+            tol = accumulated(round(case.trajectory.duration / dts[0]), eps=eps)
+            return Discrepancy(
+                case=case.name,
+                quantity="trajectory",
+                impl_a=a,
+                impl_b=b,
+                integrator=integrator,
+                dt=dts[0],
+                max_abs_err=d[0],
+                max_rel_err=d[0] / scale_q,
+                tolerance=tol.rtol,
+                tolerance_basis=tol.basis,
+                verdict=Verdict.PASSED if d[0] / scale_q <= tol.rtol else Verdict.FAILED,
+                convention="",
+                note=f"{a} and {b} are different maps ({convention}); at dt={dts[1]:g} their "
+                f"difference is within the round-off of eps = {eps:.3g}, so its order cannot "
+                f"be measured; at dt={dts[0]:g} it lies within the accumulated round-off",
+                worst_state=-1,
+            )
+    p = float(np.log(d[0] / d[1]) / np.log(dts[0] / dts[1]))
+    ok = p >= nominal - ORDER_SLACK  # two order-p maps differ by O(hᵖ) or less
+    return Discrepancy(
+        case=case.name,
+        quantity="trajectory",
+        impl_a=a,
+        impl_b=b,
+        integrator=integrator,
+        dt=dts[0],
+        max_abs_err=d[0],
+        max_rel_err=d[0] / scale_q,
+        tolerance=float("nan"),
+        tolerance_basis=f"difference of two order-{nominal} maps: shrinks at order >= "
+        f"{nominal} - {ORDER_SLACK}",
+        verdict=Verdict.EXPLAINED if ok else Verdict.FAILED,
+        convention=convention,
+        note=f"{a} and {b} are different maps ({convention}); their difference shrinks at "
+        f"order {p:.3f} from dt={dts[0]:g} to {dts[1]:g} (predicted {nominal})",
+        worst_state=-1,
+    )
+
+
+def _eps(impl: Implementation | Exception) -> float:
+    return impl.eps if isinstance(impl, Implementation) else EPS
+
+
+def engine_pairs(
+    case: Case,
+    engines: list[str],
+    runs: dict[tuple[str, str, float], np.ndarray],
+    variants: dict[str, Variant | None],
+    refs: References,
+    impls_: dict[str, Implementation | Exception],
+) -> list[Discrepancy]:
+    """Same integrator, same (coarsest) step, two engines: equal to accumulated round-off, or
+    differing by the predicted effect of their model variants on the trajectory."""
+    rows = []
+    spec = case.trajectory
+    for a, b in ((a, b) for a, b in combinations(engines, 2) if compared(a, b)):
+        for integrator, dts in spec.steps.items():
+            for dt in dts[:1]:  # the coarsest step: agreement there needs no finer repeat
+                if (a, integrator, dt) not in runs or (b, integrator, dt) not in runs:
+                    continue
+                differ = _maps_differ(case, a, b, integrator, impls_)
+                if differ is not None:
+                    order = min(_group_order(impls_[a]), _group_order(impls_[b]))
+                    nominal = order if differ == NAIVE_GROUP_RK4 else None
+                    eps = max(_eps(impls_[a]), _eps(impls_[b]))
+                    rows.append(
+                        _frame_pair(case, a, b, integrator, dts, runs, differ, nominal, eps)
+                    )
+                    continue
+                qa, qb = runs[a, integrator, dt], runs[b, integrator, dt]
+                steps = qa.shape[0] - 1
+                soft = max(soft_factor(variants[a]), soft_factor(variants[b]))
+                tol = accumulated(steps, soft, max(_eps(impls_[a]), _eps(impls_[b])))
+                scale_q = float(np.abs(qa).max())
+                diff = difference(case, qb, qa).max(axis=1)
+                # ties at float64 round-off go to the first state (machine-independent)
+                worst = first_near_max(diff, accumulated(steps, soft).rtol * scale_q)
+                err = float(diff[worst])
+                row: dict[str, Any] = dict(
+                    case=case.name,
+                    quantity="trajectory",
+                    impl_a=a,
+                    impl_b=b,
+                    integrator=integrator,
+                    dt=dt,
+                    max_abs_err=err,
+                    max_rel_err=err / scale_q,
+                    tolerance=tol.rtol,
+                    tolerance_basis=tol.basis,
+                    worst_state=worst,
+                )
+                va, vb = variants[a], variants[b]
+                if err / scale_q <= tol.rtol:
+                    rows.append(Discrepancy(**row, verdict=Verdict.PASSED, convention="", note=""))
+                elif va is not None and vb is not None and va != vb:
+                    try:
+                        predicted = refs.discrete(vb, integrator, dt) - refs.discrete(
+                            va, integrator, dt
+                        )
+                    except Exception as exc:  # no discrete prediction here: a failed row
+                        rows.append(
+                            Discrepancy(
+                                **row,
+                                verdict=Verdict.FAILED,
+                                convention="; ".join(va.conventions(vb)),
+                                note=f"no prediction: {type(exc).__name__}: {exc}",
+                            )
+                        )
+                        continue
+                    res_rel = float(difference(case, qb - qa, predicted).max()) / scale_q
+                    note = (
+                        f"predicted by the reference equations of both models, stepped by "
+                        f"{integrator}: max {np.abs(predicted).max():.3g} rad; residual "
+                        f"{res_rel:.3g}"
+                    )
+                    verdict = Verdict.EXPLAINED if res_rel <= tol.rtol else Verdict.FAILED
+                    rows.append(
+                        Discrepancy(
+                            **row,
+                            verdict=verdict,
+                            convention="; ".join(va.conventions(vb)),
+                            note=note,
+                        )
+                    )
+                else:
+                    rows.append(
+                        Discrepancy(
+                            **row,
+                            verdict=Verdict.FAILED,
+                            convention="",
+                            note="unexplained: no convention predicts this",
+                        )
+                    )
+    return rows
