@@ -181,6 +181,9 @@ def _parser() -> argparse.ArgumentParser:
         help="sweep sizes whose peak memory is measured in fresh processes",
     )
     b.add_argument("--out", type=_path, default=Path("reports"), help="report folder")
+    b.add_argument("--suite", action="store_true",
+                   help="instead: time the commands a user runs (list, explain, one case, the "
+                   "full run, report --check) in fresh processes -> benchmark-suite.md")
     for name, example in EXAMPLES.items():
         sub.choices[name].epilog = f"example: {example}"
     return p
@@ -422,6 +425,11 @@ def _bench(args: argparse.Namespace) -> int:
     from dyncheck.cases import get_case
 
     _check_out(args.out)
+    if args.suite:
+        from dyncheck import bench_suite
+
+        print(bench_suite.main(args.out))
+        return 0
     get_case(args.case)
     _positive("--states", args.states)
     _positive("--repeats", args.repeats)

@@ -64,10 +64,17 @@ PROSE_FLOOR = 1e-10
 two such numbers agree whatever their digits."""
 VOLATILE = ("| date (UTC)", "| dyncheck commit")
 """Provenance lines that change with every run without the results changing."""
-PAGES_NOT_COMPARED = ("benchmark.md", "versions.md", "reliability.md", "errata.md")
+PAGES_NOT_COMPARED = (
+    "benchmark.md",
+    "benchmark-suite.md",
+    "benchmark-ports.md",
+    "versions.md",
+    "reliability.md",
+    "errata.md",
+)
 """Pages of the report folder that a run does not write (``dyncheck bench``, ``versions``,
 ``errata`` and the fault-table test do; each has its own freshness check)."""
-TABLES_NOT_COMPARED = ("benchmark.csv", "baseline.csv")
+TABLES_NOT_COMPARED = ("benchmark.csv", "benchmark-suite.csv", "baseline.csv")
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?|\bnan\b|\binf\b")
 

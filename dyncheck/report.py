@@ -2,18 +2,12 @@
 
 from __future__ import annotations
 
-import io
 import platform
 import subprocess
 import sys
 from datetime import UTC, datetime
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-import numpy as np
 import pandas as pd
 
 from dyncheck.cases import Case
@@ -21,14 +15,24 @@ from dyncheck.catalogue import Entry
 from dyncheck.errors import EngineNotInstalled
 from dyncheck.explanations import EXPLANATIONS
 from dyncheck.freshness import Moved, compare, read_report
+from dyncheck.report_figures import figures
+from dyncheck.report_tables import (
+    conservation_matrix,
+    conservation_table,
+    controlled_matrix,
+    family_matrix,
+    instantaneous_matrix,
+    md,
+    order_matrix,
+    order_table,
+    summary,
+)
 from dyncheck.results import PROVENANCE, provenance_json, to_csv, write_atomic
 from dyncheck.run import RunResult
 from dyncheck.studies import (
     CONTROLLED,
     CONTROLLED_ACCURACIES,
     TRUNCATION,
-    TrajectoryFigures,
-    finest_pair,
 )
 from dyncheck.tolerances import ORDER_SLACK
 
@@ -86,212 +90,6 @@ def versions() -> dict[str, str]:
     return out
 
 
-TRAJECTORY_QUANTITIES = ("trajectory", "constraint_drift", "closed_form")
-"""Row quantities that come from runs (the rest are instantaneous)."""
-
-
-def _md(frame: pd.DataFrame) -> str:
-    return frame.to_markdown(index=False, floatfmt=".3g") if len(frame) else "_(none)_"
-
-
-def _cell(group: pd.DataFrame) -> str:
-    worst = group["max_rel_err"].max()
-    verdicts = sorted(set(group["verdict"]), key=["failed", "explained", "passed", "skipped"].index)
-    return f"{verdicts[0]} {worst:.1e}" if np.isfinite(worst) else verdicts[0]
-
-
-def instantaneous_matrix(d: pd.DataFrame, case: str) -> pd.DataFrame:
-    rows = d[(d["case"] == case) & ~d["quantity"].isin(TRAJECTORY_QUANTITIES)].copy()
-    rows["pair"] = rows["impl_a"] + " vs " + rows["impl_b"]
-    out = rows.groupby(["quantity", "pair"], sort=False).apply(_cell, include_groups=False)
-    return out.unstack("pair").reset_index()
-
-
-def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) -> pd.DataFrame:
-    """Per case × engine × integrator: the finest asymptotic observed order and verdict."""
-    rows = []
-    for (c, impl, integ), g in conv.groupby(["case", "impl", "integrator"]):
-        if case is not None and c != case:
-            continue
-        g = g.sort_values("dt", ascending=False)
-        i = finest_pair(list(g["asymptotic"]))
-        p = g["observed_order"].iloc[i] if i is not None else float("nan")
-        verdict = d[
-            (d.case == c)
-            & (d.quantity == "trajectory")
-            & (d.impl_a == "reference")
-            & (d.impl_b == impl)
-            & (d.integrator == integ)
-        ]["verdict"].iloc[0]
-        rows.append(
-            {
-                "case": c,
-                "implementation": impl,
-                "integrator": integ,
-                "nominal order": int(g["nominal_order"].iloc[0]),
-                "observed order": p,
-                "finest dt": g["dt"].min(),
-                "error at finest dt": g["error"].iloc[-1],
-                "verdict": verdict,
-            }
-        )
-    return pd.DataFrame(rows)
-
-
-def family_matrix(d: pd.DataFrame, trajectories: bool) -> pd.DataFrame:
-    """Pair × case: the worst verdict and worst relative error over the family's rows
-    (instantaneous quantities, or trajectories)."""
-    rows = d[d.quantity.isin(TRAJECTORY_QUANTITIES) == trajectories].copy()
-    if not len(rows):
-        return pd.DataFrame()
-    rows["pair"] = rows["impl_a"] + " vs " + rows["impl_b"]
-    out = rows.groupby(["pair", "case"], sort=True).apply(_cell, include_groups=False)
-    return out.unstack("case", fill_value="").reset_index()
-
-
-def controlled_matrix(d: pd.DataFrame) -> pd.DataFrame:
-    """Implementation × case: verdict and error of the error-controlled runs at their
-    tightest tolerance (Drake's rk3 at the last accuracy, DOP853)."""
-    tightest = f"{CONTROLLED} eps={CONTROLLED_ACCURACIES[-1]:g}"
-    rows = d[(d.impl_a == "reference") & d.integrator.isin([tightest, "dop853"])].copy()
-    rows["run"] = rows["impl_b"] + " " + rows["integrator"]
-    rows["cell"] = [
-        f"{v} {e:.1e}" if np.isfinite(e) else v
-        for v, e in zip(rows.verdict, rows.max_abs_err, strict=True)
-    ]
-    return rows.pivot(index="run", columns="case", values="cell").fillna("").reset_index()
-
-
-def order_matrix(conv: pd.DataFrame, d: pd.DataFrame) -> pd.DataFrame:
-    """Implementation/integrator × case: observed order (verdict)."""
-    t = order_table(conv, d)
-    if not len(t):
-        return t
-    t["run"] = t["implementation"] + " " + t["integrator"]
-    t["cell"] = [
-        f"{p:.3f} ({v})" if np.isfinite(p) else v
-        for p, v in zip(t["observed order"], t["verdict"], strict=True)
-    ]
-    return t.pivot(index="run", columns="case", values="cell").fillna("").reset_index()
-
-
-def conservation_table(result: RunResult) -> pd.DataFrame:
-    """Per case × implementation × integrator: the finest run's max relative energy error
-    and, for rigid bodies, of the angular momentum in space axes."""
-    rows = []
-    for case, fig in result.figures.items():
-        for (impl, integ), drift in sorted(fig.energy.items()):
-            h = fig.momentum.get((impl, integ))
-            rows.append(
-                {
-                    "case": case,
-                    "impl": impl,
-                    "integrator": integ,
-                    "dt": fig.steps[impl, integ],
-                    "max_energy_drift": float(drift.max()),
-                    "max_momentum_drift": float(h.max()) if h is not None else float("nan"),
-                }
-            )
-    columns = ["case", "impl", "integrator", "dt", "max_energy_drift", "max_momentum_drift"]
-    return pd.DataFrame(rows, columns=columns)
-
-
-def conservation_matrix(result: RunResult) -> pd.DataFrame:
-    t = conservation_table(result)
-    if not len(t):
-        return t
-    t["run"] = t["impl"] + " " + t["integrator"]
-    t["cell"] = [
-        f"{e:.1e}" + (f"; H {h:.1e}" if np.isfinite(h) else "")
-        for e, h in zip(t["max_energy_drift"], t["max_momentum_drift"], strict=True)
-    ]
-    return t.pivot(index="run", columns="case", values="cell").fillna("").reset_index()
-
-
-def _summary(d: pd.DataFrame) -> pd.DataFrame:
-    counts = d.groupby(["case", "verdict"]).size().unstack("verdict", fill_value=0)
-    for v in ("passed", "explained", "failed", "skipped"):
-        if v not in counts:
-            counts[v] = 0
-    return counts[["passed", "explained", "failed", "skipped"]].reset_index()
-
-
-def _png(fig: plt.Figure) -> bytes:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90, metadata={"Software": None})
-    plt.close(fig)
-    return buf.getvalue()
-
-
-def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str, bytes]:
-    """Deterministic PNGs: trajectory, error against time, error against step size."""
-    plt.rcParams.update({"font.family": "DejaVu Sans", "font.size": 9})
-    out = {}
-    fig, axes = plt.subplots(case.ndof, 1, figsize=(7, 2.2 * case.ndof), squeeze=False)
-    for i, ax in enumerate(axes[:, 0]):
-        ax.plot(data.t, data.reference[:, i], "k-", lw=2, label="reference (DOP853)")
-        for (impl, integ), q in sorted(data.runs.items()):
-            if integ == "rk4":
-                ax.plot(data.t, q[:, i], "--", lw=1, label=f"{impl} rk4")
-        ax.set_ylabel(f"{case.coordinates[i]} (rad)")
-    axes[-1, 0].set_xlabel("t (s)")
-    axes[0, 0].legend(fontsize=7, loc="best")
-    axes[0, 0].set_title(f"{case.title}: trajectory in the book's coordinates")
-    fig.tight_layout()
-    out["trajectory"] = _png(fig)
-
-    fig, ax = plt.subplots(figsize=(7, 3.2))
-    for (impl, integ), err in sorted(data.errors.items()):
-        ax.semilogy(
-            data.t,
-            np.maximum(err, 1e-17),
-            lw=1,
-            label=f"{impl} {integ} dt={data.steps[impl, integ]:g}",
-        )
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("max |q - q_ref| (rad)")
-    ax.set_title("Error against time (finest step of each integrator)")
-    if data.errors:
-        ax.legend(fontsize=6, ncol=2)
-    fig.tight_layout()
-    out["error_time"] = _png(fig)
-
-    fig, ax = plt.subplots(figsize=(7, 4))
-    c = conv[conv["case"] == case.name]
-    for (impl, integ), g in c.groupby(["impl", "integrator"]):
-        ax.loglog(g["dt"], g["error"], "o-", ms=3, lw=1, label=f"{impl} {integ}")
-    for _integ, g in c.groupby("integrator"):
-        p = int(g["nominal_order"].iloc[0])
-        dts = np.sort(g["dt"].unique())
-        anchor = g[g["dt"] == dts[-1]]["error"].max()
-        ax.loglog(dts, anchor * (dts / dts[-1]) ** p, "k:", lw=1)
-        ax.annotate(f"slope {p}", (dts[0], anchor * (dts[0] / dts[-1]) ** p), fontsize=7)
-    ax.set_xlabel("dt (s)")
-    ax.set_ylabel("max error (rad)")
-    ax.set_title("Error against step size (dotted: nominal slopes)")
-    if len(c):
-        ax.legend(fontsize=6, ncol=2)
-    fig.tight_layout()
-    out["convergence"] = _png(fig)
-
-    fig, ax = plt.subplots(figsize=(7, 3.2))
-    for (impl, integ), drift in sorted(data.energy.items()):
-        ax.semilogy(
-            data.t,
-            np.maximum(drift[:: (len(drift) - 1) // (len(data.t) - 1)], 1e-17),
-            lw=1,
-            label=f"{impl} {integ}",
-        )
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("|E(t) − E(0)| / max|E|")
-    ax.set_title("Conservation drift (finest step of each integrator)")
-    if data.energy:
-        ax.legend(fontsize=6, ncol=2)
-    fig.tight_layout()
-    out["energy"] = _png(fig)
-    return out
-
-
 def case_page(case: Case, result: RunResult) -> str:
     d, conv = result.discrepancies, result.convergence
     params = pd.DataFrame({"parameter": list(case.params()), "value": list(case.params().values())})
@@ -307,27 +105,27 @@ def case_page(case: Case, result: RunResult) -> str:
         "",
         "### Parameters (SI)",
         "",
-        _md(params),
+        md(params),
         "",
         "### Instantaneous quantities: verdict and worst relative error, per pair",
         "",
         f"{len(case.sample_states())} seeded states (seed {case.seed}); relative error = max "
         "|actual − desired| / max |desired|; `impl_a vs impl_b` with impl_a trusted.",
         "",
-        _md(instantaneous_matrix(d, case.name)),
+        md(instantaneous_matrix(d, case.name)),
         "",
         "### Order of accuracy against the reference of the same model",
         "",
-        _md(order_table(conv, d, case.name)),
+        md(order_table(conv, d, case.name)),
         "",
         "### Step-by-step study",
         "",
-        _md(conv[conv.case == case.name].drop(columns=["case"])),
+        md(conv[conv.case == case.name].drop(columns=["case"])),
         "",
         *_controlled_section(d[d.case == case.name]),
         "### Engine against engine, same integrator and step",
         "",
-        _md(pairs[["impl_a", "impl_b", "integrator", "dt", "max_rel_err", "tolerance", "verdict"]]),
+        md(pairs[["impl_a", "impl_b", "integrator", "dt", "max_rel_err", "tolerance", "verdict"]]),
         "",
         *_constraint_section(case, d),
         "### Figures",
@@ -361,7 +159,7 @@ def _controlled_section(d: pd.DataFrame) -> list[str]:
         f"observed slope 1 ± {ORDER_SLACK}. `dop853`: scipy's DOP853 on the engine's forward "
         "dynamics against the reference's own DOP853 run.",
         "",
-        _md(rows[["impl_b", "integrator", "max_abs_err", "verdict", "note"]]),
+        md(rows[["impl_b", "integrator", "max_abs_err", "verdict", "note"]]),
         "",
     ]
 
@@ -394,12 +192,12 @@ def _constraint_section(case: Case, d: pd.DataFrame) -> list[str]:
         "violation, and the stretch of the cords along a run "
         "(`dyncheck explain soft-vs-exact-constraints`). Constraint force = cord tension (N).",
         "",
-        _md(inst[["quantity", "impl_b", "max_rel_err", "tolerance", "verdict", "note"]]),
+        md(inst[["quantity", "impl_b", "max_rel_err", "tolerance", "verdict", "note"]]),
         "",
         "Drift of the constraint (cord stretch, m) along each run at its coarsest step, "
         "against the same model stepped by the same integrator:",
         "",
-        _md(drift[["impl_b", "integrator", "dt", "max_abs_err", "tolerance", "verdict", "note"]]),
+        md(drift[["impl_b", "integrator", "dt", "max_abs_err", "tolerance", "verdict", "note"]]),
         "",
     ]
 
@@ -427,9 +225,7 @@ def errata(d: pd.DataFrame) -> tuple[str, pd.DataFrame]:
 def index_page(result: RunResult, *, date: str) -> str:
     d, conv = result.discrepancies, result.convergence
     made_with = versions()
-    prov = pd.DataFrame(
-        {"item": ["date (UTC)", *made_with], "value": [date, *made_with.values()]}
-    )
+    prov = pd.DataFrame({"item": ["date (UTC)", *made_with], "value": [date, *made_with.values()]})
     failed = d[d.verdict.isin(["failed", "skipped"])]
     explained = d.loc[d.verdict == "explained", "convention"]
     used = sorted({c for cell in explained for c in cell.split("; ") if c} | {TRUNCATION})
@@ -441,23 +237,23 @@ def index_page(result: RunResult, *, date: str) -> str:
         "",
         "### Provenance",
         "",
-        _md(prov),
+        md(prov),
         "",
         "### Verdicts per case (rows of discrepancies.csv)",
         "",
-        _md(_summary(d)),
+        md(summary(d)),
         "",
         "### Instantaneous quantities: worst verdict and relative error, pair × case",
         "",
-        _md(family_matrix(d, trajectories=False)),
+        md(family_matrix(d, trajectories=False)),
         "",
         "### Trajectories: worst verdict and relative error, pair × case",
         "",
-        _md(family_matrix(d, trajectories=True)),
+        md(family_matrix(d, trajectories=True)),
         "",
         f"### Order of accuracy: observed order (verdict), nominal ± {ORDER_SLACK}",
         "",
-        _md(order_matrix(conv, d)),
+        md(order_matrix(conv, d)),
         "",
         "### Error-controlled integration: verdict and max error (rad or m) at the tightest "
         "tolerance",
@@ -468,7 +264,7 @@ def index_page(result: RunResult, *, date: str) -> str:
         "dynamics (on the rotation group in re-centred exponential coordinates) within twice "
         "the sum of its own and the reference's error estimates.",
         "",
-        _md(controlled_matrix(d)),
+        md(controlled_matrix(d)),
         "",
         "### Conservation: max |E(t) − E(0)| / max |E| of the finest run (measured)",
         "",
@@ -478,7 +274,7 @@ def index_page(result: RunResult, *, date: str) -> str:
         "H = ℓ Ī ω̄ ((2.2.42), (2.2.49) with no moment). Informational: no verdict "
         "(conservation.csv).",
         "",
-        _md(conservation_matrix(result)),
+        md(conservation_matrix(result)),
         "",
         "### The book's printed equations of motion against the general method",
         "",
@@ -487,11 +283,11 @@ def index_page(result: RunResult, *, date: str) -> str:
         "",
         errata(d)[0],
         "",
-        _md(errata(d)[1]),
+        md(errata(d)[1]),
         "",
         "### Failed or skipped rows",
         "",
-        _md(
+        md(
             failed[
                 [
                     "case",
@@ -581,7 +377,7 @@ def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Pat
             "",
             lead,
             "",
-            _md(table),
+            md(table),
             "",
         ]
     )

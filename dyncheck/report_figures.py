@@ -1,0 +1,94 @@
+"""The report's figures (PNG): each case's trajectories, errors against the reference,
+observed orders, energy and momentum drift."""
+
+from __future__ import annotations
+
+import io
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+
+from dyncheck.cases import Case
+from dyncheck.studies import (
+    TrajectoryFigures,
+)
+
+
+def _png(fig: plt.Figure) -> bytes:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90, metadata={"Software": None})
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str, bytes]:
+    """Deterministic PNGs: trajectory, error against time, error against step size."""
+    plt.rcParams.update({"font.family": "DejaVu Sans", "font.size": 9})
+    out = {}
+    fig, axes = plt.subplots(case.ndof, 1, figsize=(7, 2.2 * case.ndof), squeeze=False)
+    for i, ax in enumerate(axes[:, 0]):
+        ax.plot(data.t, data.reference[:, i], "k-", lw=2, label="reference (DOP853)")
+        for (impl, integ), q in sorted(data.runs.items()):
+            if integ == "rk4":
+                ax.plot(data.t, q[:, i], "--", lw=1, label=f"{impl} rk4")
+        ax.set_ylabel(f"{case.coordinates[i]} (rad)")
+    axes[-1, 0].set_xlabel("t (s)")
+    axes[0, 0].legend(fontsize=7, loc="best")
+    axes[0, 0].set_title(f"{case.title}: trajectory in the book's coordinates")
+    fig.tight_layout()
+    out["trajectory"] = _png(fig)
+
+    fig, ax = plt.subplots(figsize=(7, 3.2))
+    for (impl, integ), err in sorted(data.errors.items()):
+        ax.semilogy(
+            data.t,
+            np.maximum(err, 1e-17),
+            lw=1,
+            label=f"{impl} {integ} dt={data.steps[impl, integ]:g}",
+        )
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("max |q - q_ref| (rad)")
+    ax.set_title("Error against time (finest step of each integrator)")
+    if data.errors:
+        ax.legend(fontsize=6, ncol=2)
+    fig.tight_layout()
+    out["error_time"] = _png(fig)
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    c = conv[conv["case"] == case.name]
+    for (impl, integ), g in c.groupby(["impl", "integrator"]):
+        ax.loglog(g["dt"], g["error"], "o-", ms=3, lw=1, label=f"{impl} {integ}")
+    for _integ, g in c.groupby("integrator"):
+        p = int(g["nominal_order"].iloc[0])
+        dts = np.sort(g["dt"].unique())
+        anchor = g[g["dt"] == dts[-1]]["error"].max()
+        ax.loglog(dts, anchor * (dts / dts[-1]) ** p, "k:", lw=1)
+        ax.annotate(f"slope {p}", (dts[0], anchor * (dts[0] / dts[-1]) ** p), fontsize=7)
+    ax.set_xlabel("dt (s)")
+    ax.set_ylabel("max error (rad)")
+    ax.set_title("Error against step size (dotted: nominal slopes)")
+    if len(c):
+        ax.legend(fontsize=6, ncol=2)
+    fig.tight_layout()
+    out["convergence"] = _png(fig)
+
+    fig, ax = plt.subplots(figsize=(7, 3.2))
+    for (impl, integ), drift in sorted(data.energy.items()):
+        ax.semilogy(
+            data.t,
+            np.maximum(drift[:: (len(drift) - 1) // (len(data.t) - 1)], 1e-17),
+            lw=1,
+            label=f"{impl} {integ}",
+        )
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("|E(t) − E(0)| / max|E|")
+    ax.set_title("Conservation drift (finest step of each integrator)")
+    if data.energy:
+        ax.legend(fontsize=6, ncol=2)
+    fig.tight_layout()
+    out["energy"] = _png(fig)
+    return out

@@ -1,0 +1,146 @@
+"""The report's tables: per-case matrices of verdicts, the order study, conservation, the
+error-controlled runs (pandas frames rendered to Markdown by the pages)."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+import numpy as np
+import pandas as pd
+
+from dyncheck.run import RunResult
+from dyncheck.studies import (
+    CONTROLLED,
+    CONTROLLED_ACCURACIES,
+    finest_pair,
+)
+
+TRAJECTORY_QUANTITIES = ("trajectory", "constraint_drift", "closed_form")
+"""Row quantities that come from runs (the rest are instantaneous)."""
+
+
+def md(frame: pd.DataFrame) -> str:
+    return frame.to_markdown(index=False, floatfmt=".3g") if len(frame) else "_(none)_"
+
+
+def _cell(group: pd.DataFrame) -> str:
+    worst = group["max_rel_err"].max()
+    verdicts = sorted(set(group["verdict"]), key=["failed", "explained", "passed", "skipped"].index)
+    return f"{verdicts[0]} {worst:.1e}" if np.isfinite(worst) else verdicts[0]
+
+
+def instantaneous_matrix(d: pd.DataFrame, case: str) -> pd.DataFrame:
+    rows = d[(d["case"] == case) & ~d["quantity"].isin(TRAJECTORY_QUANTITIES)].copy()
+    rows["pair"] = rows["impl_a"] + " vs " + rows["impl_b"]
+    out = rows.groupby(["quantity", "pair"], sort=False).apply(_cell, include_groups=False)
+    return out.unstack("pair").reset_index()
+
+
+def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) -> pd.DataFrame:
+    """Per case × engine × integrator: the finest asymptotic observed order and verdict."""
+    rows = []
+    for (c, impl, integ), g in conv.groupby(["case", "impl", "integrator"]):
+        if case is not None and c != case:
+            continue
+        g = g.sort_values("dt", ascending=False)
+        i = finest_pair(list(g["asymptotic"]))
+        p = g["observed_order"].iloc[i] if i is not None else float("nan")
+        verdict = d[
+            (d.case == c)
+            & (d.quantity == "trajectory")
+            & (d.impl_a == "reference")
+            & (d.impl_b == impl)
+            & (d.integrator == integ)
+        ]["verdict"].iloc[0]
+        rows.append(
+            {
+                "case": c,
+                "implementation": impl,
+                "integrator": integ,
+                "nominal order": int(g["nominal_order"].iloc[0]),
+                "observed order": p,
+                "finest dt": g["dt"].min(),
+                "error at finest dt": g["error"].iloc[-1],
+                "verdict": verdict,
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def family_matrix(d: pd.DataFrame, trajectories: bool) -> pd.DataFrame:
+    """Pair × case: the worst verdict and worst relative error over the family's rows
+    (instantaneous quantities, or trajectories)."""
+    rows = d[d.quantity.isin(TRAJECTORY_QUANTITIES) == trajectories].copy()
+    if not len(rows):
+        return pd.DataFrame()
+    rows["pair"] = rows["impl_a"] + " vs " + rows["impl_b"]
+    out = rows.groupby(["pair", "case"], sort=True).apply(_cell, include_groups=False)
+    return out.unstack("case", fill_value="").reset_index()
+
+
+def controlled_matrix(d: pd.DataFrame) -> pd.DataFrame:
+    """Implementation × case: verdict and error of the error-controlled runs at their
+    tightest tolerance (Drake's rk3 at the last accuracy, DOP853)."""
+    tightest = f"{CONTROLLED} eps={CONTROLLED_ACCURACIES[-1]:g}"
+    rows = d[(d.impl_a == "reference") & d.integrator.isin([tightest, "dop853"])].copy()
+    rows["run"] = rows["impl_b"] + " " + rows["integrator"]
+    rows["cell"] = [
+        f"{v} {e:.1e}" if np.isfinite(e) else v
+        for v, e in zip(rows.verdict, rows.max_abs_err, strict=True)
+    ]
+    return rows.pivot(index="run", columns="case", values="cell").fillna("").reset_index()
+
+
+def order_matrix(conv: pd.DataFrame, d: pd.DataFrame) -> pd.DataFrame:
+    """Implementation/integrator × case: observed order (verdict)."""
+    t = order_table(conv, d)
+    if not len(t):
+        return t
+    t["run"] = t["implementation"] + " " + t["integrator"]
+    t["cell"] = [
+        f"{p:.3f} ({v})" if np.isfinite(p) else v
+        for p, v in zip(t["observed order"], t["verdict"], strict=True)
+    ]
+    return t.pivot(index="run", columns="case", values="cell").fillna("").reset_index()
+
+
+def conservation_table(result: RunResult) -> pd.DataFrame:
+    """Per case × implementation × integrator: the finest run's max relative energy error
+    and, for rigid bodies, of the angular momentum in space axes."""
+    rows = []
+    for case, fig in result.figures.items():
+        for (impl, integ), drift in sorted(fig.energy.items()):
+            h = fig.momentum.get((impl, integ))
+            rows.append(
+                {
+                    "case": case,
+                    "impl": impl,
+                    "integrator": integ,
+                    "dt": fig.steps[impl, integ],
+                    "max_energy_drift": float(drift.max()),
+                    "max_momentum_drift": float(h.max()) if h is not None else float("nan"),
+                }
+            )
+    columns = ["case", "impl", "integrator", "dt", "max_energy_drift", "max_momentum_drift"]
+    return pd.DataFrame(rows, columns=columns)
+
+
+def conservation_matrix(result: RunResult) -> pd.DataFrame:
+    t = conservation_table(result)
+    if not len(t):
+        return t
+    t["run"] = t["impl"] + " " + t["integrator"]
+    t["cell"] = [
+        f"{e:.1e}" + (f"; H {h:.1e}" if np.isfinite(h) else "")
+        for e, h in zip(t["max_energy_drift"], t["max_momentum_drift"], strict=True)
+    ]
+    return t.pivot(index="run", columns="case", values="cell").fillna("").reset_index()
+
+
+def summary(d: pd.DataFrame) -> pd.DataFrame:
+    counts = d.groupby(["case", "verdict"]).size().unstack("verdict", fill_value=0)
+    for v in ("passed", "explained", "failed", "skipped"):
+        if v not in counts:
+            counts[v] = 0
+    return counts[["passed", "explained", "failed", "skipped"]].reset_index()
