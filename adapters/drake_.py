@@ -33,6 +33,10 @@ State (measured, ``dyncheck.conventions``): a ball joint becomes a ``BallRpyJoin
 q = (roll, pitch, yaw), v = ω in *world* axes; a free joint a ``QuaternionFloatingJoint`` —
 q = (w, x, y, z, p), v = (ω, v) both in world axes. Drake integrates the quaternion's
 components (q̇ = ½ q ⊗ ω), so its norm drifts; the comparison layer renormalizes.
+
+Why one module of ~460 lines: one engine behind the adapter interface (the recipe's one
+module per engine): loading, the canonical quantities, the cord constraints as a KKT
+system, and Drake's own integrators.
 """
 
 from __future__ import annotations

@@ -4,12 +4,14 @@
 :mod:`dyncheck.reference`; the engines come from :mod:`dyncheck.adapters` and cross the case's
 coordinate map by the laws in :mod:`dyncheck.coordinates`. This module and the comparison are
 the only code that sees both sides.
+
+Each case's system in the reference (general method and printed form) is declared in
+:mod:`dyncheck.reference.systems`.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -25,9 +27,8 @@ from dyncheck.conventions import (
     velocity_frames,
 )
 from dyncheck.errors import UnknownName
-from dyncheck.reference import particle, pendulum, pulley, rigid
 from dyncheck.reference.constraints import Softness
-from dyncheck.reference.coordinates import cylindrical, spherical
+from dyncheck.reference.systems import SYSTEMS
 from dyncheck.reference.trajectory import solve
 from dyncheck.roster import IMPLEMENTATIONS
 
@@ -75,72 +76,22 @@ def compared(a: str, b: str) -> bool:
     return True
 
 
-_REFERENCE: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
-    "simple_pendulum": (pendulum.simple_pendulum, pendulum.simple_pendulum_printed),
-    "compound_pendulum": (pendulum.compound_pendulum, pendulum.compound_pendulum_printed),
-    "spherical_pendulum": (pendulum.spherical_pendulum, pendulum.spherical_pendulum_printed),
-    "spherical_coordinates": (
-        lambda M, g, inertia: particle.particle(spherical(), M, g, inertia=inertia),
-        particle.example5_printed,
-    ),
-    "kepler": (
-        # the engines carry the particle on three slides: its body never rotates, so a
-        # point-mass inertia floor has no effect (inertia is not passed on)
-        lambda M, mu, g, inertia: particle.particle(spherical(), M, g, mu=mu),
-        lambda M, mu: particle.example5_printed(M, mu=mu),
-    ),
-    "cylindrical_coordinates": (
-        lambda M, g, inertia: particle.particle(cylindrical(), M, g, inertia=inertia),
-        lambda M, g: particle.lagrange_form(cylindrical(), M, g),
-    ),
-    # a body with its own inertia: no point-mass floor to add
-    "rigid_body_ball": (
-        lambda m, g, inertia, **I: rigid.rigid_ball(**I),
-        lambda m, g, **I: rigid.rigid_ball_printed(**I),
-    ),
-    "rigid_body_free": (
-        lambda m, g, inertia, **I: rigid.rigid_free(m, g, **I),
-        lambda m, g, **I: rigid.rigid_free_printed(m, g, **I),
-    ),
-    "torque_free": (
-        lambda m, g, inertia, **I: rigid.rigid_ball(**I),
-        lambda m, g, **I: rigid.rigid_ball_printed(**I, principal=True),
-    ),
-    # the masses ride on slides and never rotate: an inertia floor has no effect
-    "atwood": (
-        lambda m1, m2, a, l, g, inertia, rest, softness: pulley.atwood(
-            m1, m2, a, l, g, rest[0], softness=softness
-        ),
-        lambda m1, m2, a, l, g: pulley.atwood_printed(m1, m2, g),
-    ),
-    "compound_pulley": (
-        lambda m1, m2, m3, a, l1, l2, g, inertia, rest, softness: pulley.compound_pulley(
-            m1, m2, m3, a, l1, l2, g, rest, softness=softness
-        ),
-        lambda m1, m2, m3, a, l1, l2, g: pulley.compound_pulley_printed(m1, m2, m3, g),
-    ),
-}
-"""Case name → (general method, the book's printed form). For the cylindrical particle the
-book prints no equations; its "printed" form is (2.2.23) with the closed-form metric and
-Christoffel symbols (exercise 6)."""
 
 
 def general_method(case: Case, variant: Variant | None = None):
     """The reference's general method for ``case``, on the book's model or on a model
     ``variant`` (the point-mass inertias and gravity an implementation actually holds)."""
-    general, _ = _REFERENCE[case.name]
     variant = variant or book_variant(case)
     params = case.params() | {"g": -variant.gravity[2]}
     if case.multibody().couplings:
         params["rest"] = tuple(float(x) for x in case.rest())
         params["softness"] = Softness(*variant.softness) if variant.softness else None
-    return general(**params, inertia=variant.point_inertia)
+    return SYSTEMS[case.name].general_method(params, variant.point_inertia)
 
 
 def printed_equations(case: Case):
     """The equations exactly as the book prints them."""
-    _, printed = _REFERENCE[case.name]
-    return printed(**case.params())
+    return SYSTEMS[case.name].printed_equations(case.params())
 
 
 @dataclass(frozen=True)

@@ -5,6 +5,10 @@ Index conventions are the book's: ℓ_ij are the direction cosines of (2.2.50),
 x̄_i = ℓ_ji x_j (space components x, body components x̄); e_ijk is the permutation symbol.
 Everything is numpy on batches where it matters; exact derivatives of the direction cosines
 come from sympy.
+
+Why one module of ~500 lines: the second half of §2.2 is one chain of definitions — inertia
+tensor, direction cosines, Euler angles, angular velocity, Euler's equations, torque-free
+motion — each used by the next; the clean-room reference keeps the chapter's order.
 """
 
 from __future__ import annotations

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import pytest
 from hypothesis import settings
 
@@ -84,8 +86,12 @@ settings.load_profile("ci")
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Every test that needs the full run is ``slow`` (``pytest -m "not slow"`` is the quick
-    loop; the README's test command runs everything)."""
+    """Every test that needs the full run, or runs one of MuJoCo's ports, is ``slow``
+    (``pytest -m "not slow"`` is the quick loop; the README's test command runs everything)."""
     for item in items:
         if "full_run" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.slow)
+        # MuJoCo's ports compile per model (JAX, Warp): seconds per parametrized case
+        ident = getattr(getattr(item, "callspec", None), "id", "")
+        if re.search(r"(^|-)(mjx-f64|mjx|mujoco-warp)($|-)", ident):
             item.add_marker(pytest.mark.slow)

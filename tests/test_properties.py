@@ -19,6 +19,8 @@ from dyncheck.reference.coordinates import NAMED
 
 from .conftest import CASE_NAMES, PORTS, unsupported_reason
 
+pytestmark = pytest.mark.slow  # every engine on random states (minutes)
+
 unit = st.floats(0.0, 1.0, allow_nan=False)
 
 

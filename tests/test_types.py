@@ -43,6 +43,7 @@ def _source(path: str) -> str:
     return "/".join(parts if parts[0] in MAPPED else ("dyncheck", *parts))
 
 
+@pytest.mark.slow
 def test_type_errors_do_not_grow(tmp_path, monkeypatch):
     layout = _layout(tmp_path / "layout")
     monkeypatch.setenv("MYPYPATH", str(layout))

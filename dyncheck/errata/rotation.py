@@ -6,6 +6,10 @@ skew S(t) with polynomial entries — a proper orthogonal matrix of rational fun
 angular velocity changes in size and direction — so that every identity is decided by exact
 rational arithmetic. ℓ_ij = ê_i · ē_j: column j of ℓ is the body axis ē_j on the space axes,
 x = ℓ x̄ (2.2.50).
+
+Why one module of ~600 lines: every formula of (2.2.50)–(2.2.69) and exercises 23 and 30 is
+decided on the same exact direction cosines (the Cayley transform below); splitting them
+would split one derivation's shared setup across files.
 """
 
 from __future__ import annotations

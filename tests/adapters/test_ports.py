@@ -20,6 +20,8 @@ from dyncheck.tolerances import EPS, EPS32, ROUNDOFF_FACTOR
 
 from ..conftest import BALL_CASES, CASE_NAMES, PORTS, supported
 
+pytestmark = pytest.mark.slow  # JAX and Warp compile per model
+
 PORT_CASES = [c for c in CASE_NAMES if supported(c, "mjx")]
 
 

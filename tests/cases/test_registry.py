@@ -86,3 +86,12 @@ def test_states_do_not_depend_on_chunk_size(case):
 def test_bad_state_count(n):
     with pytest.raises(InvalidInput, match=r"^states must be a positive integer"):
         get_case("simple_pendulum").sample_states(n)
+
+
+def test_every_case_has_one_reference_system_and_no_system_lacks_a_case():
+    """Adding a case = its module in cases/ + its system in reference/systems.py: a case
+    without a system (or a system left behind by a removed case) is caught here."""
+    from dyncheck.cases import CASES
+    from dyncheck.reference.systems import SYSTEMS
+
+    assert set(SYSTEMS) == set(CASES)

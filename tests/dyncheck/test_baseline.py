@@ -30,6 +30,7 @@ def test_committed_report_is_up_to_date(full_run):
     assert report.check(full_run, REPORTS) == []
 
 
+@pytest.mark.slow
 def test_stale_report_is_detected(tmp_path):
     result = run([get_case("simple_pendulum")], ["reference", "book"])
     report.write(result, tmp_path)
@@ -54,6 +55,7 @@ class _HeavierModel(SimplePendulum):
         return dataclasses.replace(mb, bodies=(bob,))
 
 
+@pytest.mark.slow
 def test_one_percent_heavier_model_regresses():
     base = baseline.load(REPORTS / "baseline.csv")
     result = run([_HeavierModel()], ["reference", "mujoco", "pinocchio"])
@@ -82,6 +84,7 @@ def test_malformed_baseline_is_usage_error(tmp_path, content, capsys):
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_jobs_give_identical_results():
     cases = [get_case("simple_pendulum"), get_case("spherical_pendulum")]
     impls = ["reference", "book", "mujoco", "pinocchio"]

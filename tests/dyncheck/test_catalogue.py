@@ -125,6 +125,7 @@ def test_drake_reads_gravity_and_eulerseq_but_not_timestep_or_integrator():
     assert "ignores integrator, timestep" in entry.engines
 
 
+@pytest.mark.slow
 def test_drake_fsal_integrators_depend_on_caching():
     """Caching must not change a result (expected: equal errors). Measured on Drake 1.51.1:
     the FSAL runge_kutta5 on a MultibodyPlant is > 100x less accurate with the cache on than

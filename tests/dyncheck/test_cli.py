@@ -6,11 +6,13 @@ import subprocess
 import sys
 
 import pandas as pd
+import pytest
 
 from dyncheck.cli import main
 from dyncheck.results import ConvergencePoint, Discrepancy
 
 
+@pytest.mark.slow
 def test_run_writes_report_with_schema(tmp_path, capsys):
     out = tmp_path / "rep"
     # the schema, not the engines: the core implementations (the ports compile per model)
@@ -43,6 +45,7 @@ def test_run_writes_report_with_schema(tmp_path, capsys):
     assert "0 failed" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_two_runs_give_identical_csv_bytes(tmp_path):
     for name in ("a", "b"):
         assert (
@@ -119,6 +122,7 @@ def test_list_imports_no_engine():
     assert pin.split()[1:] == ["pin", importlib.metadata.version("pin")]
 
 
+@pytest.mark.slow
 def test_states_option_sweeps_more_states(tmp_path):
     out = tmp_path / "rep"
     assert (

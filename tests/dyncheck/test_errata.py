@@ -58,6 +58,7 @@ def test_every_check_names_a_formula_of_the_inventory():
     assert set(checks.CHECKS) <= {f.id for f in formulas}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("ident", sorted(checks.CHECKS))
 def test_finding_carries_its_evidence(ident):
     finding = checks.CHECKS[ident]()
@@ -68,19 +69,27 @@ def test_finding_carries_its_evidence(ident):
         assert finding.method is not checks.Method.NONE
 
 
-ERRATA = sorted(k for k, fn in checks.CHECKS.items()
-                if fn().verdict in (checks.Verdict.ERRATUM, checks.Verdict.NOTATION))
+SLIPS = (checks.Verdict.ERRATUM, checks.Verdict.NOTATION)
 
 
+@pytest.mark.slow
 def test_the_action_integral_errata_are_found():
     """Derived by hand before the code (the issue's review): the Euler–Lagrange line of the
     action doubles ∂V's coefficient, and dt/dτ = √(mφ)/√(2(h−V)) is not a time rate."""
-    assert {"action-integral.d5", "action-integral.i3"} <= set(ERRATA)
+    found = {k for k, fn in checks.CHECKS.items() if fn().verdict in SLIPS}
+    assert {"action-integral.d5", "action-integral.i3"} <= found
 
 
-@pytest.mark.parametrize("ident", ERRATA)
+@pytest.mark.slow
+@pytest.mark.parametrize("ident", sorted(checks.CHECKS))
 def test_erratum_printed_form_fails_and_corrected_form_holds(ident):
+    """Every check is parametrized (no derivation runs at collection): an erratum or a
+    notation slip carries both residuals, printed ≠ 0 and corrected = 0; any other finding
+    carries no correction."""
     finding = checks.CHECKS[ident]()
+    if finding.verdict not in SLIPS:
+        assert finding.corrected is None and finding.printed_residual is None
+        return
     assert finding.corrected
     assert sp.simplify(finding.printed_residual()) != 0
     assert sp.simplify(finding.corrected_residual()) == 0
@@ -97,6 +106,7 @@ def test_explain_an_unknown_formula_is_one_line(capsys):
     assert "unknown formula '2.2.99'" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_committed_errata_page_is_current():
     assert (ROOT / "reports" / "errata.md").read_text() == page.page()
 

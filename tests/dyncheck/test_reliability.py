@@ -61,6 +61,7 @@ def test_a_crashing_simulation_becomes_failed_rows(monkeypatch):
     assert result.failed
 
 
+@pytest.mark.slow
 def test_killed_run_leaves_previous_report_intact(tmp_path):
     """SIGKILL in the middle of a run: every file of the previous report is byte-identical
     and no temporary file is left (files are written to a temp name, then renamed, after
@@ -103,6 +104,7 @@ def test_memory_probe_does_not_wait_on_a_dead_child():
         peak_memory_kib("no_such_case", 5)
 
 
+@pytest.mark.slow
 def test_missing_engine_costs_only_its_rows(tmp_path):
     """Pinocchio not importable: its rows are skipped with the pip hint, the rest of the
     report (the conventions page included) is written, exit 0."""

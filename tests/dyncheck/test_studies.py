@@ -134,6 +134,7 @@ def test_observed_orders_formula():
     assert observed_orders(dts, [3 * h**2 for h in dts])[1:] == pytest.approx([2, 2], rel=1e-12)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("engine", [e for e in ENGINES if e != "mujoco-warp"])
 def test_an_error_that_does_not_shrink_fails(engine, monkeypatch):
     """A run with a constant error offset (a wrong model, not a truncation error) fails.
@@ -189,6 +190,7 @@ def test_drake_error_controlled_rk3_is_tolerance_proportional(full_run, case):
     assert np.all(np.diff(steps) > 0), steps
 
 
+@pytest.mark.slow
 def test_error_controlled_run_with_an_offset_fails(monkeypatch):
     """An error that does not shrink with ε (a wrong model) fails the tolerance study."""
     from dyncheck import studies
@@ -220,6 +222,7 @@ def test_pinocchio_under_solve_ivp_matches_reference(full_run):
     assert (rows.verdict == "passed").all() and (rows.max_rel_err <= rows.tolerance).all()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case_name", ["rigid_body_ball", "torque_free"])
 def test_discrete_prediction_steps_quaternion_states_at_order_four(case_name):
     """The reference's equations stepped by RK4 in the engine's coordinates (a unit quaternion
@@ -241,6 +244,7 @@ def test_discrete_prediction_steps_quaternion_states_at_order_four(case_name):
     assert 16 / 1.5 < errors[0] / errors[1] < 16 * 1.5
 
 
+@pytest.mark.slow
 def test_discrete_prediction_refused_where_the_book_coordinates_lose_the_spin():
     """The spherical pendulum's (φ, θ) fix the rod, not the spin about it, which a ball joint
     stepped on the rotation group acquires: the prediction is refused (the row keeps its
@@ -254,6 +258,7 @@ def test_discrete_prediction_refused_where_the_book_coordinates_lose_the_spin():
         refs.discrete(book_variant(case), "rk4", case.trajectory.grid_step / 4)
 
 
+@pytest.mark.slow
 def test_declared_rk4_order_on_the_rotation_group_is_checked(monkeypatch):
     """An adapter's declared RK4 order on ball and free joints is a prediction, not an
     excuse: MuJoCo 4.0's RK4 is order 4 there (RKMK), so declaring the 3.x order 2 makes its

@@ -8,6 +8,8 @@ import pytest
 
 from dyncheck import catalogue, tutorials
 
+pytestmark = pytest.mark.slow  # each tutorial executed in a Jupyter kernel
+
 pytest.importorskip("nbclient", reason="extra 'tutorials' (jupytext, nbclient, nbconvert)")
 
 NAMES = list(tutorials.available())
