@@ -40,8 +40,10 @@ class Step:
     target_s: float
 
 
-def _impls() -> tuple[str, ...]:
-    return tuple(a for name in CORE for a in ("--impl", name))
+def _run(*selection: str, jobs: int, out: str) -> tuple[str, ...]:
+    """``dyncheck run`` of the core engines and Drake into ``{tmp}/out``."""
+    impls = tuple(a for name in CORE for a in ("--impl", name))
+    return ("run", *selection, *impls, "--jobs", str(jobs), "--out", f"{{tmp}}/{out}")
 
 
 STEPS: tuple[Step, ...] = (
@@ -49,22 +51,22 @@ STEPS: tuple[Step, ...] = (
     Step(what="dyncheck explain (every convention)", argv=("explain",), target_s=2.0),
     Step(
         what="one case: run simple_pendulum (core engines and Drake)",
-        argv=("run", "simple_pendulum", *_impls(), "--out", "{tmp}/one"),
+        argv=_run("simple_pendulum", jobs=1, out="one"),
         target_s=4.0,
     ),
     Step(
         what="full run, core engines and Drake, --jobs 2",
-        argv=("run", *_impls(), "--jobs", "2", "--out", "{tmp}/full"),
+        argv=_run(jobs=2, out="full"),
         target_s=20.0,
     ),
     Step(
         what="the same again (second run, warm caches)",
-        argv=("run", *_impls(), "--jobs", "2", "--out", "{tmp}/again"),
+        argv=_run(jobs=2, out="again"),
         target_s=15.0,
     ),
     Step(
         what="full run, core engines and Drake, --jobs 1",
-        argv=("run", *_impls(), "--jobs", "1", "--out", "{tmp}/serial"),
+        argv=_run(jobs=1, out="serial"),
         target_s=30.0,
     ),
     Step(
@@ -99,7 +101,7 @@ def measure(steps: tuple[Step, ...] = STEPS) -> pd.DataFrame:
 
 
 def write(table: pd.DataFrame, out: Path) -> None:
-    from dyncheck.report import versions
+    from dyncheck.report.provenance import versions
 
     v = versions()
     lines = [

@@ -344,8 +344,9 @@ def _run(args: argparse.Namespace) -> int:
     cases, impls = resolve(args.cases, args.impl)
     if args.states is not None:
         _warn_cost(args.states * len(cases), args.jobs)
+    # the conventions catalogue does not depend on the cases: it runs with the full report
     result = run(cases, impls, states=args.states, jobs=args.jobs, dask=args.dask,
-                 conventions=True, progress=report.stderr_progress)
+                 conventions=not args.cases, progress=report.stderr_progress)
     report.write(result, args.out)
     counts = result.discrepancies["verdict"].value_counts()
     print(

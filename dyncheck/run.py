@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import pandas as pd
@@ -39,8 +39,9 @@ class RunResult:
     figures: dict[str, TrajectoryFigures]
     parser_notes: dict[str, list[str]]
     """Per implementation, what its MJCF parser said it ignores (its own warnings)."""
-    conventions: list[Entry] = field(default_factory=list)
-    """The conventions catalogue's demonstrations, run with the cases (its report page)."""
+    conventions: list[Entry] | None = None
+    """The conventions catalogue's demonstrations, run with the cases (its report page), or
+    None where the run did not include them."""
 
     @property
     def failed(self) -> bool:
@@ -111,7 +112,7 @@ def run(
                 done.append(future.result())
                 progress(f"{what}: done")
     outputs = done[: len(cases)]
-    entries = [entry for (entry,) in done[len(cases) :]]
+    entries = [entry for (entry,) in done[len(cases) :]] if conventions else None
     rows: list[Discrepancy] = []
     points: list[ConvergencePoint] = []
     figures: dict[str, TrajectoryFigures] = {}

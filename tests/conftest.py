@@ -75,7 +75,7 @@ def full_run() -> RunResult:
     assert not MISSING, f"engines not installed: {MISSING}"
     # two worker processes: the same results as one (test_jobs_give_identical_results), in
     # about half the wall time on CI's two cores
-    return run([get_case(n) for n in CASE_NAMES], IMPLEMENTATIONS, jobs=2)
+    return run([get_case(n) for n in CASE_NAMES], IMPLEMENTATIONS, jobs=2, conventions=True)
 
 
 # Property tests: a fast profile for CI (the default) and a larger one for a nightly run,

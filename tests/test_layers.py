@@ -82,3 +82,54 @@ def test_the_rule_reader_sees_function_level_imports(tmp_path):
     module = tmp_path / "m.py"
     module.write_text("def f():\n    import mujoco\n    from dyncheck.reference import rigid\n")
     assert _imports(module) == {"mujoco", "dyncheck.reference"}
+
+
+def _layer(module: str) -> str | None:
+    """The layer of a dyncheck module name: errors (the bottom), reference, cases, adapters,
+    or the comparison layer (everything else under dyncheck/)."""
+    if not module.startswith("dyncheck"):
+        return None
+    parts = module.split(".")
+    if len(parts) == 1:
+        return "comparison"
+    if parts[1] == "errors":
+        return "errors"
+    return parts[1] if parts[1] in ("reference", "cases", "adapters") else "comparison"
+
+
+def _layer_of_path(path: Path) -> str:
+    rel = path.relative_to(ROOT).parts
+    if rel[0] in ("reference", "cases", "adapters"):
+        return rel[0]
+    return "errors" if path.name == "errors.py" and len(rel) == 2 else "comparison"
+
+
+def test_no_cycle_between_layers():
+    """The folders' import graph is acyclic: errors → (reference, cases) → adapters →
+    comparison, with every import (module level or in a function) counted."""
+    edges: dict[str, set[str]] = {}
+    for folder in ("reference", "cases", "adapters", "dyncheck"):
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            src = _layer_of_path(path)
+            for name in _imports(path):
+                dst = _layer(name)
+                if dst is not None and dst != src:
+                    edges.setdefault(src, set()).add(dst)
+    order: list[str] = []
+    state: dict[str, int] = {}
+
+    def visit(node: str, trail: tuple[str, ...]) -> None:
+        if state.get(node) == 1:
+            raise AssertionError(f"import cycle between layers: {' -> '.join((*trail, node))}")
+        if state.get(node) == 2:
+            return
+        state[node] = 1
+        for nxt in sorted(edges.get(node, ())):
+            visit(nxt, (*trail, node))
+        state[node] = 2
+        order.append(node)
+
+    for node in sorted(edges):
+        visit(node, ())
+    assert order.index("errors") < order.index("comparison")
+    assert "comparison" not in edges.get("adapters", set())

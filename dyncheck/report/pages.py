@@ -1,24 +1,16 @@
-"""The verification report: Markdown pages, PNG figures and the CSV tables, written atomically."""
+"""The report's Markdown pages: one per case, the index (summary, provenance, what is
+explained and why) and the conventions catalogue."""
 
 from __future__ import annotations
-
-import platform
-import subprocess
-import sys
-from datetime import UTC, datetime
-from pathlib import Path
 
 import pandas as pd
 
 from dyncheck.cases import Case
 from dyncheck.catalogue import Entry
-from dyncheck.errors import EngineNotInstalled
 from dyncheck.explanations import EXPLANATIONS
-from dyncheck.freshness import Moved, compare, read_report
-from dyncheck.report_figures import figures
-from dyncheck.report_tables import (
+from dyncheck.report.provenance import versions
+from dyncheck.report.tables import (
     conservation_matrix,
-    conservation_table,
     controlled_matrix,
     family_matrix,
     instantaneous_matrix,
@@ -27,7 +19,6 @@ from dyncheck.report_tables import (
     order_table,
     summary,
 )
-from dyncheck.results import PROVENANCE, provenance_json, to_csv, write_atomic
 from dyncheck.run import RunResult
 from dyncheck.studies import (
     CONTROLLED,
@@ -35,59 +26,6 @@ from dyncheck.studies import (
     TRUNCATION,
 )
 from dyncheck.tolerances import ORDER_SLACK
-
-
-def versions() -> dict[str, str]:
-    """Versions of everything that produced the numbers."""
-    import numpy
-    import scipy
-    import sympy
-
-    from dyncheck import __version__
-    from dyncheck.adapters import get_adapter
-
-    out = {
-        "python": platform.python_version(),
-        "numpy": numpy.__version__,
-        "scipy": scipy.__version__,
-        "sympy": sympy.__version__,
-        "pandas": pd.__version__,
-    }
-    engines = (
-        ("mujoco", "mujoco"),
-        ("pinocchio", "pinocchio"),
-        ("drake", "drake"),
-        ("mjx", "mujoco-mjx"),  # with JAX's version and device
-        ("mujoco-warp", "mujoco-warp"),  # with Warp's version and device
-    )
-    for name, pkg in engines:
-        try:
-            out[pkg] = get_adapter(name).version()
-        except EngineNotInstalled:
-            out[pkg] = "not installed"
-    out["dyncheck"] = __version__
-    try:
-        commit = subprocess.run(
-            ["git", "rev-parse", "--short", "HEAD"],
-            capture_output=True,
-            text=True,
-            cwd=Path(__file__).parent,
-            check=True,
-        ).stdout.strip()
-        dirty = subprocess.run(  # code changed since that commit (the reports aside)?
-            ["git", "status", "--porcelain", "--untracked-files=no", "--", ":(top,exclude)reports"],
-            capture_output=True,
-            text=True,
-            cwd=Path(__file__).parent,
-            check=True,
-        ).stdout.strip()
-        if dirty:
-            commit += " + uncommitted changes"
-    except (OSError, subprocess.CalledProcessError):
-        commit = "unknown"
-    out["dyncheck commit"] = commit
-    out["platform"] = f"{platform.system()} {platform.machine()}"
-    return out
 
 
 def case_page(case: Case, result: RunResult) -> str:
@@ -328,10 +266,10 @@ def index_page(result: RunResult, *, date: str) -> str:
     return "\n".join(lines)
 
 
-def conventions_page(entries: list[Entry] | None = None) -> str:
-    """The catalogue's demonstrations (``dyncheck explain`` prints the same): those the run
-    made, or all of them run now."""
-    from dyncheck.catalogue import explain, render
+def conventions_page(entries: list[Entry] | None) -> str:
+    """The catalogue's demonstrations the run made (``dyncheck explain`` prints the same), or
+    a note where the run left them out (a run of selected cases)."""
+    from dyncheck.catalogue import render
 
     head = [
         "# Conventions catalogue",
@@ -343,72 +281,13 @@ def conventions_page(entries: list[Entry] | None = None) -> str:
         "[README.md](README.md).",
         "",
     ]
-    return "\n".join(head) + "\n" + render(entries or explain())
-
-
-def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Path, str | bytes]:
-    """Every file of the report, in memory (nothing is written)."""
-    date = date or datetime.now(UTC).strftime("%Y-%m-%d")
-    files: dict[Path, str | bytes] = {
-        out / "discrepancies.csv": to_csv(result.discrepancies),
-        out / "convergence.csv": to_csv(result.convergence),
-        out / "conservation.csv": to_csv(conservation_table(result)),
-    }
-    for case in result.cases:
-        files[out / f"{case.name}.md"] = case_page(case, result)
-        for kind, png in figures(case, result.figures[case.name], result.convergence).items():
-            files[out / "figures" / f"{case.name}_{kind}.png"] = png
-    files[out / "README.md"] = index_page(result, date=date)
-    files[out / "conventions.md"] = conventions_page(result.conventions)
-    files[out / PROVENANCE] = provenance_json({"date (UTC)": date, **versions()})
-    lead, table = errata(result.discrepancies)
-    files[out / "printed-equations.md"] = "\n".join(
-        [
-            "# The book's printed equations of motion against the general method",
-            "",
-            "The errata of §2.2, formula by formula (every derivation step, identity and "
-            "exercise), are in [errata.md](errata.md); this page is the numeric check of the "
-            "equations of motion the cases implement.",
-            "",
-            "Each printed equation of motion (and its T and V) is evaluated as `book` and compared "
-            "with the general method (`reference`, Lagrange's equations (2.2.23)-(2.2.26) from the "
-            "particle positions) at the seeded states of every case; a disagreement beyond "
-            "round-off would be an erratum of the book.",
-            "",
-            lead,
-            "",
-            md(table),
-            "",
-        ]
-    )
-    return files
-
-
-def rendered_text(result: RunResult, out: Path) -> dict[str, str]:
-    """The tables and pages a run writes (figures left out), file name → text."""
-    return {
-        path.name: content
-        for path, content in render(result, out).items()
-        if isinstance(content, str) and path.parent == out and path.suffix in (".csv", ".md")
-    }
-
-
-def check(result: RunResult, out: Path) -> list[Moved]:
-    """What moved between the committed report in ``out`` and what the code computes now,
-    compared on results, not bytes (:mod:`dyncheck.freshness`)."""
-    return compare(read_report(out), rendered_text(result, out))
-
-
-def write(result: RunResult, out: Path, *, date: str | None = None) -> list[Path]:
-    """Write every file of the report under ``out``; each file atomically, after all of them
-    are computed (a run killed before this point changes nothing)."""
-    files = render(result, out, date=date)
-    for path, content in files.items():
-        write_atomic(path, content)
-    return list(files)
-
-
-def stderr_progress(message: str) -> None:
-    """Per-case progress lines on a terminal; quiet when stderr is not one (CI logs)."""
-    if sys.stderr.isatty():
-        print(f"dyncheck: {message}", file=sys.stderr, flush=True)
+    if entries is None:
+        return "\n".join(
+            [
+                *head,
+                "_Not run here: a run of selected cases leaves the catalogue out (it runs "
+                "with every case, and by `dyncheck explain`)._",
+                "",
+            ]
+        )
+    return "\n".join(head) + "\n" + render(entries)

@@ -1,0 +1,87 @@
+"""The report folder: every file rendered in memory, compared with a committed folder
+(``report --check``) or written atomically (temp file, then rename)."""
+
+from __future__ import annotations
+
+import sys
+from datetime import UTC, datetime
+from pathlib import Path
+
+from dyncheck.freshness import Moved, compare, read_report
+from dyncheck.report.figures import figures
+from dyncheck.report.pages import case_page, conventions_page, errata, index_page
+from dyncheck.report.provenance import versions
+from dyncheck.report.tables import (
+    conservation_table,
+    md,
+)
+from dyncheck.results import PROVENANCE, provenance_json, to_csv, write_atomic
+from dyncheck.run import RunResult
+
+
+def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Path, str | bytes]:
+    """Every file of the report, in memory (nothing is written)."""
+    date = date or datetime.now(UTC).strftime("%Y-%m-%d")
+    files: dict[Path, str | bytes] = {
+        out / "discrepancies.csv": to_csv(result.discrepancies),
+        out / "convergence.csv": to_csv(result.convergence),
+        out / "conservation.csv": to_csv(conservation_table(result)),
+    }
+    for case in result.cases:
+        files[out / f"{case.name}.md"] = case_page(case, result)
+        for kind, png in figures(case, result.figures[case.name], result.convergence).items():
+            files[out / "figures" / f"{case.name}_{kind}.png"] = png
+    files[out / "README.md"] = index_page(result, date=date)
+    files[out / "conventions.md"] = conventions_page(result.conventions)
+    files[out / PROVENANCE] = provenance_json({"date (UTC)": date, **versions()})
+    lead, table = errata(result.discrepancies)
+    files[out / "printed-equations.md"] = "\n".join(
+        [
+            "# The book's printed equations of motion against the general method",
+            "",
+            "The errata of §2.2, formula by formula (every derivation step, identity and "
+            "exercise), are in [errata.md](errata.md); this page is the numeric check of the "
+            "equations of motion the cases implement.",
+            "",
+            "Each printed equation of motion (and its T and V) is evaluated as `book` and compared "
+            "with the general method (`reference`, Lagrange's equations (2.2.23)-(2.2.26) from the "
+            "particle positions) at the seeded states of every case; a disagreement beyond "
+            "round-off would be an erratum of the book.",
+            "",
+            lead,
+            "",
+            md(table),
+            "",
+        ]
+    )
+    return files
+
+
+def rendered_text(result: RunResult, out: Path) -> dict[str, str]:
+    """The tables and pages a run writes (figures left out), file name → text."""
+    return {
+        path.name: content
+        for path, content in render(result, out).items()
+        if isinstance(content, str) and path.parent == out and path.suffix in (".csv", ".md")
+    }
+
+
+def check(result: RunResult, out: Path) -> list[Moved]:
+    """What moved between the committed report in ``out`` and what the code computes now,
+    compared on results, not bytes (:mod:`dyncheck.freshness`)."""
+    return compare(read_report(out), rendered_text(result, out))
+
+
+def write(result: RunResult, out: Path, *, date: str | None = None) -> list[Path]:
+    """Write every file of the report under ``out``; each file atomically, after all of them
+    are computed (a run killed before this point changes nothing)."""
+    files = render(result, out, date=date)
+    for path, content in files.items():
+        write_atomic(path, content)
+    return list(files)
+
+
+def stderr_progress(message: str) -> None:
+    """Per-case progress lines on a terminal; quiet when stderr is not one (CI logs)."""
+    if sys.stderr.isatty():
+        print(f"dyncheck: {message}", file=sys.stderr, flush=True)
