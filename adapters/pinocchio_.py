@@ -213,7 +213,7 @@ class PinocchioAdapter(Adapter):
         for jt, qa, va in self.layout.joints:
             if jt in ("ball", "free"):
                 k = qa + (3 if jt == "free" else 0)
-                q[k : k + 4] = np.roll(q[k : k + 4], 1)
+                q[k : k + 4] = q[[k + 3, k, k + 1, k + 2]]  # (x, y, z, w) → (w, x, y, z)
             if jt == "free":
                 v[va : va + 3] = quat_to_matrix(q[None, qa + 3 : qa + 7])[0] @ v[va : va + 3]
         return q, v
@@ -226,7 +226,7 @@ class PinocchioAdapter(Adapter):
                 v[va : va + 3] = quat_to_matrix(q[None, qa + 3 : qa + 7])[0].T @ v[va : va + 3]
             if jt in ("ball", "free"):
                 k = qa + (3 if jt == "free" else 0)
-                q[k : k + 4] = np.roll(q[k : k + 4], -1)
+                q[k : k + 4] = q[[k + 1, k + 2, k + 3, k]]  # (w, x, y, z) → (x, y, z, w)
         return q, v
 
     def _mujoco_acceleration(self, q: np.ndarray, v: np.ndarray, held=None) -> np.ndarray:

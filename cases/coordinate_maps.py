@@ -8,6 +8,7 @@ matrix as a covariant 2-tensor, accelerations with the second-derivative term of
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -168,11 +169,34 @@ UNIT_TOLERANCE = 1e-6
 written by hand with 6 digits passes)."""
 
 
+def _one_quat_to_matrix(q: np.ndarray, norm: np.ndarray) -> np.ndarray:
+    """:func:`quat_to_matrix` of one quaternion with Python floats: each entry is the same
+    sequence of IEEE double operations as the array path (bit-identical, tested), at a
+    fifth of the cost of nine tiny array expressions."""
+    n = float(norm[0, 0])
+    if not (math.isfinite(n) and abs(n - 1.0) <= UNIT_TOLERANCE):
+        raise InvalidInput(
+            "quaternion", tuple(float(x) for x in q[0]), "a unit quaternion (w, x, y, z)"
+        )
+    w, x, y, z = (float(c) for c in (q / norm)[0])
+    return np.array(
+        [
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+            ]
+        ]
+    )
+
+
 def quat_to_matrix(q: np.ndarray) -> np.ndarray:
     """Rotation matrices (n, 3, 3) of unit quaternions (n, 4) in (w, x, y, z) order; q and −q
     give the same rotation. A zero, non-finite or non-unit quaternion is refused."""
     q = np.asarray(q, float)
     norm = np.linalg.norm(q, axis=1, keepdims=True)
+    if q.shape[0] == 1:  # one state per integrator stage: the same IEEE operations on floats
+        return _one_quat_to_matrix(q, norm)
     bad = ~np.isfinite(norm[:, 0]) | (np.abs(norm[:, 0] - 1.0) > UNIT_TOLERANCE)
     if bad.any():
         k = int(np.argmax(bad))
@@ -181,14 +205,17 @@ def quat_to_matrix(q: np.ndarray) -> np.ndarray:
         )
     q = q / norm
     w, x, y, z = q.T
-    return np.stack(
-        [
-            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-        ],
-        -2,
-    )
+    out = np.empty((q.shape[0], 3, 3))  # filled entry by entry: no stacking (a hot path)
+    out[:, 0, 0] = 1 - 2 * (y * y + z * z)
+    out[:, 0, 1] = 2 * (x * y - w * z)
+    out[:, 0, 2] = 2 * (x * z + w * y)
+    out[:, 1, 0] = 2 * (x * y + w * z)
+    out[:, 1, 1] = 1 - 2 * (x * x + z * z)
+    out[:, 1, 2] = 2 * (y * z - w * x)
+    out[:, 2, 0] = 2 * (x * z - w * y)
+    out[:, 2, 1] = 2 * (y * z + w * x)
+    out[:, 2, 2] = 1 - 2 * (x * x + y * y)
+    return out
 
 
 @dataclass(frozen=True)
