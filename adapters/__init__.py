@@ -10,51 +10,75 @@
 from __future__ import annotations
 
 import importlib
+from dataclasses import dataclass
 from typing import Any
 
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.errors import EngineNotInstalled, UnknownName
 
-ENGINE_PACKAGES: dict[str, str] = {
-    "drake": "drake",
-    "mjx": "mujoco-mjx",
-    "mjx-f64": "mujoco-mjx",
-    "mujoco": "mujoco",
-    "mujoco-warp": "mujoco-warp",
-    "mujoco-stiff": "mujoco",
-    "pinocchio": "pin",
-    "pinocchio-mjcf": "pin",
-    "sympy-mechanics": "sympy",
+
+@dataclass(frozen=True, kw_only=True)
+class Registration:
+    """One engine implementation: where its adapter is, and the facts about its installation
+    that are needed before (or without) importing it."""
+
+    module: str
+    cls: str
+    package: str
+    """The pip package that provides the engine (its version is read from its metadata)."""
+    extra: str | None = None
+    """The optional extra of dyncheck that installs it (core engines: None)."""
+    ports: str | None = None
+    """The engine this one is a port of: then compared with that engine, the reference and its
+    own package's other builds only, not with every other engine."""
+
+
+_A = "dyncheck.adapters."
+REGISTRY: dict[str, Registration] = {
+    "sympy-mechanics": Registration(
+        module=_A + "sympy_mechanics", cls="SympyMechanicsAdapter", package="sympy"
+    ),
+    "pinocchio": Registration(module=_A + "pinocchio_", cls="PinocchioAdapter", package="pin"),
+    "pinocchio-mjcf": Registration(
+        module=_A + "pinocchio_", cls="PinocchioMJCFAdapter", package="pin"
+    ),
+    "drake": Registration(
+        module=_A + "drake_",
+        cls="DrakeAdapter",
+        package="drake",
+        extra="drake",
+    ),
+    "mujoco": Registration(module=_A + "mujoco_", cls="MuJoCoAdapter", package="mujoco"),
+    "mujoco-stiff": Registration(module=_A + "mujoco_", cls="MuJoCoStiffAdapter", package="mujoco"),
+    "mjx-f64": Registration(
+        module=_A + "mjx_", cls="MJXF64Adapter", package="mujoco-mjx", extra="mjx", ports="mujoco"
+    ),
+    "mjx": Registration(
+        module=_A + "mjx_",
+        cls="MJXAdapter",
+        package="mujoco-mjx",
+        extra="mjx",
+        ports="mujoco",
+    ),
+    "mujoco-warp": Registration(
+        module=_A + "mujoco_warp_",
+        cls="MuJoCoWarpAdapter",
+        package="mujoco-warp",
+        extra="warp",
+        ports="mujoco",
+    ),
 }
+"""Implementation name → its registration: the one line an engine adds, in the order of trust
+the report lists them (after the reference and the book). A module is imported when its
+adapter is first asked for — an engine's import (JAX and Warp take seconds) is paid only by
+the runs that use it."""
+
+ENGINE_PACKAGES: dict[str, str] = {name: r.package for name, r in REGISTRY.items()}
 """Every engine implementation dyncheck knows, installed or not → its pip package."""
-
-ENGINE_EXTRAS: dict[str, str] = {
-    "drake": "drake",
-    "mjx": "mjx",
-    "mjx-f64": "mjx",
-    "mujoco-warp": "warp",
-}
+ENGINE_EXTRAS: dict[str, str] = {n: r.extra for n, r in REGISTRY.items() if r.extra}
 """The optional extra of dyncheck that installs an engine (core engines have none)."""
-
-ENGINE_PORTS: dict[str, str] = {"mjx": "mujoco", "mjx-f64": "mujoco", "mujoco-warp": "mujoco"}
-"""Ports of another engine → that engine: a port is compared with the engine it ports, the
-reference and its own package's other builds, not with every other engine."""
-
-REGISTRY: dict[str, tuple[str, str]] = {
-    "sympy-mechanics": ("dyncheck.adapters.sympy_mechanics", "SympyMechanicsAdapter"),
-    "pinocchio": ("dyncheck.adapters.pinocchio_", "PinocchioAdapter"),
-    "pinocchio-mjcf": ("dyncheck.adapters.pinocchio_", "PinocchioMJCFAdapter"),
-    "drake": ("dyncheck.adapters.drake_", "DrakeAdapter"),
-    "mujoco": ("dyncheck.adapters.mujoco_", "MuJoCoAdapter"),
-    "mujoco-stiff": ("dyncheck.adapters.mujoco_", "MuJoCoStiffAdapter"),
-    "mjx-f64": ("dyncheck.adapters.mjx_", "MJXF64Adapter"),
-    "mjx": ("dyncheck.adapters.mjx_", "MJXAdapter"),
-    "mujoco-warp": ("dyncheck.adapters.mujoco_warp_", "MuJoCoWarpAdapter"),
-}
-"""Implementation name → (module, class): the one registration line of an engine, in the order
-of trust the report lists them (after the reference and the book). A module is
-imported when its adapter is first asked for — an engine's import (JAX and Warp take seconds)
-is paid only by the runs that use it."""
+ENGINE_PORTS: dict[str, str] = {n: r.ports for n, r in REGISTRY.items() if r.ports}
+"""Ports of another engine → that engine."""
 
 _ADAPTERS: dict[str, type[Adapter]] = {}
 _MISSING: dict[str, str] = {}
@@ -64,9 +88,9 @@ def _load(name: str) -> None:
     """Import one adapter's module once; an ImportError records the engine as missing."""
     if name in _ADAPTERS or name in _MISSING:
         return
-    module, cls = REGISTRY[name]
+    entry = REGISTRY[name]
     try:
-        _ADAPTERS[name] = getattr(importlib.import_module(module), cls)
+        _ADAPTERS[name] = getattr(importlib.import_module(entry.module), entry.cls)
     except ImportError as exc:  # depends on the environment
         _MISSING[name] = str(exc)
 
@@ -102,6 +126,7 @@ __all__ = [
     "REGISTRY",
     "Adapter",
     "LoadedBody",
+    "Registration",
     "Trajectory",
     "get_adapter",
 ]
