@@ -37,10 +37,26 @@ CORE = ("numpy", "scipy", "sympy", "pandas", "tabulate", "matplotlib", "mujoco",
 
 
 @dataclass(frozen=True, kw_only=True)
+class Needs:
+    """What a series of an engine's releases needs beyond ``constraints.txt`` to import at
+    all: pins left out (``unpin``, the whole environment then resolves around the release)
+    and requirements added (``require``), with the packaging fact that forces them."""
+
+    series: str
+    """A release prefix: ``"3."`` is every 3.x release."""
+    unpin: tuple[str, ...] = ()
+    require: tuple[str, ...] = ()
+    reason: str
+
+    def applies(self, release: str) -> bool:
+        return release.startswith(self.series)
+
+
+@dataclass(frozen=True, kw_only=True)
 class Engine:
     """One engine of the matrix: its PyPI package, the packages released with it (left out of
-    the constraints so that they follow the engine), its implementations and the releases
-    the committed matrix runs."""
+    the constraints so that they follow the engine), its implementations, the releases the
+    committed matrix runs and what some of them need to be installed (:class:`Needs`)."""
 
     name: str
     package: str
@@ -48,6 +64,10 @@ class Engine:
     impls: tuple[str, ...]
     releases: tuple[str, ...]
     extra: tuple[str, ...] = ()
+    needs: tuple[Needs, ...] = ()
+
+    def needs_of(self, release: str) -> tuple[Needs, ...]:
+        return tuple(n for n in self.needs if n.applies(release))
 
 
 ENGINES = {
@@ -67,13 +87,22 @@ ENGINES = {
                     "jrl-cmakemodules"),
             impls=("pinocchio", "pinocchio-mjcf"),
             releases=("3.4.0", "3.7.0", "3.9.0", "4.0.0", "4.1.0"),
+            needs=(
+                Needs(series="3.", unpin=("numpy",),
+                      reason="Pinocchio 3.x needs cmeel-boost < 1.90, whose wheels are built "
+                      "against numpy < 2.4: numpy resolves to the newest 2.3"),
+                Needs(series="3.", require=("cmeel-urdfdom<5", "cmeel-tinyxml2<11"),
+                      reason="Pinocchio 3.x wheels link liburdfdom 4 and libtinyxml2 10 but "
+                      "do not bound cmeel-urdfdom or cmeel-tinyxml2 (the newest fail to "
+                      "import: `liburdfdom_sensor.so.4.0: cannot open shared object file`)"),
+            ),
         ),
         Engine(
             name="drake",
             package="drake",
             family=("drake", "mosek"),
             impls=("drake",),
-            releases=("1.40.0", "1.51.1"),
+            releases=("1.40.0", "1.45.0", "1.51.1"),
             extra=("drake",),
         ),
     )
@@ -120,17 +149,20 @@ def cache_root() -> Path:
     return Path(base) / "dyncheck"
 
 
-def constraints(eng: Engine, text: str) -> str:
+def constraints(eng: Engine, text: str, release: str = "") -> str:
     """``constraints.txt`` without the lines of the engine's family (they follow the release
-    under test)."""
+    under test) and the pins the release's :class:`Needs` leave out."""
 
     def name(line: str) -> str:
         return line.split("==")[0].strip().lower().replace("_", "-")
 
+    unpin = {u for n in eng.needs_of(release) for u in n.unpin}
     keep = [
         line
         for line in text.splitlines()
-        if line.strip() and not any(name(line).startswith(f) for f in eng.family)
+        if line.strip()
+        and not any(name(line).startswith(f) for f in eng.family)
+        and name(line) not in unpin
     ]
     return "\n".join(keep) + "\n"
 
@@ -163,12 +195,14 @@ def environment(eng: Engine, release: str, *, log: Log) -> Path:
     python = folder / "bin" / "python"
     done = folder / ".installed"
     if done.exists():
+        _install_checkout(python, folder)
         return python
     log(f"creating {folder} ({eng.package}=={release})")
     subprocess.run([sys.executable, "-m", "venv", "--clear", str(folder)], check=True)
     pins = folder / "constraints.txt"
-    pins.write_text(constraints(eng, (ROOT / "constraints.txt").read_text()))
+    pins.write_text(constraints(eng, (ROOT / "constraints.txt").read_text(), release))
     wanted = [p for p in (*CORE, *eng.extra) if p != eng.package]
+    wanted += [r for n in eng.needs_of(release) for r in n.require]
     pip = [str(python), "-m", "pip", "install", "--disable-pip-version-check"]  # not -q: the
     # resolver explains a conflict only when not quiet (read by _last_line)
     result = subprocess.run(
@@ -177,9 +211,21 @@ def environment(eng: Engine, release: str, *, log: Log) -> Path:
     )
     if result.returncode != 0:
         raise ReleaseUnavailable(eng.name, release, _last_line(result.stderr))
-    subprocess.run([*pip, "--no-deps", "-e", str(ROOT)], check=True, capture_output=True)
+    _install_checkout(python, folder)
     done.write_text(release + "\n")
     return python
+
+
+def _install_checkout(python: Path, folder: Path) -> None:
+    """dyncheck from this checkout, editable and without its ranges — reinstalled when the
+    environment was made from another checkout (a clone can run the matrix while this one is
+    being edited)."""
+    marker = folder / ".checkout"
+    if marker.exists() and marker.read_text().strip() == str(ROOT):
+        return
+    subprocess.run([str(python), "-m", "pip", "install", "--disable-pip-version-check", "-q",
+                    "--no-deps", "-e", str(ROOT)], check=True, capture_output=True)
+    marker.write_text(f"{ROOT}\n")
 
 
 class ReleaseUnavailable(DyncheckError):
@@ -252,6 +298,9 @@ class Step:
     problem: str = ""
     made_by: str = ""
     """The dyncheck commits of the two runs (from their provenance)."""
+    also_changed: tuple[str, ...] = ()
+    """Other libraries whose versions differ between the two environments (``name old ->
+    new``; a release's :class:`Needs` can move one)."""
 
 
 def matrix(
@@ -279,8 +328,11 @@ def matrix(
             ta, tb = diff.load(a, "RUN_A"), diff.load(b, "RUN_B")
             made_by = " and ".join(dict.fromkeys(
                 t.versions.get("dyncheck commit", "?") for t in (ta, tb)))
+            own = {eng.name, eng.package, "dyncheck commit"}
+            also = tuple(c for c in diff.version_changes(ta.versions, tb.versions)
+                         if c.split()[0].replace("_", " ") not in own)
             steps.append(Step(engine=name, old=old, new=new, table=diff.diff(ta, tb),
-                              made_by=made_by))
+                              made_by=made_by, also_changed=also))
     return steps
 
 
@@ -301,6 +353,14 @@ def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None
     ]
     for name in dict.fromkeys(s.engine for s in steps):
         lines += [f"## {name}", ""]
+        needs = ENGINES[name].needs if name in ENGINES else ()
+        if needs:
+            lines += ["Environments that differ from `constraints.txt` beyond the engine's own "
+                      "packages:", ""]
+            lines += [f"- {n.series}x: " + ", ".join(
+                [*(f"`{u}` not pinned" for u in n.unpin), *(f"`{r}`" for r in n.require)])
+                + f" — {n.reason}." for n in needs]
+            lines += [""]
         for s in (s for s in steps if s.engine == name):
             lines += [f"### {s.old} → {s.new}", ""]
             if s.table is None:
@@ -309,6 +369,9 @@ def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None
             counts = diff.summary(s.table)
             lines += [" · ".join(f"**{n}** {m}" for m, n in counts.items())
                       + f" (runs by dyncheck {s.made_by})", ""]
+            if s.also_changed:
+                lines += ["Also different between the two environments: "
+                          + ", ".join(s.also_changed) + ".", ""]
             if (name, s.old, s.new) in notes:
                 lines += [f"**Explanation.** {notes[(name, s.old, s.new)]}", ""]
             grouped = _grouped(diff.moved(s.table))

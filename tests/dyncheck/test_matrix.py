@@ -34,6 +34,18 @@ def test_constraints_leave_out_the_engine_family_only(engine, dropped, kept):
     assert kept <= names
 
 
+@pytest.mark.parametrize(("release", "numpy_pinned"), [("3.9.0", False), ("4.1.0", True)])
+def test_a_release_series_needs_are_applied_to_its_environment_only(release, numpy_pinned):
+    """Pinocchio 3.x cannot import beside numpy 2.4 (cmeel-boost < 1.90): its environment
+    leaves numpy unpinned and bounds the libraries its wheels link; 4.x keeps every pin."""
+    eng = matrix.ENGINES["pinocchio"]
+    names = {ln.split("==")[0] for ln in matrix.constraints(eng, CONSTRAINTS, release).split()}
+    assert ("numpy" in names) is numpy_pinned
+    assert "mujoco" in names
+    required = {r for n in eng.needs_of(release) for r in n.require}
+    assert bool(required) is not numpy_pinned
+
+
 def test_pip_conflict_is_named_in_one_line():
     stderr = (
         "WARNING: Location 'x' is ignored\n"
@@ -88,13 +100,21 @@ def test_page_counts_moves_and_states_problems(tmp_path):
     a = diff.load(_run(tmp_path / "a", 1e-16, "1.0"), "A")
     b = diff.load(_run(tmp_path / "b", 1e-9, "1.1"), "B")
     steps = [
-        matrix.Step(engine="mujoco", old="1.0", new="1.1", table=diff.diff(a, b)),
+        matrix.Step(engine="mujoco", old="1.0", new="1.1", table=diff.diff(a, b),
+                    also_changed=("numpy 2.3.5 -> 2.4.6",)),
         matrix.Step(engine="mujoco", old="1.1", new="1.2", table=None, problem="no wheel"),
     ]
     page = matrix.page(steps, notes={("mujoco", "1.0", "1.1"): "a changed compiler"})
     assert "### 1.0 → 1.1" in page and "**1** regressed" in page
     assert "**Explanation.** a changed compiler" in page
     assert "_not compared_: no wheel" in page
+    assert "Also different between the two environments: numpy 2.3.5 -> 2.4.6." in page
+
+
+def test_page_states_each_engine_environment_needs():
+    page = matrix.page([matrix.Step(engine="pinocchio", old="3.9.0", new="4.0.0", table=None,
+                                    problem="x")])
+    assert "- 3.x: `numpy` not pinned — " in page and "`cmeel-urdfdom<5`" in page
 
 
 def test_full_inertia_calls_the_signature_of_the_installed_release(monkeypatch):
