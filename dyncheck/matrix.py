@@ -256,15 +256,19 @@ def run_release(
     """The run folder of one release (computed once per release and content of dyncheck's
     code; ``reuse``: the newest cached run of the release, whatever code made it — its
     ``provenance.json`` names the commit)."""
+    subset = ""
+    if cases:  # a run of some cases is cached apart from the run of all
+        subset = "-" + hashlib.sha1(",".join(sorted(cases)).encode(),
+                                    usedforsecurity=False).hexdigest()[:8]
     if reuse:
         cached = sorted(
-            (cache_root() / "runs").glob(f"*/{eng.name}-{release}/discrepancies.csv"),
+            (cache_root() / "runs").glob(f"*/{eng.name}-{release}{subset}/discrepancies.csv"),
             key=lambda p: p.stat().st_mtime,
         )
         if cached:
             return cached[-1].parent
     key = _code_key()
-    out = cache_root() / "runs" / key / f"{eng.name}-{release}"
+    out = cache_root() / "runs" / key / f"{eng.name}-{release}{subset}"
     if (out / "discrepancies.csv").exists() and not key.endswith("+dirty"):
         return out
     python = environment(eng, release, log=log)

@@ -132,3 +132,24 @@ def test_full_inertia_calls_the_signature_of_the_installed_release(monkeypatch):
     mujoco_api.full_inertia(m, d, dst)
     assert calls == [(m, dst, "qM"), (m, d, dst)]
 
+
+
+def test_a_run_of_some_cases_is_cached_apart_from_the_run_of_all(tmp_path, monkeypatch):
+    """A bisection over one case must not leave a one-case run where the matrix looks for
+    the run of every case."""
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
+    monkeypatch.setattr(matrix, "environment", lambda eng, release, log: Path("python"))
+    monkeypatch.setattr(matrix, "_code_key", lambda: "k")
+
+    def fake_run(cmd, **kw):
+        out = Path(cmd[cmd.index("--out") + 1])
+        _run(out, 1e-16, "1.0")
+        return type("R", (), {"returncode": 0, "stderr": ""})()
+
+    monkeypatch.setattr(matrix.subprocess, "run", fake_run)
+    eng = matrix.ENGINES["mujoco"]
+    some = matrix.run_release(eng, "1.0", cases=["pendulum"], log=lambda m: None)
+    every = matrix.run_release(eng, "1.0", log=lambda m: None)
+    assert some != every
+    assert every.name == "mujoco-1.0"
+    assert matrix.run_release(eng, "1.0", cases=["pendulum"], log=lambda m: None) == some
