@@ -183,24 +183,34 @@ class Case(ABC):
         """Sampling box of the book's coordinates, away from the chart's singular set."""
         return np.full(self.ndof, -np.pi), np.full(self.ndof, np.pi)
 
-    def iter_states(self, n: int | None = None, chunk: int = 8192) -> Iterator[StateSample]:
+    def iter_states(
+        self, n: int | None = None, chunk: int = 8192, *, start: int = 0, stop: int | None = None
+    ) -> Iterator[StateSample]:
         """Deterministic states in chunks of at most ``chunk``: the rest state first, then
         seeded uniform samples, angles in (−π, π). Each array has its own random stream, so
-        the states do not depend on the chunk size."""
+        the states do not depend on the chunk size; ``start``/``stop`` select the states
+        [start, stop) of the ``n`` — the same numbers, the streams jumped ahead (PCG64's
+        ``advance``: one 64-bit draw per uniform double), so that a sweep can be cut into
+        slices on several workers."""
         n = self.n_states if n is None else n
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
             raise InvalidInput("states", n, "a positive integer")
+        stop = n if stop is None else stop
+        if not 0 <= start < stop <= n:
+            raise InvalidInput("states slice", (start, stop), f"within [0, {n}]")
         streams = [np.random.default_rng(s) for s in np.random.SeedSequence(self.seed).spawn(4)]
+        for g in streams:
+            g.bit_generator.advance(start * self.ndof)
         vmax, taumax, amax = self.state_scale()
         low, high = self.q_bounds()
         bounds = ((low, high), (-vmax, vmax), (-taumax, taumax), (-amax, amax))
-        for start in range(0, n, chunk):
-            k = min(chunk, n - start)
+        for first in range(start, stop, chunk):
+            k = min(chunk, stop - first)
             q, v, tau, a = (
                 g.uniform(lo, hi, (k, self.ndof))
                 for g, (lo, hi) in zip(streams, bounds, strict=True)
             )
-            if start == 0:
+            if first == 0:
                 q[0], v[0], tau[0], a[0] = self.rest(), 0.0, 0.0, 0.0
             yield StateSample(q=q, v=v, tau=tau, a=a)
 

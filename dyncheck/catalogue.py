@@ -119,6 +119,8 @@ def _run(name: str) -> Entry:
         return Entry(name, "", "", "", nan, nan, skipped=str(exc))
     except ImportError as exc:
         return Entry(name, "", "", "", nan, nan, skipped=f"an engine is not installed ({exc})")
+    except Exception as exc:  # one demonstration lost, never the run that includes it
+        return Entry(name, "", "", "", nan, nan, failed=f"{type(exc).__name__}: {exc}")
     return dataclasses.replace(entry, origin=origin)
 
 
@@ -137,6 +139,9 @@ def render(entries: list[Entry]) -> str:
     for e in entries:
         if e.skipped:
             lines += [f"## {e.name}", "", f"- Skipped: {e.skipped}.", ""]
+            continue
+        if e.failed:
+            lines += [f"## {e.name}", "", f"- **Failed**: {e.failed}", ""]
             continue
         lines += [
             f"## {e.name}",

@@ -533,8 +533,9 @@ def _explain(args: argparse.Namespace) -> int:
 
         print(page.explain(args.name.removeprefix("erratum-")))
         return 0
-    print(render(explain(args.name)))
-    return 0
+    entries = explain(args.name)
+    print(render(entries))
+    return 1 if any(e.failed for e in entries) else 0
 
 
 def _errata(args: argparse.Namespace) -> int:

@@ -35,7 +35,7 @@ from dyncheck.implementations import (
 )
 from dyncheck.reference.constraints import MAX_IMPEDANCE
 from dyncheck.results import Discrepancy
-from dyncheck.tolerances import EPS, ROUNDOFF_FACTOR, first_near_max, instantaneous, soft_condition
+from dyncheck.tolerances import EPS, ROUNDOFF_FACTOR, instantaneous, soft_condition
 
 __all__ = ["GRAVITY_DEFAULT", "POINT_INERTIA", "compare_instantaneous", "soft_factor"]
 
@@ -68,14 +68,24 @@ def _fmt(x: np.ndarray) -> str:
 
 @dataclass
 class PairStats:
-    """Running maxima for one quantity of one pair (a = desired, b = actual)."""
+    """Running maxima for one quantity of one pair (a = desired, b = actual), whatever the
+    chunks: two stats of consecutive slices of states :meth:`merge` into the stats of both.
 
-    max_abs: float = 0.0
-    worst: int = -1
-    worst_values: str = ""
+    The worst state is the first whose error lies within round-off (``ROUNDOFF_FACTOR`` ε of
+    the largest desired value) of the largest error, so that ties at round-off go to the same
+    state on every machine and for every cut of the states into chunks or workers. Only the
+    errors' prefix maxima (each larger than all before it; a few dozen for random states) can
+    be that state: they are kept, with the state's values."""
+
     scale: float = 0.0
     residual: float = 0.0
     predicted: float = 0.0
+    records: list[tuple[int, float, str]] = field(default_factory=list)
+    """(state index, error, state values) of each prefix maximum of the error, in order."""
+
+    @property
+    def max_abs(self) -> float:
+        return self.records[-1][1] if self.records else 0.0
 
     def update(
         self,
@@ -87,19 +97,36 @@ class PairStats:
     ) -> None:
         diff = _per_state(actual - desired)
         self.scale = max(self.scale, float(np.abs(desired).max()))
-        # ties at round-off go to the first state, so that the worst state does not flip
-        # between machines whose round-off differs
-        band = ROUNDOFF_FACTOR * EPS * self.scale
-        k = first_near_max(diff, band)
-        if diff[k] > self.max_abs + band or self.worst < 0:
-            self.worst = offset + k
-            self.worst_values = (
-                f"q={_fmt(s.q[k])} v={_fmt(s.v[k])} tau={_fmt(s.tau[k])} a={_fmt(s.a[k])}"
-            )
-        self.max_abs = max(self.max_abs, float(diff.max()))
+        start = self.max_abs if self.records else -np.inf  # the first state is a record
+        before = np.maximum.accumulate(np.concatenate([[start], diff]))[:-1]
+        for k in np.flatnonzero(diff > before):
+            self._add(offset + int(k), float(diff[k]), s, int(k))
         if predicted is not None:
             self.predicted = max(self.predicted, float(np.abs(predicted).max()))
             self.residual = max(self.residual, float(np.abs(actual - desired - predicted).max()))
+
+    def _add(self, index: int, error: float, s: StateSample, k: int) -> None:
+        values = f"q={_fmt(s.q[k])} v={_fmt(s.v[k])} tau={_fmt(s.tau[k])} a={_fmt(s.a[k])}"
+        self.records.append((index, error, values))
+
+    def merge(self, later: PairStats) -> PairStats:
+        """The stats of this slice of states followed by ``later``'s."""
+        top = self.max_abs
+        return PairStats(
+            scale=max(self.scale, later.scale),
+            residual=max(self.residual, later.residual),
+            predicted=max(self.predicted, later.predicted),
+            records=[*self.records, *(r for r in later.records if r[1] > top or not self.records)],
+        )
+
+    @property
+    def worst(self) -> tuple[int, str]:
+        """(index, values) of the first state within round-off of the largest error."""
+        if not self.records:
+            return -1, ""
+        band = ROUNDOFF_FACTOR * EPS * self.scale
+        index, _error, values = next(r for r in self.records if r[1] >= self.max_abs - band)
+        return index, values
 
 
 @dataclass
@@ -167,13 +194,48 @@ class VariantPredictor:
         return self._values[variant]
 
 
+@dataclass(frozen=True, kw_only=True)
+class Status:
+    """What a row needs to know of one implementation after a sweep."""
+
+    name: str
+    variant: Variant | None
+    eps: float
+    error: str
+    skipped: bool
+
+    @property
+    def ok(self) -> bool:
+        return not self.error
+
+
+@dataclass(frozen=True, kw_only=True)
+class Sweep:
+    """What a slice of states leaves: each (quantity, a, b)'s stats, the largest condition
+    number of the book's mass matrix, and each implementation's status (its first error).
+    Slices computed apart — on other workers — :meth:`merge` in order into the sweep of all."""
+
+    case: str
+    stats: dict[tuple[str, str, str], PairStats]
+    condition: float
+    status: dict[str, Status]
+
+    def merge(self, later: Sweep) -> Sweep:
+        return Sweep(
+            case=self.case,
+            stats={k: st.merge(later.stats[k]) for k, st in self.stats.items()},
+            condition=max(self.condition, later.condition),
+            status={n: st if st.error else later.status[n] for n, st in self.status.items()},
+        )
+
+
 def _row(
-    case: Case, quantity: str, a: Evaluator, b: Evaluator, st: PairStats, condition: float
+    case: str, quantity: str, a: Status, b: Status, st: PairStats, condition: float
 ) -> Discrepancy:
     soft = max(soft_factor(a.variant), soft_factor(b.variant))
     tol = instantaneous(quantity, condition, soft, max(a.eps, b.eps))
     base: dict[str, Any] = dict(
-        case=case.name,
+        case=case,
         quantity=quantity,
         impl_a=a.name,
         impl_b=b.name,
@@ -216,8 +278,8 @@ def _row(
         verdict=verdict,
         convention=convention,
         note=note,
-        worst_state=st.worst,
-        worst_state_values=st.worst_values,
+        worst_state=st.worst[0],
+        worst_state_values=st.worst[1],
     )
 
 
@@ -228,6 +290,18 @@ def compare_instantaneous(
 ) -> list[Discrepancy]:
     """Rows for every pair (trusted first, in IMPLEMENTATIONS order) and quantity, over all
     states of ``chunks`` (one sample or an iterable of chunks)."""
+    return rows(sweep(case, impls, chunks))
+
+
+def sweep(
+    case: Case,
+    impls: Mapping[str, Implementation | Exception],
+    chunks: StateSample | Iterable[StateSample],
+    *,
+    offset: int = 0,
+) -> Sweep:
+    """Every pair on every quantity over the states of ``chunks``, the first of which has
+    index ``offset`` in the whole sweep."""
     if isinstance(chunks, StateSample):
         chunks = [chunks]
     names = [n for n in IMPLEMENTATIONS if n in impls]
@@ -243,7 +317,7 @@ def compare_instantaneous(
     stats = {key: PairStats() for key in keys}
     predict = VariantPredictor(case)
     book = book_variant(case)
-    condition, offset = 1.0, 0
+    condition = 1.0
     for s in chunks:
         predict.new_chunk(s)
         condition = max(condition, float(np.linalg.cond(predict(book)["mass_matrix"]).max()))
@@ -260,4 +334,17 @@ def compare_instantaneous(
                     predicted = pb[q] - pa[q] if differ else None
                     stats[q, a, b].update(offset, s, eb.values[q], ea.values[q], predicted)
         offset += len(s)
-    return [_row(case, q, evals[a], evals[b], stats[q, a, b], condition) for q, a, b in keys]
+    status = {
+        n: Status(name=n, variant=e.variant, eps=e.eps, error=e.error, skipped=e.skipped)
+        for n, e in evals.items()
+    }
+    return Sweep(case=case.name, stats=stats, condition=condition, status=status)
+
+
+def rows(result: Sweep) -> list[Discrepancy]:
+    """The rows of a (merged) sweep, in the order of its keys."""
+    st = result.status
+    return [
+        _row(result.case, q, st[a], st[b], stats, result.condition)
+        for (q, a, b), stats in result.stats.items()
+    ]

@@ -45,7 +45,9 @@ class RunResult:
 
     @property
     def failed(self) -> bool:
-        return bool((self.discrepancies["verdict"] == "failed").any())
+        """A row failed, or a conventions demonstration raised."""
+        lost = any(e.failed for e in self.conventions or ())
+        return lost or bool((self.discrepancies["verdict"] == "failed").any())
 
 
 def resolve(case_names: Sequence[str], impl_names: Sequence[str]) -> tuple[list[Case], list[str]]:

@@ -28,6 +28,8 @@ class Entry:
     unit: str = "max relative error"
     skipped: str = ""
     """Why the demonstration did not run (an engine not installed), or empty."""
+    failed: str = ""
+    """The demonstration raised (an engine's API it does not handle): the message, or empty."""
     origin: Origin | None = None
     """Whose property the convention is (set from :data:`DEMOS`)."""
 

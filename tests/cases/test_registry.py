@@ -82,6 +82,26 @@ def test_states_do_not_depend_on_chunk_size(case):
         )
 
 
+@pytest.mark.parametrize("case", CASE_NAMES)
+def test_a_slice_of_the_states_is_the_same_states(case):
+    """Slices [start, stop) jump the random streams ahead: concatenated, they are the whole
+    sample bit for bit (a sweep cut across workers samples the states of one process)."""
+    c = get_case(case)
+    whole = c.sample_states(1000)
+    parts = [s for a, b in ((0, 1), (1, 377), (377, 1000)) for s in c.iter_states(
+        1000, chunk=128, start=a, stop=b)]
+    for name in ("q", "v", "tau", "a"):
+        assert np.array_equal(
+            np.concatenate([getattr(s, name) for s in parts]), getattr(whole, name)
+        )
+
+
+@pytest.mark.parametrize(("start", "stop"), [(-1, 5), (5, 5), (0, 11)])
+def test_bad_state_slice(start, stop):
+    with pytest.raises(InvalidInput, match=r"^states slice"):
+        next(get_case("simple_pendulum").iter_states(10, start=start, stop=stop))
+
+
 @pytest.mark.parametrize("n", [0, -3, 2.5, True])
 def test_bad_state_count(n):
     with pytest.raises(InvalidInput, match=r"^states must be a positive integer"):

@@ -140,6 +140,43 @@ def test_drake_fsal_integrators_depend_on_caching():
     assert "(0 steps shrunk): bit-identical" in entry.engines  # no rejection, no defect
 
 
+def test_pinocchio_3x_branch_reads_the_constraints_under_a_free_root(monkeypatch):
+    """Pinocchio < 4.0 has no buildModelAndConstraintsFromMJCF: its constraint list comes from
+    buildModelFromMJCF(path, root_joint, name), whose free-flyer root is taken off nv. The
+    branch is exercised with the 3.x call faked (Pinocchio 3.9.0 itself was run by the
+    version matrix)."""
+    import pinocchio as pin
+
+    from dyncheck.adapters import pinocchio_api
+
+    calls = []
+
+    def three_x(path, root, name):
+        calls.append((path, type(root).__name__, name))
+        return type("M", (), {"nv": 8})(), ["one contact"]
+
+    monkeypatch.setattr(pinocchio_api, "CONSTRAINTS_PARSER", False)
+    monkeypatch.setattr(pin, "buildModelFromMJCF", three_x, raising=True)
+    assert pinocchio_api.mjcf_constraints("m.xml") == (2, 1)
+    assert calls == [("m.xml", "JointModelFreeFlyer", "root")]
+
+
+def test_a_demonstration_that_raises_costs_only_its_entry(monkeypatch):
+    """A demonstration meeting an engine API it does not handle is a failed entry, named with
+    the message, `dyncheck explain` exits 1 — and the catalogue (a run's units) goes on."""
+
+    def broken():
+        raise AttributeError("module 'pinocchio' has no attribute 'x'")
+
+    monkeypatch.setitem(catalogue.DEMOS, "hinge-axis-sign",
+                        (broken, catalogue.DEMOS["hinge-axis-sign"][1]))
+    (entry,) = catalogue.explain("hinge-axis-sign")
+    assert entry.failed == "AttributeError: module 'pinocchio' has no attribute 'x'"
+    text = catalogue.render([entry, *catalogue.explain("coordinate-order")])
+    assert "- **Failed**: AttributeError" in text and "## coordinate-order" in text
+    assert main(["explain", "hinge-axis-sign"]) == 1
+
+
 def test_drake_entries_are_skipped_when_drake_is_missing(monkeypatch):
     """Drake is an optional extra: without it its entries say so (with the pip hint) and the
     rest of the catalogue still runs — never a crash of the report."""

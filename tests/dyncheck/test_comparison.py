@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from dyncheck.cases import get_case
+from dyncheck.cases import StateSample, get_case
 from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.comparison import GRAVITY_DEFAULT, POINT_INERTIA, compare_instantaneous
 from dyncheck.implementations import (
@@ -182,6 +182,47 @@ def test_streaming_equals_one_chunk():
     pd.testing.assert_frame_equal(
         table(one, Discrepancy, DISCREPANCY_KEY), table(many, Discrepancy, DISCREPANCY_KEY)
     )
+
+
+def test_slices_swept_apart_merge_into_the_sweep_of_all():
+    """A sweep cut into slices (as on several workers) and merged in order gives the rows of
+    one pass — worst state included, the first within round-off of the largest error."""
+    from dyncheck.comparison import rows, sweep
+
+    case = get_case("compound_pendulum")
+    impls = {n: make_implementation(n, case) for n in ("reference", "book", "mujoco")}
+    one = compare_instantaneous(case, impls, case.sample_states(500))
+    parts = [sweep(case, impls, case.iter_states(500, chunk=64, start=a, stop=b), offset=a)
+             for a, b in ((0, 123), (123, 124), (124, 500))]
+    merged = parts[0].merge(parts[1]).merge(parts[2])
+    pd.testing.assert_frame_equal(
+        table(one, Discrepancy, DISCREPANCY_KEY), table(rows(merged), Discrepancy, DISCREPANCY_KEY)
+    )
+
+
+def test_worst_state_ties_go_to_the_first_state_however_the_states_are_cut():
+    """Errors equal to round-off: the worst state is the first within the band, whatever
+    the chunks (each chunk's own maximum would name a later state)."""
+    from dyncheck.comparison import PairStats
+
+    case = get_case("simple_pendulum")
+    s = case.sample_states(6)
+    desired = np.ones((6, 1))
+    from dyncheck.tolerances import EPS, ROUNDOFF_FACTOR
+
+    errors = np.array([0.0, 2, 4, 0, 8, 2])[:, None] * EPS  # exact on 1
+    whole = PairStats()
+    whole.update(0, s, desired + errors, desired, None)
+    cut = PairStats()
+    for a, b in ((0, 2), (2, 4), (4, 6)):
+        part = PairStats()
+        piece = StateSample(q=s.q[a:b], v=s.v[a:b], tau=s.tau[a:b], a=s.a[a:b])
+        part.update(a, piece, desired[a:b] + errors[a:b], desired[a:b], None)
+        cut = cut.merge(part)
+    assert ROUNDOFF_FACTOR * EPS * 1.0 > 8 * EPS  # the band (scale 1) holds every error
+    assert whole.worst[0] == cut.worst[0] == 0
+    assert cut.worst[1] == whole.worst[1]
+    assert whole.max_abs == cut.max_abs == 8 * EPS
 
 
 def test_worst_state_is_reported_and_reproducible():
