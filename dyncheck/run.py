@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import partial, reduce
 from typing import Any
 
 import pandas as pd
@@ -12,7 +13,8 @@ from dyncheck.cases import Case, get_case
 from dyncheck.catalogue import DEMOS, Entry
 from dyncheck.catalogue import explain as explain_convention
 from dyncheck.closed_forms import closed_form_rows
-from dyncheck.comparison import compare_instantaneous
+from dyncheck.comparison import Sweep, sweep
+from dyncheck.comparison import rows as rows_of
 from dyncheck.errors import UnknownName
 from dyncheck.implementations import (
     IMPLEMENTATIONS,
@@ -62,20 +64,53 @@ def resolve(case_names: Sequence[str], impl_names: Sequence[str]) -> tuple[list[
     return cases, impls
 
 
+STATES_PER_UNIT = 1 << 17
+"""A case sweeping more states than this cuts its instantaneous comparison into slices of this
+many states, each a unit of work (on another worker, its memory flat: it streams its slice in
+chunks); the slices' sweeps merge in order into the same rows as one pass."""
+
+_BUILT: dict[tuple[str, tuple[str, ...]], dict[str, Implementation | Exception]] = {}
+"""Implementations built in this process, by case and names: a worker that sweeps several
+slices of a case loads its engines once."""
+
+
+def _implementations(
+    case: Case, impl_names: Sequence[str], notes: dict[str, set[str]] | None = None
+) -> dict[str, Implementation | Exception]:
+    """The case's implementations (an implementation that cannot be built is its exception,
+    reported as rows); ``notes`` collects what each MJCF parser said it ignores."""
+    key = (repr(case), tuple(impl_names))
+    if key not in _BUILT:
+        impls: dict[str, Implementation | Exception] = {}
+        for name in implementations_for(case, tuple(impl_names)):
+            try:
+                impls[name] = make_implementation(name, case)
+            except Exception as exc:  # reported as a row, the run goes on
+                impls[name] = exc
+        _BUILT.clear()  # one case's engines at a time
+        _BUILT[key] = impls
+    impls = _BUILT[key]
+    if notes is not None:
+        for name, impl in impls.items():
+            warnings = getattr(getattr(impl, "adapter", None), "parser_warnings", [])
+            notes.setdefault(name, set()).update(warnings)
+    return impls
+
+
+def _sweep_slice(case: Case, impl_names: Sequence[str], n: int, start: int, stop: int) -> Sweep:
+    """The instantaneous comparison over states [start, stop) of ``n`` (a unit of work)."""
+    impls = _implementations(case, impl_names)
+    return sweep(case, impls, case.iter_states(n, start=start, stop=stop), offset=start)
+
+
 def _run_case(
-    case: Case, impl_names: Sequence[str], states: int | None
+    case: Case, impl_names: Sequence[str], states: int | None, *, sliced: bool = False
 ) -> tuple[list[Discrepancy], list[ConvergencePoint], TrajectoryFigures, dict[str, set[str]]]:
-    """Everything for one case (a unit of work for a worker process)."""
-    impls: dict[str, Implementation | Exception] = {}
+    """Everything for one case (a unit of work for a worker process); ``sliced``: the
+    instantaneous comparison is left to :func:`_sweep_slice` units."""
     notes: dict[str, set[str]] = {}
-    for name in implementations_for(case, tuple(impl_names)):
-        try:
-            impls[name] = make_implementation(name, case)
-        except Exception as exc:  # reported as a row, the run goes on
-            impls[name] = exc
-        warnings = getattr(getattr(impls[name], "adapter", None), "parser_warnings", [])
-        notes.setdefault(name, set()).update(warnings)
-    rows = compare_instantaneous(case, impls, case.iter_states(states))
+    impls = _implementations(case, impl_names, notes)
+    rows = [] if sliced else rows_of(sweep(case, impls, case.iter_states(states)))
     points, trajectory_rows, figures = study(case, impls)
     return rows + trajectory_rows + closed_form_rows(case), points, figures, notes
 
@@ -89,6 +124,7 @@ def run(
     dask: str | None = None,
     conventions: bool = False,
     progress: Callable[[str], None] = lambda _msg: None,
+    states_per_unit: int = STATES_PER_UNIT,
 ) -> RunResult:
     """Evaluate, compare and study every case (``states`` sampled states each, default the
     case's own) and, with ``conventions``, run the conventions catalogue — as units of work in
@@ -96,9 +132,19 @@ def run(
     :func:`dyncheck.workers.executor`); results do not depend on where they ran. An
     implementation that cannot be built (not installed, unsupported, raising) becomes skipped
     or failed rows, never an aborted run."""
-    units: list[tuple[str, Callable[..., Any], tuple[Any, ...]]] = [
-        (case.name, _run_case, (case, list(impl_names), states)) for case in cases
-    ]
+    units: list[tuple[str, Callable[..., Any], tuple[Any, ...]]] = []
+    slices: dict[str, list[int]] = {}  # case → the indices of its slice units
+    for case in cases:
+        n = case.n_states if states is None else states
+        sliced = n > states_per_unit
+        units.append((case.name, partial(_run_case, sliced=sliced), (case, list(impl_names), n)))
+        if sliced:
+            slices[case.name] = []
+            for start in range(0, n, states_per_unit):
+                stop = min(n, start + states_per_unit)
+                slices[case.name].append(len(units))
+                units.append((f"{case.name} states {start}..{stop - 1}", _sweep_slice,
+                              (case, list(impl_names), n, start, stop)))
     if conventions:
         units += [(f"conventions: {name}", explain_convention, (name,)) for name in DEMOS]
     with executor(jobs if len(units) > 1 else 1, dask) as pool:
@@ -113,23 +159,28 @@ def run(
             for (what, _fn, _args), future in zip(units, futures, strict=True):
                 done.append(future.result())
                 progress(f"{what}: done")
-    outputs = done[: len(cases)]
-    entries = [entry for (entry,) in done[len(cases) :]] if conventions else None
     rows: list[Discrepancy] = []
     points: list[ConvergencePoint] = []
     figures: dict[str, TrajectoryFigures] = {}
     notes: dict[str, set[str]] = {}
-    for case, (r, p, f, n) in zip(cases, outputs, strict=True):
-        rows += r
-        points += p
-        figures[case.name] = f
-        for k, v in n.items():
-            notes.setdefault(k, set()).update(v)
+    entries: list[Entry] = []
+    for (what, fn, _args), out in zip(units, done, strict=True):
+        if fn is explain_convention:
+            entries += out
+        elif fn is not _sweep_slice:  # a case; its slices' sweeps merged in order
+            r, p, f, said = out
+            if what in slices:
+                r = rows_of(reduce(Sweep.merge, (done[i] for i in slices[what]))) + r
+            rows += r
+            points += p
+            figures[what] = f
+            for k, v in said.items():
+                notes.setdefault(k, set()).update(v)
     return RunResult(
         list(cases),
         table(rows, Discrepancy, DISCREPANCY_KEY),
         table(points, ConvergencePoint, CONVERGENCE_KEY),
         figures,
         {k: sorted(v) for k, v in notes.items() if v},
-        entries,
+        entries if conventions else None,
     )

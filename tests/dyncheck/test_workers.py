@@ -37,6 +37,19 @@ def test_dask_local_cluster_gives_the_same_csv_bytes_as_one_process():
     assert not here.discrepancies.empty
 
 
+@pytest.mark.parametrize("dask", [None, pytest.param(workers.LOCAL, marks=pytest.mark.slow)])
+def test_a_sweep_cut_into_slices_gives_the_same_csv_as_one_pass(dask):
+    """2000 states in slices of 700 (three units, on a 2-worker LocalCluster or here) against
+    one unsliced pass in this process: the same bytes, worst states included."""
+    if dask:
+        pytest.importorskip("distributed", reason="the extra 'dask' (pip install 'dyncheck[dask]')")
+    case = [get_case("simple_pendulum")]
+    whole = run(case, IMPLS, states=2000, jobs=1)
+    sliced = run(case, IMPLS, states=2000, jobs=2, dask=dask, states_per_unit=700)
+    assert to_csv(whole.discrepancies) == to_csv(sliced.discrepancies)
+    assert (whole.discrepancies.worst_state > 700).any()  # a worst state in a later slice
+
+
 @pytest.mark.parametrize("jobs", [1, 2])
 def test_conventions_catalogue_entries_are_units_of_work(jobs, monkeypatch):
     """The catalogue's entries run beside the cases (in a pool with jobs=2) and come back in
