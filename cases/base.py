@@ -84,8 +84,8 @@ class TrajectorySpec:
                 raise InvalidInput(f"steps[{integrator}]", dts, "at least two step sizes")
             for dt in dts:
                 positive(f"steps[{integrator}] dt", dt)
-                n = self.duration / dt
-                if abs(n - round(n)) > 1e-9 * n:
+                steps = self.duration / dt
+                if abs(steps - round(steps)) > 1e-9 * steps:
                     raise InvalidInput(
                         f"steps[{integrator}] dt", dt, f"a divisor of duration {self.duration}"
                     )
@@ -198,12 +198,13 @@ class Case(ABC):
         stop = n if stop is None else stop
         if not 0 <= start < stop <= n:
             raise InvalidInput("states slice", (start, stop), f"within [0, {n}]")
-        streams = [np.random.default_rng(s) for s in np.random.SeedSequence(self.seed).spawn(4)]
-        for g in streams:
-            g.bit_generator.advance(start * self.ndof)
+        bits = [np.random.PCG64(s) for s in np.random.SeedSequence(self.seed).spawn(4)]
+        streams = [np.random.Generator(b.advance(start * self.ndof)) for b in bits]
         vmax, taumax, amax = self.state_scale()
         low, high = self.q_bounds()
-        bounds = ((low, high), (-vmax, vmax), (-taumax, taumax), (-amax, amax))
+        bounds: tuple[tuple[np.ndarray | float, np.ndarray | float], ...] = (
+            (low, high), (-vmax, vmax), (-taumax, taumax), (-amax, amax)
+        )
         for first in range(start, stop, chunk):
             k = min(chunk, stop - first)
             q, v, tau, a = (

@@ -57,7 +57,17 @@ def _selection(p: argparse.ArgumentParser) -> None:
     )
     _dask(p)
 
+def _no_cache(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--no-cache",
+        action="store_true",
+        help="derive every symbolic result afresh, neither reading nor writing the cache of "
+        "derivations (under $DYNCHECK_CACHE or ~/.cache/dyncheck)",
+    )
+
+
 def _dask(p: argparse.ArgumentParser) -> None:
+    _no_cache(p)
     p.add_argument(
         "--dask",
         default=None,
@@ -166,6 +176,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     e = sub.add_parser("explain", help="demonstrate a modelling convention (all if none)")
     e.add_argument("name", nargs="?", default=None, metavar="NAME")
+    _no_cache(e)
     er = sub.add_parser("errata", help="check every formula of §2.2 and write the errata page")
     er.add_argument("--out", type=_path, default=Path("reports/errata.md"),
                     metavar="FILE")
@@ -599,6 +610,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = _parser().parse_args(argv)
     except SystemExit as exc:  # --help (0) or a one-line usage error (2), already printed
         return int(exc.code or 0)
+    from dyncheck.reference.derivations import NO_CACHE
+
+    before = os.environ.get(NO_CACHE)
+    if getattr(args, "no_cache", False):  # read by this process and the workers it starts
+        os.environ[NO_CACHE] = "1"
     try:
         if args.command == "list":
             return _list(integrators=args.integrators)
@@ -613,6 +629,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("dyncheck: interrupted (nothing half-written)", file=sys.stderr)
         return 130
+    finally:
+        if before is None:
+            os.environ.pop(NO_CACHE, None)
+        else:
+            os.environ[NO_CACHE] = before
 
 
 def _one_line(text: str) -> str:

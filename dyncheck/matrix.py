@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import hashlib
 import itertools
-import os
 import subprocess
 import sys
 from collections.abc import Callable, Sequence
@@ -30,6 +29,7 @@ import pandas as pd
 
 from dyncheck import diff
 from dyncheck.errors import DyncheckError, InvalidInput, UnknownName
+from dyncheck.reference.derivations import cache_root
 
 ROOT = Path(__file__).resolve().parents[1]
 CORE = ("numpy", "scipy", "sympy", "pandas", "tabulate", "matplotlib", "mujoco", "pin")
@@ -139,14 +139,6 @@ def engine(name: str) -> Engine:
     if name not in ENGINES:
         raise UnknownName("engine", name, ENGINES)
     return ENGINES[name]
-
-
-def cache_root() -> Path:
-    """``$DYNCHECK_CACHE`` or ``$XDG_CACHE_HOME/dyncheck`` or ``~/.cache/dyncheck``."""
-    if os.environ.get("DYNCHECK_CACHE"):
-        return Path(os.environ["DYNCHECK_CACHE"])
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "dyncheck"
 
 
 def constraints(eng: Engine, text: str, release: str = "") -> str:

@@ -17,6 +17,8 @@ from functools import cache, cached_property
 import numpy as np
 import sympy as sp
 
+from dyncheck.reference.derivations import derived
+
 
 @dataclass(frozen=True)
 class CoordinateSystem:
@@ -43,18 +45,23 @@ class CoordinateSystem:
 
     @cached_property
     def metric(self) -> sp.Matrix:
-        """g_ij, derived from the map."""
+        """g_ij, derived from the map (cached on disk: :mod:`.derivations`)."""
         J = self.jacobian
-        return (J.T * J).applyfunc(lambda e: sp.simplify(sp.trigsimp(e)))
+        return derived("metric", (self.q, self.x),
+                       lambda: (J.T * J).applyfunc(lambda e: sp.simplify(sp.trigsimp(e))))
 
     @cached_property
     def inverse_metric(self) -> sp.Matrix:
         """g^ij."""
-        return self.metric.inv().applyfunc(sp.simplify)
+        return derived("inverse_metric", (self.q, self.x),
+                       lambda: self.metric.inv().applyfunc(sp.simplify))
 
     @cached_property
     def christoffel_first(self) -> list[list[list[sp.Expr]]]:
         """[mn, i] indexed [i][m][n]."""
+        return derived("christoffel_first", (self.q, self.x), self._christoffel_first)
+
+    def _christoffel_first(self) -> list[list[list[sp.Expr]]]:
         g, q, n = self.metric, self.q, self.dim
         return [
             [
@@ -73,6 +80,9 @@ class CoordinateSystem:
     @cached_property
     def christoffel(self) -> list[list[list[sp.Expr]]]:
         """{i; m n} indexed [i][m][n], derived: g^ij [mn, j]."""
+        return derived("christoffel", (self.q, self.x), self._christoffel)
+
+    def _christoffel(self) -> list[list[list[sp.Expr]]]:
         gi, c1, n = self.inverse_metric, self.christoffel_first, self.dim
         return [
             [

@@ -20,6 +20,8 @@ from functools import cached_property
 import numpy as np
 import sympy as sp
 
+from dyncheck.reference.derivations import derived
+
 
 def particle_energies(
     masses: Sequence[sp.Expr],
@@ -84,7 +86,12 @@ class SymbolicSystem:
     """Simplify M and h symbolically (exact either way; off where sympy's simplify is slow)."""
 
     def equations(self) -> tuple[sp.Matrix, sp.Matrix]:
-        """(M, h) of the canonical form, from (2.2.22)–(2.2.26)."""
+        """(M, h) of the canonical form, from (2.2.22)–(2.2.26) (cached on disk:
+        :mod:`.derivations`)."""
+        inputs = (self.q, self.qd, self.T, self.V, self.simplify)
+        return derived("lagrange_equations", inputs, self._equations)
+
+    def _equations(self) -> tuple[sp.Matrix, sp.Matrix]:
         n = len(self.q)
         p = [sp.diff(self.T, qdi) for qdi in self.qd]  # ∂T/∂ẋʳ
         tidy = sp.simplify if self.simplify else sp.expand
