@@ -128,6 +128,9 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--against", type=_path, default=None, metavar="PATH",
                    help="also compare what MuJoCo reads with this other file (a previous version)")
     k.add_argument("--out", type=_path, default=Path("reports/check"), help="output folder")
+    k.add_argument("--jobs", type=int, default=1, metavar="N",
+                   help="models checked in N parallel processes (same results)")
+    _dask(k)
     k.add_argument("--in-process", action="store_true",
                    help="load the engines in this process (faster start; an engine that "
                    "crashes on the file then ends the check)")
@@ -560,9 +563,12 @@ def _errata(args: argparse.Namespace) -> int:
 
 
 def _check(args: argparse.Namespace) -> int:
+    from functools import partial
+
     from dyncheck.check import inputs
     from dyncheck.check.model_check import check_model
     from dyncheck.check.page import summary_line, write
+    from dyncheck.workers import run_units
 
     targets = [(str(p), None) for p in args.paths]
     targets += [(str(inputs.robot(name)), name) for name in args.robot]
@@ -576,13 +582,14 @@ def _check(args: argparse.Namespace) -> int:
     if args.seed < 0:
         raise InvalidInput("--seed", args.seed, "a non-negative integer")
     _check_out(args.out)
+    _positive("--jobs", args.jobs)
+    options = {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
+               "floating": args.floating, "against": args.against,
+               "isolate": not args.in_process}
+    units = [(text, partial(check_model, **options, name=robot), (text,))
+             for text, robot in targets]
     failed = False
-    for text, robot in targets:
-        result = check_model(
-            text, impls=tuple(args.impl) or None, states=args.states, seed=args.seed,
-            floating=args.floating, against=args.against, name=robot,
-            isolate=not args.in_process,
-        )
+    for result in run_units(units, jobs=args.jobs, dask=args.dask, progress=_log):
         written = write(result, args.out)
         print(f"{summary_line(result)} -> {written[1]}")
         if not result.ok:

@@ -118,12 +118,16 @@ EXPLANATIONS: dict[tuple[str, str, str], str] = {
     ("mujoco", "3.3.7", "3.6.0"): "The compound-pulley defect of 3.3.7 is gone: its rows are "
     "back to the values of 3.2.7.",
     ("mujoco", "3.10.0", "3.14.0"): "Rigid bodies with a full (non-diagonal) inertia tensor "
-    "(`rigid_body_ball`, `rigid_body_free`): M, h, forward and inverse dynamics and T differ "
-    "from the book by ~2e-9 relative up to 3.10.0 and agree to round-off (1e-14) from 3.14.0 "
-    "on. MuJoCo's compiler turns `fullinertia` into principal moments and a frame (an "
-    "iterative eigen-decomposition); 2e-9 is the accuracy of that step in the older releases, "
-    "not of dyncheck's model (the same MJCF; Pinocchio and the book agree to round-off). "
-    "Name the release with `dyncheck versions --bisect mujoco 3.10.0 3.14.0`.",
+    "(`rigid_body_ball`, `rigid_body_free`): M, h, forward and inverse dynamics, T and the "
+    "trajectories differ from the book by ~2e-9 relative up to 3.13.0 and agree to round-off "
+    "(1e-14) from 3.14.0 on. MuJoCo's compiler turns `fullinertia` into principal moments and "
+    "a frame (an eigen-decomposition); the tensor rebuilt from the compiled `body_inertia` and "
+    "`body_iquat`, R diag(I) Rᵀ, differs from the MJCF's by 4.8e-9 relative in 3.10.0 and "
+    "3.13.0 and by 2.6e-15 in 3.14.0 (measured on a free body with products of inertia): the "
+    "accuracy of that step in the older releases, not of dyncheck's model (the same MJCF; "
+    "Pinocchio and the book agree to round-off). `dyncheck versions --bisect mujoco 3.10.0 "
+    "3.14.0 --case rigid_body_ball` names 3.14.0 the first release that moved (3.12.0 and "
+    "3.13.0 give the rows of 3.10.0).",
     ("mujoco", "3.17.0", "4.0.0"): "RK4 on ball and free joints: the difference between the "
     "two releases' errors shrinks as dt² — `diff` classifies it `definition changed`. MuJoCo "
     "4.0.0 combines RK4's stages on the rotation group (Runge-Kutta-Munthe-Kaas, dexp⁻¹): "

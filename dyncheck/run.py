@@ -5,7 +5,6 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import partial, reduce
-from typing import Any
 
 import pandas as pd
 
@@ -30,7 +29,7 @@ from dyncheck.results import (
     table,
 )
 from dyncheck.studies import TrajectoryFigures, study
-from dyncheck.workers import executor
+from dyncheck.workers import Unit, run_units
 
 
 @dataclass
@@ -132,7 +131,7 @@ def run(
     :func:`dyncheck.workers.executor`); results do not depend on where they ran. An
     implementation that cannot be built (not installed, unsupported, raising) becomes skipped
     or failed rows, never an aborted run."""
-    units: list[tuple[str, Callable[..., Any], tuple[Any, ...]]] = []
+    units: list[Unit] = []
     slices: dict[str, list[int]] = {}  # case → the indices of its slice units
     for case in cases:
         n = case.n_states if states is None else states
@@ -147,18 +146,7 @@ def run(
                               (case, list(impl_names), n, start, stop)))
     if conventions:
         units += [(f"conventions: {name}", explain_convention, (name,)) for name in DEMOS]
-    with executor(jobs if len(units) > 1 else 1, dask) as pool:
-        if pool is None:
-            done = []
-            for what, fn, args in units:
-                progress(f"{what}: running")
-                done.append(fn(*args))
-        else:
-            futures = [pool.submit(fn, *args) for _what, fn, args in units]
-            done = []
-            for (what, _fn, _args), future in zip(units, futures, strict=True):
-                done.append(future.result())
-                progress(f"{what}: done")
+    done = run_units(units, jobs=jobs, dask=dask, progress=progress)
     rows: list[Discrepancy] = []
     points: list[ConvergencePoint] = []
     figures: dict[str, TrajectoryFigures] = {}

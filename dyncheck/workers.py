@@ -8,9 +8,10 @@ on where they ran. Dask is the optional extra ``dask``; it is imported only when
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import contextmanager
+from typing import Any
 
 from dyncheck.errors import InvalidInput
 
@@ -45,12 +46,16 @@ def executor(jobs: int = 1, dask: str | None = None) -> Iterator[Executor | None
             "--dask", dask, "used with the extra 'dask' installed (pip install 'dyncheck[dask]')"
         ) from None
     if dask == LOCAL:
-        cluster = LocalCluster(
-            n_workers=max(jobs, 1),
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-        )
+        import dask as dask_config
+
+        # non-daemonic workers may start processes of their own (a model check's engines)
+        with dask_config.config.set({"distributed.worker.daemon": False}):
+            cluster = LocalCluster(
+                n_workers=max(jobs, 1),
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+            )
         with cluster, Client(cluster) as client:
             yield client.get_executor(pure=False)
         return
@@ -63,3 +68,31 @@ def executor(jobs: int = 1, dask: str | None = None) -> Iterator[Executor | None
         ) from None
     with client:
         yield client.get_executor(pure=False)
+
+
+Unit = tuple[str, Callable[..., Any], tuple[Any, ...]]
+"""A unit of work: what it is (for progress), a picklable function, its arguments."""
+
+
+def run_units(
+    units: Sequence[Unit],
+    *,
+    jobs: int = 1,
+    dask: str | None = None,
+    progress: Callable[[str], None] = lambda _msg: None,
+) -> list[Any]:
+    """The units' results in submission order, run here, on ``jobs`` processes or on a dask
+    cluster (see :func:`executor`); ``progress`` hears of each unit started (here) or done."""
+    with executor(jobs if len(units) > 1 else 1, dask) as pool:
+        if pool is None:
+            done = []
+            for what, fn, args in units:
+                progress(f"{what}: running")
+                done.append(fn(*args))
+            return done
+        futures = [pool.submit(fn, *args) for _what, fn, args in units]
+        done = []
+        for (what, _fn, _args), future in zip(units, futures, strict=True):
+            done.append(future.result())
+            progress(f"{what}: done")
+        return done

@@ -180,6 +180,12 @@ class Isolated:
         self._conn.close()
 
 
+def can_isolate() -> bool:
+    """Whether this process may start engine processes: a daemonic process (a worker of a
+    dask cluster whose workers are daemons, its default) may not."""
+    return not mp.current_process().daemon
+
+
 def start(names: list[str], source: ModelFile, *, isolate: bool) -> dict[str, ModelEngine |
                                                                            NotLoaded]:
     """Load ``source`` into each engine — side by side in their own processes when

@@ -41,6 +41,13 @@ KINETIC_WITHOUT_ARMATURE = {"pinocchio"}
 while their M includes the armature: T differs by ½ Σ aᵢ vᵢ² (measured, Pinocchio 4)."""
 
 
+IN_PROCESS_NOTE = (
+    "The engines ran in the checking process, not each in its own: a daemonic worker (a dask "
+    "worker's default) cannot start processes, so an engine crashing on this file would take "
+    "the worker with it (start the workers with `distributed.worker.daemon: False`)."
+)
+
+
 @dataclass(frozen=True, kw_only=True)
 class CheckResult:
     """The rows of one model's check (a DataFrame, :data:`~dyncheck.check.rows.COLUMNS`)."""
@@ -106,6 +113,9 @@ def check_model(
                            "checks an engine's tree)")
     model = name or source_path.stem
     source = read(source_path, floating=floating)
+    if isolate and not engine_processes.can_isolate():
+        isolate = False
+        source = replace(source, notes=(*source.notes, IN_PROCESS_NOTE))
     t0 = time.perf_counter()
     engines = engine_processes.start([i for i in chosen if i in ENGINES], source,
                                      isolate=isolate)

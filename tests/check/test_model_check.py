@@ -164,3 +164,26 @@ def test_an_engine_that_crashes_or_hangs_costs_only_its_rows(monkeypatch, engine
     others = rows.drop(mine.index)
     assert {"mujoco", "pinocchio", "reference"} <= set(others.impl_a) | set(others.impl_b)
     assert not (others.verdict == "failed").any(), others[others.verdict == "failed"]
+
+
+def test_a_daemonic_worker_checks_in_process_and_says_so():
+    """A daemonic process cannot start processes: the check runs its engines in the process
+    (the same rows as an isolated check — those of engines in their own processes) and its
+    notes say that a crash would not be contained."""
+    import multiprocessing as mp
+
+    from dyncheck.check.model_check import IN_PROCESS_NOTE
+
+    isolated = check_model(MODELS / "mixed.xml", states=10, impls=("reference", "mujoco"))
+    here = mp.current_process()
+    daemon = here._config.get("daemon")
+    here._config["daemon"] = True  # what a dask nanny's worker process is
+    try:
+        inside = check_model(MODELS / "mixed.xml", states=10, impls=("reference", "mujoco"))
+    finally:
+        if daemon is None:
+            del here._config["daemon"]
+        else:
+            here._config["daemon"] = daemon
+    assert IN_PROCESS_NOTE in inside.notes and IN_PROCESS_NOTE not in isolated.notes
+    assert inside.rows.equals(isolated.rows)

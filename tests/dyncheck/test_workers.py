@@ -91,3 +91,24 @@ def test_cli_refuses_an_unreachable_scheduler_before_any_work(tmp_path, monkeypa
     assert code == 2
     assert len(err.splitlines()) == 1 and "--dask" in err and "tcp://127.0.0.1:9" in err
     assert not (out / "discrepancies.csv").exists()
+
+
+MODELS = ("tests/check/models/branches.urdf", "tests/check/models/mixed.xml")
+
+
+@pytest.mark.parametrize("where", [["--jobs", "2"], pytest.param(
+    ["--jobs", "2", "--dask", workers.LOCAL], marks=pytest.mark.slow)])
+def test_check_of_several_models_on_workers_writes_the_same_csv_bytes(where, tmp_path):
+    """`dyncheck check` with one model per unit of work (a pool, or a LocalCluster whose
+    workers start each model's engine processes) against the same check in this process."""
+    if "--dask" in where:
+        pytest.importorskip("distributed", reason="the extra 'dask' (pip install 'dyncheck[dask]')")
+    from dyncheck.cli import main
+
+    here, there = tmp_path / "here", tmp_path / "there"
+    assert main(["check", *MODELS, "--states", "20", "--out", str(here)]) == 0
+    assert main(["check", *MODELS, "--states", "20", "--out", str(there), *where]) == 0
+    for name in ("branches.csv", "mixed.csv"):
+        assert (here / name).read_bytes() == (there / name).read_bytes()
+        assert len((here / name).read_text().splitlines()) > 10
+    assert "daemonic" not in (there / "mixed.md").read_text()  # engines isolated on workers
