@@ -131,6 +131,13 @@ class Adapter(ABC):
     def version() -> str:
         """The engine's version string."""
 
+    @classmethod
+    def release_compiled(cls) -> None:
+        """Free what the engine compiled for the models built so far (called when a run drops
+        a case's models): an engine that compiles per model and keeps every program would
+        otherwise grow without bound over a run. Nothing to free by default."""
+        return None
+
     @abstractmethod
     def loaded_bodies(self) -> list[LoadedBody]:
         """Masses and inertias as loaded, in the spec's body order."""

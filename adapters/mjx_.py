@@ -118,6 +118,15 @@ class MJXAdapter(PortAdapter):
         with self._precision():
             self.mx = self._cast(mjx.put_model(self.model))
 
+    @classmethod
+    def release_compiled(cls) -> None:
+        """JAX keeps every program its jitted functions compiled — one per model (the model's
+        static fields key the cache) and batch shape: left alone, a run of every case in one
+        process reached the kernel's limit of 65 530 memory maps and died in XLA's LLVM
+        ("Cannot allocate memory", then SIGSEGV)."""
+        _EVALUATE.clear_cache()
+        _STRETCH.clear_cache()
+
     @staticmethod
     def version() -> str:
         from importlib.metadata import version

@@ -73,6 +73,15 @@ _BUILT: dict[tuple[str, tuple[str, ...]], dict[str, Implementation | Exception]]
 slices of a case loads its engines once."""
 
 
+def _release() -> None:
+    """Drop the implementations built in this process, and what their engines compiled."""
+    engines = {type(adapter) for built in _BUILT.values() for impl in built.values()
+               if (adapter := getattr(impl, "adapter", None)) is not None}
+    _BUILT.clear()
+    for engine in engines:
+        engine.release_compiled()
+
+
 def _implementations(
     case: Case, impl_names: Sequence[str], notes: dict[str, set[str]] | None = None
 ) -> dict[str, Implementation | Exception]:
@@ -86,7 +95,7 @@ def _implementations(
                 impls[name] = make_implementation(name, case)
             except Exception as exc:  # reported as a row, the run goes on
                 impls[name] = exc
-        _BUILT.clear()  # one case's engines at a time
+        _release()  # one case's engines at a time
         _BUILT[key] = impls
     impls = _BUILT[key]
     if notes is not None:
