@@ -345,6 +345,7 @@ def _use_device(device: str) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     from dyncheck import baseline, report
+    from dyncheck.report.figures import figures as draw_figures
     from dyncheck.run import resolve, run
 
     _check_out(args.out)
@@ -360,7 +361,8 @@ def _run(args: argparse.Namespace) -> int:
         _warn_cost(args.states * len(cases), args.jobs)
     # the conventions catalogue does not depend on the cases: it runs with the full report
     result = run(cases, impls, states=args.states, jobs=args.jobs, dask=args.dask,
-                 conventions=not args.cases, progress=report.stderr_progress)
+                 conventions=not args.cases, progress=report.stderr_progress,
+                 render=draw_figures)
     report.write(result, args.out)
     counts = result.discrepancies["verdict"].value_counts()
     print(

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import partial, reduce
 
 import pandas as pd
@@ -43,6 +43,8 @@ class RunResult:
     conventions: list[Entry] | None = None
     """The conventions catalogue's demonstrations, run with the cases (its report page), or
     None where the run did not include them."""
+    pngs: dict[str, dict[str, bytes]] = field(default_factory=dict)
+    """Per case, its figures (kind → PNG) where the run rendered them in its units of work."""
 
     @property
     def failed(self) -> bool:
@@ -111,16 +113,25 @@ def _sweep_slice(case: Case, impl_names: Sequence[str], n: int, start: int, stop
     return sweep(case, impls, case.iter_states(n, start=start, stop=stop), offset=start)
 
 
+Render = Callable[[Case, TrajectoryFigures, pd.DataFrame], dict[str, bytes]]
+"""Draws a case's figures from its study and its convergence table (kind → PNG)."""
+
+
 def _run_case(
-    case: Case, impl_names: Sequence[str], states: int | None, *, sliced: bool = False
-) -> tuple[list[Discrepancy], list[ConvergencePoint], TrajectoryFigures, dict[str, set[str]]]:
-    """Everything for one case (a unit of work for a worker process); ``sliced``: the
-    instantaneous comparison is left to :func:`_sweep_slice` units."""
+    case: Case, impl_names: Sequence[str], states: int | None, *, sliced: bool = False,
+    render: Render | None = None,
+) -> tuple[list[Discrepancy], list[ConvergencePoint], TrajectoryFigures, dict[str, set[str]],
+           dict[str, bytes]]:
+    """Everything for one case (a unit of work for a worker process), its figures drawn by
+    ``render`` where given; ``sliced``: the instantaneous comparison is left to
+    :func:`_sweep_slice` units."""
     notes: dict[str, set[str]] = {}
     impls = _implementations(case, impl_names, notes)
     rows = [] if sliced else rows_of(sweep(case, impls, case.iter_states(states)))
     points, trajectory_rows, figures = study(case, impls)
-    return rows + trajectory_rows + closed_form_rows(case), points, figures, notes
+    pngs = {} if render is None else render(
+        case, figures, table(points, ConvergencePoint, CONVERGENCE_KEY))
+    return rows + trajectory_rows + closed_form_rows(case), points, figures, notes, pngs
 
 
 def run(
@@ -133,19 +144,22 @@ def run(
     conventions: bool = False,
     progress: Callable[[str], None] = lambda _msg: None,
     states_per_unit: int = STATES_PER_UNIT,
+    render: Render | None = None,
 ) -> RunResult:
     """Evaluate, compare and study every case (``states`` sampled states each, default the
     case's own) and, with ``conventions``, run the conventions catalogue — as units of work in
     this process, ``jobs`` local processes or on a Dask cluster (``dask``:
     :func:`dyncheck.workers.executor`); results do not depend on where they ran. An
     implementation that cannot be built (not installed, unsupported, raising) becomes skipped
-    or failed rows, never an aborted run."""
+    or failed rows, never an aborted run. ``render`` (the report's figures) draws each case's
+    figures in its unit of work, beside the other cases'."""
     units: list[Unit] = []
     slices: dict[str, list[int]] = {}  # case → the indices of its slice units
     for case in cases:
         n = case.n_states if states is None else states
         sliced = n > states_per_unit
-        units.append((case.name, partial(_run_case, sliced=sliced), (case, list(impl_names), n)))
+        whole = partial(_run_case, sliced=sliced, render=render)
+        units.append((case.name, whole, (case, list(impl_names), n)))
         if sliced:
             slices[case.name] = []
             for start in range(0, n, states_per_unit):
@@ -159,18 +173,21 @@ def run(
     rows: list[Discrepancy] = []
     points: list[ConvergencePoint] = []
     figures: dict[str, TrajectoryFigures] = {}
+    pngs: dict[str, dict[str, bytes]] = {}
     notes: dict[str, set[str]] = {}
     entries: list[Entry] = []
     for (what, fn, _args), out in zip(units, done, strict=True):
         if fn is explain_convention:
             entries += out
         elif fn is not _sweep_slice:  # a case; its slices' sweeps merged in order
-            r, p, f, said = out
+            r, p, f, said, drawn = out
             if what in slices:
                 r = rows_of(reduce(Sweep.merge, (done[i] for i in slices[what]))) + r
             rows += r
             points += p
             figures[what] = f
+            if drawn:
+                pngs[what] = drawn
             for k, v in said.items():
                 notes.setdefault(k, set()).update(v)
     return RunResult(
@@ -180,4 +197,5 @@ def run(
         figures,
         {k: sorted(v) for k, v in notes.items() if v},
         entries if conventions else None,
+        pngs,
     )

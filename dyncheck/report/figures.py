@@ -35,7 +35,7 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
         for (impl, integ), q in sorted(data.runs.items()):
             if integ == "rk4":
                 ax.plot(data.t, q[:, i], "--", lw=1, label=f"{impl} rk4")
-        ax.set_ylabel(f"{case.coordinates[i]} (rad)")
+        ax.set_ylabel(case.coordinates[i])  # the book's coordinate: a length or an angle
     axes[-1, 0].set_xlabel("t (s)")
     axes[0, 0].legend(fontsize=7, loc="best")
     axes[0, 0].set_title(f"{case.title}: trajectory in the book's coordinates")
@@ -51,7 +51,7 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
             label=f"{impl} {integ} dt={data.steps[impl, integ]:g}",
         )
     ax.set_xlabel("t (s)")
-    ax.set_ylabel("max |q - q_ref| (rad)")
+    ax.set_ylabel("max |q - q_ref| (m, rad)")
     ax.set_title("Error against time (finest step of each integrator)")
     if data.errors:
         ax.legend(fontsize=6, ncol=2)
@@ -69,7 +69,7 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
         ax.loglog(dts, anchor * (dts / dts[-1]) ** p, "k:", lw=1)
         ax.annotate(f"slope {p}", (dts[0], anchor * (dts[0] / dts[-1]) ** p), fontsize=7)
     ax.set_xlabel("dt (s)")
-    ax.set_ylabel("max error (rad)")
+    ax.set_ylabel("max error (m, rad)")
     ax.set_title("Error against step size (dotted: nominal slopes)")
     if len(c):
         ax.legend(fontsize=6, ncol=2)

@@ -19,8 +19,11 @@ from dyncheck.results import PROVENANCE, provenance_json, to_csv, write_atomic
 from dyncheck.run import RunResult
 
 
-def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Path, str | bytes]:
-    """Every file of the report, in memory (nothing is written)."""
+def render(
+    result: RunResult, out: Path, *, date: str | None = None, drawn: bool = True
+) -> dict[Path, str | bytes]:
+    """Every file of the report, in memory (nothing is written); the figures those the run
+    drew in its units of work, drawn here where it did not — none without ``drawn``."""
     date = date or datetime.now(UTC).strftime("%Y-%m-%d")
     files: dict[Path, str | bytes] = {
         out / "discrepancies.csv": to_csv(result.discrepancies),
@@ -29,7 +32,11 @@ def render(result: RunResult, out: Path, *, date: str | None = None) -> dict[Pat
     }
     for case in result.cases:
         files[out / f"{case.name}.md"] = case_page(case, result)
-        for kind, png in figures(case, result.figures[case.name], result.convergence).items():
+        if not drawn:
+            continue
+        pngs = result.pngs.get(case.name) or figures(
+            case, result.figures[case.name], result.convergence)
+        for kind, png in pngs.items():
             files[out / "figures" / f"{case.name}_{kind}.png"] = png
     files[out / "README.md"] = index_page(result, date=date)
     files[out / "conventions.md"] = conventions_page(result.conventions)
@@ -61,7 +68,7 @@ def rendered_text(result: RunResult, out: Path) -> dict[str, str]:
     """The tables and pages a run writes (figures left out), file name → text."""
     return {
         path.name: content
-        for path, content in render(result, out).items()
+        for path, content in render(result, out, drawn=False).items()
         if isinstance(content, str) and path.parent == out and path.suffix in (".csv", ".md")
     }
 

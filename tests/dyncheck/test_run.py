@@ -31,3 +31,19 @@ def test_moving_to_the_next_case_frees_the_compiled_programs_of_the_last():
     _run_case(get_case("atwood"), IMPLS, 16)
     _run_case(get_case("simple_pendulum"), IMPLS, 16)
     assert alone > 0 and programs() == alone
+
+
+@pytest.mark.slow
+def test_figures_drawn_in_the_workers_are_those_drawn_from_the_whole_run():
+    """Each case's figures drawn in its unit of work (on a pool, from its own convergence
+    points) are the bytes the report draws in this process from the run's whole tables."""
+    from dyncheck.report.figures import figures
+    from dyncheck.run import run
+
+    cases = [get_case("simple_pendulum"), get_case("atwood")]
+    result = run(cases, ["reference", "mujoco", "pinocchio"], jobs=2, render=figures)
+    assert set(result.pngs) == {"simple_pendulum", "atwood"}
+    for case in cases:
+        here = figures(case, result.figures[case.name], result.convergence)
+        assert set(here) == {"trajectory", "error_time", "convergence", "energy"}
+        assert result.pngs[case.name] == here
