@@ -591,7 +591,7 @@ def _check(args: argparse.Namespace) -> int:
     units = [(text, partial(check_model, **options, name=robot), (text,))
              for text, robot in targets]
     failed = False
-    for result in run_units(units, jobs=args.jobs, dask=args.dask, progress=_log):
+    for result in run_units(units, jobs=args.jobs, dask=args.dask):
         written = write(result, args.out)
         print(f"{summary_line(result)} -> {written[1]}")
         if not result.ok:
