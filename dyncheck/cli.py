@@ -56,6 +56,7 @@ def _selection(p: argparse.ArgumentParser) -> None:
         help="cases in N parallel processes (same results)",
     )
     _dask(p)
+    _no_cache(p)
 
 def _no_cache(p: argparse.ArgumentParser) -> None:
     p.add_argument(
@@ -67,7 +68,6 @@ def _no_cache(p: argparse.ArgumentParser) -> None:
 
 
 def _dask(p: argparse.ArgumentParser) -> None:
-    _no_cache(p)
     p.add_argument(
         "--dask",
         default=None,
@@ -131,6 +131,7 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--jobs", type=int, default=1, metavar="N",
                    help="models checked in N parallel processes (same results)")
     _dask(k)
+    _no_cache(k)
     k.add_argument("--in-process", action="store_true",
                    help="load the engines in this process (faster start; an engine that "
                    "crashes on the file then ends the check)")
@@ -169,6 +170,7 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--out", type=_path, default=Path("reports"), help="report folder")
     c.add_argument("--jobs", type=int, default=1, metavar="N")
     _dask(c)
+    _no_cache(c)
     c.add_argument(
         "--from",
         dest="run_dir",
