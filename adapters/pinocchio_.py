@@ -28,7 +28,7 @@ import numpy as np
 import pinocchio as pin
 
 from dyncheck.adapters.base import Adapter, Frame, LoadedBody, StateLayout, Trajectory
-from dyncheck.adapters.integrators import STEPPERS, Layout, integrate, solve_on_group
+from dyncheck.adapters.integrators import STEPPERS, Layout, cross, integrate, solve_on_group
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.cases.multibody import Joint, Multibody
@@ -145,7 +145,7 @@ class PinocchioAdapter(Adapter):
         for body, j in zip(self.spec.bodies, self._joint_ids, strict=True):
             c = d.oMi[j].act(m.inertias[j].lever)
             F = self.spec.central_force(body.mass, c)
-            fext[j] = fext[j] + d.oMi[j].actInv(pin.Force(F, np.cross(c, F)))
+            fext[j] = fext[j] + d.oMi[j].actInv(pin.Force(F, cross(c, F)))
         return fext
 
     def _constrained(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
@@ -238,7 +238,7 @@ class PinocchioAdapter(Adapter):
             if jt == "free":
                 R = quat_to_matrix(q[None, qa + 3 : qa + 7])[0]
                 lin, ang = slice(va, va + 3), slice(va + 3, va + 6)
-                a[lin] = R @ (a[lin] + np.cross(vp[ang], vp[lin]))
+                a[lin] = R @ (a[lin] + cross(vp[ang], vp[lin]))
         return a
 
     def _states_from_mujoco(self, qs: np.ndarray, vs: np.ndarray) -> tuple:

@@ -143,6 +143,8 @@ class SympyMechanicsAdapter(Adapter):
         M, F_free = forcing(gravity_loads)
         args = [*qs, *vs]
         self._kkt = None
+        K_exprs: list[sp.Expr] = []
+        rhs_exprs: list[sp.Expr] = []
         if model.couplings:
             # the cords as holonomic constraints: LagrangesMethod adds multipliers λ with
             # M q̈ − Φᵀ λ = F and the constraints' second derivative Φ q̈ = −Φ̇ q̇
@@ -155,20 +157,22 @@ class SympyMechanicsAdapter(Adapter):
             lm.form_lagranges_equations()
             K = lm.mass_matrix_full[n:, n:]
             rhs = lm.forcing_full[n:, :]
-            self._kkt = (
-                _batched([e.subs(plain) for e in K], args),
-                _batched([e.subs(plain) for e in rhs], args),
-                len(cons),
-            )
-        self._M = _batched([e.subs(plain) for e in M], args)
-        self._h = _batched([(-e).subs(plain) for e in F_free], args)
+            K_exprs, rhs_exprs = [e.subs(plain) for e in K], [e.subs(plain) for e in rhs]
+            self._kkt = (_batched(K_exprs, args), _batched(rhs_exprs, args), len(cons))
+        M_exprs = [e.subs(plain) for e in M]
+        h_exprs = [(-e).subs(plain) for e in F_free]
+        self._M = _batched(M_exprs, args)
+        self._h = _batched(h_exprs, args)
+        field_exprs: list[sp.Expr] = []
         if field_loads:
             _, F_field = forcing(gravity_loads + field_loads)
-            self._field = _batched(
-                [(a - b).subs(plain) for a, b in zip(F_field, F_free, strict=True)], args
-            )
+            field_exprs = [(a - b).subs(plain) for a, b in zip(F_field, F_free, strict=True)]
+            self._field = _batched(field_exprs, args)
         else:
             self._field = None
+        self._stepping = (args, K_exprs + rhs_exprs if model.couplings else
+                          M_exprs + h_exprs + field_exprs)
+        self._step_fn: Callable[..., list[float]] | None = None
         self._T = _batched([T.subs(plain)], args)
         self._V = _batched([V.subs(plain)], args)
         self._n = n
@@ -230,6 +234,24 @@ class SympyMechanicsAdapter(Adapter):
     def potential_energy(self, q: np.ndarray) -> np.ndarray:
         return self._check("potential energy", self._V(*self._args(q))[:, 0])
 
+    def _step_acceleration(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """q̈ at one state with no applied force (a time step's stage): M⁻¹(f − h), or with
+        cords the first n rows of the KKT system's solution (as :meth:`_constrained`) — from
+        one scalar function of the state (common subexpressions shared, Python's ``math``):
+        the per-call cost of the batched path's numpy calls dominated a trajectory."""
+        n = self._n
+        if self._step_fn is None:  # lambdified on first use: only trajectories need it
+            args, exprs = self._stepping
+            self._step_fn = sp.lambdify(args, exprs, modules="math", cse=True)
+        values = np.array(self._step_fn(*q.tolist(), *v.tolist()), float)
+        if self._kkt is not None:
+            size = n + self._kkt[2]
+            K, rhs = values[: size * size].reshape(size, size), values[size * size :]
+            return np.linalg.solve(K, rhs)[:n]
+        M, h, f = values[: n * n].reshape(n, n), values[n * n : n * n + n], values[n * n + n :]
+        rhs = (f - h) if len(f) else -h
+        return rhs / M[0, 0] if n == 1 else np.linalg.solve(M, rhs)
+
     def definition(self, integrator: str) -> str:
         """dyncheck's ``implicitfast`` has D = 0 here (no damping, no actuators): ``euler``."""
         return "euler" if integrator == "implicitfast" else integrator
@@ -237,11 +259,9 @@ class SympyMechanicsAdapter(Adapter):
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:
-        zero = np.zeros((1, self._n))
-
         def acc(q: np.ndarray, v: np.ndarray, held=None) -> np.ndarray:
             if held is None:
-                return self.forward(q[None], v[None], zero)[0]
+                return self._step_acceleration(q, v)
             rhs = held - self._field_force(q[None])
             return self.forward(q[None], v[None], rhs)[0]
 

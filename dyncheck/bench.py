@@ -267,7 +267,7 @@ def ratios(t: pd.DataFrame) -> pd.DataFrame:
 
 
 def write(times: pd.DataFrame, rat: pd.DataFrame, memory: pd.DataFrame, out: Path) -> None:
-    from dyncheck.report.provenance import versions
+    from dyncheck.provenance import versions
 
     v = versions()
     lines = [

@@ -101,7 +101,7 @@ def measure(steps: tuple[Step, ...] = STEPS) -> pd.DataFrame:
 
 
 def write(table: pd.DataFrame, out: Path) -> None:
-    from dyncheck.report.provenance import versions
+    from dyncheck.provenance import versions
 
     v = versions()
     lines = [

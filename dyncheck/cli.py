@@ -380,7 +380,7 @@ def _run(args: argparse.Namespace) -> int:
             if regressed
             else f"no regression against {args.baseline}"
         )
-        moved = baseline.version_changes(args.baseline, report.versions())
+        moved = baseline.version_changes(args.baseline, report.versions(result.engines))
         print(
             "versions changed since the baseline: " + ", ".join(moved)
             if moved
@@ -438,7 +438,7 @@ def _baseline(args: argparse.Namespace) -> int:
     if previous is not None:
         changes = baseline.compare(result.discrepancies, previous, cases=[c.name for c in cases])
         print(changes.to_string(index=False) if len(changes) else "no change")
-    baseline.write(result.discrepancies, args.out, versions=report.versions())
+    baseline.write(result.discrepancies, args.out, versions=report.versions(result.engines))
     print(f"baseline written to {args.out} ({len(result.discrepancies)} rows)")
     return 0
 

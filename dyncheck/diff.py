@@ -31,6 +31,7 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.errors import InvalidInput
+from dyncheck.provenance import NOT_USED
 from dyncheck.results import DISCREPANCY_KEY, PROVENANCE, VERDICTS
 
 FACTOR = 10.0
@@ -207,15 +208,17 @@ def read_versions(folder: Path) -> dict[str, str]:
 
 def version_changes(a: dict[str, str], b: dict[str, str]) -> list[str]:
     """``name old -> new`` for every library whose version differs (dates and commits left
-    out; names and values compared with spaces as underscores, as a baseline's header has
-    them)."""
+    out, and engines one side did not use; names and values compared with spaces as
+    underscores, as a baseline's header has them)."""
 
     def norm(d: dict[str, str]) -> dict[str, str]:
         return {k.replace(" ", "_"): v.replace(" ", "_") for k, v in d.items()}
 
     na, nb = norm(a), norm(b)
     skip = {"date_(UTC)", "dyncheck_commit"}
-    names = [k for k in dict.fromkeys([*na, *nb]) if k not in skip]
+    unused = NOT_USED.replace(" ", "_")
+    names = [k for k in dict.fromkeys([*na, *nb])
+             if k not in skip and unused not in (na.get(k), nb.get(k))]
     return [
         f"{k} {na.get(k, 'absent')} -> {nb.get(k, 'absent')}"
         for k in names

@@ -8,6 +8,7 @@ from functools import partial, reduce
 
 import pandas as pd
 
+from dyncheck.adapters import ENGINE_PACKAGES, loaded
 from dyncheck.cases import Case, get_case
 from dyncheck.catalogue import DEMOS, Entry
 from dyncheck.catalogue import explain as explain_convention
@@ -21,6 +22,7 @@ from dyncheck.implementations import (
     implementations_for,
     make_implementation,
 )
+from dyncheck.provenance import engine_versions
 from dyncheck.results import (
     CONVERGENCE_KEY,
     DISCREPANCY_KEY,
@@ -45,6 +47,9 @@ class RunResult:
     None where the run did not include them."""
     pngs: dict[str, dict[str, bytes]] = field(default_factory=dict)
     """Per case, its figures (kind → PNG) where the run rendered them in its units of work."""
+    engines: dict[str, str] = field(default_factory=dict)
+    """The versions of the engines the units of work used (provenance name → version,
+    :func:`dyncheck.provenance.engine_versions`)."""
 
     @property
     def failed(self) -> bool:
@@ -121,17 +126,24 @@ def _run_case(
     case: Case, impl_names: Sequence[str], states: int | None, *, sliced: bool = False,
     render: Render | None = None,
 ) -> tuple[list[Discrepancy], list[ConvergencePoint], TrajectoryFigures, dict[str, set[str]],
-           dict[str, bytes]]:
+           dict[str, bytes], dict[str, str]]:
     """Everything for one case (a unit of work for a worker process), its figures drawn by
-    ``render`` where given; ``sliced``: the instantaneous comparison is left to
-    :func:`_sweep_slice` units."""
+    ``render`` where given, and the versions of the engines it used; ``sliced``: the
+    instantaneous comparison is left to :func:`_sweep_slice` units."""
     notes: dict[str, set[str]] = {}
     impls = _implementations(case, impl_names, notes)
     rows = [] if sliced else rows_of(sweep(case, impls, case.iter_states(states)))
     points, trajectory_rows, figures = study(case, impls)
     pngs = {} if render is None else render(
         case, figures, table(points, ConvergencePoint, CONVERGENCE_KEY))
-    return rows + trajectory_rows + closed_form_rows(case), points, figures, notes, pngs
+    used = engine_versions(name for name in impls if name in ENGINE_PACKAGES)
+    return rows + trajectory_rows + closed_form_rows(case), points, figures, notes, pngs, used
+
+
+def _convention(name: str) -> tuple[list[Entry], dict[str, str]]:
+    """One demonstration of the conventions catalogue (a unit of work), with the versions of
+    the engines loaded where it ran."""
+    return explain_convention(name), engine_versions(loaded())
 
 
 def run(
@@ -168,7 +180,7 @@ def run(
                 units.append((f"{case.name} states {start}..{stop - 1}", _sweep_slice,
                               (case, list(impl_names), n, start, stop)))
     if conventions:
-        units += [(f"conventions: {name}", explain_convention, (name,)) for name in DEMOS]
+        units += [(f"conventions: {name}", _convention, (name,)) for name in DEMOS]
     done = run_units(units, jobs=jobs, dask=dask, progress=progress)
     rows: list[Discrepancy] = []
     points: list[ConvergencePoint] = []
@@ -176,11 +188,14 @@ def run(
     pngs: dict[str, dict[str, bytes]] = {}
     notes: dict[str, set[str]] = {}
     entries: list[Entry] = []
+    engines: dict[str, str] = {}
     for (what, fn, _args), out in zip(units, done, strict=True):
-        if fn is explain_convention:
-            entries += out
+        if fn is _convention:
+            entries += out[0]
+            engines |= out[1]
         elif fn is not _sweep_slice:  # a case; its slices' sweeps merged in order
-            r, p, f, said, drawn = out
+            r, p, f, said, drawn, used = out
+            engines |= used
             if what in slices:
                 r = rows_of(reduce(Sweep.merge, (done[i] for i in slices[what]))) + r
             rows += r
@@ -198,4 +213,5 @@ def run(
         {k: sorted(v) for k, v in notes.items() if v},
         entries if conventions else None,
         pngs,
+        engines,
     )

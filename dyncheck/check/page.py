@@ -14,7 +14,7 @@ from dyncheck.results import PROVENANCE, Verdict, provenance_json, to_csv, write
 
 
 def _versions() -> dict[str, str]:
-    from dyncheck.report.provenance import versions
+    from dyncheck.provenance import versions
 
     return versions()
 

@@ -8,9 +8,9 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from dyncheck.freshness import Moved, compare, read_report
+from dyncheck.provenance import versions
 from dyncheck.report.figures import figures
 from dyncheck.report.pages import case_page, conventions_page, errata, index_page
-from dyncheck.report.provenance import versions
 from dyncheck.report.tables import (
     conservation_table,
     md,
@@ -40,7 +40,7 @@ def render(
             files[out / "figures" / f"{case.name}_{kind}.png"] = png
     files[out / "README.md"] = index_page(result, date=date)
     files[out / "conventions.md"] = conventions_page(result.conventions)
-    files[out / PROVENANCE] = provenance_json({"date (UTC)": date, **versions()})
+    files[out / PROVENANCE] = provenance_json({"date (UTC)": date, **versions(result.engines)})
     lead, table = errata(result.discrepancies)
     files[out / "printed-equations.md"] = "\n".join(
         [

@@ -8,7 +8,7 @@ import pandas as pd
 from dyncheck.cases import Case
 from dyncheck.catalogue import Entry
 from dyncheck.explanations import EXPLANATIONS
-from dyncheck.report.provenance import versions
+from dyncheck.provenance import versions
 from dyncheck.report.tables import (
     conservation_matrix,
     controlled_matrix,
@@ -162,7 +162,7 @@ def errata(d: pd.DataFrame) -> tuple[str, pd.DataFrame]:
 
 def index_page(result: RunResult, *, date: str) -> str:
     d, conv = result.discrepancies, result.convergence
-    made_with = versions()
+    made_with = versions(result.engines)
     prov = pd.DataFrame({"item": ["date (UTC)", *made_with], "value": [date, *made_with.values()]})
     failed = d[d.verdict.isin(["failed", "skipped"])]
     explained = d.loc[d.verdict == "explained", "convention"]

@@ -187,6 +187,20 @@ def test_one_step_matches_integrator_definition(engine, integrator):
     assert_allclose(traj.v[-1], v1, rtol=0, atol=ulps(adapter, 1e-14))
 
 
+@pytest.mark.parametrize("case_name", [c for c in CASE_NAMES if supported(c, "sympy-mechanics")])
+def test_sympy_mechanics_time_step_acceleration_is_its_forward_dynamics(case_name):
+    """The one-state function a trajectory's stages call (one scalar lambdified function of
+    M, h and f, or of the cords' KKT system) against the batched forward dynamics of the same
+    equations (numpy lambdified, a linear solve per state): equal to round-off."""
+    adapter = _adapter(case_name, "sympy-mechanics")
+    rng = np.random.default_rng(3)
+    n = adapter.spec.nv
+    q, v = rng.uniform(-1, 1, (6, n)), rng.uniform(-1, 1, (6, n))
+    batched = adapter.forward(q, v, np.zeros((6, n)))
+    stepped = np.array([adapter._step_acceleration(qi, vi) for qi, vi in zip(q, v, strict=True)])
+    assert_allclose(stepped, batched, rtol=0, atol=1e-13 * np.abs(batched).max())
+
+
 def test_mjcf_point_mass_is_an_inertial_not_a_geom():
     xml = to_mjcf(get_case("compound_pendulum").multibody())
     assert "<geom" not in xml and xml.count("<inertial") == 2
