@@ -86,15 +86,11 @@ class SphericalToCartesian:
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         rho, th, ph = q.T
         st, ct, sp_, cp = np.sin(th), np.cos(th), np.sin(ph), np.cos(ph)
-        z = np.zeros_like(rho)
-        return np.stack(
-            [
-                np.stack([st * cp, rho * ct * cp, -rho * st * sp_], -1),
-                np.stack([st * sp_, rho * ct * sp_, rho * st * cp], -1),
-                np.stack([ct, -rho * st, z], -1),
-            ],
-            -2,
-        )
+        J = np.empty((q.shape[0], 3, 3))  # filled in place: a stage calls it on one state
+        J[:, 0, 0], J[:, 0, 1], J[:, 0, 2] = st * cp, rho * ct * cp, -rho * st * sp_
+        J[:, 1, 0], J[:, 1, 1], J[:, 1, 2] = st * sp_, rho * ct * sp_, rho * st * cp
+        J[:, 2, 0], J[:, 2, 1], J[:, 2, 2] = ct, -rho * st, 0.0
+        return J
 
     def hessian_term(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """(∂²x̄/∂xᵐ∂xⁿ) vᵐ vⁿ, written out from the second derivatives of x̄."""

@@ -54,11 +54,23 @@ def _vectorize(expr: sp.Expr, args: Sequence[sp.Symbol]) -> Callable[..., np.nda
 
 def _fused(exprs: Sequence[sp.Expr], args: Sequence[sp.Symbol]) -> Callable[..., np.ndarray]:
     """Many expressions in one numpy function (shared subexpressions computed once); each
-    result broadcast to the batch shape, stacked on the last axis."""
+    result broadcast to the batch shape, stacked on the last axis. A batch of one state (a
+    time step's stage) is evaluated by the same expressions in Python's ``math``, where
+    numpy's per-call overhead would cost ten times the arithmetic; an argument outside
+    ``math``'s domain falls back to numpy (its NaN or infinity, as for a batch)."""
     f = sp.lambdify(args, list(exprs), modules="numpy", cse=True)
+    scalar: list[Callable[..., list[float]]] = []  # lambdified on first use
 
     def evaluate(*values: np.ndarray) -> np.ndarray:
         shape = np.broadcast(*values).shape
+        if shape == (1,):
+            if not scalar:
+                scalar.append(sp.lambdify(args, list(exprs), modules="math", cse=True))
+            try:
+                one = [float(x[0]) if isinstance(x, np.ndarray) else float(x) for x in values]
+                return np.array([scalar[0](*one)], dtype=float)
+            except (ArithmeticError, ValueError):  # outside math's domain
+                pass
         return np.stack(
             [np.broadcast_to(np.asarray(x, dtype=float), shape) for x in f(*values)], -1
         )
