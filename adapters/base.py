@@ -15,14 +15,17 @@ Adapters never see the book's coordinates: the comparison layer maps them.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import ClassVar
+from typing import ClassVar, TypeVar
 
 import numpy as np
 
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import EngineError, Unsupported
+
+_T = TypeVar("_T")
 
 DIVERGED = 1e12
 """A coordinate beyond this (rad or m) means a run has blown up: no case here comes near it."""
@@ -111,6 +114,14 @@ class Adapter(ABC):
     couplings_with_field: ClassVar[bool] = False
     """Whether the adapter holds couplings and an external field in one model (refused, before
     any work, where it does not)."""
+
+    @staticmethod
+    def derive(kind: str, inputs: object, compute: Callable[[], _T]) -> _T:
+        """How an adapter that derives its equations symbolically keeps them: ``compute()``
+        here; the comparison layer, which may see the reference, plugs in its disk cache
+        of derivations (:func:`dyncheck.reference.derivations.derived`, same signature:
+        ``kind``, the ``inputs`` that key the result, and how to compute it)."""
+        return compute()
 
     def __init__(self, model: Multibody) -> None:
         if model.couplings and model.central_mu and not self.couplings_with_field:

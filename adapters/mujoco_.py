@@ -217,6 +217,14 @@ class MuJoCoAdapter(Adapter):
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:
+        """MuJoCo's own ``mj_step``; its divergence warnings read once at the end — where
+        one was raised, the run is made again watching each step, to name the step."""
+        return self._stepped(q0, v0, duration, dt, integrator, watch=False)
+
+    def _stepped(
+        self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str,
+        *, watch: bool,
+    ) -> Trajectory:
         m, d = self.model, self.data
         steps = round(duration / dt)
         m.opt.timestep = dt
@@ -230,22 +238,27 @@ class MuJoCoAdapter(Adapter):
         field = bool(self.spec.central_mu)
         if field and not held:
             mujoco.set_mjcb_passive(self._passive)
+        def diverged() -> bool:
+            return any(d.warning[w].number for w in _DIVERGED)
+
         try:
             for k in range(1, steps + 1):
                 if field and held:
                     mujoco.mj_kinematics(m, d)
                     self._field_xfrc(d)
                 mujoco.mj_step(m, d)
-                if any(d.warning[w].number for w in _DIVERGED):
+                qs[k], vs[k] = d.qpos, d.qvel
+                if watch and diverged():
                     # MuJoCo resets a diverged state and goes on; dyncheck reports it
                     raise EngineError(
                         f"mujoco {integrator} diverged at step {k} (t = {k * dt:g}): NaN or "
                         "huge qpos/qvel/qacc, state reset by MuJoCo"
                     )
-                qs[k], vs[k] = d.qpos, d.qvel
         finally:
             if field and not held:
                 mujoco.set_mjcb_passive(None)
+        if diverged() and not watch:  # warnings count: run again, watching each step, to name it
+            return self._stepped(q0, v0, duration, dt, integrator, watch=True)
         return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)
 
     def _passive(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:

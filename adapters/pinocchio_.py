@@ -220,6 +220,8 @@ class PinocchioAdapter(Adapter):
 
     def _from_mujoco(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The inverse of :meth:`_to_mujoco`."""
+        if not self.layout.rotating:  # the same layout: each stage's state as it is
+            return np.asarray(q, float), np.asarray(v, float)
         q, v = np.array(q, float), np.array(v, float)
         for jt, qa, va in self.layout.joints:
             if jt == "free":

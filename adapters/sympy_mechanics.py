@@ -18,7 +18,10 @@ Energies: ``kinetic_energy`` and V = −Σ m g·r. Couplings (cords) are ``hol_c
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
@@ -63,6 +66,120 @@ def _batched(exprs: list[sp.Expr], args: list[sp.Symbol]) -> Callable[..., np.nd
     return evaluate
 
 
+_SOURCE = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:16]
+"""This module's source, part of the key of its cached derivations (an edit derives afresh)."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class Equations:
+    """What LagrangesMethod derives for a model, in plain symbols x0.., v0.. (positions,
+    velocities): M and h = −F of the canonical form, the field's generalized force, the
+    cords' KKT matrix and right-hand side (with ``ncons`` multipliers), T and V."""
+
+    M: tuple[sp.Expr, ...]
+    h: tuple[sp.Expr, ...]
+    field: tuple[sp.Expr, ...]
+    K: tuple[sp.Expr, ...]
+    rhs: tuple[sp.Expr, ...]
+    ncons: int
+    T: sp.Expr
+    V: sp.Expr
+
+
+def _derive(model: Multibody) -> Equations:
+    """The model as frames, points and particles, and Lagrange's equations (the module's
+    docstring says how)."""
+    n = model.nv
+    q = me.dynamicsymbols(f"q0:{n}")
+    qd = [qi.diff() for qi in q]
+    N = me.ReferenceFrame("N")
+    O = me.Point("O")
+    O.set_vel(N, 0)
+    frames = {None: N}
+    points = {None: O}
+    particles, gravity_loads, field_loads, V = [], [], [], sp.Integer(0)
+    g = _vec(N, model.gravity)
+    k = 0
+    for body in model.bodies:
+        frame = frames[body.parent]
+        point = points[body.parent].locatenew(f"{body.name}_j", _vec(frame, body.joint_pos))
+        for joint in body.joints:
+            if joint.type == "free":  # position in the parent's axes, then a ball
+                offset = q[k] * frame.x + q[k + 1] * frame.y + q[k + 2] * frame.z
+                point = point.locatenew(f"{joint.name}_P", offset)
+                k += 3
+            if joint.type in ROTATING:  # Example 9's angles: body Z, X, Z
+                frame = frame.orientnew(
+                    f"{joint.name}_F", "Body", (q[k], q[k + 1], q[k + 2]), "ZXZ"
+                )
+                k += 3
+            elif joint.type == "hinge":
+                frame = frame.orientnew(
+                    f"{joint.name}_F", "Axis", (q[k], _vec(frame, joint.axis))
+                )
+                k += 1
+            else:
+                point = point.locatenew(f"{joint.name}_P", q[k] * _vec(frame, joint.axis))
+                k += 1
+        com = point.locatenew(f"{body.name}_c", _vec(frame, body.com))
+        r = com.pos_from(O)
+        com.set_vel(N, r.dt(N))
+        frame.set_ang_vel(N, frame.ang_vel_in(N))
+        m = sp.Rational(float(body.mass))
+        I = model.body_inertia(body)  # a point mass on a ball joint carries the floor
+        if not I.any():
+            particles.append(me.Particle(body.name, com, m))
+        else:
+            dyad = me.inertia(
+                frame,
+                *(
+                    sp.Rational(float(x))
+                    for x in (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[1, 2], I[0, 2])
+                ),
+            )
+            particles.append(me.RigidBody(body.name, com, frame, m, (dyad, com)))
+        gravity_loads.append((com, m * g))
+        V -= m * g.dot(r)
+        if model.central_mu:
+            dist = sp.sqrt(r.dot(r))
+            field_loads.append((com, -sp.Rational(float(model.central_mu)) * m * r / dist**3))
+        frames[body.name], points[body.name] = frame, point
+    T = me.kinetic_energy(N, *particles)
+    qs, vs = sp.symbols(f"x0:{n}"), sp.symbols(f"v0:{n}")
+    plain = dict(zip(qd, vs, strict=True)) | dict(zip(q, qs, strict=True))
+
+    def forcing(loads: list) -> sp.Matrix:
+        lm = me.LagrangesMethod(T, q, forcelist=loads or None, frame=N)
+        lm.form_lagranges_equations()
+        return lm.mass_matrix, lm.forcing
+
+    M, F_free = forcing(gravity_loads)
+    K_exprs: list[sp.Expr] = []
+    rhs_exprs: list[sp.Expr] = []
+    if model.couplings:
+        # the cords as holonomic constraints: LagrangesMethod adds multipliers λ with
+        # M q̈ − Φᵀ λ = F and the constraints' second derivative Φ q̈ = −Φ̇ q̇
+        index = {j.name: i for i, j in enumerate(model.joints)}
+        cons = [
+            sum(sp.Rational(float(c)) * q[index[j]] for j, c in cp.coefs)
+            for cp in model.couplings
+        ]
+        lm = me.LagrangesMethod(T, q, hol_coneqs=cons, forcelist=gravity_loads, frame=N)
+        lm.form_lagranges_equations()
+        K = lm.mass_matrix_full[n:, n:]
+        rhs = lm.forcing_full[n:, :]
+        K_exprs, rhs_exprs = [e.subs(plain) for e in K], [e.subs(plain) for e in rhs]
+    M_exprs = [e.subs(plain) for e in M]
+    h_exprs = [(-e).subs(plain) for e in F_free]
+    field_exprs: list[sp.Expr] = []
+    if field_loads:
+        _, F_field = forcing(gravity_loads + field_loads)
+        field_exprs = [(a - b).subs(plain) for a, b in zip(F_field, F_free, strict=True)]
+    return Equations(
+        M=tuple(M_exprs), h=tuple(h_exprs), field=tuple(field_exprs), K=tuple(K_exprs),
+        rhs=tuple(rhs_exprs), ncons=len(model.couplings), T=T.subs(plain), V=V.subs(plain))
+
+
 class SympyMechanicsAdapter(Adapter):
     name: ClassVar[str] = "sympy-mechanics"
     state_layout: ClassVar[StateLayout] = StateLayout(
@@ -77,104 +194,19 @@ class SympyMechanicsAdapter(Adapter):
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
         n = model.nv
-        q = me.dynamicsymbols(f"q0:{n}")
-        qd = [qi.diff() for qi in q]
-        N = me.ReferenceFrame("N")
-        O = me.Point("O")
-        O.set_vel(N, 0)
-        frames = {None: N}
-        points = {None: O}
-        particles, gravity_loads, field_loads, V = [], [], [], sp.Integer(0)
-        g = _vec(N, model.gravity)
-        k = 0
-        for body in model.bodies:
-            frame = frames[body.parent]
-            point = points[body.parent].locatenew(f"{body.name}_j", _vec(frame, body.joint_pos))
-            for joint in body.joints:
-                if joint.type == "free":  # position in the parent's axes, then a ball
-                    offset = q[k] * frame.x + q[k + 1] * frame.y + q[k + 2] * frame.z
-                    point = point.locatenew(f"{joint.name}_P", offset)
-                    k += 3
-                if joint.type in ROTATING:  # Example 9's angles: body Z, X, Z
-                    frame = frame.orientnew(
-                        f"{joint.name}_F", "Body", (q[k], q[k + 1], q[k + 2]), "ZXZ"
-                    )
-                    k += 3
-                elif joint.type == "hinge":
-                    frame = frame.orientnew(
-                        f"{joint.name}_F", "Axis", (q[k], _vec(frame, joint.axis))
-                    )
-                    k += 1
-                else:
-                    point = point.locatenew(f"{joint.name}_P", q[k] * _vec(frame, joint.axis))
-                    k += 1
-            com = point.locatenew(f"{body.name}_c", _vec(frame, body.com))
-            r = com.pos_from(O)
-            com.set_vel(N, r.dt(N))
-            frame.set_ang_vel(N, frame.ang_vel_in(N))
-            m = sp.Rational(float(body.mass))
-            I = model.body_inertia(body)  # a point mass on a ball joint carries the floor
-            if not I.any():
-                particles.append(me.Particle(body.name, com, m))
-            else:
-                dyad = me.inertia(
-                    frame,
-                    *(
-                        sp.Rational(float(x))
-                        for x in (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[1, 2], I[0, 2])
-                    ),
-                )
-                particles.append(me.RigidBody(body.name, com, frame, m, (dyad, com)))
-            gravity_loads.append((com, m * g))
-            V -= m * g.dot(r)
-            if model.central_mu:
-                dist = sp.sqrt(r.dot(r))
-                field_loads.append((com, -sp.Rational(float(model.central_mu)) * m * r / dist**3))
-            frames[body.name], points[body.name] = frame, point
-        T = me.kinetic_energy(N, *particles)
-        qs, vs = sp.symbols(f"x0:{n}"), sp.symbols(f"v0:{n}")
-        plain = dict(zip(qd, vs, strict=True)) | dict(zip(q, qs, strict=True))
-
-        def forcing(loads: list) -> sp.Matrix:
-            lm = me.LagrangesMethod(T, q, forcelist=loads or None, frame=N)
-            lm.form_lagranges_equations()
-            return lm.mass_matrix, lm.forcing
-
-        M, F_free = forcing(gravity_loads)
-        args = [*qs, *vs]
+        eq = self.derive("sympy_mechanics", (repr(model), _SOURCE), lambda: _derive(model))
+        args = [*sp.symbols(f"x0:{n}"), *sp.symbols(f"v0:{n}")]
         self._kkt = None
-        K_exprs: list[sp.Expr] = []
-        rhs_exprs: list[sp.Expr] = []
         if model.couplings:
-            # the cords as holonomic constraints: LagrangesMethod adds multipliers λ with
-            # M q̈ − Φᵀ λ = F and the constraints' second derivative Φ q̈ = −Φ̇ q̇
-            index = {j.name: i for i, j in enumerate(model.joints)}
-            cons = [
-                sum(sp.Rational(float(c)) * q[index[j]] for j, c in cp.coefs)
-                for cp in model.couplings
-            ]
-            lm = me.LagrangesMethod(T, q, hol_coneqs=cons, forcelist=gravity_loads, frame=N)
-            lm.form_lagranges_equations()
-            K = lm.mass_matrix_full[n:, n:]
-            rhs = lm.forcing_full[n:, :]
-            K_exprs, rhs_exprs = [e.subs(plain) for e in K], [e.subs(plain) for e in rhs]
-            self._kkt = (_batched(K_exprs, args), _batched(rhs_exprs, args), len(cons))
-        M_exprs = [e.subs(plain) for e in M]
-        h_exprs = [(-e).subs(plain) for e in F_free]
-        self._M = _batched(M_exprs, args)
-        self._h = _batched(h_exprs, args)
-        field_exprs: list[sp.Expr] = []
-        if field_loads:
-            _, F_field = forcing(gravity_loads + field_loads)
-            field_exprs = [(a - b).subs(plain) for a, b in zip(F_field, F_free, strict=True)]
-            self._field = _batched(field_exprs, args)
-        else:
-            self._field = None
-        self._stepping = (args, K_exprs + rhs_exprs if model.couplings else
-                          M_exprs + h_exprs + field_exprs)
+            self._kkt = (_batched(list(eq.K), args), _batched(list(eq.rhs), args), eq.ncons)
+        self._M = _batched(list(eq.M), args)
+        self._h = _batched(list(eq.h), args)
+        self._field = _batched(list(eq.field), args) if eq.field else None
+        self._stepping = (args, [*eq.K, *eq.rhs] if model.couplings else
+                          [*eq.M, *eq.h, *eq.field])
         self._step_fn: Callable[..., list[float]] | None = None
-        self._T = _batched([T.subs(plain)], args)
-        self._V = _batched([V.subs(plain)], args)
+        self._T = _batched([eq.T], args)
+        self._V = _batched([eq.V], args)
         self._n = n
 
     @staticmethod

@@ -117,45 +117,27 @@ class SphericalToCartesian:
 
 def quat_from_matrix(R: np.ndarray) -> np.ndarray:
     """Unit quaternions (w, x, y, z), w ≥ 0, of rotation matrices (n, 3, 3) (Shepperd's
-    method, the branch on the largest of w², x², y², z²)."""
-    n = R.shape[0]
+    method, the branch on the largest of w², x², y², z²; every branch computed over the
+    batch, each row taking its own)."""
     tr = np.trace(R, axis1=1, axis2=2)
     cand = np.stack(
         [1 + tr, 1 + 2 * R[:, 0, 0] - tr, 1 + 2 * R[:, 1, 1] - tr, 1 + 2 * R[:, 2, 2] - tr], -1
     )
     k = np.argmax(cand, axis=1)
-    q = np.empty((n, 4))
-    for i in range(n):
-        r, c = R[i], cand[i, k[i]]
-        s = 0.5 / np.sqrt(c)
-        if k[i] == 0:
-            q[i] = [
-                0.25 / s,
-                (r[2, 1] - r[1, 2]) * s,
-                (r[0, 2] - r[2, 0]) * s,
-                (r[1, 0] - r[0, 1]) * s,
-            ]
-        elif k[i] == 1:
-            q[i] = [
-                (r[2, 1] - r[1, 2]) * s,
-                0.25 / s,
-                (r[0, 1] + r[1, 0]) * s,
-                (r[0, 2] + r[2, 0]) * s,
-            ]
-        elif k[i] == 2:
-            q[i] = [
-                (r[0, 2] - r[2, 0]) * s,
-                (r[0, 1] + r[1, 0]) * s,
-                0.25 / s,
-                (r[1, 2] + r[2, 1]) * s,
-            ]
-        else:
-            q[i] = [
-                (r[1, 0] - r[0, 1]) * s,
-                (r[0, 2] + r[2, 0]) * s,
-                (r[1, 2] + r[2, 1]) * s,
-                0.25 / s,
-            ]
+    with np.errstate(divide="ignore", invalid="ignore"):  # branches a row does not take
+        s = 0.5 / np.sqrt(np.take_along_axis(cand, k[:, None], 1)[:, 0])
+        quarter = 0.25 / s
+    d21, d02, d10 = R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]
+    s01, s02, s12 = R[:, 0, 1] + R[:, 1, 0], R[:, 0, 2] + R[:, 2, 0], R[:, 1, 2] + R[:, 2, 1]
+    branches = np.stack(
+        [
+            np.stack([quarter, d21 * s, d02 * s, d10 * s], -1),
+            np.stack([d21 * s, quarter, s01 * s, s02 * s], -1),
+            np.stack([d02 * s, s01 * s, quarter, s12 * s], -1),
+            np.stack([d10 * s, s02 * s, s12 * s, quarter], -1),
+        ]
+    )
+    q = np.take_along_axis(branches, k[None, :, None], 0)[0]
     q *= np.where(q[:, :1] < 0, -1.0, 1.0)
     return q
 

@@ -28,9 +28,15 @@ from dyncheck.conventions import (
 )
 from dyncheck.errors import UnknownName
 from dyncheck.reference.constraints import Softness
+from dyncheck.reference.derivations import derived
 from dyncheck.reference.systems import SYSTEMS
 from dyncheck.reference.trajectory import solve
 from dyncheck.roster import IMPLEMENTATIONS
+
+# adapters that derive their equations symbolically (sympy-mechanics) keep them in the
+# reference's disk cache of derivations — the cache, not the derivation, is shared; adapters
+# cannot import the reference, so this layer plugs it in (Adapter.derive)
+Adapter.derive = staticmethod(derived)  # type: ignore[method-assign]
 
 QUANTITIES: tuple[str, ...] = (
     "mass_matrix",

@@ -1,0 +1,52 @@
+"""The comparison layer's wiring (dyncheck/implementations.py): sympy-mechanics, an adapter
+that derives its equations with sympy, keeps them in the reference's disk cache of
+derivations, which the adapter cannot import itself.
+
+Expected values: the adapter's equations derived afresh (LagrangesMethod) — those read back
+must give the same forward dynamics, with no derivation run.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import dyncheck.implementations  # noqa: F401 — plugs the cache into the adapters
+from dyncheck.adapters import get_adapter
+from dyncheck.adapters import sympy_mechanics as sm
+from dyncheck.cases import get_case
+from dyncheck.reference import derivations
+
+
+@pytest.mark.parametrize("case_name", ["compound_pendulum", "atwood", "kepler"])
+def test_sympy_mechanics_reads_its_equations_back_without_deriving(
+    case_name, tmp_path, monkeypatch
+):
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
+    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
+    model = get_case(case_name).multibody()
+    adapter = get_adapter("sympy-mechanics")
+    first = adapter(model)
+    assert list((tmp_path / "derivations").rglob("sympy_mechanics-*.pickle"))
+
+    def refuse(_model):
+        raise AssertionError("derived again although the equations are cached")
+
+    monkeypatch.setattr(sm, "_derive", refuse)
+    again = adapter(model)
+    rng = np.random.default_rng(5)
+    q, v = rng.uniform(-1, 1, (4, model.nv)), rng.uniform(-1, 1, (4, model.nv))
+    tau = np.zeros_like(q)
+    assert np.array_equal(again.forward(q, v, tau), first.forward(q, v, tau))
+
+
+def test_sympy_mechanics_without_the_cache_derives(tmp_path, monkeypatch):
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
+    monkeypatch.setenv(derivations.NO_CACHE, "1")
+    calls = []
+    derive = sm._derive
+    monkeypatch.setattr(sm, "_derive", lambda model: calls.append(1) or derive(model))
+    model = get_case("simple_pendulum").multibody()
+    get_adapter("sympy-mechanics")(model)
+    get_adapter("sympy-mechanics")(model)
+    assert len(calls) == 2 and not (tmp_path / "derivations").exists()
