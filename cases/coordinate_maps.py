@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Protocol
 
 import numpy as np
@@ -40,20 +41,29 @@ class LinearMap:
     offset: tuple[float, ...]
     description: str
 
-    @property
+    @cached_property
     def A(self) -> np.ndarray:
-        return np.asarray(self.matrix, dtype=float)
+        """The matrix as an array (read-only: built once, asked at every stage of a step)."""
+        A = np.asarray(self.matrix, dtype=float)
+        A.flags.writeable = False
+        return A
+
+    @cached_property
+    def _offset(self) -> np.ndarray:
+        c = np.asarray(self.offset, dtype=float)
+        c.flags.writeable = False
+        return c
 
     def to_engine(self, q: np.ndarray) -> np.ndarray:
-        return q @ self.A.T + np.asarray(self.offset)
+        return q @ self.A.T + self._offset
 
     def to_book(self, qe: np.ndarray) -> np.ndarray:
         """x = A⁻¹ (x̄ − c); least squares (AᵀA)⁻¹Aᵀ(x̄ − c) for an embedding (more engine
         coordinates than book ones: a constraint's), exact on A's range."""
         A = self.A
         if A.shape[0] == A.shape[1]:
-            return np.linalg.solve(A, (qe - np.asarray(self.offset)).T).T
-        return np.linalg.solve(A.T @ A, A.T @ (qe - np.asarray(self.offset)).T).T
+            return np.linalg.solve(A, (qe - self._offset).T).T
+        return np.linalg.solve(A.T @ A, A.T @ (qe - self._offset).T).T
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         """∂x̄ʳ/∂xʲ of (2.2.4), shape (n, ne, nb)."""
