@@ -34,7 +34,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, partial
 
 import numpy as np
 from scipy.integrate import DOP853, solve_ivp
@@ -193,6 +193,11 @@ STEPPERS: dict[str, Callable[..., tuple]] = {
 }
 
 
+def _stage(acc: Acceleration, held: object, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """A stage's v̇: ``held`` the force frozen at the start of the step, or None."""
+    return acc(q, v, held)
+
+
 def integrate(
     acc: Acceleration,
     q0: np.ndarray,
@@ -216,18 +221,10 @@ def integrate(
     qs = np.empty((steps + 1, q.shape[0]))
     vs = np.empty((steps + 1, v.shape[0]))
     qs[0], vs[0] = q, v
-    held = integrator == "rk4-held-force" and freeze is not None
+    hold = freeze if integrator == "rk4-held-force" else None
+    live = partial(_stage, acc, None)  # every stage evaluates the force now
     for k in range(1, steps + 1):
-        if held:
-            frozen = freeze(q, v)
-
-            def stage(qq: np.ndarray, vv: np.ndarray, frozen=frozen) -> np.ndarray:
-                return acc(qq, vv, frozen)
-        else:
-
-            def stage(qq: np.ndarray, vv: np.ndarray) -> np.ndarray:
-                return acc(qq, vv, None)
-
+        stage = live if hold is None else partial(_stage, acc, hold(q, v))
         q, v = step(stage, q, v, dt, layout, naive_group)
         qs[k], vs[k] = q, v
         if not math.isfinite(q.sum() + v.sum()):  # a NaN or an infinity (or |x| ~ 1e308)

@@ -110,6 +110,7 @@ class PinocchioAdapter(Adapter):
         self._joint_ids = [self._body_joint(b.name) for b in model.bodies]
         self._C = model.coupling_matrix() if model.couplings else None
         self.layout = Layout.of([j.type for j in model.joints])
+        self._zero_tau = np.zeros(self.model.nv)  # τ = 0 at every stage (read-only to ABA)
 
     def _build(self, model: Multibody) -> pin.Model:
         return build_model(model)
@@ -235,7 +236,9 @@ class PinocchioAdapter(Adapter):
         """v̇ in MuJoCo's layout: Pinocchio's ABA, a free joint's v̇_b turned into
         R (v̇_b + ω × v_b), the rate of v_w = R v_b."""
         qp, vp = self._from_mujoco(q, v)
-        a = self._aba(qp, vp, np.zeros(self.model.nv), held)
+        a = self._aba(qp, vp, self._zero_tau, held)
+        if not self.layout.rotating:
+            return a
         for jt, qa, va in self.layout.joints:
             if jt == "free":
                 R = quat_to_matrix(q[None, qa + 3 : qa + 7])[0]
