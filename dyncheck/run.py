@@ -8,7 +8,7 @@ from functools import partial, reduce
 
 import pandas as pd
 
-from dyncheck.adapters import ENGINE_PACKAGES, loaded
+from dyncheck.adapters import loaded
 from dyncheck.cases import Case, get_case
 from dyncheck.catalogue import DEMOS, Entry
 from dyncheck.catalogue import explain as explain_convention
@@ -136,7 +136,7 @@ def _run_case(
     points, trajectory_rows, figures = study(case, impls)
     pngs = {} if render is None else render(
         case, figures, table(points, ConvergencePoint, CONVERGENCE_KEY))
-    used = engine_versions(name for name in impls if name in ENGINE_PACKAGES)
+    used = engine_versions(impls)  # the reference and the book name no engine
     return rows + trajectory_rows + closed_form_rows(case), points, figures, notes, pngs, used
 
 
