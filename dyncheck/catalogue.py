@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
+from functools import partial
 
 import numpy as np
 
@@ -45,7 +46,7 @@ from dyncheck.explain.parsers import (
 )
 from dyncheck.explanations import Origin
 
-__all__ = ["DEMOS", "REQUIRES", "TUTORIALS", "Entry", "explain", "render"]
+__all__ = ["DEMOS", "REQUIRES", "TUTORIALS", "Entry", "explain", "explain_cached", "render"]
 
 
 DEMOS: dict[str, tuple[Callable[[], Entry], Origin]] = {
@@ -124,14 +125,31 @@ def _run(name: str) -> Entry:
     return dataclasses.replace(entry, origin=origin)
 
 
+def _names(name: str | None) -> list[str]:
+    if name is None:
+        return list(DEMOS)
+    if name not in DEMOS:
+        raise UnknownName("convention", name, DEMOS)
+    return [name]
+
+
 def explain(name: str | None = None) -> list[Entry]:
     """Run the demonstration ``name`` (all when None); an entry whose engine is not installed
     is returned skipped, with the reason."""
-    if name is None:
-        return [_run(n) for n in DEMOS]
-    if name not in DEMOS:
-        raise UnknownName("convention", name, DEMOS)
-    return [_run(name)]
+    return [_run(n) for n in _names(name)]
+
+
+def explain_cached(name: str | None = None) -> tuple[list[Entry], int]:
+    """:func:`explain`, reading back each entry that was measured before with the same
+    source, engines and machine (:mod:`dyncheck.measured_cache`; a failed entry is measured
+    every time); with how many were read back."""
+    from dyncheck.measured_cache import measured
+
+    results = [
+        measured("explain", n, partial(_run, n), keep=lambda e: not e.failed)
+        for n in _names(name)
+    ]
+    return [entry for entry, _ in results], sum(found for _, found in results)
 
 
 def render(entries: list[Entry]) -> str:

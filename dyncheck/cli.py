@@ -62,8 +62,8 @@ def _no_cache(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--no-cache",
         action="store_true",
-        help="derive every symbolic result afresh, neither reading nor writing the cache of "
-        "derivations (under $DYNCHECK_CACHE or ~/.cache/dyncheck)",
+        help="derive every symbolic result (and measure every demonstration) afresh, neither "
+        "reading nor writing the cache (under $DYNCHECK_CACHE or ~/.cache/dyncheck)",
     )
 
 
@@ -544,15 +544,19 @@ def _tutorials(args: argparse.Namespace) -> int:
 
 
 def _explain(args: argparse.Namespace) -> int:
-    from dyncheck.catalogue import explain, render
+    from dyncheck.catalogue import explain_cached, render
 
     if args.name is not None and args.name.startswith("erratum-"):
         from dyncheck.errata import page
 
         print(page.explain(args.name.removeprefix("erratum-")))
         return 0
-    entries = explain(args.name)
+    entries, read_back = explain_cached(args.name)
     print(render(entries))
+    if read_back:
+        print(f"({read_back} of {len(entries)} measured by an earlier `dyncheck explain` with "
+              "the same dyncheck, engines and machine, read from the cache; --no-cache "
+              "measures afresh)")
     return 1 if any(e.failed for e in entries) else 0
 
 

@@ -18,7 +18,7 @@ import tempfile
 from collections.abc import Callable
 from functools import cache
 from pathlib import Path
-from typing import TypeVar
+from typing import Any, TypeVar
 
 T = TypeVar("T")
 
@@ -59,12 +59,25 @@ def derived(kind: str, inputs: object, compute: Callable[[], T]) -> T:
 
     key = hashlib.sha256(f"{kind}\n{sp.srepr(inputs)}".encode()).hexdigest()[:32]
     path = cache_root() / "derivations" / _source_key() / f"{kind}-{key}.pickle"
+    found, result = read_back(path)
+    if not found:
+        result = compute()
+        store(path, result)
+    return result
+
+
+def read_back(path: Path) -> tuple[bool, Any]:
+    """(True, the object) stored at ``path``, or (False, None) when there is none or it
+    cannot be read back."""
     try:
         with path.open("rb") as f:
-            return pickle.load(f)  # our own files, in the user's cache folder
-    except (OSError, EOFError, pickle.UnpicklingError, AttributeError, ValueError):
-        pass  # not derived yet, or unreadable: derive (again)
-    result = compute()
+            return True, pickle.load(f)  # our own files, in the user's cache folder
+    except (OSError, EOFError, pickle.UnpicklingError, AttributeError, ValueError, TypeError):
+        return False, None  # not stored yet, or unreadable: the caller computes (again)
+
+
+def store(path: Path, result: object) -> None:
+    """Write ``result`` to ``path`` whole (a temporary file, then a rename)."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
@@ -73,4 +86,3 @@ def derived(kind: str, inputs: object, compute: Callable[[], T]) -> T:
         os.replace(tmp, path)
     except OSError:
         pass  # a read-only or full cache folder costs time, never a result
-    return result

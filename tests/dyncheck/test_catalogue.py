@@ -161,7 +161,7 @@ def test_pinocchio_3x_branch_reads_the_constraints_under_a_free_root(monkeypatch
     assert calls == [("m.xml", "JointModelFreeFlyer", "root")]
 
 
-def test_a_demonstration_that_raises_costs_only_its_entry(monkeypatch):
+def test_a_demonstration_that_raises_costs_only_its_entry(monkeypatch, tmp_path):
     """A demonstration meeting an engine API it does not handle is a failed entry, named with
     the message, `dyncheck explain` exits 1 — and the catalogue (a run's units) goes on."""
 
@@ -174,6 +174,7 @@ def test_a_demonstration_that_raises_costs_only_its_entry(monkeypatch):
     assert entry.failed == "AttributeError: module 'pinocchio' has no attribute 'x'"
     text = catalogue.render([entry, *catalogue.explain("coordinate-order")])
     assert "- **Failed**: AttributeError" in text and "## coordinate-order" in text
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))  # no entry measured by another test
     assert main(["explain", "hinge-axis-sign"]) == 1
 
 

@@ -1,0 +1,90 @@
+"""Measured results cached on disk, keyed by everything that can change them.
+
+A demonstration of the conventions catalogue is a deterministic function of dyncheck's source
+and data, the installed engines and numerical libraries, the Python and the machine (the same
+inputs give the same numbers). :func:`measured` stores its result under the user's cache
+folder (:func:`~dyncheck.reference.derivations.cache_root`) keyed by a hash of all of them, so
+that a second ``dyncheck explain`` prints without running the engines, while an upgrade of any
+engine, an edit of any file of dyncheck or another machine measures afresh. ``--no-cache``
+(``DYNCHECK_NO_CACHE``) neither reads nor writes. Files are written whole (a temporary file,
+then a rename); one that cannot be read back is measured again and replaced.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import platform
+import sys
+from collections.abc import Callable
+from functools import cache
+from importlib import metadata
+from pathlib import Path
+from typing import TypeVar
+
+from dyncheck.adapters import ENGINE_PACKAGES
+from dyncheck.reference.derivations import cache_root, enabled, read_back, store
+
+T = TypeVar("T")
+
+LIBRARIES = ("numpy", "scipy", "sympy", "jax", "jaxlib", "warp-lang")
+"""Numerical libraries an engine's results depend on, beside the engines' own packages."""
+
+SOURCE_SUFFIXES = (".py", ".xml", ".urdf", ".json", ".md")
+"""Files of dyncheck whose content is part of the key (code, models, data, the book's text)."""
+
+
+def _installed(package: str) -> str:
+    try:
+        return metadata.version(package)
+    except metadata.PackageNotFoundError:
+        return "not installed"
+
+
+def _source_roots() -> list[Path]:
+    """The folders of dyncheck's packages (``reference``, ``adapters`` and ``cases`` live
+    beside ``dyncheck`` in a source checkout, inside it when installed)."""
+    import dyncheck.adapters
+    import dyncheck.cases
+    import dyncheck.reference
+
+    modules = (sys.modules["dyncheck"], dyncheck.reference, dyncheck.adapters, dyncheck.cases)
+    return sorted({Path(m.__file__).resolve().parent for m in modules if m.__file__})
+
+
+@cache
+def fingerprint() -> str:
+    """A hash of dyncheck's files, the versions of every engine and library it may use, the
+    Python and the platform: two processes with the same fingerprint compute the same
+    numbers."""
+    h = hashlib.sha256()
+    h.update(f"{sys.version}\n{platform.platform()}\n{platform.machine()}\n".encode())
+    for package in sorted({*ENGINE_PACKAGES.values(), *LIBRARIES}):
+        h.update(f"{package}={_installed(package)}\n".encode())
+    for root in _source_roots():
+        for path in sorted(root.rglob("*")):
+            if path.suffix in SOURCE_SUFFIXES and "__pycache__" not in path.parts:
+                h.update(str(path.relative_to(root.parent)).encode())
+                h.update(path.read_bytes())
+    return h.hexdigest()[:24]
+
+
+def path_for(kind: str, name: str) -> Path:
+    return cache_root() / kind / fingerprint() / f"{name}.pickle"
+
+
+def measured(
+    kind: str, name: str, measure: Callable[[], T], keep: Callable[[T], bool]
+) -> tuple[T, bool]:
+    """``measure()``, or the result an earlier call with the same ``kind``, ``name`` and
+    :func:`fingerprint` stored; with whether it was read back. A result for which ``keep``
+    is false (a demonstration that failed) is returned but never stored."""
+    if not enabled():
+        return measure(), False
+    path = path_for(kind, name)
+    found, stored = read_back(path)
+    if found:
+        return stored, True
+    result = measure()
+    if keep(result):
+        store(path, result)
+    return result, False
