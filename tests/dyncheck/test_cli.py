@@ -158,26 +158,33 @@ def test_bad_states_option(tmp_path, capsys):
     assert "--states must be a positive integer, got 0" in capsys.readouterr().err
 
 
-def test_bench_writes_its_tables(tmp_path, capsys):
-    """The benchmark runs end to end (timings are not asserted: they are not tests)."""
-    assert (
-        main(
-            [
-                "bench",
-                "simple_pendulum",
-                "--states",
-                "200",
-                "--repeats",
-                "1",
-                "--memory",
-                "--out",
-                str(tmp_path),
-            ]
-        )
-        == 0
-    )
+@pytest.mark.parametrize(
+    ("selection", "parts"),
+    [
+        (
+            ("reference", "book", "mujoco", "pinocchio", "drake"),
+            {"raw engine calls", "adapter batched", "implementation (book coordinates)"},
+        ),
+        pytest.param(  # the ports' tracing and compiling: seconds each
+            ("reference", "mujoco", "mjx", "mjx-f64", "mujoco-warp"),
+            {"raw engine calls", "first call (compile included)", "adapter batched"},
+            marks=pytest.mark.slow,
+            id="ports",
+        ),
+    ],
+    ids=["core", "ports"],
+)
+def test_bench_writes_its_tables(tmp_path, monkeypatch, selection, parts):
+    """The benchmark runs end to end on the implementations selected, each of them in its
+    rows (timings are not asserted: they are not tests)."""
+    from dyncheck import bench
+
+    monkeypatch.setattr(bench, "implementations_for", lambda case: list(selection))
+    argv = ["bench", "simple_pendulum", "--states", "200", "--repeats", "1", "--memory"]
+    assert main([*argv, "--out", str(tmp_path)]) == 0
     b = pd.read_csv(tmp_path / "benchmark.csv")
-    assert {"raw engine calls", "adapter batched", "whole sweep"} <= set(b.part.dropna())
+    assert parts | {"whole sweep"} <= set(b.part.dropna())
+    assert set(b.implementation.dropna()) == {*selection, "all"}
     assert "whole sweep / sum of raw engine calls" in set(b.ratio.dropna())
     assert (tmp_path / "benchmark.md").exists()
 
