@@ -139,17 +139,30 @@ def explain(name: str | None = None) -> list[Entry]:
     return [_run(n) for n in _names(name)]
 
 
-def explain_cached(name: str | None = None) -> tuple[list[Entry], int]:
-    """:func:`explain`, reading back each entry that was measured before with the same
-    source, engines and machine (:mod:`dyncheck.measured_cache`; a failed entry is measured
-    every time); with how many were read back."""
+def measure(name: str) -> tuple[Entry, dict[str, str]]:
+    """The demonstration ``name``, with the versions of the engines loaded where it ran."""
+    from dyncheck.adapters import loaded
+    from dyncheck.provenance import engine_versions
+
+    return _run(name), engine_versions(loaded())
+
+
+def measured_entry(name: str) -> tuple[Entry, dict[str, str], bool]:
+    """:func:`measure`, or what it returned before with the same source, engines and machine
+    (:mod:`dyncheck.measured_cache`; a failed entry is measured every time); with whether it
+    was read back."""
     from dyncheck.measured_cache import measured
 
-    results = [
-        measured("explain", n, partial(_run, n), keep=lambda e: not e.failed)
-        for n in _names(name)
-    ]
-    return [entry for entry, _ in results], sum(found for _, found in results)
+    (entry, used), found = measured(
+        "explain", name, partial(measure, name), keep=lambda r: not r[0].failed
+    )
+    return entry, used, found
+
+
+def explain_cached(name: str | None = None) -> tuple[list[Entry], int]:
+    """:func:`explain` through :func:`measured_entry`, with how many entries were read back."""
+    results = [measured_entry(n) for n in _names(name)]
+    return [entry for entry, _, _ in results], sum(found for _, _, found in results)
 
 
 def render(entries: list[Entry]) -> str:

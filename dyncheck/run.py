@@ -8,10 +8,8 @@ from functools import partial, reduce
 
 import pandas as pd
 
-from dyncheck.adapters import loaded
 from dyncheck.cases import Case, get_case
-from dyncheck.catalogue import DEMOS, Entry
-from dyncheck.catalogue import explain as explain_convention
+from dyncheck.catalogue import DEMOS, Entry, measured_entry
 from dyncheck.closed_forms import closed_form_rows
 from dyncheck.comparison import Sweep, sweep
 from dyncheck.comparison import rows as rows_of
@@ -142,8 +140,10 @@ def _run_case(
 
 def _convention(name: str) -> tuple[list[Entry], dict[str, str]]:
     """One demonstration of the conventions catalogue (a unit of work), with the versions of
-    the engines loaded where it ran."""
-    return explain_convention(name), engine_versions(loaded())
+    the engines loaded where it ran; read back from the cache when measured before with the
+    same dyncheck, engines and machine (``--no-cache``: measured afresh)."""
+    entry, used, _ = measured_entry(name)
+    return [entry], used
 
 
 def run(

@@ -244,6 +244,7 @@ def test_missing_engine_is_skipped_never_passed(monkeypatch, tmp_path):
 
     monkeypatch.delitem(adapters.ADAPTERS, "drake")
     monkeypatch.setitem(adapters.MISSING, "drake", "No module named 'pydrake'")
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path / "cache"))  # no entry measured with it
     result = run([get_case("simple_pendulum")], ["reference", "drake"], conventions=True)
     d = result.discrepancies
     rows = d[(d.impl_a == "drake") | (d.impl_b == "drake")]

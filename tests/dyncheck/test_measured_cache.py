@@ -107,3 +107,19 @@ def test_the_command_says_what_it_read_back(counted, capsys):
     assert main(["explain", NAME, "--no-cache"]) == 0
     assert capsys.readouterr().out == first
     assert len(counted) == 2
+
+
+def test_a_second_run_reads_its_conventions_back_with_their_engines(counted, monkeypatch):
+    """A run's catalogue units go through the same cache: the second run's entries and the
+    engine versions they name are the first's, without running the demonstration again."""
+    import dyncheck.run as run_module
+    from dyncheck.cases import get_case
+
+    monkeypatch.setattr(run_module, "DEMOS", {NAME: catalogue.DEMOS[NAME]})
+    runs = [
+        run_module.run([get_case("simple_pendulum")], ["reference"], conventions=True)
+        for _ in range(2)
+    ]
+    assert len(counted) == 1
+    assert runs[0].conventions == runs[1].conventions == catalogue.explain(NAME)
+    assert runs[0].engines == runs[1].engines and "mujoco" in runs[1].engines
