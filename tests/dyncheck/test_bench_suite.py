@@ -25,3 +25,27 @@ def test_each_command_runs_in_a_fresh_process_with_its_exit_status(tmp_path):
 def test_a_command_over_its_target_is_marked():
     table = measure((Step(what="list", argv=("list",), target_s=1e-6),))
     assert list(table["within_target"]) == ["no"]
+
+
+def test_each_step_starts_cold_unless_marked_warm(monkeypatch):
+    """A new user's first command finds no cache: each step gets an empty cache folder of its
+    own; a step marked warm gets the folder of the step before it."""
+    import subprocess
+
+    from dyncheck import bench_suite
+
+    seen = []
+
+    def fake_run(argv, env, **kwargs):
+        seen.append(env["DYNCHECK_CACHE"])
+        return subprocess.CompletedProcess(argv, 0)
+
+    monkeypatch.setattr(bench_suite.subprocess, "run", fake_run)
+    monkeypatch.setenv("DYNCHECK_CACHE", "/the/user's/cache")
+    steps = tuple(
+        Step(what=str(i), argv=("list",), target_s=1.0, warm=warm)
+        for i, warm in enumerate((False, True, False, False, True))
+    )
+    measure(steps)
+    assert seen[1] == seen[0] and seen[4] == seen[3]
+    assert len({seen[0], seen[2], seen[3]}) == 3 and "/the/user's/cache" not in seen
