@@ -31,6 +31,9 @@ class Registration:
     ports: str | None = None
     """The engine this one is a port of: then compared with that engine, the reference and its
     own package's other builds only, not with every other engine."""
+    float32: bool = False
+    """Whether it computes in float32 (its adapter's ``dtype``): the report check derives its
+    rows' round-off bands from float32's ε without importing the engine."""
 
 
 _A = "dyncheck.adapters."
@@ -59,6 +62,7 @@ REGISTRY: dict[str, Registration] = {
         package="mujoco-mjx",
         extra="mjx",
         ports="mujoco",
+        float32=True,
     ),
     "mujoco-warp": Registration(
         module=_A + "mujoco_warp_",
@@ -66,6 +70,7 @@ REGISTRY: dict[str, Registration] = {
         package="mujoco-warp",
         extra="warp",
         ports="mujoco",
+        float32=True,
     ),
 }
 """Implementation name → its registration: the one line an engine adds, in the order of trust
@@ -79,6 +84,8 @@ ENGINE_EXTRAS: dict[str, str] = {n: r.extra for n, r in REGISTRY.items() if r.ex
 """The optional extra of dyncheck that installs an engine (core engines have none)."""
 ENGINE_PORTS: dict[str, str] = {n: r.ports for n, r in REGISTRY.items() if r.ports}
 """Ports of another engine → that engine."""
+FLOAT32: frozenset[str] = frozenset(n for n, r in REGISTRY.items() if r.float32)
+"""Engine implementations that compute in float32."""
 
 _ADAPTERS: dict[str, type[Adapter]] = {}
 _MISSING: dict[str, str] = {}
@@ -128,6 +135,7 @@ __all__ = [
     "ENGINE_EXTRAS",
     "ENGINE_PACKAGES",
     "ENGINE_PORTS",
+    "FLOAT32",
     "MISSING",
     "REGISTRY",
     "Adapter",

@@ -18,6 +18,15 @@ would call that stale; this one does not, and still catches every change of a re
 A row's band: its own tolerance where it has one (the round-off bound it was judged by, in
 relative units); otherwise (order-study rows, judged by their order) the accumulated round-off
 of the longest run, :data:`TRAJECTORY_FLOOR`, plus :data:`RELATIVE_BAND` of the value.
+
+Rows of a float32 implementation (MJX, MuJoCo Warp: ``adapters.FLOAT32``) are held to the same
+derivations with float32's ε: XLA and Warp compile for the CPU they run on (vector width, fused
+multiply-adds), so two CPUs round a float32 run differently, and its trajectory errors,
+drifts and the numbers printed from them agree only to the run's accumulated float32
+round-off, :data:`TRAJECTORY_FLOOR32` (a page's table cell whose row or column names such an
+implementation likewise). A tolerance derived from an error estimate (its basis says
+"estimate") agrees to :data:`ESTIMATE_RTOL`: an adaptive solver's estimate moves when round-off
+flips one of its step decisions.
 """
 
 from __future__ import annotations
@@ -34,7 +43,7 @@ import pandas as pd
 
 from dyncheck.errors import InvalidInput
 from dyncheck.results import CONVERGENCE_KEY, DISCREPANCY_KEY
-from dyncheck.tolerances import REFERENCE_MARGIN, accumulated
+from dyncheck.tolerances import EPS32, REFERENCE_MARGIN, accumulated
 
 
 def _longest_run() -> int:
@@ -51,6 +60,16 @@ def _longest_run() -> int:
 TRAJECTORY_FLOOR = accumulated(_longest_run()).rtol
 """Accumulated round-off of the longest run (64 ε × steps, relative to the coordinates'
 scale): two machines' errors of a run may differ by this much."""
+TRAJECTORY_FLOOR32 = accumulated(_longest_run(), eps=EPS32).rtol
+"""The same for a float32 run (64 ε₃₂ × 16 000 steps ≈ 0.12): the bound the run itself judges
+a float32 trajectory by ("within accumulated round-off: 64 float32 eps x N steps")."""
+ADAPTIVE = "dop853"
+"""The integrator of the adaptive runs judged against their error estimates."""
+ESTIMATE_RTOL = 0.25
+"""Two machines' error estimates of the same adaptive run agree to this: |y(rtol) − y(rtol/4)|
+estimates the error at rtol only to its own 1/4 part, and a step accepted on one machine and
+rejected on the other moves it further by a fraction of itself (measured: 5 % on the spherical
+pendulum's DOP853 at rtol 3.5e-8 between two CPUs)."""
 RELATIVE_BAND = 1e-6
 """Of an error far above round-off (a truncation error, a modelling difference), the part two
 machines may differ in: round-off of the trajectory relative to the error itself is < 1e-8."""
@@ -109,24 +128,72 @@ def _skeleton(text: str) -> tuple[str, list[float]]:
     return re.sub(r"-{2,}", "-", words), numbers
 
 
-def text_moved(old: str, new: str) -> str | None:
-    """Why two texts differ beyond printed round-off, or None when they agree."""
+def text_moved(
+    old: str, new: str, rtol: float = PROSE_RTOL, floor: float = PROSE_FLOOR
+) -> str | None:
+    """Why two texts differ beyond printed round-off, or None when they agree (numbers within
+    ``rtol``, or both below ``floor``)."""
     so, no = _skeleton(old)
     sn, nn = _skeleton(new)
     if so != sn or len(no) != len(nn):
         return "words"
     for a, b in zip(no, nn, strict=True):
-        if not _numbers_agree(a, b, PROSE_RTOL, PROSE_FLOOR):
+        if not _numbers_agree(a, b, rtol, floor):
             return f"number {a:g} -> {b:g}"
     return None
+
+
+def names_float32(text: str) -> bool:
+    """Whether ``text`` names a float32 implementation (``mjx``, not ``mjx-f64``)."""
+    from dyncheck.adapters import FLOAT32
+
+    return any(word in FLOAT32 for word in re.split(r"[\s|,;:()\[\]]+", text))
+
+
+def _cells(line: str) -> list[str]:
+    return line.strip().strip("|").split("|")
+
+
+def _table_row_moved(old: str, new: str, header: list[str]) -> str | None:
+    """:func:`text_moved` of a table row, cell by cell, by the rules the tables it shows are
+    compared by: numbers against the float32 floor where the row or the column names a float32
+    implementation; an adaptive run's (``dop853``) to :data:`ESTIMATE_RTOL`; an observed order
+    only in the asymptotic range (its row's ``asymptotic`` is True), as in ``convergence.csv``."""
+    if _skeleton(old)[0] != _skeleton(new)[0]:
+        return "words"
+    a, b = _cells(old), _cells(new)
+    if len(a) != len(b) or len(a) != len(header):
+        return text_moved(old, new)
+    names = [h.strip() for h in header]
+    row32 = names_float32(old)
+    rtol = ESTIMATE_RTOL if ADAPTIVE in old.split() else PROSE_RTOL
+    unread = "asymptotic" in names and a[names.index("asymptotic")].strip() != "True"
+    for x, y, column in zip(a, b, names, strict=True):
+        if column == "observed_order" and unread:
+            continue
+        floor = TRAJECTORY_FLOOR32 if row32 or names_float32(column) else PROSE_FLOOR
+        why = text_moved(x, y, rtol, floor)
+        if why is not None:
+            return why
+    return None
+
+
+def _is_rule(line: str) -> bool:
+    return line.startswith("|") and set(line) <= set("|:- ")
 
 
 def pages_moved(name: str, old: str, new: str) -> list[Moved]:
     keep = [line for line in old.splitlines() if not line.startswith(VOLATILE)]
     fresh = [line for line in new.splitlines() if not line.startswith(VOLATILE)]
     out = []
+    header: list[str] | None = None  # the cells of the table the line is in
     for i, (a, b) in enumerate(zip(keep, fresh, strict=False)):
-        why = text_moved(a, b)
+        if not a.startswith("|"):
+            header = None
+        elif i + 1 < len(keep) and _is_rule(keep[i + 1]):
+            header = _cells(a)
+        tabled = header is not None and not _is_rule(a) and _cells(a) != header
+        why = _table_row_moved(a, b, header) if tabled and header else text_moved(a, b)
         if why is not None:
             at = next((k for k, (x, y) in enumerate(zip(a, b, strict=False)) if x != y), 0)
             start = max(0, at - 20)
@@ -192,9 +259,22 @@ def _joined(
     return moved, a.loc[common], b.loc[common]
 
 
-def _band(value_a: np.ndarray, value_b: np.ndarray, tolerance: np.ndarray) -> np.ndarray:
+def _floors(*impls: pd.Series) -> np.ndarray:
+    """Per row: the accumulated round-off of the longest run in the precision of the less
+    precise of its implementations."""
+    from dyncheck.adapters import FLOAT32
+
+    f32 = np.zeros(len(impls[0]), bool)
+    for column in impls:
+        f32 |= column.isin(FLOAT32).to_numpy()
+    return np.where(f32, TRAJECTORY_FLOOR32, TRAJECTORY_FLOOR)
+
+
+def _band(
+    value_a: np.ndarray, value_b: np.ndarray, tolerance: np.ndarray, floor: np.ndarray
+) -> np.ndarray:
     """Per row: its own tolerance, else the trajectory floor plus a relative part."""
-    loose = TRAJECTORY_FLOOR + RELATIVE_BAND * np.fmax(np.abs(value_a), np.abs(value_b))
+    loose = floor + RELATIVE_BAND * np.fmax(np.abs(value_a), np.abs(value_b))
     return np.where(np.isfinite(tolerance), tolerance, loose)
 
 
@@ -226,13 +306,15 @@ def _labels_moved(name: str, a: pd.DataFrame, b: pd.DataFrame, fields: tuple) ->
     return out
 
 
-def _texts_moved(name: str, a: pd.DataFrame, b: pd.DataFrame, fields: tuple) -> list[Moved]:
-    out = []
-    for field in fields:
-        sa, sb = a[field].fillna("").astype(str), b[field].fillna("").astype(str)
-        bad = [x != y and text_moved(x, y) is not None for x, y in zip(sa, sb, strict=True)]
-        out += _moved_rows(name, a, b, field, np.array(bad, bool))
-    return out
+def _texts_moved(
+    name: str, a: pd.DataFrame, b: pd.DataFrame, field: str, rtol: np.ndarray, floor: np.ndarray
+) -> list[Moved]:
+    sa, sb = a[field].fillna("").astype(str), b[field].fillna("").astype(str)
+    bad = [
+        x != y and text_moved(x, y, r, f) is not None
+        for x, y, r, f in zip(sa, sb, rtol, floor, strict=True)
+    ]
+    return _moved_rows(name, a, b, field, np.array(bad, bool))
 
 
 def _col(frame: pd.DataFrame, field: str) -> np.ndarray:
@@ -242,15 +324,23 @@ def _col(frame: pd.DataFrame, field: str) -> np.ndarray:
 def discrepancies_moved(name: str, old: str, new: str) -> list[Moved]:
     moved, a, b = _joined(name, old, new, DISCREPANCY_KEY)
     moved += _labels_moved(name, a, b, ("verdict", "convention"))
-    moved += _texts_moved(name, a, b, ("tolerance_basis", "note"))
+    floor = _floors(a["impl_a"], a["impl_b"])
+    estimated = a["tolerance_basis"].fillna("").astype(str).str.contains("estimate").to_numpy()
+    rtol = np.where(estimated, ESTIMATE_RTOL, PROSE_RTOL)
+    prose_floor = np.where(floor > TRAJECTORY_FLOOR, floor, PROSE_FLOOR)
+    moved += _texts_moved(name, a, b, "tolerance_basis", rtol, prose_floor)
+    moved += _texts_moved(name, a, b, "note", np.full(len(a), PROSE_RTOL), prose_floor)
     tol_a, tol_b = _col(a, "tolerance"), _col(b, "tolerance")
     with np.errstate(invalid="ignore"):
-        tol_ok = (np.abs(tol_a - tol_b) <= PROSE_RTOL * np.fmax(tol_a, tol_b)) | (
-            np.isnan(tol_a) & np.isnan(tol_b)
+        gap = np.abs(tol_a - tol_b)
+        tol_ok = (
+            (gap <= rtol * np.fmax(tol_a, tol_b))
+            | (estimated & (gap <= floor))  # an estimate at round-off
+            | (np.isnan(tol_a) & np.isnan(tol_b))
         )
     moved += _moved_rows(name, a, b, "tolerance", ~tol_ok)
     ea, eb = _col(a, "max_rel_err"), _col(b, "max_rel_err")
-    band = _band(ea, eb, tol_a)
+    band = _band(ea, eb, tol_a, floor)
     moved += _moved_rows(name, a, b, "max_rel_err", ~_within(ea, eb, band))
     with np.errstate(invalid="ignore", divide="ignore"):
         scale = np.where(ea > 0, _col(a, "max_abs_err") / ea, 0.0)
@@ -269,6 +359,7 @@ def convergence_moved(name: str, old: str, new: str) -> list[Moved]:
     # coarsest step first: the order at a step pairs it with the coarser step before it
     a = a.sort_values(CONVERGENCE_KEY, ascending=[True, True, True, False])
     b = b.loc[a.index]
+    floors = dict(zip(a.index, _floors(a["impl"]), strict=True))
     previous: dict[tuple[str, str, str], bool] = {}
     for k in a.index:
         ra, rb = a.loc[k], b.loc[k]
@@ -280,7 +371,7 @@ def convergence_moved(name: str, old: str, new: str) -> list[Moved]:
                 )
         ea, eb = float(ra["error"]), float(rb["error"])
         noise = REFERENCE_MARGIN * max(float(ra["reference_error"]), float(rb["reference_error"]))
-        band = _band(np.array(ea), np.array(eb), np.array(math.nan))
+        band = _band(np.array(ea), np.array(eb), np.array(math.nan), floors[k])
         if not (_within(np.array(ea), np.array(eb), band) or max(ea, eb) <= noise):
             moved.append(Moved(file=name, key=k, field="error", old=_fmt(ea), new=_fmt(eb)))
         asym = bool(ra["asymptotic"]) and bool(rb["asymptotic"])
@@ -296,10 +387,11 @@ def convergence_moved(name: str, old: str, new: str) -> list[Moved]:
 
 def conservation_moved(name: str, old: str, new: str) -> list[Moved]:
     moved, a, b = _joined(name, old, new, ["case", "impl", "integrator", "dt"])
+    floor = _floors(a["impl"])
     for field in ("max_energy_drift", "max_momentum_drift"):
         x, y = _col(a, field), _col(b, field)
         nan = np.full(len(x), np.nan)
-        moved += _moved_rows(name, a, b, field, ~_within(x, y, _band(x, y, nan)))
+        moved += _moved_rows(name, a, b, field, ~_within(x, y, _band(x, y, nan, floor)))
     return moved
 
 

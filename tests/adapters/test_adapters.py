@@ -258,3 +258,12 @@ def test_drake_parser_ignores_the_tendon_equality():
     plant, warnings = DrakeAdapter._parse(to_mjcf(get_case("atwood").multibody()))
     assert plant.num_velocities() == 2 and plant.num_constraints() == 0
     assert any("'tendon' found as a child of 'equality'" in w for w in warnings)
+
+
+@pytest.mark.parametrize("engine", ALL_ENGINES)
+def test_registered_precision_is_the_adapters(engine):
+    """The registry says which engines compute in float32 (the report check reads it without
+    importing the engine); it must be what the adapter computes in."""
+    from dyncheck.adapters import FLOAT32
+
+    assert (engine in FLOAT32) == (ADAPTERS[engine].dtype == np.float32)

@@ -152,3 +152,99 @@ def test_check_refuses_a_missing_folder_before_any_work(tmp_path, flag, capsys):
         args += ["--from", str(REPORTS)]
     assert main(args) == 2
     assert f"{flag} must be an existing report folder" in capsys.readouterr().err
+
+
+F32_FLOOR = 64 * float(np.finfo(np.float32).eps) * 16_000
+"""64 ε₃₂ × the longest run's 16 000 steps (torque_free, 4 s at 0.25 ms): derived here from
+the run's own bound for a float32 trajectory, independently of freshness.py."""
+
+
+def _clear_of_noise(c: pd.DataFrame, impl: str) -> int:
+    """The first RK4 row of ``impl`` whose error stands far above its reference's error and
+    below the float32 floor."""
+    rows = c[(c.impl == impl) & (c.integrator == "rk4") & (c.error > 1e6 * c.reference_error)]
+    return int(rows.index[rows.error < F32_FLOOR / 2][0])
+
+
+def _move_error(impl: str, factor: float):
+    def edit(c):
+        c.loc[_clear_of_noise(c, impl), "error"] *= factor
+
+    return edit
+
+
+def test_a_float32_run_moved_within_its_round_off_passes(committed):
+    """Two CPUs round a float32 (MJX) run differently: its error moves within 64 ε₃₂ N."""
+    edited = _edit(committed, "convergence.csv", _move_error("mjx", 1.7))
+    assert freshness.compare(committed, edited) == []
+
+
+def test_the_same_move_of_a_float64_run_fails(committed):
+    moved = freshness.compare(
+        committed, _edit(committed, "convergence.csv", _move_error("mujoco", 1.7))
+    )
+    assert [m.field for m in moved] == ["error"]
+
+
+def test_a_float32_run_moved_beyond_its_round_off_fails(committed):
+    def edit(c):
+        c.loc[_clear_of_noise(c, "mjx"), "error"] += 2 * F32_FLOOR
+
+    moved = freshness.compare(committed, _edit(committed, "convergence.csv", edit))
+    assert [m.field for m in moved] == ["error"]
+
+
+@pytest.mark.parametrize(("factor", "fails"), [(1.05, False), (1.5, True)])
+def test_a_tolerance_from_an_error_estimate_agrees_to_the_estimates_accuracy(
+    committed, factor, fails
+):
+    """An adaptive run's estimate |x(rtol) − x(rtol/4)| moves with its step decisions (5 %
+    measured between two CPUs); a tolerance half as large again is a changed result."""
+
+    def edit(d):
+        rows = d[d.tolerance_basis.fillna("").str.contains("estimate") & (d.tolerance > 1e-9)]
+        d.loc[rows.index[0], "tolerance"] *= factor
+
+    moved = freshness.compare(committed, _edit(committed, "discrepancies.csv", edit))
+    assert [m.field for m in moved] == (["tolerance"] if fails else [])
+
+
+def test_a_round_off_tolerance_moved_by_five_percent_fails(committed):
+    """A tolerance not from an estimate (64 ε κ(M)) is a derivation: 5 % is a change."""
+
+    def edit(d):
+        rows = d[d.tolerance_basis.fillna("").str.startswith("round-off: 64 eps x cond")]
+        d.loc[rows.index[0], "tolerance"] *= 1.05
+
+    moved = freshness.compare(committed, _edit(committed, "discrepancies.csv", edit))
+    assert [m.field for m in moved] == ["tolerance"]
+
+
+def _step_table_row(page: str, asymptotic: str) -> str:
+    return next(
+        line for line in page.splitlines()
+        if line.startswith("| drake") and line.rstrip().endswith(f"| {asymptotic:<12} |")
+    )
+
+
+@pytest.mark.parametrize(("asymptotic", "fails"), [("False", False), ("True", True)])
+def test_a_page_compares_an_observed_order_only_in_the_asymptotic_range(
+    committed, asymptotic, fails
+):
+    """As in convergence.csv: an order computed from round-off-level errors is not read."""
+    page = committed["atwood.md"]
+    row = _step_table_row(page, asymptotic)
+    cells = row.split("|")
+    cells[5] = cells[5].replace(cells[5].strip(), f"{float(cells[5]) + 0.5:.3g}")
+    edited = {**committed, "atwood.md": page.replace(row, "|".join(cells))}
+    moved = freshness.compare(committed, edited)
+    assert [m.file for m in moved] == (["atwood.md"] if fails else [])
+
+
+def test_a_page_number_of_a_float32_implementation_is_compared_at_float32():
+    header = "| pair | atwood |\n|:--|:--|\n"
+    old = {"x.md": header + "| mujoco vs mjx | passed 8.2e-07 |\n"}
+    assert freshness.compare(old, {"x.md": old["x.md"].replace("8.2e-07", "6.9e-07")}) == []
+    f64 = {"x.md": header + "| mujoco vs mjx-f64 | passed 8.2e-07 |\n"}
+    moved = freshness.compare(f64, {"x.md": f64["x.md"].replace("8.2e-07", "6.9e-07")})
+    assert [m.field for m in moved] == ["number 8.2e-07 -> 6.9e-07"]
