@@ -51,13 +51,25 @@ def _source_roots() -> list[Path]:
     return sorted({Path(m.__file__).resolve().parent for m in modules if m.__file__})
 
 
+def _cpu() -> str:
+    """The processor's model and instruction-set flags (Linux): compiled float32 code (XLA,
+    Warp) rounds differently on CPUs with other vector units, so another CPU measures afresh
+    even where a cache folder is shared between machines."""
+    try:
+        lines = Path("/proc/cpuinfo").read_text().splitlines()
+    except OSError:
+        return platform.processor()
+    wanted = ("model name", "flags")
+    return "\n".join(next((x for x in lines if x.startswith(w)), "") for w in wanted)
+
+
 @cache
 def fingerprint() -> str:
     """A hash of dyncheck's files, the versions of every engine and library it may use, the
-    Python and the platform: two processes with the same fingerprint compute the same
+    Python, the platform and the CPU: two processes with the same fingerprint compute the same
     numbers."""
     h = hashlib.sha256()
-    h.update(f"{sys.version}\n{platform.platform()}\n{platform.machine()}\n".encode())
+    h.update(f"{sys.version}\n{platform.platform()}\n{platform.machine()}\n{_cpu()}\n".encode())
     for package in sorted({*ENGINE_PACKAGES.values(), *LIBRARIES}):
         h.update(f"{package}={_installed(package)}\n".encode())
     for root in _source_roots():

@@ -123,3 +123,13 @@ def test_a_second_run_reads_its_conventions_back_with_their_engines(counted, mon
     assert len(counted) == 1
     assert runs[0].conventions == runs[1].conventions == catalogue.explain(NAME)
     assert runs[0].engines == runs[1].engines and "mujoco" in runs[1].engines
+
+
+def test_another_cpu_measures_afresh(counted, monkeypatch):
+    """Float32 code compiled for another CPU rounds differently (two CPUs' MJX runs differ):
+    a cache folder shared between machines must not hand one CPU's numbers to another."""
+    catalogue.explain_cached(NAME)
+    monkeypatch.setattr(measured_cache, "_cpu", lambda: "model name : another\nflags : sse2")
+    measured_cache.fingerprint.cache_clear()
+    assert catalogue.explain_cached(NAME)[1] == 0
+    assert len(counted) == 2
