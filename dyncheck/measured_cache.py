@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import TypeVar
 
 from dyncheck.adapters import ENGINE_PACKAGES
-from dyncheck.reference.derivations import cache_root, enabled, read_back, store
+from dyncheck.reference.derivations import cache_root, cached, enabled
 
 T = TypeVar("T")
 
@@ -90,13 +90,6 @@ def measured(
     """``measure()``, or the result an earlier call with the same ``kind``, ``name`` and
     :func:`fingerprint` stored; with whether it was read back. A result for which ``keep``
     is false (a demonstration that failed) is returned but never stored."""
-    if not enabled():
+    if not enabled():  # before the fingerprint: it reads every file of dyncheck
         return measure(), False
-    path = path_for(kind, name)
-    found, stored = read_back(path)
-    if found:
-        return stored, True
-    result = measure()
-    if keep(result):
-        store(path, result)
-    return result, False
+    return cached(path_for(kind, name), measure, keep)

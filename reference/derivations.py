@@ -18,7 +18,7 @@ import tempfile
 from collections.abc import Callable
 from functools import cache
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TypeVar
 
 T = TypeVar("T")
 
@@ -59,30 +59,28 @@ def derived(kind: str, inputs: object, compute: Callable[[], T]) -> T:
 
     key = hashlib.sha256(f"{kind}\n{sp.srepr(inputs)}".encode()).hexdigest()[:32]
     path = cache_root() / "derivations" / _source_key() / f"{kind}-{key}.pickle"
-    found, result = read_back(path)
-    if not found:
-        result = compute()
-        store(path, result)
-    return result
+    return cached(path, compute)[0]
 
 
-def read_back(path: Path) -> tuple[bool, Any]:
-    """(True, the object) stored at ``path``, or (False, None) when there is none or it
-    cannot be read back."""
+def cached(
+    path: Path, compute: Callable[[], T], keep: Callable[[T], bool] = lambda _result: True
+) -> tuple[T, bool]:
+    """The object stored at ``path``, or ``compute()`` stored there (when ``keep`` of it is
+    true); with whether it was read back. A file that cannot be read back is computed again
+    and replaced; files are written whole (a temporary file, then a rename)."""
     try:
         with path.open("rb") as f:
-            return True, pickle.load(f)  # our own files, in the user's cache folder
+            return pickle.load(f), True  # our own files, in the user's cache folder
     except (OSError, EOFError, pickle.UnpicklingError, AttributeError, ValueError, TypeError):
-        return False, None  # not stored yet, or unreadable: the caller computes (again)
-
-
-def store(path: Path, result: object) -> None:
-    """Write ``result`` to ``path`` whole (a temporary file, then a rename)."""
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-        with os.fdopen(fd, "wb") as f:
-            pickle.dump(result, f, protocol=pickle.HIGHEST_PROTOCOL)
-        os.replace(tmp, path)
-    except OSError:
-        pass  # a read-only or full cache folder costs time, never a result
+        pass  # not stored yet, or unreadable: compute (again)
+    result = compute()
+    if keep(result):
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+            with os.fdopen(fd, "wb") as f:
+                pickle.dump(result, f, protocol=pickle.HIGHEST_PROTOCOL)
+            os.replace(tmp, path)
+        except OSError:
+            pass  # a read-only or full cache folder costs time, never a result
+    return result, False
