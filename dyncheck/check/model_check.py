@@ -58,6 +58,8 @@ class CheckResult:
     notes: tuple[str, ...]
     seconds: dict[str, float] = field(default_factory=dict)
     states: int = 0
+    impls: tuple[str, ...] = ()
+    """The implementations asked for (their versions are the page's provenance)."""
 
     @property
     def ok(self) -> bool:
@@ -234,7 +236,7 @@ def _check(model: str, source_path: Path, source: ModelFile,
     for column in ("section", "verdict"):
         frame[column] = frame[column].astype(str)
     return CheckResult(model=model, path=source_path, rows=frame, notes=tuple(notes),
-                       seconds=seconds, states=states)
+                       seconds=seconds, states=states, impls=chosen)
 
 
 def _align_free_joints(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree, list[str]]:

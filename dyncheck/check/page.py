@@ -13,10 +13,12 @@ from dyncheck.check.rows import Section
 from dyncheck.results import PROVENANCE, Verdict, provenance_json, to_csv, write_atomic
 
 
-def _versions() -> dict[str, str]:
-    from dyncheck.provenance import versions
+def _versions(result: CheckResult) -> dict[str, str]:
+    """The provenance of the engines the check used (another engine is never imported: MJX
+    and MuJoCo Warp would cost seconds of importing JAX and Warp for nothing)."""
+    from dyncheck.provenance import engine_versions, versions
 
-    return versions()
+    return versions(engine_versions(result.impls))
 
 
 def counts(result: CheckResult) -> dict[str, int]:
@@ -41,7 +43,7 @@ def _table(frame: pd.DataFrame, columns: list[str]) -> str:
 
 def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
     """The Markdown page (``versions``: the provenance, read now when not given)."""
-    versions = _versions() if versions is None else versions
+    versions = _versions(result) if versions is None else versions
     rows = result.rows
     c = counts(result)
     lines = [
@@ -86,7 +88,7 @@ def write(result: CheckResult, out: Path) -> list[Path]:
     name = result.model.replace("/", "__")
     csv_path, md_path = out / f"{name}.csv", out / f"{name}.md"
     write_atomic(csv_path, to_csv(result.rows))
-    versions = _versions()
+    versions = _versions(result)
     write_atomic(md_path, page(result, versions))
     write_atomic(out / PROVENANCE, provenance_json(versions))
     return [csv_path, md_path, out / PROVENANCE]
