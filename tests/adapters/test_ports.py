@@ -12,7 +12,8 @@ from functools import cache
 import numpy as np
 import pytest
 
-from dyncheck.adapters import ADAPTERS, MISSING, get_adapter
+from dyncheck import adapters
+from dyncheck.adapters import get_adapter
 from dyncheck.cases import get_case
 from dyncheck.comparison import compare_instantaneous
 from dyncheck.implementations import EngineImplementation, make_implementation
@@ -117,8 +118,8 @@ def test_float32_bound_catches_a_mass_off_by_1e_4(port, factor, verdict):
 def test_missing_extra_gives_skipped_rows_naming_it(monkeypatch, port):
     """Without its extra a port's rows are skipped — never passed — and say what to install."""
     extra = "warp" if port == "mujoco-warp" else "mjx"
-    monkeypatch.delitem(ADAPTERS, port)
-    monkeypatch.setitem(MISSING, port, "No module named 'jax'")
+    monkeypatch.delitem(adapters.ADAPTERS, port)
+    monkeypatch.setitem(adapters.MISSING, port, "No module named 'jax'")
     case = get_case("simple_pendulum")
     impls = {}
     for n in ("reference", "mujoco", port):
@@ -165,5 +166,5 @@ def test_declared_rk4_definitions_match_the_measured_orders(full_run, case_name)
 
 def test_ports_are_registered_with_their_extras():
     for port in PORTS:
-        assert port in ADAPTERS, MISSING.get(port)
-        assert ADAPTERS[port].dtype == (np.float64 if port == "mjx-f64" else np.float32)
+        assert port in adapters.ADAPTERS, adapters.MISSING.get(port)
+        assert adapters.ADAPTERS[port].dtype == (np.float64 if port == "mjx-f64" else np.float32)
