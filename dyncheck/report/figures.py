@@ -18,9 +18,14 @@ from dyncheck.studies import (
 )
 
 
+DPI = 90
+"""Pixels per inch of the PNGs; the figures are made at it, so that the layout pass and the
+saved drawing share one renderer (and its cache of laid-out text)."""
+
+
 def _png(fig: plt.Figure) -> bytes:
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90, metadata={"Software": None})
+    fig.savefig(buf, format="png", dpi=DPI, metadata={"Software": None})
     plt.close(fig)
     return buf.getvalue()
 
@@ -29,7 +34,7 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     """Deterministic PNGs: trajectory, error against time, error against step size."""
     plt.rcParams.update({"font.family": "DejaVu Sans", "font.size": 9})
     out = {}
-    fig, axes = plt.subplots(case.ndof, 1, figsize=(7, 2.2 * case.ndof), squeeze=False)
+    fig, axes = plt.subplots(case.ndof, 1, figsize=(7, 2.2 * case.ndof), squeeze=False, dpi=DPI)
     for i, ax in enumerate(axes[:, 0]):
         ax.plot(data.t, data.reference[:, i], "k-", lw=2, label="reference (DOP853)")
         for (impl, integ), q in sorted(data.runs.items()):
@@ -42,7 +47,7 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     fig.tight_layout()
     out["trajectory"] = _png(fig)
 
-    fig, ax = plt.subplots(figsize=(7, 3.2))
+    fig, ax = plt.subplots(figsize=(7, 3.2), dpi=DPI)
     for (impl, integ), err in sorted(data.errors.items()):
         ax.semilogy(
             data.t,
@@ -58,7 +63,7 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     fig.tight_layout()
     out["error_time"] = _png(fig)
 
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, ax = plt.subplots(figsize=(7, 4), dpi=DPI)
     c = conv[conv["case"] == case.name]
     for (impl, integ), g in c.groupby(["impl", "integrator"]):
         ax.loglog(g["dt"], g["error"], "o-", ms=3, lw=1, label=f"{impl} {integ}")
@@ -76,7 +81,7 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     fig.tight_layout()
     out["convergence"] = _png(fig)
 
-    fig, ax = plt.subplots(figsize=(7, 3.2))
+    fig, ax = plt.subplots(figsize=(7, 3.2), dpi=DPI)
     for (impl, integ), drift in sorted(data.energy.items()):
         ax.semilogy(
             data.t,
