@@ -133,6 +133,8 @@ def text_moved(
 ) -> str | None:
     """Why two texts differ beyond printed round-off, or None when they agree (numbers within
     ``rtol``, or both below ``floor``)."""
+    if old == new:  # most of a report's lines, read again: no numbers to parse
+        return None
     so, no = _skeleton(old)
     sn, nn = _skeleton(new)
     if so != sn or len(no) != len(nn):
@@ -192,6 +194,8 @@ def pages_moved(name: str, old: str, new: str) -> list[Moved]:
             header = None
         elif i + 1 < len(keep) and _is_rule(keep[i + 1]):
             header = _cells(a)
+        if a == b:
+            continue
         tabled = header is not None and not _is_rule(a) and _cells(a) != header
         why = _table_row_moved(a, b, header) if tabled and header else text_moved(a, b)
         if why is not None:
