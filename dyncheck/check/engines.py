@@ -134,7 +134,7 @@ class Isolated:
                 raise EngineError(f"{self.engine} crashed while {doing} "
                                   f"({_death(self._proc.exitcode)})")
             if time.monotonic() > deadline:
-                self.close()
+                self.close(hung=True)
                 raise EngineError(f"{self.engine} gave no answer within {timeout:g} s "
                                   f"while {doing} (stopped)")
         try:
@@ -167,8 +167,10 @@ class Isolated:
             raise answer
         return answer  # type: ignore[return-value]
 
-    def close(self) -> None:
-        if self._proc.is_alive():
+    def close(self, *, hung: bool = False) -> None:
+        """Ask the process to finish (``None``), or kill it at once when it is ``hung`` (it
+        would not read the request: waiting for it cost every hang two more seconds)."""
+        if self._proc.is_alive() and not hung:
             try:
                 self._conn.send(None)
             except OSError:
