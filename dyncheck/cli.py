@@ -347,7 +347,7 @@ def _use_device(device: str) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     from dyncheck import baseline, report
-    from dyncheck.report.figures import figures as draw_figures
+    from dyncheck.report.figures import cached_figures as draw_figures
     from dyncheck.run import resolve, run
 
     _check_out(args.out)

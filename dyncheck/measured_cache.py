@@ -26,8 +26,10 @@ from dyncheck.reference.derivations import cache_root, cached, enabled
 
 T = TypeVar("T")
 
-LIBRARIES = ("numpy", "scipy", "sympy", "jax", "jaxlib", "warp-lang")
-"""Numerical libraries an engine's results depend on, beside the engines' own packages."""
+LIBRARIES = ("numpy", "scipy", "sympy", "jax", "jaxlib", "warp-lang", "pandas", "matplotlib",
+             "pillow")
+"""Libraries the cached results depend on, beside the engines' own packages: numerical ones
+(an engine's numbers), and those that format tables and draw and encode figures."""
 
 SOURCE_SUFFIXES = (".py", ".xml", ".urdf", ".json", ".md")
 """Files of dyncheck whose content is part of the key (code, models, data, the book's text)."""

@@ -3,7 +3,9 @@ observed orders, energy and momentum drift."""
 
 from __future__ import annotations
 
+import hashlib
 import io
+import pickle
 
 import matplotlib
 
@@ -13,10 +15,11 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.cases import Case
+from dyncheck.measured_cache import measured
+from dyncheck.results import to_csv
 from dyncheck.studies import (
     TrajectoryFigures,
 )
-
 
 DPI = 90
 """Pixels per inch of the PNGs; the figures are made at it, so that the layout pass and the
@@ -97,3 +100,17 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     fig.tight_layout()
     out["energy"] = _png(fig)
     return out
+
+
+def cached_figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str, bytes]:
+    """:func:`figures`, or the PNGs it drew before from the same case, data and convergence
+    table with the same dyncheck and libraries (the cache's fingerprint, matplotlib's version
+    in it): drawing is a deterministic function of them, so a second run with unchanged
+    results draws nothing (``--no-cache``: drawn afresh). Only the drawing is reused — the
+    numbers plotted are always this run's."""
+    h = hashlib.sha256(repr(case).encode())
+    h.update(pickle.dumps(data, protocol=5))
+    h.update(to_csv(conv[conv["case"] == case.name]).encode())
+    pngs, _ = measured("figures", f"{case.name}-{h.hexdigest()[:32]}",
+                       lambda: figures(case, data, conv), keep=lambda _pngs: True)
+    return pngs

@@ -1,0 +1,71 @@
+"""The figures' cache (report/figures.py, ``cached_figures``): a second run with the same
+results reads the PNGs back instead of drawing them; any change of the plotted data draws
+afresh, as does ``--no-cache``.
+
+Expected values: the bytes :func:`figures` draws live from the same data."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from dyncheck import measured_cache
+from dyncheck.cases import get_case
+from dyncheck.reference import derivations
+from dyncheck.report import figures as module
+from dyncheck.results import CONVERGENCE_KEY, ConvergencePoint, table
+from dyncheck.run import _run_case
+
+CASE = get_case("simple_pendulum")
+
+
+@pytest.fixture(scope="module")
+def study():
+    _, points, data, *_ = _run_case(CASE, ["reference", "mujoco"], 4)
+    return data, table(points, ConvergencePoint, CONVERGENCE_KEY)
+
+
+@pytest.fixture
+def drawn(monkeypatch, tmp_path):
+    """An empty cache folder and :func:`figures` wrapped to count its drawings."""
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
+    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
+    draw, count = module.figures, []
+
+    def counting(*args):
+        count.append(1)
+        return draw(*args)
+
+    monkeypatch.setattr(module, "figures", counting)
+    measured_cache.fingerprint.cache_clear()
+    yield count
+    measured_cache.fingerprint.cache_clear()
+
+
+def test_a_second_drawing_of_the_same_results_is_read_back(study, drawn):
+    live = module.figures(CASE, *study)
+    assert module.cached_figures(CASE, *study) == live
+    assert module.cached_figures(CASE, *study) == live
+    assert len(drawn) == 2  # the live drawing and the first cached call; the second read back
+
+
+def test_changed_data_is_drawn_afresh(study, drawn):
+    data, conv = study
+    module.cached_figures(CASE, data, conv)
+    moved = dict(data.errors)
+    key = next(iter(moved))
+    moved[key] = moved[key] * (1 + 1e-12) + np.finfo(float).tiny
+    module.cached_figures(CASE, dataclasses.replace(data, errors=moved), conv)
+    changed = conv.copy()
+    changed.loc[0, "error"] *= 1.5
+    module.cached_figures(CASE, data, changed)
+    assert len(drawn) == 3
+
+
+def test_no_cache_draws_every_time(study, drawn, monkeypatch):
+    monkeypatch.setenv(derivations.NO_CACHE, "1")
+    for _ in range(2):
+        module.cached_figures(CASE, *study)
+    assert len(drawn) == 2
