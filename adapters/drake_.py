@@ -175,6 +175,7 @@ class DrakeAdapter(Adapter):
         self._iv = np.concatenate(
             [np.arange(j.velocity_start(), j.velocity_start() + j.num_velocities()) for j in joints]
         )
+        self._ivv = np.ix_(self._iv, self._iv)  # the mass matrix's rows and columns (per state)
         self._tau_port = self.plant.get_applied_generalized_force_input_port()
         self._force_port = self.plant.get_applied_spatial_force_input_port()
         self._acc_port = self.plant.get_generalized_acceleration_output_port()
@@ -291,7 +292,7 @@ class DrakeAdapter(Adapter):
         out = np.empty((len(q), len(self._iv), len(self._iv)))
         for k in range(len(q)):
             self._set(q[k])
-            out[k] = self.plant.CalcMassMatrix(self.context)[np.ix_(self._iv, self._iv)]
+            out[k] = self.plant.CalcMassMatrix(self.context)[self._ivv]
         return self._check("mass matrix", out)
 
     def _h(self) -> np.ndarray:
@@ -364,7 +365,7 @@ class DrakeAdapter(Adapter):
         force = np.empty((n, self._C.shape[0])) if coupled else None
         for k in range(n):
             self._set(q[k], v[k])
-            M[k] = plant.CalcMassMatrix(ctx)[np.ix_(iv, iv)]
+            M[k] = plant.CalcMassMatrix(ctx)[self._ivv]
             bias[k] = self._h()[iv]
             t_full[iv] = tau[k]
             if coupled:
