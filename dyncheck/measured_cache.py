@@ -5,8 +5,9 @@ and data, the installed engines and numerical libraries, the Python and the mach
 inputs give the same numbers). :func:`measured` stores its result under the user's cache
 folder (:func:`~dyncheck.reference.derivations.cache_root`) keyed by a hash of all of them, so
 that a second ``dyncheck explain`` prints without running the engines, while an upgrade of any
-engine, an edit of any file of dyncheck or another machine measures afresh. ``--no-cache``
-(``DYNCHECK_NO_CACHE``) neither reads nor writes. Files are written whole (a temporary file,
+engine, an edit of any file of dyncheck or another machine measures afresh. A case's figures
+are kept the same way (:func:`~dyncheck.report.figures.cached_figures`, the plotted data part
+of their name). ``--no-cache`` (``DYNCHECK_NO_CACHE``) neither reads nor writes. Files are written whole (a temporary file,
 then a rename); one that cannot be read back is measured again and replaced.
 """
 
