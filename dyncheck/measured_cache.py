@@ -7,14 +7,16 @@ folder (:func:`~dyncheck.reference.derivations.cache_root`) keyed by a hash of a
 that a second ``dyncheck explain`` prints without running the engines, while an upgrade of any
 engine, an edit of any file of dyncheck or another machine measures afresh. A case's figures
 are kept the same way (:func:`~dyncheck.report.figures.cached_figures`, the plotted data part
-of their name). ``--no-cache`` (``DYNCHECK_NO_CACHE``) neither reads nor writes. Files are written whole (a temporary file,
-then a rename); one that cannot be read back is measured again and replaced.
+of their name). ``--no-cache`` (``DYNCHECK_NO_CACHE``) neither reads nor writes. Files are
+written whole (a temporary file, then a rename); one that cannot be read back is measured
+again and replaced.
 """
 
 from __future__ import annotations
 
 import hashlib
 import platform
+import shutil
 import sys
 from collections.abc import Callable
 from functools import cache
@@ -88,11 +90,20 @@ def path_for(kind: str, name: str) -> Path:
 
 
 def measured(
-    kind: str, name: str, measure: Callable[[], T], keep: Callable[[T], bool]
+    kind: str, name: str, measure: Callable[[], T], keep: Callable[[T], bool], *,
+    latest_only: bool = False,
 ) -> tuple[T, bool]:
     """``measure()``, or the result an earlier call with the same ``kind``, ``name`` and
     :func:`fingerprint` stored; with whether it was read back. A result for which ``keep``
-    is false (a demonstration that failed) is returned but never stored."""
+    is false (a demonstration that failed) is returned but never stored. ``latest_only``:
+    storing a result removes what other fingerprints stored under ``kind`` (for large results
+    — a case's figures — that would otherwise pile up with every edit of dyncheck)."""
     if not enabled():  # before the fingerprint: it reads every file of dyncheck
         return measure(), False
-    return cached(path_for(kind, name), measure, keep)
+    path = path_for(kind, name)
+    result, found = cached(path, measure, keep)
+    if latest_only and not found:
+        for other in path.parent.parent.iterdir():
+            if other != path.parent:
+                shutil.rmtree(other, ignore_errors=True)  # another process's may be gone
+    return result, found

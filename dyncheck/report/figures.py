@@ -107,10 +107,13 @@ def cached_figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> d
     table with the same dyncheck and libraries (the cache's fingerprint, matplotlib's version
     in it): drawing is a deterministic function of them, so a second run with unchanged
     results draws nothing (``--no-cache``: drawn afresh). Only the drawing is reused — the
-    numbers plotted are always this run's."""
+    numbers plotted are always this run's. Only the latest fingerprint's figures are kept
+    (~0.4 MB a case: one set per edit of dyncheck would pile up on a machine that runs every
+    commit)."""
     h = hashlib.sha256(repr(case).encode())
     h.update(pickle.dumps(data, protocol=5))
     h.update(to_csv(conv[conv["case"] == case.name]).encode())
     pngs, _ = measured("figures", f"{case.name}-{h.hexdigest()[:32]}",
-                       lambda: figures(case, data, conv), keep=lambda _pngs: True)
+                       lambda: figures(case, data, conv), keep=lambda _pngs: True,
+                       latest_only=True)
     return pngs

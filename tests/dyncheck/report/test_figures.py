@@ -39,9 +39,10 @@ def drawn(monkeypatch, tmp_path):
         return draw(*args)
 
     monkeypatch.setattr(module, "figures", counting)
-    measured_cache.fingerprint.cache_clear()
+    clear = measured_cache.fingerprint.cache_clear  # (a test may replace the function)
+    clear()
     yield count
-    measured_cache.fingerprint.cache_clear()
+    clear()
 
 
 def test_a_second_drawing_of_the_same_results_is_read_back(study, drawn):
@@ -69,3 +70,14 @@ def test_no_cache_draws_every_time(study, drawn, monkeypatch):
     for _ in range(2):
         module.cached_figures(CASE, *study)
     assert len(drawn) == 2
+
+
+def test_figures_of_another_fingerprint_are_removed_when_new_ones_are_stored(
+        study, drawn, monkeypatch, tmp_path):
+    module.cached_figures(CASE, *study)
+    (old,) = (tmp_path / "figures").iterdir()
+    monkeypatch.setattr(measured_cache, "fingerprint", lambda: "an-edited-dyncheck")
+    module.cached_figures(CASE, *study)
+    assert len(drawn) == 2  # another fingerprint: drawn again
+    assert [p.name for p in (tmp_path / "figures").iterdir()] == ["an-edited-dyncheck"]
+    assert not old.exists()
