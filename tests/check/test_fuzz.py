@@ -140,7 +140,7 @@ def check_all(folder: str) -> None:
 def test_mutated_models_never_traceback_or_hang(tmp_path):
     subprocess.run([sys.executable, "-c",
                     f"from tests.check.test_fuzz import check_all; check_all({str(tmp_path)!r})"],
-                   cwd=ROOT, check=True, timeout=MUTANTS * 2 * LIMIT_S)
+                   cwd=ROOT, check=True, timeout=MUTANTS + 2 * LIMIT_S)  # ~0.04 s a mutant
     answers = json.loads((tmp_path / "answers.json").read_text())
     assert [a[0] for a in answers] == [name for name, _ in mutants()]
     codes: Counter[int] = Counter()
