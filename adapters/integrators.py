@@ -43,9 +43,9 @@ from dyncheck.cases.multibody import NQ, NV, ROTATING
 from dyncheck.errors import EngineError
 
 Acceleration = Callable[..., np.ndarray]
-"""v̇(q, v, held) for one state in the :class:`Layout`, shapes (nq,), (nv,) → (nv,); ``held``
-is ``None`` (evaluate every state-dependent external force now) or what ``freeze`` returned at
-the start of the step."""
+"""v̇(q, v[, held]) for one state in the :class:`Layout`, shapes (nq,), (nv,) → (nv,): called
+with two arguments it evaluates every state-dependent external force now; with ``held``, what
+``freeze`` returned at the start of the step, it uses that force instead."""
 
 
 def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -206,17 +206,17 @@ def _rk4_vector(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float, layou
     return out[:n], out[n:]
 
 
+def _held(acc: Acceleration, held: object, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """A stage's v̇ with the force frozen at the start of the step."""
+    return acc(q, v, held)
+
+
 STEPPERS: dict[str, Callable[..., tuple]] = {
     "euler": _euler,
     "implicitfast": _euler,  # D = 0: no damping, no actuators (see module docstring)
     "rk4": _rk4,
     "rk4-held-force": _rk4,
 }
-
-
-def _stage(acc: Acceleration, held: object, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """A stage's v̇: ``held`` the force frozen at the start of the step, or None."""
-    return acc(q, v, held)
 
 
 def integrate(
@@ -245,9 +245,8 @@ def integrate(
     vs = np.empty((steps + 1, v.shape[0]))
     qs[0], vs[0] = q, v
     hold = freeze if integrator == "rk4-held-force" else None
-    live = partial(_stage, acc, None)  # every stage evaluates the force now
     for k in range(1, steps + 1):
-        stage = live if hold is None else partial(_stage, acc, hold(q, v))
+        stage = acc if hold is None else partial(_held, acc, hold(q, v))
         q, v = step(stage, q, v, dt, layout, naive_group)
         qs[k], vs[k] = q, v
         if not math.isfinite(q.sum() + v.sum()):  # a NaN or an infinity (or |x| ~ 1e308)
