@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from dyncheck.cases import get_case
-from dyncheck.run import _release, _run_case
+from dyncheck.run import _implementations, _release
 
 IMPLS = ["reference", "mjx"]
 
@@ -15,21 +15,29 @@ IMPLS = ["reference", "mjx"]
 def test_moving_to_the_next_case_frees_the_compiled_programs_of_the_last():
     """MJX's jitted functions keep one program per model: after cases A then B the cache must
     hold what B alone compiles (measured from an empty cache), not A's programs as well — a
-    full run in one process otherwise ran out of memory maps and crashed."""
+    full run in one process otherwise ran out of memory maps and crashed. Each case's
+    implementations are built as a run builds them (:func:`_implementations`, which releases
+    the last case's) and compile both programs: a batch of states and a stepped run."""
     pytest.importorskip("mujoco.mjx", reason="the extra 'mjx' (pip install 'dyncheck[mjx]')")
     from dyncheck.adapters import mjx_
 
     def programs() -> int:
         return mjx_._EVALUATE._cache_size() + mjx_._STRETCH._cache_size()
 
+    def use(name: str) -> None:
+        case = get_case(name)
+        mjx = _implementations(case, IMPLS)["mjx"]
+        mjx.evaluate(case.sample_states(16))
+        mjx.simulate(case.trajectory.steps["euler"][0], "euler")
+
     _release()
     mjx_.MJXAdapter.release_compiled()
-    _run_case(get_case("simple_pendulum"), IMPLS, 16)
+    use("simple_pendulum")
     alone = programs()
     _release()
     assert programs() == 0
-    _run_case(get_case("atwood"), IMPLS, 16)
-    _run_case(get_case("simple_pendulum"), IMPLS, 16)
+    use("atwood")
+    use("simple_pendulum")
     assert alone > 0 and programs() == alone
 
 
