@@ -103,7 +103,10 @@ def measured(
     path = path_for(kind, name)
     result, found = cached(path, measure, keep)
     if latest_only and not found:
-        for other in path.parent.parent.iterdir():
-            if other != path.parent:
-                shutil.rmtree(other, ignore_errors=True)  # another process's may be gone
+        try:
+            others = [p for p in path.parent.parent.iterdir() if p != path.parent]
+        except OSError:  # nothing stored (a read-only or unusable cache folder)
+            others = []
+        for other in others:
+            shutil.rmtree(other, ignore_errors=True)  # another process's may be gone
     return result, found

@@ -81,3 +81,13 @@ def test_figures_of_another_fingerprint_are_removed_when_new_ones_are_stored(
     assert len(drawn) == 2  # another fingerprint: drawn again
     assert [p.name for p in (tmp_path / "figures").iterdir()] == ["an-edited-dyncheck"]
     assert not old.exists()
+
+
+def test_an_unusable_cache_folder_costs_a_drawing_never_the_figures(
+        study, drawn, monkeypatch, tmp_path):
+    blocked = tmp_path / "a-file"
+    blocked.write_text("not a folder")
+    monkeypatch.setenv("DYNCHECK_CACHE", str(blocked))
+    live = module.figures(CASE, *study)
+    assert module.cached_figures(CASE, *study) == live
+    assert len(drawn) == 2 and blocked.read_text() == "not a folder"
