@@ -80,6 +80,21 @@ def full_run() -> RunResult:
     return run([get_case(n) for n in CASE_NAMES], IMPLEMENTATIONS, jobs=2, conventions=True)
 
 
+
+@pytest.fixture
+def empty_cache(monkeypatch, tmp_path):
+    """An empty cache folder (derivations, measured demonstrations, figures), read and written
+    (``--no-cache`` off), with the fingerprint computed afresh before and after the test."""
+    from dyncheck import measured_cache
+    from dyncheck.reference.derivations import NO_CACHE
+
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
+    monkeypatch.delenv(NO_CACHE, raising=False)
+    clear = measured_cache.fingerprint.cache_clear  # (a test may replace the function)
+    clear()
+    yield tmp_path
+    clear()
+
 # Property tests: a fast profile for CI (the default) and a larger one for a nightly run,
 # chosen with pytest's --hypothesis-profile=nightly.
 settings.register_profile("ci", max_examples=8, deadline=None, derandomize=True)

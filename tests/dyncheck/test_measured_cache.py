@@ -17,10 +17,8 @@ NAME = "hinge-axis-sign"
 
 
 @pytest.fixture
-def counted(monkeypatch, tmp_path):
+def counted(monkeypatch, empty_cache):
     """An empty cache folder and the demonstration NAME wrapped to count its runs."""
-    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
     demo, origin = catalogue.DEMOS[NAME]
     runs = []
 
@@ -29,9 +27,7 @@ def counted(monkeypatch, tmp_path):
         return demo()
 
     monkeypatch.setitem(catalogue.DEMOS, NAME, (counting, origin))
-    measured_cache.fingerprint.cache_clear()
-    yield runs
-    measured_cache.fingerprint.cache_clear()
+    return runs
 
 
 def test_a_second_explain_reads_the_entry_back_without_running_it(counted):

@@ -28,10 +28,8 @@ def study():
 
 
 @pytest.fixture
-def drawn(monkeypatch, tmp_path):
+def drawn(monkeypatch, empty_cache):
     """An empty cache folder and :func:`figures` wrapped to count its drawings."""
-    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
     draw, count = module.figures, []
 
     def counting(*args):
@@ -39,10 +37,7 @@ def drawn(monkeypatch, tmp_path):
         return draw(*args)
 
     monkeypatch.setattr(module, "figures", counting)
-    clear = measured_cache.fingerprint.cache_clear  # (a test may replace the function)
-    clear()
-    yield count
-    clear()
+    return count
 
 
 def test_a_second_drawing_of_the_same_results_is_read_back(study, drawn):
