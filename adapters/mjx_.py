@@ -185,6 +185,10 @@ class MJXAdapter(PortAdapter):
             d = d.replace(
                 qpos=jnp.asarray(q0, dtype=self.dtype), qvel=jnp.asarray(v0, dtype=self.dtype)
             )
+            # committed to the device, as every chunk's output is: an uncommitted first input
+            # is another key of jit's compiled-program cache — a second lowering (~0.5 s a
+            # model, integrator and precision) on the first run longer than one chunk
+            d = jax.device_put(d, jax.devices()[0])
             qs = [np.asarray(q0, dtype=self.dtype)[None]]
             vs = [np.asarray(v0, dtype=self.dtype)[None]]
             for _ in range(-(-steps // STEPS)):
