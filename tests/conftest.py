@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import os
+import pickle
 import re
 
 import pytest
+from filelock import FileLock
 from hypothesis import settings
 
 from dyncheck import adapters
@@ -71,14 +74,31 @@ def unsupported_reason(case: str, engine: str) -> str | None:
 
 
 @pytest.fixture(scope="session")
-def full_run() -> RunResult:
+def full_run(tmp_path_factory: pytest.TempPathFactory) -> RunResult:
+    """Every case through every implementation, with the conventions catalogue: computed once
+    per test session. Under pytest-xdist the first worker that needs it computes it while the
+    others wait for it (a file lock in the session's shared temporary folder, the pattern
+    pytest-xdist documents) and read it back."""
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        return _full_run()
+    shared = tmp_path_factory.getbasetemp().parent / "full_run.pickle"
+    with FileLock(f"{shared}.lock"):
+        if shared.is_file():
+            return pickle.loads(shared.read_bytes())
+        result = _full_run()
+        tmp = shared.with_suffix(".tmp")
+        tmp.write_bytes(pickle.dumps(result))
+        tmp.replace(shared)
+        return result
+
+
+def _full_run() -> RunResult:
     # An engine that is not installed is a test failure, never a skip counted as a pass.
     # (asked here, not at import: finding out imports every adapter, JAX and Warp included)
     assert not adapters.MISSING, f"engines not installed: {adapters.MISSING}"
     # two worker processes: the same results as one (test_jobs_give_identical_results), in
     # about half the wall time on CI's two cores
     return run([get_case(n) for n in CASE_NAMES], IMPLEMENTATIONS, jobs=2, conventions=True)
-
 
 
 @pytest.fixture
