@@ -26,6 +26,9 @@ class Registration:
     cls: str
     package: str
     """The pip package that provides the engine (its version is read from its metadata)."""
+    integrators: tuple[str, ...]
+    """The fixed-step integrators its ``simulate`` accepts (its adapter's ``integrators``):
+    known without importing the engine (a test session's parameters)."""
     extra: str | None = None
     """The optional extra of dyncheck that installs it (core engines: None)."""
     ports: str | None = None
@@ -37,24 +40,39 @@ class Registration:
 
 
 _A = "dyncheck.adapters."
+_MUJOCO_C = ("euler", "implicitfast", "rk4", "rk4-held-force")
+"""MuJoCo's integrators, ``rk4-held-force`` being RK4 with a force held in ``xfrc_applied``;
+Pinocchio is stepped by the same definitions (:mod:`.integrators`)."""
+_PORTS = ("euler", "implicitfast", "rk4")
+"""The integrators of MuJoCo's ports (which have no external field to hold)."""
 REGISTRY: dict[str, Registration] = {
     "sympy-mechanics": Registration(
-        module=_A + "sympy_mechanics", cls="SympyMechanicsAdapter", package="sympy"
+        module=_A + "sympy_mechanics", cls="SympyMechanicsAdapter", package="sympy",
+        integrators=("euler", "rk4"),
     ),
-    "pinocchio": Registration(module=_A + "pinocchio_", cls="PinocchioAdapter", package="pin"),
+    "pinocchio": Registration(
+        module=_A + "pinocchio_", cls="PinocchioAdapter", package="pin", integrators=_MUJOCO_C
+    ),
     "pinocchio-mjcf": Registration(
-        module=_A + "pinocchio_", cls="PinocchioMJCFAdapter", package="pin"
+        module=_A + "pinocchio_", cls="PinocchioMJCFAdapter", package="pin",
+        integrators=_MUJOCO_C,
     ),
     "drake": Registration(
         module=_A + "drake_",
         cls="DrakeAdapter",
         package="drake",
         extra="drake",
+        integrators=("euler", "rk2", "rk3"),
     ),
-    "mujoco": Registration(module=_A + "mujoco_", cls="MuJoCoAdapter", package="mujoco"),
-    "mujoco-stiff": Registration(module=_A + "mujoco_", cls="MuJoCoStiffAdapter", package="mujoco"),
+    "mujoco": Registration(
+        module=_A + "mujoco_", cls="MuJoCoAdapter", package="mujoco", integrators=_MUJOCO_C
+    ),
+    "mujoco-stiff": Registration(
+        module=_A + "mujoco_", cls="MuJoCoStiffAdapter", package="mujoco", integrators=_MUJOCO_C
+    ),
     "mjx-f64": Registration(
-        module=_A + "mjx_", cls="MJXF64Adapter", package="mujoco-mjx", extra="mjx", ports="mujoco"
+        module=_A + "mjx_", cls="MJXF64Adapter", package="mujoco-mjx", extra="mjx", ports="mujoco",
+        integrators=_PORTS,
     ),
     "mjx": Registration(
         module=_A + "mjx_",
@@ -63,6 +81,7 @@ REGISTRY: dict[str, Registration] = {
         extra="mjx",
         ports="mujoco",
         float32=True,
+        integrators=_PORTS,
     ),
     "mujoco-warp": Registration(
         module=_A + "mujoco_warp_",
@@ -71,6 +90,7 @@ REGISTRY: dict[str, Registration] = {
         extra="warp",
         ports="mujoco",
         float32=True,
+        integrators=_PORTS,
     ),
 }
 """Implementation name → its registration: the one line an engine adds, in the order of trust

@@ -57,6 +57,7 @@ from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import LogVectorOutput
 
+from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.base import Adapter, Chart, Frame, LoadedBody, StateLayout, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Joint, Multibody
@@ -159,7 +160,7 @@ class DrakeAdapter(Adapter):
     """Its MJCF parser makes a ball joint a ``BallRpyJoint`` (ω in world axes) and a free
     joint a ``QuaternionFloatingJoint``, q = (w, x, y, z, p), v = (ω, v) in world axes."""
     package: ClassVar[str] = "drake"
-    integrators: ClassVar[tuple[str, ...]] = tuple(_INTEGRATORS)
+    integrators: ClassVar[tuple[str, ...]] = REGISTRY["drake"].integrators
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)

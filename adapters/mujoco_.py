@@ -26,7 +26,7 @@ from typing import ClassVar
 import mujoco
 import numpy as np
 
-from dyncheck.adapters import mujoco_api
+from dyncheck.adapters import REGISTRY, mujoco_api
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.mujoco_api import full_inertia
@@ -50,7 +50,7 @@ _INTEGRATORS = {
 class MuJoCoAdapter(Adapter):
     name: ClassVar[str] = "mujoco"
     package: ClassVar[str] = "mujoco"
-    integrators: ClassVar[tuple[str, ...]] = tuple(_INTEGRATORS)
+    integrators: ClassVar[tuple[str, ...]] = REGISTRY["mujoco"].integrators
     couplings_with_field: ClassVar[bool] = True
     """Tendon equalities and xfrc_applied coexist in one MuJoCo model."""
     gyroscopic_implicit: ClassVar[bool] = mujoco_api.GYROSCOPIC_IMPLICIT

@@ -31,6 +31,7 @@ import warp as wp
 wp.config.log_level = wp.LOG_ERROR  # no banner, no line per kernel module loaded
 import mujoco_warp as mjw  # noqa: E402  (after silencing Warp's log)
 
+from dyncheck.adapters import REGISTRY  # noqa: E402
 from dyncheck.adapters.mujoco_port import CHUNK, PortAdapter  # noqa: E402
 from dyncheck.cases.multibody import Multibody  # noqa: E402
 from dyncheck.errors import Unsupported  # noqa: E402
@@ -86,7 +87,7 @@ class MuJoCoWarpAdapter(PortAdapter):
 
     name: ClassVar[str] = "mujoco-warp"
     package: ClassVar[str] = "mujoco-warp"
-    integrators: ClassVar[tuple[str, ...]] = tuple(_INTEGRATORS)
+    integrators: ClassVar[tuple[str, ...]] = REGISTRY["mujoco-warp"].integrators
     rk4_group_order: ClassVar[int] = 4
     gyroscopic_implicit: ClassVar[bool] = True
     dtype: ClassVar[type[np.floating]] = np.float32

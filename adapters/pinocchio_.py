@@ -28,8 +28,9 @@ from typing import ClassVar
 import numpy as np
 import pinocchio as pin
 
+from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.base import Adapter, Frame, LoadedBody, StateLayout, Trajectory
-from dyncheck.adapters.integrators import STEPPERS, Layout, cross, integrate, solve_on_group
+from dyncheck.adapters.integrators import Layout, cross, integrate, solve_on_group
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.cases.multibody import Joint, Multibody
@@ -99,7 +100,7 @@ class PinocchioAdapter(Adapter):
     """``JointModelSpherical``: q (x, y, z, w), ω in the joint's local frame; free-flyer q
     (p, x, y, z, w), v (v, ω) both in the body frame (programmatic or from MJCF)."""
     package: ClassVar[str] = "pin"
-    integrators: ClassVar[tuple[str, ...]] = tuple(STEPPERS)
+    integrators: ClassVar[tuple[str, ...]] = REGISTRY["pinocchio"].integrators
     adaptive: ClassVar[bool] = True
 
     def __init__(self, model: Multibody) -> None:

@@ -28,6 +28,7 @@ import numpy as np
 import sympy as sp
 import sympy.physics.mechanics as me
 
+from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.base import Adapter, Chart, Frame, LoadedBody, StateLayout, Trajectory
 from dyncheck.adapters.integrators import integrate
 from dyncheck.cases.multibody import ROTATING, Multibody
@@ -186,7 +187,7 @@ class SympyMechanicsAdapter(Adapter):
         ball_chart=Chart.EULER, angular_velocity_frame=Frame.EULER_RATES)
     """dyncheck's own model: a rotating body in Example 9's angles, velocities their rates."""
     package: ClassVar[str] = "sympy"
-    integrators: ClassVar[tuple[str, ...]] = ("euler", "rk4")
+    integrators: ClassVar[tuple[str, ...]] = REGISTRY["sympy-mechanics"].integrators
     """MuJoCo's definitions (:mod:`.integrators`): semi-implicit Euler, shared with every
     engine including Drake, and RK4. Each step costs Python-level evaluations of the
     lambdified equations."""

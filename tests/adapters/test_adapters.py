@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from dyncheck.adapters import ADAPTERS, get_adapter
+from dyncheck import adapters
+from dyncheck.adapters import REGISTRY, get_adapter
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases import get_case
 from dyncheck.errors import UnknownName
@@ -159,7 +160,7 @@ def test_simple_pendulum_in_engine_coordinates(engine):
         (e, i)
         for e in ENGINES
         for i in ("euler", "rk4")
-        if i in ADAPTERS[e].integrators and supported("compound_pendulum", e)
+        if i in REGISTRY[e].integrators and supported("compound_pendulum", e)
     ],
 )
 def test_one_step_matches_integrator_definition(engine, integrator):
@@ -214,7 +215,7 @@ def test_unknown_engine_lists_valid_names():
 
 
 def test_every_engine_is_installed_here():
-    assert sorted(ADAPTERS) == ALL_ENGINES
+    assert sorted(adapters.ADAPTERS) == ALL_ENGINES
 
 
 @pytest.mark.parametrize("engine", ALL_ENGINES)
@@ -266,4 +267,24 @@ def test_registered_precision_is_the_adapters(engine):
     importing the engine); it must be what the adapter computes in."""
     from dyncheck.adapters import FLOAT32
 
-    assert (engine in FLOAT32) == (ADAPTERS[engine].dtype == np.float32)
+    assert (engine in FLOAT32) == (adapters.ADAPTERS[engine].dtype == np.float32)
+
+
+@pytest.mark.parametrize("engine", ALL_ENGINES)
+def test_registered_integrators_are_those_the_engine_maps(engine):
+    """The registry lists each engine's integrators (a test session parametrizes over them
+    without importing JAX or Warp); they must be what its adapter maps to the engine's own:
+    MuJoCo's and its ports' integrator enums, Drake's scheme names, the definitions Pinocchio
+    is stepped with (sympy-mechanics runs two of them)."""
+    import importlib
+
+    from dyncheck.adapters.integrators import STEPPERS
+
+    entry = REGISTRY[engine]
+    module = importlib.import_module(entry.module)
+    mapped = getattr(module, "_INTEGRATORS", STEPPERS)
+    assert adapters.ADAPTERS[engine].integrators == entry.integrators
+    if engine == "sympy-mechanics":
+        assert set(entry.integrators) < set(STEPPERS)
+    else:
+        assert entry.integrators == tuple(mapped)

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from dyncheck import conventions
-from dyncheck.adapters import ADAPTERS, get_adapter
+from dyncheck import adapters, conventions
+from dyncheck.adapters import get_adapter
 from dyncheck.adapters.base import Frame
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import SphericalPendulumMap, quat_to_matrix
@@ -61,7 +61,7 @@ def test_quaternion_order_and_velocity_frame(engine):
 
 def test_native_order_round_trip():
     spec = get_case("spherical_pendulum").multibody()
-    for engine in ADAPTERS:  # every installed engine declares a layout
+    for engine in adapters.ADAPTERS:  # every installed engine declares a layout
         q = conventions.to_native(engine, spec, ROT[None])
         assert_allclose(conventions.from_native(engine, spec, q), ROT[None])
     assert_allclose(

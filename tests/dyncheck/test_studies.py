@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dyncheck.adapters import ADAPTERS
+from dyncheck.adapters import REGISTRY
 from dyncheck.cases import NOMINAL_ORDER, get_case
 from dyncheck.comparison import GRAVITY_DEFAULT
 from dyncheck.implementations import SOFT_CONSTRAINT
@@ -34,13 +34,13 @@ STUDIES = [
     for c in CASE_NAMES
     for e in ALL_ENGINES
     for i in get_case(c).trajectory.steps
-    if i in ADAPTERS[e].integrators and supported(c, e)
+    if i in REGISTRY[e].integrators and supported(c, e)
 ]
 
 
 def _common(a: str, b: str, case: str) -> int:
     steps = get_case(case).trajectory.steps
-    return len(set(ADAPTERS[a].integrators) & set(ADAPTERS[b].integrators) & set(steps))
+    return len(set(REGISTRY[a].integrators) & set(REGISTRY[b].integrators) & set(steps))
 
 
 @pytest.mark.parametrize(("case", "engine", "integrator"), STUDIES)
