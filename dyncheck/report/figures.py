@@ -6,11 +6,9 @@ from __future__ import annotations
 import hashlib
 import io
 import pickle
+from types import ModuleType
+from typing import TYPE_CHECKING
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
@@ -21,20 +19,35 @@ from dyncheck.studies import (
     TrajectoryFigures,
 )
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 DPI = 90
 """Pixels per inch of the PNGs; the figures are made at it, so that the layout pass and the
 saved drawing share one renderer (and its cache of laid-out text)."""
 
 
-def _png(fig: plt.Figure) -> bytes:
+def _pyplot() -> ModuleType:
+    """matplotlib's pyplot on the Agg backend, imported when a figure is drawn (a run whose
+    figures are all read back from the cache never imports it: ~0.5 s a process)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _png(fig: Figure) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=DPI, metadata={"Software": None})
-    plt.close(fig)
+    _pyplot().close(fig)
     return buf.getvalue()
 
 
 def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str, bytes]:
     """Deterministic PNGs: trajectory, error against time, error against step size."""
+    plt = _pyplot()
     plt.rcParams.update({"font.family": "DejaVu Sans", "font.size": 9})
     out = {}
     fig, axes = plt.subplots(case.ndof, 1, figsize=(7, 2.2 * case.ndof), squeeze=False, dpi=DPI)

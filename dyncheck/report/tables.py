@@ -3,9 +3,6 @@ error-controlled runs (pandas frames rendered to Markdown by the pages)."""
 
 from __future__ import annotations
 
-import matplotlib
-
-matplotlib.use("Agg")
 import numpy as np
 import pandas as pd
 
