@@ -177,6 +177,11 @@ class DrakeAdapter(Adapter):
             [np.arange(j.velocity_start(), j.velocity_start() + j.num_velocities()) for j in joints]
         )
         self._ivv = np.ix_(self._iv, self._iv)  # the mass matrix's rows and columns (per state)
+        self._native = np.array_equal(self._iq, np.arange(self.plant.num_positions())) and (
+            np.array_equal(self._iv, np.arange(self.plant.num_velocities()))
+        )
+        """Drake's coordinates are the spec's, in its order: states pass as they are (a batch's
+        per-state cost is its numpy calls around the engine's)."""
         self._tau_port = self.plant.get_applied_generalized_force_input_port()
         self._force_port = self.plant.get_applied_spatial_force_input_port()
         self._acc_port = self.plant.get_generalized_acceleration_output_port()
@@ -364,23 +369,34 @@ class DrakeAdapter(Adapter):
         field = bool(self.spec.central_mu)
         coupled = self._C is not None
         force = np.empty((n, self._C.shape[0])) if coupled else None
+        native = self._native
         for k in range(n):
-            self._set(q[k], v[k])
-            M[k] = plant.CalcMassMatrix(ctx)[self._ivv]
-            bias[k] = self._h()[iv]
-            t_full[iv] = tau[k]
+            if native:
+                plant.SetPositions(ctx, q[k])
+                plant.SetVelocities(ctx, v[k])
+                M[k] = plant.CalcMassMatrix(ctx)
+                bias[k] = self._h()
+                t_full = tau[k]
+            else:
+                self._set(q[k], v[k])
+                M[k] = plant.CalcMassMatrix(ctx)[self._ivv]
+                bias[k] = self._h()[iv]
+                t_full[iv] = tau[k]
             if coupled:
                 acc, force[k] = self._closed(ctx, t_full)
-                fwd[k] = acc[iv]
+                fwd[k] = acc if native else acc[iv]
             else:
                 self._tau_port.FixValue(ctx, t_full)
                 if field:
                     self._force_port.FixValue(ctx, self._field_forces(ctx))
-                fwd[k] = self._acc_port.Eval(ctx)[iv]
+                fwd[k] = self._acc_port.Eval(ctx) if native else self._acc_port.Eval(ctx)[iv]
             forces.SetZero()
             plant.CalcForceElementsContribution(ctx, forces)
-            vdot[iv] = a[k]
-            inv[k] = plant.CalcInverseDynamics(ctx, vdot, forces)[iv]
+            if native:
+                inv[k] = plant.CalcInverseDynamics(ctx, a[k], forces)
+            else:
+                vdot[iv] = a[k]
+                inv[k] = plant.CalcInverseDynamics(ctx, vdot, forces)[iv]
             if field:
                 inv[k] -= self._field_generalized()
             kin[k] = plant.CalcKineticEnergy(ctx)
