@@ -389,7 +389,8 @@ class DrakeAdapter(Adapter):
                 self._tau_port.FixValue(ctx, t_full)
                 if field:
                     self._force_port.FixValue(ctx, self._field_forces(ctx))
-                fwd[k] = self._acc_port.Eval(ctx) if native else self._acc_port.Eval(ctx)[iv]
+                vdot_now = np.asarray(self._acc_port.Eval(ctx))
+                fwd[k] = vdot_now if native else vdot_now[iv]
             forces.SetZero()
             plant.CalcForceElementsContribution(ctx, forces)
             if native:
