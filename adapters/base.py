@@ -15,7 +15,7 @@ Adapters never see the book's coordinates: the comparison layer maps them.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from enum import StrEnum
 from typing import ClassVar, TypeVar
@@ -180,6 +180,17 @@ class Adapter(ABC):
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:
         """Fixed-step integration from (q0, v0) for ``round(duration / dt)`` steps, τ = 0."""
+
+    batches_steps: ClassVar[bool] = False
+    """Whether :meth:`simulate_many` runs several step sizes at once (MuJoCo Warp: one world
+    per step size) rather than one after another."""
+
+    def simulate_many(
+        self, q0: np.ndarray, v0: np.ndarray, duration: float, dts: Sequence[float],
+        integrator: str,
+    ) -> list[Trajectory]:
+        """:meth:`simulate` at each step size of ``dts`` — the same runs, one per step size."""
+        return [self.simulate(q0, v0, duration, dt, integrator) for dt in dts]
 
     def constraint_force(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """The couplings' multipliers f (n, n_couplings) of the forward-dynamics solve at τ,

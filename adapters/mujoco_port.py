@@ -17,6 +17,7 @@ returned as float64 arrays, so that the comparison sees exactly what the port co
 from __future__ import annotations
 
 from abc import abstractmethod
+from collections.abc import Sequence
 from operator import attrgetter
 from typing import ClassVar
 
@@ -182,5 +183,26 @@ class PortAdapter(MuJoCoAdapter):
             raise Unsupported(f"{self.name} offers no integrator {integrator!r}")
         steps = round(duration / dt)
         qs, vs = self._run(np.asarray(q0), np.asarray(v0), steps, dt, integrator)
+        return self._trajectory(qs, vs, dt)
+
+    def _trajectory(self, qs: np.ndarray, vs: np.ndarray, dt: float) -> Trajectory:
         qs, vs = qs.astype(float), vs.astype(float)
-        return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)
+        return Trajectory(np.arange(len(qs)) * dt, self._check("simulate", qs), vs)
+
+    def simulate_many(
+        self, q0: np.ndarray, v0: np.ndarray, duration: float, dts: Sequence[float],
+        integrator: str,
+    ) -> list[Trajectory]:
+        if not self.batches_steps:
+            return super().simulate_many(q0, v0, duration, dts, integrator)
+        if integrator not in self.integrators:
+            raise Unsupported(f"{self.name} offers no integrator {integrator!r}")
+        steps = [round(duration / dt) for dt in dts]
+        runs = self._run_many(np.asarray(q0), np.asarray(v0), steps, list(dts), integrator)
+        return [self._trajectory(qs, vs, dt) for (qs, vs), dt in zip(runs, dts, strict=True)]
+
+    def _run_many(
+        self, q0: np.ndarray, v0: np.ndarray, steps: list[int], dts: list[float], integrator: str
+    ) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Runs of ``steps[i]`` steps of ``dts[i]`` at once (where :attr:`batches_steps`)."""
+        raise NotImplementedError(f"{self.name} runs one step size at a time")

@@ -164,22 +164,36 @@ class MuJoCoWarpAdapter(PortAdapter):
             out[w] = force[w, rows[np.argsort(ident[w, rows], kind="stable")]]
         return out
 
+    batches_steps: ClassVar[bool] = True
+    """A study's step sizes run as worlds of one batch, each with its own ``opt.timestep``
+    (MuJoCo Warp reads the timestep per world): a step of every world costs one step's kernel
+    launches, which dominate on a CPU."""
+
     def _run(
         self, q0: np.ndarray, v0: np.ndarray, steps: int, dt: float, integrator: str
     ) -> tuple[np.ndarray, np.ndarray]:
-        if self.max_steps is not None and steps > self.max_steps:
-            raise Unsupported(too_long(steps))
-        self.model.opt.timestep = dt
+        return self._run_many(q0, v0, [steps], [dt], integrator)[0]
+
+    def _run_many(
+        self, q0: np.ndarray, v0: np.ndarray, steps: list[int], dts: list[float], integrator: str
+    ) -> list[tuple[np.ndarray, np.ndarray]]:
+        """World i steps ``dts[i]`` and is read for its first ``steps[i]`` steps; the worlds
+        do not interact (each world's arithmetic is that of a run of its own)."""
+        longest, worlds = max(steps), len(dts)
+        if self.max_steps is not None and longest > self.max_steps:
+            raise Unsupported(too_long(longest))
+        self.model.opt.timestep = dts[0]
         self.model.opt.integrator = _INTEGRATORS[integrator]
         with wp.ScopedDevice(self.device):
             m = mjw.put_model(self.model)
-            d = mjw.make_data(self.model, nworld=1)
-            d.qpos.assign(wp.array(np.asarray(q0, np.float32)[None]))
-            d.qvel.assign(wp.array(np.asarray(v0, np.float32)[None]))
-            qs = np.empty((steps + 1, self.model.nq))
-            vs = np.empty((steps + 1, self.model.nv))
-            qs[0], vs[0] = d.qpos.numpy()[0], d.qvel.numpy()[0]
-            for k in range(1, steps + 1):
+            m.opt.timestep = wp.array(np.asarray(dts, np.float32), dtype=float)
+            d = mjw.make_data(self.model, nworld=worlds)
+            d.qpos.assign(wp.array(np.tile(np.asarray(q0, np.float32), (worlds, 1))))
+            d.qvel.assign(wp.array(np.tile(np.asarray(v0, np.float32), (worlds, 1))))
+            qs = np.empty((longest + 1, worlds, self.model.nq))
+            vs = np.empty((longest + 1, worlds, self.model.nv))
+            qs[0], vs[0] = d.qpos.numpy(), d.qvel.numpy()
+            for k in range(1, longest + 1):
                 mjw.step(m, d)
-                qs[k], vs[k] = d.qpos.numpy()[0], d.qvel.numpy()[0]
-        return qs, vs
+                qs[k], vs[k] = d.qpos.numpy(), d.qvel.numpy()
+        return [(qs[: n + 1, i], vs[: n + 1, i]) for i, n in enumerate(steps)]

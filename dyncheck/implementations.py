@@ -12,13 +12,14 @@ Each case's system in the reference (general method and printed form) is declare
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
 from dyncheck import coordinates as co
-from dyncheck.adapters import ENGINE_PACKAGES, ENGINE_PORTS, Adapter, get_adapter
+from dyncheck.adapters import ENGINE_PACKAGES, ENGINE_PORTS, Adapter, Trajectory, get_adapter
 from dyncheck.cases import Case, StateSample
 from dyncheck.conventions import (
     from_native,
@@ -345,12 +346,32 @@ class EngineImplementation(Implementation):
         qe0, ve0 = self._engine_start()
         key = (dt, self.adapter.definition(integrator))
         if key not in self._runs:  # two names for one map (implicitfast = euler, D = 0) run once
-            traj = self.adapter.simulate(qe0, ve0, spec.duration, dt, integrator)
-            qb = self.map.to_book(traj.q)
-            self._runs[key] = (traj.t, qb)
-            self._engine_q[key] = traj.q
-            self._velocities[key] = co.velocity_to_book(self.map, qb, traj.v)
+            self._keep(key, self.adapter.simulate(qe0, ve0, spec.duration, dt, integrator))
         return self._runs[key]
+
+    def _keep(self, key: tuple[float, str], traj: Trajectory) -> None:
+        qb = self.map.to_book(traj.q)
+        self._runs[key] = (traj.t, qb)
+        self._engine_q[key] = traj.q
+        self._velocities[key] = co.velocity_to_book(self.map, qb, traj.v)
+
+    def simulate_all(self, dts: Sequence[float], integrator: str) -> None:
+        """The runs :meth:`simulate` makes at each step size of ``dts``, made at once where the
+        engine batches step sizes (``batches_steps``: MuJoCo Warp's worlds) — the same runs.
+        A batch that raises is left to :meth:`simulate`, one step size at a time, so that the
+        step size that fails is the one reported."""
+        definition = self.adapter.definition(integrator)
+        missing = [dt for dt in dict.fromkeys(dts) if (dt, definition) not in self._runs]
+        if not self.adapter.batches_steps or len(missing) < 2:
+            return
+        spec = self.case.trajectory
+        qe0, ve0 = self._engine_start()
+        try:
+            runs = self.adapter.simulate_many(qe0, ve0, spec.duration, missing, integrator)
+        except Exception:  # reported by the one-by-one runs that follow
+            return
+        for dt, traj in zip(missing, runs, strict=True):
+            self._keep((dt, definition), traj)
 
     def engine_positions(self, dt: float, integrator: str) -> np.ndarray:
         """Engine-coordinate positions of a run :meth:`simulate` made (native storage)."""

@@ -12,6 +12,7 @@ from dyncheck.comparison import describe
 from dyncheck.errors import Unsupported
 from dyncheck.implementations import (
     IMPLEMENTATIONS,
+    EngineImplementation,
     Implementation,
     Variant,
     book_variant,
@@ -74,6 +75,8 @@ def study(
                 rows.append(unavailable(case, name, why, integrator, dts[0]))
                 continue
             try:
+                if isinstance(impl, EngineImplementation):
+                    impl.simulate_all(dts, integrator)  # at once where the engine batches them
                 for dt in dts:
                     _, q = impl.simulate(dt, integrator)
                     runs[name, integrator, dt] = q

@@ -168,3 +168,40 @@ def test_ports_are_registered_with_their_extras():
     for port in PORTS:
         assert port in adapters.ADAPTERS, adapters.MISSING.get(port)
         assert adapters.ADAPTERS[port].dtype == (np.float64 if port == "mjx-f64" else np.float32)
+
+
+@pytest.mark.parametrize("case_name", ["cylindrical_coordinates", "rigid_body_free"])
+def test_warp_worlds_with_their_own_step_are_the_runs_one_by_one(case_name):
+    """A study's step sizes run as worlds of one MuJoCo Warp batch, each world with its own
+    ``opt.timestep``: every world's trajectory must be the run of that step size alone, to
+    the last bit (the worlds do not interact; a world that stepped with another's timestep, or
+    read past its own steps, would differ)."""
+    case = get_case(case_name)
+    spec, impl = case.trajectory, make_implementation("mujoco-warp", case)
+    assert isinstance(impl, EngineImplementation) and impl.adapter.batches_steps
+    qe0, ve0 = impl._engine_start()
+    dts = spec.steps["rk4"]
+    many = impl.adapter.simulate_many(qe0, ve0, spec.duration, dts, "rk4")
+    for dt, run in zip(dts, many, strict=True):
+        alone = impl.adapter.simulate(qe0, ve0, spec.duration, dt, "rk4")
+        assert len(run.q) == round(spec.duration / dt) + 1
+        for got, want in ((run.t, alone.t), (run.q, alone.q), (run.v, alone.v)):
+            np.testing.assert_array_equal(got, want, err_msg=f"dt={dt}")
+
+
+def test_a_batch_that_fails_leaves_each_step_size_to_its_own_run(monkeypatch):
+    """Where the batch raises (a world diverged), no run is kept from it: the study's runs one
+    step size at a time then report the step size that fails, as without batching."""
+    case = get_case("cylindrical_coordinates")
+    impl = make_implementation("mujoco-warp", case)
+    assert isinstance(impl, EngineImplementation)
+
+    def diverged(*_args, **_kwargs):
+        raise FloatingPointError("a world diverged")
+
+    monkeypatch.setattr(impl.adapter, "simulate_many", diverged)
+    dts = case.trajectory.steps["rk4"]
+    impl.simulate_all(dts, "rk4")
+    assert impl._runs == {}
+    t, _ = impl.simulate(dts[0], "rk4")  # the one-by-one run still works
+    assert len(t) == round(case.trajectory.duration / dts[0]) + 1
