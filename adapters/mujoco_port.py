@@ -17,7 +17,6 @@ returned as float64 arrays, so that the comparison sees exactly what the port co
 from __future__ import annotations
 
 from abc import abstractmethod
-from collections.abc import Sequence
 from operator import attrgetter
 from typing import ClassVar
 
@@ -179,30 +178,16 @@ class PortAdapter(MuJoCoAdapter):
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:
-        if integrator not in self.integrators:
-            raise Unsupported(f"{self.name} offers no integrator {integrator!r}")
+        self._require(integrator)
         steps = round(duration / dt)
         qs, vs = self._run(np.asarray(q0), np.asarray(v0), steps, dt, integrator)
         return self._trajectory(qs, vs, dt)
 
-    def _trajectory(self, qs: np.ndarray, vs: np.ndarray, dt: float) -> Trajectory:
-        qs, vs = qs.astype(float), vs.astype(float)
-        return Trajectory(np.arange(len(qs)) * dt, self._check("simulate", qs), vs)
-
-    def simulate_many(
-        self, q0: np.ndarray, v0: np.ndarray, duration: float, dts: Sequence[float],
-        integrator: str,
-    ) -> list[Trajectory]:
-        if not self.batches_steps:
-            return super().simulate_many(q0, v0, duration, dts, integrator)
+    def _require(self, integrator: str) -> None:
         if integrator not in self.integrators:
             raise Unsupported(f"{self.name} offers no integrator {integrator!r}")
-        steps = [round(duration / dt) for dt in dts]
-        runs = self._run_many(np.asarray(q0), np.asarray(v0), steps, list(dts), integrator)
-        return [self._trajectory(qs, vs, dt) for (qs, vs), dt in zip(runs, dts, strict=True)]
 
-    def _run_many(
-        self, q0: np.ndarray, v0: np.ndarray, steps: list[int], dts: list[float], integrator: str
-    ) -> list[tuple[np.ndarray, np.ndarray]]:
-        """Runs of ``steps[i]`` steps of ``dts[i]`` at once (where :attr:`batches_steps`)."""
-        raise NotImplementedError(f"{self.name} runs one step size at a time")
+    def _trajectory(self, qs: np.ndarray, vs: np.ndarray, dt: float) -> Trajectory:
+        """A run as the comparison sees it: float64, times from 0 every ``dt``, checked."""
+        qs, vs = qs.astype(float), vs.astype(float)
+        return Trajectory(np.arange(len(qs)) * dt, self._check("simulate", qs), vs)

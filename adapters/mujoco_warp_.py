@@ -20,6 +20,7 @@ from __future__ import annotations
 import os
 import sys
 import tempfile
+from collections.abc import Sequence
 from importlib.metadata import version as _version
 from operator import attrgetter
 from typing import ClassVar
@@ -32,6 +33,7 @@ wp.config.log_level = wp.LOG_ERROR  # no banner, no line per kernel module loade
 import mujoco_warp as mjw  # noqa: E402  (after silencing Warp's log)
 
 from dyncheck.adapters import REGISTRY  # noqa: E402
+from dyncheck.adapters.base import Trajectory  # noqa: E402
 from dyncheck.adapters.mujoco_port import CHUNK, PortAdapter  # noqa: E402
 from dyncheck.cases.multibody import Multibody  # noqa: E402
 from dyncheck.errors import Unsupported  # noqa: E402
@@ -168,6 +170,15 @@ class MuJoCoWarpAdapter(PortAdapter):
     """A study's step sizes run as worlds of one batch, each with its own ``opt.timestep``
     (MuJoCo Warp reads the timestep per world): a step of every world costs one step's kernel
     launches, which dominate on a CPU."""
+
+    def simulate_many(
+        self, q0: np.ndarray, v0: np.ndarray, duration: float, dts: Sequence[float],
+        integrator: str,
+    ) -> list[Trajectory]:
+        self._require(integrator)
+        steps = [round(duration / dt) for dt in dts]
+        runs = self._run_many(np.asarray(q0), np.asarray(v0), steps, list(dts), integrator)
+        return [self._trajectory(qs, vs, dt) for (qs, vs), dt in zip(runs, dts, strict=True)]
 
     def _run(
         self, q0: np.ndarray, v0: np.ndarray, steps: int, dt: float, integrator: str
