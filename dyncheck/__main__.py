@@ -1,3 +1,3 @@
-from dyncheck.cli import main
+from dyncheck.cli import console
 
-raise SystemExit(main())
+raise SystemExit(console())

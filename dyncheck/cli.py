@@ -651,9 +651,18 @@ def main(argv: Sequence[str] | None = None) -> int:
             os.environ[NO_CACHE] = before
 
 
+def console() -> int:
+    """The ``dyncheck`` command: :func:`main` in a process that exits without a last garbage
+    collection (:func:`dyncheck.workers.exit_without_collecting`)."""
+    from dyncheck.workers import exit_without_collecting
+
+    exit_without_collecting()
+    return main()
+
+
 def _one_line(text: str) -> str:
     return " ".join(text.split())
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(console())
