@@ -249,7 +249,9 @@ def integrate(
         stage = acc if hold is None else partial(_held, acc, hold(q, v))
         q, v = step(stage, q, v, dt, layout, naive_group)
         qs[k], vs[k] = q, v
-        if not math.isfinite(q.sum() + v.sum()):  # a NaN or an infinity (or |x| ~ 1e308)
+        # a NaN or an infinity (or |x| ~ 1e308); summed as Python floats: a small state's two
+        # numpy reductions cost 2 µs, 40 % of an Euler step, its lists' sums 0.3 µs
+        if not math.isfinite(sum(q.tolist()) + sum(v.tolist())):
             raise FloatingPointError(f"{integrator} diverged at step {k} (t = {k * dt:g})")
     return qs, vs
 
