@@ -212,17 +212,31 @@ def test_worst_state_ties_go_to_the_first_state_however_the_states_are_cut():
 
     errors = np.array([0.0, 2, 4, 0, 8, 2])[:, None] * EPS  # exact on 1
     whole = PairStats()
-    whole.update(0, s, desired + errors, desired, None)
+    whole.update(0, s, desired + errors, desired, None, scale=1.0)
     cut = PairStats()
     for a, b in ((0, 2), (2, 4), (4, 6)):
         part = PairStats()
         piece = StateSample(q=s.q[a:b], v=s.v[a:b], tau=s.tau[a:b], a=s.a[a:b])
-        part.update(a, piece, desired[a:b] + errors[a:b], desired[a:b], None)
+        part.update(a, piece, desired[a:b] + errors[a:b], desired[a:b], None, scale=1.0)
         cut = cut.merge(part)
     assert ROUNDOFF_FACTOR * EPS * 1.0 > 8 * EPS  # the band (scale 1) holds every error
     assert whole.worst[0] == cut.worst[0] == 0
     assert cut.worst[1] == whole.worst[1]
     assert whole.max_abs == cut.max_abs == 8 * EPS
+
+
+@pytest.mark.parametrize("shape", [(50,), (50, 1), (50, 2), (50, 3, 3), (50, 6, 6)])
+def test_per_state_maxima_are_numpys_over_each_state(shape):
+    """The per-state maximum laid out for speed is numpy's own max |x| over each state's
+    values (an independent reduction), including a NaN, which must surface."""
+    from dyncheck.comparison import _per_state
+
+    x = np.random.default_rng(0).normal(size=shape)
+    x[7].flat[-1] = np.nan
+    expected = np.abs(x).reshape(shape[0], -1).max(axis=1)
+    got = _per_state(x.copy())
+    assert got.shape == (shape[0],)
+    np.testing.assert_array_equal(got, expected)
 
 
 def test_worst_state_is_reported_and_reproducible():
