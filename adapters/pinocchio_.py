@@ -299,6 +299,7 @@ class PinocchioAdapter(Adapter):
         )
         kin, pot = np.empty(n), np.empty(n)
         crba, rnea, aba = pin.crba, pin.rnea, pin.aba
+        kinetic, potential = pin.computeKineticEnergy, pin.computePotentialEnergy
         field = bool(self.spec.central_mu)
         coupled = self._C is not None
         force = np.empty((n, self._C.shape[0])) if coupled else None
@@ -316,8 +317,8 @@ class PinocchioAdapter(Adapter):
             else:
                 fwd[k] = aba(m, d, qk, vk, tau[k])
                 inv[k] = rnea(m, d, qk, vk, a[k])
-            kin[k] = pin.computeKineticEnergy(m, d, qk, vk)
-            pot[k] = pin.computePotentialEnergy(m, d, qk)
+            kin[k] = kinetic(m, d, qk, vk)
+            pot[k] = potential(m, d, qk)
         M = np.triu(M) + np.swapaxes(np.triu(M, 1), 1, 2)
         return self._outputs(M, bias, fwd, inv, kin, pot, force)
 
