@@ -113,7 +113,9 @@ class Curve:
         return T, dT, kappa, N, B, dN, tau, dB
 
     def _eval(self, expr, t0: float) -> np.ndarray:
-        f = sp.lambdify(self.t, expr, "numpy")
+        """``expr`` at t = t0, its repeated subexpressions computed once (``cse``: the frame's
+        derivatives repeat the curve's, and printing them whole cost seconds a frame)."""
+        f = sp.lambdify(self.t, expr, "numpy", cse=True)
         return np.asarray(f(t0), dtype=float).reshape(
             np.shape(expr) if hasattr(expr, "shape") else ()
         )
