@@ -283,12 +283,12 @@ def _jacobi_christoffel(cs: CoordinateSystem):
         for i in range(n)
     ]
     second = [
-        sp.simplify(sum(Gi[i, j] * first[j][m][k] for j in range(n)))
+        sum(Gi[i, j] * first[j][m][k] for j in range(n))
         for i in range(n)
         for m in range(n)
         for k in range(n)
     ]
-    fns = [sp.lambdify((*q, M, g, h), e, "numpy") for e in second]
+    fns = [sp.lambdify((*q, M, g, h), e, "numpy", cse=True) for e in second]
 
     def evaluate(qv: np.ndarray, Mv: float, gv: float, hv: float) -> np.ndarray:
         cols = [np.broadcast_to(np.asarray(f(*qv.T, Mv, gv, hv), float), qv.shape[:1]) for f in fns]
