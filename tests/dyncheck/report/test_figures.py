@@ -86,3 +86,13 @@ def test_an_unusable_cache_folder_costs_a_drawing_never_the_figures(
     live = module.figures(CASE, *study)
     assert module.cached_figures(CASE, *study) == live
     assert len(drawn) == 2 and blocked.read_text() == "not a folder"
+
+
+@pytest.mark.parametrize(
+    ("value", "label"),
+    [(1e-8, "10⁻⁸"), (1.0, "10⁰"), (100.0, "10²"), (1e-17, "10⁻¹⁷"), (2e-3, ""), (0.0, "")],
+)
+def test_log_axes_label_decades_in_plain_text(value, label):
+    """A log axis's major labels: 10ⁿ written with Unicode superscripts at each decade (the
+    expected strings typed here), nothing between decades or at zero."""
+    assert module._decade(value) == label
