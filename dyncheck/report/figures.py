@@ -7,6 +7,7 @@ import hashlib
 import io
 import math
 import pickle
+from dataclasses import dataclass
 from types import ModuleType
 from typing import TYPE_CHECKING
 
@@ -41,26 +42,38 @@ def _pyplot() -> ModuleType:
     return plt
 
 
-MARGINS_IN = {"left": 0.8, "right": 0.15, "top": 0.3, "bottom": 0.48, "between": 0.4}
-"""Fixed margins of every figure, inches: room for a title, tick labels and axis labels at the
-figures' font sizes. Set once rather than measured per figure (``tight_layout`` drew each
-figure's text a second time: ~0.1 s a figure, 44 in a run)."""
-LINE_IN = 0.18
-"""Height of one more line of a title, inches."""
+@dataclass(frozen=True, kw_only=True)
+class Margins:
+    """A figure's fixed margins, inches: room for a title, tick labels and axis labels at the
+    figures' font sizes. Set once rather than measured per figure (``tight_layout`` drew each
+    figure's text a second time: ~0.1 s a figure, 44 in a run)."""
+
+    left: float = 0.8
+    right: float = 0.15
+    top: float = 0.3
+    bottom: float = 0.48
+    between: float = 0.4
+    """Between stacked axes."""
+    title_line: float = 0.18
+    """Each line of a title past its first."""
+
+
+MARGINS = Margins()
 
 
 def _layout(fig: Figure, rows: int = 1, title_lines: int = 1) -> None:
-    """Place ``fig``'s ``rows`` stacked axes within :data:`MARGINS_IN`, below a title of
+    """Place ``fig``'s ``rows`` stacked axes within :data:`MARGINS`, below a title of
     ``title_lines`` lines."""
     w, h = fig.get_size_inches()
-    m = MARGINS_IN
-    top = m["top"] + (title_lines - 1) * LINE_IN
-    height = (h - top - m["bottom"] - (rows - 1) * m["between"]) / rows
-    fig.subplots_adjust(left=m["left"] / w, right=1 - m["right"] / w, top=1 - top / h,
-                        bottom=m["bottom"] / h, hspace=m["between"] / height)
+    m = MARGINS
+    top = m.top + (title_lines - 1) * m.title_line
+    height = (h - top - m.bottom - (rows - 1) * m.between) / rows
+    fig.subplots_adjust(left=m.left / w, right=1 - m.right / w, top=1 - top / h,
+                        bottom=m.bottom / h, hspace=m.between / height)
 
 
 SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+"""Digits and minus sign → their Unicode superscripts (DejaVu Sans draws them)."""
 
 
 def _decade(x: float, _pos: int | None = None) -> str:
