@@ -15,6 +15,9 @@ from dyncheck.adapters import ENGINE_PACKAGES
 from dyncheck.cases import CASES, get_case
 from dyncheck.implementations import IMPLEMENTATIONS
 from dyncheck.run import RunResult, run
+from dyncheck.workers import exit_without_collecting
+
+exit_without_collecting()  # each test process (xdist's workers too): ~3 s with every engine loaded
 
 CASE_NAMES = sorted(CASES)
 ALL_ENGINES = sorted(ENGINE_PACKAGES)
