@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import pickle
 import re
+from typing import TYPE_CHECKING
 
 import pytest
 from filelock import FileLock
@@ -13,9 +14,10 @@ from hypothesis import settings
 from dyncheck import adapters
 from dyncheck.adapters import ENGINE_PACKAGES
 from dyncheck.cases import CASES, get_case
-from dyncheck.implementations import IMPLEMENTATIONS
-from dyncheck.run import RunResult, run
 from dyncheck.workers import exit_without_collecting
+
+if TYPE_CHECKING:
+    from dyncheck.run import RunResult
 
 exit_without_collecting()  # each test process (xdist's workers too): ~3 s with every engine loaded
 
@@ -96,6 +98,11 @@ def full_run(tmp_path_factory: pytest.TempPathFactory) -> RunResult:
 
 
 def _full_run() -> RunResult:
+    # imported here: xdist's controller process loads this file and runs no test (the run's
+    # modules — sympy, scipy, pandas — cost it ~1 s before the workers start)
+    from dyncheck.implementations import IMPLEMENTATIONS
+    from dyncheck.run import run
+
     # An engine that is not installed is a test failure, never a skip counted as a pass.
     # (asked here, not at import: finding out imports every adapter, JAX and Warp included)
     assert not adapters.MISSING, f"engines not installed: {adapters.MISSING}"
