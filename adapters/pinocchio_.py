@@ -113,6 +113,14 @@ class PinocchioAdapter(Adapter):
         self._C = model.coupling_matrix() if model.couplings else None
         self.layout = Layout.of([j.type for j in model.joints])
         self._zero_tau = np.zeros(self.model.nv)  # τ = 0 at every stage (read-only to ABA)
+        # the field's constants, read once (:meth:`_fext` runs at every stage): each body's
+        # mass, joint and centre of mass in that joint's frame, and every joint's zero force
+        self._levers = [
+            (b.mass, j, np.array(self.model.inertias[j].lever))
+            for b, j in zip(model.bodies, self._joint_ids, strict=True)
+        ]
+        self._no_forces = pin.StdVec_Force()
+        self._no_forces.extend([pin.Force.Zero() for _ in range(self.model.njoints)])
 
     def _build(self, model: Multibody) -> pin.Model:
         return build_model(model)
@@ -141,13 +149,12 @@ class PinocchioAdapter(Adapter):
         the force at each body's centre of mass (``None`` without a field)."""
         if not self.spec.central_mu:
             return None
-        m, d = self.model, self.data
-        pin.forwardKinematics(m, d, q)
-        fext = pin.StdVec_Force()
-        fext.extend([pin.Force.Zero() for _ in range(m.njoints)])
-        for body, j in zip(self.spec.bodies, self._joint_ids, strict=True):
-            c = d.oMi[j].act(m.inertias[j].lever)
-            F = self.spec.central_force(body.mass, c)
+        d = self.data
+        pin.forwardKinematics(self.model, d, q)
+        fext = pin.StdVec_Force(self._no_forces)  # a copy
+        for mass, j, lever in self._levers:
+            c = d.oMi[j].act(lever)
+            F = self.spec.central_force(mass, c)
             fext[j] = fext[j] + d.oMi[j].actInv(pin.Force(F, cross(c, F)))
         return fext
 
