@@ -168,6 +168,13 @@ class DrakeAdapter(Adapter):
         self.plant, self.parser_warnings = self._parse(self.xml)
         self.context = self.plant.CreateDefaultContext()
         self._bodies = [self.plant.GetBodyByName(b.name) for b in model.bodies]
+        # the field's constants, read once (:meth:`_field_forces` runs at every stage): each
+        # body's mass, centre of mass in its frame, Drake body and frame; the world frame
+        self._world = self.plant.world_frame()
+        self._field_bodies = [
+            (b.mass, np.asarray(b.com, float), body, body.body_frame())
+            for b, body in zip(model.bodies, self._bodies, strict=True)
+        ]
         # engine coordinates in the spec's joint order; Drake orders its own
         joints = [self._joint(b.name, j) for b in model.bodies for j in b.joints]
         self._iq = np.concatenate(
@@ -245,15 +252,13 @@ class DrakeAdapter(Adapter):
         out = []
         if not self.spec.central_mu:
             return out
-        world = self.plant.world_frame()
-        for spec, body in zip(self.spec.bodies, self._bodies, strict=True):
-            p = self.plant.CalcPointsPositions(
-                context, body.body_frame(), np.asarray(spec.com, float), world
-            )[:, 0]
+        points, world = self.plant.CalcPointsPositions, self._world
+        for mass, com, body, frame in self._field_bodies:
+            p = points(context, frame, com, world)[:, 0]
             f = ExternallyAppliedSpatialForce()
             f.body_index = body.index()
-            f.p_BoBq_B = np.asarray(spec.com, float)
-            f.F_Bq_W = SpatialForce(np.zeros(3), self.spec.central_force(spec.mass, p))
+            f.p_BoBq_B = com
+            f.F_Bq_W = SpatialForce(np.zeros(3), self.spec.central_force(mass, p))
             out.append(f)
         return out
 
