@@ -77,9 +77,9 @@ def exit_without_collecting() -> None:
     """At this process's exit, skip the interpreter's final cyclic garbage collection over
     every object still alive (``gc.freeze`` from an ``atexit`` hook): ~0.5 s a process
     that loaded the core engines, sympy and matplotlib, ~2.7 s one that loaded JAX and Warp
-    too. Nothing is lost — the memory goes back
-    to the system with the process, results are written and closed before exit (files whole,
-    then renamed), and objects freed by reference counting still are."""
+    too. Nothing is lost — the memory goes back to the system with the process, results are
+    written and closed before exit (files whole, then renamed), and objects freed by
+    reference counting still are."""
     atexit.register(gc.freeze)
 
 
