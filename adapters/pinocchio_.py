@@ -112,6 +112,16 @@ class PinocchioAdapter(Adapter):
         self._joint_ids = [self._body_joint(b.name) for b in model.bodies]
         self._C = model.coupling_matrix() if model.couplings else None
         self.layout = Layout.of([j.type for j in model.joints])
+        # MuJoCo's positions → Pinocchio's: each quaternion (w, x, y, z) → (x, y, z, w), as
+        # one permutation of q; the free joints, whose linear velocity changes frame
+        self._to_pin = np.arange(self.model.nq)
+        self._free: list[tuple[int, int]] = []
+        for jt, qa, va in self.layout.joints:
+            if jt in ("ball", "free"):
+                k = qa + (3 if jt == "free" else 0)
+                self._to_pin[k : k + 4] = [k + 1, k + 2, k + 3, k]
+            if jt == "free":
+                self._free.append((qa, va))
         self._zero_tau = np.zeros(self.model.nv)  # τ = 0 at every stage (read-only to ABA)
         # the field's constants, read once (:meth:`_fext` runs at every stage): each body's
         # mass, joint and centre of mass in that joint's frame, and every joint's zero force
@@ -232,14 +242,12 @@ class PinocchioAdapter(Adapter):
         """The inverse of :meth:`_to_mujoco`."""
         if not self.layout.rotating:  # the same layout: each stage's state as it is
             return np.asarray(q, float), np.asarray(v, float)
-        q, v = np.array(q, float), np.array(v, float)
-        for jt, qa, va in self.layout.joints:
-            if jt == "free":
+        q = np.asarray(q, float)
+        if self._free:
+            v = np.array(v, float)
+            for qa, va in self._free:
                 v[va : va + 3] = quat_to_matrix(q[None, qa + 3 : qa + 7])[0].T @ v[va : va + 3]
-            if jt in ("ball", "free"):
-                k = qa + (3 if jt == "free" else 0)
-                q[k : k + 4] = q[[k + 1, k + 2, k + 3, k]]  # (w, x, y, z) → (x, y, z, w)
-        return q, v
+        return q[self._to_pin], np.asarray(v, float)
 
     def _mujoco_acceleration(self, q: np.ndarray, v: np.ndarray, held=None) -> np.ndarray:
         """v̇ in MuJoCo's layout: Pinocchio's ABA, a free joint's v̇_b turned into
@@ -269,6 +277,10 @@ class PinocchioAdapter(Adapter):
         return acc
 
     def _states_from_mujoco(self, qs: np.ndarray, vs: np.ndarray) -> tuple:
+        """:meth:`_from_mujoco` of every state of a run: at once where no free joint turns a
+        velocity (moving values only), state by state otherwise."""
+        if not self._free:
+            return qs[:, self._to_pin], vs
         pairs = [self._from_mujoco(q, v) for q, v in zip(qs, vs, strict=True)]
         return np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
 
