@@ -112,6 +112,19 @@ def _full_run() -> RunResult:
 
 
 @pytest.fixture
+def pretend_missing(monkeypatch):
+    """``pretend_missing(engine, why)``: the engine as if its adapter's import failed with
+    ``why`` — skipped rows naming its extra — without importing every other adapter, as
+    asking for ``adapters.MISSING`` would (~4 s with JAX and Warp)."""
+
+    def hide(engine: str, why: str) -> None:
+        monkeypatch.delitem(adapters._ADAPTERS, engine, raising=False)
+        monkeypatch.setitem(adapters._MISSING, engine, why)
+
+    return hide
+
+
+@pytest.fixture
 def empty_cache(monkeypatch, tmp_path):
     """An empty cache folder (derivations, measured demonstrations, figures), read and written
     (``--no-cache`` off), with the fingerprint computed afresh before and after the test."""

@@ -115,11 +115,10 @@ def test_float32_bound_catches_a_mass_off_by_1e_4(port, factor, verdict):
 
 
 @pytest.mark.parametrize("port", PORTS)
-def test_missing_extra_gives_skipped_rows_naming_it(monkeypatch, port):
+def test_missing_extra_gives_skipped_rows_naming_it(pretend_missing, port):
     """Without its extra a port's rows are skipped — never passed — and say what to install."""
     extra = "warp" if port == "mujoco-warp" else "mjx"
-    monkeypatch.delitem(adapters.ADAPTERS, port)
-    monkeypatch.setitem(adapters.MISSING, port, "No module named 'jax'")
+    pretend_missing(port, "No module named 'jax'")
     case = get_case("simple_pendulum")
     impls = {}
     for n in ("reference", "mujoco", port):

@@ -178,12 +178,10 @@ def test_a_demonstration_that_raises_costs_only_its_entry(monkeypatch, tmp_path)
     assert main(["explain", "hinge-axis-sign"]) == 1
 
 
-def test_drake_entries_are_skipped_when_drake_is_missing(monkeypatch):
+def test_drake_entries_are_skipped_when_drake_is_missing(pretend_missing):
     """Drake is an optional extra: without it its entries say so (with the pip hint) and the
     rest of the catalogue still runs — never a crash of the report."""
-    from dyncheck import adapters
-
-    monkeypatch.setitem(adapters.MISSING, "drake", "No module named 'pydrake'")
+    pretend_missing("drake", "No module named 'pydrake'")
     (entry,) = catalogue.explain("drake-mjcf-options")
     assert entry.skipped and "pip install 'dyncheck[drake]'" in entry.skipped
     text = catalogue.render([entry, *catalogue.explain("hinge-axis-sign")])

@@ -250,14 +250,13 @@ def test_worst_state_is_reported_and_reproducible():
     assert row.worst_state_values.startswith(f"q=[{s.q[k][0]:.6g}, {s.q[k][1]:.6g}]")
 
 
-def test_missing_engine_is_skipped_never_passed(monkeypatch, tmp_path):
+def test_missing_engine_is_skipped_never_passed(monkeypatch, tmp_path, pretend_missing):
     """An engine that is not installed gives `skipped` rows with the pip hint, never `passed`,
     and the report (with its conventions catalogue) is still written."""
-    from dyncheck import adapters, report
+    from dyncheck import report
     from dyncheck.run import run
 
-    monkeypatch.delitem(adapters.ADAPTERS, "drake")
-    monkeypatch.setitem(adapters.MISSING, "drake", "No module named 'pydrake'")
+    pretend_missing("drake", "No module named 'pydrake'")
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path / "cache"))  # no entry measured with it
     result = run([get_case("simple_pendulum")], ["reference", "drake"], conventions=True)
     d = result.discrepancies
