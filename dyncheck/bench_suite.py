@@ -92,6 +92,9 @@ def measure(steps: tuple[Step, ...] = STEPS) -> pd.DataFrame:
     with tempfile.TemporaryDirectory(prefix="dyncheck-suite-") as tmp:
         env = os.environ.copy()
         env.pop("DYNCHECK_NO_CACHE", None)
+        # Python's own bytecode cache as Python keeps it by default (a machine that sets
+        # PYTHONDONTWRITEBYTECODE compiles dyncheck's sources again in every process)
+        env.pop("PYTHONDONTWRITEBYTECODE", None)
         for i, step in enumerate(steps):
             if not step.warm:
                 env["DYNCHECK_CACHE"] = f"{tmp}/cache-{i}"
@@ -125,7 +128,8 @@ def write(table: pd.DataFrame, out: Path) -> None:
         f"seconds on this machine ({platform.machine()}, {v['platform']}), against the "
         "targets of issue #19. Each command starts with an empty cache (derivations, measured "
         "demonstrations), as on a new machine, except the ones marked \"again\", which read "
-        "what the command before them stored. Versions: "
+        "what the command before them stored; Python keeps its bytecode cache as it does by "
+        "default (PYTHONDONTWRITEBYTECODE unset). Versions: "
         + ", ".join(f"{k} {val}" for k, val in v.items() if k != "platform")
         + ".",
         "",
