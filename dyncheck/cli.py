@@ -62,8 +62,9 @@ def _no_cache(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--no-cache",
         action="store_true",
-        help="derive every symbolic result (and measure every demonstration) afresh, neither "
-        "reading nor writing the cache (under $DYNCHECK_CACHE or ~/.cache/dyncheck)",
+        help="derive every symbolic result (measure every demonstration, solve every "
+        "reference, draw every figure) afresh, neither reading nor writing the cache (under "
+        "$DYNCHECK_CACHE or ~/.cache/dyncheck)",
     )
 
 

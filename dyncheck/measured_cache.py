@@ -7,7 +7,9 @@ folder (:func:`~dyncheck.reference.derivations.cache_root`) keyed by a hash of a
 that a second ``dyncheck explain`` prints without running the engines, while an upgrade of any
 engine, an edit of any file of dyncheck or another machine measures afresh. A case's figures
 are kept the same way (:func:`~dyncheck.report.figures.cached_figures`, the plotted data part
-of their name). ``--no-cache`` (``DYNCHECK_NO_CACHE``) neither reads nor writes. Files are
+of their name), and so are the studies' reference trajectories
+(:class:`~dyncheck.studies.references.References`, keyed by case, model variant and step).
+``--no-cache`` (``DYNCHECK_NO_CACHE``) neither reads nor writes. Files are
 written whole (a temporary file, then a rename); one that cannot be read back is measured
 again and replaced.
 """

@@ -3,6 +3,10 @@ estimate) and the general method stepped by the engines' fixed-step integrators.
 
 from __future__ import annotations
 
+import hashlib
+from collections.abc import Callable
+from typing import TypeVar
+
 import numpy as np
 
 from dyncheck import coordinates as co
@@ -10,6 +14,9 @@ from dyncheck.adapters.integrators import Layout, integrate
 from dyncheck.cases import Case
 from dyncheck.cases.coordinate_maps import CoordinateMap
 from dyncheck.implementations import Variant, general_method, reference_trajectory
+from dyncheck.measured_cache import measured
+
+T = TypeVar("T")
 
 
 def difference(case: Case, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -33,10 +40,23 @@ class References:
     def __call__(self, variant: Variant) -> tuple[np.ndarray, float]:
         """(q on the grid, estimated max error of q)."""
         if variant not in self._cache:
-            ref = reference_trajectory(self.case, variant, self.t, rtol=1e-13)
-            tighter = reference_trajectory(self.case, variant, self.t, rtol=2.5e-14)
-            self._cache[variant] = ref, float(np.abs(ref - tighter).max())
+            self._cache[variant] = self._stored("dop853", (variant,), lambda: self._solve(variant))
         return self._cache[variant]
+
+    def _solve(self, variant: Variant) -> tuple[np.ndarray, float]:
+        ref = reference_trajectory(self.case, variant, self.t, rtol=1e-13)
+        tighter = reference_trajectory(self.case, variant, self.t, rtol=2.5e-14)
+        return ref, float(np.abs(ref - tighter).max())
+
+    def _stored(self, what: str, key: tuple, compute: Callable[[], T]) -> T:
+        """``compute()``, or what an earlier run stored for the same case and ``key`` with the
+        same dyncheck, libraries and machine (:func:`~dyncheck.measured_cache.measured`: the
+        same inputs give the same numbers, read back to the last bit), so that a second run
+        steps no reference; ``--no-cache`` computes afresh. Only the latest fingerprint's are
+        kept."""
+        h = hashlib.sha256(repr((self.case, *key)).encode()).hexdigest()[:32]
+        name = f"{self.case.name}-{what}-{h}"
+        return measured("references", name, compute, keep=lambda _r: True, latest_only=True)[0]
 
     def discrete(self, variant: Variant, integrator: str, dt: float) -> np.ndarray:
         """q (book coordinates) at every step of the general method stepped by a fixed-step
@@ -55,52 +75,57 @@ class References:
         integrator = "euler" if integrator == "implicitfast" else integrator  # same map, D = 0
         key = (variant, integrator, dt)
         if key not in self._discrete:
-            dyn = general_method(self.case, variant)
-            cmap = self.case.engine_map()
-            spec = self.case.trajectory
-            steps = round(spec.duration / dt)
-            if getattr(dyn, "softness", None) is not None:
-                if not (
-                    np.array_equal(cmap.A, dyn.cords.A)
-                    and np.array_equal(np.asarray(cmap.offset), dyn.cords.b)
-                ):
-                    raise ValueError(f"{self.case.name}: engine map is not the free coordinates")
-                s0, sd0 = dyn.cords.to_free(np.asarray(spec.q0), np.asarray(spec.v0))
-                qe, _ = integrate(
-                    lambda s, sd, held=None: dyn.free(s[None], sd[None])[0],
-                    s0[0],
-                    sd0[0],
-                    dt,
-                    steps,
-                    integrator,
-                )
-                self._discrete[key] = (cmap.to_book(qe), qe)
-                return self._discrete[key]
-
-            def book_state(qe: np.ndarray, ve: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-                qb = cmap.to_book(qe[None])
-                return qb, co.velocity_to_book(cmap, qb, ve[None])
-
-            def acc(qe: np.ndarray, ve: np.ndarray, held=None) -> np.ndarray:
-                qb, vb = book_state(qe, ve)
-                tau = np.zeros_like(qb)
-                if held is not None:  # replace the live field force by the frozen one
-                    tau = co.force_to_book(cmap, qb, held[None]) - dyn.field_force(qb)
-                ab = dyn.forward(qb, vb, tau)
-                return co.acceleration_to_engine(cmap, qb, vb, ab)[0]
-
-            def freeze(qe: np.ndarray, ve: np.ndarray) -> np.ndarray:
-                qb, _ = book_state(qe, ve)
-                return co.force_to_engine(cmap, qb, dyn.field_force(qb))[0]
-
-            q0 = np.asarray(spec.q0, float)[None]
-            qe0 = cmap.to_engine(q0)[0]
-            ve0 = co.velocity_to_engine(cmap, q0, np.asarray(spec.v0, float)[None])[0]
-            layout = Layout.of([j.type for j in self.case.multibody().joints])
-            qe, _ = integrate(acc, qe0, ve0, dt, steps, integrator, freeze=freeze, layout=layout)
-            _require_chart(cmap, layout, qe)
-            self._discrete[key] = (cmap.to_book(qe), qe)
+            self._discrete[key] = self._stored(
+                "discrete", key, lambda: self._step(variant, integrator, dt)
+            )
         return self._discrete[key]
+
+    def _step(self, variant: Variant, integrator: str, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`discrete_engine`'s run, computed."""
+        dyn = general_method(self.case, variant)
+        cmap = self.case.engine_map()
+        spec = self.case.trajectory
+        steps = round(spec.duration / dt)
+        if getattr(dyn, "softness", None) is not None:
+            if not (
+                np.array_equal(cmap.A, dyn.cords.A)
+                and np.array_equal(np.asarray(cmap.offset), dyn.cords.b)
+            ):
+                raise ValueError(f"{self.case.name}: engine map is not the free coordinates")
+            s0, sd0 = dyn.cords.to_free(np.asarray(spec.q0), np.asarray(spec.v0))
+            qe, _ = integrate(
+                lambda s, sd, held=None: dyn.free(s[None], sd[None])[0],
+                s0[0],
+                sd0[0],
+                dt,
+                steps,
+                integrator,
+            )
+            return cmap.to_book(qe), qe
+
+        def book_state(qe: np.ndarray, ve: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            qb = cmap.to_book(qe[None])
+            return qb, co.velocity_to_book(cmap, qb, ve[None])
+
+        def acc(qe: np.ndarray, ve: np.ndarray, held=None) -> np.ndarray:
+            qb, vb = book_state(qe, ve)
+            tau = np.zeros_like(qb)
+            if held is not None:  # replace the live field force by the frozen one
+                tau = co.force_to_book(cmap, qb, held[None]) - dyn.field_force(qb)
+            ab = dyn.forward(qb, vb, tau)
+            return co.acceleration_to_engine(cmap, qb, vb, ab)[0]
+
+        def freeze(qe: np.ndarray, ve: np.ndarray) -> np.ndarray:
+            qb, _ = book_state(qe, ve)
+            return co.force_to_engine(cmap, qb, dyn.field_force(qb))[0]
+
+        q0 = np.asarray(spec.q0, float)[None]
+        qe0 = cmap.to_engine(q0)[0]
+        ve0 = co.velocity_to_engine(cmap, q0, np.asarray(spec.v0, float)[None])[0]
+        layout = Layout.of([j.type for j in self.case.multibody().joints])
+        qe, _ = integrate(acc, qe0, ve0, dt, steps, integrator, freeze=freeze, layout=layout)
+        _require_chart(cmap, layout, qe)
+        return cmap.to_book(qe), qe
 
 
 def _require_chart(cmap: CoordinateMap, layout: Layout, qe: np.ndarray) -> None:

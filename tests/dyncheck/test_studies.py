@@ -277,3 +277,30 @@ def test_declared_rk4_order_on_the_rotation_group_is_checked(monkeypatch):
     wrong = [r for r in study(case, impls)[1] if r.integrator == "rk4" and r.impl_b == "mujoco"]
     assert {r.verdict for r in wrong} == {"failed"}
     assert all("nominal 2" in r.note for r in wrong)
+
+
+def test_references_are_read_back_to_the_last_bit(empty_cache, monkeypatch):
+    """A second study's references — DOP853 and the general method stepped by an integrator —
+    come from the cache equal to the first's to the last bit, without solving or stepping
+    again (both refused here); ``--no-cache`` computes them (the refusal is met)."""
+    from dyncheck.implementations import book_variant
+    from dyncheck.reference.derivations import NO_CACHE
+    from dyncheck.studies import references
+
+    case = get_case("simple_pendulum")
+    variant, dt = book_variant(case), case.trajectory.steps["rk4"][0]
+    first = references.References(case)
+    ref, disc = first(variant), first.discrete_engine(variant, "rk4", dt)
+
+    def refuse(*_args, **_kwargs):
+        raise AssertionError("computed again")
+
+    monkeypatch.setattr(references, "reference_trajectory", refuse)
+    monkeypatch.setattr(references, "integrate", refuse)
+    again = references.References(case)
+    ref2, disc2 = again(variant), again.discrete_engine(variant, "rk4", dt)
+    assert np.array_equal(ref[0], ref2[0]) and ref[1] == ref2[1]
+    assert all(np.array_equal(a, b) for a, b in zip(disc, disc2, strict=True))
+    monkeypatch.setenv(NO_CACHE, "1")
+    with pytest.raises(AssertionError, match="computed again"):
+        references.References(case)(variant)
