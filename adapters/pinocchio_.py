@@ -113,7 +113,8 @@ class PinocchioAdapter(Adapter):
         self._C = model.coupling_matrix() if model.couplings else None
         self.layout = Layout.of([j.type for j in model.joints])
         # MuJoCo's positions → Pinocchio's: each quaternion (w, x, y, z) → (x, y, z, w), as
-        # one permutation of q; the free joints, whose linear velocity changes frame
+        # one permutation of q (and its inverse); the free joints, whose linear velocity
+        # changes frame
         self._to_pin = np.arange(self.model.nq)
         self._free: list[tuple[int, int]] = []
         for jt, qa, va in self.layout.joints:
@@ -122,6 +123,7 @@ class PinocchioAdapter(Adapter):
                 self._to_pin[k : k + 4] = [k + 1, k + 2, k + 3, k]
             if jt == "free":
                 self._free.append((qa, va))
+        self._to_mj = np.argsort(self._to_pin)
         self._zero_tau = np.zeros(self.model.nv)  # τ = 0 at every stage (read-only to ABA)
         # the field's constants, read once (:meth:`_fext` runs at every stage): each body's
         # mass, joint and centre of mass in that joint's frame, and every joint's zero force
@@ -229,13 +231,9 @@ class PinocchioAdapter(Adapter):
     def _to_mujoco(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pinocchio's state → MuJoCo's layout: quaternions (x, y, z, w) → (w, x, y, z), a
         free joint's body-frame linear velocity v_b → v_w = R v_b."""
-        q, v = np.array(q, float), np.array(v, float)
-        for jt, qa, va in self.layout.joints:
-            if jt in ("ball", "free"):
-                k = qa + (3 if jt == "free" else 0)
-                q[k : k + 4] = q[[k + 3, k, k + 1, k + 2]]  # (x, y, z, w) → (w, x, y, z)
-            if jt == "free":
-                v[va : va + 3] = quat_to_matrix(q[None, qa + 3 : qa + 7])[0] @ v[va : va + 3]
+        q, v = np.asarray(q, float)[self._to_mj], np.array(v, float)
+        for qa, va in self._free:
+            v[va : va + 3] = quat_to_matrix(q[None, qa + 3 : qa + 7])[0] @ v[va : va + 3]
         return q, v
 
     def _from_mujoco(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -256,11 +254,10 @@ class PinocchioAdapter(Adapter):
         a = self._aba(qp, vp, self._zero_tau, held)
         if not self.layout.rotating:
             return a
-        for jt, qa, va in self.layout.joints:
-            if jt == "free":
-                R = quat_to_matrix(q[None, qa + 3 : qa + 7])[0]
-                lin, ang = slice(va, va + 3), slice(va + 3, va + 6)
-                a[lin] = R @ (a[lin] + cross(vp[ang], vp[lin]))
+        for qa, va in self._free:
+            R = quat_to_matrix(q[None, qa + 3 : qa + 7])[0]
+            lin, ang = slice(va, va + 3), slice(va + 3, va + 6)
+            a[lin] = R @ (a[lin] + cross(vp[ang], vp[lin]))
         return a
 
     def _stage_acceleration(self) -> Callable[..., np.ndarray]:

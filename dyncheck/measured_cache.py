@@ -20,7 +20,7 @@ import hashlib
 import platform
 import shutil
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from functools import cache
 from importlib import metadata
 from pathlib import Path
@@ -112,3 +112,17 @@ def measured(
         for other in others:
             shutil.rmtree(other, ignore_errors=True)  # another process's may be gone
     return result, found
+
+
+def reused(kind: str, label: str, inputs: Sequence[bytes], compute: Callable[[], T]) -> T:
+    """``compute()``, or what an earlier call stored for the same ``kind``, ``label``, inputs
+    and :func:`fingerprint` — for a deterministic computation that cannot fail (always
+    stored) and whose results are large enough that only the latest fingerprint's are kept
+    (a case's figures, the studies' reference trajectories). Its name: ``label`` and a hash
+    of ``inputs`` (everything the result depends on beside the fingerprint)."""
+    h = hashlib.sha256()
+    for part in inputs:
+        h.update(part)
+    name = f"{label}-{h.hexdigest()[:32]}"
+    return measured(kind, name, compute, keep=lambda _result: True, latest_only=True)[0]
+

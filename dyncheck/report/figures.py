@@ -3,7 +3,6 @@ observed orders, energy and momentum drift."""
 
 from __future__ import annotations
 
-import hashlib
 import io
 import math
 import pickle
@@ -15,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.cases import Case
-from dyncheck.measured_cache import measured
+from dyncheck.measured_cache import reused
 from dyncheck.results import to_csv
 from dyncheck.studies import (
     TrajectoryFigures,
@@ -187,10 +186,6 @@ def cached_figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> d
     numbers plotted are always this run's. Only the latest fingerprint's figures are kept
     (~0.4 MB a case: one set per edit of dyncheck would pile up on a machine that runs every
     commit)."""
-    h = hashlib.sha256(repr(case).encode())
-    h.update(pickle.dumps(data, protocol=5))
-    h.update(to_csv(conv[conv["case"] == case.name]).encode())
-    pngs, _ = measured("figures", f"{case.name}-{h.hexdigest()[:32]}",
-                       lambda: figures(case, data, conv), keep=lambda _pngs: True,
-                       latest_only=True)
-    return pngs
+    inputs = (repr(case).encode(), pickle.dumps(data, protocol=5),
+              to_csv(conv[conv["case"] == case.name]).encode())
+    return reused("figures", case.name, inputs, lambda: figures(case, data, conv))

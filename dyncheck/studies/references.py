@@ -3,7 +3,6 @@ estimate) and the general method stepped by the engines' fixed-step integrators.
 
 from __future__ import annotations
 
-import hashlib
 from collections.abc import Callable
 from typing import TypeVar
 
@@ -14,7 +13,7 @@ from dyncheck.adapters.integrators import Layout, integrate
 from dyncheck.cases import Case
 from dyncheck.cases.coordinate_maps import CoordinateMap
 from dyncheck.implementations import Variant, general_method, reference_trajectory
-from dyncheck.measured_cache import measured
+from dyncheck.measured_cache import reused
 
 T = TypeVar("T")
 
@@ -50,13 +49,11 @@ class References:
 
     def _stored(self, what: str, key: tuple, compute: Callable[[], T]) -> T:
         """``compute()``, or what an earlier run stored for the same case and ``key`` with the
-        same dyncheck, libraries and machine (:func:`~dyncheck.measured_cache.measured`: the
+        same dyncheck, libraries and machine (:func:`~dyncheck.measured_cache.reused`: the
         same inputs give the same numbers, read back to the last bit), so that a second run
-        steps no reference; ``--no-cache`` computes afresh. Only the latest fingerprint's are
-        kept."""
-        h = hashlib.sha256(repr((self.case, *key)).encode()).hexdigest()[:32]
-        name = f"{self.case.name}-{what}-{h}"
-        return measured("references", name, compute, keep=lambda _r: True, latest_only=True)[0]
+        steps no reference; ``--no-cache`` computes afresh."""
+        label = f"{self.case.name}-{what}"
+        return reused("references", label, [repr((self.case, *key)).encode()], compute)
 
     def discrete(self, variant: Variant, integrator: str, dt: float) -> np.ndarray:
         """q (book coordinates) at every step of the general method stepped by a fixed-step
