@@ -9,7 +9,7 @@ behaviour, the entry's numbers change and its test fails.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from functools import partial
 
 import numpy as np
@@ -46,7 +46,8 @@ from dyncheck.explain.parsers import (
 )
 from dyncheck.explanations import Origin
 
-__all__ = ["DEMOS", "REQUIRES", "TUTORIALS", "Entry", "explain", "explain_cached", "render"]
+__all__ = ["DEMOS", "REQUIRES", "TUTORIALS", "Entry", "explain", "explain_cached", "not_selected",
+           "render"]
 
 
 DEMOS: dict[str, tuple[Callable[[], Entry], Origin]] = {
@@ -99,11 +100,25 @@ REQUIRES: dict[str, tuple[str, ...]] = {
 """Demonstrations that need an optional engine (MuJoCo and Pinocchio are core dependencies)."""
 
 
+def _skipped(name: str, why: str) -> Entry:
+    nan = float("nan")
+    return Entry(name, "", "", "", nan, nan, skipped=why)
+
+
+def not_selected(name: str, selected: Collection[str]) -> Entry | None:
+    """The entry ``name`` skipped when it needs an optional engine that a run leaves out
+    (``dyncheck run --impl ...`` without it), else None: a run of the core engines loads
+    neither JAX nor Drake for its catalogue, as on a machine without them."""
+    left_out = [engine for engine in REQUIRES.get(name, ()) if engine not in selected]
+    if not left_out:
+        return None
+    return _skipped(name, f"{', '.join(left_out)} not selected (--impl)")
+
+
 def _run(name: str) -> Entry:
     """One demonstration, or a skipped entry naming the engine that is not installed."""
     from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES, get_adapter
 
-    nan = float("nan")
     for engine in REQUIRES.get(name, ()):
         try:
             get_adapter(engine)
@@ -112,15 +127,16 @@ def _run(name: str) -> Entry:
             if engine in ENGINE_EXTRAS:
                 extra = ENGINE_EXTRAS[engine]
                 why = f"{engine} is not installed (pip install 'dyncheck[{extra}]')"
-            return Entry(name, "", "", "", nan, nan, skipped=why)
+            return _skipped(name, why)
     demo, origin = DEMOS[name]
     try:
         entry = demo()
     except EngineNotInstalled as exc:  # a core engine missing: only this entry is lost
-        return Entry(name, "", "", "", nan, nan, skipped=str(exc))
+        return _skipped(name, str(exc))
     except ImportError as exc:
-        return Entry(name, "", "", "", nan, nan, skipped=f"an engine is not installed ({exc})")
+        return _skipped(name, f"an engine is not installed ({exc})")
     except Exception as exc:  # one demonstration lost, never the run that includes it
+        nan = float("nan")
         return Entry(name, "", "", "", nan, nan, failed=f"{type(exc).__name__}: {exc}")
     return dataclasses.replace(entry, origin=origin)
 

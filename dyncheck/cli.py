@@ -46,7 +46,8 @@ def _selection(p: argparse.ArgumentParser) -> None:
         action="append",
         default=[],
         metavar="NAME",
-        help="implementation to include (repeatable; default: all)",
+        help="implementation to include (repeatable; default: all); the catalogue's entries "
+        "that need an optional engine left out (Drake, MJX) are skipped",
     )
     p.add_argument(
         "--jobs",

@@ -9,7 +9,7 @@ from functools import partial, reduce
 import pandas as pd
 
 from dyncheck.cases import Case, get_case
-from dyncheck.catalogue import DEMOS, Entry, measured_entry
+from dyncheck.catalogue import DEMOS, Entry, measured_entry, not_selected
 from dyncheck.closed_forms import closed_form_rows
 from dyncheck.comparison import Sweep, sweep
 from dyncheck.comparison import rows as rows_of
@@ -138,10 +138,14 @@ def _run_case(
     return rows + trajectory_rows + closed_form_rows(case), points, figures, notes, pngs, used
 
 
-def _convention(name: str) -> tuple[list[Entry], dict[str, str]]:
+def _convention(name: str, impl_names: Sequence[str]) -> tuple[list[Entry], dict[str, str]]:
     """One demonstration of the conventions catalogue (a unit of work), with the versions of
     the engines loaded where it ran; read back from the cache when measured before with the
-    same dyncheck, engines and machine (``--no-cache``: measured afresh)."""
+    same dyncheck, engines and machine (``--no-cache``: measured afresh); skipped when it needs
+    an optional engine the run leaves out (:func:`~dyncheck.catalogue.not_selected`)."""
+    skipped = not_selected(name, impl_names)
+    if skipped is not None:
+        return [skipped], {}
     entry, used, _ = measured_entry(name)
     return [entry], used
 
@@ -180,7 +184,8 @@ def run(
                 units.append((f"{case.name} states {start}..{stop - 1}", _sweep_slice,
                               (case, list(impl_names), n, start, stop)))
     if conventions:
-        units += [(f"conventions: {name}", _convention, (name,)) for name in DEMOS]
+        units += [(f"conventions: {name}", _convention, (name, list(impl_names)))
+                  for name in DEMOS]
     done = run_units(units, jobs=jobs, dask=dask, progress=progress)
     rows: list[Discrepancy] = []
     points: list[ConvergencePoint] = []

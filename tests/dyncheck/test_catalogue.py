@@ -3,6 +3,8 @@ naive mapping wrong and the correct one right — if an engine changes, these sa
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -136,7 +138,8 @@ def test_drake_fsal_integrators_depend_on_caching():
     (entry,) = catalogue.explain("drake-fsal-caching")
     assert entry.naive_error > 100 * entry.correct_error
     assert entry.correct_error < 1e-10
-    assert "runge_kutta3 (not FSAL): bit-identical" in entry.engines
+    assert re.search(r"runge_kutta3 \(not FSAL\) at ε = \S+ \([1-9]\d* steps shrunk\): "
+                     "bit-identical", entry.engines)  # rejected steps, and no defect
     assert "(0 steps shrunk): bit-identical" in entry.engines  # no rejection, no defect
 
 
@@ -189,6 +192,7 @@ def test_drake_entries_are_skipped_when_drake_is_missing(pretend_missing):
     assert "## hinge-axis-sign" in text and "Correct mapping" in text
 
 
+@pytest.mark.slow  # compiles MJX's RK4 (a port: see the conftest's marking)
 def test_mjx_integrator_definitions_are_measured():
     """MJX 3.17's RK4 sums the stages' angular velocities in one tangent space (its source,
     ``mujoco/mjx/_src/forward.py``): order 2 on a ball joint; MuJoCo C 4.0's RKMK: order 4.
@@ -197,3 +201,16 @@ def test_mjx_integrator_definitions_are_measured():
     assert entry.naive_error == pytest.approx(2.0, abs=0.1)
     assert entry.correct_error == pytest.approx(4.0, abs=0.1)
     assert "implicitfast" in entry.what and "gyroscopic" in entry.what
+
+
+@pytest.mark.parametrize("name", sorted(catalogue.DEMOS))
+def test_an_entry_is_left_out_only_when_an_engine_it_needs_is(name):
+    """An entry that needs an optional engine (Drake, MJX) is skipped by a run that selects
+    the others, never by one that selects it; entries of the core engines are never skipped."""
+    needs = catalogue.REQUIRES.get(name, ())
+    assert catalogue.not_selected(name, ["reference", "mujoco", "pinocchio", *needs]) is None
+    left_out = catalogue.not_selected(name, ["reference", "mujoco", "pinocchio"])
+    if needs:
+        assert left_out is not None and left_out.skipped == f"{needs[0]} not selected (--impl)"
+    else:
+        assert left_out is None

@@ -55,3 +55,24 @@ def test_figures_drawn_in_the_workers_are_those_drawn_from_the_whole_run():
         here = figures(case, result.figures[case.name], result.convergence)
         assert set(here) == {"trajectory", "error_time", "convergence", "energy"}
         assert result.pngs[case.name] == here
+
+
+def test_a_catalogue_entry_whose_engine_is_left_out_is_skipped_without_running(monkeypatch):
+    """``--impl`` without Drake: Drake's entries are skipped naming the engine left out, and
+    their demonstration never runs (it would load Drake); an entry that needs only the core
+    engines runs as ``dyncheck explain`` runs it."""
+    import dyncheck.run as run_module
+    from dyncheck import catalogue
+
+    def never() -> catalogue.Entry:
+        raise AssertionError("the demonstration of an engine left out ran")
+
+    demos = {"drake-fsal-caching": (never, catalogue.DEMOS["drake-fsal-caching"][1]),
+             "hinge-axis-sign": catalogue.DEMOS["hinge-axis-sign"]}
+    monkeypatch.setattr(run_module, "DEMOS", demos)
+    monkeypatch.setattr(catalogue, "DEMOS", demos)
+    result = run_module.run([get_case("simple_pendulum")], ["reference", "mujoco"],
+                            conventions=True)
+    drake, hinge = result.conventions
+    assert drake.skipped == "drake not selected (--impl)" and not drake.failed
+    assert hinge == catalogue.explain("hinge-axis-sign")[0] and not hinge.skipped
