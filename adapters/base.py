@@ -18,7 +18,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import ClassVar, TypeVar
+from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
@@ -122,6 +122,16 @@ class Adapter(ABC):
         of derivations (:func:`dyncheck.reference.derivations.derived`, same signature:
         ``kind``, the ``inputs`` that key the result, and how to compute it)."""
         return compute()
+
+    @staticmethod
+    def lambdify(args: Sequence[Any], exprs: Any, modules: str) -> Callable[..., Any]:
+        """How such an adapter makes numeric functions of its expressions:
+        ``sympy.lambdify(args, exprs, modules=modules, cse=True)`` here; the comparison layer
+        plugs in the reference's disk cache of their compiled code
+        (:func:`dyncheck.reference.derivations.lambdified`, same signature)."""
+        import sympy as sp
+
+        return sp.lambdify(args, exprs, modules=modules, cse=True)
 
     def __init__(self, model: Multibody) -> None:
         if model.couplings and model.central_mu and not self.couplings_with_field:

@@ -22,7 +22,7 @@ import hashlib
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 import sympy as sp
@@ -41,7 +41,9 @@ def _vec(frame: me.ReferenceFrame, xyz) -> me.Vector:
     )
 
 
-def _batched(exprs: list[sp.Expr], args: list[sp.Symbol]) -> Callable[..., np.ndarray]:
+def _batched(
+    exprs: list[sp.Expr], args: list[sp.Symbol], lambdify: Callable[..., Callable[..., Any]]
+) -> Callable[..., np.ndarray]:
     """One function for all of ``exprs`` (common subexpressions shared): numpy over a batch
     of states, Python's ``math`` on scalars for one state (a time step: numpy's per-call
     overhead would dominate). Constant entries are filled in, not evaluated. Returns
@@ -51,8 +53,8 @@ def _batched(exprs: list[sp.Expr], args: list[sp.Symbol]) -> Callable[..., np.nd
     const = [i for i, e in enumerate(exprs) if not e.free_symbols & symbols]
     values_const = np.array([float(exprs[i]) for i in const])
     terms = [exprs[i] for i in varying]
-    batch = sp.lambdify(args, terms, modules="numpy", cse=True)
-    scalar = sp.lambdify(args, terms, modules="math", cse=True)
+    batch = lambdify(args, terms, "numpy")
+    scalar = lambdify(args, terms, "math")
 
     def evaluate(*values: np.ndarray) -> np.ndarray:
         n = np.broadcast(*values).shape[0]
@@ -197,17 +199,21 @@ class SympyMechanicsAdapter(Adapter):
         n = model.nv
         eq = self.derive("sympy_mechanics", (repr(model), _SOURCE), lambda: _derive(model))
         args = [*sp.symbols(f"x0:{n}"), *sp.symbols(f"v0:{n}")]
+
+        def batched(exprs: list[sp.Expr]) -> Callable[..., np.ndarray]:
+            return _batched(exprs, args, self.lambdify)
+
         self._kkt = None
         if model.couplings:
-            self._kkt = (_batched(list(eq.K), args), _batched(list(eq.rhs), args), eq.ncons)
-        self._M = _batched(list(eq.M), args)
-        self._h = _batched(list(eq.h), args)
-        self._field = _batched(list(eq.field), args) if eq.field else None
+            self._kkt = (batched(list(eq.K)), batched(list(eq.rhs)), eq.ncons)
+        self._M = batched(list(eq.M))
+        self._h = batched(list(eq.h))
+        self._field = batched(list(eq.field)) if eq.field else None
         self._stepping = (args, [*eq.K, *eq.rhs] if model.couplings else
                           [*eq.M, *eq.h, *eq.field])
         self._step_fn: Callable[..., list[float]] | None = None
-        self._T = _batched([eq.T], args)
-        self._V = _batched([eq.V], args)
+        self._T = batched([eq.T])
+        self._V = batched([eq.V])
         self._n = n
 
     @staticmethod
@@ -275,7 +281,7 @@ class SympyMechanicsAdapter(Adapter):
         n = self._n
         if self._step_fn is None:  # lambdified on first use: only trajectories need it
             args, exprs = self._stepping
-            self._step_fn = sp.lambdify(args, exprs, modules="math", cse=True)
+            self._step_fn = self.lambdify(args, exprs, "math")
         values = np.array(self._step_fn(*q.tolist(), *v.tolist()), float)
         if self._kkt is not None:
             size = n + self._kkt[2]

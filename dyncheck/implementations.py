@@ -29,7 +29,7 @@ from dyncheck.conventions import (
 )
 from dyncheck.errors import UnknownName
 from dyncheck.reference.constraints import Softness
-from dyncheck.reference.derivations import derived
+from dyncheck.reference.derivations import derived, lambdified
 from dyncheck.reference.systems import SYSTEMS
 from dyncheck.reference.trajectory import solve
 from dyncheck.roster import IMPLEMENTATIONS
@@ -38,6 +38,7 @@ from dyncheck.roster import IMPLEMENTATIONS
 # reference's disk cache of derivations — the cache, not the derivation, is shared; adapters
 # cannot import the reference, so this layer plugs it in (Adapter.derive)
 Adapter.derive = staticmethod(derived)  # type: ignore[method-assign]
+Adapter.lambdify = staticmethod(lambdified)  # type: ignore[method-assign]
 
 QUANTITIES: tuple[str, ...] = (
     "mass_matrix",

@@ -17,7 +17,7 @@ from functools import cache, cached_property
 import numpy as np
 import sympy as sp
 
-from dyncheck.reference.derivations import derived
+from dyncheck.reference.derivations import derived, lambdified
 
 
 @dataclass(frozen=True)
@@ -118,7 +118,7 @@ class CoordinateSystem:
 def _batched(
     exprs: Sequence[sp.Expr], q: Sequence[sp.Symbol], shape: tuple[int, ...]
 ) -> Callable[[np.ndarray], np.ndarray]:
-    fns = [sp.lambdify(q, e, "numpy") for e in exprs]
+    fns = [lambdified(q, e, "numpy", cse=False) for e in exprs]
 
     def evaluate(qv: np.ndarray) -> np.ndarray:
         qv = np.atleast_2d(qv)

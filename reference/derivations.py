@@ -7,18 +7,25 @@ edit of any derivation, or another sympy, derives afresh. ``DYNCHECK_NO_CACHE=1`
 command line's ``--no-cache``) neither reads nor writes the cache. A file that cannot be read
 back is derived again and replaced; files are written whole (a temporary file, then a rename),
 so that processes deriving the same thing at once never read half a file.
+
+The numeric functions made from derived expressions are kept too (:func:`lambdified`): the
+code ``sympy.lambdify`` generates and compiles, stored as Python's code object, so that a
+second process builds the same function without printing the expressions again.
 """
 
 from __future__ import annotations
 
 import hashlib
+import marshal
 import os
 import pickle
+import sys
 import tempfile
-from collections.abc import Callable
+import types
+from collections.abc import Callable, Sequence
 from functools import cache
 from pathlib import Path
-from typing import TypeVar
+from typing import Any, TypeVar
 
 T = TypeVar("T")
 
@@ -84,3 +91,70 @@ def cached(
         except OSError:
             pass  # a read-only or full cache folder costs time, never a result
     return result, False
+
+
+@cache
+def _namespace(modules: str) -> dict[str, Any]:
+    """The globals ``sympy.lambdify`` gives a function of ``modules`` ("numpy": numpy's and
+    numpy.linalg's names; "math": math's), with Python's builtins."""
+    import sympy as sp
+
+    return sp.lambdify((), 0, modules=modules).__globals__
+
+
+def _global_names(code: types.CodeType) -> set[str]:
+    """Every global name ``code`` and the code objects inside it look up."""
+    names = set(code.co_names)
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            names |= _global_names(const)
+    return names
+
+
+def _storable(f: Callable[..., Any], modules: str) -> bool:
+    """Whether ``f`` is rebuilt exactly from its code and :func:`_namespace`: no defaults, no
+    closure, and every name its code reads bound to the same object in both globals, or in
+    neither (an attribute's name, or a builtin)."""
+    if not isinstance(f, types.FunctionType) or f.__defaults__ or f.__closure__:
+        return False
+    ns, own, missing = _namespace(modules), f.__globals__, object()
+    same_builtins = own.get("__builtins__") is ns.get("__builtins__")
+    return same_builtins and all(
+        own.get(name, missing) is ns.get(name, missing) for name in _global_names(f.__code__)
+    )
+
+
+def lambdified(
+    args: Sequence[Any], exprs: Any, modules: str, cse: bool = True
+) -> Callable[..., Any]:
+    """``sympy.lambdify(args, exprs, modules=modules, cse=cse)``, its compiled code kept on
+    disk beside the derivations (keyed by the pickled arguments and expressions, the option,
+    sympy's and Python's versions and this package's source): a second process builds the
+    same function — the same code in the same names — from the stored code object instead of
+    printing and compiling the expressions again (~1 s of a warm run). A function that reads
+    anything but the module's names, or of expressions that cannot be pickled, is never
+    stored (made afresh each time)."""
+    import sympy as sp
+
+    def make() -> Callable[..., Any]:
+        return sp.lambdify(args, exprs, modules=modules, cse=cse)
+
+    if not enabled():
+        return make()
+    h = hashlib.sha256(f"{modules}\n{cse}\n{sys.version}\n".encode())
+    try:
+        h.update(pickle.dumps((tuple(args), exprs), protocol=pickle.HIGHEST_PROTOCOL))
+    except (pickle.PicklingError, AttributeError, TypeError):  # no key: made every time
+        return make()
+    path = cache_root() / "lambdified" / _source_key() / f"{h.hexdigest()[:32]}.pickle"
+    made: list[Callable[..., Any]] = []
+
+    def code() -> bytes | None:
+        made.append(make())
+        return marshal.dumps(made[0].__code__) if _storable(made[0], modules) else None
+
+    stored = cached(path, code, keep=lambda c: c is not None)[0]
+    if made:
+        return made[0]
+    assert stored is not None  # only a storable function's code is stored
+    return types.FunctionType(marshal.loads(stored), _namespace(modules))

@@ -20,7 +20,7 @@ from functools import cached_property
 import numpy as np
 import sympy as sp
 
-from dyncheck.reference.derivations import derived
+from dyncheck.reference.derivations import derived, lambdified
 
 
 def particle_energies(
@@ -43,7 +43,7 @@ def particle_energies(
 
 def _vectorize(expr: sp.Expr, args: Sequence[sp.Symbol]) -> Callable[..., np.ndarray]:
     """A numpy function of batched arguments; constants broadcast to the batch shape."""
-    f = sp.lambdify(args, expr, modules="numpy", cse=True)
+    f = lambdified(args, expr, "numpy")
 
     def evaluate(*values: np.ndarray) -> np.ndarray:
         out = np.asarray(f(*values), dtype=float)
@@ -58,14 +58,14 @@ def _fused(exprs: Sequence[sp.Expr], args: Sequence[sp.Symbol]) -> Callable[...,
     time step's stage) is evaluated by the same expressions in Python's ``math``, where
     numpy's per-call overhead would cost ten times the arithmetic; an argument outside
     ``math``'s domain falls back to numpy (its NaN or infinity, as for a batch)."""
-    f = sp.lambdify(args, list(exprs), modules="numpy", cse=True)
+    f = lambdified(args, list(exprs), "numpy")
     scalar: list[Callable[..., list[float]]] = []  # lambdified on first use
 
     def evaluate(*values: np.ndarray) -> np.ndarray:
         shape = np.broadcast(*values).shape
         if shape == (1,):
             if not scalar:
-                scalar.append(sp.lambdify(args, list(exprs), modules="math", cse=True))
+                scalar.append(lambdified(args, list(exprs), "math"))
             try:
                 one = [float(x[0]) if isinstance(x, np.ndarray) else float(x) for x in values]
                 return np.array([scalar[0](*one)], dtype=float)

@@ -15,6 +15,7 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 from dyncheck.reference.coordinates import CoordinateSystem, cylindrical, spherical
+from dyncheck.reference.derivations import lambdified
 from dyncheck.reference.lagrange import LagrangianDynamics, SymbolicSystem
 from dyncheck.reference.printed import PrintedDynamics
 
@@ -117,7 +118,7 @@ def _closed_christoffel(cs: CoordinateSystem) -> Callable[[np.ndarray], np.ndarr
         return cs.numeric.christoffel
     n = cs.dim
     exprs = [e for a in cs.closed_form_christoffel() for b in a for e in b]
-    fns = [sp.lambdify(cs.q, e, "numpy") for e in exprs]
+    fns = [lambdified(cs.q, e, "numpy", cse=False) for e in exprs]
 
     def evaluate(q: np.ndarray) -> np.ndarray:
         cols = [np.broadcast_to(np.asarray(f(*q.T), float), q.shape[:1]) for f in fns]

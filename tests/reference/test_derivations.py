@@ -6,7 +6,10 @@ Expected values: the book's closed-form metric of Example 5, ds² = dρ² + ρ²
 
 from __future__ import annotations
 
+import numpy as np
+import pytest
 import sympy as sp
+from sympy.utilities.lambdify import implemented_function
 
 from dyncheck.reference import derivations
 from dyncheck.reference.coordinates import spherical
@@ -69,3 +72,72 @@ def test_the_key_is_what_a_derivation_is_made_from(tmp_path, monkeypatch):
     assert derivations.derived("root", (plain,), lambda: "plain") == "plain"
     assert derivations.derived("root", (positive,), lambda: "positive") == "positive"
     assert derivations.derived("root", (plain,), lambda: "again") == "plain"
+
+
+def _lambdified_twice(tmp_path, monkeypatch, args, exprs, modules):
+    """``lambdified`` made afresh, then read back with ``sympy.lambdify`` refused."""
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
+    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
+    first = derivations.lambdified(args, exprs, modules)
+    assert list((tmp_path / "lambdified").rglob("*.pickle"))
+
+    def refuse(*_args, **_kwargs):
+        raise AssertionError("lambdify called although its code is stored")
+
+    monkeypatch.setattr(sp, "lambdify", refuse)
+    return first, derivations.lambdified(args, exprs, modules)
+
+
+@pytest.mark.parametrize("modules", ["numpy", "math"])
+def test_a_stored_function_computes_what_lambdify_makes_to_the_last_bit(
+    tmp_path, monkeypatch, modules
+):
+    """Expected: sympy's own lambdify of the same expressions (made before any is stored), on
+    states where every function's rounding shows (transcendentals, powers, a constant)."""
+    x, y = sp.symbols("x y")
+    exprs = [sp.sin(x) * sp.cos(y) + sp.sqrt(x), sp.sin(x) ** 2 / (1 + y**2), sp.pi * x,
+             sp.Abs(y) ** sp.Rational(3, 2), sp.atan2(y, x), sp.exp(-x * y)]
+    expected = sp.lambdify((x, y), exprs, modules=modules, cse=True)
+    first, again = _lambdified_twice(tmp_path, monkeypatch, (x, y), exprs, modules)
+    rng = np.random.default_rng(7)
+    for a, b in rng.uniform(0.1, 3, (50, 2)):
+        if modules == "numpy":
+            a, b = np.array([a, 2 * a]), np.array([b, -b])
+        want = np.asarray(expected(a, b), float)
+        for f in (first, again):
+            assert np.array_equal(np.asarray(f(a, b), float), want)
+
+
+def test_different_expressions_are_never_read_back_for_each_other(tmp_path, monkeypatch):
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
+    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
+    x = sp.Symbol("x")
+    assert derivations.lambdified((x,), x**2, "math")(3.0) == 9.0
+    assert derivations.lambdified((x,), x**3, "math")(3.0) == 27.0
+    assert derivations.lambdified((x,), x**2, "math", cse=False)(3.0) == 9.0
+    assert len(list((tmp_path / "lambdified").rglob("*.pickle"))) == 3
+
+
+def test_a_function_reading_a_name_lambdify_adds_is_not_stored(tmp_path, monkeypatch):
+    """A function whose code reads a global outside the module's names (an implemented
+    function's callable) cannot be rebuilt from its code alone: made afresh, never stored."""
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
+    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
+    x = sp.Symbol("x")
+    twice = implemented_function("twice", lambda v: 2 * v)
+    assert derivations.lambdified((x,), twice(x) + 1, "math")(3.0) == 7.0
+    assert not list((tmp_path / "lambdified").rglob("*.pickle"))
+
+
+def test_only_a_function_of_the_module_names_is_storable():
+    """Its code read back must find the same objects: a function that reads a name the
+    module does not have, or binds a module's name to something else, is not storable."""
+    def made(source: str, **extra):
+        ns = {**derivations._namespace("math"), **extra}
+        exec(source, ns)
+        return ns["g"]
+
+    assert derivations._storable(made("def g(x):\n    return sin(x) + abs(x)"), "math")
+    assert not derivations._storable(made("def g(x):\n    return extra(x)", extra=abs), "math")
+    assert not derivations._storable(made("def g(x):\n    return sin(x)", sin=abs), "math")
+    assert not derivations._storable(made("def g(x, k=2):\n    return k * x"), "math")
