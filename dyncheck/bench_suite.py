@@ -2,7 +2,9 @@
 a fresh process, wall-clock seconds on this machine — against the targets of issue #19.
 
 The engines' per-state costs are :mod:`dyncheck.bench`'s; this page is about the whole
-commands (imports, symbolic derivations, trajectory studies, figures, writing the report).
+commands (imports, symbolic derivations, trajectory studies, figures, writing the report) and,
+in a source checkout, the README's test command and the quick test loop, as CI runs them on a
+machine whose caches are empty (JAX's compiled programs included).
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import sys
 import tempfile
 import time
 from dataclasses import dataclass
+from enum import Enum
 from pathlib import Path
 
 import pandas as pd
@@ -33,11 +36,24 @@ CORE = (
 """The default run without MuJoCo's ports (core engines and Drake): what the targets name."""
 
 
+class Program(Enum):
+    """What a step runs, as ``python -m MODULE``."""
+
+    DYNCHECK = "dyncheck"
+    PYTEST = "pytest"
+    """In the source checkout (its ``tests/``): skipped where dyncheck is installed without."""
+
+
+CHECKOUT = Path(__file__).resolve().parents[1]
+"""The folder that holds the ``dyncheck`` package: a source checkout has ``tests/`` there."""
+
+
 @dataclass(frozen=True, kw_only=True)
 class Step:
     what: str
     argv: tuple[str, ...]
-    """Arguments of ``dyncheck``; ``{tmp}`` is this suite's scratch folder."""
+    """Arguments of the program; ``{tmp}`` is this suite's scratch folder."""
+    program: Program = Program.DYNCHECK
     target_s: float
     warm: bool = False
     """Whether the step keeps the cache the step before it filled (derivations, measured
@@ -81,13 +97,27 @@ STEPS: tuple[Step, ...] = (
         argv=("report", "--check", "--out", "{tmp}/full", "--from", "{tmp}/again"),
         target_s=25.0,
     ),
+    Step(
+        what="the README's test command (pytest -q: every test), empty caches as in CI",
+        argv=("-q", "-p", "no:cacheprovider"),
+        program=Program.PYTEST,
+        target_s=150.0,
+    ),
+    Step(
+        what="the quick loop: pytest -m 'not slow' (again: the caches the tests left)",
+        argv=("-q", "-p", "no:cacheprovider", "-m", "not slow"),
+        program=Program.PYTEST,
+        target_s=30.0,
+        warm=True,
+    ),
 )
 
 
 def measure(steps: tuple[Step, ...] = STEPS) -> pd.DataFrame:
     """Wall seconds of each step, in order (later steps reuse earlier ones' output). Each
-    step starts with an empty cache (derivations, measured demonstrations) in the suite's
-    scratch folder, except a ``warm`` one, which reads what the step before it stored."""
+    step starts with empty caches (derivations, measured demonstrations, JAX's compiled
+    programs) in the suite's scratch folder, except a ``warm`` one, which reads what the step
+    before it stored. A test step outside a source checkout is skipped, with the reason."""
     rows = []
     with tempfile.TemporaryDirectory(prefix="dyncheck-suite-") as tmp:
         env = os.environ.copy()
@@ -96,25 +126,27 @@ def measure(steps: tuple[Step, ...] = STEPS) -> pd.DataFrame:
         # PYTHONDONTWRITEBYTECODE compiles dyncheck's sources again in every process)
         env.pop("PYTHONDONTWRITEBYTECODE", None)
         for i, step in enumerate(steps):
+            row: dict[str, object] = {"command": step.what, "target_s": step.target_s}
+            if step.program is Program.PYTEST and not (CHECKOUT / "tests").is_dir():
+                rows.append(row | {"within_target": "skipped: no tests/ (not a source checkout)"})
+                continue
             if not step.warm:
                 env["DYNCHECK_CACHE"] = f"{tmp}/cache-{i}"
+                env["DYNCHECK_JAX_CACHE"] = f"{tmp}/cache-{i}/jax"
             argv = [a.replace("{tmp}", tmp) for a in step.argv]
             start = time.perf_counter()
             done = subprocess.run(
-                [sys.executable, "-m", "dyncheck", *argv], capture_output=True, text=True,
-                env=env,
+                [sys.executable, "-m", step.program.value, *argv], capture_output=True,
+                text=True, env=env, cwd=CHECKOUT if step.program is Program.PYTEST else None,
             )
             seconds = time.perf_counter() - start
-            rows.append(
-                {
-                    "command": step.what,
-                    "seconds": round(seconds, 2),
-                    "target_s": step.target_s,
-                    "within_target": "yes" if seconds <= step.target_s else "no",
-                    "exit": done.returncode,
-                }
-            )
-    return pd.DataFrame(rows)
+            rows.append(row | {
+                "seconds": round(seconds, 2),
+                "within_target": "yes" if seconds <= step.target_s else "no",
+                "exit": done.returncode,
+            })
+    columns = ["command", "seconds", "target_s", "within_target", "exit"]
+    return pd.DataFrame(rows, columns=columns).astype({"exit": "Int64"})
 
 
 def write(table: pd.DataFrame, out: Path) -> None:
@@ -126,9 +158,10 @@ def write(table: pd.DataFrame, out: Path) -> None:
         "",
         "Generated by `dyncheck bench --suite`: each command in a fresh process, wall-clock "
         f"seconds on this machine ({platform.machine()}, {v['platform']}), against the "
-        "targets of issue #19. Each command starts with an empty cache (derivations, measured "
-        "demonstrations), as on a new machine, except the ones marked \"again\", which read "
-        "what the command before them stored; Python keeps its bytecode cache as it does by "
+        "targets of issue #19. Each command starts with empty caches (derivations, measured "
+        "demonstrations, JAX's compiled programs), as on a new machine or in CI, except the "
+        "ones marked \"again\", which read what the command before them stored; the test "
+        "commands run in the source checkout; Python keeps its bytecode cache as it does by "
         "default (PYTHONDONTWRITEBYTECODE unset). Versions: "
         + ", ".join(f"{k} {val}" for k, val in v.items() if k != "platform")
         + ".",

@@ -3,7 +3,9 @@
 
 from __future__ import annotations
 
-from dyncheck.bench_suite import Step, measure, write
+import pandas as pd
+
+from dyncheck.bench_suite import Program, Step, measure, write
 
 
 def test_each_command_runs_in_a_fresh_process_with_its_exit_status(tmp_path):
@@ -49,3 +51,27 @@ def test_each_step_starts_cold_unless_marked_warm(monkeypatch):
     measure(steps)
     assert seen[1] == seen[0] and seen[4] == seen[3]
     assert len({seen[0], seen[2], seen[3]}) == 3 and "/the/user's/cache" not in seen
+
+
+def test_a_test_step_runs_pytest_in_the_checkout(tmp_path, monkeypatch):
+    """A relative test path collects only from the checkout's root: exit 0 there, where the
+    same step run from anywhere else — this test's own folder — finds no such file (4)."""
+    monkeypatch.chdir(tmp_path)
+    step = Step(what="collect", argv=("--co", "-q", "-n", "0", "-p", "no:cacheprovider",
+                                      "tests/test_layers.py"),
+                program=Program.PYTEST, target_s=120.0)
+    table = measure((step,))
+    assert list(table["exit"]) == [0] and list(table["within_target"]) == ["yes"]
+
+
+def test_a_test_step_outside_a_checkout_is_skipped_never_timed(tmp_path, monkeypatch):
+    from dyncheck import bench_suite
+
+    monkeypatch.setattr(bench_suite, "CHECKOUT", tmp_path)  # an installed package: no tests/
+    table = measure((Step(what="tests", argv=("-q",), program=Program.PYTEST, target_s=1.0),
+                     Step(what="list", argv=("list",), target_s=120.0)))
+    assert table["within_target"].iloc[0] == "skipped: no tests/ (not a source checkout)"
+    assert pd.isna(table["seconds"].iloc[0]) and pd.isna(table["exit"].iloc[0])
+    assert list(table["exit"].iloc[1:]) == [0]
+    write(table, tmp_path)
+    assert "skipped: no tests/" in (tmp_path / "benchmark-suite.md").read_text()
