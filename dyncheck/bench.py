@@ -286,9 +286,9 @@ def ratios(t: pd.DataFrame) -> pd.DataFrame:
 
 
 def write(times: pd.DataFrame, rat: pd.DataFrame, memory: pd.DataFrame, out: Path) -> None:
-    from dyncheck.provenance import versions
+    from dyncheck.provenance import engine_versions, versions
 
-    v = versions()
+    v = versions(engine_versions(times["implementation"].dropna().unique()))  # those timed
     lines = [
         "# dyncheck benchmark",
         "",

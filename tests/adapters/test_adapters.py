@@ -214,8 +214,23 @@ def test_unknown_engine_lists_valid_names():
         get_adapter("bullet")
 
 
+@pytest.mark.slow  # imports every engine, JAX and Warp included (~4 s)
 def test_every_engine_is_installed_here():
     assert sorted(adapters.ADAPTERS) == ALL_ENGINES
+
+
+def test_every_engine_package_is_installed_here():
+    """The quick loop's check, without importing an engine: each engine's distribution is
+    installed (an engine missing is a failure, never a skip; its import is the test above)."""
+    from dyncheck.adapters import ENGINE_PACKAGES
+
+    missing = []
+    for engine, package in sorted(ENGINE_PACKAGES.items()):
+        try:
+            importlib.metadata.version(package)
+        except importlib.metadata.PackageNotFoundError:
+            missing.append(f"{engine} ({package})")
+    assert not missing, f"not installed: {missing}"
 
 
 @pytest.mark.parametrize("engine", ALL_ENGINES)
@@ -294,7 +309,7 @@ def test_registered_precision_is_the_adapters(engine):
     importing the engine); it must be what the adapter computes in."""
     from dyncheck.adapters import FLOAT32
 
-    assert (engine in FLOAT32) == (adapters.ADAPTERS[engine].dtype == np.float32)
+    assert (engine in FLOAT32) == (get_adapter(engine).dtype == np.float32)
 
 
 @pytest.mark.parametrize("engine", ALL_ENGINES)
@@ -310,7 +325,7 @@ def test_registered_integrators_are_those_the_engine_maps(engine):
     entry = REGISTRY[engine]
     module = importlib.import_module(entry.module)
     mapped = getattr(module, "_INTEGRATORS", STEPPERS)
-    assert adapters.ADAPTERS[engine].integrators == entry.integrators
+    assert get_adapter(engine).integrators == entry.integrators
     if engine == "sympy-mechanics":
         assert set(entry.integrators) < set(STEPPERS)
     else:

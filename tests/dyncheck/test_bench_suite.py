@@ -4,8 +4,16 @@
 from __future__ import annotations
 
 import pandas as pd
+import pytest
 
 from dyncheck.bench_suite import Program, Step, measure, write
+
+
+@pytest.fixture(autouse=True)
+def _versions_without_engines(monkeypatch):
+    """The page's versions line names every engine (importing each, JAX and Warp included:
+    ~4 s); these tests are about the commands' rows, so it names none."""
+    monkeypatch.setattr("dyncheck.provenance.versions", lambda: {"platform": "test"})
 
 
 def test_each_command_runs_in_a_fresh_process_with_its_exit_status(tmp_path):

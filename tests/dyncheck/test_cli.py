@@ -95,6 +95,7 @@ def test_out_that_is_a_file_is_usage_error(tmp_path, capsys):
     assert f.read_text() == "keep"
 
 
+@pytest.mark.slow  # --integrators imports every engine, JAX and Warp included (~4 s)
 def test_list_names_engine_versions(capsys):
     assert main(["list", "--integrators"]) == 0
     out = capsys.readouterr().out
