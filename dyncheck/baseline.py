@@ -16,7 +16,7 @@ import pandas as pd
 
 from dyncheck import diff
 from dyncheck.errors import InvalidInput
-from dyncheck.results import DISCREPANCY_KEY, to_csv, write_atomic
+from dyncheck.results import DISCREPANCY_KEY, texts, to_csv, write_atomic
 
 COLUMNS = [*DISCREPANCY_KEY, "max_rel_err", "tolerance", "verdict"]
 FACTOR = diff.FACTOR
@@ -74,7 +74,7 @@ def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
             frame[col] = frame[col].astype(float)
     except ValueError as exc:
         raise InvalidInput(flag, str(path), f"numeric errors and steps ({exc})") from None
-    frame["integrator"] = frame["integrator"].fillna("").astype(str)
+    frame["integrator"] = texts(frame["integrator"])
     diff.checked_signs(frame, ["max_rel_err", "tolerance"], flag=flag, path=path)
     diff.checked_keys(frame, DISCREPANCY_KEY, flag=flag, path=path)
     judged = frame["verdict"].isin(["passed", "explained"])

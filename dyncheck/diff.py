@@ -32,7 +32,7 @@ import pandas as pd
 
 from dyncheck.errors import InvalidInput
 from dyncheck.provenance import NOT_USED
-from dyncheck.results import DISCREPANCY_KEY, PROVENANCE, VERDICTS
+from dyncheck.results import DISCREPANCY_KEY, PROVENANCE, VERDICTS, texts
 
 FACTOR = 10.0
 """Default factor an error must grow or shrink by, above its tolerance, to count as moved."""
@@ -140,7 +140,7 @@ def _normalise(rows: pd.DataFrame, kind: RunKind, flag: str, path: Path) -> pd.D
         if col == "dt":
             out[col] = pd.to_numeric(out[col], errors="coerce")
         else:
-            out[col] = out[col].fillna("").astype(str)
+            out[col] = texts(out[col])
     try:
         out["error"] = rows[ERROR[kind]].astype(float)
         out["tolerance"] = rows["tolerance"].astype(float).fillna(0.0)

@@ -42,7 +42,7 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.errors import InvalidInput
-from dyncheck.results import CONVERGENCE_KEY, DISCREPANCY_KEY
+from dyncheck.results import CONVERGENCE_KEY, DISCREPANCY_KEY, texts
 from dyncheck.tolerances import EPS32, REFERENCE_MARGIN, accumulated
 
 
@@ -226,7 +226,7 @@ def _keys(frame: pd.DataFrame, key: list[str]) -> pd.Series:
     parts = [
         frame[c].map(lambda x: "" if pd.isna(x) else f"{x:.6e}")
         if frame[c].dtype.kind == "f"
-        else frame[c].fillna("").astype(str)
+        else texts(frame[c])
         for c in key
     ]
     out = parts[0]
@@ -305,7 +305,7 @@ def _moved_rows(
 def _labels_moved(name: str, a: pd.DataFrame, b: pd.DataFrame, fields: tuple) -> list[Moved]:
     out = []
     for field in fields:
-        sa, sb = a[field].fillna("").astype(str), b[field].fillna("").astype(str)
+        sa, sb = texts(a[field]), texts(b[field])
         out += _moved_rows(name, a, b, field, (sa != sb).to_numpy())
     return out
 
@@ -313,7 +313,7 @@ def _labels_moved(name: str, a: pd.DataFrame, b: pd.DataFrame, fields: tuple) ->
 def _texts_moved(
     name: str, a: pd.DataFrame, b: pd.DataFrame, field: str, rtol: np.ndarray, floor: np.ndarray
 ) -> list[Moved]:
-    sa, sb = a[field].fillna("").astype(str), b[field].fillna("").astype(str)
+    sa, sb = texts(a[field]), texts(b[field])
     bad = [
         x != y and text_moved(x, y, r, f) is not None
         for x, y, r, f in zip(sa, sb, rtol, floor, strict=True)

@@ -113,3 +113,10 @@ def write_atomic(path: Path, content: str | bytes) -> None:
 def to_csv(frame: pd.DataFrame) -> str:
     """Deterministic CSV text: fixed float format, LF line ends."""
     return frame.to_csv(index=False, float_format="%.6e", lineterminator="\n")
+
+
+def texts(column: pd.Series) -> pd.Series:
+    """A column read from a CSV as text, ``""`` where a cell is empty — also for a column
+    that pandas read as floats because every cell of it was empty (filling a float column
+    with a string is refused by pandas ≥ 4)."""
+    return column.astype(object).where(column.notna(), "").astype(str)

@@ -5,10 +5,12 @@ A user's model is untrusted input to C extensions: an engine that crashes the in
 (a segfault in its parser or its dynamics) or never answers must cost only its own rows.
 :func:`start` therefore loads each engine in its own process and serves its dynamics from
 there. On Linux the process is forked (the engines are imported only in the children; the
-cost measured on the 2-core machine: 0.08 s against 0.04 s in-process for three engines);
-elsewhere it is spawned (one interpreter and the engine's import each, about 1 s, the loads
-side by side). ``isolate=False`` loads in this process (what the library API's callers choose
-when they trust their models).
+cost measured on the 2-core machine: 0.08 s against 0.04 s in-process for three engines),
+unless this process already runs a multithreaded runtime (JAX, Warp: a fork copies one thread
+of it, and a child can deadlock on a lock another thread held); otherwise it is spawned (one
+interpreter and the engine's import each, about 1 s, the loads side by side).
+``isolate=False`` loads in this process (what the library API's callers choose when they
+trust their models).
 """
 
 from __future__ import annotations
@@ -104,6 +106,17 @@ def _serve(name: str, spec: Engine, source: ModelFile, conn: Connection) -> None
             conn.send(EngineError(f"{type(exc).__name__}: {' '.join(str(exc).split())}"))
 
 
+THREADED_RUNTIMES = ("jax", "warp")
+"""Modules that start threads of their own when imported: a process holding one is not
+forked."""
+
+
+def start_method() -> str:
+    """``fork`` on Linux while no :data:`THREADED_RUNTIMES` is imported here, else ``spawn``."""
+    threaded = any(name in sys.modules for name in THREADED_RUNTIMES)
+    return "fork" if sys.platform == "linux" and not threaded else "spawn"
+
+
 def _death(code: int | None) -> str:
     if code is not None and code < 0:
         try:
@@ -118,7 +131,7 @@ class Isolated:
     ``dynamics`` as :class:`ModelEngine`, a crash or a hang an :class:`EngineError`."""
 
     def __init__(self, name: str, source: ModelFile) -> None:
-        ctx = mp.get_context("fork" if sys.platform == "linux" else "spawn")
+        ctx = mp.get_context(start_method())
         self.engine = name
         self._conn, child = ctx.Pipe()
         # the spec travels with the call: a spawned child would not see a patched ENGINES

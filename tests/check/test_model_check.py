@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import importlib.util
 import re
+import sys
+import types
 from pathlib import Path
 
 import pytest
@@ -145,10 +147,16 @@ def test_readme_pytest_recipe_names_the_api():
         ("HangOnDynamics", "gave no answer within 1 s while computing the dynamics (stopped)"),
     ],
 )
-def test_an_engine_that_crashes_or_hangs_costs_only_its_rows(monkeypatch, engine_class, words):
+@pytest.mark.parametrize("method", ["fork", "spawn"])
+def test_an_engine_that_crashes_or_hangs_costs_only_its_rows(
+    monkeypatch, engine_class, words, method
+):
     """A segfault or a hang in one engine (tests/check/crashing_engine.py) fails that engine's
-    rows; the other engines' rows are those of a check without it (all pass on this model)."""
+    rows; the other engines' rows are those of a check without it (all pass on this model) —
+    in forked and in spawned processes."""
     from dyncheck.check import engines, model_check
+
+    monkeypatch.setattr(engines, "start_method", lambda: method)
 
     monkeypatch.setitem(engines.ENGINES, "crashing",
                         engines.Engine("tests.check.crashing_engine", engine_class, None))
@@ -164,6 +172,21 @@ def test_an_engine_that_crashes_or_hangs_costs_only_its_rows(monkeypatch, engine
     others = rows.drop(mine.index)
     assert {"mujoco", "pinocchio", "reference"} <= set(others.impl_a) | set(others.impl_b)
     assert not (others.verdict == "failed").any(), others[others.verdict == "failed"]
+
+
+@pytest.mark.parametrize("runtime", ["jax", "warp"])
+def test_a_process_running_a_threaded_runtime_spawns_its_engines(monkeypatch, runtime):
+    """JAX and Warp start threads when imported (JAX warns that a fork "will likely lead to a
+    deadlock"): a process that imported one spawns the engines' processes; one without
+    forks them on Linux."""
+    from dyncheck.check import engines
+
+    for name in engines.THREADED_RUNTIMES:
+        monkeypatch.delitem(sys.modules, name, raising=False)
+    monkeypatch.setattr(sys, "platform", "linux")
+    assert engines.start_method() == "fork"
+    monkeypatch.setitem(sys.modules, runtime, types.ModuleType(runtime))
+    assert engines.start_method() == "spawn"
 
 
 def test_a_daemonic_worker_checks_in_process_and_says_so():
