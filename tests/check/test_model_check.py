@@ -6,16 +6,20 @@ the field; engines that order the joints differently must still agree."""
 from __future__ import annotations
 
 import importlib.util
+import io
 import re
+import subprocess
 import sys
 import types
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 from dyncheck.check.model_check import check_model
 
 MODELS = Path(__file__).parent / "models"
+ROOT = Path(__file__).resolve().parents[2]
 CASES = [
     ("mixed.xml", False),
     ("floating_arm.xml", False),
@@ -148,23 +152,20 @@ def test_readme_pytest_recipe_names_the_api():
     ],
 )
 @pytest.mark.parametrize("method", ["fork", "spawn"])
-def test_an_engine_that_crashes_or_hangs_costs_only_its_rows(
-    monkeypatch, engine_class, words, method
-):
+def test_an_engine_that_crashes_or_hangs_costs_only_its_rows(engine_class, words, method):
     """A segfault or a hang in one engine (tests/check/crashing_engine.py) fails that engine's
     rows; the other engines' rows are those of a check without it (all pass on this model) —
-    in forked and in spawned processes."""
-    from dyncheck.check import engines, model_check
-
-    monkeypatch.setattr(engines, "start_method", lambda: method)
-
-    monkeypatch.setitem(engines.ENGINES, "crashing",
-                        engines.Engine("tests.check.crashing_engine", engine_class, None))
-    monkeypatch.setattr(model_check, "IMPLEMENTATIONS", (*engines.IMPLEMENTATIONS, "crashing"))
-    monkeypatch.setattr(engines, "TIMEOUT_S", 1.0)  # a batch of 5 states: milliseconds
-    result = check_model(MODELS / "mixed.xml", impls=("reference", "mujoco", "pinocchio",
-                                                      "crashing"), states=5)
-    rows = result.rows
+    with the engines' processes forked and spawned. Forked from a fresh interpreter, as the
+    command's own process forks them: this test process may hold JAX or Warp, whose threads
+    make a fork unsafe (the reason :func:`engines.start_method` spawns there)."""
+    if method == "fork":
+        code = ("from tests.check.test_model_check import crash_check; "
+                f"print(crash_check({engine_class!r}, 'fork').to_json(orient='records'))")
+        out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
+                             text=True, timeout=120, check=True).stdout
+        rows = pd.read_json(io.StringIO(out), orient="records", dtype=False)
+    else:
+        rows = crash_check(engine_class, method)
     mine = rows[(rows.impl_a == "crashing") | (rows.impl_b == "crashing")]
     failed = mine[mine.verdict == "failed"]
     assert len(failed) == 1 and words in failed.note.iloc[0], mine
@@ -172,6 +173,22 @@ def test_an_engine_that_crashes_or_hangs_costs_only_its_rows(
     others = rows.drop(mine.index)
     assert {"mujoco", "pinocchio", "reference"} <= set(others.impl_a) | set(others.impl_b)
     assert not (others.verdict == "failed").any(), others[others.verdict == "failed"]
+
+
+def crash_check(engine_class: str, method: str) -> pd.DataFrame:
+    """The rows of a check of mixed.xml with the crashing engine ``engine_class`` beside the
+    reference, MuJoCo and Pinocchio, its processes started by ``method``."""
+    from dyncheck.check import engines, model_check
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(engines, "start_method", lambda: method)
+        mp.setitem(engines.ENGINES, "crashing",
+                   engines.Engine("tests.check.crashing_engine", engine_class, None))
+        mp.setattr(model_check, "IMPLEMENTATIONS", (*engines.IMPLEMENTATIONS, "crashing"))
+        mp.setattr(engines, "TIMEOUT_S", 1.0)  # a batch of 5 states: milliseconds
+        result = check_model(MODELS / "mixed.xml", impls=("reference", "mujoco", "pinocchio",
+                                                          "crashing"), states=5)
+    return result.rows
 
 
 @pytest.mark.parametrize("runtime", ["jax", "warp"])
