@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import importlib.util
 import io
+import json
 import re
 import subprocess
 import sys
@@ -143,32 +144,43 @@ def test_readme_pytest_recipe_names_the_api():
     assert re.search(r"from dyncheck import check_model", readme)
 
 
+CRASHES = {
+    "CrashOnLoad": "crashed while loading the model (killed by SIGSEGV)",
+    "CrashOnDynamics": "crashed while computing the dynamics (killed by SIGSEGV)",
+    "HangOnDynamics": "gave no answer within 1 s while computing the dynamics (stopped)",
+}
+"""tests/check/crashing_engine.py's engines, and the words of the one row each must fail."""
+
+
+@pytest.fixture(scope="module")
+def forked_checks() -> dict[str, pd.DataFrame]:
+    """:func:`crash_check` of every crashing engine with forked processes, forked from a
+    fresh interpreter, as the command's own process forks them: this test process may hold
+    JAX or Warp, whose threads make a fork unsafe (why :func:`engines.start_method` spawns
+    there). One interpreter for the three checks."""
+    code = ("import json; from tests.check.test_model_check import CRASHES, crash_check; "
+            "print(json.dumps({c: crash_check(c, 'fork').to_json(orient='records') "
+            "for c in CRASHES}))")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
+                         text=True, timeout=120, check=True).stdout
+    return {c: pd.read_json(io.StringIO(rows), orient="records", dtype=False)
+            for c, rows in json.loads(out).items()}
+
+
 @pytest.mark.parametrize(
-    ("engine_class", "words"),
-    [
-        ("CrashOnLoad", "crashed while loading the model (killed by SIGSEGV)"),
-        ("CrashOnDynamics", "crashed while computing the dynamics (killed by SIGSEGV)"),
-        ("HangOnDynamics", "gave no answer within 1 s while computing the dynamics (stopped)"),
-    ],
+    ("engine_class", "method"),
+    [*((c, "fork") for c in CRASHES), ("CrashOnDynamics", "spawn")],
 )
-@pytest.mark.parametrize("method", ["fork", "spawn"])
-def test_an_engine_that_crashes_or_hangs_costs_only_its_rows(engine_class, words, method):
+def test_an_engine_that_crashes_or_hangs_costs_only_its_rows(forked_checks, engine_class,
+                                                             method):
     """A segfault or a hang in one engine (tests/check/crashing_engine.py) fails that engine's
-    rows; the other engines' rows are those of a check without it (all pass on this model) —
-    with the engines' processes forked and spawned. Forked from a fresh interpreter, as the
-    command's own process forks them: this test process may hold JAX or Warp, whose threads
-    make a fork unsafe (the reason :func:`engines.start_method` spawns there)."""
-    if method == "fork":
-        code = ("from tests.check.test_model_check import crash_check; "
-                f"print(crash_check({engine_class!r}, 'fork').to_json(orient='records'))")
-        out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
-                             text=True, timeout=120, check=True).stdout
-        rows = pd.read_json(io.StringIO(out), orient="records", dtype=False)
-    else:
-        rows = crash_check(engine_class, method)
+    rows; the other engines' rows are those of a check without it (all pass on this model).
+    Forked, each crashing engine; spawned (where this process runs JAX or Warp), a crash — the
+    start method is all that differs, the crash and hang handling being the same code."""
+    rows = forked_checks[engine_class] if method == "fork" else crash_check(engine_class, method)
     mine = rows[(rows.impl_a == "crashing") | (rows.impl_b == "crashing")]
     failed = mine[mine.verdict == "failed"]
-    assert len(failed) == 1 and words in failed.note.iloc[0], mine
+    assert len(failed) == 1 and CRASHES[engine_class] in failed.note.iloc[0], mine
     assert not ((mine.section == "dynamics") & (mine.verdict == "passed")).any()
     others = rows.drop(mine.index)
     assert {"mujoco", "pinocchio", "reference"} <= set(others.impl_a) | set(others.impl_b)
