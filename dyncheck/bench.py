@@ -13,6 +13,11 @@ Measured in one process, one run, medians of repeats (time.perf_counter):
   rawest), so that this ratio compares like with like.
 
 Peak memory of a sweep is measured in a fresh child process per size (its max RSS).
+
+With ``--jobs N`` or ``--dask ADDRESS`` the sweep is also run as a run cuts a large one: in
+slices of states (units of work, :func:`dyncheck.run.run`'s ``_sweep_slice``) on this process
+and on the workers, timed whole (the workers' start-up and their implementations' builds
+included, as a run pays them), its merged rows required to be the same CSV bytes in both.
 Timings are not test assertions; they go to ``benchmark.csv`` and ``benchmark.md``.
 """
 
@@ -24,8 +29,8 @@ import queue as queue_module
 import resource
 import statistics
 import time
-from collections.abc import Callable
-from functools import partial
+from collections.abc import Callable, Sequence
+from functools import partial, reduce
 from pathlib import Path
 
 import numpy as np
@@ -285,7 +290,52 @@ def ratios(t: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
-def write(times: pd.DataFrame, rat: pd.DataFrame, memory: pd.DataFrame, out: Path) -> None:
+def sliced_sweep(
+    case: Case, impl_names: Sequence[str], states: int, *, jobs: int, dask: str | None,
+    repeats: int,
+) -> pd.DataFrame:
+    """The sweep of ``states`` states cut into slices — a run's (2¹⁷ states), or two per
+    worker where the sweep is smaller — run here and on ``jobs`` processes or the ``dask``
+    cluster (:func:`dyncheck.workers.run_units`): one row each, seconds medians of
+    ``repeats``, with the speed-up. Rows that differ between the two are an
+    :class:`EngineError` (the workers must reproduce this process to the byte)."""
+    from dyncheck.comparison import Sweep
+    from dyncheck.comparison import rows as rows_of
+    from dyncheck.results import DISCREPANCY_KEY, Discrepancy, table
+    from dyncheck.run import STATES_PER_UNIT, _sweep_slice
+    from dyncheck.workers import LOCAL, run_units
+
+    per_unit = min(STATES_PER_UNIT, -(-states // (2 * max(jobs, 1))))
+    units = [
+        (f"states {start}..", _sweep_slice,
+         (case, list(impl_names), states, start, min(states, start + per_unit)))
+        for start in range(0, states, per_unit)
+    ]
+    where = (f"--jobs {jobs}" if dask is None
+             else f"--dask local --jobs {jobs}" if dask == LOCAL else f"--dask {dask}")
+    seconds, csv = {}, {}
+    # the workers first: an unreachable scheduler is an error before this process's sweep
+    for label, kw in ((where, {"jobs": jobs, "dask": dask}), ("this process", {})):
+        done: list[Sweep] = []
+
+        def once(kw: dict = kw, done: list[Sweep] = done) -> None:
+            done[:] = run_units(units, **kw)
+
+        seconds[label] = _median_time(once, repeats)
+        csv[label] = to_csv(table(rows_of(reduce(Sweep.merge, done)), Discrepancy,
+                                  DISCREPANCY_KEY))
+    if csv[where] != csv["this process"]:
+        raise EngineError(f"bench {where}: the sweep's rows differ from this process's")
+    out = [{"case": case.name, "states": states, "slices": len(units), "where": label,
+            "seconds": seconds[label], "us_per_state": 1e6 * seconds[label] / states}
+           for label in ("this process", where)]
+    frame = pd.DataFrame(out)
+    frame["speedup"] = frame["seconds"].iloc[0] / frame["seconds"]
+    return frame
+
+
+def write(times: pd.DataFrame, rat: pd.DataFrame, memory: pd.DataFrame, out: Path,
+          sliced: pd.DataFrame | None = None) -> None:
     from dyncheck.provenance import engine_versions, versions
 
     v = versions(engine_versions(times["implementation"].dropna().unique()))  # those timed
@@ -309,13 +359,24 @@ def write(times: pd.DataFrame, rat: pd.DataFrame, memory: pd.DataFrame, out: Pat
         "",
         memory.to_markdown(index=False) if len(memory) else "_(not measured)_",
         "",
+        "### The sweep in slices, here and on workers (seconds, medians of repeats; the "
+        "same rows to the byte)",
+        "",
+        sliced.to_markdown(index=False, floatfmt=".3g") if sliced is not None
+        else "_(not measured: `dyncheck bench --jobs N` or `--dask ADDRESS`)_",
+        "",
     ]
-    write_atomic(out / "benchmark.csv", to_csv(pd.concat([times, rat, memory])))
+    frames = [times, rat, memory] + ([] if sliced is None else [sliced])
+    write_atomic(out / "benchmark.csv", to_csv(pd.concat(frames)))
     write_atomic(out / "benchmark.md", "\n".join(lines))
 
 
-def main(case_name: str, states: int, repeats: int, memory_sizes: list[int], out: Path) -> str:
+def main(case_name: str, states: int, repeats: int, memory_sizes: list[int], out: Path, *,
+         jobs: int = 1, dask: str | None = None) -> str:
     case = get_case(case_name)
+    # on the workers first: an unreachable scheduler is an error before the long work
+    sliced = None if jobs <= 1 and dask is None else sliced_sweep(
+        case, implementations_for(case), states, jobs=jobs, dask=dask, repeats=repeats)
     times = bench(case, states, repeats)
     rat = ratios(times)
     mem = pd.DataFrame(
@@ -328,7 +389,6 @@ def main(case_name: str, states: int, repeats: int, memory_sizes: list[int], out
             for n in memory_sizes
         ]
     )
-    write(times, rat, mem, out)
-    return "\n\n".join(
-        [times.to_string(index=False), rat.to_string(index=False), mem.to_string(index=False)]
-    )
+    write(times, rat, mem, out, sliced)
+    tables = [times, rat, mem] + ([] if sliced is None else [sliced])
+    return "\n\n".join(t.to_string(index=False) for t in tables)

@@ -203,6 +203,10 @@ def _parser() -> argparse.ArgumentParser:
         help="sweep sizes whose peak memory is measured in fresh processes",
     )
     b.add_argument("--out", type=_path, default=Path("reports"), help="report folder")
+    b.add_argument("--jobs", type=int, default=1, metavar="N",
+                   help="also time the sweep in slices on N processes against this one "
+                   "(the same rows, checked)")
+    _dask(b)
     b.add_argument("--suite", action="store_true",
                    help="instead: time the commands a user runs (list, explain, one case, the "
                    "full run, report --check) in fresh processes -> benchmark-suite.md")
@@ -460,7 +464,9 @@ def _bench(args: argparse.Namespace) -> int:
     _positive("--repeats", args.repeats)
     for n in args.memory:
         _positive("--memory", n)
-    print(bench.main(args.case, args.states, args.repeats, args.memory, args.out))
+    _positive("--jobs", args.jobs)
+    print(bench.main(args.case, args.states, args.repeats, args.memory, args.out,
+                     jobs=args.jobs, dask=args.dask))
     return 0
 
 

@@ -1,0 +1,65 @@
+"""dyncheck.bench: the sweep in slices, here and on workers (``bench --jobs``, ``--dask``)."""
+
+from __future__ import annotations
+
+import pytest
+
+from dyncheck import bench, workers
+from dyncheck.cases import get_case
+from dyncheck.cli import main
+from dyncheck.errors import EngineError
+
+IMPLS = ("reference", "mujoco")
+STATES = 600
+
+
+@pytest.mark.slow  # worker processes that import the engines: seconds
+@pytest.mark.parametrize("dask", [None, workers.LOCAL])
+def test_sliced_sweep_on_workers_is_timed_beside_this_process(dask):
+    """Two slices per worker; the same rows on the workers as here (checked inside: a
+    difference raises), each side timed, the speed-up relative to this process."""
+    if dask is not None:
+        pytest.importorskip("distributed", reason="the extra 'dask' (pip install 'dyncheck[dask]')")
+    frame = bench.sliced_sweep(get_case("simple_pendulum"), IMPLS, STATES, jobs=2, dask=dask,
+                               repeats=1)
+    where = "--jobs 2" if dask is None else "--dask local --jobs 2"
+    assert frame["where"].tolist() == ["this process", where]
+    assert frame["slices"].tolist() == [4, 4]  # ⌈600 / (2 × 2)⌉ = 150 states a slice
+    assert (frame["seconds"] > 0).all()
+    assert frame["speedup"].iloc[0] == 1.0
+    assert frame["speedup"].iloc[1] == frame["seconds"].iloc[0] / frame["seconds"].iloc[1]
+
+
+def test_workers_that_give_other_rows_are_an_error(monkeypatch):
+    """Workers whose slices are not the sweep's (here: the first slice four times) give other
+    rows than this process: the bench says so instead of timing them."""
+    run_units = workers.run_units
+
+    def wrong(units, **kw):
+        return run_units(units if kw.get("jobs", 1) == 1 else units[:1] * len(units), jobs=1)
+
+    monkeypatch.setattr(workers, "run_units", wrong)
+    with pytest.raises(EngineError, match=r"bench --jobs 2: the sweep's rows differ"):
+        bench.sliced_sweep(get_case("simple_pendulum"), IMPLS, STATES, jobs=2, dask=None,
+                           repeats=1)
+
+
+@pytest.mark.parametrize(
+    ("argv", "words"),
+    [
+        (["--jobs", "0"], "--jobs"),
+        (["--dask", "tcp://127.0.0.1:9"], "tcp://127.0.0.1:9"),  # the discard port
+    ],
+)
+def test_bad_workers_are_a_one_line_error_before_any_timing(argv, words, tmp_path, monkeypatch,
+                                                            capsys):
+    if "--dask" in argv:
+        pytest.importorskip("distributed", reason="the extra 'dask' (pip install 'dyncheck[dask]')")
+    monkeypatch.setattr(workers, "CONNECT_SECONDS", 0.2)  # refused at once: no wait needed
+    monkeypatch.setattr(bench, "bench", lambda *a, **k: pytest.fail("timed before the check"))
+    code = main(["bench", "simple_pendulum", "--states", "10", "--memory", *argv,
+                 "--out", str(tmp_path)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert len(err.splitlines()) == 1 and words in err, err
+    assert not (tmp_path / "benchmark.md").exists()
