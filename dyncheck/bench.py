@@ -362,6 +362,10 @@ def write(times: pd.DataFrame, rat: pd.DataFrame, memory: pd.DataFrame, out: Pat
         "### The sweep in slices, here and on workers (seconds, medians of repeats; the "
         "same rows to the byte)",
         "",
+        "Each side timed whole: on the workers their start-up, imports and engines' loading "
+        "(MuJoCo's ports compile in every worker) are part of the time, as a run pays them; "
+        "a sweep pays off on workers once its states cost more than that.",
+        "",
         sliced.to_markdown(index=False, floatfmt=".3g") if sliced is not None
         else "_(not measured: `dyncheck bench --jobs N` or `--dask ADDRESS`)_",
         "",
