@@ -16,6 +16,7 @@ second process builds the same function without printing the expressions again.
 from __future__ import annotations
 
 import hashlib
+import io
 import marshal
 import os
 import pickle
@@ -93,6 +94,31 @@ def cached(
     return result, False
 
 
+class _Canonical(pickle.Pickler):
+    """A pickler whose bytes depend on values only (see :func:`value_bytes`)."""
+
+    def reducer_override(self, obj: Any) -> Any:
+        import numpy as np
+
+        if isinstance(obj, np.ndarray) and not obj.flags.c_contiguous:
+            return np.ascontiguousarray(obj).__reduce_ex__(5)
+        return NotImplemented
+
+
+def value_bytes(obj: object) -> bytes:
+    """``obj`` pickled so that equal values give equal bytes, for a cache key (never read
+    back): pickle's memo off, so that how objects share parts does not show (an expression
+    rebuilt from the cache shares its subexpressions unlike one just derived), and every
+    array C-contiguous (a column view pickles unlike its copy). Without both, a run keyed
+    what it had just computed unlike what the next run read back, and the next run computed
+    it again. A self-referential object raises ``ValueError``."""
+    buf = io.BytesIO()
+    pickler = _Canonical(buf, protocol=5)
+    pickler.fast = True  # no memo
+    pickler.dump(obj)
+    return buf.getvalue()
+
+
 @cache
 def _namespace(modules: str) -> dict[str, Any]:
     """The globals ``sympy.lambdify`` gives a function of ``modules`` ("numpy": numpy's and
@@ -128,12 +154,12 @@ def lambdified(
     args: Sequence[Any], exprs: Any, modules: str, cse: bool = True
 ) -> Callable[..., Any]:
     """``sympy.lambdify(args, exprs, modules=modules, cse=cse)``, its compiled code kept on
-    disk beside the derivations (keyed by the pickled arguments and expressions, the option,
-    sympy's and Python's versions and this package's source): a second process builds the
-    same function — the same code in the same names — from the stored code object instead of
-    printing and compiling the expressions again (~1 s of a warm run). A function that reads
-    anything but the module's names, or of expressions that cannot be pickled, is never
-    stored (made afresh each time)."""
+    disk beside the derivations (keyed by the arguments' and expressions' :func:`value_bytes`,
+    the option, sympy's and Python's versions and this package's source): a second process
+    builds the same function — the same code in the same names — from the stored code object
+    instead of printing and compiling the expressions again (~1 s of a warm run). A function
+    that reads anything but the module's names, or of expressions that cannot be pickled, is
+    never stored (made afresh each time)."""
     import sympy as sp
 
     def make() -> Callable[..., Any]:
@@ -143,8 +169,8 @@ def lambdified(
         return make()
     h = hashlib.sha256(f"{modules}\n{cse}\n{sys.version}\n".encode())
     try:
-        h.update(pickle.dumps((tuple(args), exprs), protocol=pickle.HIGHEST_PROTOCOL))
-    except (pickle.PicklingError, AttributeError, TypeError):  # no key: made every time
+        h.update(value_bytes((tuple(args), exprs)))
+    except (pickle.PicklingError, AttributeError, TypeError, ValueError):  # no key: made anew
         return make()
     path = cache_root() / "lambdified" / _source_key() / f"{h.hexdigest()[:32]}.pickle"
     made: list[Callable[..., Any]] = []

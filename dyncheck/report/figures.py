@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import io
 import math
-import pickle
 from dataclasses import dataclass
 from types import ModuleType
 from typing import TYPE_CHECKING
@@ -15,6 +14,7 @@ import pandas as pd
 
 from dyncheck.cases import Case
 from dyncheck.measured_cache import reused
+from dyncheck.reference.derivations import value_bytes
 from dyncheck.results import to_csv
 from dyncheck.studies import (
     TrajectoryFigures,
@@ -186,6 +186,6 @@ def cached_figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> d
     numbers plotted are always this run's. Only the latest fingerprint's figures are kept
     (~0.4 MB a case: one set per edit of dyncheck would pile up on a machine that runs every
     commit)."""
-    inputs = (repr(case).encode(), pickle.dumps(data, protocol=5),
+    inputs = (repr(case).encode(), value_bytes(data),
               to_csv(conv[conv["case"] == case.name]).encode())
     return reused("figures", case.name, inputs, lambda: figures(case, data, conv))

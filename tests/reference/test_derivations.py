@@ -141,3 +141,59 @@ def test_only_a_function_of_the_module_names_is_storable():
     assert not derivations._storable(made("def g(x):\n    return extra(x)", extra=abs), "math")
     assert not derivations._storable(made("def g(x):\n    return sin(x)", sin=abs), "math")
     assert not derivations._storable(made("def g(x, k=2):\n    return k * x"), "math")
+
+
+def _apart(*build):
+    """Expressions built with sympy's cache cleared between them: equal subexpressions are
+    then different objects, as in expressions read back from the cache."""
+    from sympy.core.cache import clear_cache
+
+    made = []
+    for f in build:
+        clear_cache()
+        made.append(f())
+    return made
+
+
+def test_value_bytes_depend_on_values_not_on_how_objects_share_parts():
+    """Expected: equal values give equal keys whatever their objects share or however their
+    arrays lie in memory (a value read back from the cache is rebuilt with other sharing:
+    keyed unlike what a run had just computed, the next run computed it again), and a value
+    that differs in one bit gives another key."""
+    import pickle
+
+    x, y = sp.symbols("x y")
+    shared = sp.sin(x) * y
+    a = [shared, shared + 1]                      # one subexpression, two uses
+    b = _apart(lambda: sp.sin(x) * y, lambda: sp.sin(x) * y + 1)
+    assert a == b and b[0] is not b[1].args[1]
+    assert pickle.dumps(a) != pickle.dumps(b)    # what the key was before: sharing shows
+    assert derivations.value_bytes(a) == derivations.value_bytes(b)
+    assert derivations.value_bytes(a) != derivations.value_bytes([shared, shared + 2])
+
+    states = np.arange(12.0).reshape(6, 2)
+    column = states[:, :1]                        # a view with a stride of two
+    assert not column.flags.c_contiguous
+    copy = column.copy()
+    assert derivations.value_bytes({"r": column}) == derivations.value_bytes({"r": copy})
+    other = copy.copy()
+    other[3, 0] = np.nextafter(other[3, 0], np.inf)
+    assert derivations.value_bytes({"r": other}) != derivations.value_bytes({"r": copy})
+
+
+def test_a_function_of_equal_expressions_built_apart_is_found_in_the_cache(
+    tmp_path, monkeypatch
+):
+    """Expected: one stored file for expressions whose equal parts are one object and for
+    the same expressions built apart (as a second run reads them from the derivations'
+    cache), the function read back computing sin(1)·2 as sympy's own lambdify does."""
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
+    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
+    x, y = sp.symbols("x y")
+    s = sp.sin(x) * y
+    first = derivations.lambdified((x, y), [s, s * x], "math")
+    apart = _apart(lambda: sp.sin(x) * y, lambda: sp.sin(x) * y * x)
+    again = derivations.lambdified((x, y), apart, "math")
+    assert len(list((tmp_path / "lambdified").rglob("*.pickle"))) == 1
+    want = sp.lambdify((x, y), [s, s * x], modules="math")(1.0, 2.0)
+    assert first(1.0, 2.0) == again(1.0, 2.0) == want

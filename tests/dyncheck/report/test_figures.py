@@ -47,6 +47,20 @@ def test_a_second_drawing_of_the_same_results_is_read_back(study, drawn):
     assert len(drawn) == 2  # the live drawing and the first cached call; the second read back
 
 
+def test_the_same_results_rebuilt_as_the_next_run_gets_them_are_read_back(study, drawn):
+    """The next run's study data are equal but lie otherwise in memory (its reference
+    trajectories read back from the cache as copies, not as column views of the states):
+    still the stored figures, not a second drawing."""
+    data, conv = study
+    module.cached_figures(CASE, data, conv)
+    columns = np.column_stack([data.reference, data.reference])[:, :data.reference.shape[1]]
+    assert not columns.flags.c_contiguous and np.array_equal(columns, data.reference)
+    rebuilt = dataclasses.replace(data, reference=columns,
+                                  errors={k: v.copy() for k, v in data.errors.items()})
+    module.cached_figures(CASE, rebuilt, conv.copy())
+    assert len(drawn) == 1
+
+
 def test_changed_data_is_drawn_afresh(study, drawn):
     data, conv = study
     module.cached_figures(CASE, data, conv)
