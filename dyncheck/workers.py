@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import atexit
 import gc
+import sys
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import contextmanager
@@ -22,6 +23,20 @@ LOCAL = "local"
 
 CONNECT_SECONDS = 20
 """How long to wait for a scheduler before giving up (an error, before any work)."""
+
+
+THREADED_RUNTIMES = ("jax", "warp")
+"""Modules that start threads of their own when imported: a process holding one is not
+forked."""
+
+
+def start_method() -> str:
+    """How this process starts worker processes: ``fork`` on Linux while no
+    :data:`THREADED_RUNTIMES` is imported here (a forked worker has the engines and libraries
+    this process loaded: ~1 s of a cold ``run --jobs 2``), else ``spawn`` (JAX warns that a
+    fork "will likely lead to a deadlock")."""
+    threaded = any(name in sys.modules for name in THREADED_RUNTIMES)
+    return "fork" if sys.platform == "linux" and not threaded else "spawn"
 
 
 @contextmanager
@@ -37,7 +52,7 @@ def executor(jobs: int = 1, dask: str | None = None) -> Iterator[Executor | None
             return
         import multiprocessing
 
-        ctx = multiprocessing.get_context("spawn")  # JAX and Warp do not survive a fork
+        ctx = multiprocessing.get_context(start_method())
         with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx,
                                  initializer=exit_without_collecting) as pool:
             yield pool

@@ -19,7 +19,6 @@ import faulthandler
 import importlib
 import multiprocessing as mp
 import signal
-import sys
 import time
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
@@ -30,6 +29,7 @@ import numpy as np
 from dyncheck.adapters.model_files import ModelFile
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.errors import DyncheckError, EngineError, Unsupported
+from dyncheck.workers import start_method
 
 
 class ModelEngine(Protocol):
@@ -105,16 +105,6 @@ def _serve(name: str, spec: Engine, source: ModelFile, conn: Connection) -> None
         except Exception as exc:
             conn.send(EngineError(f"{type(exc).__name__}: {' '.join(str(exc).split())}"))
 
-
-THREADED_RUNTIMES = ("jax", "warp")
-"""Modules that start threads of their own when imported: a process holding one is not
-forked."""
-
-
-def start_method() -> str:
-    """``fork`` on Linux while no :data:`THREADED_RUNTIMES` is imported here, else ``spawn``."""
-    threaded = any(name in sys.modules for name in THREADED_RUNTIMES)
-    return "fork" if sys.platform == "linux" and not threaded else "spawn"
 
 
 def _death(code: int | None) -> str:

@@ -11,7 +11,6 @@ import json
 import re
 import subprocess
 import sys
-import types
 from pathlib import Path
 
 import pandas as pd
@@ -156,7 +155,7 @@ CRASHES = {
 def forked_checks() -> dict[str, pd.DataFrame]:
     """:func:`crash_check` of every crashing engine with forked processes, forked from a
     fresh interpreter, as the command's own process forks them: this test process may hold
-    JAX or Warp, whose threads make a fork unsafe (why :func:`engines.start_method` spawns
+    JAX or Warp, whose threads make a fork unsafe (why :func:`workers.start_method` spawns
     there). One interpreter for the three checks."""
     code = ("import json; from tests.check.test_model_check import CRASHES, crash_check; "
             "print(json.dumps({c: crash_check(c, 'fork').to_json(orient='records') "
@@ -203,19 +202,6 @@ def crash_check(engine_class: str, method: str) -> pd.DataFrame:
     return result.rows
 
 
-@pytest.mark.parametrize("runtime", ["jax", "warp"])
-def test_a_process_running_a_threaded_runtime_spawns_its_engines(monkeypatch, runtime):
-    """JAX and Warp start threads when imported (JAX warns that a fork "will likely lead to a
-    deadlock"): a process that imported one spawns the engines' processes; one without
-    forks them on Linux."""
-    from dyncheck.check import engines
-
-    for name in engines.THREADED_RUNTIMES:
-        monkeypatch.delitem(sys.modules, name, raising=False)
-    monkeypatch.setattr(sys, "platform", "linux")
-    assert engines.start_method() == "fork"
-    monkeypatch.setitem(sys.modules, runtime, types.ModuleType(runtime))
-    assert engines.start_method() == "spawn"
 
 
 def test_a_daemonic_worker_checks_in_process_and_says_so():

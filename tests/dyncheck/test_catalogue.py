@@ -214,3 +214,19 @@ def test_an_entry_is_left_out_only_when_an_engine_it_needs_is(name):
         assert left_out is not None and left_out.skipped == f"{needs[0]} not selected (--impl)"
     else:
         assert left_out is None
+
+
+def test_an_entry_records_the_engines_it_uses_not_those_its_process_loaded():
+    """Expected: the installed packages' versions (their metadata, read here) of MuJoCo and
+    Pinocchio for an entry of the core engines, measured in a process that has loaded Drake
+    first — Drake named only by the entry that requires it. (Recorded from whatever the
+    process held, a run without Drake that read the first entry back named Drake.)"""
+    from importlib.metadata import version
+
+    from dyncheck.adapters import get_adapter
+
+    get_adapter("drake")  # loaded here, as a catalogue run in one process loads it
+    _, used = catalogue.measure("hinge-axis-sign")
+    assert used == {"mujoco": version("mujoco"), "pinocchio": version("pin")}
+    _, used = catalogue.measure("drake-mjcf-equality")
+    assert used["drake"] == version("drake")

@@ -7,6 +7,7 @@ which shares no scheduling code with the pool or the cluster.
 from __future__ import annotations
 
 import sys
+import types
 
 import pandas as pd
 import pytest
@@ -19,6 +20,36 @@ from dyncheck.run import run
 
 CASES = ("simple_pendulum", "atwood")
 IMPLS = ["reference", "book", "mujoco", "pinocchio"]
+
+
+@pytest.mark.parametrize("runtime", ["jax", "warp"])
+def test_a_process_running_a_threaded_runtime_spawns_its_workers(monkeypatch, runtime):
+    """JAX and Warp start threads when imported (JAX warns that a fork "will likely lead to a
+    deadlock"): a process that imported one spawns its workers (a pool's, a model check's
+    engines'); one without forks them on Linux."""
+    for name in workers.THREADED_RUNTIMES:
+        monkeypatch.delitem(sys.modules, name, raising=False)
+    monkeypatch.setattr(sys, "platform", "linux")
+    assert workers.start_method() == "fork"
+    monkeypatch.setitem(sys.modules, runtime, types.ModuleType(runtime))
+    assert workers.start_method() == "spawn"
+    monkeypatch.setattr(sys, "platform", "darwin")
+    monkeypatch.delitem(sys.modules, runtime)
+    assert workers.start_method() == "spawn"
+
+
+def test_a_pool_starts_its_workers_by_the_start_method(monkeypatch):
+    """The pool asks :func:`workers.start_method` (spawned here: this test process may hold
+    JAX) and its workers compute what this process does."""
+    import multiprocessing
+
+    asked, real = [], multiprocessing.get_context
+    monkeypatch.setattr(multiprocessing, "get_context",
+                        lambda method=None: asked.append(method) or real(method))
+    monkeypatch.setattr(workers, "start_method", lambda: "spawn")
+    units = [(f"{n}", pow, (n, 2)) for n in range(3)]
+    assert workers.run_units(units, jobs=2) == [0, 1, 4]
+    assert asked == ["spawn"]
 
 
 def test_one_job_runs_here():
