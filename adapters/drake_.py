@@ -59,6 +59,7 @@ from pydrake.systems.primitives import LogVectorOutput
 
 from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.base import Adapter, Chart, Frame, LoadedBody, StateLayout, Trajectory
+from dyncheck.adapters.linalg import solve
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Joint, Multibody
 from dyncheck.errors import EngineError
@@ -147,8 +148,11 @@ class _Cords(LeafSystem):
 def kkt(M: np.ndarray, rhs: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """v̇ and f of M v̇ − Cᵀ f = rhs, C v̇ = 0 (a constant constraint: no drift term)."""
     n, m = M.shape[0], C.shape[0]
-    K = np.block([[M, -C.T], [C, np.zeros((m, m))]])
-    x = np.linalg.solve(K, np.concatenate([rhs, np.zeros(m)]))
+    K = np.zeros((n + m, n + m))
+    K[:n, :n], K[:n, n:], K[n:, :n] = M, -C.T, C
+    b = np.zeros(n + m)
+    b[:n] = rhs
+    x = solve(K, b)
     return x[:n], x[n:]
 
 

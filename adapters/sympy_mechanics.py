@@ -31,6 +31,7 @@ import sympy.physics.mechanics as me
 from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.base import Adapter, Chart, Frame, LoadedBody, StateLayout, Trajectory
 from dyncheck.adapters.integrators import integrate
+from dyncheck.adapters.linalg import solve
 from dyncheck.cases.multibody import ROTATING, Multibody
 
 
@@ -286,10 +287,10 @@ class SympyMechanicsAdapter(Adapter):
         if self._kkt is not None:
             size = n + self._kkt[2]
             K, rhs = values[: size * size].reshape(size, size), values[size * size :]
-            return np.linalg.solve(K, rhs)[:n]
+            return solve(K, rhs)[:n]
         M, h, f = values[: n * n].reshape(n, n), values[n * n : n * n + n], values[n * n + n :]
         rhs = (f - h) if len(f) else -h
-        return rhs / M[0, 0] if n == 1 else np.linalg.solve(M, rhs)
+        return rhs / M[0, 0] if n == 1 else solve(M, rhs)
 
     def definition(self, integrator: str) -> str:
         """dyncheck's ``implicitfast`` has D = 0 here (no damping, no actuators): ``euler``."""

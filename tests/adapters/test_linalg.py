@@ -1,0 +1,43 @@
+"""The stage solve (adapters/linalg.py).
+
+Expected values: numpy.linalg.solve of the same systems (numpy's own LAPACK build, reached
+through numpy's checks and conversions): the same LU with partial pivoting, so within the
+forward error bound of a backward-stable solve, 4·n·κ(a)·ε relative (the two builds' kernels
+may round differently); numpy's LinAlgError for a singular matrix."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from dyncheck.adapters.linalg import solve
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 5, 8])
+def test_solve_is_numpys_solve_within_round_off(n):
+    rng = np.random.default_rng(n)
+    eps = np.finfo(float).eps
+    for _ in range(50):
+        a = rng.standard_normal((n, n)) + n * np.eye(n)
+        b = rng.standard_normal(n)
+        x, want = solve(a, b), np.linalg.solve(a, b)
+        assert x.shape == (n,)
+        bound = 4 * n * np.linalg.cond(a) * eps * np.linalg.norm(want)
+        assert np.linalg.norm(x - want) <= bound
+
+
+def test_a_kkt_matrix_needs_pivoting_and_is_solved():
+    """A mass matrix bordered by a constraint row has a zero on its diagonal: only a pivoting
+    LU solves it (the Drake adapter's cords)."""
+    m = np.diag([2.0, 3.0])
+    c = np.array([[1.0, -1.0]])
+    k = np.block([[m, -c.T], [c, np.zeros((1, 1))]])
+    b = np.array([1.0, 2.0, 0.0])
+    want = np.linalg.solve(k, b)
+    bound = 4 * 3 * np.linalg.cond(k) * np.finfo(float).eps * np.linalg.norm(want)
+    assert np.linalg.norm(solve(k, b) - want) <= bound
+
+
+def test_a_singular_matrix_raises_numpys_error():
+    with pytest.raises(np.linalg.LinAlgError, match="singular"):
+        solve(np.array([[1.0, 2.0], [2.0, 4.0]]), np.array([1.0, 0.0]))
