@@ -72,7 +72,10 @@ def executor(jobs: int = 1, dask: str | None = None) -> Iterator[Executor | None
                 n_workers=max(jobs, 1),
                 threads_per_worker=1,
                 processes=True,
-                dashboard_address=None,
+                # no dashboard; the scheduler's HTTP server (health routes) on a free port:
+                # its default 8787 is taken by any other cluster on the machine (a warning)
+                dashboard_address=":0",
+                scheduler_kwargs={"dashboard": False},
             )
         with cluster, Client(cluster) as client:
             yield client.get_executor(pure=False)

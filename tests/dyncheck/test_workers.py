@@ -174,3 +174,17 @@ def test_a_process_can_exit_without_the_last_collection(skip):
                          capture_output=True, text=True, check=True).stdout
     assert out.startswith("exiting")
     assert ("collected at exit" in out) is not skip
+
+
+@pytest.mark.slow  # two clusters' worker processes: seconds
+def test_two_local_clusters_at_once_take_no_port_of_each_other():
+    """`--dask local` beside another cluster on the machine (another run, a test worker): no
+    "Port 8787 is already in use" — each scheduler's HTTP server on a free port, no
+    dashboard."""
+    pytest.importorskip("distributed", reason="the extra 'dask' (pip install 'dyncheck[dask]')")
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with workers.executor(1, workers.LOCAL) as one, workers.executor(1, workers.LOCAL) as two:
+            assert one.submit(pow, 2, 3).result() == two.submit(pow, 3, 2).result() - 1
