@@ -37,19 +37,18 @@ def instantaneous_matrix(d: pd.DataFrame, case: str) -> pd.DataFrame:
 def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) -> pd.DataFrame:
     """Per case × engine × integrator: the finest asymptotic observed order and verdict."""
     rows = []
+    if case is not None:
+        conv, d = conv[conv["case"] == case], d[d["case"] == case]
+    runs = d[(d["quantity"] == "trajectory") & (d["impl_a"] == "reference")]
+    verdicts: dict[tuple[str, str, str], str] = {}  # each run's first row's verdict
+    for key in zip(runs["case"], runs["impl_b"], runs["integrator"], runs["verdict"],
+                   strict=True):
+        verdicts.setdefault(key[:3], key[3])
     for (c, impl, integ), g in conv.groupby(["case", "impl", "integrator"]):
-        if case is not None and c != case:
-            continue
         g = g.sort_values("dt", ascending=False)
         i = finest_pair(list(g["asymptotic"]))
         p = g["observed_order"].iloc[i] if i is not None else float("nan")
-        verdict = d[
-            (d.case == c)
-            & (d.quantity == "trajectory")
-            & (d.impl_a == "reference")
-            & (d.impl_b == impl)
-            & (d.integrator == integ)
-        ]["verdict"].iloc[0]
+        verdict = verdicts[c, impl, integ]
         rows.append(
             {
                 "case": c,
