@@ -21,17 +21,29 @@ def md(frame: pd.DataFrame) -> str:
     return frame.to_markdown(index=False, floatfmt=".3g") if len(frame) else "_(none)_"
 
 
-def _cell(group: pd.DataFrame) -> str:
-    worst = group["max_rel_err"].max()
-    verdicts = sorted(set(group["verdict"]), key=["failed", "explained", "passed", "skipped"].index)
-    return f"{verdicts[0]} {worst:.1e}" if np.isfinite(worst) else verdicts[0]
+SEVERITY = ("failed", "explained", "passed", "skipped")
+"""Verdicts, worst first: a cell shows its rows' worst."""
+
+
+def _cells(rows: pd.DataFrame, keys: list[str], sort: bool) -> pd.Series:
+    """Per group of ``keys``: its worst verdict and its worst relative error ("failed 1.2e-03";
+    the verdict alone where no row has a finite error)."""
+    severity = rows["verdict"].map({v: i for i, v in enumerate(SEVERITY)})
+    if severity.isna().any():
+        raise ValueError(f"unknown verdict {rows['verdict'][severity.isna()].iloc[0]!r}")
+    groups = rows.assign(severity=severity).groupby(keys, sort=sort)
+    worst, first = groups["max_rel_err"].max(), groups["severity"].min()
+    return pd.Series(
+        [f"{SEVERITY[int(s)]} {w:.1e}" if np.isfinite(w) else SEVERITY[int(s)]
+         for s, w in zip(first, worst, strict=True)],
+        index=worst.index,
+    )
 
 
 def instantaneous_matrix(d: pd.DataFrame, case: str) -> pd.DataFrame:
     rows = d[(d["case"] == case) & ~d["quantity"].isin(TRAJECTORY_QUANTITIES)].copy()
     rows["pair"] = rows["impl_a"] + " vs " + rows["impl_b"]
-    out = rows.groupby(["quantity", "pair"], sort=False).apply(_cell, include_groups=False)
-    return out.unstack("pair").reset_index()
+    return _cells(rows, ["quantity", "pair"], sort=False).unstack("pair").reset_index()
 
 
 def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) -> pd.DataFrame:
@@ -71,8 +83,7 @@ def family_matrix(d: pd.DataFrame, trajectories: bool) -> pd.DataFrame:
     if not len(rows):
         return pd.DataFrame()
     rows["pair"] = rows["impl_a"] + " vs " + rows["impl_b"]
-    out = rows.groupby(["pair", "case"], sort=True).apply(_cell, include_groups=False)
-    return out.unstack("case", fill_value="").reset_index()
+    return _cells(rows, ["pair", "case"], sort=True).unstack("case", fill_value="").reset_index()
 
 
 def controlled_matrix(d: pd.DataFrame) -> pd.DataFrame:

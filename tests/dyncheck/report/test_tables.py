@@ -1,16 +1,18 @@
-"""The report's order table (report/tables.py, ``order_table``): per case × implementation ×
+"""The report's tables (report/tables.py): the order table — per case × implementation ×
 integrator, the observed order at the finest pair of steps both in the asymptotic range, and
-the verdict of that run's trajectory row.
+the verdict of that run's trajectory row — and the verdict matrices, whose cell is its rows'
+worst verdict and worst relative error.
 
-Expected values: a small study written out by hand (the orders and verdicts typed here)."""
+Expected values: small studies and rows written out by hand (the cells typed here)."""
 
 from __future__ import annotations
 
 import math
 
 import pandas as pd
+import pytest
 
-from dyncheck.report.tables import order_table
+from dyncheck.report.tables import family_matrix, instantaneous_matrix, order_table
 
 
 def _point(case, impl, integrator, dt, error, order, asymptotic, nominal=4):
@@ -59,3 +61,43 @@ def test_each_run_gets_its_finest_asymptotic_order_and_its_trajectory_verdict():
 def test_one_case_only():
     t = order_table(CONV, ROWS, case="b")
     assert t["case"].tolist() == ["b"] and t["verdict"].tolist() == ["failed"]
+
+
+def _inst(case, quantity, a, b, verdict, err):
+    return {"case": case, "quantity": quantity, "impl_a": a, "impl_b": b, "integrator": "",
+            "verdict": verdict, "max_rel_err": err}
+
+
+INSTANT = pd.DataFrame([
+    _inst("a", "mass_matrix", "reference", "mujoco", "passed", 1e-15),
+    _inst("a", "mass_matrix", "reference", "mujoco", "failed", 2e-3),   # one bad row: failed
+    _inst("a", "mass_matrix", "reference", "mujoco", "passed", 4e-3),   # worst error any row's
+    _inst("a", "bias", "reference", "mujoco", "explained", float("nan")),
+    _inst("a", "bias", "reference", "mujoco", "passed", float("nan")),  # no error: verdict only
+    _inst("a", "mass_matrix", "reference", "pinocchio", "skipped", float("nan")),
+    _inst("b", "mass_matrix", "reference", "mujoco", "explained", 3e-9),
+    {**_inst("a", "trajectory", "reference", "mujoco", "failed", 1.0), "integrator": "rk4"},
+])
+
+
+def test_a_cell_is_its_rows_worst_verdict_and_worst_error():
+    m = instantaneous_matrix(INSTANT, "a").set_index("quantity")
+    assert m.loc["mass_matrix", "reference vs mujoco"] == "failed 4.0e-03"
+    assert m.loc["bias", "reference vs mujoco"] == "explained"
+    assert m.loc["mass_matrix", "reference vs pinocchio"] == "skipped"
+    assert list(m.index) == ["mass_matrix", "bias"]  # in the rows' order; no trajectory row
+
+
+def test_the_family_matrix_has_a_column_per_case_and_blanks_where_a_pair_is_absent():
+    m = family_matrix(INSTANT, trajectories=False).set_index("pair")
+    assert m.loc["reference vs mujoco", "a"] == "failed 4.0e-03"
+    assert m.loc["reference vs mujoco", "b"] == "explained 3.0e-09"
+    assert m.loc["reference vs pinocchio", "b"] == ""
+    t = family_matrix(INSTANT, trajectories=True).set_index("pair")
+    assert t.loc["reference vs mujoco", "a"] == "failed 1.0e+00"
+
+
+def test_an_unknown_verdict_is_an_error_not_a_cell():
+    with pytest.raises(ValueError, match="unknown verdict 'great'"):
+        instantaneous_matrix(pd.concat([INSTANT, pd.DataFrame(
+            [_inst("a", "bias", "reference", "mujoco", "great", 0.0)])]), "a")
