@@ -188,3 +188,37 @@ def test_two_local_clusters_at_once_take_no_port_of_each_other():
         warnings.simplefilter("error")
         with workers.executor(1, workers.LOCAL) as one, workers.executor(1, workers.LOCAL) as two:
             assert one.submit(pow, 2, 3).result() == two.submit(pow, 3, 2).result() - 1
+
+
+FORKED_RUN = """
+import json, multiprocessing, sys
+from dyncheck import workers
+from dyncheck.cases import get_case
+from dyncheck.results import to_csv
+from dyncheck.run import run
+assert workers.start_method() == "fork", workers.start_method()
+methods = []
+real = multiprocessing.get_context
+multiprocessing.get_context = lambda m=None: methods.append(m) or real(m)
+result = run([get_case(n) for n in {cases!r}], {impls!r}, jobs=2)
+print(json.dumps({{"methods": methods, "rows": to_csv(result.discrepancies),
+                  "points": to_csv(result.convergence)}}))
+"""
+
+
+@pytest.mark.slow  # a fresh interpreter and two forked workers: seconds
+def test_a_pool_forked_from_a_process_without_jax_gives_the_same_csv_bytes():
+    """What `dyncheck run --jobs 2` does in its own process (no JAX or Warp loaded there: its
+    workers forked, inheriting the loaded engines) against the same run in this process."""
+    import json
+    import subprocess
+
+    code = FORKED_RUN.format(cases=CASES, impls=IMPLS)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=300).stdout
+    forked = json.loads(out.strip().splitlines()[-1])
+    here = run([get_case(n) for n in CASES], IMPLS, jobs=1)
+    assert forked["methods"] == ["fork"]
+    assert forked["rows"] == to_csv(here.discrepancies)
+    assert forked["points"] == to_csv(here.convergence)
+    assert len(here.discrepancies) > 100
