@@ -132,12 +132,6 @@ def __getattr__(attr: str) -> dict[str, Any]:
     raise AttributeError(f"module {__name__!r} has no attribute {attr!r}")
 
 
-def loaded() -> list[str]:
-    """The implementations whose adapter this process has asked for (imported, or found not
-    installed): the engines a unit of work used."""
-    return [name for name in REGISTRY if name in _ADAPTERS or name in _MISSING]
-
-
 def get_adapter(name: str) -> type[Adapter]:
     """The adapter class for an installed engine implementation."""
     if name not in REGISTRY:
@@ -163,5 +157,4 @@ __all__ = [
     "Registration",
     "Trajectory",
     "get_adapter",
-    "loaded",
 ]

@@ -155,19 +155,16 @@ def explain(name: str | None = None) -> list[Entry]:
     return [_run(n) for n in _names(name)]
 
 
-CORE_ENGINES = ("mujoco", "pinocchio")
-"""The engines the catalogue's demonstrations use beside those they require (core
-dependencies, always installed)."""
-
-
 def measure(name: str) -> tuple[Entry, dict[str, str]]:
-    """The demonstration ``name``, with the versions of the engines it uses: the core ones and
-    those it requires (:data:`REQUIRES`) — not every engine loaded in the process where it ran
-    (an entry measured after another had imported JAX named MJX, and a run that read it back
-    from the cache, without MJX, recorded MJX's version)."""
+    """The demonstration ``name``, with the versions of the engines it uses: the core ones (no
+    extra installs them) and those it requires (:data:`REQUIRES`) — not every engine loaded
+    in the process where it ran (an entry measured after another had imported JAX named MJX,
+    and a run that read it back from the cache, without MJX, recorded MJX's version)."""
+    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES
     from dyncheck.provenance import engine_versions
 
-    return _run(name), engine_versions((*CORE_ENGINES, *REQUIRES.get(name, ())))
+    core = [engine for engine in ENGINE_PACKAGES if engine not in ENGINE_EXTRAS]
+    return _run(name), engine_versions((*core, *REQUIRES.get(name, ())))
 
 
 def measured_entry(name: str) -> tuple[Entry, dict[str, str], bool]:

@@ -140,7 +140,7 @@ def _run_case(
 
 def _convention(name: str, impl_names: Sequence[str]) -> tuple[list[Entry], dict[str, str]]:
     """One demonstration of the conventions catalogue (a unit of work), with the versions of
-    the engines loaded where it ran; read back from the cache when measured before with the
+    the engines it uses; read back from the cache when measured before with the
     same dyncheck, engines and machine (``--no-cache``: measured afresh); skipped when it needs
     an optional engine the run leaves out (:func:`~dyncheck.catalogue.not_selected`)."""
     skipped = not_selected(name, impl_names)

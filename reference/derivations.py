@@ -28,6 +28,8 @@ from functools import cache
 from pathlib import Path
 from typing import Any, TypeVar
 
+import numpy as np
+
 T = TypeVar("T")
 
 NO_CACHE = "DYNCHECK_NO_CACHE"
@@ -97,9 +99,7 @@ def cached(
 class _Canonical(pickle.Pickler):
     """A pickler whose bytes depend on values only (see :func:`value_bytes`)."""
 
-    def reducer_override(self, obj: Any) -> Any:
-        import numpy as np
-
+    def reducer_override(self, obj: Any) -> Any:  # called for every object pickled
         if isinstance(obj, np.ndarray) and not obj.flags.c_contiguous:
             return np.ascontiguousarray(obj).__reduce_ex__(5)
         return NotImplemented

@@ -106,7 +106,6 @@ def _serve(name: str, spec: Engine, source: ModelFile, conn: Connection) -> None
             conn.send(EngineError(f"{type(exc).__name__}: {' '.join(str(exc).split())}"))
 
 
-
 def _death(code: int | None) -> str:
     if code is not None and code < 0:
         try:

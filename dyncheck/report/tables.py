@@ -51,11 +51,10 @@ def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) ->
     rows = []
     if case is not None:
         conv, d = conv[conv["case"] == case], d[d["case"] == case]
-    runs = d[(d["quantity"] == "trajectory") & (d["impl_a"] == "reference")]
-    verdicts: dict[tuple[str, str, str], str] = {}  # each run's first row's verdict
-    for key in zip(runs["case"], runs["impl_b"], runs["integrator"], runs["verdict"],
-                   strict=True):
-        verdicts.setdefault(key[:3], key[3])
+    run = ["case", "impl_b", "integrator"]
+    first = d[(d["quantity"] == "trajectory") & (d["impl_a"] == "reference")].drop_duplicates(run)
+    verdicts = dict(zip(first[run].itertuples(index=False, name=None), first["verdict"],
+                        strict=True))  # each run's first row's verdict
     for (c, impl, integ), g in conv.groupby(["case", "impl", "integrator"]):
         g = g.sort_values("dt", ascending=False)
         i = finest_pair(list(g["asymptotic"]))

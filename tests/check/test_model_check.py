@@ -202,8 +202,6 @@ def crash_check(engine_class: str, method: str) -> pd.DataFrame:
     return result.rows
 
 
-
-
 def test_a_daemonic_worker_checks_in_process_and_says_so():
     """A daemonic process cannot start processes: the check runs its engines in the process
     (the same rows as an isolated check — those of engines in their own processes) and its
