@@ -16,13 +16,16 @@ if in one tangent space (MuJoCo C before 4.0; order 2 on ball and free joints), 
 derivative") — no gyroscopic derivative on a free body (MuJoCo C ≥ 3.11 has one).
 
 JAX's persistent compilation cache is switched on (under the user's cache directory, or
-``DYNCHECK_JAX_CACHE``), so a second run does not compile again.
+``DYNCHECK_JAX_CACHE``), so a second run does not compile again — only where that folder is
+this user's and writable by nobody else (its entries are machine code that XLA loads
+unchecked), and never under ``--no-cache``.
 """
 
 from __future__ import annotations
 
 import os
 import re
+import stat
 from contextlib import AbstractContextManager
 from operator import attrgetter
 from pathlib import Path
@@ -39,8 +42,23 @@ from dyncheck.adapters.mujoco_port import STEPS, PortAdapter
 from dyncheck.cases.multibody import Multibody
 
 _CACHE = Path(os.environ.get("DYNCHECK_JAX_CACHE", Path.home() / ".cache" / "dyncheck" / "jax"))
-jax.config.update("jax_compilation_cache_dir", str(_CACHE))
-jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
+
+
+def _private(folder: Path) -> bool:
+    """Whether ``folder`` (created 0700 where missing) is a real folder of this user's that
+    nobody else can write: XLA's cached executables are machine code, loaded unchecked."""
+    try:
+        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+        info = folder.lstat()
+    except OSError:
+        return False
+    return stat.S_ISDIR(info.st_mode) and info.st_uid == os.getuid() and not info.st_mode & 0o022
+
+
+if os.environ.get("DYNCHECK_NO_CACHE", "") in ("", "0") and _private(_CACHE):
+    jax.config.update("jax_compilation_cache_dir", str(_CACHE))
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
+
 
 def _clear_trace_caches() -> None:
     """Clear the two tracing caches that keep a NumPy constant's 64-bit-mode type across a

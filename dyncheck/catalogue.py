@@ -174,7 +174,7 @@ def measured_entry(name: str) -> tuple[Entry, dict[str, str], bool]:
     from dyncheck.measured_cache import measured
 
     (entry, used), found = measured(
-        "explain", name, partial(measure, name), keep=lambda r: not r[0].failed
+        "explain", name, partial(measure, name), keep=lambda r: not r[0].failed, expect=tuple
     )
     return entry, used, found
 

@@ -31,6 +31,7 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.errors import InvalidInput
+from dyncheck.escaping import markdown_code, markdown_table
 from dyncheck.provenance import NOT_USED
 from dyncheck.results import DISCREPANCY_KEY, PROVENANCE, VERDICTS, texts
 
@@ -327,7 +328,7 @@ def markdown(
 ) -> str:
     """The diff as a Markdown page: versions that changed, counts, then every moved row
     (``every``: every row)."""
-    unrecorded = [f"`{t.path}`" for t in (a, b) if not t.versions]
+    unrecorded = [markdown_code(t.path) for t in (a, b) if not t.versions]
     changes = version_changes(a.versions, b.versions) if not unrecorded else []
     versions = (
         f"not recorded in {' and '.join(unrecorded)}"
@@ -337,7 +338,7 @@ def markdown(
     counts = summary(table)
     shown = _display(table if every else moved(table), a.kind)
     lines = [
-        f"# dyncheck diff: `{a.path}` → `{b.path}`",
+        f"# dyncheck diff: {markdown_code(a.path)} → {markdown_code(b.path)}",
         "",
         f"{len(table)} rows joined ({a.kind}); a row moved when its verdict changed or its "
         f"error, above its tolerance, changed by more than x{factor:g}.",
@@ -350,7 +351,7 @@ def markdown(
     if shown.empty:
         lines.append("_nothing moved_")
     else:
-        lines.append(shown.to_markdown(index=False))
+        lines.append(markdown_table(shown))
     return "\n".join(lines) + "\n"
 
 

@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import TypeVar
 
 from dyncheck.adapters import ENGINE_PACKAGES
-from dyncheck.reference.derivations import cache_root, cached, enabled
+from dyncheck.reference.store import cache_root, cached, enabled
 
 T = TypeVar("T")
 
@@ -93,17 +93,18 @@ def path_for(kind: str, name: str) -> Path:
 
 def measured(
     kind: str, name: str, measure: Callable[[], T], keep: Callable[[T], bool], *,
-    latest_only: bool = False,
+    latest_only: bool = False, expect: type | tuple[type, ...] = object,
 ) -> tuple[T, bool]:
     """``measure()``, or the result an earlier call with the same ``kind``, ``name`` and
     :func:`fingerprint` stored; with whether it was read back. A result for which ``keep``
     is false (a demonstration that failed) is returned but never stored. ``latest_only``:
     storing a result removes what other fingerprints stored under ``kind`` (for large results
-    — a case's figures — that would otherwise pile up with every edit of dyncheck)."""
+    — a case's figures — that would otherwise pile up with every edit of dyncheck). What is
+    read back must be an ``expect`` (:func:`~dyncheck.reference.store.cached`)."""
     if not enabled():  # before the fingerprint: it reads every file of dyncheck
         return measure(), False
     path = path_for(kind, name)
-    result, found = cached(path, measure, keep)
+    result, found = cached(path, measure, keep, expect=expect)
     if latest_only and not found:
         try:
             others = [p for p in path.parent.parent.iterdir() if p != path.parent]
@@ -114,7 +115,8 @@ def measured(
     return result, found
 
 
-def reused(kind: str, label: str, inputs: Sequence[bytes], compute: Callable[[], T]) -> T:
+def reused(kind: str, label: str, inputs: Sequence[bytes], compute: Callable[[], T], *,
+           expect: type | tuple[type, ...] = object) -> T:
     """``compute()``, or what an earlier call stored for the same ``kind``, ``label``, inputs
     and :func:`fingerprint` — for a deterministic computation that cannot fail (always
     stored) and whose results are large enough that only the latest fingerprint's are kept
@@ -124,5 +126,6 @@ def reused(kind: str, label: str, inputs: Sequence[bytes], compute: Callable[[],
     for part in inputs:
         h.update(part)
     name = f"{label}-{h.hexdigest()[:32]}"
-    return measured(kind, name, compute, keep=lambda _result: True, latest_only=True)[0]
+    return measured(kind, name, compute, keep=lambda _result: True, latest_only=True,
+                    expect=expect)[0]
 

@@ -111,8 +111,11 @@ def write_atomic(path: Path, content: str | bytes) -> None:
 
 
 def to_csv(frame: pd.DataFrame) -> str:
-    """Deterministic CSV text: fixed float format, LF line ends."""
-    return frame.to_csv(index=False, float_format="%.6e", lineterminator="\n")
+    """Deterministic CSV text: fixed float format, LF line ends, no text cell a spreadsheet
+    would read as a formula (:func:`~dyncheck.escaping.csv_safe`)."""
+    from dyncheck.escaping import csv_safe
+
+    return csv_safe(frame).to_csv(index=False, float_format="%.6e", lineterminator="\n")
 
 
 def texts(column: pd.Series) -> pd.Series:

@@ -1,16 +1,17 @@
 """Exact derivations cached on disk: a second run does no symbolic work.
 
 A derivation (a metric, Christoffel symbols, the canonical form M, h of (2.2.26)) is stored
-as its pickled sympy result under the user's cache folder, keyed by what it is derived from
-(the ``srepr`` of its inputs), sympy's version and the content of this package's source — an
-edit of any derivation, or another sympy, derives afresh. ``DYNCHECK_NO_CACHE=1`` (the
-command line's ``--no-cache``) neither reads nor writes the cache. A file that cannot be read
-back is derived again and replaced; files are written whole (a temporary file, then a rename),
-so that processes deriving the same thing at once never read half a file.
+as its sympy result under the user's cache folder, keyed by what it is derived from (the
+``srepr`` of its inputs), sympy's version and the content of this package's source — an
+edit of any derivation, or another sympy, derives afresh. Entries are authenticated data
+(:mod:`dyncheck.reference.store`): a file placed in the cache folder by anyone else is never
+deserialized. ``DYNCHECK_NO_CACHE=1`` (the command line's ``--no-cache``) neither reads nor
+writes the cache.
 
 The numeric functions made from derived expressions are kept too (:func:`lambdified`): the
 code ``sympy.lambdify`` generates and compiles, stored as Python's code object, so that a
-second process builds the same function without printing the expressions again.
+second process builds the same function without printing the expressions again (only from
+an authenticated entry: see :mod:`dyncheck.reference.store`).
 """
 
 from __future__ import annotations
@@ -18,10 +19,8 @@ from __future__ import annotations
 import hashlib
 import io
 import marshal
-import os
 import pickle
 import sys
-import tempfile
 import types
 from collections.abc import Callable, Sequence
 from functools import cache
@@ -30,18 +29,11 @@ from typing import Any, TypeVar
 
 import numpy as np
 
+from dyncheck.reference.store import NO_CACHE, cache_root, cached, enabled
+
+__all__ = ["NO_CACHE", "cache_root", "cached", "derived", "enabled", "lambdified", "value_bytes"]
+
 T = TypeVar("T")
-
-NO_CACHE = "DYNCHECK_NO_CACHE"
-"""Environment variable: set (to anything but empty or 0), the cache is bypassed."""
-
-
-def cache_root() -> Path:
-    """``$DYNCHECK_CACHE`` or ``$XDG_CACHE_HOME/dyncheck`` or ``~/.cache/dyncheck``."""
-    if os.environ.get("DYNCHECK_CACHE"):
-        return Path(os.environ["DYNCHECK_CACHE"])
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "dyncheck"
 
 
 @cache
@@ -56,10 +48,6 @@ def _source_key() -> str:
     return h.hexdigest()[:16]
 
 
-def enabled() -> bool:
-    return os.environ.get(NO_CACHE, "") in ("", "0")
-
-
 def derived(kind: str, inputs: object, compute: Callable[[], T]) -> T:
     """``compute()``, or its result stored by an earlier call with the same ``kind`` and
     ``inputs`` (sympy objects, tuples of them, plain values)."""
@@ -70,30 +58,6 @@ def derived(kind: str, inputs: object, compute: Callable[[], T]) -> T:
     key = hashlib.sha256(f"{kind}\n{sp.srepr(inputs)}".encode()).hexdigest()[:32]
     path = cache_root() / "derivations" / _source_key() / f"{kind}-{key}.pickle"
     return cached(path, compute)[0]
-
-
-def cached(
-    path: Path, compute: Callable[[], T], keep: Callable[[T], bool] = lambda _result: True
-) -> tuple[T, bool]:
-    """The object stored at ``path``, or ``compute()`` stored there (when ``keep`` of it is
-    true); with whether it was read back. A file that cannot be read back is computed again
-    and replaced; files are written whole (a temporary file, then a rename)."""
-    try:
-        with path.open("rb") as f:
-            return pickle.load(f), True  # our own files, in the user's cache folder
-    except (OSError, EOFError, pickle.UnpicklingError, AttributeError, ValueError, TypeError):
-        pass  # not stored yet, or unreadable: compute (again)
-    result = compute()
-    if keep(result):
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-            with os.fdopen(fd, "wb") as f:
-                pickle.dump(result, f, protocol=pickle.HIGHEST_PROTOCOL)
-            os.replace(tmp, path)
-        except OSError:
-            pass  # a read-only or full cache folder costs time, never a result
-    return result, False
 
 
 class _Canonical(pickle.Pickler):
@@ -179,7 +143,7 @@ def lambdified(
         made.append(make())
         return marshal.dumps(made[0].__code__) if _storable(made[0], modules) else None
 
-    stored = cached(path, code, keep=lambda c: c is not None)[0]
+    stored = cached(path, code, keep=lambda c: c is not None, expect=bytes)[0]
     if made:
         return made[0]
     assert stored is not None  # only a storable function's code is stored

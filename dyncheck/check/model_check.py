@@ -44,7 +44,7 @@ while their M includes the armature: T differs by ½ Σ aᵢ vᵢ² (measured, P
 IN_PROCESS_NOTE = (
     "The engines ran in the checking process, not each in its own: a daemonic worker (a dask "
     "worker's default) cannot start processes, so an engine crashing on this file would take "
-    "the worker with it (start the workers with `distributed.worker.daemon: False`)."
+    "the worker with it (start the workers with distributed.worker.daemon set to False)."
 )
 
 

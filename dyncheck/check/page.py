@@ -10,6 +10,7 @@ import pandas as pd
 
 from dyncheck.check.model_check import CheckResult
 from dyncheck.check.rows import Section
+from dyncheck.escaping import markdown, markdown_code, markdown_table
 from dyncheck.results import PROVENANCE, Verdict, provenance_json, to_csv, write_atomic
 
 
@@ -38,7 +39,7 @@ def _table(frame: pd.DataFrame, columns: list[str]) -> str:
     for col in ("error", "tolerance"):
         if col in shown:
             shown[col] = shown[col].map(lambda x: f"{x:.3g}")
-    return shown.to_markdown(index=False)
+    return markdown_table(shown)
 
 
 def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
@@ -47,9 +48,9 @@ def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
     rows = result.rows
     c = counts(result)
     lines = [
-        f"# Model check: `{result.model}`",
+        f"# Model check: {markdown_code(result.model)}",
         "",
-        f"File: `{result.path.name}` · {result.states} sampled states · "
+        f"File: {markdown_code(result.path.name)} · {result.states} sampled states · "
         + " · ".join(f"**{n} {v}**" for v, n in c.items()),
         "",
         "**Outcome: " + ("the engines agree** (every row passed or is explained)."
@@ -57,7 +58,7 @@ def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
         "",
         "## How it was checked",
         "",
-        *(f"- {note}" for note in result.notes),
+        *(f"- {markdown(note)}" for note in result.notes),
         "- each engine read the file through its own parser; the neutral trees (joints matched "
         "by name, world axes at the reference configuration) are compared field by field; the "
         "reference is the book's general method (§2.2, (2.2.23)–(2.2.24), (2.2.39)–(2.2.40)) "
@@ -78,7 +79,7 @@ def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
     lines += ["## Time (seconds on this machine, loading and evaluating)", "",
               pd.DataFrame([result.seconds]).to_markdown(index=False, floatfmt=".3f"), "",
               "## Versions", ""]
-    lines += [f"- {k}: {v}" for k, v in versions.items()]
+    lines += [f"- {markdown(k)}: {markdown(v)}" for k, v in versions.items()]
     lines += [f"- machine: {platform.processor() or platform.machine()}", ""]
     return "\n".join(lines)
 

@@ -188,4 +188,4 @@ def cached_figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> d
     commit)."""
     inputs = (repr(case).encode(), value_bytes(data),
               to_csv(conv[conv["case"] == case.name]).encode())
-    return reused("figures", case.name, inputs, lambda: figures(case, data, conv))
+    return reused("figures", case.name, inputs, lambda: figures(case, data, conv), expect=dict)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from dyncheck.escaping import markdown_table
 from dyncheck.run import RunResult
 from dyncheck.studies import (
     CONTROLLED,
@@ -18,7 +19,7 @@ TRAJECTORY_QUANTITIES = ("trajectory", "constraint_drift", "closed_form")
 
 
 def md(frame: pd.DataFrame) -> str:
-    return frame.to_markdown(index=False, floatfmt=".3g") if len(frame) else "_(none)_"
+    return markdown_table(frame, floatfmt=".3g") if len(frame) else "_(none)_"
 
 
 SEVERITY = ("failed", "explained", "passed", "skipped")

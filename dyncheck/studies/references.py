@@ -53,7 +53,8 @@ class References:
         same inputs give the same numbers, read back to the last bit), so that a second run
         steps no reference; ``--no-cache`` computes afresh."""
         label = f"{self.case.name}-{what}"
-        return reused("references", label, [repr((self.case, *key)).encode()], compute)
+        return reused("references", label, [repr((self.case, *key)).encode()], compute,
+                      expect=tuple)
 
     def discrete(self, variant: Variant, integrator: str, dt: float) -> np.ndarray:
         """q (book coordinates) at every step of the general method stepped by a fixed-step
