@@ -6,8 +6,10 @@ welded to) and leaves a URDF's root link floating unless welded: the root is wel
 world, or with ``--floating`` given a ``QuaternionFloatingJoint`` named ``root_joint``. Drake
 names the floating joint of an MJCF ``<freejoint>`` after its body. Joint damping is read back
 as a field, then zeroed before ``Finalize`` (Drake applies it in every dynamics call; the check
-compares damping-free dynamics in every engine). Drake has no joint armature (rotor inertia
-belongs to its actuators). M = ``CalcMassMatrix``, h = ``CalcBiasTerm`` −
+compares damping-free dynamics in every engine). Drake has no joint armature: rotor inertia
+belongs to its actuators, and its MJCF parser turns a joint's ``armature`` into the reflected
+inertia (rotor inertia × gear²) of the actuator on that joint — read back here as the joint's
+armature; a joint without an actuator keeps none (a hint names the fix). M = ``CalcMassMatrix``, h = ``CalcBiasTerm`` −
 ``CalcGravityGeneralizedForces``, forward dynamics the plant's generalized-acceleration
 output, inverse ``CalcInverseDynamics`` with gravity from ``CalcForceElementsContribution``.
 State layout: a floating joint q = (w, x, y, z, p), v = (ω, v), both in world axes. A ball
@@ -35,6 +37,11 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.errors import EngineError, Unsupported
 
 ENGINE = "drake"
+UNACTUATED_ARMATURE = (
+    "Drake's MJCF parser keeps armature only as the reflected inertia of an actuator on the "
+    "joint, and {joint!r} has none: Drake's M leaves its armature out (fix: give the joint an "
+    "actuator, e.g. <motor joint=\"{joint}\"/>, or model the rotor as body inertia)"
+)
 _TYPES = {
     "revolute": JointType.HINGE,
     "prismatic": JointType.SLIDE,
@@ -108,6 +115,7 @@ class DrakeModel:
 
     def __init__(self, source: ModelFile) -> None:
         self.plant, notes, self._damping = _plant(source)
+        self._source = source
         self.context = self.plant.CreateDefaultContext()
         actuation = self.plant.get_actuation_input_port()
         if self.plant.num_actuated_dofs() > 0:
@@ -135,6 +143,7 @@ class DrakeModel:
             for body in plant.GetBodiesWeldedTo(joint.child_body()):
                 owner_of[body.index()] = joint
         joints = []
+        reflected = self._reflected
         for joint in moving:
             kind = _TYPES[joint.type_name()]
             group = plant.GetBodiesWeldedTo(joint.child_body())
@@ -171,7 +180,8 @@ class DrakeModel:
                     body=joint.child_body().name(), axis=np.asarray(axis, float),
                     anchor=np.asarray(child_pose.translation(), float),
                     frame=child_pose.rotation().matrix(), mass=mass, com=com, inertia=inertia,
-                    armature=(0.0,) * nv, damping=self._damping.get(joint.name(), (0.0,) * nv),
+                    armature=(reflected.get(joint.name(), 0.0),) if nv == 1 else (0.0,) * nv,
+                    damping=self._damping.get(joint.name(), (0.0,) * nv),
                     range=(float(lower[0]), float(upper[0])) if limited else None,
                     layout=Layout(
                         q_start=joint.position_start(), v_start=joint.velocity_start(),
@@ -182,8 +192,26 @@ class DrakeModel:
                 )
             )
         gravity = np.asarray(plant.gravity_field().gravity_vector(), float)
+        hints = tuple(
+            (j.name, "armature", UNACTUATED_ARMATURE.format(joint=j.name))
+            for j in joints
+            if j.type in (JointType.HINGE, JointType.SLIDE) and j.name not in self._reflected
+            and self._source.format is Format.MJCF
+        )
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
-                         nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes)
+                         nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,
+                         hints=hints)
+
+    @property
+    def _reflected(self) -> dict[str, float]:
+        """Each actuated joint's armature as Drake holds it: the sum of its actuators'
+        reflected inertia, rotor inertia × gear ratio²."""
+        out: dict[str, float] = {}
+        for index in self.plant.GetJointActuatorIndices():
+            actuator = self.plant.get_joint_actuator(index)
+            name = actuator.joint().name()
+            out[name] = out.get(name, 0.0) + float(actuator.default_reflected_inertia())
+        return out
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
         plant, ctx = self.plant, self.context

@@ -80,6 +80,9 @@ class TreeJoint:
     damping: tuple[float, ...]
     range: tuple[float, float] | None  # (lower, upper) where the joint is limited
     layout: Layout
+    rotor_in_kinetic: bool = True
+    """Whether the engine's kinetic energy counts this joint's rotor energy ½ aᵢ vᵢ² (its M
+    does wherever it holds the armature)."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -92,6 +95,12 @@ class ModelTree:
     nq: int
     nv: int
     notes: tuple[str, ...] = field(default=())
+    hints: tuple[tuple[str, str, str], ...] = field(default=())
+    """(joint, field, why): what the engine is known to do with that field of that joint and
+    how to change it — the note of a description row that finds the field read differently."""
+
+    def hint(self, joint: str, name: str) -> str | None:
+        return next((why for j, f, why in self.hints if j == joint and f == name), None)
 
     def joint(self, name: str) -> TreeJoint:
         for j in self.joints:

@@ -41,6 +41,11 @@ _SMOOTH_ONLY = (
     | mujoco.mjtDisableBit.mjDSBL_SPRING
     | mujoco.mjtDisableBit.mjDSBL_DAMPER
 )
+GRAVITY_OFF = (
+    "the file switches gravity off with <flag gravity=\"disable\"/>, which MuJoCo applies and "
+    "the other engines' parsers ignore (they apply <option gravity>): to switch it off in "
+    "every engine, set <option gravity=\"0 0 0\"/>"
+)
 FLOATING_NAME = "root_joint"
 """The free joint added to a URDF's root link with ``--floating`` (Pinocchio's name)."""
 
@@ -98,6 +103,14 @@ class MujocoModel:
     def __init__(self, source: ModelFile) -> None:
         self.model, notes = _compile(source)
         m = self.model
+        self._gravity = m.opt.gravity.copy()
+        if m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_GRAVITY:
+            self._gravity[:] = 0.0
+            notes += ("mujoco: <flag gravity=\"disable\"/>: no gravity in MuJoCo's dynamics "
+                      f"(<option gravity> {' '.join(f'{g:g}' for g in m.opt.gravity)} unused)",)
+            self._hints: tuple[tuple[str, str, str], ...] = (("model", "gravity", GRAVITY_OFF),)
+        else:
+            self._hints = ()
         m.opt.disableflags |= int(_SMOOTH_ONLY)
         m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
         self.data = mujoco.MjData(m)
@@ -166,8 +179,8 @@ class MujocoModel:
                 )
             )
         return ModelTree(
-            engine=ENGINE, joints=tuple(joints), gravity=m.opt.gravity.copy(),
-            nq=m.nq, nv=m.nv, notes=notes,
+            engine=ENGINE, joints=tuple(joints), gravity=self._gravity.copy(),
+            nq=m.nq, nv=m.nv, notes=notes, hints=self._hints,
         )
 
     def reference_q(self) -> np.ndarray:

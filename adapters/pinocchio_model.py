@@ -3,8 +3,10 @@
 ``JointModelFreeFlyer``, as Pinocchio's users do).
 
 M = ``crba`` (armature included; upper triangle mirrored), h = ``rnea(q, v, 0)``, forward
-dynamics ``aba`` at τ = 0, inverse ``rnea``, ``computeKineticEnergy`` (the bodies' energy:
-armature *not* included), ``computePotentialEnergy``. Pinocchio applies no damping: its
+dynamics ``aba`` at τ = 0, inverse ``rnea``, ``computeKineticEnergy``, ``computePotentialEnergy``.
+Whether the kinetic energy counts a joint's rotor energy ½ a q̇² is measured per joint at load
+(:func:`_rotor_in_kinetic`): Pinocchio 3 never does; Pinocchio 4.1 does from each joint's
+``joint_v``, which its ``JointModelRevoluteUnaligned`` leaves at zero. Pinocchio applies no damping: its
 ``model.damping`` is read back as a field only. State layout: quaternions (x, y, z, w); a free
 joint v = (linear, angular), both in local axes; an unbounded revolute joint q = (cos θ, sin θ).
 """
@@ -57,6 +59,26 @@ def _load(source: ModelFile) -> pin.Model:
         raise EngineError(f"pinocchio refused {source.path}: {message}") from None
 
 
+def _rotor_in_kinetic(m: pin.Model, q0: np.ndarray) -> dict[int, bool]:
+    """For each joint with armature: whether ``computeKineticEnergy`` counts its rotor
+    energy, measured at ``q0`` with that joint alone moving at unit speed (the engine's T
+    minus its bodies' energy ½ Σ vᵢ·Iᵢ vᵢ is ½ a or 0)."""
+    d = m.createData()
+    out = {}
+    for i in range(1, m.njoints):
+        jm = m.joints[i]
+        if jm.nv != 1 or m.armature[jm.idx_v] == 0.0:
+            continue
+        v = np.zeros(m.nv)
+        v[jm.idx_v] = 1.0
+        total = pin.computeKineticEnergy(m, d, q0, v)
+        bodies = 0.5 * sum(float(d.v[k].vector @ (m.inertias[k].matrix() @ d.v[k].vector))
+                           for k in range(1, m.njoints))
+        rotor = 0.5 * float(m.armature[jm.idx_v])
+        out[i] = abs(total - bodies - rotor) < abs(total - bodies)
+    return out
+
+
 class PinocchioModel:
     """A Pinocchio model and its neutral tree."""
 
@@ -79,6 +101,7 @@ class PinocchioModel:
             if m.joints[i].shortname() == "JointModelFreeFlyer":
                 place = m.jointPlacements[i]
                 q0[m.joints[i].idx_q : m.joints[i].idx_q + 7] = pin.SE3ToXYZQUAT(place.inverse())
+        counted = _rotor_in_kinetic(m, q0)
         pin.forwardKinematics(m, d, q0)
         joints = []
         for i in range(1, m.njoints):
@@ -122,8 +145,16 @@ class PinocchioModel:
                         zero=float(q0[jm.idx_q]) if jm.nq == 1 else 0.0,
                         placement=np.asarray(m.jointPlacements[i].homogeneous, float),
                     ),
+                    rotor_in_kinetic=counted.get(i, True),
                 )
             )
+        left_out = [f"{j.name} ({m.joints[i].shortname()})"
+                    for i, j in enumerate(joints, start=1) if not j.rotor_in_kinetic]
+        if left_out:
+            notes = (*notes, "pinocchio: computeKineticEnergy leaves out the rotor energy "
+                     "½ a q̇² of " + ", ".join(left_out) + " (measured; its M holds their "
+                     "armature): Pinocchio 4.1 adds ½ a q̇² from each joint's joint_v, which "
+                     "JointModelRevoluteUnaligned does not set")
         return ModelTree(
             engine=ENGINE, joints=tuple(joints), gravity=np.asarray(m.gravity.linear, float),
             nq=m.nq, nv=m.nv, notes=notes,

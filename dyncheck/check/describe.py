@@ -119,11 +119,14 @@ def diff(model: str, a: ModelTree, b: ModelTree) -> list[CheckRow]:
         for field, va, vb, err, scale in _compare(ja, jb, length):
             compared += 1
             if err > rtol * scale:
+                known = b.hint(ja.name, field) or a.hint(ja.name, field)
                 row(ja.name, field, va, vb, err / scale, rtol, Verdict.FAILED,
-                    f"{a.engine} and {b.engine} read {ja.name!r} ({ja.body}) differently")
+                    known or f"{a.engine} and {b.engine} read {ja.name!r} ({ja.body}) "
+                    "differently")
     gravity_err = float(np.abs(a.gravity - b.gravity).max())
     if gravity_err > rtol * max(1.0, float(np.abs(a.gravity).max())):
-        row("model", "gravity", a.gravity, b.gravity, gravity_err, rtol, Verdict.FAILED)
+        row("model", "gravity", a.gravity, b.gravity, gravity_err, rtol, Verdict.FAILED,
+            a.hint("model", "gravity") or b.hint("model", "gravity") or "")
     if names_a != names_b and set(names_a) == set(names_b):
         row("model", "joint order", " ".join(names_a), " ".join(names_b), 0.0, 0.0,
             Verdict.PASSED, "the engines order the joints differently; matched by name")

@@ -7,10 +7,14 @@ uniform on the rotation group (a normalized 4-D Gaussian), free bodies' position
 [−1, 1]³ m; velocities and accelerations standard normal. One seed, one stream: the same
 states on every machine.
 
-Tolerances (relative to the quantity's scale, max |desired| over the states): the recursive
-algorithms accumulate round-off along a chain, 64 ε × the tree's depth; forward dynamics
-solves M v̇ = −h and is amplified by κ(M), the largest over the states. Potential energies are
-compared as V(q) − V(q₀) (q₀ the first state): each engine's datum is its own.
+Tolerances (relative to the quantity's scale): the recursive algorithms accumulate round-off
+along a chain, 64 ε × the tree's depth; forward dynamics solves M v̇ = −h and is amplified by
+κ(M), the largest over the states. Potential energies are compared as V(q) − V(q₀) (q₀ the
+first state): each engine's datum is its own. A quantity's scale is the largest |value| over
+the states, never below the scale the states themselves set (:func:`floors`), so that a
+quantity that vanishes or is constant on this model — the potential energy of a model moving
+in a horizontal plane, h without gravity — is measured against an absolute scale, never
+divided by zero.
 """
 
 from __future__ import annotations
@@ -20,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters.model_tree import Dynamics, JointType, ModelTree
-from dyncheck.check.describe import EPS, ROUNDOFF, depth
+from dyncheck.check.describe import EPS, ROUNDOFF, depth, size
 from dyncheck.check.layout import Canonical
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.results import Verdict
@@ -62,6 +66,23 @@ def sample(canon: Canonical, tree: ModelTree, n: int, seed: int) -> States:
     return States(q=q, v=rng.normal(size=(n, canon.nv)), a=rng.normal(size=(n, canon.nv)))
 
 
+def floors(tree: ModelTree, dyn: Dynamics, states: States) -> dict[str, tuple[float, str]]:
+    """The smallest scale of each quantity, with its name: generalized forces (h, τ) the
+    largest |M a| of the sampled accelerations; accelerations the largest sampled |a|;
+    energies the larger of the largest kinetic energy and m g L (total mass, |gravity|, the
+    model's size)."""
+    force = float(np.abs(np.einsum("nij,nj->ni", dyn.mass_matrix, states.a)).max())
+    accel = float(np.abs(states.a).max())
+    mgl = sum(j.mass for j in tree.joints) * float(np.linalg.norm(tree.gravity)) * size(tree)
+    energy = max(float(np.abs(dyn.kinetic).max()), mgl)
+    return {
+        "mass_matrix": (0.0, ""),
+        "bias_forces": (force, "|M a|"), "inverse_dynamics": (force, "|M a|"),
+        "forward_dynamics": (accel, "|a|"),
+        "kinetic_energy": (energy, "max(T, m g L)"), "potential_energy": (energy, "max(T, m g L)"),
+    }
+
+
 def condition(mass: np.ndarray) -> float:
     return float(np.linalg.cond(mass).max())
 
@@ -90,20 +111,25 @@ def compare(
     dyn_b: Dynamics,
     explanations: dict[str, Explanation],
     caused_by: str,
+    states: States,
 ) -> list[CheckRow]:
     """One row per quantity. A failure is ``explained`` where ``explanations`` predicts it (the
     difference within prediction + tolerance), or where ``caused_by`` names a description
     difference found between the two (the dynamics follow from it)."""
     d = depth(tree)
     kappa = condition(dyn_a.mass_matrix)
+    least = floors(tree, dyn_a, states)
     rows = []
     for quantity in QUANTITIES:
         desired, actual = _values(dyn_a, quantity), _values(dyn_b, quantity)
-        scale = max(float(np.abs(desired).max()), 1e-300)
+        floor, floor_name = least[quantity]
+        scale = max(float(np.abs(desired).max()), floor, 1e-300)
         errors = np.abs(actual - desired).max(axis=1)
         worst = int(np.argmax(errors))
         rtol = ROUNDOFF * EPS * d
         basis = f"round-off: {ROUNDOFF} eps x tree depth {d}"
+        if floor >= float(np.abs(desired).max()) and floor_name:
+            basis += f"; scale {floor_name} {floor:.3g} (the value's own is smaller)"
         if quantity == "forward_dynamics":
             rtol *= kappa
             basis += f" x cond(M) {kappa:.3g}"

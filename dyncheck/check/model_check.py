@@ -36,9 +36,6 @@ SMOOTH_NOTE = (
     "forces (springs, damping) are left out of M, h, forward and inverse dynamics; damping and "
     "armature are compared as fields of the model"
 )
-KINETIC_WITHOUT_ARMATURE = {"pinocchio"}
-"""Engines whose kinetic-energy function sums the bodies' energy only (no rotor inertia),
-while their M includes the armature: T differs by ½ Σ aᵢ vᵢ² (measured, Pinocchio 4)."""
 
 
 IN_PROCESS_NOTE = (
@@ -217,26 +214,48 @@ def _check(model: str, source_path: Path, source: ModelFile,
             rows.append(_row(model, Section.DYNAMICS, name, Verdict.FAILED,
                              f"{name} returned a non-finite {', '.join(bad)}", field="dynamics"))
             del results[name]
-    armature = np.concatenate([np.asarray(j.armature) for j in canonical_tree.joints])
-    rotor = 0.5 * np.einsum("i,ni,ni->n", armature, batch.v, batch.v)
+    referee_tree = replace(canonical_tree, joints=tuple(  # the referee counts every rotor
+        replace(j, rotor_in_kinetic=True) for j in canonical_tree.joints))
+    trees = {name: loaded[name].tree if name in loaded else referee_tree for name in results}
     order = list(results)
     for i, a in enumerate(order):
         for b in order[i + 1 :]:
             explanations = {}
-            if (a in KINETIC_WITHOUT_ARMATURE) != (b in KINETIC_WITHOUT_ARMATURE):
-                explanations["kinetic_energy"] = Explanation(
-                    rotor, "the rotor inertia's energy ½ Σ aᵢ vᵢ² is in M but not in "
-                    f"{a if a in KINETIC_WITHOUT_ARMATURE else b}'s kinetic energy "
-                    "(computeKineticEnergy sums the bodies)",
-                )
+            rotor = _rotor_difference(canon, canonical_tree, trees[a], trees[b], batch.v)
+            if rotor is not None:
+                explanations["kinetic_energy"] = rotor
             cause = ", ".join(differing[e] for e in (a, b) if e in differing)
             rows.extend(compare(model, canonical_tree, a, results[a], b, results[b],
-                                explanations, cause))
+                                explanations, cause, batch))
     frame = pd.DataFrame([vars(r) for r in rows], columns=COLUMNS)
     for column in ("section", "verdict"):
         frame[column] = frame[column].astype(str)
     return CheckResult(model=model, path=source_path, rows=frame, notes=tuple(notes),
                        seconds=seconds, states=states, impls=chosen)
+
+
+def _rotor_difference(canon: layout.Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
+                      tree_b: ModelTree, v: np.ndarray) -> Explanation | None:
+    """The kinetic energies' predicted difference where one engine counts a joint's rotor
+    energy ½ aᵢ vᵢ² and the other does not (both hold the armature in M): ½ Σ aᵢ vᵢ² over
+    those joints, aᵢ as the canonical engine read it."""
+    names = [n for n in canon.names
+             if tree_a.joint(n).rotor_in_kinetic != tree_b.joint(n).rotor_in_kinetic
+             and any(canonical_tree.joint(n).armature)]
+    if not names:
+        return None
+    weights = np.zeros(canon.nv)
+    for n in names:
+        k = canon.names.index(n)
+        armature = canonical_tree.joint(n).armature
+        weights[canon.v_start[k] : canon.v_start[k] + len(armature)] = armature
+    without = [t.engine for t in (tree_a, tree_b)
+               if not all(t.joint(n).rotor_in_kinetic for n in names)]
+    return Explanation(
+        0.5 * np.einsum("i,ni,ni->n", weights, v, v),
+        f"{' and '.join(without)}'s kinetic energy leaves out the rotor energy ½ Σ aᵢ vᵢ² of "
+        f"{', '.join(names)}, which its M holds (predicted per state from the armature)",
+    )
 
 
 def _align_free_joints(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree, list[str]]:
