@@ -9,7 +9,8 @@ as a field, then zeroed before ``Finalize`` (Drake applies it in every dynamics 
 compares damping-free dynamics in every engine). Drake has no joint armature: rotor inertia
 belongs to its actuators, and its MJCF parser turns a joint's ``armature`` into the reflected
 inertia (rotor inertia × gear²) of the actuator on that joint — read back here as the joint's
-armature; a joint without an actuator keeps none (a hint names the fix). M = ``CalcMassMatrix``, h = ``CalcBiasTerm`` −
+armature; a joint without an actuator keeps none (a hint names the fix).
+M = ``CalcMassMatrix``, h = ``CalcBiasTerm`` −
 ``CalcGravityGeneralizedForces``, forward dynamics the plant's generalized-acceleration
 output, inverse ``CalcInverseDynamics`` with gravity from ``CalcForceElementsContribution``.
 State layout: a floating joint q = (w, x, y, z, p), v = (ω, v), both in world axes. A ball

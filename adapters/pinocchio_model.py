@@ -3,11 +3,13 @@
 ``JointModelFreeFlyer``, as Pinocchio's users do).
 
 M = ``crba`` (armature included; upper triangle mirrored), h = ``rnea(q, v, 0)``, forward
-dynamics ``aba`` at τ = 0, inverse ``rnea``, ``computeKineticEnergy``, ``computePotentialEnergy``.
-Whether the kinetic energy counts a joint's rotor energy ½ a q̇² is measured per joint at load
-(:func:`_rotor_in_kinetic`): Pinocchio 3 never does; Pinocchio 4.1 does from each joint's
-``joint_v``, which its ``JointModelRevoluteUnaligned`` leaves at zero. Pinocchio applies no damping: its
-``model.damping`` is read back as a field only. State layout: quaternions (x, y, z, w); a free
+dynamics ``aba`` at τ = 0, inverse ``rnea``, ``computeKineticEnergy``,
+``computePotentialEnergy``. Whether the kinetic energy counts a coordinate's rotor energy
+½ a q̇² is measured at load (:func:`_rotor_in_kinetic`): Pinocchio 4.1 adds it from each
+joint's ``joint_v``, which ``JointModelRevoluteUnaligned`` leaves at zero. A composite joint
+(the MJCF parser's for a body with several joints) is read back component by component.
+Pinocchio applies no damping: its ``model.damping`` is read back as a field only. State
+layout: quaternions (x, y, z, w); a free
 joint v = (linear, angular), both in local axes; an unbounded revolute joint q = (cos θ, sin θ).
 """
 
@@ -60,22 +62,48 @@ def _load(source: ModelFile) -> pin.Model:
 
 
 def _rotor_in_kinetic(m: pin.Model, q0: np.ndarray) -> dict[int, bool]:
-    """For each joint with armature: whether ``computeKineticEnergy`` counts its rotor
-    energy, measured at ``q0`` with that joint alone moving at unit speed (the engine's T
-    minus its bodies' energy ½ Σ vᵢ·Iᵢ vᵢ is ½ a or 0)."""
+    """For each velocity index with armature: whether ``computeKineticEnergy`` counts its
+    rotor energy, measured at ``q0`` with that coordinate alone moving at unit speed (the
+    engine's T minus its bodies' energy ½ Σ vᵢ·Iᵢ vᵢ is ½ a or 0)."""
     d = m.createData()
     out = {}
-    for i in range(1, m.njoints):
-        jm = m.joints[i]
-        if jm.nv != 1 or m.armature[jm.idx_v] == 0.0:
-            continue
+    for index in np.flatnonzero(m.armature):
         v = np.zeros(m.nv)
-        v[jm.idx_v] = 1.0
+        v[index] = 1.0
         total = pin.computeKineticEnergy(m, d, q0, v)
         bodies = 0.5 * sum(float(d.v[k].vector @ (m.inertias[k].matrix() @ d.v[k].vector))
                            for k in range(1, m.njoints))
-        rotor = 0.5 * float(m.armature[jm.idx_v])
-        out[i] = abs(total - bodies - rotor) < abs(total - bodies)
+        rotor = 0.5 * float(m.armature[index])
+        out[int(index)] = abs(total - bodies - rotor) < abs(total - bodies)
+    return out
+
+
+def _axis(kind: JointType, d: pin.Data, i: int, v_offset: int) -> np.ndarray:
+    """A hinge's or slide's unit axis in world axes: its column of joint ``i``'s motion
+    subspace S (a composite joint's columns are its components', all in its last frame)."""
+    if kind not in (JointType.HINGE, JointType.SLIDE):
+        return np.zeros(3)
+    column = np.asarray(d.joints[i].S).reshape(6, -1)[:, v_offset]
+    local = column[3:] if kind is JointType.HINGE else column[:3]
+    return np.asarray(d.oMi[i].rotation @ local, float)
+
+
+def _components(m: pin.Model, d: pin.Data, i: int) -> list[tuple]:
+    """Joint ``i`` as (name, shortname, world pose of the joint frame, q start, v start, nq,
+    nv) for each of its components: itself, or a composite joint's components in order
+    (Pinocchio's MJCF parser makes one of a body's several joints), named
+    ``<composite>[k]`` — the model check matches them to another engine's joints by body
+    and order."""
+    jm = m.joints[i]
+    if jm.shortname() != "JointModelComposite":
+        return [(m.names[i], jm.shortname(), d.oMi[i], jm.idx_q, jm.idx_v, jm.nq, jm.nv)]
+    composite, data = jm.extract(), d.joints[i].extract()
+    out, q_at, v_at = [], jm.idx_q, jm.idx_v
+    for k, part in enumerate(composite.joints):
+        pose = d.oMi[i] * data.iMlast[k].inverse() * composite.jointPlacements[k]
+        out.append((f"{m.names[i]}[{k}]", part.shortname(), pose, q_at, v_at, part.nq,
+                    part.nv))
+        q_at, v_at = q_at + part.nq, v_at + part.nv
     return out
 
 
@@ -103,53 +131,52 @@ class PinocchioModel:
                 q0[m.joints[i].idx_q : m.joints[i].idx_q + 7] = pin.SE3ToXYZQUAT(place.inverse())
         counted = _rotor_in_kinetic(m, q0)
         pin.forwardKinematics(m, d, q0)
-        joints = []
+        bodies = {f.parentJoint: f.name for f in reversed(list(m.frames))
+                  if f.type == pin.FrameType.BODY}
+        joints: list[TreeJoint] = []
+        last_name: dict[int, str] = {}  # Pinocchio joint → the name of its last component
         for i in range(1, m.njoints):
-            jm = m.joints[i]
-            short = jm.shortname()
-            kind = _type(short)
-            placement = d.oMi[i]
-            rotation, origin = placement.rotation, placement.translation
-            subspace = np.asarray(d.joints[i].S).reshape(6, -1)
-            if kind is JointType.HINGE:
-                axis = rotation @ subspace[3:, 0]
-            elif kind is JointType.SLIDE:
-                axis = rotation @ subspace[:3, 0]
-            else:
-                axis = np.zeros(3)
-            inertia = m.inertias[i]
-            dofs = slice(jm.idx_v, jm.idx_v + jm.nv)
-            lower, upper = m.lowerPositionLimit[jm.idx_q], m.upperPositionLimit[jm.idx_q]
-            limited = (
-                kind in (JointType.HINGE, JointType.SLIDE) and jm.nq == 1
-                and np.isfinite(lower) and np.isfinite(upper)
-                and abs(lower) < 1e10 and abs(upper) < 1e10  # Pinocchio's "no limit" is ±max
-            )
             parent = int(m.parents[i])
-            joints.append(
-                TreeJoint(
-                    name=m.names[i], type=kind,
-                    parent=None if parent == 0 else m.names[parent],
-                    body=m.names[i],
-                    axis=np.asarray(axis, float), anchor=origin.copy(), frame=rotation.copy(),
-                    mass=float(inertia.mass),
-                    com=placement.act(inertia.lever).copy(),
-                    inertia=rotation @ inertia.inertia @ rotation.T,
-                    armature=tuple(float(x) for x in m.armature[dofs]),
-                    damping=tuple(float(x) for x in m.damping[dofs]),
-                    range=(float(lower), float(upper)) if limited else None,
-                    layout=Layout(
-                        q_start=jm.idx_q, v_start=jm.idx_v, nq=jm.nq, nv=jm.nv, quat="xyzw",
-                        linear_axes=Axes.LOCAL, angular_axes=Axes.LOCAL,
-                        cos_sin=short in _HINGE_UNBOUNDED,
-                        zero=float(q0[jm.idx_q]) if jm.nq == 1 else 0.0,
-                        placement=np.asarray(m.jointPlacements[i].homogeneous, float),
-                    ),
-                    rotor_in_kinetic=counted.get(i, True),
+            parent_name = last_name.get(parent)
+            parts = _components(m, d, i)
+            for k, (name, short, pose, q_at, v_at, nq, nv) in enumerate(parts):
+                kind = _type(short)
+                rotation, origin = pose.rotation, pose.translation
+                last = k == len(parts) - 1
+                inertia = m.inertias[i]
+                dofs = slice(v_at, v_at + nv)
+                lower, upper = m.lowerPositionLimit[q_at], m.upperPositionLimit[q_at]
+                limited = (
+                    kind in (JointType.HINGE, JointType.SLIDE) and nq == 1
+                    and np.isfinite(lower) and np.isfinite(upper)
+                    and abs(lower) < 1e10 and abs(upper) < 1e10  # Pinocchio's "no limit": ±max
                 )
-            )
-        left_out = [f"{j.name} ({m.joints[i].shortname()})"
-                    for i, j in enumerate(joints, start=1) if not j.rotor_in_kinetic]
+                joints.append(
+                    TreeJoint(
+                        name=name, type=kind, parent=parent_name,
+                        body=bodies.get(i, m.names[i]),
+                        axis=_axis(kind, d, i, v_at - m.joints[i].idx_v), anchor=origin.copy(),
+                        frame=rotation.copy(),
+                        mass=float(inertia.mass) if last else 0.0,
+                        com=d.oMi[i].act(inertia.lever).copy() if last else np.zeros(3),
+                        inertia=(d.oMi[i].rotation @ inertia.inertia @ d.oMi[i].rotation.T
+                                 if last else np.zeros((3, 3))),
+                        armature=tuple(float(x) for x in m.armature[dofs]),
+                        damping=tuple(float(x) for x in m.damping[dofs]),
+                        range=(float(lower), float(upper)) if limited else None,
+                        layout=Layout(
+                            q_start=q_at, v_start=v_at, nq=nq, nv=nv, quat="xyzw",
+                            linear_axes=Axes.LOCAL, angular_axes=Axes.LOCAL,
+                            cos_sin=short in _HINGE_UNBOUNDED,
+                            zero=float(q0[q_at]) if nq == 1 else 0.0,
+                            placement=np.asarray(m.jointPlacements[i].homogeneous, float),
+                        ),
+                        rotor_in_kinetic=counted.get(v_at, True),
+                    )
+                )
+                parent_name = name
+            last_name[i] = parent_name or ""
+        left_out = [j.name for j in joints if not j.rotor_in_kinetic]
         if left_out:
             notes = (*notes, "pinocchio: computeKineticEnergy leaves out the rotor energy "
                      "½ a q̇² of " + ", ".join(left_out) + " (measured; its M holds their "

@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials
-from dyncheck.adapters.model_tree import JointType, ModelTree
+from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.check import describe, inputs, layout
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.dynamics import Explanation, compare, sample
@@ -142,8 +142,8 @@ def _check(model: str, source_path: Path, source: ModelFile,
                 raise inputs.ModelFileError(source_path, result.message)
             continue
         if loaded:
-            result.tree, renamed = _align_free_joints(next(iter(loaded.values())).tree,
-                                                      result.tree)
+            result.tree, renamed = _align_by_body(next(iter(loaded.values())).tree,
+                                                  result.tree)
             notes.extend(renamed)
         loaded[engine] = result
         notes.extend(result.tree.notes)
@@ -258,16 +258,23 @@ def _rotor_difference(canon: layout.Canonical, canonical_tree: ModelTree, tree_a
     )
 
 
-def _align_free_joints(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree, list[str]]:
-    """Free joints matched by their body where an engine names them otherwise (Drake names an
-    MJCF ``<freejoint>`` after its body)."""
+def _align_by_body(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree, list[str]]:
+    """Joints an engine names otherwise matched to the canonical engine's by their body and
+    their order in it, where the types agree: Drake names an MJCF ``<freejoint>`` after its
+    body; Pinocchio's MJCF parser makes a body's several joints one composite joint whose
+    components it names ``<composite>[k]``."""
+    known = {j.name for j in canonical.joints}
     names = {j.name for j in tree.joints}
-    by_body = {j.body: j.name for j in canonical.joints if j.type is JointType.FREE}
-    renames = {
-        j.name: by_body[j.body] for j in tree.joints
-        if j.type is JointType.FREE and j.name not in {c.name for c in canonical.joints}
-        and j.body in by_body and by_body[j.body] not in names
-    }
+    renames: dict[str, str] = {}
+    for body in dict.fromkeys(j.body for j in tree.joints):
+        mine = [j for j in tree.joints if j.body == body]
+        theirs = [j for j in canonical.joints if j.body == body]
+        if (len(mine) == len(theirs) and any(j.name not in known for j in mine)
+                and all(a.type is b.type for a, b in zip(mine, theirs, strict=True))
+                and not any(b.name in names and b.name != a.name
+                            for a, b in zip(mine, theirs, strict=True))):
+            renames.update({a.name: b.name for a, b in zip(mine, theirs, strict=True)
+                            if a.name != b.name})
     if not renames:
         return tree, []
     joints = tuple(
@@ -275,10 +282,10 @@ def _align_free_joints(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree
                 parent=renames.get(j.parent, j.parent) if j.parent else None)
         for j in tree.joints
     )
-    notes = [f"{tree.engine}: free joint {old!r} (body {old_body!r}) matched to {new!r} by its "
-             "body" for old, new, old_body in
-             ((o, n, tree.joint(o).body) for o, n in renames.items())]
-    return replace(tree, joints=joints), notes
+    notes = [f"{tree.engine}: joint {old!r} (body {tree.joint(old).body!r}) matched to {new!r} "
+             "by its body and its place in it" for old, new in renames.items()]
+    return replace(tree, joints=joints, hints=tuple(
+        (renames.get(j, j), f, why) for j, f, why in tree.hints)), notes
 
 
 def _against(model: str, mine: ModelTree, other: ModelFile) -> list[CheckRow]:

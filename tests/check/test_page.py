@@ -71,7 +71,8 @@ def _table_widths(md: str) -> set[int]:
 def test_hostile_names_reach_neither_markdown_nor_csv_raw(tmp_path, kind):
     """Names from the file in every place a page shows them (model, file name, joints,
     bodies, notes): the Markdown, rendered by markdown-it (CommonMark with tables, raw HTML
-    allowed), has no script and no link; its source keeps one heading per section and tables of constant width
+    allowed), has no script and no link; its source keeps one heading per section and tables
+    of constant width
     (expected: the same page made from ordinary names), shows no raw HTML; no CSV text cell
     starts a formula (OWASP's rule)."""
     import csv
