@@ -22,9 +22,9 @@ import pandas as pd
 
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials
 from dyncheck.adapters.model_tree import ModelTree
-from dyncheck.check import describe, inputs, layout
+from dyncheck.check import describe, inputs, layout, partial
 from dyncheck.check import engines as engine_processes
-from dyncheck.check.dynamics import Explanation, compare, sample
+from dyncheck.check.dynamics import Explanation, States, compare, sample
 from dyncheck.check.engines import ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
 from dyncheck.check.referee import ReferenceModel
 from dyncheck.check.rows import COLUMNS, CheckRow, Section
@@ -180,10 +180,21 @@ def _check(model: str, source_path: Path, source: ModelFile,
         rows.extend(_against(model, canonical_tree, read(against_path, floating=floating)))
     # Step 5 and 6: dynamics at the same states, every pair.
     canon = layout.canonical(canonical_tree)
-    unmatched = [e for e, m in loaded.items()
-                 if {j.name for j in m.tree.joints} != set(canon.names)
-                 or any(m.tree.joint(n).type is not t for n, t in zip(canon.names, canon.types,
-                                                                      strict=True))]
+    parts: dict[str, partial.Part | None] = {}  # None: the engine holds the whole tree
+    unmatched = []
+    for e, m in loaded.items():
+        if {j.name for j in m.tree.joints} == set(canon.names) and all(
+                m.tree.joint(n).type is t for n, t in zip(canon.names, canon.types, strict=True)):
+            parts[e] = None
+        elif (part := partial.common_part(canonical_tree, m.tree)) is not None:
+            parts[e] = part
+            notes.append(
+                f"{e} holds {len(part.tree.joints)} of the {len(canon.names)} joints (it "
+                f"dropped {', '.join(part.dropped)}: whole subtrees, independent blocks of the "
+                f"dynamics): its M, h, forward and inverse dynamics are compared on the "
+                "joints it holds; its energies, sums over every body, are not")
+        else:
+            unmatched.append(e)
     batch = sample(canon, canonical_tree, states, seed)
     results = {}
     if REFEREE in chosen:
@@ -201,7 +212,10 @@ def _check(model: str, source_path: Path, source: ModelFile,
                              field="dynamics"))
             continue
         t0 = time.perf_counter()
-        maps, q_e, v_e, a_e = layout.engine_states(canon, m.tree, batch.q, batch.v, batch.a)
+        part = parts[engine]
+        on = batch if part is None else partial.states(batch, part)
+        maps, q_e, v_e, a_e = layout.engine_states(
+            canon if part is None else layout.canonical(part.tree), m.tree, on.q, on.v, on.a)
         try:
             results[engine] = layout.to_canonical(maps, m.dynamics(q_e, v_e, a_e))
         except Exception as exc:  # an engine failing mid-way costs its own rows
@@ -220,18 +234,34 @@ def _check(model: str, source_path: Path, source: ModelFile,
     order = list(results)
     for i, a in enumerate(order):
         for b in order[i + 1 :]:
-            explanations = {}
-            rotor = _rotor_difference(canon, canonical_tree, trees[a], trees[b], batch.v)
-            if rotor is not None:
-                explanations["kinetic_energy"] = rotor
             cause = ", ".join(differing[e] for e in (a, b) if e in differing)
-            rows.extend(compare(model, canonical_tree, a, results[a], b, results[b],
-                                explanations, cause, batch))
+            dofs = {n: _held(parts.get(n)) for n in (a, b)}
+            if dofs[a] is None and dofs[b] is None:
+                explanations = {}
+                rotor = _rotor_difference(canon, canonical_tree, trees[a], trees[b], batch.v)
+                if rotor is not None:
+                    explanations["kinetic_energy"] = rotor
+                rows.extend(compare(model, canonical_tree, a, results[a], b, results[b],
+                                    explanations, cause, batch))
+                continue
+            common = np.arange(canon.nv)
+            for held in dofs.values():
+                common = np.intersect1d(common, held) if held is not None else common
+            on = States(q=batch.q, v=batch.v[:, common], a=batch.a[:, common])
+            rows.extend(compare(
+                model, canonical_tree,
+                a, partial.restrict(results[a], partial.columns(dofs[a], common)),
+                b, partial.restrict(results[b], partial.columns(dofs[b], common)),
+                {}, cause, on))
     frame = pd.DataFrame([vars(r) for r in rows], columns=COLUMNS)
     for column in ("section", "verdict"):
         frame[column] = frame[column].astype(str)
     return CheckResult(model=model, path=source_path, rows=frame, notes=tuple(notes),
                        seconds=seconds, states=states, impls=chosen)
+
+
+def _held(part: partial.Part | None) -> np.ndarray | None:
+    return None if part is None else part.v
 
 
 def _rotor_difference(canon: layout.Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
