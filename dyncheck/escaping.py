@@ -15,10 +15,9 @@ import re
 
 import pandas as pd
 
-_MARKDOWN = {"\\": "\\\\", "|": "\\|", "`": "\\`", "[": "\\[", "]": "\\]", "*": "\\*",
-             "<": "&lt;"}
+_MARKDOWN = {"\\": "\\\\", "|": "\\|", "`": "\\`", "](": "]\\(", "*": "\\*", "<": "&lt;"}
 """What is escaped: ``<`` alone opens HTML (``>`` and ``&`` cannot: an entity only shows a
-character), the rest Markdown's own syntax in a line."""
+character), ``](`` a link or an image, the rest Markdown's own syntax in a line."""
 _MARKDOWN_RE = re.compile("|".join(re.escape(c) for c in _MARKDOWN))
 _LINE_BREAKS = re.compile(r"[\r\n\u2028\u2029\x0b\x0c\x85]+")
 _CONTROL = re.compile(r"[\x00-\x08\x0e-\x1f\x7f]")
