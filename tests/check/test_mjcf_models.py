@@ -1,0 +1,139 @@
+"""The model check on MJCF the way other people write it (issue #42's failure classes), each
+model written here, each outcome asserted with where it comes from.
+
+Expected values: MuJoCo's own compiled model (the canonical tree) and the other engines'
+readings of the same file; the armature's place in Drake from Drake's documented MJCF
+reading (rotor inertia × gear² on the joint's actuator); a corrupted copy must fail.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from dyncheck.check.model_check import check_model
+
+LINK = """<body name="{name}" pos="{pos}">
+  <joint name="{joint}" type="hinge" axis="0 1 0"{extra}/>
+  <inertial pos="0 0 -0.25" mass="{mass}" diaginertia="0.02 0.02 0.002"/>
+  {child}
+</body>"""
+
+
+def _write(tmp_path, name: str, body: str, *, head: str = "", tail: str = "") -> object:
+    path = tmp_path / f"{name}.xml"
+    path.write_text(f'<mujoco model="{name}">{head}<worldbody>{body}</worldbody>{tail}'
+                    "</mujoco>")
+    return path
+
+
+def _rows(result, section=None, verdict=None):
+    rows = result.rows
+    if section:
+        rows = rows[rows["section"] == section]
+    if verdict:
+        rows = rows[rows["verdict"] == verdict]
+    return rows
+
+
+PLANAR = """<body name="torso" pos="0 0 1">
+  <joint name="rootx" type="slide" axis="1 0 0"/>
+  <joint name="rootz" type="slide" axis="0 0 1"/>
+  <joint name="rooty" type="hinge" axis="0 1 0"/>
+  <inertial pos="0 0 0" mass="{mass}" diaginertia="0.1 0.2 0.3"/>
+  <body name="leg" pos="0.1 0 -0.2">
+    <joint name="hip" type="hinge" axis="0 1 0"/>
+    <inertial pos="0 0 -0.2" mass="1" diaginertia="0.02 0.02 0.002"/>
+  </body>
+</body>"""
+
+
+def test_several_joints_in_one_body_are_compared_in_every_engine(tmp_path):
+    """A planar walker's root (x, z, pitch in one body): Pinocchio's composite joint and
+    Drake's intermediate bodies matched joint by joint; every engine's dynamics compared
+    with the referee, nothing skipped, nothing failed (the three engines agree on it)."""
+    result = check_model(_write(tmp_path, "planar", PLANAR.format(mass=3)), states=10)
+    assert result.ok, result.failures()
+    assert _rows(result, verdict="skipped").empty
+    pairs = set(zip(*(_rows(result, "dynamics")[c] for c in ("impl_a", "impl_b")),
+                    strict=True))
+    for engine in ("mujoco", "pinocchio", "drake"):
+        assert ("reference", engine) in pairs
+
+
+def test_a_mass_changed_on_a_composite_joint_body_fails_naming_the_body(tmp_path):
+    """The corrupted copy against the original (``--against``, both read by MuJoCo): the
+    mass × 1.01 of the body carrying the composite joint is a failed row naming it."""
+    original = _write(tmp_path, "planar", PLANAR.format(mass=3))
+    corrupted = _write(tmp_path, "corrupted", PLANAR.format(mass=3 * 1.01))
+    result = check_model(corrupted, states=5, against=original)
+    failed = _rows(result, verdict="failed")
+    assert not failed.empty
+    assert set(failed["subject"]) == {"rooty"} and "torso" in " ".join(failed["note"])
+    assert set(failed["field"]) >= {"mass"}
+
+
+def test_top_level_bodies_pinocchio_drops_leave_the_rest_compared(tmp_path):
+    """Two top-level bodies: Pinocchio's MJCF parser reads only the first; its dynamics are
+    compared on the joints it holds (independent blocks), energies skipped with the reason,
+    and the dropped joint named."""
+    arm = LINK.format(name="a", pos="0 0 1", joint="j1", extra="", mass=1, child="")
+    box = LINK.format(name="box", pos="1 0 1", joint="box_j", extra="", mass=2, child="")
+    result = check_model(_write(tmp_path, "two", arm + box), states=10)
+    dynamics = _rows(result, "dynamics")
+    with_pin = dynamics[(dynamics["impl_b"] == "pinocchio") | (dynamics["impl_a"] == "pinocchio")]
+    compared = with_pin[with_pin["subject"] == "mass_matrix"]
+    assert len(compared) >= 2 and set(compared["verdict"]) == {"passed"}
+    energies = with_pin[with_pin["subject"].str.endswith("_energy")]
+    assert set(energies["verdict"]) == {"skipped"}
+    assert any("dropped box_j" in n for n in result.notes)
+    absent = _rows(result, "description", "failed")
+    assert list(absent["subject"]) == ["box_j"] or "box_j" in set(absent["subject"])
+
+
+def test_armature_in_a_default_class_on_actuated_and_unactuated_joints(tmp_path):
+    """Drake holds an actuated joint's armature as reflected inertia (read back: agrees with
+    MuJoCo); an unactuated joint loses it in Drake — a failed row naming the joint and the
+    fix, and Drake's dynamics explained by it. Pinocchio reads both."""
+    inner = LINK.format(name="b", pos="0 0 -0.5", joint="j2", extra="", mass=1, child="")
+    body = LINK.format(name="a", pos="0 0 1", joint="j1", extra="", mass=1, child=inner)
+    path = _write(tmp_path, "arm", body, head='<default><joint armature="0.3"/></default>',
+                  tail='<actuator><motor joint="j1" gear="3"/></actuator>')
+    result = check_model(path, states=10)
+    description = _rows(result, "description", "failed")
+    drake = description[description["impl_b"] == "drake"]
+    assert list(drake["subject"]) == ["j2"] and list(drake["field"]) == ["armature"]
+    assert "<motor joint=\"j2\"/>" in drake["note"].iloc[0]
+    assert description[description["impl_b"] == "pinocchio"].empty
+    drake_dynamics = _rows(result, "dynamics")
+    drake_dynamics = drake_dynamics[drake_dynamics["impl_b"] == "drake"]
+    assert "failed" not in set(drake_dynamics["verdict"])
+
+
+def test_constant_potential_energy_is_never_divided_by_zero(tmp_path):
+    """Motion in a horizontal plane (hinges about the vertical): V is constant, so the
+    potential-energy rows pass with an error of round-off against the stated m g L floor."""
+    inner = LINK.format(name="b", pos="0.5 0 0", joint="j2", extra="", mass=1, child="")
+    body = LINK.format(name="a", pos="0 0 1", joint="j1", extra="", mass=1, child=inner)
+    path = _write(tmp_path, "flat", body.replace('axis="0 1 0"', 'axis="0 0 1"'))
+    result = check_model(path, states=10)
+    rows = _rows(result, "dynamics")
+    potential = rows[rows["subject"] == "potential_energy"]
+    assert set(potential["verdict"]) == {"passed"}
+    assert (potential["error"] < 1e-12).all()
+    assert potential["basis"].str.contains("m g L").all()
+    assert result.ok, result.failures()
+
+
+@pytest.mark.parametrize("flag", ['<option><flag gravity="disable"/></option>'])
+def test_gravity_disabled_by_flag_is_a_finding_with_its_fix(tmp_path, flag):
+    """MuJoCo applies <flag gravity="disable">, Pinocchio and Drake apply <option gravity>:
+    the gravity rows fail with the fix, the referee (on MuJoCo's tree) agrees with MuJoCo."""
+    body = LINK.format(name="a", pos="0 0 1", joint="j1", extra="", mass=1, child="")
+    result = check_model(_write(tmp_path, "nograv", body, head=flag), states=10)
+    gravity = _rows(result, "description", "failed")
+    gravity = gravity[gravity["field"] == "gravity"]
+    assert set(gravity["impl_b"]) == {"pinocchio", "drake"}
+    assert gravity["note"].str.contains('option gravity="0 0 0"').all()
+    rows = _rows(result, "dynamics")
+    referee = rows[(rows["impl_a"] == "reference") & (rows["impl_b"] == "mujoco")]
+    assert set(referee["verdict"]) == {"passed"}
