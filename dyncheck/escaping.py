@@ -70,4 +70,4 @@ def markdown_table(frame: pd.DataFrame, **options: object) -> str:
         if shown[column].dtype == object or pd.api.types.is_string_dtype(shown[column]):
             shown[column] = shown[column].map(lambda v: markdown(v) if isinstance(v, str) else v)
     shown.columns = [markdown(c) for c in shown.columns]
-    return shown.to_markdown(index=False, **options)  # type: ignore[arg-type]
+    return shown.to_markdown(index=False, **options)

@@ -260,7 +260,7 @@ def cached(
     found = read_entry(path)
     if found is not None:
         if isinstance(found, expect):
-            return found, True  # type: ignore[return-value]
+            return found, True
         note(f"{_name(path, cache_root())} holds a {type(found).__name__}, not the "
              f"expected {getattr(expect, '__name__', expect)}: computed afresh")
     result = compute()

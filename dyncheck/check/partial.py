@@ -39,7 +39,9 @@ def common_part(canonical: ModelTree, tree: ModelTree) -> Part | None:
     known = {j.name for j in canonical.joints}
     if set(held) - known or not held:
         return None
-    q, v, kept, dropped = [], [], [], []
+    q: list[int] = []
+    v: list[int] = []
+    kept, dropped = [], []
     q_at = v_at = 0
     for j in canonical.joints:
         if j.name in held:
