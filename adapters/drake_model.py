@@ -196,7 +196,7 @@ class DrakeModel:
         hints = tuple(
             (j.name, "armature", UNACTUATED_ARMATURE.format(joint=j.name))
             for j in joints
-            if j.type in (JointType.HINGE, JointType.SLIDE) and j.name not in self._reflected
+            if j.type in (JointType.HINGE, JointType.SLIDE) and j.name not in reflected
             and self._source.format is Format.MJCF
         )
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
