@@ -25,6 +25,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, MultibodyForces, QuaternionFloatingJoint
 
 from dyncheck.adapters.drake_ import parser_warnings
+from dyncheck.adapters.mjcf_copy import for_parser
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -35,7 +36,7 @@ from dyncheck.adapters.model_tree import (
     TreeJoint,
     lump,
 )
-from dyncheck.errors import EngineError, Unsupported
+from dyncheck.errors import DyncheckError, EngineError, Unsupported
 
 ENGINE = "drake"
 UNACTUATED_ARMATURE = (
@@ -43,6 +44,9 @@ UNACTUATED_ARMATURE = (
     "joint, and {joint!r} has none: Drake's M leaves its armature out (fix: give the joint an "
     "actuator, e.g. <motor joint=\"{joint}\"/>, or model the rotor as body inertia)"
 )
+MESH_FORMATS = (".obj",)
+"""The mesh files Drake's MJCF parser reads (others: the geoms dropped where they carry no
+inertia, see :mod:`dyncheck.adapters.mjcf_copy`)."""
 _TYPES = {
     "revolute": JointType.HINGE,
     "prismatic": JointType.SLIDE,
@@ -55,10 +59,16 @@ def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str
     notes: list[str] = []
     with parser_warnings() as warnings:
         try:
-            if source.format is Format.MJCF:
+            if source.format is Format.MJCF and (copy := for_parser(
+                    source.path, ENGINE, MESH_FORMATS)).notes:
+                Parser(plant).AddModelsFromString(copy.text, "xml")
+                notes.extend(copy.notes)
+            elif source.format is Format.MJCF:
                 Parser(plant).AddModels(str(source.path))
             else:
                 Parser(plant).AddModelsFromString(source.text, "urdf")
+        except DyncheckError:
+            raise
         except Exception as exc:
             raise EngineError(
                 f"drake refused {source.path}: {' '.join(str(exc).split())}"

@@ -7,8 +7,9 @@ import importlib.metadata
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from dyncheck.adapters.mjcf_copy import inline
 from dyncheck.adapters.model_files import INERTIA_KEYS
-from dyncheck.errors import InvalidInput, UnknownName
+from dyncheck.errors import EngineError, InvalidInput, UnknownName
 
 URDF_JOINTS = ("revolute", "continuous", "prismatic", "fixed")
 """The URDF joint types every engine here reads alike (``floating`` and ``planar`` are not:
@@ -45,6 +46,11 @@ def model_path(text: str) -> Path:
         _check_urdf(path, root)
     elif root.tag != "mujoco":
         raise ModelFileError(path, f"root element <{root.tag}> is neither <mujoco> nor <robot>")
+    else:  # an include cycle or a FIFO would hang a parser: refused before any engine runs
+        try:
+            inline(path)
+        except EngineError as exc:
+            raise ModelFileError(path, str(exc).removeprefix(f"{path.resolve()}: ")) from None
     return path
 
 

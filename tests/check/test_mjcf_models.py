@@ -137,3 +137,87 @@ def test_gravity_disabled_by_flag_is_a_finding_with_its_fix(tmp_path, flag):
     rows = _rows(result, "dynamics")
     referee = rows[(rows["impl_a"] == "reference") & (rows["impl_b"] == "mujoco")]
     assert set(referee["verdict"]) == {"passed"}
+
+
+def _stl(path, half: float = 0.05) -> None:
+    """A closed cube of half-width ``half`` as binary STL (12 outward triangles)."""
+    import struct
+
+    import numpy as np
+
+    c = np.array([[x, y, z] for x in (-half, half) for y in (-half, half) for z in (-half, half)])
+    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1),
+             (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+    data = bytearray(b"\0" * 80 + struct.pack("<I", len(faces)))
+    for face in faces:
+        a, b, d = (c[i] for i in face)
+        normal = np.cross(b - a, d - a)
+        data += struct.pack("<12fH", *normal, *a, *b, *d, 0)
+    path.write_bytes(bytes(data))
+
+
+MESHED = """<body name="arm" pos="0 0 1">
+  <joint name="shoulder" type="hinge" axis="0 1 0"/>
+  {inertial}
+  <geom type="mesh" mesh="cube" {geom}/>
+  <geom type="mesh" mesh="cube" class="visual"/>
+</body>"""
+MESH_HEAD = ('<compiler meshdir="assets"/><default><default class="visual">'
+             '<geom density="0" contype="0" conaffinity="0"/></default></default>'
+             '<asset><mesh name="cube" file="cube.stl"/></asset>')
+
+
+def test_stl_meshes_on_bodies_that_state_their_inertia_are_dropped_for_drake(tmp_path):
+    """Drake's MJCF parser reads only .obj meshes: a copy without the STL geoms (the body
+    states its inertia; the visual geom has density 0) is loaded instead, said in the notes,
+    and Drake's dynamics pass against the referee and MuJoCo (the inertia is the file's)."""
+    (tmp_path / "assets").mkdir()
+    _stl(tmp_path / "assets" / "cube.stl")
+    body = MESHED.format(inertial='<inertial pos="0 0 -0.2" mass="1.5" '
+                         'diaginertia="0.03 0.03 0.004"/>', geom='mass="7"')
+    result = check_model(_write(tmp_path, "meshed", body, head=MESH_HEAD), states=10)
+    assert result.ok, result.failures()
+    assert any("copy without its 1 mesh assets (.stl" in n for n in result.notes)
+    pairs = set(zip(*(_rows(result, "dynamics")[c] for c in ("impl_a", "impl_b")),
+                    strict=True))
+    assert {("reference", "drake"), ("mujoco", "drake")} <= pairs
+
+
+def test_an_inertia_taken_from_an_stl_mesh_skips_drake_naming_the_mesh(tmp_path):
+    """The body states no inertia: MuJoCo computes it from the mesh, which Drake cannot read
+    — Drake is skipped naming the body, the mesh and the conversion; MuJoCo is still checked
+    against the referee."""
+    (tmp_path / "assets").mkdir()
+    _stl(tmp_path / "assets" / "cube.stl")
+    body = MESHED.format(inertial="", geom='mass="2"')
+    result = check_model(_write(tmp_path, "mesh_inertia", body, head=MESH_HEAD), states=5)
+    drake = _rows(result, verdict="skipped")
+    drake = drake[(drake["impl_a"] == "drake") | (drake["impl_b"] == "drake")]
+    assert not drake.empty
+    note = " ".join(drake["note"])
+    assert "'arm'" in note and "'cube'" in note and "convert the mesh to .obj" in note
+    mujoco = _rows(result, "dynamics")
+    assert not mujoco[(mujoco["impl_a"] == "reference")
+                      & (mujoco["impl_b"] == "mujoco")].empty
+
+
+def test_a_rotated_and_offset_root_is_read_alike_in_one_frame(tmp_path):
+    """Every read-back in world axes at the reference configuration: a root body offset and
+    rotated (a quaternion, an Euler sequence down the chain, joints off the body origins)
+    reads alike in every engine and matches the referee (the three engines and the book's
+    method agree). One joint per body: several joints in a rotated body meet Drake's reading
+    of their frames, a finding of its own."""
+    body = """<body name="base" pos="0.3 -0.2 0.8" quat="0.9238795 0.3826834 0 0">
+  <joint name="j1" type="hinge" axis="0 0 1" pos="0.05 0 0"/>
+  <inertial pos="0.1 0.02 -0.03" mass="2" fullinertia="0.04 0.05 0.03 0.001 -0.002 0.003"/>
+  <body name="link" pos="0.4 0 0" euler="0.3 -0.2 0.5">
+    <joint name="j2" type="hinge" axis="1 1 0" pos="0 0.1 0"/>
+    <inertial pos="0 0 -0.2" mass="1" diaginertia="0.02 0.02 0.002"/>
+  </body>
+</body>"""
+    result = check_model(_write(tmp_path, "offset", body), states=10)
+    assert result.ok, result.failures()
+    description = _rows(result, "description")
+    for engine in ("pinocchio", "drake"):
+        read = description[description["impl_b"] == engine]
+        assert not read.empty and set(read["verdict"]) == {"passed"}

@@ -1,0 +1,243 @@
+"""An MJCF file as a parser that cannot read all of it is given it: ``<include>`` inlined (a
+cycle, a missing or special file found here, never handed to a parser that can loop or block
+on it), mesh geoms the parser cannot read removed where they carry no inertia, a missing
+model name supplied.
+
+Removing a geom is safe for the dynamics exactly when MuJoCo's compiler takes no inertia from
+it: ``<compiler inertiafromgeom="false">``; or ``"auto"`` (the default) and its body states an
+``<inertial>``; or the geom has ``mass="0"`` or ``density="0"`` (directly or through its
+default class), or its group is outside ``inertiagrouprange``. Otherwise the inertia comes from
+the mesh, and the copy is refused naming the mesh and the conversion that would let it load.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from enum import Enum
+from pathlib import Path
+
+from dyncheck.errors import EngineError, Unsupported
+
+
+class Owner(Enum):
+    """What a geom's body is, for its inertia."""
+
+    WELDED = "the world or a body welded to it: no inertia that moves"
+    STATES_INERTIA = "a moving body with an <inertial>"
+    PLAIN = "a moving body without one"
+
+MAX_INCLUDE_BYTES = 64 * 2**20
+MAX_INCLUDE_DEPTH = 32
+GEOM_INERTIA_KEYS = ("type", "mesh", "mass", "density", "group")
+"""The geom attributes (from defaults too) that decide whether a geom carries inertia."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class Copy:
+    """The document the parser is given, and what was changed (empty: use the file itself)."""
+
+    text: str
+    notes: tuple[str, ...]
+
+
+def _read(path: Path, including: Path) -> ET.Element:
+    """An included file's root, read only if it is a regular file (a FIFO or a device would
+    block or never end)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError as exc:
+        raise EngineError(f"{including}: <include file={path.name!r}>: cannot be read "
+                          f"({exc.strerror})") from None
+    with os.fdopen(fd, "rb") as handle:
+        info = os.fstat(handle.fileno())
+        if not stat.S_ISREG(info.st_mode):
+            raise EngineError(f"{including}: <include file={path.name!r}>: not a regular file")
+        if info.st_size > MAX_INCLUDE_BYTES:
+            raise EngineError(f"{including}: <include file={path.name!r}>: larger than "
+                              f"{MAX_INCLUDE_BYTES // 2**20} MiB")
+        raw = handle.read()
+    try:
+        return ET.fromstring(raw)
+    except ET.ParseError as exc:
+        raise EngineError(f"{path}: not XML ({exc})") from None
+
+
+def inline(path: Path) -> ET.Element:
+    """The model's root with every ``<include>`` replaced by the included file's children
+    (paths relative to the main file's folder, as MuJoCo resolves them, else to the including
+    file's)."""
+    main = path.resolve()
+
+    def expand(element: ET.Element, chain: tuple[Path, ...]) -> None:
+        children = list(element)
+        for index, child in reversed(list(enumerate(children))):
+            if child.tag != "include":
+                expand(child, chain)
+                continue
+            name = child.get("file", "")
+            target = (main.parent / name).resolve()
+            if not target.exists():  # older files: relative to the including file
+                target = (chain[-1].parent / name).resolve()
+            if target in chain:
+                raise EngineError(f"{chain[-1]}: <include file={name!r}> includes itself "
+                                  "(an include cycle)")
+            if len(chain) > MAX_INCLUDE_DEPTH:
+                raise EngineError(f"{chain[-1]}: includes nested deeper than "
+                                  f"{MAX_INCLUDE_DEPTH}")
+            included = _read(target, chain[-1])
+            expand(included, (*chain, target))
+            element.remove(child)
+            for offset, part in enumerate(included):
+                element.insert(index + offset, part)
+
+    root = _read(main, main)
+    expand(root, (main,))
+    return root
+
+
+def _defaults(root: ET.Element) -> dict[str, dict[str, str]]:
+    """Each default class's geom attributes that matter here, inherited from its parents."""
+    out: dict[str, dict[str, str]] = {}
+
+    def walk(element: ET.Element, inherited: dict[str, str], top: bool) -> None:
+        name = "main" if top else element.get("class", "main")
+        own = dict(inherited)
+        geom = element.find("geom")
+        if geom is not None:
+            own.update({k: v for k, v in geom.attrib.items() if k in GEOM_INERTIA_KEYS})
+        out[name] = own
+        for child in element.findall("default"):
+            walk(child, own, False)
+
+    for top in root.findall("default"):
+        walk(top, {}, True)
+    return out
+
+
+def _compiler(root: ET.Element, key: str, default: str) -> str:
+    value = default
+    for compiler in root.iter("compiler"):
+        value = compiler.get(key, value)
+    return value
+
+
+ASSET_DIRS = {"mesh": "meshdir", "skin": "meshdir", "hfield": "meshdir",
+              "texture": "texturedir"}
+"""The compiler attribute each asset's file is relative to (``assetdir`` where it is absent)."""
+
+
+def _asset_file(root: ET.Element, folder: Path, element: ET.Element) -> Path | None:
+    file = element.get("file")
+    if not file:
+        return None
+    base = _compiler(root, ASSET_DIRS.get(element.tag, "assetdir"),
+                     _compiler(root, "assetdir", ""))
+    return (folder / base / file).resolve()
+
+
+def _mesh_name(mesh: ET.Element) -> str:
+    return mesh.get("name") or Path(mesh.get("file", "")).stem
+
+
+def _mesh_files(root: ET.Element, folder: Path) -> dict[str, Path | None]:
+    """Every ``<mesh>`` asset by name: its file (absolute), None for a mesh without one."""
+    return {_mesh_name(m): _asset_file(root, folder, m) for m in root.iter("mesh")
+            if m.get("file") or m.get("name")}
+
+
+def _carries_inertia(attrs: dict[str, str], owner: Owner, mode: str,
+                     groups: tuple[int, int]) -> bool:
+    if owner is Owner.WELDED:
+        return False
+    if mode == "false" or (mode == "auto" and owner is Owner.STATES_INERTIA):
+        return False
+    if float(attrs.get("mass", "nan")) == 0.0:
+        return False
+    if "mass" not in attrs and float(attrs.get("density", "1000")) == 0.0:
+        return False
+    return groups[0] <= int(attrs.get("group", "0")) <= groups[1]
+
+
+def for_parser(path: Path, engine: str, readable: tuple[str, ...]) -> Copy:
+    """The copy of ``path`` that ``engine`` can read, whose mesh parser reads only files ending
+    in ``readable``; ``Copy.notes`` empty when nothing had to change (load the file itself).
+    Raises :class:`Unsupported` where an inertia comes from an unreadable mesh."""
+    root = inline(path)
+    folder = path.resolve().parent
+    notes: list[str] = []
+    files = _mesh_files(root, folder)
+    unreadable = {name for name, file in files.items()
+                  if file is None or file.suffix.lower() not in readable}
+    if unreadable:
+        defaults = _defaults(root)
+        mode = _compiler(root, "inertiafromgeom", "auto")
+        low, high = (int(float(x)) for x in
+                     _compiler(root, "inertiagrouprange", "0 5").split()[:2])
+        removed = 0
+
+        def walk(element: ET.Element, childclass: str, owner: Owner) -> None:
+            """Remove ``element``'s unreadable mesh geoms (a frame's geoms belong to its
+            body; the world's, and those of bodies welded to it, carry no inertia that
+            moves)."""
+            nonlocal removed
+            for geom in element.findall("geom"):
+                cls = geom.get("class", childclass)
+                attrs = {**defaults.get(cls, defaults.get("main", {})),
+                         **{k: v for k, v in geom.attrib.items() if k in GEOM_INERTIA_KEYS}}
+                mesh = attrs.get("mesh")
+                if mesh not in unreadable:
+                    continue
+                if _carries_inertia(attrs, owner, mode, (low, high)):
+                    file = files.get(mesh or "")
+                    raise Unsupported(
+                        f"{engine}: body {element.get('name', '(unnamed)')!r} takes its "
+                        f"inertia from mesh {mesh!r} ({file.name if file else 'no file'}), "
+                        f"which {engine}'s MJCF parser cannot read (it reads "
+                        f"{', '.join(readable)}): convert the mesh to {readable[0]} or state "
+                        "the body's <inertial>"
+                    )
+                element.remove(geom)
+                removed += 1
+            for frame in element.findall("frame"):
+                walk(frame, frame.get("childclass", childclass), owner)
+            for body in element.findall("body"):
+                if owner is Owner.WELDED and not any(
+                        body.findall(tag) for tag in ("joint", "freejoint")):
+                    kind = Owner.WELDED
+                elif body.find("inertial") is not None:
+                    kind = Owner.STATES_INERTIA
+                else:
+                    kind = Owner.PLAIN
+                walk(body, body.get("childclass", childclass), kind)
+
+        for world in root.findall("worldbody"):
+            walk(world, "main", Owner.WELDED)
+        for asset in root.findall("asset"):
+            for mesh in asset.findall("mesh"):
+                if _mesh_name(mesh) in unreadable:
+                    asset.remove(mesh)
+        for default in root.iter("default"):
+            for geom in default.findall("geom"):
+                if geom.get("mesh") in unreadable:
+                    del geom.attrib["mesh"]
+        kinds = sorted({f.suffix if (f := files[n]) else "vertex data" for n in unreadable})
+        notes.append(f"{engine}: given a copy without its {len(unreadable)} mesh assets "
+                     f"({', '.join(kinds)}, which its MJCF parser cannot read) and the "
+                     f"{removed} geoms using them; every such geom is on a body that states "
+                     "its inertia, or carries none, so the dynamics are unchanged")
+    if not root.get("model"):
+        root.set("model", path.stem)
+        notes.append(f"{engine}: the model has no name (<mujoco model=...>); "
+                     f"given the copy the name {path.stem!r}")
+    if not notes:
+        return Copy(text="", notes=())
+    for element in root.iter():  # what stays is read from absolute paths
+        if element.tag in (*ASSET_DIRS, "model") and (file := _asset_file(root, folder, element)):
+            element.set("file", str(file))
+    for compiler in root.iter("compiler"):
+        for key in ("meshdir", "texturedir", "assetdir"):
+            compiler.attrib.pop(key, None)
+    return Copy(text=ET.tostring(root, encoding="unicode"), notes=tuple(notes))
