@@ -97,10 +97,15 @@ class ModelTree:
     notes: tuple[str, ...] = field(default=())
     hints: tuple[tuple[str, str, str], ...] = field(default=())
     """(joint, field, why): what the engine is known to do with that field of that joint and
-    how to change it — the note of a description row that finds the field read differently."""
+    how to change it — the note of a description row that finds the field read differently;
+    joint ``model``: of every joint."""
 
     def hint(self, joint: str, name: str) -> str | None:
-        return next((why for j, f, why in self.hints if j == joint and f == name), None)
+        for wanted in (joint, "model"):
+            why = next((w for j, f, w in self.hints if j == wanted and f == name), None)
+            if why is not None:
+                return why
+        return None
 
     def joint(self, name: str) -> TreeJoint:
         for j in self.joints:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from dyncheck.adapters.mjcf_copy import inline
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     NQ,
@@ -95,6 +96,25 @@ def _layouts(m: mujoco.MjModel) -> list[Layout]:
     return out
 
 
+TOTAL_MASS = (
+    "MuJoCo scales every body's mass and inertia so that the total is {total} "
+    "(<compiler settotalmass>); a parser that ignores the attribute reads the unscaled values "
+    "(fix: write the scaled masses and inertias in the file)"
+)
+
+
+def _total_mass_hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
+    """Why masses and inertias read differently where ``settotalmass`` rescales them."""
+    if source.format is not Format.MJCF:
+        return ()
+    total = next((c.get("settotalmass") for c in inline(source.path).iter("compiler")
+                  if c.get("settotalmass") and float(c.get("settotalmass", "-1")) > 0), None)
+    if total is None:
+        return ()
+    why = TOTAL_MASS.format(total=total)
+    return tuple(("model", f, why) for f in ("mass", "inertia", "com"))
+
+
 class MujocoModel:
     """A compiled model and its neutral tree."""
 
@@ -111,6 +131,7 @@ class MujocoModel:
             self._hints: tuple[tuple[str, str, str], ...] = (("model", "gravity", GRAVITY_OFF),)
         else:
             self._hints = ()
+        self._hints += _total_mass_hints(source)
         m.opt.disableflags |= int(_SMOOTH_ONLY)
         m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
         self.data = mujoco.MjData(m)

@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from dyncheck.adapters.mjcf_copy import inline
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -59,6 +60,26 @@ def _load(source: ModelFile) -> pin.Model:
     except Exception as exc:
         message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise EngineError(f"pinocchio refused {source.path}: {message}") from None
+
+
+FIRST_BODY_ONLY = (
+    "Pinocchio's MJCF parser reads only the first body under <worldbody> ({first!r}); the "
+    "other top-level bodies ({others}) and their joints are not in its model (fix: put the "
+    "robot in one tree under one top-level body, or check its URDF)"
+)
+
+
+def _top_level_hint(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
+    """The reason a joint is missing from Pinocchio's reading of an MJCF with several
+    top-level bodies (the file read as XML, includes inlined)."""
+    if source.format is not Format.MJCF:
+        return ()
+    bodies = [b.get("name", "(unnamed)") for world in inline(source.path).findall("worldbody")
+              for b in world.findall("body")]
+    if len(bodies) < 2:
+        return ()
+    others = ", ".join(repr(b) for b in bodies[1:6]) + (" …" if len(bodies) > 6 else "")
+    return (("model", "joint", FIRST_BODY_ONLY.format(first=bodies[0], others=others)),)
 
 
 def _rotor_in_kinetic(m: pin.Model, q0: np.ndarray) -> dict[int, bool]:
@@ -116,6 +137,7 @@ class PinocchioModel:
         self.model = _load(source)
         self.data = self.model.createData()
         notes = ()
+        self._hints = _top_level_hint(source)
         if source.floating and source.format is Format.URDF:
             notes = ("pinocchio: JointModelFreeFlyer 'root_joint' at the URDF root",)
         self.tree = self._tree(notes)
@@ -184,7 +206,7 @@ class PinocchioModel:
                      "JointModelRevoluteUnaligned does not set")
         return ModelTree(
             engine=ENGINE, joints=tuple(joints), gravity=np.asarray(m.gravity.linear, float),
-            nq=m.nq, nv=m.nv, notes=notes,
+            nq=m.nq, nv=m.nv, notes=notes, hints=self._hints,
         )
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:

@@ -93,8 +93,9 @@ def diff(model: str, a: ModelTree, b: ModelTree) -> list[CheckRow]:
     names_a, names_b = [j.name for j in a.joints], [j.name for j in b.joints]
     for name in names_a:
         if name not in names_b:
+            why = b.hint(name, "joint") or b.hint("model", "joint")
             row(name, "joint", "present", "absent", np.inf, 0.0, Verdict.FAILED,
-                f"{b.engine} has no joint {name!r}")
+                f"{b.engine} has no joint {name!r}" + (f": {why}" if why else ""))
     for name in names_b:
         if name not in names_a:
             row(name, "joint", "absent", "present", np.inf, 0.0, Verdict.FAILED,

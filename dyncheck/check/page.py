@@ -10,8 +10,16 @@ import pandas as pd
 
 from dyncheck.check.model_check import CheckResult
 from dyncheck.check.rows import Section
+from dyncheck.check.verdicts import per_engine
 from dyncheck.escaping import markdown, markdown_code, markdown_table
 from dyncheck.results import PROVENANCE, Verdict, provenance_json, to_csv, write_atomic
+
+TITLES = {
+    Section.LOAD: "Loading",
+    Section.DESCRIPTION: "Model reading (each engine's tree against MuJoCo's)",
+    Section.VALIDITY: "Physical validity",
+    Section.DYNAMICS: "Dynamics",
+}
 
 
 def _versions(result: CheckResult) -> dict[str, str]:
@@ -56,6 +64,11 @@ def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
         "**Outcome: " + ("the engines agree** (every row passed or is explained)."
                          if result.ok else "differences found** (failed rows below)."),
         "",
+        "## Per engine",
+        "",
+        *(f"- **{markdown(v.engine)}** — {markdown(v.line())}"
+          for v in per_engine(rows, result.impls)),
+        "",
         "## How it was checked",
         "",
         *(f"- {markdown(note)}" for note in result.notes),
@@ -73,7 +86,7 @@ def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
     ]
     for section in Section:
         part = rows[rows["section"] == section.value]
-        lines += [f"## {section.value.capitalize()}", "",
+        lines += [f"## {TITLES[section]}", "",
                   _table(part, ["subject", "field", "impl_a", "impl_b", "error", "tolerance",
                                 "verdict", "note"]), ""]
     lines += ["## Time (seconds on this machine, loading and evaluating)", "",

@@ -1,0 +1,132 @@
+"""A model check's answer per engine, from its rows: did the engine load the file, read it as
+the canonical engine (MuJoCo) did, and compute the same dynamics — with the first reason and
+fix where not. What a page says in its first lines."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+
+import pandas as pd
+
+from dyncheck.check.rows import Section
+from dyncheck.results import Verdict
+
+CANONICAL = "mujoco"
+REFEREE = "reference"
+
+
+class Reading(StrEnum):
+    """How an engine read the model, compared with the canonical engine."""
+
+    ALIKE = "read the model alike"
+    DIFFERENTLY = "read it differently"
+    REFUSED = "refused it"
+    SKIPPED = "not run"
+
+
+class Agreement(StrEnum):
+    """Whether the engine's dynamics agree with the referee and the canonical engine."""
+
+    AGREE = "dynamics agree"
+    EXPLAINED = "dynamics differ only as explained"
+    DIFFER = "dynamics differ"
+    NOT_COMPARED = "dynamics not compared"
+
+
+@dataclass(frozen=True, kw_only=True)
+class EngineVerdict:
+    engine: str
+    reading: Reading
+    reading_why: str
+    agreement: Agreement
+    agreement_why: str
+
+    @property
+    def ok(self) -> bool:
+        return self.reading is Reading.ALIKE and self.agreement in (Agreement.AGREE,
+                                                                    Agreement.EXPLAINED)
+
+    def line(self) -> str:
+        """One sentence: the reading, then the dynamics, each with its first reason."""
+        reading = self.reading.value + (f" ({self.reading_why})" if self.reading_why else "")
+        if self.reading in (Reading.REFUSED, Reading.SKIPPED):
+            return reading
+        agreement = self.agreement.value + (f" ({self.agreement_why})"
+                                            if self.agreement_why else "")
+        return f"{reading}; {agreement}"
+
+
+def _first_notes(rows: pd.DataFrame, limit: int = 2) -> str:
+    """The rows' first distinct notes, those that name a fix first."""
+    notes = [str(n) for n in dict.fromkeys(rows["note"].fillna("")) if str(n)]
+    notes.sort(key=lambda n: "fix" not in n)
+    more = f" (+{len(notes) - limit} other notes in the rows)" if len(notes) > limit else ""
+    return "; ".join(notes[:limit]) + more
+
+
+def _reading(engine: str, rows: pd.DataFrame) -> tuple[Reading, str]:
+    load = rows[(rows["section"] == Section.LOAD) & (rows["impl_a"] == engine)]
+    for verdict, reading in ((Verdict.SKIPPED, Reading.SKIPPED), (Verdict.FAILED,
+                                                                  Reading.REFUSED)):
+        part = load[load["verdict"] == verdict]
+        if not part.empty:
+            return reading, _first_notes(part, 1)
+    if engine == CANONICAL:
+        return Reading.ALIKE, "the canonical reading, which the others are compared with"
+    description = rows[(rows["section"] == Section.DESCRIPTION) & (rows["impl_b"] == engine)]
+    failed = description[description["verdict"] == Verdict.FAILED]
+    if not failed.empty:
+        subjects = list(dict.fromkeys(failed["subject"]))
+        fields = ", ".join(dict.fromkeys(failed["field"]))
+        where = f"{len(subjects)} joints" if len(subjects) > 1 else repr(subjects[0])
+        return Reading.DIFFERENTLY, f"{fields} on {where}: {_first_notes(failed, 1)}"
+    explained = description[description["verdict"] == Verdict.EXPLAINED]
+    return Reading.ALIKE, (f"except, as explained: {_first_notes(explained)}"
+                           if not explained.empty else "")
+
+
+def _agreement(engine: str, rows: pd.DataFrame) -> tuple[Agreement, str]:
+    """Judged against the referee (MuJoCo where the referee was not run): a difference
+    between two engines belongs to the one that differs from the judge."""
+    dynamics = rows[(rows["section"] == Section.DYNAMICS)
+                    & ((rows["impl_a"] == engine) | (rows["impl_b"] == engine))]
+    for judge in (REFEREE, CANONICAL):  # the referee judges; without it, the canonical engine
+        against = dynamics[(dynamics["impl_a"] == judge) | (dynamics["impl_b"] == judge)]
+        if not against.empty and judge != engine:
+            dynamics = against
+            break
+    compared = dynamics[dynamics["verdict"] != Verdict.SKIPPED]
+    if compared.empty:
+        skipped = dynamics[dynamics["verdict"] == Verdict.SKIPPED]
+        why = _first_notes(skipped, 1) if not skipped.empty else "no other engine to compare"
+        return Agreement.NOT_COMPARED, why
+    failed = compared[compared["verdict"] == Verdict.FAILED]
+    if not failed.empty:
+        worst = failed.loc[(failed["error"] / failed["tolerance"].where(
+            failed["tolerance"] > 0, 1.0)).idxmax()]
+        other = worst["impl_b"] if worst["impl_a"] == engine else worst["impl_a"]
+        quantities = ", ".join(dict.fromkeys(failed["subject"]))
+        return Agreement.DIFFER, (f"{quantities}; worst {worst['subject']} against {other}: "
+                                  f"error {worst['error']:.3g}, tolerance "
+                                  f"{worst['tolerance']:.3g}")
+    partners = sorted({*compared["impl_a"], *compared["impl_b"]} - {engine})
+    explained = compared[compared["verdict"] == Verdict.EXPLAINED]
+    if len(explained) == len(compared):
+        return Agreement.EXPLAINED, _first_notes(explained, 1)
+    skipped = dynamics[dynamics["verdict"] == Verdict.SKIPPED]
+    tail = f"; not compared: {_first_notes(skipped, 1)}" if not skipped.empty else ""
+    return Agreement.AGREE, f"with {' and '.join(partners)}{tail}"
+
+
+def per_engine(rows: pd.DataFrame, impls: tuple[str, ...]) -> list[EngineVerdict]:
+    """One verdict per engine asked for (the referee is the judge, not judged)."""
+    out = []
+    for engine in impls:
+        if engine == REFEREE:
+            continue
+        reading, reading_why = _reading(engine, rows)
+        agreement, agreement_why = _agreement(engine, rows)
+        out.append(EngineVerdict(engine=engine, reading=reading, reading_why=reading_why,
+                                 agreement=agreement, agreement_why=agreement_why))
+    return out

@@ -1,0 +1,103 @@
+"""The page's first lines (:mod:`dyncheck.check.verdicts`): one answer per engine, from the
+rows. Expected outcomes: synthetic rows whose verdicts are set here, and models written here
+whose engine readings are known (Pinocchio's MJCF parser reads only the first top-level body;
+MuJoCo alone applies ``settotalmass``)."""
+
+from __future__ import annotations
+
+import pandas as pd
+import pytest
+
+from dyncheck.check.model_check import check_model
+from dyncheck.check.rows import COLUMNS, Section
+from dyncheck.check.verdicts import Agreement, Reading, per_engine
+from dyncheck.results import Verdict
+
+IMPLS = ("reference", "mujoco", "pinocchio", "drake")
+
+
+def _row(section, a, b, verdict, subject="mass_matrix", error=0.0, tolerance=1e-12, note=""):
+    return dict(zip(COLUMNS, ["m", section.value, subject, "all", a, b, "", "", error,
+                              tolerance, "", verdict.value, note, -1], strict=True))
+
+
+def _frame(*rows):
+    return pd.DataFrame(list(rows), columns=COLUMNS)
+
+
+def _by_engine(rows, impls=IMPLS):
+    return {v.engine: v for v in per_engine(rows, impls)}
+
+
+def test_a_difference_between_two_engines_belongs_to_the_one_the_referee_disowns():
+    rows = _frame(
+        _row(Section.DYNAMICS, "reference", "mujoco", Verdict.PASSED),
+        _row(Section.DYNAMICS, "reference", "drake", Verdict.FAILED, "bias_forces", 3e-3, 1e-9),
+        _row(Section.DYNAMICS, "mujoco", "drake", Verdict.FAILED, "bias_forces", 3e-3, 1e-9),
+        _row(Section.DYNAMICS, "reference", "pinocchio", Verdict.PASSED),
+    )
+    verdicts = _by_engine(rows)
+    assert verdicts["mujoco"].agreement is Agreement.AGREE
+    assert verdicts["pinocchio"].agreement is Agreement.AGREE
+    drake = verdicts["drake"]
+    assert drake.agreement is Agreement.DIFFER and not drake.ok
+    assert "worst bias_forces against reference: error 0.003" in drake.agreement_why
+
+
+@pytest.mark.parametrize(("verdict", "reading"), [(Verdict.SKIPPED, Reading.SKIPPED),
+                                                  (Verdict.FAILED, Reading.REFUSED)])
+def test_an_engine_that_did_not_load_says_why_and_nothing_else(verdict, reading):
+    rows = _frame(_row(Section.LOAD, "drake", "", verdict, "model", note="needs the extra"))
+    drake = _by_engine(rows)["drake"]
+    assert drake.reading is reading and drake.line() == f"{reading.value} (needs the extra)"
+
+
+def test_a_fix_is_named_before_other_notes():
+    rows = _frame(
+        _row(Section.DESCRIPTION, "mujoco", "drake", Verdict.FAILED, "j1", note="read apart"),
+        _row(Section.DESCRIPTION, "mujoco", "drake", Verdict.FAILED, "j2",
+             note="no actuator (fix: add one)"),
+    )
+    drake = _by_engine(rows)["drake"]
+    assert drake.reading is Reading.DIFFERENTLY
+    assert drake.reading_why.startswith("all on 2 joints: no actuator (fix: add one)")
+
+
+def _write(tmp_path, name, text):
+    path = tmp_path / f"{name}.xml"
+    path.write_text(text)
+    return path
+
+
+LINK = ('<body name="{n}" pos="{p}"><joint name="{n}_j" type="hinge" axis="0 1 0"/>'
+        '<inertial pos="0 0 -0.2" mass="1" diaginertia="0.02 0.02 0.002"/></body>')
+
+
+def test_every_engine_reads_a_plain_chain_alike_and_agrees(tmp_path):
+    path = _write(tmp_path, "chain", '<mujoco model="chain"><worldbody>'
+                  + LINK.format(n="a", p="0 0 1") + "</worldbody></mujoco>")
+    result = check_model(path, states=5)
+    for verdict in per_engine(result.rows, result.impls):
+        assert verdict.ok, verdict.line()
+
+
+def test_the_first_lines_name_pinocchio_s_first_body_and_the_fix(tmp_path):
+    path = _write(tmp_path, "two", '<mujoco model="two"><worldbody>'
+                  + LINK.format(n="table", p="0 0 1").replace(
+                      '<joint name="table_j" type="hinge" axis="0 1 0"/>', "")
+                  + LINK.format(n="arm", p="1 0 1") + "</worldbody></mujoco>")
+    result = check_model(path, states=5)
+    pinocchio = _by_engine(result.rows, result.impls)["pinocchio"]
+    assert pinocchio.reading is Reading.DIFFERENTLY
+    assert "only the first body under <worldbody> ('table')" in pinocchio.reading_why
+    assert "fix: put the robot in one tree" in pinocchio.reading_why
+
+
+def test_settotalmass_is_the_named_reason_masses_read_differently(tmp_path):
+    path = _write(tmp_path, "scaled", '<mujoco model="scaled"><compiler settotalmass="3"/>'
+                  "<worldbody>" + LINK.format(n="a", p="0 0 1") + "</worldbody></mujoco>")
+    result = check_model(path, states=5)
+    verdicts = _by_engine(result.rows, result.impls)
+    for engine in ("pinocchio", "drake"):
+        assert verdicts[engine].reading is Reading.DIFFERENTLY
+        assert "settotalmass" in verdicts[engine].reading_why
