@@ -98,7 +98,7 @@ def inline(path: Path) -> ET.Element:
     return root
 
 
-def _defaults(root: ET.Element) -> dict[str, dict[str, str]]:
+def geom_defaults(root: ET.Element) -> dict[str, dict[str, str]]:
     """Each default class's geom attributes that matter here, inherited from its parents."""
     out: dict[str, dict[str, str]] = {}
 
@@ -172,7 +172,7 @@ def for_parser(path: Path, engine: str, readable: tuple[str, ...]) -> Copy:
     unreadable = {name for name, file in files.items()
                   if file is None or file.suffix.lower() not in readable}
     if unreadable:
-        defaults = _defaults(root)
+        defaults = geom_defaults(root)
         mode = _compiler(root, "inertiafromgeom", "auto")
         low, high = (int(float(x)) for x in
                      _compiler(root, "inertiagrouprange", "0 5").split()[:2])

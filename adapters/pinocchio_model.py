@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from dyncheck.adapters.mjcf_copy import inline
+from dyncheck.adapters.mjcf_copy import geom_defaults, inline
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -58,7 +58,10 @@ def _load(source: ModelFile) -> pin.Model:
             return pin.buildModelFromXML(source.text, pin.JointModelFreeFlyer())
         return pin.buildModelFromXML(source.text)
     except Exception as exc:
-        message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        text = str(exc).strip()
+        # Pinocchio's C++ exceptions: "From file: … in function: … message:\n<the reason>"
+        text = text.split("message:", 1)[1] if "message:" in text else text
+        message = " ".join(text.split()) or type(exc).__name__
         raise EngineError(f"pinocchio refused {source.path}: {message}") from None
 
 
@@ -69,17 +72,31 @@ FIRST_BODY_ONLY = (
 )
 
 
-def _top_level_hint(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
-    """The reason a joint is missing from Pinocchio's reading of an MJCF with several
-    top-level bodies (the file read as XML, includes inlined)."""
+DEFAULT_MASS = (
+    "the file sets geom masses in <default> classes ({classes}), which Pinocchio's MJCF "
+    "parser ignores (measured: it computes those geoms' mass from their density, 1000 unless "
+    "stated) (fix: write mass= on each geom, or give the bodies an <inertial>)"
+)
+
+
+def _hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
+    """Why Pinocchio's reading of an MJCF differs, where the file shows the cause (read as
+    XML, includes inlined): joints missing when there are several top-level bodies; masses
+    from default classes."""
     if source.format is not Format.MJCF:
         return ()
-    bodies = [b.get("name", "(unnamed)") for world in inline(source.path).findall("worldbody")
+    root = inline(source.path)
+    out = []
+    bodies = [b.get("name", "(unnamed)") for world in root.findall("worldbody")
               for b in world.findall("body")]
-    if len(bodies) < 2:
-        return ()
-    others = ", ".join(repr(b) for b in bodies[1:6]) + (" …" if len(bodies) > 6 else "")
-    return (("model", "joint", FIRST_BODY_ONLY.format(first=bodies[0], others=others)),)
+    if len(bodies) > 1:
+        others = ", ".join(repr(b) for b in bodies[1:6]) + (" …" if len(bodies) > 6 else "")
+        out.append(("model", "joint", FIRST_BODY_ONLY.format(first=bodies[0], others=others)))
+    massed = [c for c, attrs in geom_defaults(root).items() if "mass" in attrs]
+    if massed:
+        why = DEFAULT_MASS.format(classes=", ".join(repr(c) for c in massed[:4]))
+        out += [("model", f, why) for f in ("mass", "inertia", "com")]
+    return tuple(out)
 
 
 def _rotor_in_kinetic(m: pin.Model, q0: np.ndarray) -> dict[int, bool]:
@@ -137,7 +154,7 @@ class PinocchioModel:
         self.model = _load(source)
         self.data = self.model.createData()
         notes = ()
-        self._hints = _top_level_hint(source)
+        self._hints = _hints(source)
         if source.floating and source.format is Format.URDF:
             notes = ("pinocchio: JointModelFreeFlyer 'root_joint' at the URDF root",)
         self.tree = self._tree(notes)

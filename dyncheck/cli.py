@@ -118,7 +118,9 @@ def _parser() -> argparse.ArgumentParser:
         help="report every row that regressed against this baseline (exit 1)",
     )
     k = sub.add_parser("check", help="do the engines read and simulate YOUR model alike?")
-    k.add_argument("paths", nargs="*", type=_path, metavar="PATH", help="MJCF (.xml) or URDF")
+    k.add_argument("paths", nargs="*", type=_path, metavar="PATH",
+                   help="MJCF (.xml) or URDF files, or folders (every model file under "
+                   "them; files another one includes left out); several: an index page too")
     k.add_argument("--robot", action="append", default=[], metavar="NAME",
                    help="a robot of example-robot-data (extra 'robots'; see `dyncheck list`)")
     k.add_argument("--impl", action="append", default=[], metavar="NAME",
@@ -578,20 +580,61 @@ def _errata(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_targets(args: argparse.Namespace) -> list[tuple[Path, str | None]]:
+    """The files to check: PATHs (a folder: every model file under it), then ``--robot``s."""
+    from dyncheck.check import index, inputs
+
+    targets: list[tuple[Path, str | None]] = []
+    for path in args.paths:
+        if path.is_dir():
+            found = index.in_folder(path)
+            if not found:
+                raise InvalidInput("PATH", str(path), "a folder holding MJCF or URDF files")
+            targets += [(p, None) for p in found]
+        else:
+            targets.append((path, None))
+    targets += [(inputs.robot(name), name) for name in args.robot]
+    if not targets:
+        raise InvalidInput("PATH", "", "at least one model file, folder or --robot NAME")
+    return targets
+
+
+def _without(message: str, path: Path) -> str:
+    """``message`` with the model's path as its file name: no machine path on a page."""
+    for text in (str(path.resolve()), str(path)):
+        message = message.replace(text, path.name)
+    return message
+
+
 def _check(args: argparse.Namespace) -> int:
     from functools import partial
 
-    from dyncheck.check import inputs
+    from dyncheck.check import index, inputs
+    from dyncheck.check.engines import IMPLEMENTATIONS
     from dyncheck.check.model_check import check_model
     from dyncheck.check.page import summary_line, write
-    from dyncheck.workers import run_units
+    from dyncheck.workers import each_unit
 
-    targets = [(str(p), None) for p in args.paths]
-    targets += [(str(inputs.robot(name)), name) for name in args.robot]
-    if not targets:
-        raise InvalidInput("PATH", "", "at least one model file or --robot NAME")
-    for text, _ in targets:  # every input validated before any engine runs
-        inputs.model_path(text)
+    targets = _check_targets(args)
+    names = index.page_names([p for p, _ in targets])
+    names = [robot.replace("/", "__") if robot else name
+             for (_, robot), name in zip(targets, names, strict=True)]
+    several = len(targets) > 1
+    base = index.common_folder([p for p, _ in targets])
+    files = {name: str(p.resolve().relative_to(base)) if not robot else f"robot {robot}"
+             for (p, robot), name in zip(targets, names, strict=True)}
+    entries: list[index.Entry] = []
+    valid = []
+    for (path, robot), name in zip(targets, names, strict=True):  # all before any engine runs
+        try:
+            inputs.model_path(str(path))
+        except DyncheckError as exc:
+            if not several:
+                raise
+            print(f"dyncheck: error: {exc}", file=sys.stderr)
+            entries.append(index.refused(name, files[name], _without(str(exc), path)))
+            continue
+        valid.append((path, robot, name))
     if args.against is not None:
         inputs.model_path(str(args.against))
     inputs.states(args.states)
@@ -602,16 +645,30 @@ def _check(args: argparse.Namespace) -> int:
     options = {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
                "floating": args.floating, "against": args.against,
                "isolate": not args.in_process}
-    units = [(text, partial(check_model, **options, name=robot), (text,))
-             for text, robot in targets]
-    failed = False
-    for result in run_units(units, jobs=args.jobs, dask=args.dask):
-        written = write(result, args.out)
-        print(f"{summary_line(result)} -> {written[1]}")
-        if not result.ok:
-            failed = True
-            print(result.failures())
-    return 1 if failed else 0
+    units = [(name, partial(check_model, **options, name=robot or (name if several else None)),
+              (str(path),)) for path, robot, name in valid]
+    engines = tuple(i for i in (args.impl or IMPLEMENTATIONS) if i != "reference")
+    failed, refusals = False, len(entries)
+    for name, result in each_unit(units, jobs=args.jobs, dask=args.dask):
+        if isinstance(result, DyncheckError):
+            if not several:
+                raise result
+            print(f"dyncheck: error: {name}: {result}", file=sys.stderr)
+            path = next(p for p, _, n in valid if n == name)
+            entries.append(index.refused(name, files[name], _without(str(result), path)))
+            refusals += 1
+        else:
+            written = write(result, args.out, name=name)
+            print(f"{summary_line(result)} -> {written[1]}")
+            entries.append(index.entry(result, name, files[name]))
+            if not result.ok:
+                failed = True
+                print(result.failures())
+        if several:
+            index.write(entries, engines, args.out)
+    if several:
+        print(f"{len(entries)} models: index -> {args.out / (index.INDEX + '.md')}")
+    return 2 if refusals else 1 if failed else 0
 
 
 COMMANDS = {

@@ -9,8 +9,19 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 
+def _rebuilt(cls: type[DyncheckError], message: str, state: dict) -> DyncheckError:
+    error = cls.__new__(cls)
+    Exception.__init__(error, message)
+    error.__dict__.update(state)
+    return error
+
+
 class DyncheckError(Exception):
-    """Base class of every error dyncheck raises on purpose."""
+    """Base class of every error dyncheck raises on purpose. Pickled as its class, message
+    and fields, whatever its constructor takes: it survives a process pool or a cluster."""
+
+    def __reduce__(self) -> tuple:
+        return (_rebuilt, (type(self), self.args[0] if self.args else "", self.__dict__))
 
 
 class InvalidInput(DyncheckError, ValueError):

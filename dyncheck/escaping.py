@@ -63,10 +63,22 @@ def csv_safe(frame: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-def markdown_table(frame: pd.DataFrame, **options: object) -> str:
-    """``frame.to_markdown`` with every text cell and column name through :func:`markdown`."""
+def markdown_link(text: object, target: str) -> str:
+    """A link whose text is escaped and whose target is percent-encoded (a file name from a
+    user's model cannot close the link or add one)."""
+    from urllib.parse import quote
+
+    return f"[{markdown(text)}]({quote(target)})"
+
+
+def markdown_table(frame: pd.DataFrame, *, escaped: tuple[str, ...] = (),
+                   **options: object) -> str:
+    """``frame.to_markdown`` with every text cell and column name through :func:`markdown`,
+    except the columns ``escaped`` (built from escaped parts by the caller: links)."""
     shown = frame.copy()
     for column in shown.columns:
+        if column in escaped:
+            continue
         if shown[column].dtype == object or pd.api.types.is_string_dtype(shown[column]):
             shown[column] = shown[column].map(lambda v: markdown(v) if isinstance(v, str) else v)
     shown.columns = [markdown(c) for c in shown.columns]

@@ -16,7 +16,7 @@ from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import contextmanager
 from typing import Any
 
-from dyncheck.errors import InvalidInput
+from dyncheck.errors import DyncheckError, EngineError, InvalidInput
 
 LOCAL = "local"
 """``--dask local``: a ``LocalCluster`` of ``--jobs`` single-threaded worker processes."""
@@ -127,3 +127,31 @@ def run_units(
             done.append(future.result())
             progress(f"{what}: done")
         return done
+
+
+def each_unit(
+    units: Sequence[Unit], *, jobs: int = 1, dask: str | None = None,
+) -> Iterator[tuple[str, Any]]:
+    """``(what, result)`` for each unit in submission order, as soon as it and the units
+    before it are done — so a caller writes each result before the next is waited for. A
+    unit's :class:`~dyncheck.errors.DyncheckError` is its result (the units after it still
+    run); a worker that died is one, naming the unit."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    with executor(jobs if len(units) > 1 else 1, dask) as pool:
+        if pool is None:
+            for what, fn, args in units:
+                try:
+                    yield what, fn(*args)
+                except DyncheckError as exc:
+                    yield what, exc
+            return
+        futures = [pool.submit(fn, *args) for _what, fn, args in units]
+        for (what, _fn, _args), future in zip(units, futures, strict=True):
+            try:
+                yield what, future.result()
+            except DyncheckError as exc:
+                yield what, exc
+            except BrokenProcessPool:
+                yield what, EngineError(f"{what}: its worker process died (a crash in an "
+                                        "engine outside its own process, or out of memory)")

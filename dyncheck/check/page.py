@@ -4,6 +4,7 @@ page: summary, what was changed before loading, findings first, then every row, 
 from __future__ import annotations
 
 import platform
+from dataclasses import replace
 from pathlib import Path
 
 import pandas as pd
@@ -97,9 +98,29 @@ def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
     return "\n".join(lines)
 
 
-def write(result: CheckResult, out: Path) -> list[Path]:
-    """Both files, each written to a temporary name and renamed."""
-    name = result.model.replace("/", "__")
+def without_paths(result: CheckResult) -> CheckResult:
+    """The result with the model's folder cut from every note and value (engine messages
+    name files by absolute path): no path of the machine that made it on a page."""
+    folder = str(result.path.resolve().parent) + "/"
+    given = str(result.path.parent) + "/"
+
+    def cut(text: object) -> object:
+        if not isinstance(text, str):
+            return text
+        text = text.replace(folder, "")
+        return text.replace(given, "") if given not in ("./", "/") else text
+
+    rows = result.rows.copy()
+    for column in ("note", "value_a", "value_b"):
+        rows[column] = rows[column].map(cut)
+    return replace(result, rows=rows, notes=tuple(str(cut(n)) for n in result.notes))
+
+
+def write(result: CheckResult, out: Path, *, name: str | None = None) -> list[Path]:
+    """Both files, each written to a temporary name and renamed (``name``: the files' name,
+    by default the model's)."""
+    name = name or result.model.replace("/", "__")
+    result = without_paths(result)
     csv_path, md_path = out / f"{name}.csv", out / f"{name}.md"
     write_atomic(csv_path, to_csv(result.rows))
     versions = _versions(result)

@@ -1,0 +1,155 @@
+"""Several models checked at once: which files (folders searched), the page name of each (no
+two alike), and the index page — one line per model, one column per engine — rewritten as each
+model is done, so an interrupted run keeps what it finished."""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from dyncheck.check.model_check import CheckResult
+from dyncheck.check.page import counts
+from dyncheck.check.verdicts import Agreement, EngineVerdict, Reading, per_engine
+from dyncheck.escaping import markdown, markdown_link, markdown_table
+from dyncheck.results import to_csv, write_atomic
+
+MODEL_SUFFIXES = (".xml", ".urdf", ".mjcf")
+MAX_MODELS = 10_000
+"""Most files one ``check`` takes from folders (a folder of more is refused, named)."""
+INDEX = "index"
+
+READING = {Reading.ALIKE: "read alike", Reading.DIFFERENTLY: "read differently",
+           Reading.REFUSED: "refused", Reading.SKIPPED: "not run"}
+AGREEMENT = {Agreement.AGREE: "agree", Agreement.EXPLAINED: "agree as explained",
+             Agreement.DIFFER: "differ", Agreement.NOT_COMPARED: "not compared"}
+
+
+def _root_tag(path: Path) -> str:
+    try:
+        return ET.parse(path).getroot().tag
+    except (ET.ParseError, OSError):
+        return ""
+
+
+def in_folder(folder: Path) -> list[Path]:
+    """The model files under ``folder``: MJCF and URDF roots, MJCF files that another one
+    includes left out (fragments: materials, assets, shared bodies)."""
+    candidates = []
+    for path in sorted(folder.rglob("*")):
+        if path.suffix.lower() in MODEL_SUFFIXES and path.is_file() and not path.is_symlink():
+            tag = _root_tag(path)
+            if tag in ("mujoco", "robot"):
+                candidates.append((path, tag))
+            if len(candidates) > MAX_MODELS:
+                from dyncheck.errors import InvalidInput
+
+                raise InvalidInput("PATH", str(folder), f"a folder of at most {MAX_MODELS} "
+                                   "model files")
+    included = set()
+    for path, tag in candidates:
+        if tag == "mujoco":
+            root = ET.parse(path).getroot()
+            included |= {(path.parent / i.get("file", "")).resolve() for i in root.iter("include")}
+    return [p for p, _ in candidates if p.resolve() not in included]
+
+
+def page_names(paths: list[Path]) -> list[str]:
+    """One page name per file: its stem; where stems collide, the suffix too (``a-xml``,
+    ``a-urdf``); where those collide, the folders that tell them apart."""
+    names = [p.stem for p in paths]
+    for attempt in (lambda p: f"{p.stem}-{p.suffix.lstrip('.')}",
+                    lambda p: "__".join(p.resolve().parts[-3:-1]) + f"__{p.stem}"
+                    + f"-{p.suffix.lstrip('.')}"):
+        clash = {n for n in names if names.count(n) > 1}
+        names = [attempt(p) if n in clash else n for p, n in zip(paths, names, strict=True)]
+    for i, name in enumerate(names):  # still alike: the same file named twice
+        while names.count(name) > 1 and names.index(name) != i:
+            name += "-2"
+        names[i] = name
+    return names
+
+
+@dataclass(frozen=True, kw_only=True)
+class Entry:
+    """One model's line: its page (empty where it was refused), file, and answers."""
+
+    model: str
+    file: str
+    page: str
+    counts: dict[str, int]
+    verdicts: tuple[EngineVerdict, ...]
+    refused: str = ""
+
+    @property
+    def outcome(self) -> str:
+        if self.refused:
+            return "refused"
+        return "differences found" if self.counts.get("failed", 0) else "engines agree"
+
+
+def entry(result: CheckResult, page: str, file: str) -> Entry:
+    return Entry(model=result.model, file=file, page=page, counts=counts(result),
+                 verdicts=tuple(per_engine(result.rows, result.impls)))
+
+
+def refused(model: str, file: str, why: str) -> Entry:
+    return Entry(model=model, file=file, page="", counts={}, verdicts=(), refused=why)
+
+
+def common_folder(paths: list[Path]) -> Path:
+    return Path(os.path.commonpath([str(p.resolve().parent) for p in paths]))
+
+
+def _cell(verdict: EngineVerdict | None) -> str:
+    if verdict is None:
+        return ""
+    if verdict.reading in (Reading.REFUSED, Reading.SKIPPED):
+        return READING[verdict.reading]
+    return f"{READING[verdict.reading]} · {AGREEMENT[verdict.agreement]}"
+
+
+def frame(entries: list[Entry], engines: tuple[str, ...]) -> pd.DataFrame:
+    rows = []
+    for e in sorted(entries, key=lambda e: e.model):
+        by = {v.engine: v for v in e.verdicts}
+        rows.append({"model": e.model, "file": e.file, "outcome": e.outcome,
+                     **{engine: _cell(by.get(engine)) for engine in engines},
+                     "rows": ", ".join(f"{n} {v}" for v, n in e.counts.items() if n),
+                     "refused": e.refused, "page": f"{e.page}.md" if e.page else ""})
+    return pd.DataFrame(rows)
+
+
+def index_page(entries: list[Entry], engines: tuple[str, ...]) -> str:
+    table = frame(entries, engines)
+    shown = table.copy()
+    shown["model"] = [markdown_link(m, p) if p else markdown(m)
+                      for m, p in zip(table["model"], table["page"], strict=True)]
+    shown["outcome"] = [o + (f": {markdown(r)}" if r else "")
+                        for o, r in zip(table["outcome"], table["refused"], strict=True)]
+    shown = shown.drop(columns=["page", "refused"])
+    agree = sum(e.outcome == "engines agree" for e in entries)
+    refusals = sum(bool(e.refused) for e in entries)
+    lines = [
+        f"# Model checks: {len(entries)} models",
+        "",
+        f"{agree} with every engine in agreement, {len(entries) - agree - refusals} with "
+        f"differences found, {refusals} refused. One line per model; per engine: how it read "
+        "the model, against MuJoCo's reading (read alike / read differently / refused / not "
+        "run), then whether its dynamics agree with the referee, the book's general method "
+        "(agree / agree as explained / differ / not compared). Each model's page gives the "
+        "reasons and the fixes in its first lines.",
+        "",
+        markdown_table(shown, escaped=("model", "outcome")),
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def write(entries: list[Entry], engines: tuple[str, ...], out: Path) -> Path:
+    write_atomic(out / f"{INDEX}.csv", to_csv(frame(entries, engines)))
+    write_atomic(out / f"{INDEX}.md", index_page(entries, engines))
+    return out / f"{INDEX}.md"

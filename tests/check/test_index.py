@@ -1,0 +1,88 @@
+"""Several models in one ``check`` (:mod:`dyncheck.check.index`): folders searched, page names
+that never collide, each model's page and the index written as it is done, a refused model
+costing only its own line. Expected outcomes from the files written here (which one MuJoCo
+refuses, which are included fragments) and from a Markdown parser reading the index."""
+
+from __future__ import annotations
+
+import pickle
+import re
+
+import pytest
+
+from dyncheck.check import index
+from dyncheck.check.inputs import ModelFileError
+from dyncheck.cli import main
+
+CHAIN = ('<mujoco model="{n}"><worldbody><body name="b" pos="0 0 1"><joint name="j" '
+         'type="hinge" axis="0 1 0"/><inertial pos="0 0 -0.2" mass="1" '
+         'diaginertia="0.02 0.02 0.002"/></body></worldbody></mujoco>')
+URDF = ('<robot name="{n}"><link name="base"/><link name="l"><inertial><mass value="1"/>'
+        '<origin xyz="0 0 -0.2"/><inertia ixx="0.02" iyy="0.02" izz="0.002"/></inertial>'
+        '</link><joint name="j" type="continuous"><parent link="base"/><child link="l"/>'
+        '<axis xyz="0 1 0"/></joint></robot>')
+
+
+def test_page_names_never_collide(tmp_path):
+    paths = [tmp_path / "a.xml", tmp_path / "a.urdf", tmp_path / "x" / "b.xml",
+             tmp_path / "y" / "b.xml", tmp_path / "c.xml"]
+    names = index.page_names(paths)
+    assert len(set(names)) == len(names)
+    assert names[:2] == ["a-xml", "a-urdf"] and names[4] == "c"
+    assert names[2].endswith("x__b-xml") and names[3].endswith("y__b-xml")
+
+
+def test_a_folder_gives_its_models_not_their_fragments(tmp_path):
+    (tmp_path / "robot.xml").write_text('<mujoco model="r"><include file="parts.xml"/>'
+                                        "</mujoco>")
+    (tmp_path / "parts.xml").write_text("<mujoco><worldbody/></mujoco>")
+    (tmp_path / "notes.xml").write_text("<html/>")
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "arm.urdf").write_text(URDF.format(n="arm"))
+    assert [p.name for p in index.in_folder(tmp_path)] == ["robot.xml", "arm.urdf"]
+
+
+def test_a_check_error_survives_a_process_pool():
+    error = pickle.loads(pickle.dumps(ModelFileError("a.xml", "no such file")))
+    assert isinstance(error, ModelFileError) and str(error) == "a.xml: no such file"
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_several_models_each_get_a_page_and_one_line_of_the_index(tmp_path, capsys, jobs):
+    """a.xml and a.urdf (the same stem), a model MuJoCo refuses (a negative geom size) and
+    a good one: three pages, the refused model a line of its own, exit 2 (a refusal)."""
+    models = tmp_path / "models"
+    models.mkdir()
+    (models / "a.xml").write_text(CHAIN.format(n="a"))
+    (models / "a.urdf").write_text(URDF.format(n="a"))
+    (models / "good.xml").write_text(CHAIN.format(n="good"))
+    (models / "bad.xml").write_text('<mujoco model="bad"><worldbody><body><joint/>'
+                                    "<geom size='-1'/></body></worldbody></mujoco>")
+    out = tmp_path / "out"
+    code = main(["check", str(models), "--states", "3", "--out", str(out),
+                 "--jobs", str(jobs)])
+    assert code == 2
+    assert {p.name for p in out.glob("*.md")} == {"a-xml.md", "a-urdf.md", "good.md",
+                                                  "index.md"}
+    from markdown_it import MarkdownIt
+
+    html = MarkdownIt("commonmark").enable("table").render((out / "index.md").read_text())
+    assert set(re.findall(r'href="([^"]+)"', html)) == {"a-xml.md", "a-urdf.md", "good.md"}
+    assert html.count("<tr>") == 1 + 4  # the header and one line per model
+    assert "refused" in html and "bad.xml" in html and str(tmp_path) not in html
+    assert "good: " in capsys.readouterr().out
+
+
+def test_a_hostile_file_name_cannot_break_the_index(tmp_path):
+    folder = tmp_path / "m"
+    folder.mkdir()
+    hostile = folder / "x](javascript:alert(1))<b>.xml"
+    hostile.write_text(CHAIN.format(n="h"))
+    out = tmp_path / "out"
+    assert main(["check", str(folder), str(folder / "x](javascript:alert(1))<b>.xml"),
+                 "--states", "2", "--out", str(out)]) == 0
+    from markdown_it import MarkdownIt
+
+    html = MarkdownIt("commonmark").enable("table").render((out / "index.md").read_text())
+    assert "javascript:" not in " ".join(re.findall(r'href="([^"]+)"', html))
+    assert "<b>" not in html
