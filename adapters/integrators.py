@@ -37,7 +37,6 @@ from dataclasses import dataclass
 from functools import cached_property, partial
 
 import numpy as np
-from scipy.integrate import DOP853, solve_ivp
 
 from dyncheck.cases.multibody import NQ, NV, ROTATING
 from dyncheck.errors import EngineError
@@ -284,6 +283,8 @@ def solve_on_group(
     step size it had (never at an interpolated point: the dense output is less accurate than
     the steps). Samples at ``t_eval`` come from each step's dense output, as in ``solve_ivp``.
     Returns q, v at ``t_eval``, shapes (n, nq), (n, nv)."""
+    from scipy.integrate import DOP853, solve_ivp  # 0.5 s to import: only where used
+
     nv = v0.shape[0]
     if not layout.rotating:  # a vector state is its own global chart: one solve
         sol = solve_ivp(
@@ -305,7 +306,8 @@ def solve_on_group(
             [layout.dexp_inv(theta, vel), acc(layout.integrate_pos(centre, theta), vel, None)]
         )
 
-    def start(t: float, centre: np.ndarray, v: np.ndarray, first_step: float | None) -> DOP853:
+    def start(t: float, centre: np.ndarray, v: np.ndarray,
+              first_step: float | None) -> DOP853:
         return DOP853(
             lambda t, y: rhs(t, y, centre),
             t,

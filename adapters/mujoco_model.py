@@ -10,6 +10,8 @@ axes, angular in local axes); a ball joint v = angular velocity in local axes.
 
 from __future__ import annotations
 
+import warnings
+
 import mujoco
 import numpy as np
 
@@ -62,7 +64,11 @@ def _compile(source: ModelFile) -> tuple[mujoco.MjModel, tuple[str, ...]]:
             root = spec.worldbody.first_body()
             root.add_freejoint(name=FLOATING_NAME)
             notes.append(f"mujoco: free joint {FLOATING_NAME!r} added to root link {root.name!r}")
-        model = spec.compile()
+        with warnings.catch_warnings(record=True) as caught:  # to the page, not stderr
+            warnings.simplefilter("always")
+            model = spec.compile()
+        notes += [f"mujoco compiler warning: {' '.join(str(w.message).split())}"
+                  for w in caught]
     except Exception as exc:  # MuJoCo raises ValueError with its compiler's message
         raise EngineError(
             f"mujoco refused {source.path}: {' '.join(str(exc).split())}"

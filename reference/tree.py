@@ -51,18 +51,21 @@ class Body:
     armature: tuple[float, ...]
 
 
+CHUNK_ROWS = 4096
+"""Complex-step rows evaluated together (states × (nv + 1)): numpy's per-call overhead
+amortised, memory bounded (a 35-dof tree: ~110 states a chunk, tens of MB)."""
 NQ = {"hinge": 1, "slide": 1, "ball": 4, "free": 7}
 NV = {"hinge": 1, "slide": 1, "ball": 3, "free": 6}
 
 
 def _hat(x: np.ndarray) -> np.ndarray:
-    """(B, 3) → (B, 3, 3) skew matrices, x̂ y = x × y."""
-    z = np.zeros_like(x[:, 0])
+    """(..., 3) → (..., 3, 3) skew matrices, x̂ y = x × y."""
+    z = np.zeros_like(x[..., 0])
     return np.stack(
         [
-            np.stack([z, -x[:, 2], x[:, 1]], -1),
-            np.stack([x[:, 2], z, -x[:, 0]], -1),
-            np.stack([-x[:, 1], x[:, 0], z], -1),
+            np.stack([z, -x[..., 2], x[..., 1]], -1),
+            np.stack([x[..., 2], z, -x[..., 0]], -1),
+            np.stack([-x[..., 1], x[..., 0], z], -1),
         ],
         -2,
     )
@@ -71,31 +74,33 @@ def _hat(x: np.ndarray) -> np.ndarray:
 def _exp_and_jr(xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """exp(ξ̂) and the right Jacobian J_r(ξ) (ω = J_r ξ̇), by their series in s = ξ·ξ
     (complex-analytic; |ξ| ≤ η makes four terms exact)."""
-    s = np.einsum("bi,bi->b", xi, xi)[:, None, None]
+    s = np.einsum("...i,...i->...", xi, xi)[..., None, None]
     a = 1 - s / 6 + s**2 / 120 - s**3 / 5040  # sin θ / θ
     b = 0.5 - s / 24 + s**2 / 720 - s**3 / 40320  # (1 − cos θ) / θ²
     c = 1.0 / 6 - s / 120 + s**2 / 5040 - s**3 / 362880  # (θ − sin θ) / θ³
     k = _hat(xi)
     k2 = k @ k
-    eye = np.eye(3)[None]
+    eye = np.eye(3)
     return eye + a * k + b * k2, eye - b * k + c * k2
 
 
 def _rotation(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """Rodrigues' rotation about a fixed unit axis by angles (B,) (complex-analytic)."""
-    k = _hat(np.broadcast_to(axis, (len(angle), 3)).astype(angle.dtype))
-    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
-    return np.eye(3)[None] + s * k + (1 - c) * (k @ k)
+    """Rodrigues' rotation about a fixed unit axis by angles (...) (complex-analytic)."""
+    k = _hat(np.asarray(axis, float))
+    s, c = np.sin(angle)[..., None, None], np.cos(angle)[..., None, None]
+    return np.eye(3) + s * k + (1 - c) * (k @ k)
 
 
 def _quat_matrix(q: np.ndarray) -> np.ndarray:
-    w, x, y, z = q / np.linalg.norm(q)
-    return np.array(
+    """(B, 4) unit quaternions (w, x, y, z; normalised here) → (B, 3, 3) rotations."""
+    w, x, y, z = (q / np.linalg.norm(q, axis=-1, keepdims=True)).T
+    return np.stack(
         [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        -2,
     )
 
 
@@ -120,109 +125,165 @@ class TreeDynamics:
                             for i in chain])
             for chain in chains
         ]
-
-    def _kinematics(
-        self, q: np.ndarray, x: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, list[list[tuple[slice, np.ndarray, np.ndarray | None]]]]:
-        """At the state q (chart centre) displaced by chart coordinates x (B, nv), complex:
-        each body's rigid transform x ↦ R x + t (R (nb, B, 3, 3), t (nb, B, 3)) and each
-        joint's Jacobian columns (angular about a pivot, or linear: pivot None)."""
-        nb, batch = len(self.bodies), x.shape[0]
-        dtype = x.dtype
-        rot = np.empty((nb, batch, 3, 3), dtype)
-        trans = np.empty((nb, batch, 3), dtype)
-        # Per joint: its Jacobian columns — angular (B, 3, d) about a pivot (B, 3), or linear.
-        columns: list[list[tuple[slice, np.ndarray, np.ndarray | None]]] = []
-        for j, body in enumerate(self.bodies):
-            qs, vs = int(self.q_start[j]), int(self.v_start[j])
-            cols = slice(vs, vs + NV[body.kind])
-            xj = x[:, cols]
-            if body.parent >= 0:
-                rp, tp = rot[body.parent], trans[body.parent]
-            else:
-                rp = np.broadcast_to(np.eye(3, dtype=dtype), (batch, 3, 3))
-                tp = np.zeros((batch, 3), dtype)
-            anchor = np.asarray(body.anchor, float)
-            pivot = np.einsum("bij,j->bi", rp, anchor) + tp
-            if body.kind == "hinge":
-                local = _rotation(body.axis, q[qs] - body.zero + xj[:, 0])
-                w = np.einsum("bij,j->bi", rp, body.axis)[:, :, None]
-                columns.append([(cols, w, pivot)])
-            elif body.kind == "slide":
-                local = np.broadcast_to(np.eye(3, dtype=dtype), (batch, 3, 3))
-                disp = (q[qs] - body.zero + xj[:, 0])[:, None] * body.axis
-                w = np.einsum("bij,j->bi", rp, body.axis)[:, :, None]
-                columns.append([(cols, w, None)])
-            elif body.kind == "ball":
-                e, jr = _exp_and_jr(xj)
-                frame = body.frame
-                current = frame @ _quat_matrix(q[qs : qs + 4]) @ e  # (B, 3, 3)
-                local = current @ frame.T
-                columns.append([(cols, rp @ current @ jr, pivot)])
-            else:  # free: q = (p, quat) world pose; x = (dp, ξ)
-                e, jr = _exp_and_jr(xj[:, 3:])
-                world = _quat_matrix(q[qs + 3 : qs + 7]) @ e
-                p = q[qs : qs + 3] + xj[:, :3]
-                rot[j] = world @ body.frame.T
-                trans[j] = p - np.einsum("bij,j->bi", rot[j], anchor)
-                columns.append(
-                    [
-                        (slice(vs, vs + 3), np.broadcast_to(np.eye(3), (batch, 3, 3)), None),
-                        (slice(vs + 3, vs + 6), world @ jr, p),
-                    ]
-                )
-                continue
-            rot[j] = rp @ local  # x ↦ Rp (a + L (x − a)) + tp
-            trans[j] = pivot - np.einsum("bij,j->bi", rot[j], anchor)
-            if body.kind == "slide":
-                trans[j] = trans[j] + np.einsum("bij,bj->bi", rp, disp)
-        return rot, trans, columns
+        self._rows()
 
     def at(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
-        """M, h, T, V at one state (MuJoCo layout). A body's energy depends only on its
-        ancestors' coordinates, so each body is evaluated on the complex steps of those
-        columns alone (plus the unperturbed state, the last row)."""
-        nv = self.nv
-        x = np.zeros((nv + 1, nv), complex)
-        x[np.arange(nv), np.arange(nv)] = 1j * STEP
-        rot, trans, columns = self._kinematics(np.asarray(q, float), x)
-        mass = np.diag(self.armature).astype(float)
-        dg = np.zeros((nv, nv, nv))  # dg[k] = ∂_k g
-        dv = np.zeros(nv)
-        potential = 0.0
-        # All joints' columns at once: angular (B, 3, nv) with their pivots, linear (B, 3, nv).
-        angular = np.zeros((nv + 1, 3, nv), complex)
-        pivots = np.zeros((nv + 1, 3, nv), complex)
-        linear = np.zeros((nv + 1, 3, nv), complex)
-        for joint_columns in columns:
-            for span, w, pivot in joint_columns:
-                if pivot is None:
-                    linear[:, :, span] = w
+        """M, h, T, V at one state (MuJoCo layout); :meth:`at_states` for several."""
+        mass, h, kinetic, potential = self.at_states(np.asarray(q, float)[None],
+                                                     np.asarray(v, float)[None])
+        return mass[0], h[0], float(kinetic[0]), float(potential[0])
+
+    def at_states(
+        self, q: np.ndarray, v: np.ndarray, chunk: int = CHUNK_ROWS
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """M (S, nv, nv), h (S, nv), T (S,), V (S,) at S states, evaluated together in
+        chunks of about ``chunk`` states × rows (memory bounded whatever S)."""
+        q, v = np.asarray(q, float), np.asarray(v, float)
+        per = max(1, chunk // (self.nv + 2))
+        parts = [self._at_chunk(q[i : i + per], v[i : i + per]) for i in range(0, len(q), per)]
+        if not parts:
+            nv = self.nv
+            return np.empty((0, nv, nv)), np.empty((0, nv)), np.empty(0), np.empty(0)
+        mass, h, kinetic, potential = (np.concatenate(x) for x in zip(*parts, strict=True))
+        return mass, h, kinetic, potential
+
+    def _rows(self) -> None:
+        """Each body's rows of complex steps: one per ancestor column (that column stepped),
+        then the velocity direction, then the unperturbed state; and, for each ancestor
+        joint, which of that joint's rows each of these rows is (a column that is not the
+        ancestor's own is its unperturbed row)."""
+        self.rows_of: list[dict[int, np.ndarray]] = []
+        for j, body in enumerate(self.bodies):
+            cols = self.ancestor_columns[j]
+            n = len(cols)
+            maps: dict[int, np.ndarray] = {j: np.arange(n + 2)}
+            if body.parent >= 0:
+                parent_cols = list(self.ancestor_columns[body.parent])
+                pn = len(parent_cols)
+                to_parent = np.array(
+                    [parent_cols.index(c) if c in parent_cols else pn + 1 for c in cols]
+                    + [pn, pn + 1]
+                )
+                for ancestor, rows in self.rows_of[body.parent].items():
+                    maps[ancestor] = rows[to_parent]
+            self.rows_of.append(maps)
+
+    def _at_chunk(
+        self, q: np.ndarray, v: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """M, h, T, V at the states q (S, nq), v (S, nv).
+
+        Each body b is evaluated on its rows (:meth:`_rows`): the chart coordinates x of its
+        ancestors stepped by iη one at a time, then by iη v, then not at all. With g the
+        metric (the formula in the module's docstring), 2T_b = vᵀ g_b v = m |ċ|² + ωᵀ I ω, and
+
+            Σ_k ∂_k g_ij vᵏ vʲ = Im(g(q + iηv) v)_i / η,   ∂_i (vᵀ g_b v) = Im(2T_b)_i / η,
+
+        so h needs no tensor ∂g: (g v)_i is joint i's axis against the momentum of the
+        bodies it carries — w·(L − p × P) for a rotation about pivot p, w·P for a
+        translation (L the angular momentum about the world origin, P the linear) — and
+        every body's ċ, ω come from its twist, its parent's plus its own joint's. M is g at
+        the unperturbed row. A body's kinematics depend only on its ancestors' coordinates:
+        c_b + 2 rows each."""
+        ns, nv = len(q), self.nv
+        nb = len(self.bodies)
+        mass = np.tile(np.diag(self.armature).astype(float), (ns, 1, 1))
+        h = np.zeros((ns, nv))
+        potential = np.zeros(ns)
+        step = 1j * STEP
+        poses: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []  # R t Ω V
+        # per joint, at its v row (complex) and its unperturbed row (real): columns as
+        # (angular (S, 3, k), pivot (S, 3)) or (linear (S, 3, k), None), with their span
+        at_v: list[list[tuple[slice, np.ndarray, np.ndarray | None]]] = []
+        angular0 = np.zeros((ns, 3, nv))
+        pivot0 = np.zeros((ns, 3, nv))
+        linear0 = np.zeros((ns, 3, nv))
+        momentum = np.zeros((nb, ns, 3), complex)  # P of the subtree, at the v row
+        spin_sum = np.zeros((nb, ns, 3), complex)  # L about the origin, at the v row
+        for j, body in enumerate(self.bodies):
+            cols = self.ancestor_columns[j]
+            n, own = len(cols), NV[body.kind]
+            qs, vs = int(self.q_start[j]), int(self.v_start[j])
+            vj = v[:, vs : vs + own]
+            xj = np.zeros((ns, n + 2, own), complex)  # this joint's chart coordinates
+            xj[:, np.arange(n - own, n), np.arange(own)] = step
+            xj[:, n, :] = step * vj
+            if body.parent >= 0:
+                up = self.rows_of[j][body.parent]
+                rp, tp, omega, vel = (x[:, up] for x in poses[body.parent])
+            else:
+                rp = np.broadcast_to(np.eye(3), (ns, n + 2, 3, 3))
+                tp = np.zeros((ns, n + 2, 3))
+                omega = vel = np.zeros((ns, n + 2, 3), complex)
+            anchor = np.asarray(body.anchor, float)
+            pivot = np.einsum("srij,j->sri", rp, anchor) + tp
+            span = slice(vs, vs + own)
+            if body.kind in ("hinge", "slide"):
+                axis = np.einsum("srij,j->sri", rp, body.axis)
+                coordinate = (q[:, qs] - body.zero)[:, None] + xj[..., 0]
+                columns = [(span, axis[..., None], pivot if body.kind == "hinge" else None)]
+            if body.kind == "hinge":
+                rot = rp @ _rotation(body.axis, coordinate)
+                trans = pivot - np.einsum("srij,j->sri", rot, anchor)
+            elif body.kind == "slide":
+                rot = np.asarray(rp)
+                trans = tp + coordinate[..., None] * axis
+            elif body.kind == "ball":
+                e, jr = _exp_and_jr(xj)
+                current = body.frame @ _quat_matrix(q[:, qs : qs + 4])[:, None] @ e
+                rot = rp @ current @ body.frame.T
+                trans = pivot - np.einsum("srij,j->sri", rot, anchor)
+                columns = [(span, rp @ current @ jr, pivot)]
+            else:  # free: q = (p, quat) world pose; x = (dp, ξ)
+                e, jr = _exp_and_jr(xj[..., 3:])
+                world = _quat_matrix(q[:, qs + 3 : qs + 7])[:, None] @ e
+                position = q[:, None, qs : qs + 3] + xj[..., :3]
+                rot = world @ body.frame.T
+                trans = position - np.einsum("srij,j->sri", rot, anchor)
+                columns = [(slice(vs, vs + 3), np.broadcast_to(np.eye(3), rot.shape), None),
+                           (slice(vs + 3, vs + 6), world @ jr, position)]
+            for part, w, point in columns:  # the twist: the parent's plus this joint's
+                turn = np.einsum("srik,sk->sri", w, v[:, part])
+                if point is None:
+                    vel = vel + turn
                 else:
-                    angular[:, :, span] = w
-                    pivots[:, :, span] = pivot[:, :, None]
-        for b, body in enumerate(self.bodies):
+                    omega = omega + turn
+                    vel = vel + np.cross(point, turn)
+                angular0[..., part] = w[:, -1].real if point is not None else 0.0
+                linear0[..., part] = w[:, -1].real if point is None else 0.0
+                if point is not None:
+                    pivot0[..., part] = point[:, -1, :, None].real
+            at_v.append([(part, w[:, n], None if point is None else point[:, n])
+                         for part, w, point in columns])
+            poses.append((rot, trans, omega, vel))
             if body.mass == 0.0 and not np.any(body.inertia):
                 continue
-            cols = self.ancestor_columns[b]
-            rows = np.append(cols, nv)
-            r, t = rot[b][rows], trans[b][rows]
-            c = np.einsum("bij,j->bi", r, body.com) + t
-            jw = angular[np.ix_(rows, np.arange(3), cols)]
-            arm = c[:, :, None] - pivots[np.ix_(rows, np.arange(3), cols)]
-            jc = linear[np.ix_(rows, np.arange(3), cols)] + np.stack(  # ω × (c − p)
-                [
-                    jw[:, 1] * arm[:, 2] - jw[:, 2] * arm[:, 1],
-                    jw[:, 2] * arm[:, 0] - jw[:, 0] * arm[:, 2],
-                    jw[:, 0] * arm[:, 1] - jw[:, 1] * arm[:, 0],
-                ],
-                1,
-            )
-            inertia = r @ body.inertia @ np.swapaxes(r, 1, 2)
-            gb = body.mass * np.swapaxes(jc, 1, 2) @ jc + np.swapaxes(jw, 1, 2) @ inertia @ jw
-            mass[np.ix_(cols, cols)] += gb[-1].real
-            dg[np.ix_(cols, cols, cols)] += gb[:-1].imag / STEP
-            dv[cols] -= body.mass * (self.gravity @ jc[-1].real)
-            potential -= body.mass * float(self.gravity @ c[-1].real)
-        h = np.einsum("kij,k,j->i", dg, v, v) - 0.5 * np.einsum("ijk,j,k->i", dg, v, v) + dv
-        return mass, h, 0.5 * float(v @ mass @ v), potential
+            com = np.einsum("srij,j->sri", rot, body.com) + trans
+            cdot = vel + np.cross(omega, com)
+            local = np.einsum("srji,srj->sri", rot, omega) @ body.inertia  # (I₀ symmetric)
+            spin = np.einsum("srij,srj->sri", rot, local)  # I ω in world axes
+            twice_t = (body.mass * np.einsum("sri,sri->sr", cdot, cdot)
+                       + np.einsum("sri,sri->sr", omega, spin))
+            h[:, cols] -= 0.5 * twice_t[:, :n].imag / STEP
+            momentum[j] += body.mass * cdot[:, n]
+            spin_sum[j] += np.cross(com[:, n], body.mass * cdot[:, n]) + spin[:, n]
+            # M, gravity and V at the unperturbed row, from the joints' real columns
+            com0, rot0 = com[:, -1].real, rot[:, -1].real
+            jw = angular0[..., cols]
+            arm = com0[..., None] - pivot0[..., cols]
+            jc = linear0[..., cols] + np.cross(jw, arm, axis=1)
+            inertia = rot0 @ body.inertia @ np.swapaxes(rot0, 1, 2)
+            mass[:, cols[:, None], cols[None, :]] += (
+                body.mass * np.swapaxes(jc, 1, 2) @ jc + np.swapaxes(jw, 1, 2) @ inertia @ jw)
+            h[:, cols] -= body.mass * np.einsum("j,sjc->sc", self.gravity, jc)
+            potential -= body.mass * (com0 @ self.gravity)
+        for j in reversed(range(nb)):  # each joint against the momentum of what it carries
+            parent = self.bodies[j].parent
+            if parent >= 0:
+                momentum[parent] += momentum[j]
+                spin_sum[parent] += spin_sum[j]
+            for part, w, point in at_v[j]:
+                arm = momentum[j] if point is None else spin_sum[j] - np.cross(point, momentum[j])
+                h[:, part] += np.einsum("sik,si->sk", w, arm).imag / STEP
+        kinetic = 0.5 * np.einsum("si,sij,sj->s", v, mass, v)
+        return mass, h, kinetic, potential

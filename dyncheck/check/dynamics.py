@@ -88,7 +88,16 @@ def floors(tree: ModelTree, dyn: Dynamics, states: States) -> dict[str, tuple[fl
 
 
 def condition(mass: np.ndarray) -> float:
-    return float(np.linalg.cond(mass).max())
+    """The largest condition number of M over the states (the symmetric M's eigenvalues:
+    a fifth of the SVD's cost; an indefinite M from a broken model still gives |λ|
+    max/min)."""
+    with np.errstate(all="ignore"):
+        symmetric = 0.5 * (mass + np.swapaxes(mass, -1, -2))
+        eig = np.abs(np.linalg.eigvalsh(symmetric))
+        if not np.all(np.isfinite(eig)):
+            return float(np.linalg.cond(mass).max())
+        ratio = eig.max(axis=-1) / eig.min(axis=-1)
+        return float(np.nan_to_num(ratio, nan=np.inf).max()) if eig.size else 1.0
 
 
 def _values(dyn: Dynamics, quantity: str) -> np.ndarray:

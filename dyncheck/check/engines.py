@@ -41,17 +41,20 @@ class ModelEngine(Protocol):
 
 @dataclass(frozen=True)
 class Engine:
-    """Where an engine's model loader lives and the extra that installs it."""
+    """Where an engine's model loader lives, the extra that installs it, and the package
+    whose version a page records (read from its metadata: the engine is never imported in
+    this process for it)."""
 
     module: str
     cls: str
     extra: str | None
+    distribution: str = ""
 
 
 ENGINES = {
-    "mujoco": Engine("dyncheck.adapters.mujoco_model", "MujocoModel", None),
-    "pinocchio": Engine("dyncheck.adapters.pinocchio_model", "PinocchioModel", None),
-    "drake": Engine("dyncheck.adapters.drake_model", "DrakeModel", "drake"),
+    "mujoco": Engine("dyncheck.adapters.mujoco_model", "MujocoModel", None, "mujoco"),
+    "pinocchio": Engine("dyncheck.adapters.pinocchio_model", "PinocchioModel", None, "pin"),
+    "drake": Engine("dyncheck.adapters.drake_model", "DrakeModel", "drake", "drake"),
 }
 REFEREE = "reference"
 IMPLEMENTATIONS = (REFEREE, *ENGINES)
@@ -101,7 +104,9 @@ def _serve(name: str, spec: Engine, source: ModelFile, conn: Connection) -> None
     conn.send(loaded.tree)
     while (batch := conn.recv()) is not None:
         try:
-            conn.send(loaded.dynamics(*batch))
+            t0 = time.perf_counter()
+            answer = loaded.dynamics(*batch)
+            conn.send((answer, time.perf_counter() - t0))
         except Exception as exc:
             conn.send(EngineError(f"{type(exc).__name__}: {' '.join(str(exc).split())}"))
 
@@ -159,11 +164,20 @@ class Isolated:
         return self
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
+        self.submit(q, v, a)
+        return self.collect()[0]
+
+    def submit(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
+        """Hand the engine a batch of states; :meth:`collect` waits for its answer (the
+        caller computes meanwhile: the engines and the referee side by side)."""
         try:
             self._conn.send((q, v, a))
         except OSError:
             raise EngineError(f"{self.engine} crashed earlier "
                               f"({_death(self._proc.exitcode)})") from None
+
+    def collect(self) -> tuple[Dynamics, float]:
+        """The submitted batch's dynamics and the seconds the engine spent on them."""
         answer = self._receive("computing the dynamics", TIMEOUT_S)
         if isinstance(answer, Exception):
             raise answer

@@ -197,14 +197,7 @@ def _check(model: str, source_path: Path, source: ModelFile,
             unmatched.append(e)
     batch = sample(canon, canonical_tree, states, seed)
     results = {}
-    if REFEREE in chosen:
-        t0 = time.perf_counter()
-        try:
-            results[REFEREE] = ReferenceModel(canonical_tree).dynamics(batch.q, batch.v, batch.a)
-        except Exception as exc:  # the referee failing on a tree costs its own rows too
-            rows.append(_row(model, Section.DYNAMICS, REFEREE, Verdict.FAILED,
-                             f"{type(exc).__name__}: {exc}", field="dynamics"))
-        seconds[REFEREE] = time.perf_counter() - t0
+    pending = {}  # engines in processes of their own compute while the referee does
     for engine, m in loaded.items():
         if engine in unmatched:
             rows.append(_row(model, Section.DYNAMICS, engine, Verdict.SKIPPED,
@@ -217,11 +210,33 @@ def _check(model: str, source_path: Path, source: ModelFile,
         maps, q_e, v_e, a_e = layout.engine_states(
             canon if part is None else layout.canonical(part.tree), m.tree, on.q, on.v, on.a)
         try:
-            results[engine] = layout.to_canonical(maps, m.dynamics(q_e, v_e, a_e))
+            if isinstance(m, engine_processes.Isolated):
+                m.submit(q_e, v_e, a_e)
+                pending[engine] = (m, maps)
+            else:
+                results[engine] = layout.to_canonical(maps, m.dynamics(q_e, v_e, a_e))
         except Exception as exc:  # an engine failing mid-way costs its own rows
             rows.append(_row(model, Section.DYNAMICS, engine, Verdict.FAILED,
                              f"{type(exc).__name__}: {exc}", field="dynamics"))
         seconds[engine] = seconds.get(engine, 0.0) + time.perf_counter() - t0
+    if REFEREE in chosen:
+        t0 = time.perf_counter()
+        try:
+            results[REFEREE] = ReferenceModel(canonical_tree).dynamics(batch.q, batch.v, batch.a)
+        except Exception as exc:  # the referee failing on a tree costs its own rows too
+            rows.append(_row(model, Section.DYNAMICS, REFEREE, Verdict.FAILED,
+                             f"{type(exc).__name__}: {exc}", field="dynamics"))
+        seconds[REFEREE] = time.perf_counter() - t0
+    for engine, (proxy, maps) in pending.items():
+        try:
+            answer, took = proxy.collect()
+            results[engine] = layout.to_canonical(maps, answer)
+            seconds[engine] += took
+        except Exception as exc:
+            rows.append(_row(model, Section.DYNAMICS, engine, Verdict.FAILED,
+                             f"{type(exc).__name__}: {exc}", field="dynamics"))
+    results = {name: results[name] for name in (REFEREE, *loaded) if name in results}
+    seconds = {k: seconds[k] for k in ("load", REFEREE, *loaded) if k in seconds}
     for name in list(results):
         bad = [f for f, value in vars(results[name]).items() if not np.all(np.isfinite(value))]
         if bad:

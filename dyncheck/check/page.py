@@ -24,11 +24,24 @@ TITLES = {
 
 
 def _versions(result: CheckResult) -> dict[str, str]:
-    """The provenance of the engines the check used (another engine is never imported: MJX
-    and MuJoCo Warp would cost seconds of importing JAX and Warp for nothing)."""
-    from dyncheck.provenance import engine_versions, versions
+    """The provenance of the engines the check used, from their packages' metadata (an
+    engine is never imported here for it: the engines ran in processes of their own, and
+    importing Drake alone costs 0.3 s)."""
+    from importlib.metadata import PackageNotFoundError, version
 
-    return versions(engine_versions(result.impls))
+    from dyncheck.check.engines import ENGINES
+    from dyncheck.provenance import ENGINES as LABELS
+    from dyncheck.provenance import versions
+
+    labels = dict(LABELS)
+    used = {}
+    for name in result.impls:
+        if name in ENGINES and name in labels:
+            try:
+                used[labels[name]] = version(ENGINES[name].distribution)
+            except PackageNotFoundError:
+                used[labels[name]] = "not installed"
+    return versions(used)
 
 
 def counts(result: CheckResult) -> dict[str, int]:

@@ -33,18 +33,21 @@ class ReferenceModel:
         self.solver = TreeDynamics(bodies(tree), tree.gravity)
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
-        n, nv = len(q), self.solver.nv
-        mass = np.empty((n, nv, nv))
-        bias, forward, inverse = (np.empty((n, nv)) for _ in range(3))
-        kinetic, potential = np.empty(n), np.empty(n)
+        """Every state at once (:meth:`TreeDynamics.at_states`); forward dynamics by one
+        batched solve, a singular M (a joint moving no mass, a NaN) giving NaN for its state:
+        a failed row (non-finite), never a crash."""
         with np.errstate(all="ignore"):  # an overflow shows as a non-finite result: a row
-            for i in range(n):
-                mass[i], bias[i], kinetic[i], potential[i] = self.solver.at(q[i], v[i])
-                try:
-                    forward[i] = np.linalg.solve(mass[i], -bias[i])
-                except np.linalg.LinAlgError:  # M singular (a joint moving no mass, a NaN):
-                    forward[i] = np.nan  # no forward dynamics — a failed row (non-finite)
-                inverse[i] = mass[i] @ a[i] + bias[i]
+            mass, bias, kinetic, potential = self.solver.at_states(q, v)
+            forward = np.full_like(bias, np.nan)
+            try:
+                forward = np.linalg.solve(mass, -bias[..., None])[..., 0]
+            except np.linalg.LinAlgError:  # one singular M fails the batch: state by state
+                for i in range(len(q)):
+                    try:
+                        forward[i] = np.linalg.solve(mass[i], -bias[i])
+                    except np.linalg.LinAlgError:
+                        pass
+            inverse = np.einsum("sij,sj->si", mass, a) + bias
         return Dynamics(
             mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
             kinetic=kinetic, potential=potential,
