@@ -14,7 +14,9 @@ M = ``CalcMassMatrix``, h = ``CalcBiasTerm`` −
 ``CalcGravityGeneralizedForces``, forward dynamics the plant's generalized-acceleration
 output, inverse ``CalcInverseDynamics`` with gravity from ``CalcForceElementsContribution``.
 State layout: a floating joint q = (w, x, y, z, p), v = (ω, v), both in world axes. A ball
-joint is a ``BallRpyJoint`` (roll-pitch-yaw coordinates): not mapped here (its rows skipped).
+joint is a ``BallRpyJoint``: q = (roll, pitch, yaw) of the child frame M in the parent-side
+frame F, v = ω_FM in F (measured: the body's world angular velocity equals v when F is the
+world).
 """
 
 from __future__ import annotations
@@ -51,7 +53,13 @@ _TYPES = {
     "revolute": JointType.HINGE,
     "prismatic": JointType.SLIDE,
     "quaternion_floating": JointType.FREE,
+    "ball_rpy": JointType.BALL,
 }
+BALL_ARMATURE = (
+    "Drake's MJCF parser keeps armature only as the reflected inertia of an actuator, and "
+    "only a one-degree-of-freedom joint carries one: Drake's M leaves out the armature of "
+    "ball joint {joint!r} (fix: model the rotor as body inertia)"
+)
 
 
 def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str, tuple]]:
@@ -196,17 +204,20 @@ class DrakeModel:
                     range=(float(lower[0]), float(upper[0])) if limited else None,
                     layout=Layout(
                         q_start=joint.position_start(), v_start=joint.velocity_start(),
-                        nq=joint.num_positions(), nv=nv, quat="wxyz", quat_first=True,
-                        angular_first=True, linear_axes=Axes.WORLD, angular_axes=Axes.WORLD,
+                        nq=joint.num_positions(), nv=nv,
+                        quat="rpy" if kind is JointType.BALL else "wxyz", quat_first=True,
+                        angular_first=True, linear_axes=Axes.WORLD,
+                        angular_axes=Axes.PARENT if kind is JointType.BALL else Axes.WORLD,
                         zero=float(q0[joint.position_start()]) if nv == 1 else 0.0,
                     ),
                 )
             )
         gravity = np.asarray(plant.gravity_field().gravity_vector(), float)
         hints = tuple(
-            (j.name, "armature", UNACTUATED_ARMATURE.format(joint=j.name))
+            (j.name, "armature", (BALL_ARMATURE if j.type is JointType.BALL
+                                  else UNACTUATED_ARMATURE).format(joint=j.name))
             for j in joints
-            if j.type in (JointType.HINGE, JointType.SLIDE) and j.name not in reflected
+            if j.type is not JointType.FREE and j.name not in reflected
             and self._source.format is Format.MJCF
         )
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,

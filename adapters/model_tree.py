@@ -33,6 +33,9 @@ class Axes(StrEnum):
 
     WORLD = "world"
     LOCAL = "local"
+    PARENT = "parent"
+    """A ball joint's parent-side frame F, which coincides with the child's frame at the
+    reference configuration (Drake's ``BallRpyJoint``: v = ω of the child in F, in F)."""
 
 
 NQ = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 4, JointType.FREE: 7}
@@ -43,7 +46,8 @@ NV = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 3, JointType.FREE:
 class Layout:
     """Where one joint's coordinates sit in an engine's q and v, and in which convention.
 
-    ``quat`` is ``"wxyz"`` or ``"xyzw"``; a free joint's q is ``(p, quat)`` unless
+    ``quat`` is ``"wxyz"`` or ``"xyzw"``, or for a ball joint ``"rpy"`` (roll, pitch, yaw:
+    R = R_z(yaw) R_y(pitch) R_x(roll), three coordinates); a free joint's q is ``(p, quat)`` unless
     ``quat_first``; its v is ``(linear, angular)`` unless ``angular_first``, each resolved in
     ``linear_axes`` / ``angular_axes``. ``cos_sin``: a hinge stored as (cos θ, sin θ) (an
     unbounded revolute joint)."""

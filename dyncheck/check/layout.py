@@ -3,7 +3,8 @@
 The canonical layout is MuJoCo's convention in the canonical joint order: a hinge or slide its
 coordinate; a quaternion (w, x, y, z); a free joint q = (p, quat) as the world pose of its body,
 v = (linear velocity in world axes, angular velocity in local axes); a ball joint v = angular
-velocity in local axes. Each engine declares its own
+velocity in local axes (an engine may hold it in roll-pitch-yaw coordinates with v in the
+parent-side frame: T = R there, and Ṫ v = 0). Each engine declares its own
 (:class:`~dyncheck.adapters.model_tree.Layout`).
 
 Velocities map linearly, v_e = T(q) v_c, with T orthogonal (a permutation of the joints'
@@ -50,6 +51,15 @@ def canonical(tree: ModelTree) -> Canonical:
     )
 
 
+def rpy_from_matrix(rot: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw with R = R_z(yaw) R_y(pitch) R_x(roll) (any of the two solutions
+    gives the same R; at pitch ±π/2 roll and yaw share one angle, chosen with roll 0)."""
+    pitch = np.arcsin(np.clip(-rot[2, 0], -1.0, 1.0))
+    if abs(rot[2, 0]) > 1 - 1e-12:
+        return np.array([0.0, pitch, np.arctan2(-rot[0, 1], rot[1, 1])])
+    return np.array([np.arctan2(rot[2, 1], rot[2, 2]), pitch, np.arctan2(rot[1, 0], rot[0, 0])])
+
+
 def _quat_out(quat_wxyz: np.ndarray, order: str) -> np.ndarray:
     return quat_wxyz if order == "wxyz" else np.concatenate([quat_wxyz[1:], quat_wxyz[:1]])
 
@@ -84,6 +94,11 @@ def _state_map(
             else:
                 q_e[qe] = value
             t[ve, vs] = 1.0
+        elif kind is JointType.BALL and lay.quat == "rpy":
+            rot = quat_to_matrix(q_c[None, qs : qs + 4])[0]
+            q_e[qe : qe + 3] = rpy_from_matrix(rot)
+            # ω in F = R ω in the child's axes; d/dt(R ω) = R ω̇ (Ṙ ω = R ω̂ ω = 0): Ṫ v = 0
+            t[ve : ve + 3, vs : vs + 3] = rot if lay.angular_axes is Axes.PARENT else np.eye(3)
         elif kind is JointType.BALL:
             q_e[qe : qe + 4] = _quat_out(q_c[qs : qs + 4], lay.quat)
             t[ve : ve + 3, vs : vs + 3] = np.eye(3)
