@@ -132,6 +132,9 @@ class MJXAdapter(PortAdapter):
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
+        self._put()
+
+    def _put(self) -> None:
         # MJX has no energy flag (put_model refuses it): energies come from M and xipos
         self.model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_ENERGY)
         with self._precision():

@@ -99,6 +99,9 @@ class ModelTree:
     nq: int
     nv: int
     notes: tuple[str, ...] = field(default=())
+    eps: float = float(np.finfo(float).eps)
+    """The engine's arithmetic precision (a float32 port: ε₃₂), which its round-off bounds
+    use."""
     hints: tuple[tuple[str, str, str], ...] = field(default=())
     """(joint, field, why): what the engine is known to do with that field of that joint and
     how to change it — the note of a description row that finds the field read differently;

@@ -20,6 +20,7 @@ from abc import abstractmethod
 from operator import attrgetter
 from typing import ClassVar
 
+import mujoco
 import numpy as np
 
 from dyncheck.adapters.base import LoadedBody, Trajectory
@@ -57,7 +58,31 @@ class PortAdapter(MuJoCoAdapter):
             )
         super().__init__(model)
 
+    @classmethod
+    def on_model(cls, model: mujoco.MjModel) -> PortAdapter:
+        """The port holding a compiled C model directly — a user's file, which no
+        :class:`Multibody` describes (``dyncheck check``): only :meth:`raw` and
+        :meth:`_loaded` are meaningful on it."""
+        port = cls.__new__(cls)
+        port.model = model
+        port._put()
+        return port
+
+    def raw(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray,
+            a: np.ndarray) -> dict[str, np.ndarray]:
+        """Every state's ``M``, ``bias``, ``qacc``, ``qfrc_inverse`` and ``xipos`` as the port
+        computes them (float64 arrays of the port's numbers)."""
+        return self._chunks(q, v, tau, a)
+
+    def model_array(self, field: str) -> np.ndarray:
+        """A model array as the port holds it (:meth:`_loaded`)."""
+        return self._loaded(field)
+
     # --- what each port provides ----------------------------------------------------------
+
+    @abstractmethod
+    def _put(self) -> None:
+        """Hand ``self.model`` (the C model) to the port."""
 
     @abstractmethod
     def _loaded(self, field: str) -> np.ndarray:

@@ -96,6 +96,9 @@ class MuJoCoWarpAdapter(PortAdapter):
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
+        self._put()
+
+    def _put(self) -> None:
         self.model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_ENERGY)
         self.device = device()
         self.max_steps = CPU_STEPS if self.device == "cpu" else None

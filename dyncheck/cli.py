@@ -124,7 +124,9 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--robot", action="append", default=[], metavar="NAME",
                    help="a robot of example-robot-data (extra 'robots'; see `dyncheck list`)")
     k.add_argument("--impl", action="append", default=[], metavar="NAME",
-                   help="reference, mujoco, pinocchio, drake (repeatable; default: all)")
+                   help="reference, mujoco, pinocchio, drake, and MuJoCo's ports mjx, mjx-f64, "
+                   "mujoco-warp (repeatable; default: the first four; a port only when named: "
+                   "compiling a model for it takes seconds)")
     k.add_argument("--states", type=int, default=100, metavar="N", help="sampled states")
     k.add_argument("--seed", type=int, default=0, metavar="S")
     k.add_argument("--floating", action="store_true",
@@ -610,8 +612,7 @@ def _check(args: argparse.Namespace) -> int:
     from functools import partial
 
     from dyncheck.check import index, inputs
-    from dyncheck.check.engines import IMPLEMENTATIONS
-    from dyncheck.check.model_check import check_model
+    from dyncheck.check.model_check import check_model, implementations
     from dyncheck.check.page import summary_line, write
     from dyncheck.workers import each_unit
 
@@ -647,7 +648,7 @@ def _check(args: argparse.Namespace) -> int:
                "isolate": not args.in_process}
     units = [(name, partial(check_model, **options, name=robot or (name if several else None)),
               (str(path),)) for path, robot, name in valid]
-    engines = tuple(i for i in (args.impl or IMPLEMENTATIONS) if i != "reference")
+    engines = tuple(i for i in implementations(tuple(args.impl) or None) if i != "reference")
     failed, refusals = False, len(entries)
     for name, result in each_unit(units, jobs=args.jobs, dask=args.dask):
         if isinstance(result, DyncheckError):

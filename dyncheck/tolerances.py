@@ -28,7 +28,8 @@ EPS32 = float(np.finfo(np.float32).eps)
 ROUNDOFF_FACTOR = 64
 
 
-def _unit(eps: float) -> str:
+def eps_name(eps: float) -> str:
+    """How a round-off basis names ε: "eps" (float64), "float32 eps", or its value."""
     return "eps" if eps == EPS else ("float32 eps" if eps == EPS32 else f"eps {eps:.3g}")
 
 
@@ -56,7 +57,7 @@ def instantaneous(
     the unit round-off of the pair's less precise implementation."""
     if quantity not in QUANTITIES:
         raise KeyError(quantity)
-    unit = _unit(eps)
+    unit = eps_name(eps)
     if quantity in ("forward_dynamics", "constraint_force"):
         basis = f"round-off: {ROUNDOFF_FACTOR} {unit} x cond(M) = {condition:.3g}"
         if soft > 1.0:
@@ -70,7 +71,7 @@ def accumulated(steps: int, soft: float = 1.0, eps: float = EPS) -> Tolerance:
     linearly over the steps (no exponential growth on these regular orbits); ``soft`` as in
     :func:`instantaneous`, for runs through a soft-constraint solve; ``eps`` the unit
     round-off of the less precise run."""
-    basis = f"accumulated round-off: {ROUNDOFF_FACTOR} {_unit(eps)} x {steps} steps"
+    basis = f"accumulated round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x {steps} steps"
     if soft > 1.0:
         basis += f" x soft-constraint Hessian {soft:.3g}"
     return Tolerance(ROUNDOFF_FACTOR * eps * steps * soft, basis)

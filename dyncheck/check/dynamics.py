@@ -28,6 +28,7 @@ from dyncheck.check.describe import EPS, ROUNDOFF, depth, size
 from dyncheck.check.layout import Canonical
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.results import Verdict
+from dyncheck.tolerances import eps_name
 
 QUANTITIES = {
     "mass_matrix": "mass_matrix",
@@ -125,10 +126,13 @@ def compare(
     explanations: dict[str, Explanation],
     caused_by: str,
     states: States,
+    *,
+    eps: float = EPS,
 ) -> list[CheckRow]:
     """One row per quantity. A failure is ``explained`` where ``explanations`` predicts it (the
     difference within prediction + tolerance), or where ``caused_by`` names a description
-    difference found between the two (the dynamics follow from it)."""
+    difference found between the two (the dynamics follow from it). ``eps``: the coarser
+    precision of the two (a float32 port's ε₃₂: the same bounds in its arithmetic)."""
     d = depth(tree)
     kappa = condition(dyn_a.mass_matrix)
     least = floors(tree, dyn_a, states)
@@ -145,8 +149,8 @@ def compare(
         scale = max(float(np.abs(desired).max()), floor, 1e-300)
         errors = np.abs(actual - desired).max(axis=1)
         worst = int(np.argmax(errors))
-        rtol = ROUNDOFF * EPS * d
-        basis = f"round-off: {ROUNDOFF} eps x tree depth {d}"
+        rtol = ROUNDOFF * eps * d
+        basis = f"round-off: {ROUNDOFF} {eps_name(eps)} x tree depth {d}"
         if floor >= float(np.abs(desired).max()) and floor_name:
             basis += f"; scale {floor_name} {floor:.3g} (the value's own is smaller)"
         if quantity == "forward_dynamics":

@@ -55,9 +55,17 @@ ENGINES = {
     "mujoco": Engine("dyncheck.adapters.mujoco_model", "MujocoModel", None, "mujoco"),
     "pinocchio": Engine("dyncheck.adapters.pinocchio_model", "PinocchioModel", None, "pin"),
     "drake": Engine("dyncheck.adapters.drake_model", "DrakeModel", "drake", "drake"),
+    "mjx": Engine("dyncheck.adapters.port_models", "MjxModel", "mjx", "mujoco-mjx"),
+    "mjx-f64": Engine("dyncheck.adapters.port_models", "MjxF64Model", "mjx", "mujoco-mjx"),
+    "mujoco-warp": Engine("dyncheck.adapters.port_models", "MujocoWarpModel", "warp",
+                          "mujoco-warp"),
 }
 REFEREE = "reference"
 IMPLEMENTATIONS = (REFEREE, *ENGINES)
+PORTS = ("mjx", "mjx-f64", "mujoco-warp")
+"""Checked only when asked for (``--impl mjx``): compiling a model for a port takes seconds
+to minutes on a CPU."""
+DEFAULT = tuple(i for i in IMPLEMENTATIONS if i not in PORTS)
 LOAD_TIMEOUT_S = 600.0
 """Longest an isolated engine may take to load a model."""
 TIMEOUT_S = 600.0

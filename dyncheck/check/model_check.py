@@ -25,7 +25,7 @@ from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.check import describe, inputs, layout, partial
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.dynamics import Explanation, States, compare, sample
-from dyncheck.check.engines import ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
+from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
 from dyncheck.check.referee import ReferenceModel
 from dyncheck.check.rows import COLUMNS, CheckRow, Section
 from dyncheck.errors import InvalidInput, UnknownName
@@ -71,13 +71,15 @@ class CheckResult:
         )
 
 
-def _impls(impls: tuple[str, ...] | None) -> tuple[str, ...]:
+def implementations(impls: tuple[str, ...] | None) -> tuple[str, ...]:
+    """The implementations asked for, in :data:`IMPLEMENTATIONS`' order whatever the flags'
+    (MuJoCo first where asked for: the canonical engine, whose tree the others meet)."""
     if impls is None:
-        return IMPLEMENTATIONS
+        return DEFAULT
     for name in impls:
         if name not in IMPLEMENTATIONS:
             raise UnknownName("implementation", name, IMPLEMENTATIONS)
-    return tuple(dict.fromkeys(impls))
+    return tuple(i for i in IMPLEMENTATIONS if i in impls)
 
 
 def _row(model: str, section: Section, engine: str, verdict: Verdict, note: str,
@@ -106,7 +108,7 @@ def check_model(
     source_path = inputs.model_path(str(path))
     against_path = inputs.model_path(str(against)) if against is not None else None
     inputs.states(states)
-    chosen = _impls(impls)
+    chosen = implementations(impls)
     if not any(i in ENGINES for i in chosen):
         raise InvalidInput("--impl", ",".join(chosen), "at least one engine (the referee "
                            "checks an engine's tree)")
@@ -257,7 +259,8 @@ def _check(model: str, source_path: Path, source: ModelFile,
                 if rotor is not None:
                     explanations["kinetic_energy"] = rotor
                 rows.extend(compare(model, canonical_tree, a, results[a], b, results[b],
-                                    explanations, cause, batch))
+                                    explanations, cause, batch,
+                                    eps=max(trees[a].eps, trees[b].eps)))
                 continue
             common = np.arange(canon.nv)
             for held in dofs.values():
@@ -267,7 +270,7 @@ def _check(model: str, source_path: Path, source: ModelFile,
                 model, canonical_tree,
                 a, partial.restrict(results[a], partial.columns(dofs[a], common)),
                 b, partial.restrict(results[b], partial.columns(dofs[b], common)),
-                {}, cause, on))
+                {}, cause, on, eps=max(trees[a].eps, trees[b].eps)))
     frame = pd.DataFrame([vars(r) for r in rows], columns=COLUMNS)
     for column in ("section", "verdict"):
         frame[column] = frame[column].astype(str)

@@ -1,6 +1,6 @@
 """A model check's answer per engine, from its rows: did the engine load the file, read it as
-the canonical engine (MuJoCo) did, and compute the same dynamics — with the first reason and
-fix where not. What a page says in its first lines."""
+the canonical engine (the first loaded: MuJoCo where asked for) did, and compute the same
+dynamics — with the first reason and fix where not. What a page says in its first lines."""
 
 from __future__ import annotations
 
@@ -12,7 +12,6 @@ import pandas as pd
 from dyncheck.check.rows import Section
 from dyncheck.results import Verdict
 
-CANONICAL = "mujoco"
 REFEREE = "reference"
 
 
@@ -65,14 +64,14 @@ def _first_notes(rows: pd.DataFrame, limit: int = 2) -> str:
     return "; ".join(notes[:limit]) + more
 
 
-def _reading(engine: str, rows: pd.DataFrame) -> tuple[Reading, str]:
+def _reading(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Reading, str]:
     load = rows[(rows["section"] == Section.LOAD) & (rows["impl_a"] == engine)]
     for verdict, reading in ((Verdict.SKIPPED, Reading.SKIPPED), (Verdict.FAILED,
                                                                   Reading.REFUSED)):
         part = load[load["verdict"] == verdict]
         if not part.empty:
             return reading, _first_notes(part, 1)
-    if engine == CANONICAL:
+    if engine == canonical:
         return Reading.ALIKE, "the canonical reading, which the others are compared with"
     description = rows[(rows["section"] == Section.DESCRIPTION) & (rows["impl_b"] == engine)]
     failed = description[description["verdict"] == Verdict.FAILED]
@@ -86,12 +85,12 @@ def _reading(engine: str, rows: pd.DataFrame) -> tuple[Reading, str]:
                            if not explained.empty else "")
 
 
-def _agreement(engine: str, rows: pd.DataFrame) -> tuple[Agreement, str]:
+def _agreement(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Agreement, str]:
     """Judged against the referee (MuJoCo where the referee was not run): a difference
     between two engines belongs to the one that differs from the judge."""
     dynamics = rows[(rows["section"] == Section.DYNAMICS)
                     & ((rows["impl_a"] == engine) | (rows["impl_b"] == engine))]
-    for judge in (REFEREE, CANONICAL):  # the referee judges; without it, the canonical engine
+    for judge in (REFEREE, canonical):  # the referee judges; without it, the canonical engine
         against = dynamics[(dynamics["impl_a"] == judge) | (dynamics["impl_b"] == judge)]
         if not against.empty and judge != engine:
             dynamics = against
@@ -121,12 +120,14 @@ def _agreement(engine: str, rows: pd.DataFrame) -> tuple[Agreement, str]:
 
 def per_engine(rows: pd.DataFrame, impls: tuple[str, ...]) -> list[EngineVerdict]:
     """One verdict per engine asked for (the referee is the judge, not judged)."""
+    loads = rows[(rows["section"] == Section.LOAD) & (rows["verdict"] == Verdict.PASSED)]
+    canonical = next((e for e in impls if e != REFEREE and e in set(loads["impl_a"])), "")
     out = []
     for engine in impls:
         if engine == REFEREE:
             continue
-        reading, reading_why = _reading(engine, rows)
-        agreement, agreement_why = _agreement(engine, rows)
+        reading, reading_why = _reading(engine, rows, canonical)
+        agreement, agreement_why = _agreement(engine, rows, canonical)
         out.append(EngineVerdict(engine=engine, reading=reading, reading_why=reading_why,
                                  agreement=agreement, agreement_why=agreement_why))
     return out

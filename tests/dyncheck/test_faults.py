@@ -326,7 +326,8 @@ FAULTS: tuple[Fault, ...] = (
           answer=r"no_such_robot"),
     Fault(kind="unknown implementation", area="check",
           argv=("check", BRANCHES, "--impl", "bullet", "--out", OUT),
-          answer=r"unknown implementation 'bullet'; valid: drake, mujoco, pinocchio, reference$"),
+          answer=r"unknown implementation 'bullet'; valid: drake, mjx, mjx-f64, mujoco, "
+                 r"mujoco-warp, pinocchio, reference$"),
     Fault(kind="only the referee chosen", area="check",
           argv=("check", BRANCHES, "--impl", "reference", "--out", OUT),
           answer=r"--impl must be at least one engine"),

@@ -1,0 +1,70 @@
+"""A user's model on MuJoCo's ports — MJX in float32 and in float64, MuJoCo Warp — for
+``dyncheck check --impl mjx …``: the question of a user moving a model to a port.
+
+A port reads no file: the file is compiled by MuJoCo's parser exactly as
+:class:`~dyncheck.adapters.mujoco_model.MujocoModel` compiles it (the same tree, the same
+smooth-dynamics flags), then handed to the port (``on_model``). M, h, forward and inverse
+dynamics are the port's; the ports compute no energies, so T = ½ vᵀ M v from the port's M and
+V = −Σ mᵢ g·xᵢ from the port's centres of mass — MuJoCo's own definitions (``mj_energyVel``,
+``mj_energyPos``) on the port's numbers. A float32 port's tree declares ε₃₂: its round-off
+bounds are the same formula with that ε.
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import replace
+from typing import ClassVar
+
+import numpy as np
+
+from dyncheck.adapters.model_files import ModelFile
+from dyncheck.adapters.model_tree import Dynamics
+from dyncheck.adapters.mujoco_model import MujocoModel
+
+
+class PortModel(MujocoModel):
+    """MuJoCo's reading of the file, computed on a port."""
+
+    engine = ""
+    port: ClassVar[str] = ""
+    """``module:class`` of the port's adapter (imported here only: JAX and Warp cost seconds)."""
+
+    def __init__(self, source: ModelFile) -> None:
+        super().__init__(source)
+        module, cls = self.port.split(":")
+        adapter = getattr(importlib.import_module(module), cls)
+        self.adapter = adapter.on_model(self.model)
+        eps = float(np.finfo(adapter.dtype).eps)
+        self.tree = replace(self.tree, engine=self.engine, eps=eps, notes=(
+            *self.tree.notes,
+            f"{self.engine}: MuJoCo's compiled model put on the port ({adapter.version()}), "
+            f"computing in {np.dtype(adapter.dtype).name} (round-off bounds with eps "
+            f"{eps:.3g}); energies from the port's M and centres of mass",
+        ))
+
+    def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
+        raw = self.adapter.raw(q, v, np.zeros_like(v), a)
+        mass = raw["M"]
+        kinetic = 0.5 * np.einsum("ni,nij,nj->n", v, mass, v)
+        masses = self.adapter.model_array("body_mass")[1:]
+        gravity = self.adapter.model_array("opt.gravity") if np.any(self._gravity) else \
+            self._gravity  # <flag gravity="disable">: none, as in MuJoCo's reading
+        potential = -np.einsum("b,nb->n", masses, raw["xipos"][:, 1:] @ gravity)
+        return Dynamics(mass_matrix=mass, bias=raw["bias"], forward=raw["qacc"],
+                        inverse=raw["qfrc_inverse"], kinetic=kinetic, potential=potential)
+
+
+class MjxModel(PortModel):
+    engine = "mjx"
+    port = "dyncheck.adapters.mjx_:MJXAdapter"
+
+
+class MjxF64Model(PortModel):
+    engine = "mjx-f64"
+    port = "dyncheck.adapters.mjx_:MJXF64Adapter"
+
+
+class MujocoWarpModel(PortModel):
+    engine = "mujoco-warp"
+    port = "dyncheck.adapters.mujoco_warp_:MuJoCoWarpAdapter"

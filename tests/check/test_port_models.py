@@ -1,0 +1,43 @@
+"""MuJoCo's ports on a user's model (``check --impl mjx …``): the file compiled by MuJoCo,
+computed on the port. Expected values: MuJoCo C and the referee (the book's general method)
+on the same states; a float32 port held to the same round-off bound with ε₃₂ (its basis says
+so), float64 MJX to ε₆₄."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+from dyncheck.check.model_check import check_model, implementations
+
+MODELS = Path(__file__).parent / "models"
+PORTS = {"mjx": "mujoco.mjx", "mjx-f64": "mujoco.mjx", "mujoco-warp": "mujoco_warp"}
+
+
+def _installed(port: str) -> bool:
+    try:
+        return importlib.util.find_spec(PORTS[port]) is not None
+    except ModuleNotFoundError:
+        return False
+
+
+def test_ports_are_checked_only_when_named():
+    assert not set(PORTS) & set(implementations(None))
+    assert implementations(("mjx", "mujoco", "reference")) == ("reference", "mujoco", "mjx")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("port", list(PORTS))
+def test_a_port_agrees_with_mujoco_and_the_referee_within_its_precision(port):
+    if not _installed(port):
+        pytest.skip(f"needs the extra that installs {port}")
+    result = check_model(MODELS / "mixed.xml", impls=("reference", "mujoco", port), states=10)
+    assert result.ok, result.failures()
+    rows = result.rows[(result.rows["section"] == "dynamics") & (result.rows["impl_b"] == port)]
+    assert set(rows["impl_a"]) == {"reference", "mujoco"} and len(rows) == 12
+    unit = "float32 eps" if port != "mjx-f64" else "64 eps x"
+    assert rows["basis"].str.contains(unit).all()
+    if port != "mjx-f64":  # float32: errors at its round-off, far above float64's
+        assert rows["error"].max() > 1e-9
