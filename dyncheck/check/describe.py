@@ -12,6 +12,7 @@ mass; the model's size for positions; the larger inertia, or m·size², for iner
 from __future__ import annotations
 
 from collections.abc import Iterator
+from dataclasses import replace
 
 import numpy as np
 
@@ -73,12 +74,47 @@ def _compare(a: TreeJoint, b: TreeJoint, length: float) -> Iterator[tuple[str, o
         yield name, va, vb, float(np.abs(va - vb).max(initial=0)), scale
 
 
+SHIFTED = (
+    "{b} places the whole model {t} m from where {a} does: every joint anchor and centre of "
+    "mass moved by that one vector, nothing rotated (a parser that drops the pos of the root "
+    "body, say); under uniform gravity no dynamics depend on where the model sits, so the "
+    "anchor and com rows are compared after that shift"
+)
+
+
+def shift(a: ModelTree, b: ModelTree, tol: float) -> np.ndarray | None:
+    """The one translation t that carries every common joint's anchor and centre of mass in
+    ``a`` onto ``b``'s (axes unchanged), where there is one and it is not zero (within
+    ``tol``): the model placed elsewhere in the world."""
+    pairs = [(ja, b.joint(ja.name)) for ja in a.joints
+             if ja.name in {j.name for j in b.joints} and b.joint(ja.name).type is ja.type]
+    coms = [(ja.com, jb.com) for ja, jb in pairs if ja.mass > 0 and jb.mass > 0]
+    if not coms:
+        return None
+    t = coms[0][1] - coms[0][0]
+    if float(np.abs(t).max()) <= tol:
+        return None
+    for ja, jb in pairs:
+        if np.abs(ja.axis - jb.axis).max() > tol:
+            return None
+        moved = jb.anchor - t - ja.anchor
+        off = np.cross(moved, ja.axis) if ja.type is JointType.HINGE else moved
+        if ja.type is not JointType.SLIDE and float(np.abs(off).max()) > tol:
+            return None
+    if any(float(np.abs(cb - t - ca).max()) > tol for ca, cb in coms):
+        return None
+    return t
+
+
 def diff(model: str, a: ModelTree, b: ModelTree) -> list[CheckRow]:
-    """Every difference between two engines' trees (one row each), or one passed row."""
+    """Every difference between two engines' trees (one row each), or one passed row. A model
+    placed elsewhere as a whole (:func:`shift`) is one explained row, its fields compared
+    after the shift."""
     rtol = ROUNDOFF * EPS * max(depth(a), depth(b))
     basis = f"round-off: {ROUNDOFF} eps x tree depth {max(depth(a), depth(b))}"
     length = size(a)
     rows: list[CheckRow] = []
+    moved = shift(a, b, rtol * length)
 
     def row(subject: str, field: str, va: object, vb: object, err: float, tol: float,
             verdict: Verdict, note: str = "") -> None:
@@ -101,10 +137,15 @@ def diff(model: str, a: ModelTree, b: ModelTree) -> list[CheckRow]:
             row(name, "joint", "absent", "present", np.inf, 0.0, Verdict.FAILED,
                 f"{a.engine} has no joint {name!r}")
     compared = 0
+    if moved is not None:
+        row("model", "placement", np.zeros(3), moved, float(np.abs(moved).max()) / length, rtol,
+            Verdict.EXPLAINED, SHIFTED.format(a=a.engine, b=b.engine, t=_fmt(moved)))
     for ja in a.joints:
         if ja.name not in names_b:
             continue
         jb = b.joint(ja.name)
+        if moved is not None:
+            jb = replace(jb, anchor=jb.anchor - moved, com=jb.com - moved)
         if ja.type is not jb.type:
             row(ja.name, "type", ja.type, jb.type, np.inf, 0.0, Verdict.FAILED)
             continue

@@ -221,3 +221,22 @@ def test_a_rotated_and_offset_root_is_read_alike_in_one_frame(tmp_path):
     for engine in ("pinocchio", "drake"):
         read = description[description["impl_b"] == engine]
         assert not read.empty and set(read["verdict"]) == {"passed"}
+
+
+def test_a_model_placed_elsewhere_as_a_whole_is_explained_not_failed(tmp_path):
+    """A jointless root body with a pos: Pinocchio's MJCF parser puts it at the world origin
+    (measured on dm_control's ant), so every anchor and centre of mass moves by one vector.
+    Under uniform gravity no dynamics depend on where the model sits (M, h, τ are invariant
+    under a rigid translation; V(q) − V(q₀) too): one explained row naming the vector, the
+    fields compared after the shift, every dynamics row passed."""
+    body = ('<body name="torso" pos="0.1 -0.2 0.5"><inertial pos="0 0 0" mass="2" '
+            'diaginertia="0.1 0.1 0.1"/>' + LINK.format(
+                name="leg", pos="0.2 0 0", joint="hip", extra="", mass=1, child="") + "</body>")
+    result = check_model(_write(tmp_path, "placed", body), states=10,
+                         impls=("reference", "mujoco", "pinocchio"))
+    assert result.ok, result.failures()
+    placement = _rows(result, "description")
+    placement = placement[placement["field"] == "placement"]
+    assert list(placement["verdict"]) == ["explained"]
+    assert placement["value_b"].iloc[0] == "[-0.1 0.2 -0.5]"
+    assert set(_rows(result, "dynamics")["verdict"]) == {"passed"}
