@@ -72,6 +72,10 @@ FIRST_BODY_ONLY = (
 )
 
 
+GRAVITY_IGNORED = (
+    "Pinocchio's MJCF parser does not read <option gravity=\"{gravity}\"> (its model keeps "
+    "its default, 0 0 -9.81; measured) (fix: set model.gravity after loading)"
+)
 DEFAULT_MASS = (
     "the file sets geom masses in <default> classes ({classes}), which Pinocchio's MJCF "
     "parser ignores (measured: it computes those geoms' mass from their density, 1000 unless "
@@ -92,6 +96,9 @@ def _hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
     if len(bodies) > 1:
         others = ", ".join(repr(b) for b in bodies[1:6]) + (" …" if len(bodies) > 6 else "")
         out.append(("model", "joint", FIRST_BODY_ONLY.format(first=bodies[0], others=others)))
+    stated = [o.get("gravity") for o in root.iter("option") if o.get("gravity")]
+    if stated and not np.allclose([float(x) for x in stated[-1].split()], (0.0, 0.0, -9.81)):
+        out.append(("model", "gravity", GRAVITY_IGNORED.format(gravity=stated[-1])))
     massed = [c for c, attrs in geom_defaults(root).items() if "mass" in attrs]
     if massed:
         why = DEFAULT_MASS.format(classes=", ".join(repr(c) for c in massed[:4]))

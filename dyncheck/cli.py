@@ -123,6 +123,9 @@ def _parser() -> argparse.ArgumentParser:
                    "them; files another one includes left out); several: an index page too")
     k.add_argument("--robot", action="append", default=[], metavar="NAME",
                    help="a robot of example-robot-data (extra 'robots'; see `dyncheck list`)")
+    k.add_argument("--case", action="append", default=[], metavar="CASE",
+                   help="a book case's MJCF, the file `run` gives MuJoCo (repeatable; 'all': "
+                   "every case)")
     k.add_argument("--impl", action="append", default=[], metavar="NAME",
                    help="reference, mujoco, pinocchio, drake, and MuJoCo's ports mjx, mjx-f64, "
                    "mujoco-warp (repeatable; default: the first four; a port only when named: "
@@ -582,8 +585,25 @@ def _errata(args: argparse.Namespace) -> int:
     return 0
 
 
-def _check_targets(args: argparse.Namespace) -> list[tuple[Path, str | None]]:
-    """The files to check: PATHs (a folder: every model file under it), then ``--robot``s."""
+def _case_files(names: list[str], folder: Path) -> list[tuple[Path, str | None]]:
+    """Each book case's MJCF (:func:`~dyncheck.adapters.mjcf.to_mjcf`, what ``run`` gives
+    MuJoCo) written into ``folder``."""
+    from dyncheck.adapters.mjcf import to_mjcf
+    from dyncheck.cases import CASES, get_case
+
+    chosen = list(CASES) if "all" in names else names
+    out: list[tuple[Path, str | None]] = []
+    for name in chosen:
+        case = get_case(name)  # an unknown name: one line, exit 2, before any work
+        path = folder / f"{name}.xml"
+        path.write_text(to_mjcf(case.multibody()))
+        out.append((path, None))
+    return out
+
+
+def _check_targets(args: argparse.Namespace, cases: Path) -> list[tuple[Path, str | None]]:
+    """The files to check: PATHs (a folder: every model file under it), ``--robot``s, then
+    ``--case``s (written into ``cases``)."""
     from dyncheck.check import index, inputs
 
     targets: list[tuple[Path, str | None]] = []
@@ -596,8 +616,9 @@ def _check_targets(args: argparse.Namespace) -> list[tuple[Path, str | None]]:
         else:
             targets.append((path, None))
     targets += [(inputs.robot(name), name) for name in args.robot]
+    targets += _case_files(args.case, cases)
     if not targets:
-        raise InvalidInput("PATH", "", "at least one model file, folder or --robot NAME")
+        raise InvalidInput("PATH", "", "at least one model file, folder, --robot or --case")
     return targets
 
 
@@ -609,6 +630,12 @@ def _without(message: str, path: Path) -> str:
 
 
 def _check(args: argparse.Namespace) -> int:
+    with tempfile.TemporaryDirectory(prefix="dyncheck-cases-") as cases:
+        return _check_all(args, _check_targets(args, Path(cases)), Path(cases))
+
+
+def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
+               cases: Path) -> int:
     from functools import partial
 
     from dyncheck.check import index, inputs
@@ -616,13 +643,13 @@ def _check(args: argparse.Namespace) -> int:
     from dyncheck.check.page import summary_line, write
     from dyncheck.workers import each_unit
 
-    targets = _check_targets(args)
     names = index.page_names([p for p, _ in targets])
     names = [robot.replace("/", "__") if robot else name
              for (_, robot), name in zip(targets, names, strict=True)]
     several = len(targets) > 1
     base = index.common_folder([p for p, _ in targets])
-    files = {name: str(p.resolve().relative_to(base)) if not robot else f"robot {robot}"
+    files = {name: f"robot {robot}" if robot else f"book case {p.stem}" if p.parent == cases
+             else str(p.resolve().relative_to(base))
              for (p, robot), name in zip(targets, names, strict=True)}
     entries: list[index.Entry] = []
     valid = []

@@ -6,7 +6,10 @@ triangle inequality, Iₐ + I_b ≥ I_c, because each is a sum of m (r² − r�
 Tolerances: every field is the file's numbers carried through a chain of rigid transforms
 (one per joint and fused link above it), so two parsers of the same text differ by round-off
 growing with the chain: 64 ε × the tree's depth, relative to the field's scale (the body's
-mass; the model's size for positions; the larger inertia, or m·size², for inertia tensors).
+mass; the model's size for positions; for inertia tensors the larger inertia, or m d² with d
+the distance of the centre of mass from the joint — an engine that stores the inertia about
+the body's origin (Drake) holds the one about the centre of mass to round-off of that
+parallel-axis term: 1e-8 kg m² of a point mass 1 m from its pivot to ~1e-16 absolute).
 """
 
 from __future__ import annotations
@@ -62,9 +65,10 @@ def _compare(a: TreeJoint, b: TreeJoint, length: float) -> Iterator[tuple[str, o
     yield "mass", a.mass, b.mass, abs(a.mass - b.mass), mass_scale
     if max(a.mass, b.mass) > 0:
         yield "com", a.com, b.com, float(np.abs(a.com - b.com).max()), length
-    inertia_scale = max(
-        float(np.abs(a.inertia).max()), float(np.abs(b.inertia).max()),
-        mass_scale * length**2 * 1e-6, 1e-300,
+    lever = float(np.linalg.norm(a.com - a.anchor))
+    inertia_scale = max(  # an engine holding the inertia about its body origin (Drake) holds
+        float(np.abs(a.inertia).max()), float(np.abs(b.inertia).max()),  # it to round-off of
+        mass_scale * lever**2, mass_scale * length**2 * 1e-6, 1e-300,  # m d², d the lever
     )
     yield "inertia", a.inertia, b.inertia, float(np.abs(a.inertia - b.inertia).max()), \
         inertia_scale

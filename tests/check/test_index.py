@@ -86,3 +86,22 @@ def test_a_hostile_file_name_cannot_break_the_index(tmp_path):
     html = MarkdownIt("commonmark").enable("table").render((out / "index.md").read_text())
     assert "javascript:" not in " ".join(re.findall(r'href="([^"]+)"', html))
     assert "<b>" not in html
+
+
+def test_the_book_cases_files_are_checked_and_agree(tmp_path):
+    """``--case``: the MJCF ``run`` gives MuJoCo, checked like a user's file. Point masses
+    with 1e-8 kg m² inertia 1 m from their pivot: Drake holds the inertia about the body
+    origin, so to round-off of m d² — not a finding (it was, before the scale said so).
+    Expected: every engine agrees on these models (the run report's instantaneous rows)."""
+    out = tmp_path / "out"
+    code = main(["check", "--case", "simple_pendulum", "--case", "spherical_pendulum",
+                 "--case", "rigid_body_free", "--states", "10", "--out", str(out)])
+    assert code == 0
+    index_text = (out / "index.md").read_text()
+    assert "book case simple_pendulum" in index_text and "3 with every engine" in index_text
+
+
+def test_an_unknown_case_is_one_line_before_any_work(tmp_path, capsys):
+    assert main(["check", "--case", "no_such_case", "--out", str(tmp_path / "o")]) == 2
+    assert "unknown case 'no_such_case'" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists() or not any((tmp_path / "o").iterdir())

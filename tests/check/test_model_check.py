@@ -112,8 +112,9 @@ def _corrupt(tmp_path: Path, old: str, new: str) -> Path:
     [
         ('<mass value="1.5"/>', '<mass value="1.515"/>', "leg_joint", "mass"),
         ('<axis xyz="0 1 0"/>', '<axis xyz="0 -1 0"/>', "leg_joint", "axis"),
+        ('ixx="0.03" ixy="0.001"', 'ixx="0.0303" ixy="0.001"', "leg_joint", "inertia"),
     ],
-    ids=["mass-x1.01", "axis-flipped"],
+    ids=["mass-x1.01", "axis-flipped", "inertia-x1.01"],
 )
 def test_corrupted_copy_fails_naming_body_and_field(tmp_path, old, new, subject, field):
     corrupted = _corrupt(tmp_path, old, new)

@@ -244,7 +244,7 @@ FAULTS: tuple[Fault, ...] = (
           answer=r"^dyncheck: interrupted \(nothing half-written\)$"),
     # --- check
     Fault(kind="no model given", area="check", argv=("check", "--out", OUT),
-          answer=r"PATH must be at least one model file, folder or --robot NAME"),
+          answer=r"PATH must be at least one model file, folder, --robot or --case"),
     Fault(kind="model file missing", area="check", argv=("check", "{tmp}/nope.xml"),
           answer=r"<tmp>/nope.xml: no such file$"),
     Fault(kind="model path a folder without models", area="check", prepare=_folder("m"),
