@@ -96,7 +96,7 @@ def _hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
     if len(bodies) > 1:
         others = ", ".join(repr(b) for b in bodies[1:6]) + (" …" if len(bodies) > 6 else "")
         out.append(("model", "joint", FIRST_BODY_ONLY.format(first=bodies[0], others=others)))
-    stated = [o.get("gravity") for o in root.iter("option") if o.get("gravity")]
+    stated = [o.get("gravity", "") for o in root.iter("option") if o.get("gravity")]
     if stated and not np.allclose([float(x) for x in stated[-1].split()], (0.0, 0.0, -9.81)):
         out.append(("model", "gravity", GRAVITY_IGNORED.format(gravity=stated[-1])))
     massed = [c for c, attrs in geom_defaults(root).items() if "mass" in attrs]
@@ -160,7 +160,7 @@ class PinocchioModel:
     def __init__(self, source: ModelFile) -> None:
         self.model = _load(source)
         self.data = self.model.createData()
-        notes = ()
+        notes: tuple[str, ...] = ()
         self._hints = _hints(source)
         if source.floating and source.format is Format.URDF:
             notes = ("pinocchio: JointModelFreeFlyer 'root_joint' at the URDF root",)
