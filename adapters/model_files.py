@@ -24,6 +24,20 @@ MIMIC_NOTE = (
 )
 
 
+WELDED_NOTE = (
+    "--floating not applied: the URDF's root link is 'world', so the file itself welds the "
+    "robot to the world (every engine reads it so; MuJoCo and Pinocchio would otherwise float "
+    "different links)"
+)
+
+
+def urdf_root_link(robot: ET.Element) -> str | None:
+    """The URDF link no joint points to (the first, where a malformed file has several)."""
+    children = {c.get("link") for j in robot.findall("joint") for c in j.findall("child")}
+    return next((link.get("name") for link in robot.findall("link")
+                 if link.get("name") not in children), None)
+
+
 @dataclass(frozen=True, kw_only=True)
 class ModelFile:
     """The file as read: its format, its text as every engine gets it, and what was changed."""
@@ -40,16 +54,23 @@ def read(path: Path, *, floating: bool = False) -> ModelFile:
     tree = ET.parse(path)
     root = tree.getroot()
     if root.tag == "robot":
+        missing = missing_meshes(path, root)
         for link in root.iter("link"):
             for tag in ("visual", "collision"):
                 for element in link.findall(tag):
                     link.remove(element)
         notes = [GEOMETRY_NOTE]
+        if missing:
+            notes.append(f"{len(missing)} mesh files the URDF names were not found (first: "
+                         f"{missing[0]!r}); no mesh is read, so the check does not need them")
         mimics = [(j, m) for j in root.findall("joint") for m in j.findall("mimic")]
         for joint, mimic in mimics:
             joint.remove(mimic)
         if mimics:
             notes.append(MIMIC_NOTE + f" ({len(mimics)} joints)")
+        if floating and urdf_root_link(root) == "world":
+            floating = False
+            notes.append(WELDED_NOTE)
         text = ET.tostring(root, encoding="unicode")
         return ModelFile(
             path=path, format=Format.URDF, text=text, floating=floating, notes=tuple(notes)
@@ -58,6 +79,32 @@ def read(path: Path, *, floating: bool = False) -> ModelFile:
         path=path, format=Format.MJCF, text=path.read_text(encoding="utf-8"),
         floating=floating, notes=(),
     )
+
+
+def missing_meshes(path: Path, root: ET.Element) -> list[str]:
+    """The URDF's mesh references that name no regular file (none is ever opened: the check
+    removes the geometry before loading — a note on the page, not a refusal)."""
+    out = []
+    for mesh in root.iter("mesh"):
+        name = mesh.get("filename", "")
+        target = _mesh_file(path, name)
+        if target is not None and not target.is_file():
+            out.append(name)
+    return out
+
+
+def _mesh_file(urdf: Path, name: str) -> Path | None:
+    """The file a mesh reference names, where it can be resolved: relative or absolute paths,
+    ``file://``, and ``package://NAME/...`` when a folder NAME is an ancestor of the URDF."""
+    if name.startswith("file://"):
+        return Path(name[len("file://") :])
+    if name.startswith("package://"):
+        package, _, rest = name[len("package://") :].lstrip("/").partition("/")
+        for ancestor in urdf.resolve().parents:
+            if ancestor.name == package:
+                return ancestor / rest
+        return None
+    return urdf.parent / name if not Path(name).is_absolute() else Path(name)
 
 
 INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")

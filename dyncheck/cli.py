@@ -122,7 +122,8 @@ def _parser() -> argparse.ArgumentParser:
                    help="MJCF (.xml) or URDF files, or folders (every model file under "
                    "them; files another one includes left out); several: an index page too")
     k.add_argument("--robot", action="append", default=[], metavar="NAME",
-                   help="a robot of example-robot-data (extra 'robots'; see `dyncheck list`)")
+                   help="a robot of example-robot-data (extra 'robots'; see `dyncheck list`; "
+                   "'all': every one)")
     k.add_argument("--case", action="append", default=[], metavar="CASE",
                    help="a book case's MJCF, the file `run` gives MuJoCo (repeatable; 'all': "
                    "every case)")
@@ -615,7 +616,8 @@ def _check_targets(args: argparse.Namespace, cases: Path) -> list[tuple[Path, st
             targets += [(p, None) for p in found]
         else:
             targets.append((path, None))
-    targets += [(inputs.robot(name), name) for name in args.robot]
+    robots = list(inputs.robots()) if "all" in args.robot else args.robot
+    targets += [(inputs.robot(name), name) for name in robots]
     targets += _case_files(args.case, cases)
     if not targets:
         raise InvalidInput("PATH", "", "at least one model file, folder, --robot or --case")

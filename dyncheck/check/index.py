@@ -58,18 +58,37 @@ def in_folder(folder: Path) -> list[Path]:
 
 
 def page_names(paths: list[Path]) -> list[str]:
-    """One page name per file: its stem; where stems collide, the suffix too (``a-xml``,
-    ``a-urdf``); where those collide, the folders that tell them apart."""
+    """One page name per file: its stem; where stems collide, the fewest enclosing folders
+    that tell the files apart (``suite__hopper``), else the suffix (``a-urdf``), else both;
+    the same file given twice gets ``-2``."""
     names = [p.stem for p in paths]
-    for attempt in (lambda p: f"{p.stem}-{p.suffix.lstrip('.')}",
-                    lambda p: "__".join(p.resolve().parts[-3:-1]) + f"__{p.stem}"
-                    + f"-{p.suffix.lstrip('.')}"):
-        clash = {n for n in names if names.count(n) > 1}
-        names = [attempt(p) if n in clash else n for p, n in zip(paths, names, strict=True)]
+    groups: dict[str, list[int]] = {}
+    for i, name in enumerate(names):
+        groups.setdefault(name, []).append(i)
+    for stem, members in groups.items():
+        if len(members) < 2:
+            continue
+        distinct = len({paths[i].resolve() for i in members})
+        if distinct < 2:
+            continue
+        parents = [paths[i].resolve().parent.parts for i in members]
+        suffixes = [paths[i].suffix.lstrip(".") for i in members]
+        for depth in range(0, max(len(p) for p in parents) + 1):
+            folders = ["__".join(p[len(p) - depth:]) if depth else "" for p in parents]
+            for with_suffix in (False, True):
+                tried = [(f"{f}__" if f else "") + stem + (f"-{x}" if with_suffix else "")
+                         for f, x in zip(folders, suffixes, strict=True)]
+                if len(set(tried)) == distinct:
+                    break
+            if len(set(tried)) == distinct:
+                break
+        for i, name in zip(members, tried, strict=True):
+            names[i] = name
+    seen: dict[str, int] = {}
     for i, name in enumerate(names):  # still alike: the same file named twice
-        while names.count(name) > 1 and names.index(name) != i:
-            name += "-2"
-        names[i] = name
+        seen[name] = seen.get(name, 0) + 1
+        if seen[name] > 1:
+            names[i] = f"{name}-{seen[name]}"
     return names
 
 

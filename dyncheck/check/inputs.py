@@ -73,25 +73,6 @@ def _check_urdf(path: Path, root: ET.Element) -> None:
                 except ValueError:
                     raise ModelFileError(path, f"link {link.get('name')!r}: <{tag} {key}="
                                          f"{text!r}> is not a number") from None
-    for mesh in root.iter("mesh"):
-        name = mesh.get("filename", "")
-        target = _mesh_file(path, name)
-        if target is not None and not target.is_file():
-            raise ModelFileError(path, f"mesh {name!r} not found (looked for {target})")
-
-
-def _mesh_file(urdf: Path, name: str) -> Path | None:
-    """The file a mesh reference names, where it can be resolved: relative or absolute paths,
-    ``file://``, and ``package://NAME/...`` when a folder NAME is an ancestor of the URDF."""
-    if name.startswith("file://"):
-        return Path(name[len("file://") :])
-    if name.startswith("package://"):
-        package, _, rest = name[len("package://") :].lstrip("/").partition("/")
-        for ancestor in urdf.resolve().parents:
-            if ancestor.name == package:
-                return ancestor / rest
-        return None
-    return urdf.parent / name if not Path(name).is_absolute() else Path(name)
 
 
 def states(value: int) -> int:

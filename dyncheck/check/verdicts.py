@@ -105,6 +105,8 @@ def _agreement(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Agreeme
         worst = failed.loc[(failed["error"] / failed["tolerance"].where(
             failed["tolerance"] > 0, 1.0)).idxmax()]
         other = worst["impl_b"] if worst["impl_a"] == engine else worst["impl_a"]
+        if not isinstance(other, str) or not other:  # a failure of its own: its message
+            return Agreement.DIFFER, _first_notes(failed, 1)
         quantities = ", ".join(dict.fromkeys(failed["subject"]))
         return Agreement.DIFFER, (f"{quantities}; worst {worst['subject']} against {other}: "
                                   f"error {worst['error']:.3g}, tolerance "

@@ -28,8 +28,8 @@ def test_page_names_never_collide(tmp_path):
              tmp_path / "y" / "b.xml", tmp_path / "c.xml"]
     names = index.page_names(paths)
     assert len(set(names)) == len(names)
-    assert names[:2] == ["a-xml", "a-urdf"] and names[4] == "c"
-    assert names[2].endswith("x__b-xml") and names[3].endswith("y__b-xml")
+    assert names == ["a-xml", "a-urdf", "x__b", "y__b", "c"]
+    assert index.page_names([tmp_path / "a.xml", tmp_path / "a.xml"]) == ["a", "a-2"]
 
 
 def test_a_folder_gives_its_models_not_their_fragments(tmp_path):

@@ -229,3 +229,28 @@ def test_a_daemonic_worker_checks_in_process_and_says_so():
             here._config["daemon"] = daemon
     assert IN_PROCESS_NOTE in inside.notes and IN_PROCESS_NOTE not in isolated.notes
     assert inside.rows.equals(isolated.rows)
+
+
+WELDED = ('<robot name="welded"><link name="world"/><link name="base"><inertial><mass value="2"/>'
+          '<inertia ixx="0.1" iyy="0.1" izz="0.1"/></inertial><visual><geometry><mesh '
+          'filename="meshes/gone.stl"/></geometry></visual></link><link name="arm"><inertial>'
+          '<origin xyz="0 0 -0.2"/><mass value="1"/><inertia ixx="0.02" iyy="0.02" izz="0.002"/>'
+          '</inertial></link><joint name="fix" type="fixed"><parent link="world"/><child '
+          'link="base"/></joint><joint name="shoulder" type="continuous"><parent link="base"/>'
+          '<child link="arm"/><axis xyz="0 1 0"/></joint></robot>')
+
+
+def test_floating_is_not_applied_to_a_urdf_welded_to_world_and_a_missing_mesh_is_a_note(
+        tmp_path):
+    """A root link named ``world`` welds the robot in the file itself: MuJoCo would float
+    the first link below it and Pinocchio the world link, Drake neither — so ``--floating``
+    is not applied, said once, and the engines agree. A mesh file that is not there is never
+    read (geometry is removed first): a note, and the model checked."""
+    path = tmp_path / "welded.urdf"
+    path.write_text(WELDED)
+    result = check_model(path, floating=True, states=10)
+    assert result.ok, result.failures()
+    assert any("--floating not applied" in n for n in result.notes)
+    assert any("'meshes/gone.stl'" in n for n in result.notes)
+    assert set(_rows(result, section="load", verdict="passed")["impl_a"]) == {
+        "mujoco", "pinocchio", *(("drake",) if DRAKE else ())}
