@@ -231,13 +231,16 @@ def test_a_daemonic_worker_checks_in_process_and_says_so():
     assert inside.rows.equals(isolated.rows)
 
 
-WELDED = ('<robot name="welded"><link name="world"/><link name="base"><inertial><mass value="2"/>'
-          '<inertia ixx="0.1" iyy="0.1" izz="0.1"/></inertial><visual><geometry><mesh '
-          'filename="meshes/gone.stl"/></geometry></visual></link><link name="arm"><inertial>'
-          '<origin xyz="0 0 -0.2"/><mass value="1"/><inertia ixx="0.02" iyy="0.02" izz="0.002"/>'
-          '</inertial></link><joint name="fix" type="fixed"><parent link="world"/><child '
-          'link="base"/></joint><joint name="shoulder" type="continuous"><parent link="base"/>'
-          '<child link="arm"/><axis xyz="0 1 0"/></joint></robot>')
+INERTIA = '<inertia ixx="{0}" ixy="0" ixz="0" iyy="{0}" iyz="0" izz="{1}"/>'
+WELDED = (
+    '<robot name="welded"><link name="world"/><link name="base"><inertial><mass value="2"/>'
+    + INERTIA.format(0.1, 0.1) + '</inertial><visual><geometry><mesh '
+    'filename="meshes/gone.stl"/></geometry></visual></link><link name="arm"><inertial>'
+    '<origin xyz="0 0 -0.2"/><mass value="1"/>' + INERTIA.format(0.02, 0.002)
+    + '</inertial></link><joint name="fix" type="fixed"><parent link="world"/><child '
+    'link="base"/></joint><joint name="shoulder" type="continuous"><parent link="base"/>'
+    '<child link="arm"/><axis xyz="0 1 0"/></joint></robot>'
+)
 
 
 def test_floating_is_not_applied_to_a_urdf_welded_to_world_and_a_missing_mesh_is_a_note(
