@@ -86,7 +86,8 @@ def load(path: Path, flag: str) -> RunTables:
         raise InvalidInput(flag, str(path), "an existing output folder of `run` or `check`")
     if path.is_dir():
         disc = path / "discrepancies.csv"
-        files = [disc] if disc.is_file() else sorted(path.glob("*.csv"))
+        files = [disc] if disc.is_file() else sorted(  # a check's index is a summary
+            f for f in path.glob("*.csv") if f.name != "index.csv")
         folder = path
     else:
         files, folder = [path], path.parent
