@@ -15,10 +15,11 @@ import numpy as np
 
 from dyncheck.cases import Case
 from dyncheck.implementations import general_method
+from dyncheck.precision import EPS
 from dyncheck.reference import rigid
 from dyncheck.reference.trajectory import solve
 from dyncheck.results import Discrepancy, Verdict
-from dyncheck.tolerances import EPS, first_near_max
+from dyncheck.tolerances import first_near_max
 
 
 def closed_form_rows(case: Case) -> list[Discrepancy]:

@@ -33,9 +33,10 @@ from dyncheck.implementations import (
     general_method,
     quantities,
 )
+from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.reference.constraints import MAX_IMPEDANCE
 from dyncheck.results import Discrepancy
-from dyncheck.tolerances import EPS, ROUNDOFF_FACTOR, instantaneous, soft_condition
+from dyncheck.tolerances import instantaneous, soft_condition
 
 __all__ = ["GRAVITY_DEFAULT", "POINT_INERTIA", "compare_instantaneous", "soft_factor"]
 

@@ -42,8 +42,9 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.errors import InvalidInput
+from dyncheck.precision import EPS32
 from dyncheck.results import CONVERGENCE_KEY, DISCREPANCY_KEY, texts
-from dyncheck.tolerances import EPS32, REFERENCE_MARGIN, accumulated
+from dyncheck.tolerances import REFERENCE_MARGIN, accumulated
 
 
 def _longest_run() -> int:

@@ -22,15 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.implementations import QUANTITIES
-
-EPS = float(np.finfo(float).eps)
-EPS32 = float(np.finfo(np.float32).eps)
-ROUNDOFF_FACTOR = 64
-
-
-def eps_name(eps: float) -> str:
-    """How a round-off basis names ε: "eps" (float64), "float32 eps", or its value."""
-    return "eps" if eps == EPS else ("float32 eps" if eps == EPS32 else f"eps {eps:.3g}")
+from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
 
 
 @dataclass(frozen=True)

@@ -21,10 +21,10 @@ import numpy as np
 
 from dyncheck.adapters.model_tree import JointType, ModelTree, TreeJoint
 from dyncheck.check.rows import CheckRow, Section
+from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.results import Verdict
 
-EPS = float(np.finfo(float).eps)
-ROUNDOFF = 64
+ROUNDOFF = ROUNDOFF_FACTOR
 
 
 def depth(tree: ModelTree) -> int:

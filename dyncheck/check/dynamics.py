@@ -27,8 +27,8 @@ from dyncheck.adapters.model_tree import Dynamics, JointType, ModelTree
 from dyncheck.check.describe import EPS, ROUNDOFF, depth, size
 from dyncheck.check.layout import Canonical
 from dyncheck.check.rows import CheckRow, Section
+from dyncheck.precision import eps_name
 from dyncheck.results import Verdict
-from dyncheck.tolerances import eps_name
 
 QUANTITIES = {
     "mass_matrix": "mass_matrix",
@@ -128,13 +128,15 @@ def compare(
     states: States,
     *,
     eps: float = EPS,
+    kappa: float | None = None,
 ) -> list[CheckRow]:
     """One row per quantity. A failure is ``explained`` where ``explanations`` predicts it (the
     difference within prediction + tolerance), or where ``caused_by`` names a description
     difference found between the two (the dynamics follow from it). ``eps``: the coarser
-    precision of the two (a float32 port's ε₃₂: the same bounds in its arithmetic)."""
+    precision of the two (a float32 port's ε₃₂: the same bounds in its arithmetic); ``kappa``:
+    κ(M) of ``dyn_a`` where the caller has it (one per implementation, not per pair)."""
     d = depth(tree)
-    kappa = condition(dyn_a.mass_matrix)
+    kappa = condition(dyn_a.mass_matrix) if kappa is None else kappa
     least = floors(tree, dyn_a, states)
     rows = []
     for quantity in QUANTITIES:

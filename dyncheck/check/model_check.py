@@ -24,7 +24,7 @@ from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials
 from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.check import describe, inputs, layout, partial
 from dyncheck.check import engines as engine_processes
-from dyncheck.check.dynamics import Explanation, States, compare, sample
+from dyncheck.check.dynamics import Explanation, States, compare, condition, sample
 from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
 from dyncheck.check.referee import ReferenceModel
 from dyncheck.check.rows import COLUMNS, CheckRow, Section
@@ -249,6 +249,7 @@ def _check(model: str, source_path: Path, source: ModelFile,
         replace(j, rotor_in_kinetic=True) for j in canonical_tree.joints))
     trees = {name: loaded[name].tree if name in loaded else referee_tree for name in results}
     order = list(results)
+    kappas: dict[str, float] = {}  # κ(M) of each implementation, for every pair it leads
     for i, a in enumerate(order):
         for b in order[i + 1 :]:
             cause = ", ".join(differing[e] for e in (a, b) if e in differing)
@@ -258,9 +259,11 @@ def _check(model: str, source_path: Path, source: ModelFile,
                 rotor = _rotor_difference(canon, canonical_tree, trees[a], trees[b], batch.v)
                 if rotor is not None:
                     explanations["kinetic_energy"] = rotor
+                if a not in kappas:
+                    kappas[a] = condition(results[a].mass_matrix)
                 rows.extend(compare(model, canonical_tree, a, results[a], b, results[b],
                                     explanations, cause, batch,
-                                    eps=max(trees[a].eps, trees[b].eps)))
+                                    eps=max(trees[a].eps, trees[b].eps), kappa=kappas[a]))
                 continue
             common = np.arange(canon.nv)
             for held in dofs.values():

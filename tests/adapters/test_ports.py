@@ -17,7 +17,7 @@ from dyncheck.adapters import get_adapter
 from dyncheck.cases import get_case
 from dyncheck.comparison import compare_instantaneous
 from dyncheck.implementations import EngineImplementation, make_implementation
-from dyncheck.tolerances import EPS, EPS32, ROUNDOFF_FACTOR
+from dyncheck.precision import EPS, EPS32, ROUNDOFF_FACTOR
 
 from ..conftest import BALL_CASES, CASE_NAMES, PORTS, supported
 

@@ -208,7 +208,7 @@ def test_worst_state_ties_go_to_the_first_state_however_the_states_are_cut():
     case = get_case("simple_pendulum")
     s = case.sample_states(6)
     desired = np.ones((6, 1))
-    from dyncheck.tolerances import EPS, ROUNDOFF_FACTOR
+    from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 
     errors = np.array([0.0, 2, 4, 0, 8, 2])[:, None] * EPS  # exact on 1
     whole = PairStats()
