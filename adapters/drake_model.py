@@ -27,7 +27,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, MultibodyForces, QuaternionFloatingJoint
 
 from dyncheck.adapters.drake_ import parser_warnings
-from dyncheck.adapters.mjcf_copy import for_parser
+from dyncheck.adapters.mjcf_copy import for_parser, inline
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -100,6 +100,29 @@ def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str
             joint.set_default_damping_vector(np.zeros(joint.num_velocities()))
     plant.Finalize()
     return plant, tuple(notes), damping
+
+
+FIRST_OF_SEVERAL = (
+    "{joint!r} is the first of {n} joints in body {body!r}: Drake's MJCF parser places that "
+    "joint's frame as if the body had no pos or orientation (measured: anchor and axis taken "
+    "in the parent's frame), so Drake's M and h differ wherever the body is offset or rotated "
+    "(fix: one joint per body, with massless bodies of your own between them)"
+)
+
+
+def _first_of_several(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
+    """Why the first joint of a body with several reads differently in Drake (the MJCF
+    read as XML, includes inlined)."""
+    if source.format is not Format.MJCF:
+        return ()
+    out: list[tuple[str, str, str]] = []
+    for body in inline(source.path).iter("body"):
+        named = [j.get("name") for j in body.findall("joint")]
+        if len(named) > 1 and named[0]:
+            why = FIRST_OF_SEVERAL.format(joint=named[0], n=len(named),
+                                          body=body.get("name", "(unnamed)"))
+            out += [(named[0], field, why) for field in ("anchor", "axis")]
+    return tuple(out)
 
 
 def _summary(warnings: list[str]) -> list[str]:
@@ -219,7 +242,7 @@ class DrakeModel:
             for j in joints
             if j.type is not JointType.FREE and j.name not in reflected
             and self._source.format is Format.MJCF
-        )
+        ) + _first_of_several(self._source)
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
                          nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,
                          hints=hints)

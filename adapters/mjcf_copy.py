@@ -117,6 +117,29 @@ def geom_defaults(root: ET.Element) -> dict[str, dict[str, str]]:
     return out
 
 
+def resolved_geoms(root: ET.Element) -> list[tuple[ET.Element, dict[str, str]]]:
+    """Every geom of a moving or welded body, with its body and its inertia attributes
+    resolved through default classes (its ``class``, else the nearest ``childclass``)."""
+    defaults = geom_defaults(root)
+    out: list[tuple[ET.Element, dict[str, str]]] = []
+
+    def walk(element: ET.Element, body: ET.Element, childclass: str) -> None:
+        for geom in element.findall("geom"):
+            cls = geom.get("class", childclass)
+            out.append((body, {**defaults.get(cls, defaults.get("main", {})),
+                               **{k: v for k, v in geom.attrib.items()
+                                  if k in GEOM_INERTIA_KEYS}}))
+        for child in element.findall("frame"):
+            walk(child, body, child.get("childclass", childclass))
+        for child in element.findall("body"):
+            walk(child, child, child.get("childclass", childclass))
+
+    for world in root.findall("worldbody"):
+        for body in world.findall("body"):
+            walk(body, body, body.get("childclass", "main"))
+    return out
+
+
 def _compiler(root: ET.Element, key: str, default: str) -> str:
     value = default
     for compiler in root.iter("compiler"):

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from dyncheck.adapters.mjcf_copy import geom_defaults, inline
+from dyncheck.adapters.mjcf_copy import geom_defaults, inline, resolved_geoms
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -76,6 +76,11 @@ GRAVITY_IGNORED = (
     "Pinocchio's MJCF parser does not read <option gravity=\"{gravity}\"> (its model keeps "
     "its default, 0 0 -9.81; measured) (fix: set model.gravity after loading)"
 )
+MESH_MASS = (
+    "mesh geoms on bodies {bodies} state their mass, which Pinocchio's MJCF parser ignores "
+    "(measured: a 0.1 m cube stated 2 kg read as 1 kg, density × volume) (fix: give those "
+    "bodies an <inertial>)"
+)
 DEFAULT_MASS = (
     "the file sets geom masses in <default> classes ({classes}), which Pinocchio's MJCF "
     "parser ignores (measured: it computes those geoms' mass from their density, 1000 unless "
@@ -99,10 +104,18 @@ def _hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
     stated = [o.get("gravity", "") for o in root.iter("option") if o.get("gravity")]
     if stated and not np.allclose([float(x) for x in stated[-1].split()], (0.0, 0.0, -9.81)):
         out.append(("model", "gravity", GRAVITY_IGNORED.format(gravity=stated[-1])))
+    reasons = []
     massed = [c for c, attrs in geom_defaults(root).items() if "mass" in attrs]
     if massed:
-        why = DEFAULT_MASS.format(classes=", ".join(repr(c) for c in massed[:4]))
-        out += [("model", f, why) for f in ("mass", "inertia", "com")]
+        reasons.append(DEFAULT_MASS.format(classes=", ".join(repr(c) for c in massed[:4])))
+    meshes = sorted({b.get("name", "(unnamed)") for b, attrs in resolved_geoms(root)
+                     if "mesh" in attrs and attrs.get("type", "mesh") == "mesh"
+                     and "mass" in attrs and b.find("inertial") is None})
+    if meshes:
+        reasons.append(MESH_MASS.format(bodies=", ".join(repr(b) for b in meshes[:4])
+                                        + (" …" if len(meshes) > 4 else "")))
+    if reasons:
+        out += [("model", f, "; ".join(reasons)) for f in ("mass", "inertia", "com")]
     return tuple(out)
 
 

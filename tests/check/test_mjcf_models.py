@@ -240,3 +240,33 @@ def test_a_model_placed_elsewhere_as_a_whole_is_explained_not_failed(tmp_path):
     assert list(placement["verdict"]) == ["explained"]
     assert placement["value_b"].iloc[0] == "[-0.1 0.2 -0.5]"
     assert set(_rows(result, "dynamics")["verdict"]) == {"passed"}
+
+
+def test_the_first_of_several_joints_in_an_offset_body_is_drake_s_reading_named(tmp_path):
+    """Two joints in a body 1 m above the world: Drake's MJCF parser places the first one's
+    frame as if the body had no pos (measured: anchor (0.1, 0, 0) for MuJoCo's (0.1, 0, 1)).
+    A finding with its reason and fix; the second joint reads alike."""
+    body = ('<body name="b" pos="0 0 1"><joint name="j" type="hinge" axis="0 1 0" '
+            'pos="0.1 0 0"/><joint name="k" type="hinge" axis="1 0 0" pos="0.1 0 0"/>'
+            '<inertial pos="0 0 -0.2" mass="1" diaginertia="0.02 0.02 0.002"/></body>')
+    result = check_model(_write(tmp_path, "two_joints", body), states=5)
+    failed = _rows(result, "description", "failed")
+    failed = failed[failed["impl_b"] == "drake"]
+    assert set(zip(failed["subject"], failed["field"], strict=True)) == {("j", "anchor")}
+    assert "'j' is the first of 2 joints in body 'b'" in failed["note"].iloc[0]
+    assert "fix: one joint per body" in failed["note"].iloc[0]
+
+
+def test_a_mesh_geom_s_stated_mass_pinocchio_ignores_is_named(tmp_path):
+    """A mesh geom stating 7 kg on a body without <inertial>: Pinocchio's MJCF parser takes
+    density × volume instead (measured); MuJoCo and Drake read the stated mass."""
+    (tmp_path / "assets").mkdir()
+    _stl(tmp_path / "assets" / "cube.stl")
+    body = MESHED.format(inertial="", geom='mass="7"').replace('<geom type="mesh" mesh="cube" '
+                                                               'class="visual"/>', "")
+    result = check_model(_write(tmp_path, "mesh_mass", body, head=MESH_HEAD), states=5,
+                         impls=("reference", "mujoco", "pinocchio"))
+    mass = _rows(result, "description", "failed")
+    mass = mass[(mass["field"] == "mass") & (mass["impl_b"] == "pinocchio")]
+    assert mass["value_a"].iloc[0] == "7"
+    assert "mesh geoms on bodies 'arm' state their mass" in mass["note"].iloc[0]
