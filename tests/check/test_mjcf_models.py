@@ -270,3 +270,16 @@ def test_a_mesh_geom_s_stated_mass_pinocchio_ignores_is_named(tmp_path):
     mass = mass[(mass["field"] == "mass") & (mass["impl_b"] == "pinocchio")]
     assert mass["value_a"].iloc[0] == "7"
     assert "mesh geoms on bodies 'arm' state their mass" in mass["note"].iloc[0]
+
+
+def test_a_dropped_armature_fails_naming_the_joint_and_field(tmp_path):
+    """The corrupted copy loses one joint's armature (``--against`` the original, both read
+    by MuJoCo): a failed armature row on that joint, nothing else."""
+    chain = LINK.format(name="a", pos="0 0 1", joint="j1", extra=' armature="0.05"', mass=1,
+                        child=LINK.format(name="b", pos="0 0 -0.5", joint="j2",
+                                          extra=' armature="0.02"', mass=1, child=""))
+    original = _write(tmp_path, "original", chain)
+    corrupted = _write(tmp_path, "corrupted", chain.replace(' armature="0.02"', ""))
+    result = check_model(corrupted, states=5, against=original, impls=("reference", "mujoco"))
+    failed = _rows(result, verdict="failed")
+    assert set(zip(failed["subject"], failed["field"], strict=True)) == {("j2", "armature")}
