@@ -18,9 +18,12 @@ import sys
 import tempfile
 from collections.abc import Sequence
 from pathlib import Path
-from typing import NoReturn
+from typing import TYPE_CHECKING, NoReturn
 
 from dyncheck.errors import DyncheckError, EngineNotInstalled, InvalidInput, UnknownName
+
+if TYPE_CHECKING:
+    from dyncheck.check.engines import Limits
 
 
 class _Parser(argparse.ArgumentParser):
@@ -142,6 +145,12 @@ def _parser() -> argparse.ArgumentParser:
                    help="models checked in N parallel processes (same results)")
     _dask(k)
     _no_cache(k)
+    k.add_argument("--engine-memory", type=int, default=None, metavar="MIB",
+                   help="address space each engine process may use (default 8192 MiB; 0: no "
+                   "cap; MuJoCo's ports are never capped)")
+    k.add_argument("--engine-seconds", type=float, default=None, metavar="S",
+                   help="base time limit of an engine's load and of each batch of states "
+                   "(default 120 s), scaled up with the file's size and states x dofs^2")
     k.add_argument("--in-process", action="store_true",
                    help="load the engines in this process (faster start; an engine that "
                    "crashes on the file then ends the check)")
@@ -624,6 +633,25 @@ def _check_targets(args: argparse.Namespace, cases: Path) -> list[tuple[Path, st
     return targets
 
 
+MAX_ENGINE_MIB = 1 << 20
+MAX_ENGINE_SECONDS = 86_400.0
+
+
+def _limits(args: argparse.Namespace) -> Limits:
+    """The engines' limits from ``--engine-memory`` and ``--engine-seconds`` (checked)."""
+    from dyncheck.check.engines import MEMORY_MIB, Limits
+
+    memory = MEMORY_MIB if args.engine_memory is None else args.engine_memory
+    if not (memory == 0 or 256 <= memory <= MAX_ENGINE_MIB):
+        raise InvalidInput("--engine-memory", memory,
+                           f"0 (no cap) or a size in MiB in [256, {MAX_ENGINE_MIB}]")
+    if args.engine_seconds is not None and not (
+            1.0 <= args.engine_seconds <= MAX_ENGINE_SECONDS):
+        raise InvalidInput("--engine-seconds", args.engine_seconds,
+                           f"a number of seconds in [1, {MAX_ENGINE_SECONDS:g}]")
+    return Limits(memory_mib=memory or None, seconds=args.engine_seconds)
+
+
 def _without(message: str, path: Path) -> str:
     """``message`` with the model's path as its file name: no machine path on a page."""
     for text in (str(path.resolve()), str(path)):
@@ -674,7 +702,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     _positive("--jobs", args.jobs)
     options = {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
                "floating": args.floating, "against": args.against,
-               "isolate": not args.in_process}
+               "isolate": not args.in_process, "limits": _limits(args)}
     units = [(name, partial(check_model, **options, name=robot or (name if several else None)),
               (str(path),)) for path, robot, name in valid]
     engines = tuple(i for i in implementations(tuple(args.impl) or None) if i != "reference")

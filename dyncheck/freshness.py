@@ -88,12 +88,14 @@ PAGES_NOT_COMPARED = (
     "benchmark.md",
     "benchmark-suite.md",
     "benchmark-ports.md",
+    "benchmark-check.md",
     "versions.md",
     "reliability.md",
     "errata.md",
 )
-"""Pages of the report folder that a run does not write (``dyncheck bench``, ``versions``,
-``errata`` and the fault-table test do; each has its own freshness check)."""
+"""Pages of the report folder that a run does not write (``dyncheck bench``, the scripts
+under ``benchmarks/``, ``versions``, ``errata`` and the fault-table test do; each has its own
+freshness check, the timings none: they are of this machine)."""
 TABLES_NOT_COMPARED = ("benchmark.csv", "benchmark-suite.csv", "baseline.csv")
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?|\bnan\b|\binf\b")

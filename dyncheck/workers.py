@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import atexit
 import gc
+import os
 import sys
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, ProcessPoolExecutor
@@ -53,8 +54,8 @@ def executor(jobs: int = 1, dask: str | None = None) -> Iterator[Executor | None
         import multiprocessing
 
         ctx = multiprocessing.get_context(start_method())
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx,
-                                 initializer=exit_without_collecting) as pool:
+        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_start,
+                                 initargs=(os.getpid(),)) as pool:
             yield pool
         return
     try:
@@ -89,6 +90,15 @@ def executor(jobs: int = 1, dask: str | None = None) -> Iterator[Executor | None
         ) from None
     with client:
         yield client.get_executor(pure=False)
+
+
+def _worker_start(parent: int) -> None:
+    """A local worker dies with the process that started it (SIGTERM or SIGKILL of
+    ``dyncheck run --jobs 2`` left its workers computing) and skips the final collection."""
+    from dyncheck.confinement import die_with_parent
+
+    die_with_parent(parent)
+    exit_without_collecting()
 
 
 def exit_without_collecting() -> None:

@@ -17,7 +17,9 @@ from __future__ import annotations
 
 import faulthandler
 import importlib
+import importlib.metadata
 import multiprocessing as mp
+import os
 import signal
 import time
 from dataclasses import dataclass
@@ -28,6 +30,7 @@ import numpy as np
 
 from dyncheck.adapters.model_files import ModelFile
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
+from dyncheck.confinement import confine
 from dyncheck.errors import DyncheckError, EngineError, Unsupported
 from dyncheck.workers import start_method
 
@@ -66,10 +69,34 @@ PORTS = ("mjx", "mjx-f64", "mujoco-warp")
 """Checked only when asked for (``--impl mjx``): compiling a model for a port takes seconds
 to minutes on a CPU."""
 DEFAULT = tuple(i for i in IMPLEMENTATIONS if i not in PORTS)
-LOAD_TIMEOUT_S = 600.0
-"""Longest an isolated engine may take to load a model."""
-TIMEOUT_S = 600.0
-"""Longest an isolated engine may take to answer one batch of states."""
+LOAD_TIMEOUT_S = 120.0
+"""Longest an isolated engine may take to load a model, plus :data:`LOAD_S_PER_MB` of its
+file (the parsers here load a 1 MB file in well under a second)."""
+LOAD_S_PER_MB = 30.0
+TIMEOUT_S = 120.0
+"""Longest an isolated engine may take to answer one batch of states, plus
+:data:`S_PER_STATE_DOF2` × states × nv² (the engines here: ~1e-7 s per state and nv²)."""
+S_PER_STATE_DOF2 = 1e-5
+MEMORY_MIB = 8192
+"""Address space an isolated engine may use (MuJoCo's ports excepted: JAX and Warp reserve
+far more address space than they use)."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class Limits:
+    """An isolated engine's limits: ``memory_mib`` of address space (None: no cap) and a base
+    number of seconds (None: :data:`TIMEOUT_S`), scaled to the model (see the constants)."""
+
+    memory_mib: int | None = MEMORY_MIB
+    seconds: float | None = None
+
+    def load_seconds(self, source: ModelFile) -> float:
+        base = LOAD_TIMEOUT_S if self.seconds is None else self.seconds
+        return base + LOAD_S_PER_MB * len(source.text.encode()) / 2**20
+
+    def batch_seconds(self, states: int, nv: int) -> float:
+        base = TIMEOUT_S if self.seconds is None else self.seconds
+        return base + S_PER_STATE_DOF2 * states * nv * nv
 
 
 @dataclass(frozen=True)
@@ -84,15 +111,40 @@ class NotLoaded:
     refused: bool = False
 
 
-def load(name: str, source: ModelFile, spec: Engine | None = None) -> ModelEngine | NotLoaded:
-    """Load ``source`` into engine ``name`` in this process."""
+def _installed(distribution: str) -> bool:
+    try:
+        importlib.metadata.distribution(distribution)
+    except importlib.metadata.PackageNotFoundError:
+        return False
+    return True
+
+
+def _out_of_memory(name: str, memory_mib: int | None) -> str:
+    cap = f"its address space capped at {memory_mib} MiB (--engine-memory)" if memory_mib \
+        else "no cap set"
+    return f"{name} ran out of memory ({cap})"
+
+
+def load(name: str, source: ModelFile, spec: Engine | None = None,
+         memory_mib: int | None = None) -> ModelEngine | NotLoaded:
+    """Load ``source`` into engine ``name`` in this process (``memory_mib``: the cap this
+    process runs under, for the message when it is reached)."""
     spec = spec or ENGINES[name]
     try:
         module = importlib.import_module(spec.module)
+    except MemoryError:
+        return NotLoaded(name, False, _out_of_memory(name, memory_mib))
     except ImportError as exc:
-        return NotLoaded(name, True, f"needs the '{spec.extra}' extra ({exc.name} not installed)")
+        if spec.distribution and _installed(spec.distribution):  # installed, yet failing
+            why = _out_of_memory(name, memory_mib) if memory_mib else \
+                f"{name} is installed but failed to import ({exc})"
+            return NotLoaded(name, False, why)
+        extra = f"the '{spec.extra}' extra" if spec.extra else f"'{spec.distribution}'"
+        return NotLoaded(name, True, f"needs {extra} ({exc.name} not installed)")
     try:
         return getattr(module, spec.cls)(source)
+    except MemoryError:
+        return NotLoaded(name, False, _out_of_memory(name, memory_mib))
     except Unsupported as exc:
         return NotLoaded(name, True, str(exc))
     except DyncheckError as exc:
@@ -102,10 +154,15 @@ def load(name: str, source: ModelFile, spec: Engine | None = None) -> ModelEngin
         return NotLoaded(name, False, f"{name} failed: {type(exc).__name__}: {message}")
 
 
-def _serve(name: str, spec: Engine, source: ModelFile, conn: Connection) -> None:
-    """The isolated engine's process: load, send the tree, then answer batches until None."""
+def _serve(name: str, spec: Engine, source: ModelFile, conn: Connection, parent: int,
+           memory_mib: int | None) -> None:
+    """The isolated engine's process: confined (it dies with dyncheck, lets go of the
+    caller's output, its memory capped), it loads, sends the tree, then answers batches
+    until None."""
     faulthandler.disable()  # a crash here is reported by the parent, in one line
-    loaded = load(name, source, spec)
+    confine(parent, memory_bytes=None if memory_mib is None else memory_mib * 2**20,
+            quiet=True)
+    loaded = load(name, source, spec, memory_mib)
     if isinstance(loaded, NotLoaded):
         conn.send(loaded)
         return
@@ -115,6 +172,8 @@ def _serve(name: str, spec: Engine, source: ModelFile, conn: Connection) -> None
             t0 = time.perf_counter()
             answer = loaded.dynamics(*batch)
             conn.send((answer, time.perf_counter() - t0))
+        except MemoryError:
+            conn.send(EngineError(_out_of_memory(name, memory_mib)))
         except Exception as exc:
             conn.send(EngineError(f"{type(exc).__name__}: {' '.join(str(exc).split())}"))
 
@@ -132,13 +191,16 @@ class Isolated:
     """An engine in its own process (see the module's docstring): its ``tree`` and
     ``dynamics`` as :class:`ModelEngine`, a crash or a hang an :class:`EngineError`."""
 
-    def __init__(self, name: str, source: ModelFile) -> None:
+    def __init__(self, name: str, source: ModelFile, limits: Limits | None = None) -> None:
         ctx = mp.get_context(start_method())
         self.engine = name
+        self.limits = limits or Limits()
+        self._source = source
         self._conn, child = ctx.Pipe()
+        memory = None if name in PORTS else self.limits.memory_mib
         # the spec travels with the call: a spawned child would not see a patched ENGINES
-        self._proc = ctx.Process(target=_serve, args=(name, ENGINES[name], source, child),
-                                 daemon=True)
+        self._proc = ctx.Process(target=_serve, args=(name, ENGINES[name], source, child,
+                                                      os.getpid(), memory), daemon=True)
         self._proc.start()
         child.close()
 
@@ -150,7 +212,7 @@ class Isolated:
                                   f"({_death(self._proc.exitcode)})")
             if time.monotonic() > deadline:
                 self.close(hung=True)
-                raise EngineError(f"{self.engine} gave no answer within {timeout:g} s "
+                raise EngineError(f"{self.engine} gave no answer within {timeout:.0f} s "
                                   f"while {doing} (stopped)")
         try:
             return self._conn.recv()
@@ -162,7 +224,7 @@ class Isolated:
     def loaded(self) -> Isolated | NotLoaded:
         """Wait for the load: this proxy with the engine's tree, or why it has none."""
         try:
-            answer = self._receive("loading the model", LOAD_TIMEOUT_S)
+            answer = self._receive("loading the model", self.limits.load_seconds(self._source))
         except EngineError as exc:
             return NotLoaded(self.engine, False, str(exc))
         if isinstance(answer, NotLoaded):
@@ -178,6 +240,7 @@ class Isolated:
     def submit(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
         """Hand the engine a batch of states; :meth:`collect` waits for its answer (the
         caller computes meanwhile: the engines and the referee side by side)."""
+        self._batch_seconds = self.limits.batch_seconds(len(q), v.shape[1] if v.ndim > 1 else 1)
         try:
             self._conn.send((q, v, a))
         except OSError:
@@ -186,7 +249,7 @@ class Isolated:
 
     def collect(self) -> tuple[Dynamics, float]:
         """The submitted batch's dynamics and the seconds the engine spent on them."""
-        answer = self._receive("computing the dynamics", TIMEOUT_S)
+        answer = self._receive("computing the dynamics", self._batch_seconds)
         if isinstance(answer, Exception):
             raise answer
         return answer  # type: ignore[return-value]
@@ -212,13 +275,13 @@ def can_isolate() -> bool:
     return not mp.current_process().daemon
 
 
-def start(names: list[str], source: ModelFile, *, isolate: bool) -> dict[str, ModelEngine |
-                                                                           NotLoaded]:
-    """Load ``source`` into each engine — side by side in their own processes when
-    ``isolate`` — in the order given."""
+def start(names: list[str], source: ModelFile, *, isolate: bool,
+          limits: Limits | None = None) -> dict[str, ModelEngine | NotLoaded]:
+    """Load ``source`` into each engine — side by side in their own processes, within
+    ``limits``, when ``isolate`` — in the order given."""
     if not isolate:
         return {name: load(name, source) for name in names}
-    started = {name: Isolated(name, source) for name in names}
+    started = {name: Isolated(name, source, limits) for name in names}
     return {name: proxy.loaded() for name, proxy in started.items()}
 
 

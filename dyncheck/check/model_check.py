@@ -100,11 +100,13 @@ def check_model(
     against: str | Path | None = None,
     name: str | None = None,
     isolate: bool = True,
+    limits: engine_processes.Limits | None = None,
 ) -> CheckResult:
     """Check one model file (see the module's docstring); bad input raises
     :class:`~dyncheck.errors.InvalidInput` before any engine runs. With ``isolate`` (the
-    default) each engine runs in its own process, so that one crashing on the file costs only
-    its rows (:mod:`dyncheck.check.engines`)."""
+    default) each engine runs in its own process, within ``limits`` (memory, seconds scaled to
+    the model), so that one crashing, hanging or growing on the file costs only its rows
+    (:mod:`dyncheck.check.engines`)."""
     source_path = inputs.model_path(str(path))
     against_path = inputs.model_path(str(against)) if against is not None else None
     inputs.states(states)
@@ -119,7 +121,7 @@ def check_model(
         source = replace(source, notes=(*source.notes, IN_PROCESS_NOTE))
     t0 = time.perf_counter()
     engines = engine_processes.start([i for i in chosen if i in ENGINES], source,
-                                     isolate=isolate)
+                                     isolate=isolate, limits=limits)
     try:
         return _check(model, source_path, source, engines, chosen, states, seed, floating,
                       against_path, time.perf_counter() - t0)

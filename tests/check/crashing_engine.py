@@ -27,3 +27,31 @@ class CrashOnDynamics(MujocoModel):
 class HangOnDynamics(MujocoModel):
     def dynamics(self, q, v, a):  # type: ignore[no-untyped-def]
         time.sleep(3600)
+
+
+class GrowOnLoad(MujocoModel):
+    """A parser that grows without bound (Drake's on an MJCF that includes itself did)."""
+
+    def __init__(self, source):  # type: ignore[no-untyped-def]
+        held = []
+        while True:
+            held.append(bytearray(64 * 2**20))
+
+
+class NoisyHangOnDynamics(MujocoModel):
+    """Writes to the caller's stdout and stderr at the C level, records its pid, then never
+    answers: it must neither reach the caller's output nor outlive the check's process."""
+
+    def __init__(self, source):  # type: ignore[no-untyped-def]
+        import os
+
+        os.write(1, b"ENGINE-NOISE-STDOUT\n")
+        os.write(2, b"ENGINE-NOISE-STDERR\n")
+        pid_file = os.environ.get("DYNCHECK_TEST_PID_FILE")
+        if pid_file:
+            with open(pid_file, "w") as handle:
+                handle.write(str(os.getpid()))
+        super().__init__(source)
+
+    def dynamics(self, q, v, a):  # type: ignore[no-untyped-def]
+        time.sleep(3600)

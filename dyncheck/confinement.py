@@ -1,0 +1,59 @@
+"""What a child process of dyncheck does first, so that it can neither outlive dyncheck nor
+hold its caller hostage: it dies with its parent (Linux ``PR_SET_PDEATHSIG``: SIGKILL when the
+parent exits for any reason, a SIGKILL of dyncheck included), it lets go of the caller's
+stdout and stderr (an engine's C++ messages would otherwise keep ``dyncheck check … | tee
+log`` or a CI step open after dyncheck is gone), and its address space is capped where a cap
+is asked for (a model that makes a parser grow without bound fails there, in one line,
+instead of taking the machine).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import resource
+import signal
+import sys
+
+PR_SET_PDEATHSIG = 1
+"""``prctl`` option: the signal this process receives when its parent thread exits."""
+
+
+def die_with_parent(parent: int) -> None:
+    """SIGKILL this process when ``parent`` exits (Linux); where the parent is already gone
+    (it exited before this ran) exit now."""
+    if sys.platform == "linux":
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+        except (OSError, AttributeError):  # no prctl: the parent's own cleanup stops us
+            pass
+    if os.getppid() != parent:
+        os._exit(0)
+
+
+def release_output() -> None:
+    """Point this process's stdout and stderr at /dev/null (the caller's pipe is let go)."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    null = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(null, 1)
+    os.dup2(null, 2)
+    os.close(null)
+
+
+def cap_memory(limit_bytes: int | None) -> None:
+    """At most ``limit_bytes`` of address space for this process (None: no cap)."""
+    if limit_bytes is None:
+        return
+    _soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    cap = limit_bytes if hard == resource.RLIM_INFINITY else min(limit_bytes, hard)
+    resource.setrlimit(resource.RLIMIT_AS, (cap, hard))
+
+
+def confine(parent: int, *, memory_bytes: int | None = None, quiet: bool = False) -> None:
+    """All of the above for a child of ``parent``."""
+    die_with_parent(parent)
+    if quiet:
+        release_output()
+    cap_memory(memory_bytes)
