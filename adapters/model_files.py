@@ -75,10 +75,17 @@ def read(path: Path, *, floating: bool = False) -> ModelFile:
         return ModelFile(
             path=path, format=Format.URDF, text=text, floating=floating, notes=tuple(notes)
         )
-    return ModelFile(
-        path=path, format=Format.MJCF, text=path.read_text(encoding="utf-8"),
-        floating=floating, notes=(),
-    )
+    return ModelFile(path=path, format=Format.MJCF, text=_decoded(path.read_bytes()),
+                     floating=floating, notes=())
+
+
+def _decoded(raw: bytes) -> str:
+    """The file's text as its XML declaration (or byte-order mark) says it is encoded; UTF-8
+    where it says nothing."""
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError:
+        return ET.tostring(ET.fromstring(raw), encoding="unicode")
 
 
 def missing_meshes(path: Path, root: ET.Element) -> list[str]:

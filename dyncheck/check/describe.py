@@ -189,7 +189,12 @@ def _violation(mass: float, inertia: np.ndarray) -> tuple[str, object, float, fl
     if not np.isfinite(mass) or not np.all(np.isfinite(inertia)):
         return ("finite", mass, float("inf"), 0.0,
                 f"mass {mass:g} or inertia {_fmt(np.asarray(inertia).ravel())} not finite")
-    moments = np.linalg.eigvalsh(0.5 * (inertia + inertia.T))
+    scale = float(np.abs(inertia).max()) or 1.0  # eigenvalues of I/scale: no overflow at 1e308
+    unit = np.asarray(inertia, float) / scale
+    moments = np.linalg.eigvalsh(0.5 * (unit + unit.T)) * scale
+    if not np.all(np.isfinite(moments)):
+        return ("finite", mass, float("inf"), 0.0,
+                f"principal moments of inertia {_fmt(np.asarray(inertia).ravel())} overflow")
     tol = ROUNDOFF * EPS * max(float(np.abs(moments).sum()), 1e-300)
     if moments[0] < -tol:
         return ("inertia", moments, -float(moments[0]), tol,

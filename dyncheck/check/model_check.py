@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials
-from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.adapters.model_tree import ModelTree, TreeJoint
 from dyncheck.check import describe, inputs, layout, partial
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.dynamics import Explanation, States, compare, condition, sample
@@ -122,9 +122,10 @@ def check_model(
     t0 = time.perf_counter()
     engines = engine_processes.start([i for i in chosen if i in ENGINES], source,
                                      isolate=isolate, limits=limits)
-    try:
-        return _check(model, source_path, source, engines, chosen, states, seed, floating,
-                      against_path, time.perf_counter() - t0)
+    try:  # an overflow is a non-finite value, reported as a row: never a warning on stderr
+        with np.errstate(all="ignore"):
+            return _check(model, source_path, source, engines, chosen, states, seed,
+                          floating, against_path, time.perf_counter() - t0)
     finally:
         engine_processes.stop(engines)
 
@@ -311,11 +312,17 @@ def _rotor_difference(canon: layout.Canonical, canonical_tree: ModelTree, tree_a
     )
 
 
+def _parent(joint: TreeJoint, renames: dict[str, str]) -> str | None:
+    return renames.get(joint.parent, joint.parent) if joint.parent else None
+
+
 def _align_by_body(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree, list[str]]:
     """Joints an engine names otherwise matched to the canonical engine's by their body and
     their order in it, where the types agree: Drake names an MJCF ``<freejoint>`` after its
     body; Pinocchio's MJCF parser makes a body's several joints one composite joint whose
-    components it names ``<composite>[k]``."""
+    components it names ``<composite>[k]``. What is left — joints and bodies without names
+    in the file, which each engine names its own way — is matched by place in the tree: the
+    same number, the same types in the same order, the same parents."""
     known = {j.name for j in canonical.joints}
     names = {j.name for j in tree.joints}
     renames: dict[str, str] = {}
@@ -328,6 +335,15 @@ def _align_by_body(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree, li
                             for a, b in zip(mine, theirs, strict=True))):
             renames.update({a.name: b.name for a, b in zip(mine, theirs, strict=True)
                             if a.name != b.name})
+    renamed = {renames.get(j.name, j.name) for j in tree.joints}
+    mine = [j for j in tree.joints if renames.get(j.name, j.name) not in known]
+    theirs = [j for j in canonical.joints if j.name not in renamed]
+    by_place = {a.name: b.name for a, b in zip(mine, theirs, strict=False)}
+    placed = bool(mine) and len(mine) == len(theirs) and all(  # the rest by place in the tree
+        a.type is b.type and _parent(a, renames | by_place) == b.parent
+        for a, b in zip(mine, theirs, strict=True))
+    if placed:
+        renames.update(by_place)
     if not renames:
         return tree, []
     joints = tuple(
@@ -336,7 +352,12 @@ def _align_by_body(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree, li
         for j in tree.joints
     )
     notes = [f"{tree.engine}: joint {old!r} (body {tree.joint(old).body!r}) matched to {new!r} "
-             "by its body and its place in it" for old, new in renames.items()]
+             "by its body and its place in it" for old, new in renames.items()
+             if not (placed and old in by_place)]
+    if placed:
+        notes.append(f"{tree.engine}: {len(by_place)} joints without a common name (unnamed in "
+                     "the file) matched by their place in the tree: " + ", ".join(
+                         f"{old!r} = {new!r}" for old, new in by_place.items()))
     return replace(tree, joints=joints, hints=tuple(
         (renames.get(j, j), f, why) for j, f, why in tree.hints)), notes
 

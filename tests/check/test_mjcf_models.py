@@ -283,3 +283,20 @@ def test_a_dropped_armature_fails_naming_the_joint_and_field(tmp_path):
     result = check_model(corrupted, states=5, against=original, impls=("reference", "mujoco"))
     failed = _rows(result, verdict="failed")
     assert set(zip(failed["subject"], failed["field"], strict=True)) == {("j2", "armature")}
+
+
+def test_joints_and_bodies_without_names_are_matched_by_place(tmp_path):
+    """MJCF needs no names: MuJoCo, Drake and Pinocchio then name the joints each their own
+    way (':hinge', 'world-body1', …). Matched by their place in the tree (same number, types
+    and parents), said in the notes — never 'has no joint' rows — and compared."""
+    body = ('<body pos="0 0 1"><joint type="hinge" axis="0 1 0"/><inertial pos="0 0 -0.2" '
+            'mass="1" diaginertia="0.02 0.02 0.002"/><body pos="0 0 -0.4"><joint type="slide" '
+            'axis="1 0 0"/><inertial pos="0 0 -0.2" mass="2" diaginertia="0.02 0.02 0.002"/>'
+            "</body></body>")
+    result = check_model(_write(tmp_path, "anonymous", body), states=5,
+                         impls=("reference", "mujoco", "drake"))
+    assert result.ok, result.failures()
+    assert any("matched by their place in the tree" in n for n in result.notes)
+    pairs = set(zip(*(_rows(result, "dynamics")[c] for c in ("impl_a", "impl_b")),
+                    strict=True))
+    assert ("reference", "drake") in pairs

@@ -325,6 +325,34 @@ FAULTS: tuple[Fault, ...] = (
     Fault(kind="unknown robot", area="check", argv=("check", "--robot", "no_such_robot",
                                                     "--out", OUT),
           answer=r"no_such_robot"),
+    Fault(kind="MJCF encoded as UTF-16 (it says so; read as UTF-8 before: a traceback)",
+          area="check",
+          prepare=_file("u16.xml", ('<?xml version="1.0" encoding="UTF-16"?>' + SMALL_MJCF)
+                        .encode("utf-16")),
+          argv=("check", "{tmp}/u16.xml", "--out", OUT),
+          answer=r"<tmp>/u16.xml: is encoded as UTF-16; the engines' MJCF parsers read UTF-8 "
+                 r"only \(save the file as UTF-8\)$"),
+    Fault(kind="MJCF encoded as Latin-1 with a non-ASCII name (every engine failed)",
+          area="check",
+          prepare=_file("l1.xml", ('<?xml version="1.0" encoding="ISO-8859-1"?><mujoco '
+                                   "model='ïn'><worldbody><body name='bödy'><joint name='j' "
+                                   "type='hinge'/><geom size='0.1'/></body></worldbody>"
+                                   "</mujoco>").encode("latin-1")),
+          argv=("check", "{tmp}/l1.xml", "--states", "2", "--out", OUT),
+          answer=r"<tmp>/l1.xml: is encoded as ISO-8859-1; the engines' MJCF parsers read "),
+    Fault(kind="URDF encoded as Latin-1 with a non-ASCII link name (decoded as declared)",
+          area="check",
+          prepare=_file("l1.urdf", ('<?xml version="1.0" encoding="ISO-8859-1"?>' + URDF
+                                    .split("?>", 1)[-1].replace('name="base"', 'name="bäse"')
+                                    .replace('link="base"', 'link="bäse"')).encode("latin-1")),
+          argv=("check", "{tmp}/l1.urdf", "--states", "2", "--out", OUT),
+          answer=r"^l1: \d+ passed", exit=0),
+    Fault(kind="inertia of 1e308 (eigenvalues overflowed: a traceback before)", area="check",
+          prepare=_file("big.xml", "<mujoco><worldbody><body><joint type='hinge'/><inertial "
+                        "pos='0 0 -0.2' mass='1e308' diaginertia='1e308 1e308 1e308'/></body>"
+                        "</worldbody></mujoco>"),
+          argv=("check", "{tmp}/big.xml", "--states", "2", "--out", OUT),
+          answer=r"returned a non-finite", exit=1),
     Fault(kind="--engine-memory below the smallest cap", area="check",
           argv=("check", BRANCHES, "--engine-memory", "16", "--out", OUT),
           answer=r"--engine-memory must be 0 \(no cap\) or a size in MiB in \[256, 1048576\], "
