@@ -72,6 +72,32 @@ def _no_cache(p: argparse.ArgumentParser) -> None:
     )
 
 
+def _ci(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--junit", type=_path, default=None, metavar="FILE",
+                   help="also write the rows as JUnit XML (one test suite per case or model, "
+                   "one test case per quantity and pair) for a CI system to show")
+    p.add_argument("--json", type=_path, default=None, metavar="FILE",
+                   help="also write a JSON summary: the counts, each case's or model's, every "
+                   "row")
+
+
+def _ci_files(args: argparse.Namespace) -> None:
+    """The ``--junit`` and ``--json`` files writable, checked before any work."""
+    for flag, path in (("--junit", args.junit), ("--json", args.json)):
+        if path is not None:
+            _check_out_file(flag, path)
+
+
+def _write_ci(args: argparse.Namespace, tables: dict, columns: object,
+              versions: dict[str, str], refused: dict[str, str] | None = None) -> None:
+    from dyncheck import ci_outputs
+
+    if args.junit is not None:
+        ci_outputs.write_junit(args.junit, tables, columns)  # type: ignore[arg-type]
+    if args.json is not None:
+        ci_outputs.write_json(args.json, tables, versions, refused)
+
+
 def _dask(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--dask",
@@ -120,6 +146,7 @@ def _parser() -> argparse.ArgumentParser:
         metavar="FILE",
         help="report every row that regressed against this baseline (exit 1)",
     )
+    _ci(r)
     k = sub.add_parser("check", help="do the engines read and simulate YOUR model alike?")
     k.add_argument("paths", nargs="*", type=_path, metavar="PATH",
                    help="MJCF (.xml) or URDF files, or folders (every model file under "
@@ -144,6 +171,7 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--jobs", type=int, default=1, metavar="N",
                    help="models checked in N parallel processes (same results)")
     _dask(k)
+    _ci(k)
     _no_cache(k)
     k.add_argument("--engine-memory", type=int, default=None, metavar="MIB",
                    help="address space each engine process may use (default 8192 MiB; 0: no "
@@ -312,19 +340,22 @@ def _list(*, integrators: bool = False) -> int:
     return 0
 
 
-def _check_out(out: Path) -> None:
+def _check_out(out: Path, flag: str = "--out") -> None:
     """--out must be a directory, or creatable, and writable — tried for real (a probe file
     created and removed, any folder made for it removed again) before any work, so bad usage
-    changes nothing."""
+    changes nothing. ``flag``: the option the folder comes from."""
     if out.exists() and not out.is_dir():
-        raise InvalidInput("--out", str(out), "a directory")
+        raise InvalidInput(flag, str(out), "a directory")
+    bad = next((p for p in out.parents if p.exists() and not p.is_dir()), None)
+    if bad is not None:
+        raise InvalidInput(flag, str(out), f"a folder path ({bad} is a file)")
     missing = [p for p in (out, *out.parents) if not p.exists()]
     try:
         out.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile(dir=out, prefix=".dyncheck-probe-"):
             pass
     except OSError as exc:
-        raise InvalidInput("--out", str(out), f"a writable directory ({exc.strerror})") from None
+        raise InvalidInput(flag, str(out), f"a writable directory ({exc.strerror})") from None
     finally:
         for p in missing:  # innermost first: leave no trace of the probe
             if p.is_dir() and not any(p.iterdir()):
@@ -335,7 +366,7 @@ def _check_out_file(flag: str, path: Path) -> None:
     """A file to write: not a folder, and its folder writable (:func:`_check_out`)."""
     if path.is_dir():
         raise InvalidInput(flag, str(path), "a file path, not a folder")
-    _check_out(path.parent)
+    _check_out(path.parent, flag)
 
 
 MAX_STATES = 10**9
@@ -374,6 +405,7 @@ def _run(args: argparse.Namespace) -> int:
     from dyncheck.run import resolve, run
 
     _check_out(args.out)
+    _ci_files(args)
     if args.device is not None:
         _use_device(args.device)
     _positive("--states", args.states)
@@ -389,6 +421,9 @@ def _run(args: argparse.Namespace) -> int:
                  conventions=not args.cases, progress=report.stderr_progress,
                  render=draw_figures)
     report.write(result, args.out)
+    from dyncheck.ci_outputs import RUN, split
+
+    _write_ci(args, split(result.discrepancies, RUN), RUN, report.versions(result.engines))
     counts = result.discrepancies["verdict"].value_counts()
     print(
         ", ".join(f"{counts.get(v, 0)} {v}" for v in ("passed", "explained", "failed", "skipped"))
@@ -699,6 +734,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     if args.seed < 0:
         raise InvalidInput("--seed", args.seed, "a non-negative integer")
     _check_out(args.out)
+    _ci_files(args)
     _positive("--jobs", args.jobs)
     options = {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
                "floating": args.floating, "against": args.against,
@@ -707,6 +743,8 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
               (str(path),)) for path, robot, name in valid]
     engines = tuple(i for i in implementations(tuple(args.impl) or None) if i != "reference")
     failed, refusals = False, len(entries)
+    tables: dict[str, object] = {}
+    refused: dict[str, str] = {}
     for name, result in each_unit(units, jobs=args.jobs, dask=args.dask):
         if isinstance(result, DyncheckError):
             if not several:
@@ -714,11 +752,13 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
             print(f"dyncheck: error: {name}: {result}", file=sys.stderr)
             path = next(p for p, _, n in valid if n == name)
             entries.append(index.refused(name, files[name], _without(str(result), path)))
+            refused[name] = _without(str(result), path)
             refusals += 1
         else:
             written = write(result, args.out, name=name)
             print(f"{summary_line(result)} -> {written[1]}")
             entries.append(index.entry(result, name, files[name]))
+            tables[name] = result.rows
             if not result.ok:
                 failed = True
                 print(result.failures())
@@ -726,6 +766,13 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
             index.write(entries, engines, args.out)
     if several:
         print(f"{len(entries)} models: index -> {args.out / (index.INDEX + '.md')}")
+    refused |= {e.model: e.refused for e in entries if e.refused}
+    if args.junit is not None or args.json is not None:
+        from dyncheck.check.page import engine_versions_of
+        from dyncheck.ci_outputs import CHECK
+
+        _write_ci(args, tables, CHECK, engine_versions_of(implementations(
+            tuple(args.impl) or None)), refused)
     return 2 if refusals else 1 if failed else 0
 
 

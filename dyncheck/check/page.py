@@ -24,9 +24,14 @@ TITLES = {
 
 
 def _versions(result: CheckResult) -> dict[str, str]:
-    """The provenance of the engines the check used, from their packages' metadata (an
-    engine is never imported here for it: the engines ran in processes of their own, and
-    importing Drake alone costs 0.3 s)."""
+    """The provenance of the engines the check used (:func:`engine_versions_of`)."""
+    return engine_versions_of(result.impls)
+
+
+def engine_versions_of(impls: tuple[str, ...]) -> dict[str, str]:
+    """The provenance of ``impls``' engines, from their packages' metadata (an engine is
+    never imported here for it: the engines ran in processes of their own, and importing
+    Drake alone costs 0.3 s)."""
     from importlib.metadata import PackageNotFoundError, version
 
     from dyncheck.check.engines import ENGINES
@@ -35,7 +40,7 @@ def _versions(result: CheckResult) -> dict[str, str]:
 
     labels = dict(LABELS)
     used = {}
-    for name in result.impls:
+    for name in impls:
         if name in ENGINES and name in labels:
             try:
                 used[labels[name]] = version(ENGINES[name].distribution)

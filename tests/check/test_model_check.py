@@ -8,7 +8,6 @@ from __future__ import annotations
 import importlib.util
 import io
 import json
-import re
 import subprocess
 import sys
 from pathlib import Path
@@ -144,9 +143,14 @@ def test_check_model_is_deterministic():
     assert a.rows.equals(b.rows)
 
 
-def test_readme_pytest_recipe_names_the_api():
+def test_readme_pytest_recipe_names_the_plugin_s_options_and_fixture():
+    """The README's recipe uses what the plugin defines (its run: test_pytest_plugin.py)."""
+    from dyncheck import pytest_plugin
+
     readme = (Path(__file__).parents[2] / "README.md").read_text()
-    assert re.search(r"from dyncheck import check_model", readme)
+    source = Path(pytest_plugin.__file__).read_text()
+    for name in ("--dyncheck-model", "--dyncheck-floating", "dyncheck_model"):
+        assert name in readme and name in source
 
 
 CRASHES = {

@@ -1,0 +1,82 @@
+"""dyncheck as a pytest plugin (registered by entry point: installing dyncheck is enough) —
+a user's own test suite checks their models without copied code:
+
+    pytest --dyncheck-model robots/arm.xml --dyncheck-model robots/dog.urdf --dyncheck-floating
+
+adds one test per model, ``dyncheck[robots/arm.xml]``, that fails with the check's failed rows
+(every row passed or explained: it passes). In a test, the fixture ``dyncheck_model`` checks a
+model and asserts the same::
+
+    def test_my_arm(dyncheck_model):
+        result = dyncheck_model("robots/arm.xml", states=100)   # a CheckResult
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import pytest
+
+DEFAULT_STATES = 100
+
+
+class CheckFailed(AssertionError):
+    """A model the check finds wrong: its message the failed rows."""
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    group = parser.getgroup("dyncheck", "dyncheck: do the engines read your model alike?")
+    group.addoption("--dyncheck-model", action="append", default=[], metavar="PATH",
+                    help="check this MJCF or URDF file as one test (repeatable)")
+    group.addoption("--dyncheck-floating", action="store_true",
+                    help="a URDF's root link is a free body")
+    group.addoption("--dyncheck-states", type=int, default=DEFAULT_STATES, metavar="N",
+                    help=f"sampled states per model (default {DEFAULT_STATES})")
+
+
+def _check(path: str, **options: Any) -> Any:
+    from dyncheck.check.model_check import check_model
+
+    result = check_model(path, **options)
+    if not result.ok:
+        raise CheckFailed(f"dyncheck check {path}: differences found\n{result.failures()}")
+    return result
+
+
+class ModelItem(pytest.Item):
+    """One model file, checked."""
+
+    def __init__(self, *, model: str, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.model = model
+
+    def runtest(self) -> None:
+        config = self.config
+        _check(self.model, floating=config.getoption("dyncheck_floating"),
+               states=config.getoption("dyncheck_states"))
+
+    def repr_failure(self, excinfo: pytest.ExceptionInfo[BaseException],
+                     style: Any = None) -> Any:
+        """The failed rows (or a bad file's one line), not a traceback into dyncheck."""
+        from dyncheck.errors import DyncheckError
+
+        if isinstance(excinfo.value, CheckFailed | DyncheckError):
+            return str(excinfo.value)
+        return super().repr_failure(excinfo)
+
+    def reportinfo(self) -> tuple[Any, int | None, str]:
+        return self.path, None, f"dyncheck[{self.model}]"
+
+
+def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config,
+                                  items: list[pytest.Item]) -> None:
+    for model in config.getoption("dyncheck_model"):
+        items.append(ModelItem.from_parent(session, name=f"dyncheck[{model}]", model=model))
+
+
+@pytest.fixture
+def dyncheck_model() -> Callable[..., Any]:
+    """``check(path, **options)``: :func:`~dyncheck.check.model_check.check_model` that fails
+    the test with the failed rows, and returns the result otherwise."""
+    return _check

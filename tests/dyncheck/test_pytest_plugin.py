@@ -1,0 +1,45 @@
+"""The pytest plugin (:mod:`dyncheck.pytest_plugin`, registered by entry point) in a test
+project created here, run by pytest in a fresh process as a user's CI would: a model the
+engines read alike passes, a corrupted one fails with its failed rows, the fixture does the
+same from a test. Expected outcomes: the check's own verdicts on the same files (the
+corrupted mass × 1.01 fails, see ``tests/check/test_model_check.py``)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+MODELS = Path(__file__).resolve().parents[1] / "check" / "models"
+
+
+def _project(tmp_path: Path) -> Path:
+    project = tmp_path / "user_project"
+    (project / "robots").mkdir(parents=True)
+    (project / "robots" / "good.urdf").write_text((MODELS / "branches.urdf").read_text())
+    (project / "robots" / "heavy.urdf").write_text((MODELS / "branches.urdf").read_text()
+                                                   .replace('<mass value="1.5"/>',
+                                                            '<mass value="-1.5"/>'))
+    (project / "test_robots.py").write_text(
+        "def test_good_arm(dyncheck_model):\n"
+        "    result = dyncheck_model('robots/good.urdf', states=5, floating=True)\n"
+        "    assert result.states == 5\n")
+    return project
+
+
+def _pytest(project: Path, *args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                           "-p", "no:randomly", *args], cwd=project, capture_output=True,
+                          text=True, timeout=300)
+
+
+def test_the_plugin_checks_models_named_on_the_command_line(tmp_path):
+    project = _project(tmp_path)
+    good = _pytest(project, "--dyncheck-model", "robots/good.urdf", "--dyncheck-floating",
+                   "--dyncheck-states", "5")
+    assert good.returncode == 0, good.stdout + good.stderr
+    assert "2 passed" in good.stdout  # the fixture's test and the model's
+    bad = _pytest(project, "--dyncheck-model", "robots/heavy.urdf", "--dyncheck-states", "5")
+    assert bad.returncode == 1, bad.stdout + bad.stderr
+    assert "dyncheck[robots/heavy.urdf]" in bad.stdout
+    assert "differences found" in bad.stdout and "mass" in bad.stdout
