@@ -72,6 +72,12 @@ def _no_cache(p: argparse.ArgumentParser) -> None:
     )
 
 
+def _quiet(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress on stderr (by default: a live bar on a terminal, one line "
+                   "per finished unit in a log)")
+
+
 def _ci(p: argparse.ArgumentParser) -> None:
     p.add_argument("--junit", type=_path, default=None, metavar="FILE",
                    help="also write the rows as JUnit XML (one test suite per case or model, "
@@ -147,6 +153,7 @@ def _parser() -> argparse.ArgumentParser:
         help="report every row that regressed against this baseline (exit 1)",
     )
     _ci(r)
+    _quiet(r)
     k = sub.add_parser("check", help="do the engines read and simulate YOUR model alike?")
     k.add_argument("paths", nargs="*", type=_path, metavar="PATH",
                    help="MJCF (.xml) or URDF files, or folders (every model file under "
@@ -172,6 +179,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="models checked in N parallel processes (same results)")
     _dask(k)
     _ci(k)
+    _quiet(k)
     _no_cache(k)
     k.add_argument("--engine-memory", type=int, default=None, metavar="MIB",
                    help="address space each engine process may use (default 8192 MiB; 0: no "
@@ -417,9 +425,11 @@ def _run(args: argparse.Namespace) -> int:
     if args.states is not None:
         _warn_cost(args.states * len(cases), args.jobs)
     # the conventions catalogue does not depend on the cases: it runs with the full report
-    result = run(cases, impls, states=args.states, jobs=args.jobs, dask=args.dask,
-                 conventions=not args.cases, progress=report.stderr_progress,
-                 render=draw_figures)
+    from dyncheck.progress import Progress
+
+    with Progress("run", quiet=args.quiet) as progress:
+        result = run(cases, impls, states=args.states, jobs=args.jobs, dask=args.dask,
+                     conventions=not args.cases, progress=progress, render=draw_figures)
     report.write(result, args.out)
     from dyncheck.ci_outputs import RUN, split
 
@@ -706,6 +716,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     from dyncheck.check import index, inputs
     from dyncheck.check.model_check import check_model, implementations
     from dyncheck.check.page import summary_line, write
+    from dyncheck.progress import Progress
     from dyncheck.workers import each_unit
 
     names = index.page_names([p for p, _ in targets])
@@ -745,7 +756,9 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     failed, refusals = False, len(entries)
     tables: dict[str, object] = {}
     refused: dict[str, str] = {}
+    progress = Progress("check", len(units) if several else None, quiet=args.quiet or not several)
     for name, result in each_unit(units, jobs=args.jobs, dask=args.dask):
+        progress.done(name)
         if isinstance(result, DyncheckError):
             if not several:
                 raise result
@@ -764,6 +777,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
                 print(result.failures())
         if several:
             index.write(entries, engines, args.out)
+    progress.close()
     if several:
         print(f"{len(entries)} models: index -> {args.out / (index.INDEX + '.md')}")
     refused |= {e.model: e.refused for e in entries if e.refused}

@@ -20,6 +20,7 @@ from dyncheck.implementations import (
     implementations_for,
     make_implementation,
 )
+from dyncheck.progress import Progress
 from dyncheck.provenance import engine_versions
 from dyncheck.results import (
     CONVERGENCE_KEY,
@@ -158,7 +159,7 @@ def run(
     jobs: int = 1,
     dask: str | None = None,
     conventions: bool = False,
-    progress: Callable[[str], None] = lambda _msg: None,
+    progress: Progress | None = None,
     states_per_unit: int = STATES_PER_UNIT,
     render: Render | None = None,
 ) -> RunResult:

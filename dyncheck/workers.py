@@ -18,6 +18,7 @@ from contextlib import contextmanager
 from typing import Any
 
 from dyncheck.errors import DyncheckError, EngineError, InvalidInput
+from dyncheck.progress import Progress
 
 LOCAL = "local"
 """``--dask local``: a ``LocalCluster`` of ``--jobs`` single-threaded worker processes."""
@@ -120,22 +121,25 @@ def run_units(
     *,
     jobs: int = 1,
     dask: str | None = None,
-    progress: Callable[[str], None] = lambda _msg: None,
+    progress: Progress | None = None,
 ) -> list[Any]:
     """The units' results in submission order, run here, on ``jobs`` processes or on a dask
-    cluster (see :func:`executor`); ``progress`` hears of each unit started (here) or done."""
+    cluster (see :func:`executor`); ``progress`` hears of each unit done."""
+    if progress is not None:
+        progress.begin(len(units))
     with executor(jobs if len(units) > 1 else 1, dask) as pool:
+        done = []
         if pool is None:
-            done = []
             for what, fn, args in units:
-                progress(f"{what}: running")
                 done.append(fn(*args))
+                if progress is not None:
+                    progress.done(what)
             return done
         futures = [pool.submit(fn, *args) for _what, fn, args in units]
-        done = []
         for (what, _fn, _args), future in zip(units, futures, strict=True):
             done.append(future.result())
-            progress(f"{what}: done")
+            if progress is not None:
+                progress.done(what)
         return done
 
 

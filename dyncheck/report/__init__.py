@@ -7,7 +7,7 @@
 from __future__ import annotations
 
 from dyncheck.provenance import versions
-from dyncheck.report.folder import check, render, rendered_text, stderr_progress, write
+from dyncheck.report.folder import check, render, rendered_text, write
 from dyncheck.report.pages import case_page, conventions_page, index_page
 
 __all__ = [
@@ -17,7 +17,6 @@ __all__ = [
     "index_page",
     "render",
     "rendered_text",
-    "stderr_progress",
     "versions",
     "write",
 ]

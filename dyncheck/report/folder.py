@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import sys
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -88,7 +87,3 @@ def write(result: RunResult, out: Path, *, date: str | None = None) -> list[Path
     return list(files)
 
 
-def stderr_progress(message: str) -> None:
-    """Per-case progress lines on a terminal; quiet when stderr is not one (CI logs)."""
-    if sys.stderr.isatty():
-        print(f"dyncheck: {message}", file=sys.stderr, flush=True)
