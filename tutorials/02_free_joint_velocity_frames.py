@@ -14,7 +14,7 @@
 # first check of any velocity mapping.
 #
 # The code in dyncheck: [`cases/coordinate_maps.py`](../../cases/coordinate_maps.py) (`FreeBodyMap`) and
-# `dyncheck explain free-body-velocity`.
+# `dyncheck explain free-body-velocity-frames`.
 
 # %%
 import tempfile

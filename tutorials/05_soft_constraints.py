@@ -16,7 +16,7 @@
 # a₁ = −g + d · 2 g m₂ / (m₁ + m₂) (derived in the cell below): exact only as d → 1.
 #
 # The code in dyncheck: `mujoco-stiff` in [`adapters/mujoco_.py`](../../adapters/mujoco_.py) and
-# `dyncheck explain soft-constraint`.
+# `dyncheck explain soft-vs-exact-constraints`.
 
 # %%
 import matplotlib.pyplot as plt
@@ -82,4 +82,4 @@ assert abs(atwood(0.9) - exact) > 0.5  # the default's 10 % of 2g m₂/(m₁+m�
 # %% [markdown]
 # **Exercise.** Give the cord an initial violation (`qpos = (0.01, 0)`) and derive a_ref
 # from `solref` (time constant, damping ratio): how long until the cord is taut again? Then
-# compare with `dyncheck explain soft-constraint`, which measures it on the suite's case.
+# compare with `dyncheck explain soft-vs-exact-constraints`, which measures it on the suite's case.
