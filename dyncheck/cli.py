@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 import tempfile
 from collections.abc import Sequence
@@ -393,14 +394,45 @@ def _warn_cost(states: int, jobs: int) -> None:
               "memory stays flat", file=sys.stderr, flush=True)
 
 
-def _positive(name: str, value: int | None) -> None:
-    if value is not None and value < 1:
-        raise InvalidInput(name, value, "a positive integer")
+MAX_JOBS = 256
+"""More local processes than this: refused (each holds the engines, ~0.3 GB)."""
+BENCH_MAX = {"--states": 10**7, "--repeats": 100, "--memory": 10**8}
+"""``bench``'s bounds: its sweeps hold every state's arrays in memory (10⁷ states of a
+six-dof case: ~4 GB)."""
+
+
+def _positive(name: str, value: int | None, most: int | None = None) -> None:
+    """A positive integer (at most ``most``; ``--jobs`` at most :data:`MAX_JOBS`)."""
+    most = MAX_JOBS if most is None and name == "--jobs" else most
+    if value is not None and (value < 1 or (most is not None and value > most)):
+        expected = "a positive integer" + (f" at most {most}" if most is not None else "")
+        raise InvalidInput(name, value, expected)
+
+
+DEVICE = re.compile(r"cpu|cuda(:\d+)?")
+
+
+def _device_env() -> None:
+    """``DYNCHECK_DEVICE`` from the environment, checked before any work."""
+    value = os.environ.get("DYNCHECK_DEVICE")
+    if value is not None and not DEVICE.fullmatch(value):
+        raise InvalidInput("DYNCHECK_DEVICE", value, "cpu, cuda or cuda:N (the environment)")
+
+
+def _has_cuda() -> bool:
+    """An NVIDIA driver on this machine (its library or its /proc entry)."""
+    import ctypes.util
+
+    return Path("/proc/driver/nvidia/version").exists() or \
+        ctypes.util.find_library("cuda") is not None
 
 
 def _use_device(device: str) -> None:
     """The ports' device, for this process and the workers it starts: Warp reads
-    ``DYNCHECK_DEVICE``, JAX its platform (set before its first computation)."""
+    ``DYNCHECK_DEVICE``, JAX its platform (set before its first computation). ``cuda`` on a
+    machine without an NVIDIA driver is refused here, before any work."""
+    if device == "cuda" and not _has_cuda():
+        raise InvalidInput("--device", device, "cpu on this machine (no NVIDIA driver found)")
     os.environ["DYNCHECK_DEVICE"] = device
     os.environ["JAX_PLATFORMS"] = device
     if "jax" in sys.modules:
@@ -414,6 +446,7 @@ def _run(args: argparse.Namespace) -> int:
 
     _check_out(args.out)
     _ci_files(args)
+    _device_env()
     if args.device is not None:
         _use_device(args.device)
     _positive("--states", args.states)
@@ -522,10 +555,10 @@ def _bench(args: argparse.Namespace) -> int:
         print(bench_suite.main(args.out))
         return 0
     get_case(args.case)
-    _positive("--states", args.states)
-    _positive("--repeats", args.repeats)
+    _positive("--states", args.states, BENCH_MAX["--states"])
+    _positive("--repeats", args.repeats, BENCH_MAX["--repeats"])
     for n in args.memory:
-        _positive("--memory", n)
+        _positive("--memory", n, BENCH_MAX["--memory"])
     _positive("--jobs", args.jobs)
     print(bench.main(args.case, args.states, args.repeats, args.memory, args.out,
                      jobs=args.jobs, dask=args.dask))
@@ -746,6 +779,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
         raise InvalidInput("--seed", args.seed, "a non-negative integer")
     _check_out(args.out)
     _ci_files(args)
+    _device_env()
     _positive("--jobs", args.jobs)
     options = {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
                "floating": args.floating, "against": args.against,
