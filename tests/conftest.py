@@ -147,7 +147,7 @@ settings.load_profile("ci")
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     """Every test that needs the full run, or runs one of MuJoCo's ports, is ``slow``
-    (``pytest -m "not slow"`` is the quick loop; the README's test command runs everything)."""
+    (``pytest -m "not slow"`` is the README's test command; ``-m slow`` its second one)."""
     for item in items:
         if "full_run" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.slow)
