@@ -24,6 +24,10 @@ MIMIC_NOTE = (
 )
 
 
+FLOATING_MJCF = (
+    "--floating not applied: it frees a URDF's root link; an MJCF states its own free joints "
+    "(<freejoint/>), read as written"
+)
 WELDED_NOTE = (
     "--floating not applied: the URDF's root link is 'world', so the file itself welds the "
     "robot to the world (every engine reads it so; MuJoCo and Pinocchio would otherwise float "
@@ -75,8 +79,9 @@ def read(path: Path, *, floating: bool = False) -> ModelFile:
         return ModelFile(
             path=path, format=Format.URDF, text=text, floating=floating, notes=tuple(notes)
         )
+    notes = (FLOATING_MJCF,) if floating else ()
     return ModelFile(path=path, format=Format.MJCF, text=_decoded(path.read_bytes()),
-                     floating=floating, notes=())
+                     floating=False, notes=notes)
 
 
 def _decoded(raw: bytes) -> str:

@@ -300,3 +300,13 @@ def test_joints_and_bodies_without_names_are_matched_by_place(tmp_path):
     pairs = set(zip(*(_rows(result, "dynamics")[c] for c in ("impl_a", "impl_b")),
                     strict=True))
     assert ("reference", "drake") in pairs
+
+
+def test_floating_on_an_mjcf_is_said_not_silently_ignored(tmp_path):
+    """``--floating`` frees a URDF's root link; an MJCF states its own free joints: the flag
+    is not applied, and the notes say so (it was ignored without a word)."""
+    path = _write(tmp_path, "fixed", LINK.format(name="a", pos="0 0 1", joint="j", extra="",
+                                                mass=1, child=""))
+    result = check_model(path, floating=True, states=3, impls=("reference", "mujoco"))
+    assert result.ok and any("--floating not applied" in n for n in result.notes)
+    assert {j for j in _rows(result, "load")["note"]} == {"nq=1 nv=1"}
