@@ -79,9 +79,9 @@ def read(path: Path, *, floating: bool = False) -> ModelFile:
         return ModelFile(
             path=path, format=Format.URDF, text=text, floating=floating, notes=tuple(notes)
         )
-    notes = (FLOATING_MJCF,) if floating else ()
+    said: tuple[str, ...] = (FLOATING_MJCF,) if floating else ()
     return ModelFile(path=path, format=Format.MJCF, text=_decoded(path.read_bytes()),
-                     floating=False, notes=notes)
+                     floating=False, notes=said)
 
 
 def _decoded(raw: bytes) -> str:
