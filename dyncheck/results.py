@@ -96,7 +96,9 @@ def table(records: Iterable[Any], record_type: type, key: list[str]) -> pd.DataF
 
 
 def write_atomic(path: Path, content: str | bytes) -> None:
-    """Write to a temporary file in the same folder, then rename over ``path``."""
+    """Write to a temporary file in the same folder, then rename over ``path``; where the
+    write fails, the temporary file and any folder made for it are removed again."""
+    made = [p for p in (path.parent, *path.parent.parents) if not p.exists()]
     path.parent.mkdir(parents=True, exist_ok=True)
     mode = "wb" if isinstance(content, bytes) else "w"
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
@@ -104,6 +106,15 @@ def write_atomic(path: Path, content: str | bytes) -> None:
         with os.fdopen(fd, mode) as f:
             f.write(content)
         os.replace(tmp, path)
+    except OSError as exc:  # a full disk or a size limit: named with the file it was writing
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        for folder in made:  # innermost first
+            if folder.is_dir() and not any(folder.iterdir()):
+                folder.rmdir()
+        if exc.filename is None:
+            raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
+        raise
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)

@@ -235,6 +235,14 @@ FAULTS: tuple[Fault, ...] = (
                                               "out/x.csv")),
           argv=("run", "simple_pendulum", "--impl", "reference", "--out", OUT),
           answer=r"^dyncheck: error: cannot write out/x.csv: No space left on device$"),
+    Fault(kind="disk full at the write itself (/dev/full): the file named", area="check",
+          patch=lambda mp, tmp: mp.setattr(
+              "dyncheck.results.tempfile.mkstemp",
+              lambda dir, prefix, suffix: (os.open("/dev/full", os.O_WRONLY),
+                                           str(Path(dir) / f"{prefix}{suffix}"))),
+          argv=("check", BRANCHES, "--states", "2", "--out", OUT),
+          answer=r"^dyncheck: error: cannot write <tmp>/out/branches.csv: No space left on "
+                 r"device$"),
     Fault(kind="file-size limit while the report is written", area="run",
           patch=_patch_run_then_write(OSError(errno.EFBIG, "File too large", "out/x.csv")),
           argv=("run", "simple_pendulum", "--impl", "reference", "--out", OUT),
