@@ -117,26 +117,45 @@ def geom_defaults(root: ET.Element) -> dict[str, dict[str, str]]:
     return out
 
 
-def resolved_geoms(root: ET.Element) -> list[tuple[ET.Element, dict[str, str]]]:
-    """Every geom of a moving or welded body, with its body and its inertia attributes
-    resolved through default classes (its ``class``, else the nearest ``childclass``)."""
-    defaults = geom_defaults(root)
-    out: list[tuple[ET.Element, dict[str, str]]] = []
+@dataclass(frozen=True, kw_only=True)
+class Geom:
+    """A geom as the compiler sees it: the element holding it (a body, a frame, the world),
+    the body it belongs to (the world's own: ``<worldbody>``), whether that body's inertia
+    moves and is stated, and its inertia attributes resolved through default classes (its
+    ``class``, else the nearest ``childclass``)."""
 
-    def walk(element: ET.Element, body: ET.Element, childclass: str) -> None:
-        for geom in element.findall("geom"):
+    element: ET.Element
+    holder: ET.Element
+    body: ET.Element
+    owner: Owner
+    attrs: dict[str, str]
+
+
+def geoms(root: ET.Element) -> list[Geom]:
+    """Every geom of the model, in document order."""
+    defaults = geom_defaults(root)
+    out: list[Geom] = []
+
+    def walk(holder: ET.Element, body: ET.Element, childclass: str, owner: Owner) -> None:
+        for geom in holder.findall("geom"):
             cls = geom.get("class", childclass)
-            out.append((body, {**defaults.get(cls, defaults.get("main", {})),
-                               **{k: v for k, v in geom.attrib.items()
-                                  if k in GEOM_INERTIA_KEYS}}))
-        for child in element.findall("frame"):
-            walk(child, body, child.get("childclass", childclass))
-        for child in element.findall("body"):
-            walk(child, child, child.get("childclass", childclass))
+            attrs = {**defaults.get(cls, defaults.get("main", {})),
+                     **{k: v for k, v in geom.attrib.items() if k in GEOM_INERTIA_KEYS}}
+            out.append(Geom(element=geom, holder=holder, body=body, owner=owner, attrs=attrs))
+        for frame in holder.findall("frame"):  # a frame's geoms belong to its body
+            walk(frame, body, frame.get("childclass", childclass), owner)
+        for child in holder.findall("body"):
+            if owner is Owner.WELDED and not any(
+                    child.findall(tag) for tag in ("joint", "freejoint")):
+                kind = Owner.WELDED
+            elif child.find("inertial") is not None:
+                kind = Owner.STATES_INERTIA
+            else:
+                kind = Owner.PLAIN
+            walk(child, child, child.get("childclass", childclass), kind)
 
     for world in root.findall("worldbody"):
-        for body in world.findall("body"):
-            walk(body, body, body.get("childclass", "main"))
+        walk(world, world, "main", Owner.WELDED)
     return out
 
 
@@ -195,49 +214,25 @@ def for_parser(path: Path, engine: str, readable: tuple[str, ...]) -> Copy:
     unreadable = {name for name, file in files.items()
                   if file is None or file.suffix.lower() not in readable}
     if unreadable:
-        defaults = geom_defaults(root)
         mode = _compiler(root, "inertiafromgeom", "auto")
         low, high = (int(float(x)) for x in
                      _compiler(root, "inertiagrouprange", "0 5").split()[:2])
         removed = 0
-
-        def walk(element: ET.Element, childclass: str, owner: Owner) -> None:
-            """Remove ``element``'s unreadable mesh geoms (a frame's geoms belong to its
-            body; the world's, and those of bodies welded to it, carry no inertia that
-            moves)."""
-            nonlocal removed
-            for geom in element.findall("geom"):
-                cls = geom.get("class", childclass)
-                attrs = {**defaults.get(cls, defaults.get("main", {})),
-                         **{k: v for k, v in geom.attrib.items() if k in GEOM_INERTIA_KEYS}}
-                mesh = attrs.get("mesh")
-                if mesh not in unreadable:
-                    continue
-                if _carries_inertia(attrs, owner, mode, (low, high)):
-                    file = files.get(mesh or "")
-                    raise Unsupported(
-                        f"{engine}: body {element.get('name', '(unnamed)')!r} takes its "
-                        f"inertia from mesh {mesh!r} ({file.name if file else 'no file'}), "
-                        f"which {engine}'s MJCF parser cannot read (it reads "
-                        f"{', '.join(readable)}): convert the mesh to {readable[0]} or state "
-                        "the body's <inertial>"
-                    )
-                element.remove(geom)
-                removed += 1
-            for frame in element.findall("frame"):
-                walk(frame, frame.get("childclass", childclass), owner)
-            for body in element.findall("body"):
-                if owner is Owner.WELDED and not any(
-                        body.findall(tag) for tag in ("joint", "freejoint")):
-                    kind = Owner.WELDED
-                elif body.find("inertial") is not None:
-                    kind = Owner.STATES_INERTIA
-                else:
-                    kind = Owner.PLAIN
-                walk(body, body.get("childclass", childclass), kind)
-
-        for world in root.findall("worldbody"):
-            walk(world, "main", Owner.WELDED)
+        for found in geoms(root):  # the world's, and those of bodies welded to it, carry no
+            uses = found.attrs.get("mesh")  # inertia that moves
+            if uses not in unreadable:
+                continue
+            if _carries_inertia(found.attrs, found.owner, mode, (low, high)):
+                file = files.get(uses or "")
+                raise Unsupported(
+                    f"{engine}: body {found.body.get('name', '(unnamed)')!r} takes its "
+                    f"inertia from mesh {uses!r} ({file.name if file else 'no file'}), "
+                    f"which {engine}'s MJCF parser cannot read (it reads "
+                    f"{', '.join(readable)}): convert the mesh to {readable[0]} or state "
+                    "the body's <inertial>"
+                )
+            found.holder.remove(found.element)
+            removed += 1
         for asset in root.findall("asset"):
             for mesh in asset.findall("mesh"):
                 if _mesh_name(mesh) in unreadable:

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from dyncheck.adapters.mjcf_copy import geom_defaults, inline, resolved_geoms
+from dyncheck.adapters.mjcf_copy import geom_defaults, geoms, inline
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -108,9 +108,10 @@ def _hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
     massed = [c for c, attrs in geom_defaults(root).items() if "mass" in attrs]
     if massed:
         reasons.append(DEFAULT_MASS.format(classes=", ".join(repr(c) for c in massed[:4])))
-    meshes = sorted({b.get("name", "(unnamed)") for b, attrs in resolved_geoms(root)
-                     if "mesh" in attrs and attrs.get("type", "mesh") == "mesh"
-                     and "mass" in attrs and b.find("inertial") is None})
+    meshes = sorted({g.body.get("name", "(unnamed)") for g in geoms(root)
+                     if g.body.tag == "body" and "mesh" in g.attrs
+                     and g.attrs.get("type", "mesh") == "mesh" and "mass" in g.attrs
+                     and g.body.find("inertial") is None})
     if meshes:
         reasons.append(MESH_MASS.format(bodies=", ".join(repr(b) for b in meshes[:4])
                                         + (" …" if len(meshes) > 4 else "")))

@@ -24,7 +24,10 @@ from typing import TYPE_CHECKING, NoReturn
 from dyncheck.errors import DyncheckError, EngineNotInstalled, InvalidInput, UnknownName
 
 if TYPE_CHECKING:
+    import pandas as pd
+
     from dyncheck.check.engines import Limits
+    from dyncheck.ci_outputs import Columns
 
 
 class _Parser(argparse.ArgumentParser):
@@ -95,12 +98,12 @@ def _ci_files(args: argparse.Namespace) -> None:
             _check_out_file(flag, path)
 
 
-def _write_ci(args: argparse.Namespace, tables: dict, columns: object,
+def _write_ci(args: argparse.Namespace, tables: dict[str, pd.DataFrame], columns: Columns,
               versions: dict[str, str], refused: dict[str, str] | None = None) -> None:
     from dyncheck import ci_outputs
 
     if args.junit is not None:
-        ci_outputs.write_junit(args.junit, tables, columns)  # type: ignore[arg-type]
+        ci_outputs.write_junit(args.junit, tables, columns)
     if args.json is not None:
         ci_outputs.write_json(args.json, tables, versions, refused)
 
@@ -788,7 +791,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
               (str(path),)) for path, robot, name in valid]
     engines = tuple(i for i in implementations(tuple(args.impl) or None) if i != "reference")
     failed, refusals = False, len(entries)
-    tables: dict[str, object] = {}
+    tables: dict[str, pd.DataFrame] = {}
     refused: dict[str, str] = {}
     progress = Progress("check", len(units) if several else None, quiet=args.quiet or not several)
     for name, result in each_unit(units, jobs=args.jobs, dask=args.dask):

@@ -24,8 +24,6 @@ from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.results import Verdict
 
-ROUNDOFF = ROUNDOFF_FACTOR
-
 
 def depth(tree: ModelTree) -> int:
     """The number of joints on the longest chain from the world."""
@@ -114,8 +112,8 @@ def diff(model: str, a: ModelTree, b: ModelTree) -> list[CheckRow]:
     """Every difference between two engines' trees (one row each), or one passed row. A model
     placed elsewhere as a whole (:func:`shift`) is one explained row, its fields compared
     after the shift."""
-    rtol = ROUNDOFF * EPS * max(depth(a), depth(b))
-    basis = f"round-off: {ROUNDOFF} eps x tree depth {max(depth(a), depth(b))}"
+    rtol = ROUNDOFF_FACTOR * EPS * max(depth(a), depth(b))
+    basis = f"round-off: {ROUNDOFF_FACTOR} eps x tree depth {max(depth(a), depth(b))}"
     length = size(a)
     rows: list[CheckRow] = []
     moved = shift(a, b, rtol * length)
@@ -195,7 +193,7 @@ def _violation(mass: float, inertia: np.ndarray) -> tuple[str, object, float, fl
     if not np.all(np.isfinite(moments)):
         return ("finite", mass, float("inf"), 0.0,
                 f"principal moments of inertia {_fmt(np.asarray(inertia).ravel())} overflow")
-    tol = ROUNDOFF * EPS * max(float(np.abs(moments).sum()), 1e-300)
+    tol = ROUNDOFF_FACTOR * EPS * max(float(np.abs(moments).sum()), 1e-300)
     if moments[0] < -tol:
         return ("inertia", moments, -float(moments[0]), tol,
                 f"principal moments {_fmt(moments)}: not positive semi-definite (2.2.39)")
@@ -225,7 +223,8 @@ def validity(
                 CheckRow(
                     model=model, section=Section.VALIDITY, subject=name, field=field,
                     impl_a=holder, impl_b="", value_a=_fmt(value), value_b="", error=err,
-                    tolerance=tol, basis=f"round-off: {ROUNDOFF} eps x trace(I)" if tol else "",
+                    tolerance=tol,
+                    basis=f"round-off: {ROUNDOFF_FACTOR} eps x trace(I)" if tol else "",
                     verdict=Verdict.FAILED, note=note,
                 )
             )

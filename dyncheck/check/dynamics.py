@@ -24,10 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters.model_tree import Dynamics, JointType, ModelTree
-from dyncheck.check.describe import EPS, ROUNDOFF, depth, size
+from dyncheck.check.describe import depth, size
 from dyncheck.check.layout import Canonical
 from dyncheck.check.rows import CheckRow, Section
-from dyncheck.precision import eps_name
+from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
 from dyncheck.results import Verdict
 
 QUANTITIES = {
@@ -151,8 +151,8 @@ def compare(
         scale = max(float(np.abs(desired).max()), floor, 1e-300)
         errors = np.abs(actual - desired).max(axis=1)
         worst = int(np.argmax(errors))
-        rtol = ROUNDOFF * eps * d
-        basis = f"round-off: {ROUNDOFF} {eps_name(eps)} x tree depth {d}"
+        rtol = ROUNDOFF_FACTOR * eps * d
+        basis = f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth {d}"
         if floor >= float(np.abs(desired).max()) and floor_name:
             basis += f"; scale {floor_name} {floor:.3g} (the value's own is smaller)"
         if quantity == "forward_dynamics":

@@ -14,6 +14,7 @@ import pandas as pd
 from dyncheck.check.model_check import CheckResult
 from dyncheck.check.page import counts
 from dyncheck.check.verdicts import Agreement, EngineVerdict, Reading, per_engine
+from dyncheck.errors import InvalidInput
 from dyncheck.escaping import markdown, markdown_link, markdown_table
 from dyncheck.results import to_csv, write_atomic
 
@@ -28,32 +29,27 @@ AGREEMENT = {Agreement.AGREE: "agree", Agreement.EXPLAINED: "agree as explained"
              Agreement.DIFFER: "differ", Agreement.NOT_COMPARED: "not compared"}
 
 
-def _root_tag(path: Path) -> str:
+def _root(path: Path) -> ET.Element | None:
     try:
-        return ET.parse(path).getroot().tag
+        return ET.parse(path).getroot()
     except (ET.ParseError, OSError):
-        return ""
+        return None
 
 
 def in_folder(folder: Path) -> list[Path]:
     """The model files under ``folder``: MJCF and URDF roots, MJCF files that another one
-    includes left out (fragments: materials, assets, shared bodies)."""
-    candidates = []
+    includes left out (fragments: materials, assets, shared bodies). Each file parsed once."""
+    candidates: list[tuple[Path, ET.Element]] = []
     for path in sorted(folder.rglob("*")):
         if path.suffix.lower() in MODEL_SUFFIXES and path.is_file() and not path.is_symlink():
-            tag = _root_tag(path)
-            if tag in ("mujoco", "robot"):
-                candidates.append((path, tag))
+            root = _root(path)
+            if root is not None and root.tag in ("mujoco", "robot"):
+                candidates.append((path, root))
             if len(candidates) > MAX_MODELS:
-                from dyncheck.errors import InvalidInput
-
                 raise InvalidInput("PATH", str(folder), f"a folder of at most {MAX_MODELS} "
                                    "model files")
-    included = set()
-    for path, tag in candidates:
-        if tag == "mujoco":
-            root = ET.parse(path).getroot()
-            included |= {(path.parent / i.get("file", "")).resolve() for i in root.iter("include")}
+    included = {(path.parent / i.get("file", "")).resolve() for path, root in candidates
+                if root.tag == "mujoco" for i in root.iter("include")}
     return [p for p, _ in candidates if p.resolve() not in included]
 
 
