@@ -37,6 +37,20 @@ class Registration:
     float32: bool = False
     """Whether it computes in float32 (its adapter's ``dtype``): the report check derives its
     rows' round-off bands from float32's ε without importing the engine."""
+    model: str | None = None
+    """``module:class`` of its loader of a user's file (``dyncheck check``); None: not in
+    the check."""
+    on_request: bool = False
+    """Checked only when asked for (``--impl``): compiling a model for it takes seconds to
+    minutes on a CPU."""
+    label: str | None = None
+    """Its engine's name in a report's provenance, where its adapter reports the version
+    (one implementation per engine)."""
+    canonical: bool = False
+    """The check's canonical engine: first in the check, whose tree the others meet."""
+    couplings_only: bool = False
+    """Differs from another implementation only in how couplings are held: run on cases with
+    couplings only (elsewhere it would repeat that one under a second name)."""
 
 
 _A = "dyncheck.adapters."
@@ -51,7 +65,8 @@ REGISTRY: dict[str, Registration] = {
         integrators=("euler", "rk4"),
     ),
     "pinocchio": Registration(
-        module=_A + "pinocchio_", cls="PinocchioAdapter", package="pin", integrators=_MUJOCO_C
+        module=_A + "pinocchio_", cls="PinocchioAdapter", package="pin", integrators=_MUJOCO_C,
+        model=_A + "pinocchio_model:PinocchioModel", label="pinocchio",
     ),
     "pinocchio-mjcf": Registration(
         module=_A + "pinocchio_", cls="PinocchioMJCFAdapter", package="pin",
@@ -63,16 +78,21 @@ REGISTRY: dict[str, Registration] = {
         package="drake",
         extra="drake",
         integrators=("euler", "rk2", "rk3"),
+        model=_A + "drake_model:DrakeModel",
+        label="drake",
     ),
     "mujoco": Registration(
-        module=_A + "mujoco_", cls="MuJoCoAdapter", package="mujoco", integrators=_MUJOCO_C
+        module=_A + "mujoco_", cls="MuJoCoAdapter", package="mujoco", integrators=_MUJOCO_C,
+        model=_A + "mujoco_model:MujocoModel", label="mujoco", canonical=True,
     ),
     "mujoco-stiff": Registration(
-        module=_A + "mujoco_", cls="MuJoCoStiffAdapter", package="mujoco", integrators=_MUJOCO_C
+        module=_A + "mujoco_", cls="MuJoCoStiffAdapter", package="mujoco", integrators=_MUJOCO_C,
+        couplings_only=True,
     ),
     "mjx-f64": Registration(
         module=_A + "mjx_", cls="MJXF64Adapter", package="mujoco-mjx", extra="mjx", ports="mujoco",
         integrators=_PORTS,
+        model=_A + "port_models:MjxF64Model", on_request=True,
     ),
     "mjx": Registration(
         module=_A + "mjx_",
@@ -82,6 +102,7 @@ REGISTRY: dict[str, Registration] = {
         ports="mujoco",
         float32=True,
         integrators=_PORTS,
+        model=_A + "port_models:MjxModel", on_request=True, label="mujoco-mjx",
     ),
     "mujoco-warp": Registration(
         module=_A + "mujoco_warp_",
@@ -91,6 +112,7 @@ REGISTRY: dict[str, Registration] = {
         ports="mujoco",
         float32=True,
         integrators=_PORTS,
+        model=_A + "port_models:MujocoWarpModel", on_request=True, label="mujoco-warp",
     ),
 }
 """Implementation name → its registration: the one line an engine adds, in the order of trust
@@ -106,6 +128,15 @@ ENGINE_PORTS: dict[str, str] = {n: r.ports for n, r in REGISTRY.items() if r.por
 """Ports of another engine → that engine."""
 FLOAT32: frozenset[str] = frozenset(n for n, r in REGISTRY.items() if r.float32)
 """Engine implementations that compute in float32."""
+MODELS: dict[str, Registration] = dict(sorted(
+    ((n, r) for n, r in REGISTRY.items() if r.model), key=lambda item: not item[1].canonical))
+"""The engines that load a user's file (``dyncheck check``), the canonical one first, the
+others in :data:`REGISTRY`'s order."""
+COUPLINGS_ONLY: frozenset[str] = frozenset(n for n, r in REGISTRY.items() if r.couplings_only)
+"""Implementations run on cases with couplings only (:attr:`Registration.couplings_only`)."""
+LABELS: dict[str, str] = {n: r.label for n, r in REGISTRY.items() if r.label}
+"""Implementation whose adapter reports its engine's version → the engine's name in a
+report's provenance."""
 
 _ADAPTERS: dict[str, type[Adapter]] = {}
 _MISSING: dict[str, str] = {}
@@ -146,11 +177,14 @@ def get_adapter(name: str) -> type[Adapter]:
 
 __all__ = [
     "ADAPTERS",
+    "COUPLINGS_ONLY",
     "ENGINE_EXTRAS",
     "ENGINE_PACKAGES",
     "ENGINE_PORTS",
     "FLOAT32",
+    "LABELS",
     "MISSING",
+    "MODELS",
     "REGISTRY",
     "Adapter",
     "LoadedBody",

@@ -19,7 +19,14 @@ from typing import Any, ClassVar
 import numpy as np
 
 from dyncheck import coordinates as co
-from dyncheck.adapters import ENGINE_PACKAGES, ENGINE_PORTS, Adapter, Trajectory, get_adapter
+from dyncheck.adapters import (
+    COUPLINGS_ONLY,
+    ENGINE_PACKAGES,
+    ENGINE_PORTS,
+    Adapter,
+    Trajectory,
+    get_adapter,
+)
 from dyncheck.cases import Case, StateSample
 from dyncheck.conventions import (
     from_native,
@@ -60,10 +67,6 @@ def quantities(case: Case) -> tuple[str, ...]:
     return tuple(q for q in QUANTITIES if q != "constraint_force")
 
 
-
-COUPLINGS_ONLY: frozenset[str] = frozenset({"mujoco-stiff"})
-"""Implementations that differ from another only in how couplings are held: run on cases
-with couplings only (elsewhere they would repeat ``mujoco`` under a second name)."""
 
 
 def implementations_for(case: Case, names: tuple[str, ...] = IMPLEMENTATIONS) -> list[str]:

@@ -12,15 +12,6 @@ import pandas as pd
 
 from dyncheck.errors import EngineNotInstalled
 
-ENGINES = (
-    ("mujoco", "mujoco"),
-    ("pinocchio", "pinocchio"),
-    ("drake", "drake"),
-    ("mjx", "mujoco-mjx"),  # with JAX's version and device
-    ("mujoco-warp", "mujoco-warp"),  # with Warp's version and device
-)
-"""(implementation whose adapter reports its engine's version, the name in the provenance)."""
-
 NOT_USED = "not used in this run"
 
 
@@ -28,11 +19,11 @@ def engine_versions(names: Iterable[str]) -> dict[str, str]:
     """The versions of the engines behind the implementations ``names`` (provenance name →
     version, "not installed" for an engine that is not), each implementation standing for
     its package's engine (``mujoco-stiff`` for MuJoCo)."""
-    from dyncheck.adapters import ENGINE_PACKAGES, get_adapter
+    from dyncheck.adapters import ENGINE_PACKAGES, LABELS, get_adapter
 
     packages = {ENGINE_PACKAGES[n] for n in names if n in ENGINE_PACKAGES}
     out = {}
-    for name, label in ENGINES:
+    for name, label in LABELS.items():
         if ENGINE_PACKAGES[name] in packages:
             try:
                 out[label] = get_adapter(name).version()
@@ -51,7 +42,7 @@ def versions(engines: Mapping[str, str] | None = None) -> dict[str, str]:
     import numpy
 
     from dyncheck import __version__
-    from dyncheck.adapters import REGISTRY
+    from dyncheck.adapters import LABELS, REGISTRY
 
     out = {
         "python": platform.python_version(),
@@ -61,7 +52,7 @@ def versions(engines: Mapping[str, str] | None = None) -> dict[str, str]:
         "pandas": pd.__version__,
     }
     used = engine_versions(REGISTRY) if engines is None else engines
-    out |= {label: used.get(label, NOT_USED) for _, label in ENGINES}
+    out |= {label: used.get(label, NOT_USED) for label in LABELS.values()}
     out["dyncheck"] = __version__
     try:
         commit = subprocess.run(

@@ -28,6 +28,7 @@ from typing import Protocol
 
 import numpy as np
 
+from dyncheck.adapters import MODELS, Registration
 from dyncheck.adapters.model_files import ModelFile
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.confinement import confine
@@ -42,30 +43,11 @@ class ModelEngine(Protocol):
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics: ...
 
 
-@dataclass(frozen=True)
-class Engine:
-    """Where an engine's model loader lives, the extra that installs it, and the package
-    whose version a page records (read from its metadata: the engine is never imported in
-    this process for it)."""
-
-    module: str
-    cls: str
-    extra: str | None
-    distribution: str = ""
-
-
-ENGINES = {
-    "mujoco": Engine("dyncheck.adapters.mujoco_model", "MujocoModel", None, "mujoco"),
-    "pinocchio": Engine("dyncheck.adapters.pinocchio_model", "PinocchioModel", None, "pin"),
-    "drake": Engine("dyncheck.adapters.drake_model", "DrakeModel", "drake", "drake"),
-    "mjx": Engine("dyncheck.adapters.port_models", "MjxModel", "mjx", "mujoco-mjx"),
-    "mjx-f64": Engine("dyncheck.adapters.port_models", "MjxF64Model", "mjx", "mujoco-mjx"),
-    "mujoco-warp": Engine("dyncheck.adapters.port_models", "MujocoWarpModel", "warp",
-                          "mujoco-warp"),
-}
+ENGINES: dict[str, Registration] = dict(MODELS)
+"""The engines that load a user's file: their registrations (:data:`~dyncheck.adapters.MODELS`)."""
 REFEREE = "reference"
 IMPLEMENTATIONS = (REFEREE, *ENGINES)
-PORTS = ("mjx", "mjx-f64", "mujoco-warp")
+PORTS = tuple(name for name, r in ENGINES.items() if r.on_request)
 """Checked only when asked for (``--impl mjx``): compiling a model for a port takes seconds
 to minutes on a CPU."""
 DEFAULT = tuple(i for i in IMPLEMENTATIONS if i not in PORTS)
@@ -125,24 +107,26 @@ def _out_of_memory(name: str, memory_mib: int | None) -> str:
     return f"{name} ran out of memory ({cap})"
 
 
-def load(name: str, source: ModelFile, spec: Engine | None = None,
+def load(name: str, source: ModelFile, spec: Registration | None = None,
          memory_mib: int | None = None) -> ModelEngine | NotLoaded:
     """Load ``source`` into engine ``name`` in this process (``memory_mib``: the cap this
     process runs under, for the message when it is reached)."""
     spec = spec or ENGINES[name]
+    assert spec.model is not None, name
+    module_name, cls = spec.model.split(":")
     try:
-        module = importlib.import_module(spec.module)
+        module = importlib.import_module(module_name)
     except MemoryError:
         return NotLoaded(name, False, _out_of_memory(name, memory_mib))
     except ImportError as exc:
-        if spec.distribution and _installed(spec.distribution):  # installed, yet failing
+        if spec.package and _installed(spec.package):  # installed, yet failing
             why = _out_of_memory(name, memory_mib) if memory_mib else \
                 f"{name} is installed but failed to import ({exc})"
             return NotLoaded(name, False, why)
-        extra = f"the '{spec.extra}' extra" if spec.extra else f"'{spec.distribution}'"
+        extra = f"the '{spec.extra}' extra" if spec.extra else f"'{spec.package}'"
         return NotLoaded(name, True, f"needs {extra} ({exc.name} not installed)")
     try:
-        return getattr(module, spec.cls)(source)
+        return getattr(module, cls)(source)
     except MemoryError:
         return NotLoaded(name, False, _out_of_memory(name, memory_mib))
     except Unsupported as exc:
@@ -154,7 +138,7 @@ def load(name: str, source: ModelFile, spec: Engine | None = None,
         return NotLoaded(name, False, f"{name} failed: {type(exc).__name__}: {message}")
 
 
-def _serve(name: str, spec: Engine, source: ModelFile, conn: Connection, parent: int,
+def _serve(name: str, spec: Registration, source: ModelFile, conn: Connection, parent: int,
            memory_mib: int | None) -> None:
     """The isolated engine's process: confined (it dies with dyncheck, lets go of the
     caller's output, its memory capped), it loads, sends the tree, then answers batches

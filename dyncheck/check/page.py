@@ -34,18 +34,16 @@ def engine_versions_of(impls: tuple[str, ...]) -> dict[str, str]:
     Drake alone costs 0.3 s)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    from dyncheck.check.engines import ENGINES
-    from dyncheck.provenance import ENGINES as LABELS
+    from dyncheck.adapters import LABELS, MODELS
     from dyncheck.provenance import versions
 
-    labels = dict(LABELS)
     used = {}
     for name in impls:
-        if name in ENGINES and name in labels:
+        if name in MODELS and name in LABELS:
             try:
-                used[labels[name]] = version(ENGINES[name].distribution)
+                used[LABELS[name]] = version(MODELS[name].package)
             except PackageNotFoundError:
-                used[labels[name]] = "not installed"
+                used[LABELS[name]] = "not installed"
     return versions(used)
 
 

@@ -15,6 +15,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from dyncheck.adapters import Registration
 from dyncheck.check.model_check import check_model
 
 MODELS = Path(__file__).parent / "models"
@@ -60,7 +61,8 @@ def test_missing_engine_is_skipped_not_passed(monkeypatch):
     gives a skipped row naming the extra, and no dynamics rows."""
     from dyncheck.check import engines
 
-    missing = engines.Engine("dyncheck.adapters.no_such_module", "X", "drake")
+    missing = Registration(module="", cls="", package="", integrators=(), extra="drake",
+                           model="dyncheck.adapters.no_such_module:X")
     monkeypatch.setitem(engines.ENGINES, "drake", missing)
     result = check_model(MODELS / "branches.urdf", states=5)
     load = _rows(result, section="load", impl_a="drake")
@@ -204,7 +206,8 @@ def crash_check(engine_class: str, method: str) -> pd.DataFrame:
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(engines, "start_method", lambda: method)
         mp.setitem(engines.ENGINES, "crashing",
-                   engines.Engine("tests.check.crashing_engine", engine_class, None))
+                   Registration(module="", cls="", package="", integrators=(),
+                                model=f"tests.check.crashing_engine:{engine_class}"))
         mp.setattr(model_check, "IMPLEMENTATIONS", (*engines.IMPLEMENTATIONS, "crashing"))
         mp.setattr(engines, "TIMEOUT_S", 1.0)  # a batch of 5 states: milliseconds
         result = check_model(MODELS / "mixed.xml", impls=("reference", "mujoco", "pinocchio",

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pytest
 
+from dyncheck.adapters import Registration
 from dyncheck.check import engines
 from dyncheck.check.model_check import check_model
 
@@ -26,7 +27,8 @@ def _with_double(mp: pytest.MonkeyPatch, engine_class: str) -> None:
     from dyncheck.check import model_check
 
     mp.setitem(engines.ENGINES, "double",
-               engines.Engine("tests.check.crashing_engine", engine_class, None))
+               Registration(module="", cls="", package="", integrators=(),
+                                model=f"tests.check.crashing_engine:{engine_class}"))
     mp.setattr(model_check, "IMPLEMENTATIONS", (*engines.IMPLEMENTATIONS, "double"))
 
 
@@ -54,8 +56,10 @@ SCRIPT = """
 import sys
 from pathlib import Path
 from dyncheck.check import engines, model_check
-engines.ENGINES["double"] = engines.Engine("tests.check.crashing_engine",
-                                           "NoisyHangOnDynamics", None)
+from dyncheck.adapters import Registration
+engines.ENGINES["double"] = Registration(
+    module="", cls="", package="", integrators=(),
+    model="tests.check.crashing_engine:NoisyHangOnDynamics")
 model_check.IMPLEMENTATIONS = (*engines.IMPLEMENTATIONS, "double")
 model_check.check_model(Path(sys.argv[1]), impls=("mujoco", "double"), states=3)
 """
