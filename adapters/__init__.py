@@ -22,11 +22,12 @@ class Registration:
     """One engine implementation: where its adapter is, and the facts about its installation
     that are needed before (or without) importing it."""
 
-    module: str
-    cls: str
     package: str
     """The pip package that provides the engine (its version is read from its metadata)."""
-    integrators: tuple[str, ...]
+    module: str | None = None
+    """Where its adapter of a book case is (``dyncheck run``); None: not in the run."""
+    cls: str | None = None
+    integrators: tuple[str, ...] = ()
     """The fixed-step integrators its ``simulate`` accepts (its adapter's ``integrators``):
     known without importing the engine (a test session's parameters)."""
     extra: str | None = None
@@ -41,8 +42,8 @@ class Registration:
     """``module:class`` of its loader of a user's file (``dyncheck check``); None: not in
     the check."""
     on_request: bool = False
-    """Checked only when asked for (``--impl``): compiling a model for it takes seconds to
-    minutes on a CPU."""
+    """Checked only when asked for (``--impl``): a port (compiling a model for it takes
+    seconds to minutes on a CPU), or an engine a user names when moving a model to it."""
     label: str | None = None
     """Its engine's name in a report's provenance, where its adapter reports the version
     (one implementation per engine)."""
@@ -114,12 +115,19 @@ REGISTRY: dict[str, Registration] = {
         integrators=_PORTS,
         model=_A + "port_models:MujocoWarpModel", on_request=True, label="mujoco-warp",
     ),
+
+    "pybullet": Registration(
+        package="pybullet", extra="pybullet", model=_A + "pybullet_model:PybulletModel",
+        label="pybullet", on_request=True,
+    ),
 }
 """Implementation name → its registration: the one line an engine adds, in the order of trust
 the report lists them (after the reference and the book). A module is imported when its
 adapter is first asked for — an engine's import (JAX and Warp take seconds) is paid only by
 the runs that use it."""
 
+RUN: tuple[str, ...] = tuple(n for n, r in REGISTRY.items() if r.module)
+"""The implementations with an adapter of a book case (``dyncheck run``)."""
 ENGINE_PACKAGES: dict[str, str] = {name: r.package for name, r in REGISTRY.items()}
 """Every engine implementation dyncheck knows, installed or not → its pip package."""
 ENGINE_EXTRAS: dict[str, str] = {n: r.extra for n, r in REGISTRY.items() if r.extra}
@@ -147,6 +155,7 @@ def _load(name: str) -> None:
     if name in _ADAPTERS or name in _MISSING:
         return
     entry = REGISTRY[name]
+    assert entry.module is not None and entry.cls is not None, name
     try:
         _ADAPTERS[name] = getattr(importlib.import_module(entry.module), entry.cls)
     except ImportError as exc:  # depends on the environment
@@ -157,7 +166,7 @@ def __getattr__(attr: str) -> dict[str, Any]:
     """``ADAPTERS`` (name → class of every installed engine) and ``MISSING`` (name → why not):
     asking for either imports every adapter (PEP 562)."""
     if attr in ("ADAPTERS", "MISSING"):
-        for name in REGISTRY:
+        for name in RUN:
             _load(name)
         return _ADAPTERS if attr == "ADAPTERS" else _MISSING
     raise AttributeError(f"module {__name__!r} has no attribute {attr!r}")
@@ -165,8 +174,8 @@ def __getattr__(attr: str) -> dict[str, Any]:
 
 def get_adapter(name: str) -> type[Adapter]:
     """The adapter class for an installed engine implementation."""
-    if name not in REGISTRY:
-        raise UnknownName("implementation", name, ENGINE_PACKAGES)
+    if name not in RUN:
+        raise UnknownName("implementation", name, RUN)
     _load(name)
     if name in _MISSING:
         raise EngineNotInstalled(
@@ -186,6 +195,7 @@ __all__ = [
     "MISSING",
     "MODELS",
     "REGISTRY",
+    "RUN",
     "Adapter",
     "LoadedBody",
     "Registration",

@@ -38,6 +38,17 @@ class Axes(StrEnum):
     reference configuration (Drake's ``BallRpyJoint``: v = ω of the child in F, in F)."""
 
 
+class GravityFrame(StrEnum):
+    """The rotation through which an engine's dynamics resolve gravity in a free body's frame."""
+
+    STATE = "state"
+    """The body's orientation in the state (every engine, as the book, (2.2.23)–(2.2.26))."""
+    RPY_REVERSED = "rpy-reversed"
+    """Rx(r) Ry(p) Rz(y) of the roll, pitch, yaw (r, p, y) of the state's orientation
+    Rz(y) Ry(p) Rx(r): the three composed in reverse order (PyBullet 3.2.7's
+    ``calculateInverseDynamics`` of a floating base, measured)."""
+
+
 NQ = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 4, JointType.FREE: 7}
 NV = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 3, JointType.FREE: 6}
 
@@ -64,6 +75,9 @@ class Layout:
     cos_sin: bool = False
     zero: float = 0.0  # hinge, slide: the coordinate's value at the reference configuration
     placement: np.ndarray = field(default_factory=lambda: np.eye(4))  # free: world ← q's frame
+    offset: np.ndarray = field(default_factory=lambda: np.eye(4))
+    """Free: the body's frame ← the frame whose pose q holds and whose point's velocity v
+    holds (PyBullet: the base's centre-of-mass frame); ``local`` axes are that frame's."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -87,6 +101,9 @@ class TreeJoint:
     rotor_in_kinetic: bool = True
     """Whether the engine's kinetic energy counts this joint's rotor energy ½ aᵢ vᵢ² (its M
     does wherever it holds the armature)."""
+    gravity_frame: GravityFrame = GravityFrame.STATE
+    """A free joint: how the engine's h and inverse dynamics resolve gravity in its body's
+    frame (the frame whose pose q holds, :attr:`Layout.offset`)."""
 
 
 @dataclass(frozen=True, kw_only=True)

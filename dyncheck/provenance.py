@@ -19,12 +19,12 @@ def engine_versions(names: Iterable[str]) -> dict[str, str]:
     """The versions of the engines behind the implementations ``names`` (provenance name →
     version, "not installed" for an engine that is not), each implementation standing for
     its package's engine (``mujoco-stiff`` for MuJoCo)."""
-    from dyncheck.adapters import ENGINE_PACKAGES, LABELS, get_adapter
+    from dyncheck.adapters import ENGINE_PACKAGES, LABELS, RUN, get_adapter
 
     packages = {ENGINE_PACKAGES[n] for n in names if n in ENGINE_PACKAGES}
     out = {}
     for name, label in LABELS.items():
-        if ENGINE_PACKAGES[name] in packages:
+        if name in RUN and ENGINE_PACKAGES[name] in packages:
             try:
                 out[label] = get_adapter(name).version()
             except EngineNotInstalled:
@@ -42,7 +42,7 @@ def versions(engines: Mapping[str, str] | None = None) -> dict[str, str]:
     import numpy
 
     from dyncheck import __version__
-    from dyncheck.adapters import LABELS, REGISTRY
+    from dyncheck.adapters import LABELS, RUN
 
     out = {
         "python": platform.python_version(),
@@ -51,8 +51,9 @@ def versions(engines: Mapping[str, str] | None = None) -> dict[str, str]:
         "sympy": version("sympy"),
         "pandas": pd.__version__,
     }
-    used = engine_versions(REGISTRY) if engines is None else engines
-    out |= {label: used.get(label, NOT_USED) for label in LABELS.values()}
+    used = engine_versions(RUN) if engines is None else engines
+    out |= {label: used.get(label, NOT_USED) for name, label in LABELS.items()
+            if name in RUN or label in used}
     out["dyncheck"] = __version__
     try:
         commit = subprocess.run(

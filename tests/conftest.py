@@ -12,7 +12,7 @@ from filelock import FileLock
 from hypothesis import settings
 
 from dyncheck import adapters
-from dyncheck.adapters import ENGINE_PACKAGES
+from dyncheck.adapters import RUN
 from dyncheck.cases import CASES, get_case
 from dyncheck.workers import exit_without_collecting
 
@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 exit_without_collecting()  # each test process (xdist's workers too): ~3 s with every engine loaded
 
 CASE_NAMES = sorted(CASES)
-ALL_ENGINES = sorted(ENGINE_PACKAGES)
+ALL_ENGINES = sorted(RUN)
 """Every engine implementation, including those that exist only for couplings."""
 BALL_CASES = sorted(
     n for n in CASES if any(j.type in ("ball", "free") for j in get_case(n).multibody().joints)

@@ -110,10 +110,21 @@ def _values(dyn: Dynamics, quantity: str) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Explanation:
-    """A predicted difference (absolute, per state) and why, for a pair and a quantity."""
+    """A predicted difference and why, for a pair and a quantity: per state, its size (n,)
+    or the difference b − a itself (n, k), component by component."""
 
     size: np.ndarray
     note: str
+
+
+def _as_predicted(difference: np.ndarray, errors: np.ndarray, predicted: np.ndarray,
+                  tolerance: float) -> bool:
+    """Whether the differences are the prediction within ``tolerance`` (and 1e-9 of the
+    prediction's own size): sizes per state, or the vectors where it predicts them."""
+    if predicted.ndim == 1:
+        return bool(np.all(np.abs(errors - predicted) <= tolerance + 1e-9 * predicted))
+    off = np.abs(difference - predicted.reshape(difference.shape)).max(axis=1)
+    return bool(np.all(off <= tolerance + 1e-9 * np.abs(predicted).max(axis=1)))
 
 
 def compare(
@@ -163,9 +174,8 @@ def compare(
         if error > rtol:
             verdict = Verdict.FAILED
             known = explanations.get(quantity)
-            if known is not None and np.all(
-                np.abs(errors - known.size) <= rtol * scale + 1e-9 * known.size
-            ):
+            if known is not None and _as_predicted(actual - desired, errors, known.size,
+                                                   rtol * scale):
                 verdict, note = Verdict.EXPLAINED, known.note
             elif caused_by:
                 verdict = Verdict.EXPLAINED

@@ -21,7 +21,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters.integrators import quat_mul
-from dyncheck.adapters.model_tree import NQ, NV, Axes, Dynamics, JointType, ModelTree, TreeJoint
+from dyncheck.adapters.model_tree import (
+    NQ,
+    NV,
+    Axes,
+    Dynamics,
+    JointType,
+    Layout,
+    ModelTree,
+    TreeJoint,
+)
 from dyncheck.cases.coordinate_maps import quat_from_matrix, quat_to_matrix
 
 
@@ -103,24 +112,48 @@ def _state_map(
             q_e[qe : qe + 4] = _quat_out(q_c[qs : qs + 4], lay.quat)
             t[ve : ve + 3, vs : vs + 3] = np.eye(3)
         else:
-            p_w, quat_w = q_c[qs : qs + 3], q_c[qs + 3 : qs + 7]
-            place_r, place_p = lay.placement[:3, :3], lay.placement[:3, 3]
-            p_e = place_r.T @ (p_w - place_p)
-            quat_e = _quat_out(quat_mul(place_quat, quat_w), lay.quat)
-            q_e[qe : qe + 7] = (
-                np.concatenate([quat_e, p_e]) if lay.quat_first else np.concatenate([p_e, quat_e])
-            )
-            rot = quat_to_matrix(quat_w[None])[0]
-            lin_rows = slice(ve + 3, ve + 6) if lay.angular_first else slice(ve, ve + 3)
-            ang_rows = slice(ve, ve + 3) if lay.angular_first else slice(ve + 3, ve + 6)
-            v_lin, omega = v_c[vs : vs + 3], v_c[vs + 3 : vs + 6]
-            if lay.linear_axes is Axes.LOCAL:
-                t[lin_rows, vs : vs + 3] = rot.T
-                tdot_v[lin_rows] = -np.cross(omega, rot.T @ v_lin)
-            else:
-                t[lin_rows, vs : vs + 3] = np.eye(3)
-            t[ang_rows, vs + 3 : vs + 6] = rot if lay.angular_axes is Axes.WORLD else np.eye(3)
+            q_e[qe : qe + 7], t_free, tdot_v[ve : ve + 6] = _free(
+                lay, place_quat, q_c[qs : qs + 7], v_c[vs : vs + 6])
+            t[ve : ve + 6, vs : vs + 6] = t_free
     return StateMap(q=q_e, t=t, tdot_v=tdot_v)
+
+
+def _free(lay: Layout, place_quat: np.ndarray, q_c: np.ndarray,
+          v_c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A free joint's q, T and Ṫ v in the engine's layout, from the canonical (p, quat) of
+    the body's frame and v = (linear velocity of its origin, world axes; ω, body axes).
+
+    The engine's q holds the pose of the frame O = ``lay.offset`` fixed in the body (R_o,
+    p_o): p = p_w + R p_o, R_O = R R_o; its linear velocity is that of O's origin,
+    v_O = v + R (ω × p_o) (world axes; in O's axes R_Oᵀ v_O), its angular velocity R ω (world)
+    or R_oᵀ ω (O's axes). Ṫ v holds the terms of the engine's acceleration that are not T v̇:
+    R (ω × (ω × p_o)), and −ω_O × v_O in O's rotating axes."""
+    p_w, quat_w = q_c[:3], q_c[3:7]
+    rot = quat_to_matrix(quat_w[None])[0]
+    r_o, p_o = lay.offset[:3, :3], lay.offset[:3, 3]
+    quat_o = quat_from_matrix(r_o[None])[0]
+    place_r, place_p = lay.placement[:3, :3], lay.placement[:3, 3]
+    p_e = place_r.T @ (p_w + rot @ p_o - place_p)
+    quat_e = _quat_out(quat_mul(place_quat, quat_mul(quat_w, quat_o)), lay.quat)
+    q_e = np.concatenate([quat_e, p_e]) if lay.quat_first else np.concatenate([p_e, quat_e])
+    t = np.zeros((6, 6))
+    tdot_v = np.zeros(6)
+    lin = slice(3, 6) if lay.angular_first else slice(0, 3)
+    ang = slice(0, 3) if lay.angular_first else slice(3, 6)
+    omega = v_c[3:6]
+    cross_p = np.array([[0.0, -p_o[2], p_o[1]], [p_o[2], 0.0, -p_o[0]], [-p_o[1], p_o[0], 0.0]])
+    centripetal = np.cross(omega, np.cross(omega, p_o))
+    if lay.linear_axes is Axes.LOCAL:
+        r_e = rot @ r_o
+        t[lin, 0:3] = r_e.T
+        t[lin, 3:6] = -r_o.T @ cross_p
+        tdot_v[lin] = r_o.T @ centripetal - np.cross(r_o.T @ omega, t[lin] @ v_c)
+    else:
+        t[lin, 0:3] = np.eye(3)
+        t[lin, 3:6] = -rot @ cross_p
+        tdot_v[lin] = rot @ centripetal
+    t[ang, 3:6] = rot if lay.angular_axes is Axes.WORLD else r_o.T
+    return q_e, t, tdot_v
 
 
 def engine_states(

@@ -22,9 +22,9 @@ import pandas as pd
 
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials
 from dyncheck.adapters.model_tree import ModelTree, TreeJoint
-from dyncheck.check import describe, inputs, layout, partial
+from dyncheck.check import describe, inputs, layout, partial, predicted
 from dyncheck.check import engines as engine_processes
-from dyncheck.check.dynamics import Explanation, States, compare, condition, sample
+from dyncheck.check.dynamics import States, compare, condition, sample
 from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
 from dyncheck.check.referee import ReferenceModel
 from dyncheck.check.rows import COLUMNS, CheckRow, Section
@@ -258,10 +258,8 @@ def _check(model: str, source_path: Path, source: ModelFile,
             cause = ", ".join(differing[e] for e in (a, b) if e in differing)
             dofs = {n: _held(parts.get(n)) for n in (a, b)}
             if dofs[a] is None and dofs[b] is None:
-                explanations = {}
-                rotor = _rotor_difference(canon, canonical_tree, trees[a], trees[b], batch.v)
-                if rotor is not None:
-                    explanations["kinetic_energy"] = rotor
+                explanations = predicted.differences(canon, canonical_tree, trees[a],
+                                                     trees[b], batch, results[a])
                 if a not in kappas:
                     kappas[a] = condition(results[a].mass_matrix)
                 rows.extend(compare(model, canonical_tree, a, results[a], b, results[b],
@@ -286,30 +284,6 @@ def _check(model: str, source_path: Path, source: ModelFile,
 
 def _held(part: partial.Part | None) -> np.ndarray | None:
     return None if part is None else part.v
-
-
-def _rotor_difference(canon: layout.Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
-                      tree_b: ModelTree, v: np.ndarray) -> Explanation | None:
-    """The kinetic energies' predicted difference where one engine counts a joint's rotor
-    energy ½ aᵢ vᵢ² and the other does not (both hold the armature in M): ½ Σ aᵢ vᵢ² over
-    those joints, aᵢ as the canonical engine read it."""
-    names = [n for n in canon.names
-             if tree_a.joint(n).rotor_in_kinetic != tree_b.joint(n).rotor_in_kinetic
-             and any(canonical_tree.joint(n).armature)]
-    if not names:
-        return None
-    weights = np.zeros(canon.nv)
-    for n in names:
-        k = canon.names.index(n)
-        armature = canonical_tree.joint(n).armature
-        weights[canon.v_start[k] : canon.v_start[k] + len(armature)] = armature
-    without = [t.engine for t in (tree_a, tree_b)
-               if not all(t.joint(n).rotor_in_kinetic for n in names)]
-    return Explanation(
-        0.5 * np.einsum("i,ni,ni->n", weights, v, v),
-        f"{' and '.join(without)}'s kinetic energy leaves out the rotor energy ½ Σ aᵢ vᵢ² of "
-        f"{', '.join(names)}, which its M holds (predicted per state from the armature)",
-    )
 
 
 def _parent(joint: TreeJoint, renames: dict[str, str]) -> str | None:

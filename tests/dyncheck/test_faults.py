@@ -411,9 +411,9 @@ FAULTS: tuple[Fault, ...] = (
           argv=("check", BRANCHES, "--engine-seconds", "nan", "--out", OUT),
           answer=r"--engine-seconds must be a number of seconds"),
     Fault(kind="unknown implementation", area="check",
-          argv=("check", BRANCHES, "--impl", "bullet", "--out", OUT),
-          answer=r"unknown implementation 'bullet'; valid: drake, mjx, mjx-f64, mujoco, "
-                 r"mujoco-warp, pinocchio, reference$"),
+          argv=("check", BRANCHES, "--impl", "bulet", "--out", OUT),
+          answer=r"unknown implementation 'bulet'; valid: drake, mjx, mjx-f64, mujoco, "
+                 r"mujoco-warp, pinocchio, pybullet, reference$"),
     Fault(kind="only the referee chosen", area="check",
           argv=("check", BRANCHES, "--impl", "reference", "--out", OUT),
           answer=r"--impl must be at least one engine"),

@@ -1,0 +1,92 @@
+"""Differences between two engines' dynamics predicted from what an engine declares it does
+(:class:`~dyncheck.adapters.model_tree.TreeJoint`'s ``rotor_in_kinetic`` and
+``gravity_frame``): a row whose difference matches the prediction is ``explained`` by it,
+anything beyond stays ``failed``."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from dyncheck.adapters.model_tree import Dynamics, GravityFrame, JointType, ModelTree
+from dyncheck.cases.coordinate_maps import quat_to_matrix
+from dyncheck.check.dynamics import Explanation, States
+from dyncheck.check.layout import Canonical
+from dyncheck.check.referee import ReferenceModel
+
+
+def differences(canon: Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
+                tree_b: ModelTree, states: States, dyn_a: Dynamics) -> dict[str, Explanation]:
+    """Quantity → the predicted difference b − a, for the pair (a, b)."""
+    out = {}
+    rotor = rotor_energy(canon, canonical_tree, tree_a, tree_b, states.v)
+    if rotor is not None:
+        out["kinetic_energy"] = rotor
+    for tree, sign in ((tree_b, 1.0), (tree_a, -1.0)):
+        out |= base_gravity(canon, canonical_tree, tree, states, dyn_a, sign)
+    return out
+
+
+def rotor_energy(canon: Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
+                 tree_b: ModelTree, v: np.ndarray) -> Explanation | None:
+    """The kinetic energies' predicted difference where one engine counts a joint's rotor
+    energy ½ aᵢ vᵢ² and the other does not (both hold the armature in M): ½ Σ aᵢ vᵢ² over
+    those joints, aᵢ as the canonical engine read it (a magnitude per state)."""
+    names = [n for n in canon.names
+             if tree_a.joint(n).rotor_in_kinetic != tree_b.joint(n).rotor_in_kinetic
+             and any(canonical_tree.joint(n).armature)]
+    if not names:
+        return None
+    weights = np.zeros(canon.nv)
+    for n in names:
+        k = canon.names.index(n)
+        armature = canonical_tree.joint(n).armature
+        weights[canon.v_start[k] : canon.v_start[k] + len(armature)] = armature
+    without = [t.engine for t in (tree_a, tree_b)
+               if not all(t.joint(n).rotor_in_kinetic for n in names)]
+    return Explanation(
+        0.5 * np.einsum("i,ni,ni->n", weights, v, v),
+        f"{' and '.join(without)}'s kinetic energy leaves out the rotor energy ½ Σ aᵢ vᵢ² of "
+        f"{', '.join(names)}, which its M holds (predicted per state from the armature)",
+    )
+
+
+def _reversed_rpy(rotation: np.ndarray) -> np.ndarray:
+    """Rx(r) Ry(p) Rz(y) where ``rotation`` = Rz(y) Ry(p) Rx(r), p in [−π/2, π/2]."""
+    rpy = Rotation.from_matrix(rotation).as_euler("xyz")
+    return Rotation.from_euler("XYZ", rpy).as_matrix()
+
+
+def base_gravity(canon: Canonical, canonical_tree: ModelTree, tree: ModelTree,
+                 states: States, dyn_a: Dynamics, sign: float) -> dict[str, Explanation]:
+    """Where ``tree``'s engine resolves gravity in a free body's frame through another
+    rotation R′ than the state's R (:class:`GravityFrame`): its h and inverse dynamics are
+    those of the gravity g′ = R R′ᵀ g, so they differ by G(g′) − G(g), G(g) the generalized
+    gravity force — linear in g, so G(g′ − g) = Σₖ (g′ − g)ₖ G(eₖ), with G(eₖ) from the
+    referee (h at v = 0 under unit gravity eₖ) —, and its forward dynamics by −M⁻¹ that
+    (the vectors per state, ``sign``: +1 where the engine is the pair's second)."""
+    frees = [(k, j) for k, j in enumerate(tree.joint(n) for n in canon.names)
+             if j.type is JointType.FREE and j.gravity_frame is GravityFrame.RPY_REVERSED]
+    if not frees:
+        return {}
+    gravity = np.asarray(canonical_tree.gravity, float)
+    zero = np.zeros_like(states.v)
+    unit = [ReferenceModel(replace(canonical_tree, gravity=e)).dynamics(states.q, zero, zero).bias
+            for e in np.eye(3)]
+    delta = np.zeros_like(states.v)
+    for k, joint in frees:
+        qs = canon.q_start[k]
+        rotation = quat_to_matrix(states.q[:, qs + 3 : qs + 7]) @ joint.layout.offset[:3, :3]
+        for i, r in enumerate(rotation):
+            shift = r @ _reversed_rpy(r).T @ gravity - gravity
+            delta[i] += sum(shift[c] * unit[c][i] for c in range(3))
+    delta *= sign
+    forward = -np.linalg.solve(dyn_a.mass_matrix, delta[..., None])[..., 0]
+    note = (f"{tree.engine} resolves gravity in the frame of {', '.join(j.name for _, j in frees)} "
+            "through Rx(r) Ry(p) Rz(y) of the orientation's roll, pitch, yaw — the state's "
+            "Rz(y) Ry(p) Rx(r) composed in reverse order (measured): predicted per state as "
+            "G(g′) − G(g), g′ = R R′ᵀ g")
+    return {"bias_forces": Explanation(delta, note), "inverse_dynamics": Explanation(delta, note),
+            "forward_dynamics": Explanation(forward, note)}
