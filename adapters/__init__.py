@@ -116,6 +116,10 @@ REGISTRY: dict[str, Registration] = {
         model=_A + "port_models:MujocoWarpModel", on_request=True, label="mujoco-warp",
     ),
 
+    "newton": Registration(
+        package="newton", extra="newton", model=_A + "newton_model:NewtonModel",
+        label="newton", on_request=True, float32=True,
+    ),
     "pybullet": Registration(
         package="pybullet", extra="pybullet", model=_A + "pybullet_model:PybulletModel",
         label="pybullet", on_request=True,

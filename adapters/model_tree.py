@@ -76,8 +76,11 @@ class Layout:
     zero: float = 0.0  # hinge, slide: the coordinate's value at the reference configuration
     placement: np.ndarray = field(default_factory=lambda: np.eye(4))  # free: world ← q's frame
     offset: np.ndarray = field(default_factory=lambda: np.eye(4))
-    """Free: the body's frame ← the frame whose pose q holds and whose point's velocity v
-    holds (PyBullet: the base's centre-of-mass frame); ``local`` axes are that frame's."""
+    """Free: the body's frame ← the frame whose pose q holds (PyBullet: the base's
+    centre-of-mass frame; Newton: ``joint_X_c``); ``local`` axes are that frame's."""
+    point: np.ndarray | None = None
+    """Free: the point of the body (body frame) whose velocity v holds (Newton: the centre
+    of mass); None: the origin of :attr:`offset`'s frame."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -119,6 +122,10 @@ class ModelTree:
     eps: float = float(np.finfo(float).eps)
     """The engine's arithmetic precision (a float32 port: ε₃₂), which its round-off bounds
     use."""
+    inertia_accuracy: float = 0.0
+    """How exactly, relative to its trace, the engine stores a body's inertia tensor beyond
+    round-off (PyBullet: principal moments from a Jacobi diagonalization that stops at
+    off-diagonal terms ≤ 1e-6 trace); why: :meth:`hint` of ("model", "inertia accuracy")."""
     hints: tuple[tuple[str, str, str], ...] = field(default=())
     """(joint, field, why): what the engine is known to do with that field of that joint and
     how to change it — the note of a description row that finds the field read differently;

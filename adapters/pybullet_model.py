@@ -29,6 +29,7 @@ declared on the tree so that the check predicts the difference it makes.
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,6 +62,20 @@ GRAVITY_HINT = (
     "setGravity; here 0 0 -9.81)"
 )
 ARMATURE_HINT = "PyBullet has no joint armature (rotor inertia): its M leaves it out"
+DIAGONALIZATION = 1e-6
+"""PyBullet's URDF importer stores a link's inertia as principal moments found by
+``btMatrix3x3::diagonalize(basis, 1e-6, 30)``: Jacobi rotations until every off-diagonal term
+is ≤ 1e-6 × the trace (then one more rotation); what is left is dropped."""
+ACCURACY_HINT = (
+    "PyBullet stores a link's inertia as principal moments from a Jacobi diagonalization "
+    "that stops once the off-diagonal terms are below 1e-6 of the trace (its URDF importer: "
+    "btMatrix3x3::diagonalize(basis, 1e-6, 30)), dropping them"
+)
+NO_INERTIAL = (
+    "PyBullet's URDF importer gives a link without <inertial> ({links}) a mass of 1 kg and a "
+    "unit inertia (its default; MuJoCo and Pinocchio give it none) (fix: give the link an "
+    "<inertial>, with mass 0 where it is a frame)"
+)
 ZEROED_INERTIA = (
     "PyBullet's URDF importer sets the inertia of {links} to zero: it breaks the triangle "
     "inequality I1 + I2 >= I3 (its warning: 'Bad inertia tensor properties, setting inertia "
@@ -135,6 +150,28 @@ def _zeroed(source: ModelFile, links: list[_Link]) -> tuple[tuple[str, str, str]
                  for name in sorted(bad) if name in joints)
 
 
+def _defaulted(source: ModelFile, links: list[_Link]) -> tuple[tuple[str, str, str], ...]:
+    """Why a joint's mass reads 1 kg more: a URDF link it carries has no ``<inertial>``."""
+    if source.format is not Format.URDF:
+        return ()
+    bare = {link.get("name", "") for link in ET.fromstring(source.text).findall("link")
+            if link.find("inertial") is None}
+    by_key = {(link.body, link.index): link for link in links}
+    out: dict[str, list[str]] = {}
+    for link in links:
+        if link.name not in bare:
+            continue
+        owner: _Link | None = link
+        while owner is not None and owner.kind == pb.JOINT_FIXED:
+            owner = by_key.get((owner.body, owner.parent))
+        if owner is not None:
+            out.setdefault(owner.joint, []).append(link.name)
+    why = {joint: NO_INERTIAL.format(links=", ".join(repr(n) for n in names))
+           for joint, names in out.items()}
+    return tuple((joint, field, text) for joint, text in why.items()
+                 for field in ("mass", "com", "inertia"))
+
+
 class PybulletModel:
     """A PyBullet client holding the file's multibodies, and their neutral tree."""
 
@@ -152,7 +189,9 @@ class PybulletModel:
         hints: tuple[tuple[str, str, str], ...] = (("model", "armature", ARMATURE_HINT),)
         if source.format is Format.MJCF:
             hints += (("model", "gravity", GRAVITY_HINT), ("model", "inertia", INERTIA_HINT))
-        hints += _zeroed(source, links)
+        hints += _zeroed(source, links) + _defaulted(source, links)
+        if source.format is Format.URDF:
+            hints += (("model", "inertia accuracy", ACCURACY_HINT),)
         self.tree = self._tree(links, notes, hints)
 
     def _moving_base(self, body: int) -> bool:
@@ -257,7 +296,8 @@ class PybulletModel:
             q_at, v_at = q_at + 1, v_at + 1
         self._masses = [(link.body, link.index, link.mass) for link in links]
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=GRAVITY.copy(),
-                         nq=q_at, nv=v_at, notes=notes, hints=hints)
+                         nq=q_at, nv=v_at, notes=notes, hints=hints,
+                         inertia_accuracy=DIAGONALIZATION)
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
         c, n, nv = self.client, len(q), self.tree.nv

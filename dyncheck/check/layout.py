@@ -110,7 +110,9 @@ def _state_map(
             t[ve : ve + 3, vs : vs + 3] = rot if lay.angular_axes is Axes.PARENT else np.eye(3)
         elif kind is JointType.BALL:
             q_e[qe : qe + 4] = _quat_out(q_c[qs : qs + 4], lay.quat)
-            t[ve : ve + 3, vs : vs + 3] = np.eye(3)
+            # ω in the parent-side frame = R ω in the child's axes; Ṫ v = 0 as above
+            t[ve : ve + 3, vs : vs + 3] = (quat_to_matrix(q_c[None, qs : qs + 4])[0]
+                                           if lay.angular_axes is Axes.PARENT else np.eye(3))
         else:
             q_e[qe : qe + 7], t_free, tdot_v[ve : ve + 6] = _free(
                 lay, place_quat, q_c[qs : qs + 7], v_c[vs : vs + 6])
@@ -124,16 +126,17 @@ def _free(lay: Layout, place_quat: np.ndarray, q_c: np.ndarray,
     the body's frame and v = (linear velocity of its origin, world axes; ω, body axes).
 
     The engine's q holds the pose of the frame O = ``lay.offset`` fixed in the body (R_o,
-    p_o): p = p_w + R p_o, R_O = R R_o; its linear velocity is that of O's origin,
-    v_O = v + R (ω × p_o) (world axes; in O's axes R_Oᵀ v_O), its angular velocity R ω (world)
-    or R_oᵀ ω (O's axes). Ṫ v holds the terms of the engine's acceleration that are not T v̇:
-    R (ω × (ω × p_o)), and −ω_O × v_O in O's rotating axes."""
+    origin o): p = p_w + R o, R_O = R R_o; its linear velocity is that of the body's point
+    p_o (``lay.point``, else o), v_O = v + R (ω × p_o) (world axes; in O's axes R_Oᵀ v_O), its
+    angular velocity R ω (world) or R_oᵀ ω (O's axes). Ṫ v holds the terms of the engine's
+    acceleration that are not T v̇: R (ω × (ω × p_o)), and −ω_O × v_O in O's rotating axes."""
     p_w, quat_w = q_c[:3], q_c[3:7]
     rot = quat_to_matrix(quat_w[None])[0]
-    r_o, p_o = lay.offset[:3, :3], lay.offset[:3, 3]
+    r_o = lay.offset[:3, :3]
     quat_o = quat_from_matrix(r_o[None])[0]
     place_r, place_p = lay.placement[:3, :3], lay.placement[:3, 3]
-    p_e = place_r.T @ (p_w + rot @ p_o - place_p)
+    p_e = place_r.T @ (p_w + rot @ lay.offset[:3, 3] - place_p)
+    p_o = lay.offset[:3, 3] if lay.point is None else np.asarray(lay.point, float)
     quat_e = _quat_out(quat_mul(place_quat, quat_mul(quat_w, quat_o)), lay.quat)
     q_e = np.concatenate([quat_e, p_e]) if lay.quat_first else np.concatenate([p_e, quat_e])
     t = np.zeros((6, 6))
@@ -182,7 +185,9 @@ def to_canonical(maps: list[StateMap], dyn: Dynamics) -> Dynamics:
     ):
         mass.append(s.t.T @ m_e @ s.t)
         bias.append(s.t.T @ (h_e + m_e @ s.tdot_v))
-        forward.append(s.t.T @ (a_e - s.tdot_v))
+        # v_e = T v: accelerations map back by T⁻¹ (T is not orthogonal where a free joint's
+        # velocity is that of an offset point); forces, duals, by Tᵀ
+        forward.append(np.linalg.solve(s.t, a_e - s.tdot_v))
         inverse.append(s.t.T @ tau_e)
     return Dynamics(
         mass_matrix=np.array(mass), bias=np.array(bias), forward=np.array(forward),

@@ -173,7 +173,8 @@ def _check(model: str, source_path: Path, source: ModelFile,
             (i.link, i.mass, np.array(i.inertia)) for i in stated]))
     differing: dict[str, str] = {}
     for engine, m in loaded.items():
-        rows.extend(describe.validity(model, engine, describe.tree_bodies(m.tree)))
+        rows.extend(describe.validity(model, engine, describe.tree_bodies(m.tree),
+                                      eps=m.tree.eps))
         if m is first:
             continue
         found = describe.diff(model, canonical_tree, m.tree)

@@ -413,7 +413,7 @@ FAULTS: tuple[Fault, ...] = (
     Fault(kind="unknown implementation", area="check",
           argv=("check", BRANCHES, "--impl", "bulet", "--out", OUT),
           answer=r"unknown implementation 'bulet'; valid: drake, mjx, mjx-f64, mujoco, "
-                 r"mujoco-warp, pinocchio, pybullet, reference$"),
+                 r"mujoco-warp, newton, pinocchio, pybullet, reference$"),
     Fault(kind="only the referee chosen", area="check",
           argv=("check", BRANCHES, "--impl", "reference", "--out", OUT),
           answer=r"--impl must be at least one engine"),

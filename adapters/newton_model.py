@@ -1,0 +1,259 @@
+"""A user's model in Newton (optional extra ``newton``), through Newton's own importers
+(``ModelBuilder.add_urdf``, ``add_mjcf``; ``--floating`` gives the URDF root a free joint,
+``floating=True``), finalized on Warp's CPU device, computing in float32.
+
+Newton keeps fixed joints (lumped here into the moving body they are fixed to). A joint's
+frame is the child body's pose composed with ``joint_X_c``; its axis ``joint_axis`` is in that
+frame. M and the generalized gravity and Coriolis forces are ``eval_inverse_dynamics_passive``
+(M with ``joint_armature`` on its diagonal), h = C v̇ + g, inverse dynamics
+``eval_inverse_dynamics_force``; Newton offers no forward dynamics outside its solvers, so
+forward dynamics is M⁻¹(−h) from its M and h (float64 solve); T = ½ vᵀ M v and
+V = −Σ mᵢ g·xᵢ from its M and its bodies' centres of mass (MuJoCo's ``mj_energyVel`` and
+``mj_energyPos`` definitions). The tree declares ε₃₂: its round-off bounds use it.
+
+State layout (Newton 1.8's ``Model.joint_qd``): a free joint's q = (p, quat x-y-z-w) of the
+frame ``joint_X_c`` in the child body, relative to ``joint_X_p`` in the parent; its
+v = (velocity of the child's centre of mass, angular velocity), both in the parent's axes
+(the world's for a root), linear first; a ball joint's q = quat x-y-z-w.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dyncheck.adapters.model_files import Format, ModelFile
+from dyncheck.adapters.model_tree import (
+    Axes,
+    Dynamics,
+    JointType,
+    Layout,
+    ModelTree,
+    TreeJoint,
+    lump,
+)
+from dyncheck.errors import EngineError, Unsupported
+
+ENGINE = "newton"
+EPS32 = float(np.finfo(np.float32).eps)
+NO_LIMIT = 1e9
+"""Newton's unlimited joints carry ±1e10 (``newton.MAXVAL``)."""
+DEVICE = "cpu"
+
+
+def _pose(transform: np.ndarray) -> np.ndarray:
+    """A Warp transform (p, quat x-y-z-w) as a 4×4 matrix, in float64."""
+    from scipy.spatial.transform import Rotation
+
+    pose = np.eye(4)
+    pose[:3, :3] = Rotation.from_quat(np.asarray(transform[3:7], float)).as_matrix()
+    pose[:3, 3] = transform[:3]
+    return pose
+
+
+def _transform(pose: np.ndarray) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+
+    return np.concatenate([pose[:3, 3], Rotation.from_matrix(pose[:3, :3]).as_quat()])
+
+
+def _last(label: str) -> str:
+    """A joint's or body's name from Newton's label, which prefixes the path to it (URDF:
+    ``robot/joint``; MJCF: ``worldbody/body/…/joint``)."""
+    return label.rsplit("/", 1)[-1]
+
+
+def _load(source: ModelFile):  # -> newton.Model
+    import warp as wp
+
+    wp.config.log_level = wp.LOG_ERROR  # in the engine's own process: no banner, no kernel log
+    import newton
+
+    builder = newton.ModelBuilder()
+    try:
+        if source.format is Format.MJCF:
+            builder.add_mjcf(str(source.path))
+        else:
+            builder.add_urdf(str(source.path), floating=source.floating)
+        return builder.finalize(device=DEVICE)
+    except (ValueError, KeyError, IndexError, TypeError, RuntimeError, OSError) as exc:
+        message = " ".join(str(exc).split()) or type(exc).__name__
+        raise EngineError(f"newton refused {source.path}: {message}") from None
+
+
+class NewtonModel:
+    """A finalized Newton model on the CPU and its neutral tree."""
+
+    engine = ENGINE
+
+    def __init__(self, source: ModelFile) -> None:
+        import newton
+
+        self.newton = newton
+        self.model = _load(source)
+        m = self.model
+        self.types = m.joint_type.numpy()
+        kinds = {int(newton.JointType.REVOLUTE): JointType.HINGE,
+                 int(newton.JointType.PRISMATIC): JointType.SLIDE,
+                 int(newton.JointType.BALL): JointType.BALL,
+                 int(newton.JointType.FREE): JointType.FREE}
+        fixed = int(newton.JointType.FIXED)
+        for j, t in enumerate(self.types):
+            if int(t) not in kinds and int(t) != fixed:
+                raise Unsupported(f"newton joint type {newton.JointType(int(t)).name} "
+                                  f"({self._name(j)!r}) is not checked")
+        self.kinds, self.fixed = kinds, fixed
+        self.q_start, self.v_start = m.joint_q_start.numpy(), m.joint_qd_start.numpy()
+        self.state = m.state()
+        notes: tuple[str, ...] = (
+            f"newton: {newton.__version__} on Warp's {DEVICE} device, float32",)
+        if source.floating and source.format is Format.URDF:
+            notes += ("newton: add_urdf(floating=True): a free joint at the URDF root",)
+        self.tree = self._tree(notes)
+
+    def _name(self, joint: int) -> str:
+        return _last(self.model.joint_label[joint])
+
+    def _reference_q(self) -> np.ndarray:
+        """Joints at zero, ball joints at identity, free bodies at the world origin,
+        unrotated: q = X_p⁻¹ X_c."""
+        m = self.model
+        q = np.zeros(m.joint_coord_count)
+        x_p, x_c = m.joint_X_p.numpy(), m.joint_X_c.numpy()
+        for j, t in enumerate(self.types):
+            qs = self.q_start[j]
+            if self.kinds.get(int(t)) is JointType.BALL:
+                q[qs + 3] = 1.0
+            elif self.kinds.get(int(t)) is JointType.FREE:
+                q[qs : qs + 7] = _transform(np.linalg.inv(_pose(x_p[j])) @ _pose(x_c[j]))
+        return q
+
+    def _fk(self, q: np.ndarray, v: np.ndarray | None = None) -> np.ndarray:
+        """Body poses (4×4, float64 from Newton's float32) at ``q``."""
+        s = self.state
+        s.joint_q.assign(q.astype(np.float32))
+        s.joint_qd.assign(np.zeros(self.model.joint_dof_count, np.float32) if v is None
+                          else v.astype(np.float32))
+        self.newton.eval_fk(self.model, s.joint_q, s.joint_qd, s)
+        return np.array([_pose(t) for t in s.body_q.numpy()])
+
+    def _tree(self, notes: tuple[str, ...]) -> ModelTree:
+        m = self.model
+        bodies = self._fk(self._reference_q())
+        x_p, x_c = m.joint_X_p.numpy(), m.joint_X_c.numpy()
+        parent, child = m.joint_parent.numpy(), m.joint_child.numpy()
+        axes = m.joint_axis.numpy()
+        mass, com, inertia = m.body_mass.numpy(), m.body_com.numpy(), m.body_inertia.numpy()
+        armature, damping = m.joint_armature.numpy(), m.joint_damping.numpy()
+        lower, upper = m.joint_limit_lower.numpy(), m.joint_limit_upper.numpy()
+        joint_of = {int(c): j for j, c in enumerate(child)}
+
+        def mover(body: int) -> int | None:
+            """The joint that moves ``body`` (through fixed joints), None: the world."""
+            while body >= 0:
+                j = joint_of.get(body)
+                if j is None:
+                    return None
+                if int(self.types[j]) != self.fixed:
+                    return j
+                body = int(parent[j])
+            return None
+
+        carried: dict[int, list[int]] = {}
+        for b in range(m.body_count):
+            owner = mover(b)
+            if owner is not None:
+                carried.setdefault(owner, []).append(b)
+        joints = []
+        self._masses = mass.astype(float)
+        self._coms = com.astype(float)
+        for j, t in enumerate(self.types):
+            kind = self.kinds.get(int(t))
+            if kind is None:
+                continue
+            parts = carried.get(j, [])
+            masses = [float(mass[b]) for b in parts]
+            coms = [bodies[b][:3, :3] @ com[b] + bodies[b][:3, 3] for b in parts]
+            tensors = [bodies[b][:3, :3] @ inertia[b] @ bodies[b][:3, :3].T for b in parts]
+            total, centre, tensor = lump(masses, coms, tensors)
+            frame = bodies[child[j]] @ _pose(x_c[j])
+            qs, vs = int(self.q_start[j]), int(self.v_start[j])
+            nv = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 3,
+                  JointType.FREE: 6}[kind]
+            dofs = slice(vs, vs + nv)
+            above = mover(int(parent[j]))
+            limited = nv == 1 and abs(lower[vs]) < NO_LIMIT and abs(upper[vs]) < NO_LIMIT
+            if kind is JointType.FREE:
+                layout = Layout(q_start=qs, v_start=vs, nq=7, nv=6, quat="xyzw",
+                                linear_axes=Axes.WORLD, angular_axes=Axes.WORLD,
+                                placement=_pose(x_p[j]), offset=_pose(x_c[j]),
+                                point=np.asarray(com[child[j]], float))
+            elif kind is JointType.BALL:
+                layout = Layout(q_start=qs, v_start=vs, nq=4, nv=3, quat="xyzw",
+                                angular_axes=Axes.PARENT)
+            else:
+                layout = Layout(q_start=qs, v_start=vs, nq=1, nv=1)
+            joints.append(TreeJoint(
+                name=self._name(j), type=kind,
+                parent=None if above is None else self._name(above),
+                body=self._body(int(child[j])),
+                axis=frame[:3, :3] @ axes[vs] if nv == 1 else np.zeros(3),
+                anchor=frame[:3, 3], frame=frame[:3, :3], mass=total, com=centre,
+                inertia=tensor, armature=tuple(float(x) for x in armature[dofs]),
+                damping=tuple(float(x) for x in damping[dofs]),
+                range=(float(lower[vs]), float(upper[vs])) if limited else None,
+                layout=layout,
+            ))
+        gravity = np.asarray(m.gravity.numpy()[0], float)
+        return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
+                         nq=m.joint_coord_count, nv=m.joint_dof_count, notes=notes, eps=EPS32)
+
+    def _body(self, b: int) -> str:
+        return _last(self.model.body_label[b])
+
+    def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
+        import warp as wp
+
+        m, newton = self.model, self.newton
+        n, nv = len(q), m.joint_dof_count
+        width = m.max_dofs_per_articulation
+        mass_out = wp.zeros((m.articulation_count, width, width), dtype=wp.float32,
+                            device=DEVICE)
+        gravity_out, coriolis_out, force_out = (
+            wp.zeros(nv, dtype=wp.float32, device=DEVICE) for _ in range(3))
+        qdd = wp.zeros(nv, dtype=wp.float32, device=DEVICE)
+        dofs = self._articulation_dofs()
+        mass = np.zeros((n, nv, nv))
+        bias, inverse = np.zeros((n, nv)), np.zeros((n, nv))
+        potential = np.zeros(n)
+        gravity = np.asarray(m.gravity.numpy()[0], float)
+        for i in range(n):
+            bodies = self._fk(q[i], v[i])
+            newton.eval_inverse_dynamics_passive(m, self.state, mass_matrix=mass_out,
+                                                 gravity_force=gravity_out,
+                                                 coriolis_force=coriolis_out)
+            blocks = mass_out.numpy()
+            for k, index in enumerate(dofs):
+                mass[i][np.ix_(index, index)] = blocks[k, : len(index), : len(index)]
+            bias[i] = gravity_out.numpy() + coriolis_out.numpy()
+            qdd.assign(a[i].astype(np.float32))
+            newton.eval_inverse_dynamics_force(m, self.state, mass_matrix=mass_out,
+                                               joint_qdd=qdd, coriolis_force=coriolis_out,
+                                               gravity_force=gravity_out, joint_f=force_out)
+            inverse[i] = force_out.numpy()
+            centres = np.einsum("bij,bj->bi", bodies[:, :3, :3], self._coms) + bodies[:, :3, 3]
+            potential[i] = -float(self._masses @ (centres @ gravity))
+        forward = -np.linalg.solve(mass, bias[..., None])[..., 0]
+        kinetic = 0.5 * np.einsum("ni,nij,nj->n", v, mass, v)
+        return Dynamics(mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
+                        kinetic=kinetic, potential=potential)
+
+    def _articulation_dofs(self) -> list[np.ndarray]:
+        """Each articulation's velocity indices, in Newton's order."""
+        m = self.model
+        of = m.joint_articulation.numpy()
+        out = []
+        for k in range(m.articulation_count):
+            index = [np.arange(self.v_start[j], self.v_start[j + 1])
+                     for j in np.flatnonzero(of == k)]
+            out.append(np.concatenate(index) if index else np.zeros(0, int))
+        return out

@@ -1,0 +1,93 @@
+"""The check's map of a free joint's state into an engine's layout (frame offset, velocity
+point, axes, order), against finite differences of the map itself: along a motion of the
+body, the engine's velocity T v must be the time derivative of what the engine's q and point
+describe, and its acceleration T v̇ + Ṫ v the derivative of that velocity (an independent
+differentiation, central differences with error O(h²))."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from dyncheck.adapters.model_tree import Axes, Layout
+from dyncheck.check.layout import _free
+
+H = 1e-5
+RNG = np.random.default_rng(7)
+OFFSET = np.eye(4)
+OFFSET[:3, :3] = Rotation.from_rotvec([0.3, -0.2, 0.5]).as_matrix()
+OFFSET[:3, 3] = [0.1, -0.05, 0.2]
+POINT = np.array([0.04, 0.12, -0.07])
+
+
+def _ry(b: float) -> np.ndarray:
+    return Rotation.from_rotvec([0.0, b, 0.0]).as_matrix()
+
+
+def _motion(t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A body's canonical state at time t — (p, quat w-x-y-z), v = (ṗ world, ω body) and v̇ —
+    in closed form: p(t) quadratic, R(t) = R₀ Rz(a(t)) Ry(b(t)) with a, b quadratic, whose
+    body angular velocity is ω = Ry(b)ᵀ e_z ȧ + e_y ḃ and ω̇ = Ry(b)ᵀ e_z ä − ḃ e_y ×
+    (Ry(b)ᵀ e_z ȧ) + e_y b̈."""
+    p0, v0, acc = np.array([0.2, -0.1, 0.4]), np.array([0.3, 0.5, -0.2]), np.array([1.0, -2.0, 0.5])
+    a, a_dot, a_ddot = 0.3 + 0.9 * t + 0.35 * t * t, 0.9 + 0.7 * t, 0.7
+    b, b_dot, b_ddot = -0.2 - 1.3 * t + 0.4 * t * t, -1.3 + 0.8 * t, 0.8
+    e_y, e_z = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0])
+    rot = (Rotation.from_rotvec([0.4, 0.1, -0.3]) * Rotation.from_rotvec(a * e_z)
+           * Rotation.from_rotvec(b * e_y))
+    spin = _ry(b).T @ e_z * a_dot
+    omega = spin + e_y * b_dot
+    omega_dot = _ry(b).T @ e_z * a_ddot - np.cross(b_dot * e_y, spin) + e_y * b_ddot
+    quat = np.roll(rot.as_quat(), 1)
+    return (np.concatenate([p0 + v0 * t + 0.5 * acc * t * t, quat]),
+            np.concatenate([v0 + acc * t, omega]), np.concatenate([acc, omega_dot]))
+
+
+def _engine_point(lay: Layout, q_e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where the engine's q puts its velocity point (world) and its frame's rotation."""
+    p, quat = (q_e[3:], q_e[:4]) if lay.quat_first else (q_e[:3], q_e[3:])
+    xyzw = quat if lay.quat == "xyzw" else np.roll(quat, -1)
+    rot_q = Rotation.from_quat(xyzw).as_matrix()
+    point = lay.offset[:3, 3] if lay.point is None else lay.point
+    # the point in the q frame: offset⁻¹ · point (body frame)
+    local = lay.offset[:3, :3].T @ (point - lay.offset[:3, 3])
+    return p + rot_q @ local, rot_q
+
+
+LAYOUTS = [
+    Layout(q_start=0, v_start=0, nq=7, nv=6, quat=quat, angular_first=first,
+           linear_axes=lin, angular_axes=ang, offset=offset, point=point)
+    for quat, first, lin, ang, (offset, point) in itertools.product(
+        ("wxyz", "xyzw"), (False, True), (Axes.WORLD, Axes.LOCAL), (Axes.WORLD, Axes.LOCAL),
+        ((np.eye(4), None), (OFFSET, None), (np.eye(4), POINT), (OFFSET, POINT)))
+]
+
+
+@pytest.mark.parametrize("lay", LAYOUTS, ids=lambda lay: (
+    f"{lay.quat}-{'ang' if lay.angular_first else 'lin'}first-{lay.linear_axes}-"
+    f"{lay.angular_axes}-offset{int(not np.allclose(lay.offset, np.eye(4)))}-"
+    f"point{int(lay.point is not None)}"))
+def test_free_joint_map_matches_finite_differences_of_itself(lay):
+    identity = np.array([1.0, 0.0, 0.0, 0.0])
+    q_c, v_c, a_c = _motion(0.0)
+    q_e, t, tdot_v = _free(lay, identity, q_c, v_c)
+    v_e = t @ v_c
+    lin = slice(3, 6) if lay.angular_first else slice(0, 3)
+    ang = slice(0, 3) if lay.angular_first else slice(3, 6)
+    (plus, rot_p), (minus, rot_m) = (_engine_point(lay, _free(lay, identity, *_motion(s)[:2])[0])
+                                     for s in (H, -H))
+    _, rot_0 = _engine_point(lay, q_e)
+    velocity = (plus - minus) / (2 * H)  # world
+    omega_hat = rot_0.T @ (rot_p - rot_m) / (2 * H)  # in the q frame's axes
+    omega = np.array([omega_hat[2, 1], omega_hat[0, 2], omega_hat[1, 0]])
+    expected_lin = rot_0.T @ velocity if lay.linear_axes is Axes.LOCAL else velocity
+    expected_ang = omega if lay.angular_axes is Axes.LOCAL else rot_0 @ omega
+    np.testing.assert_allclose(v_e[lin], expected_lin, atol=1e-8)
+    np.testing.assert_allclose(v_e[ang], expected_ang, atol=1e-8)
+    # the acceleration: d/dt (T v) along the motion
+    v_plus = _free(lay, identity, *_motion(H)[:2])[1] @ _motion(H)[1]
+    v_minus = _free(lay, identity, *_motion(-H)[:2])[1] @ _motion(-H)[1]
+    np.testing.assert_allclose(t @ a_c + tdot_v, (v_plus - v_minus) / (2 * H), atol=1e-7)
