@@ -1,0 +1,58 @@
+"""The registry is the one place that names an engine (#43, #47): an engine's name written as
+a string literal anywhere in the package but its own modules and ``adapters/__init__.py`` is
+a second home for what the registration says. Engines registered since the rule (Newton,
+PyBullet) have none; the older ones have the counts below, which may only go down (lower the
+number with the change that removes one: the test fails on a count that shrank too, so the
+table stays true)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from dyncheck.adapters import REGISTRY
+
+ROOT = Path(__file__).resolve().parents[2]
+PACKAGE = ("dyncheck", "adapters", "cases", "reference")
+LEGACY = {"mujoco": 20, "pinocchio": 11, "drake": 11, "pinocchio-mjcf": 3, "mujoco-stiff": 2,
+          "mjx-f64": 2, "sympy-mechanics": 1}
+"""Engine-name literals outside the registry and the engine's modules, counted when the rule
+was set (5a550eb had 61 in 11 files)."""
+
+
+def _own(name: str) -> set[str]:
+    reg = REGISTRY[name]
+    modules = {m for m in (reg.module, (reg.model or "").split(":")[0]) if m}
+    return {"adapters/__init__.py"} | {
+        m.removeprefix("dyncheck.").replace(".", "/") + ".py" for m in modules}
+
+
+def _literals(name: str, root: Path = ROOT) -> list[str]:
+    pattern = re.compile(r"""(["'])""" + re.escape(name) + r"""\1""")
+    own = _own(name)
+    found = []
+    for folder in PACKAGE:
+        for path in sorted((root / folder).rglob("*.py")):
+            relative = path.relative_to(root).as_posix()
+            if relative not in own:
+                found += [relative] * len(pattern.findall(path.read_text(encoding="utf-8")))
+    return found
+
+
+@pytest.mark.parametrize("name", sorted(REGISTRY))
+def test_an_engine_is_named_only_in_its_modules_and_the_registry(name):
+    found = _literals(name)
+    assert len(found) == LEGACY.get(name, 0), (
+        f"{name!r} written in {sorted(set(found))} ({len(found)} times; "
+        f"allowed {LEGACY.get(name, 0)}): read it from adapters.REGISTRY instead")
+
+
+def test_the_rule_catches_a_name_written_elsewhere(tmp_path):
+    """The scan itself: a module that writes "newton" is found, its own module is not."""
+    for folder in PACKAGE:
+        (tmp_path / folder).mkdir()
+    (tmp_path / "dyncheck" / "leak.py").write_text('ENGINE = "newton"\n')
+    (tmp_path / "adapters" / "newton_model.py").write_text('ENGINE = "newton"\n')
+    assert _literals("newton", tmp_path) == ["dyncheck/leak.py"]
