@@ -72,8 +72,8 @@ def _load(source: ModelFile):  # -> newton.Model
     try:
         if source.format is Format.MJCF:
             builder.add_mjcf(str(source.path))
-        else:
-            builder.add_urdf(str(source.path), floating=source.floating)
+        else:  # the file's text without geometry and <mimic> (model_files.read), as for all
+            builder.add_urdf(source.text, floating=source.floating)
         return builder.finalize(device=DEVICE)
     except (ValueError, KeyError, IndexError, TypeError, RuntimeError, OSError) as exc:
         message = " ".join(str(exc).split()) or type(exc).__name__

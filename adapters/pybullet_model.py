@@ -29,8 +29,10 @@ declared on the tree so that the check predicts the difference it makes.
 
 from __future__ import annotations
 
+import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pybullet as pb
@@ -124,12 +126,19 @@ class _Link:
 
 
 def _load(client: int, source: ModelFile) -> list[int]:
+    """The file's multibodies; a URDF as the other engines get it, without geometry and
+    ``<mimic>`` (:func:`~dyncheck.adapters.model_files.read`): written to a file of its own
+    (``loadURDF`` reads files only), removed once loaded."""
     try:
         if source.format is Format.MJCF:
             bodies = list(pb.loadMJCF(str(source.path), physicsClientId=client))
         else:
-            bodies = [pb.loadURDF(str(source.path), useFixedBase=not source.floating,
-                                  flags=pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client)]
+            with tempfile.TemporaryDirectory(prefix="dyncheck-pybullet-") as folder:
+                copy = Path(folder) / "model.urdf"
+                copy.write_text(source.text, encoding="utf-8")
+                bodies = [pb.loadURDF(str(copy), useFixedBase=not source.floating,
+                                      flags=pb.URDF_USE_INERTIA_FROM_FILE,
+                                      physicsClientId=client)]
     except pb.error as exc:
         raise EngineError(f"pybullet refused {source.path}: {exc}") from None
     if not bodies:
