@@ -19,6 +19,8 @@ v = (velocity of the child's centre of mass, angular velocity), both in the pare
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from dyncheck.adapters.model_files import Format, ModelFile
@@ -62,7 +64,16 @@ def _last(label: str) -> str:
     return label.rsplit("/", 1)[-1]
 
 
-def _load(source: ModelFile):  # -> newton.Model
+CORRECTED = (
+    "Newton's finalize corrected the inertia of {bodies} (its validation, on by default: a "
+    "principal moment below 1e-6 of the largest, or the triangle inequality broken, is "
+    "repaired by adding the shift it needs plus 1e-6 kg m² to the diagonal; it warns only "
+    "with a count) (fix: correct the file's inertia, or set the builder's balance_inertia, "
+    "inertia_relative_tolerance, inertia_correction)"
+)
+
+
+def _load(source: ModelFile):  # -> (newton.Model, names of the bodies whose inertia it changed)
     import warp as wp
 
     wp.config.log_level = wp.LOG_ERROR  # in the engine's own process: no banner, no kernel log
@@ -74,10 +85,17 @@ def _load(source: ModelFile):  # -> newton.Model
             builder.add_mjcf(str(source.path))
         else:  # the file's text without geometry and <mimic> (model_files.read), as for all
             builder.add_urdf(source.text, floating=source.floating)
-        return builder.finalize(device=DEVICE)
+        with warnings.catch_warnings():  # its count of corrected bodies: named below instead
+            warnings.simplefilter("ignore", newton.NewtonWarning)
+            model = builder.finalize(device=DEVICE)
     except (ValueError, KeyError, IndexError, TypeError, RuntimeError, OSError) as exc:
         message = " ".join(str(exc).split()) or type(exc).__name__
         raise EngineError(f"newton refused {source.path}: {message}") from None
+    stated = np.array([np.asarray(i, float) for i in builder.body_inertia]).reshape(-1, 3, 3)
+    kept = model.body_inertia.numpy().astype(float)
+    scale = np.maximum(np.abs(stated).max(axis=(1, 2)), 1e-30)
+    changed = np.abs(kept - stated).max(axis=(1, 2)) > 1e-5 * scale  # beyond float32 rounding
+    return model, [_last(model.body_label[b]) for b in np.flatnonzero(changed)]
 
 
 class NewtonModel:
@@ -89,7 +107,7 @@ class NewtonModel:
         import newton
 
         self.newton = newton
-        self.model = _load(source)
+        self.model, corrected = _load(source)
         m = self.model
         self.types = m.joint_type.numpy()
         kinds = {int(newton.JointType.REVOLUTE): JointType.HINGE,
@@ -108,6 +126,7 @@ class NewtonModel:
             f"newton: {newton.__version__} on Warp's {DEVICE} device, float32",)
         if source.floating and source.format is Format.URDF:
             notes += ("newton: add_urdf(floating=True): a free joint at the URDF root",)
+        self._corrected = corrected
         self.tree = self._tree(notes)
 
     def _name(self, joint: int) -> str:
@@ -204,8 +223,16 @@ class NewtonModel:
                 layout=layout,
             ))
         gravity = np.asarray(m.gravity.numpy()[0], float)
+        hints = []
+        for j in range(len(self.types)):
+            bodies = [self._body(b) for b in carried.get(j, [])
+                      if self._body(b) in self._corrected]
+            if bodies:
+                why = CORRECTED.format(bodies=", ".join(repr(b) for b in bodies))
+                hints.append((self._name(j), "inertia", why))
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
-                         nq=m.joint_coord_count, nv=m.joint_dof_count, notes=notes, eps=EPS32)
+                         nq=m.joint_coord_count, nv=m.joint_dof_count, notes=notes, eps=EPS32,
+                         hints=tuple(hints))
 
     def _body(self, b: int) -> str:
         return _last(self.model.body_label[b])

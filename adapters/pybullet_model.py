@@ -90,6 +90,9 @@ INERTIA_HINT = (
 )
 
 
+MAX_LINKS = 128
+"""PyBullet's client state holds at most 128 links (``MAX_NUM_LINKS`` =
+``MAX_DEGREE_OF_FREEDOM`` in its SharedMemoryPublic.h): ``getLinkState`` fails beyond."""
 _FREE = -1
 """A moving base's link (PyBullet has no joint for it)."""
 
@@ -217,6 +220,10 @@ class PybulletModel:
         link frame at the world origin, unrotated (its centre-of-mass frame, whose pose
         PyBullet's base state holds, at the local inertial frame)."""
         c = self.client
+        count = pb.getNumJoints(body, physicsClientId=c)
+        if count > MAX_LINKS:
+            raise Unsupported(f"pybullet holds at most {MAX_LINKS} links of a multibody in its "
+                              f"client state (MAX_NUM_LINKS); this one has {count}")
         out = []
         base = pb.getDynamicsInfo(body, -1, physicsClientId=c)
         if self._floating[body]:

@@ -9,6 +9,7 @@ behaviour, the entry's numbers change and its test fails.
 from __future__ import annotations
 
 import dataclasses
+import importlib.metadata
 from collections.abc import Callable, Collection
 from functools import partial
 
@@ -39,6 +40,7 @@ from dyncheck.explain.engine_defaults import (
 )
 from dyncheck.explain.entry import Entry
 from dyncheck.explain.integrators import drake_fsal_caching, group_rk4, port_integrators
+from dyncheck.explain.moving import newton_free_velocity, pybullet_inertia_source
 from dyncheck.explain.parsers import (
     drake_mjcf_options,
     pinocchio_mjcf_options,
@@ -73,6 +75,8 @@ DEMOS: dict[str, tuple[Callable[[], Entry], Origin]] = {
     "relative-vs-absolute-angles": (relative_angles, Origin.BOOK),
     "rk4-on-the-rotation-group": (group_rk4, Origin.MATHEMATICS),
     "mjx-integrator-definitions": (port_integrators, Origin.ENGINE),
+    "pybullet-inertia-source": (pybullet_inertia_source, Origin.ENGINE),
+    "newton-free-joint-velocity": (newton_free_velocity, Origin.ENGINE),
 }
 """Conventions demonstrated by a run of their own, with whose property each is; the others
 (point-mass inertia floor, MJCF gravity, held forces, soft constraints: :mod:`.explanations`)
@@ -96,6 +100,8 @@ REQUIRES: dict[str, tuple[str, ...]] = {
     "drake-mjcf-equality": ("drake",),
     "drake-mjcf-options": ("drake",),
     "mjx-integrator-definitions": ("mjx-f64",),
+    "pybullet-inertia-source": ("pybullet",),
+    "newton-free-joint-velocity": ("newton",),
 }
 """Demonstrations that need an optional engine (MuJoCo and Pinocchio are core dependencies)."""
 
@@ -117,12 +123,15 @@ def not_selected(name: str, selected: Collection[str]) -> Entry | None:
 
 def _run(name: str) -> Entry:
     """One demonstration, or a skipped entry naming the engine that is not installed."""
-    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES, get_adapter
+    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES, RUN, get_adapter
 
     for engine in REQUIRES.get(name, ()):
         try:
-            get_adapter(engine)
-        except EngineNotInstalled:
+            if engine in RUN:
+                get_adapter(engine)
+            else:  # an engine of the check only: installed or not, from its metadata
+                importlib.metadata.version(ENGINE_PACKAGES[engine])
+        except (EngineNotInstalled, importlib.metadata.PackageNotFoundError):
             why = f"{engine} is not installed (pip install {ENGINE_PACKAGES[engine]})"
             if engine in ENGINE_EXTRAS:
                 extra = ENGINE_EXTRAS[engine]

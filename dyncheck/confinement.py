@@ -14,6 +14,8 @@ import os
 import resource
 import signal
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 PR_SET_PDEATHSIG = 1
 """``prctl`` option: the signal this process receives when its parent thread exits."""
@@ -40,6 +42,23 @@ def release_output() -> None:
     os.dup2(null, 1)
     os.dup2(null, 2)
     os.close(null)
+
+
+@contextmanager
+def c_output_dropped() -> Iterator[None]:
+    """This process's stdout (file descriptor 1) at /dev/null for the duration: what an
+    engine's C code prints while it loads in dyncheck's own process (PyBullet's "build time"
+    line on import) never reaches the caller's output; Python's own writes are flushed first."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    null = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(null)
+        os.close(saved)
 
 
 def cap_memory(limit_bytes: int | None) -> None:

@@ -230,3 +230,25 @@ def test_an_entry_records_the_engines_it_uses_not_those_its_process_loaded():
     assert used == {"mujoco": version("mujoco"), "pinocchio": version("pin")}
     _, used = catalogue.measure("drake-mjcf-equality")
     assert used["drake"] == version("drake")
+
+
+def test_pybullet_reads_the_inertia_from_the_file_only_when_told():
+    """PyBullet against Pinocchio on the same URDF: without URDF_USE_INERTIA_FROM_FILE the
+    stated inertia gives way to the collision shapes' (M off by > 1 %); with it, M agrees to
+    round-off (expected values: Pinocchio's M of the file, an independent reading)."""
+    pytest.importorskip("pybullet", reason="needs the 'pybullet' extra")
+    (entry,) = catalogue.explain("pybullet-inertia-source")
+    assert not entry.skipped and not entry.failed, entry
+    assert entry.naive_error > 1e-2, entry
+    assert entry.correct_error < 64 * np.finfo(float).eps, entry
+
+
+def test_newton_free_joint_velocity_is_its_centre_of_mass_velocity():
+    """Newton's free body against the referee on MuJoCo's reading: its linear velocity read
+    as the origin's is off by > 10 %; read as the centre of mass's (its declared layout) it
+    agrees within float32 round-off (64 ε₃₂ × κ)."""
+    pytest.importorskip("newton", reason="needs the 'newton' extra")
+    (entry,) = catalogue.explain("newton-free-joint-velocity")
+    assert not entry.skipped and not entry.failed, entry
+    assert entry.naive_error > 0.1, entry
+    assert entry.correct_error < 64 * np.finfo(np.float32).eps * 10, entry
