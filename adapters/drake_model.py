@@ -21,22 +21,34 @@ world).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+from pydrake.autodiffutils import AutoDiffXd
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import BodyIndex, MultibodyForces, QuaternionFloatingJoint
+from pydrake.multibody.tree import (
+    BodyIndex,
+    MultibodyForces,
+    MultibodyForces_,
+    QuaternionFloatingJoint,
+)
 
 from dyncheck.adapters.drake_ import parser_warnings
 from dyncheck.adapters.mjcf_copy import for_parser, inline
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
+    Derivatives,
     Dynamics,
     JointType,
     Layout,
     ModelTree,
     TreeJoint,
     lump,
+)
+from dyncheck.adapters.model_tree import (
+    derivatives as _derivatives,
 )
 from dyncheck.errors import DyncheckError, EngineError, Unsupported
 
@@ -163,6 +175,7 @@ class DrakeModel:
         if self.plant.num_actuated_dofs() > 0:
             actuation.FixValue(self.context, np.zeros(self.plant.num_actuated_dofs()))
         self._acc = self.plant.get_generalized_acceleration_output_port()
+        self._ad: Any = None  # the AutoDiffXd plant, made on the first derivatives asked for
         self.tree = self._tree(notes)
 
     def _tree(self, notes: tuple[str, ...]) -> ModelTree:
@@ -278,3 +291,42 @@ class DrakeModel:
             potential[i] = plant.CalcPotentialEnergy(ctx)
         return Dynamics(mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
                           kinetic=kinetic, potential=potential)
+
+    def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
+        """Forward-mode automatic differentiation (``ToAutoDiffXd``, q and v seeded) of
+        ``CalcInverseDynamics`` with gravity (``CalcForceElementsContribution``) at v̇ = a
+        for ∂τ/∂q, ∂τ/∂v, and at v̇ = its forward acceleration for the forward derivatives
+        through ∂v̇/∂x = −M⁻¹ ∂τ/∂x; ∂v̇/∂τ = M⁻¹ of ``CalcMassMatrix``. With respect to
+        Drake's q (a hinge's or slide's coordinate)."""
+        from pydrake.autodiffutils import ExtractGradient, InitializeAutoDiff
+
+        plant = self.plant
+        if self._ad is None:
+            self._ad = plant.ToAutoDiffXd()
+            self._ad_context = self._ad.CreateDefaultContext()
+        ad, ctx = self._ad, self._ad_context
+        n, nq, nv = len(q), plant.num_positions(), plant.num_velocities()
+        out = {k: np.empty((n, nv, nv)) for k in
+               ("forward_q", "forward_v", "forward_tau", "inverse_q", "inverse_v")}
+        forces = MultibodyForces_[AutoDiffXd](ad)
+        dynamics = self.dynamics(q, v, np.asarray(a))
+        for i in range(n):
+            state = np.concatenate([q[i], v[i]]).astype(float)
+            seeded = InitializeAutoDiff(state)  # type: ignore[arg-type]  # pydrake's stub
+            ad.SetPositions(ctx, seeded[:nq, 0])
+            ad.SetVelocities(ctx, seeded[nq:, 0])
+            inverse_mass = np.linalg.inv(dynamics.mass_matrix[i])
+            for acceleration, key in ((dynamics.forward[i], "forward"), (a[i], "inverse")):
+                forces.SetZero()
+                ad.CalcForceElementsContribution(ctx, forces)
+                tau = ad.CalcInverseDynamics(ctx, np.array([AutoDiffXd(x) for x in
+                                                            acceleration]), forces)
+                gradient = ExtractGradient(tau)
+                d_q, d_v = gradient[:, :nq], gradient[:, nq:]
+                if key == "inverse":
+                    out["inverse_q"][i], out["inverse_v"][i] = d_q, d_v
+                else:
+                    out["forward_q"][i] = -inverse_mass @ d_q
+                    out["forward_v"][i] = -inverse_mass @ d_v
+            out["forward_tau"][i] = inverse_mass
+        return _derivatives(out, method="automatic differentiation (AutoDiffXd)")

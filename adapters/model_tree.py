@@ -173,3 +173,28 @@ class Dynamics:
     inverse: np.ndarray
     kinetic: np.ndarray
     potential: np.ndarray
+
+
+@dataclass(frozen=True, kw_only=True)
+class Derivatives:
+    """An engine's derivatives of the smooth dynamics at a batch of states, in its own layout
+    and chart (n, nv, nv each; J[s, i, j] = ∂ outᵢ / ∂ inⱼ): of the forward dynamics at
+    τ = 0 with respect to q, v and τ (the last is M⁻¹), and of the inverse dynamics at the
+    given accelerations with respect to q and v (with respect to v̇ it is M, compared with
+    the dynamics). ``method`` says how the engine computed them; ``step``, a finite
+    difference's step (0: none)."""
+
+    forward_q: np.ndarray
+    forward_v: np.ndarray
+    forward_tau: np.ndarray
+    inverse_q: np.ndarray
+    inverse_v: np.ndarray
+    method: str
+    step: float = 0.0
+
+
+def derivatives(found: dict[str, np.ndarray], *, method: str, step: float = 0.0) -> Derivatives:
+    """:class:`Derivatives` from a dict of its five matrices (the engines fill one)."""
+    return Derivatives(forward_q=found["forward_q"], forward_v=found["forward_v"],
+                       forward_tau=found["forward_tau"], inverse_q=found["inverse_q"],
+                       inverse_v=found["inverse_v"], method=method, step=step)

@@ -21,12 +21,16 @@ from dyncheck.adapters.model_tree import (
     NQ,
     NV,
     Axes,
+    Derivatives,
     Dynamics,
     JointType,
     Layout,
     ModelTree,
     TreeJoint,
     lump,
+)
+from dyncheck.adapters.model_tree import (
+    derivatives as _derivatives,
 )
 from dyncheck.adapters.mujoco_api import full_inertia
 from dyncheck.errors import EngineError
@@ -50,6 +54,9 @@ GRAVITY_OFF = (
     "every engine, set <option gravity=\"0 0 0\"/>"
 )
 FLOATING_NAME = "root_joint"
+FD_STEP = 1e-6
+"""The step of MuJoCo's finite differences (``mjd_inverseFD``) here: one-sided, so its error
+is ≈ step/2 × |∂²τ| + 2 × (τ's round-off) / step — the check predicts both."""
 """The free joint added to a URDF's root link with ``--floating`` (Pinocchio's name)."""
 
 
@@ -231,3 +238,34 @@ class MujocoModel:
             mujoco.mj_inverse(m, d)
             out["inverse"][i] = d.qfrc_inverse
         return Dynamics(mass_matrix=mass, kinetic=kinetic, potential=potential, **out)
+
+    def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
+        """``mjd_inverseFD`` (one-sided differences of ``mj_inverse``, step
+        :data:`FD_STEP`, q nudged by ``mj_integratePos``: MuJoCo's chart) at v̇ = a for
+        ∂τ/∂q, ∂τ/∂v; MuJoCo has no derivative of its forward dynamics, so those are the
+        same differences at v̇ = its forward acceleration at τ = 0, through the identity
+        ∂v̇/∂x = −M⁻¹ ∂τ/∂x (τ = ID(q, v, FD(q, v, τ)) differentiated), and ∂v̇/∂τ = M⁻¹."""
+        m, d = self.model, self.data
+        n, nv = len(q), m.nv
+        out = {k: np.empty((n, nv, nv)) for k in
+               ("forward_q", "forward_v", "forward_tau", "inverse_q", "inverse_v")}
+        dq, dv = np.empty((nv, nv)), np.empty((nv, nv))
+        mass = np.empty((nv, nv))
+        for i in range(n):
+            d.qpos[:], d.qvel[:] = q[i], v[i]
+            d.qfrc_applied[:] = 0.0
+            mujoco.mj_forward(m, d)
+            full_inertia(m, d, mass)
+            inverse_mass = np.linalg.inv(mass)
+            for acceleration, key in ((d.qacc.copy(), "forward"), (a[i], "inverse")):
+                d.qacc[:] = acceleration
+                mujoco.mjd_inverseFD(m, d, FD_STEP, False, dq, dv, None, None, None, None,
+                                     None)
+                if key == "inverse":  # MuJoCo's rows are the inputs (transposed)
+                    out["inverse_q"][i], out["inverse_v"][i] = dq.T, dv.T
+                else:
+                    out["forward_q"][i] = -inverse_mass @ dq.T
+                    out["forward_v"][i] = -inverse_mass @ dv.T
+            out["forward_tau"][i] = inverse_mass
+        return _derivatives(out, method=f"finite differences (mjd_inverseFD, one-sided, "
+                            f"step {FD_STEP:g})", step=FD_STEP)

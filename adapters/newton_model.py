@@ -92,7 +92,8 @@ def _load(source: ModelFile):  # -> (newton.Model, names of the bodies whose ine
         message = " ".join(str(exc).split()) or type(exc).__name__
         raise EngineError(f"newton refused {source.path}: {message}") from None
     stated = np.array([np.asarray(i, float) for i in builder.body_inertia]).reshape(-1, 3, 3)
-    kept = model.body_inertia.numpy().astype(float)
+    kept = np.asarray(model.body_inertia.numpy() if model.body_inertia is not None
+                      else stated, float)
     scale = np.maximum(np.abs(stated).max(axis=(1, 2)), 1e-30)
     changed = np.abs(kept - stated).max(axis=(1, 2)) > 1e-5 * scale  # beyond float32 rounding
     return model, [_last(model.body_label[b]) for b in np.flatnonzero(changed)]
@@ -223,12 +224,12 @@ class NewtonModel:
                 layout=layout,
             ))
         gravity = np.asarray(m.gravity.numpy()[0], float)
-        hints = []
+        hints: list[tuple[str, str, str]] = []
         for j in range(len(self.types)):
-            bodies = [self._body(b) for b in carried.get(j, [])
-                      if self._body(b) in self._corrected]
-            if bodies:
-                why = CORRECTED.format(bodies=", ".join(repr(b) for b in bodies))
+            named = [self._body(b) for b in carried.get(j, [])
+                     if self._body(b) in self._corrected]
+            if named:
+                why = CORRECTED.format(bodies=", ".join(repr(b) for b in named))
                 hints.append((self._name(j), "inertia", why))
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
                          nq=m.joint_coord_count, nv=m.joint_dof_count, notes=notes, eps=EPS32,

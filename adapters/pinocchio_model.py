@@ -22,11 +22,15 @@ from dyncheck.adapters.mjcf_copy import geom_defaults, geoms, inline
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
+    Derivatives,
     Dynamics,
     JointType,
     Layout,
     ModelTree,
     TreeJoint,
+)
+from dyncheck.adapters.model_tree import (
+    derivatives as _derivatives,
 )
 from dyncheck.errors import EngineError, Unsupported
 
@@ -266,3 +270,22 @@ class PinocchioModel:
             mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
             kinetic=kinetic, potential=potential,
         )
+
+    def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
+        """``computeABADerivatives`` at τ = 0 (∂v̇/∂q, ∂v̇/∂v, M⁻¹, upper triangle mirrored)
+        and ``computeRNEADerivatives`` at v̇ = a (∂τ/∂q, ∂τ/∂v): analytic, in Pinocchio's
+        tangent space (a hinge's or slide's: its coordinate)."""
+        m, d = self.model, self.data
+        n, nv = len(q), m.nv
+        out = {k: np.empty((n, nv, nv)) for k in
+               ("forward_q", "forward_v", "forward_tau", "inverse_q", "inverse_v")}
+        zero = np.zeros(nv)
+        for i in range(n):
+            pin.computeABADerivatives(m, d, q[i], v[i], zero)
+            out["forward_q"][i], out["forward_v"][i] = d.ddq_dq, d.ddq_dv
+            upper = np.asarray(d.Minv)
+            out["forward_tau"][i] = np.triu(upper) + np.triu(upper, 1).T
+            pin.computeRNEADerivatives(m, d, q[i], v[i], a[i])
+            out["inverse_q"][i], out["inverse_v"][i] = d.dtau_dq, d.dtau_dv
+        return _derivatives(out, method="analytic (computeABADerivatives, "
+                            "computeRNEADerivatives)")

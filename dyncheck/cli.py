@@ -169,13 +169,16 @@ def _parser() -> argparse.ArgumentParser:
                    help="a book case's MJCF, the file `run` gives MuJoCo (repeatable; 'all': "
                    "every case)")
     k.add_argument("--impl", action="append", default=[], metavar="NAME",
-                   help="reference, mujoco, pinocchio, drake, and MuJoCo's ports mjx, mjx-f64, "
-                   "mujoco-warp (repeatable; default: the first four; a port only when named: "
-                   "compiling a model for it takes seconds)")
+                   help="reference, mujoco, pinocchio, drake, MuJoCo's ports mjx, mjx-f64, "
+                   "mujoco-warp, and newton, pybullet (repeatable; default: the first four; the "
+                   "others only when named)")
     k.add_argument("--states", type=int, default=100, metavar="N", help="sampled states")
     k.add_argument("--seed", type=int, default=0, metavar="S")
     k.add_argument("--floating", action="store_true",
                    help="a URDF's root link is a free body (a free joint in every engine)")
+    k.add_argument("--derivatives", action="store_true",
+                   help="also compare the derivatives of the dynamics (d(forward)/d(q, v, tau), "
+                   "d(inverse)/d(q, v)) of every engine that offers them with the referee's")
     k.add_argument("--against", type=_path, default=None, metavar="PATH",
                    help="also compare what MuJoCo reads with this other file (a previous version)")
     k.add_argument("--out", type=_path, default=Path("reports/check"), help="output folder")
@@ -786,7 +789,8 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     _positive("--jobs", args.jobs)
     options = {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
                "floating": args.floating, "against": args.against,
-               "isolate": not args.in_process, "limits": _limits(args)}
+               "isolate": not args.in_process, "limits": _limits(args),
+               "derivatives": args.derivatives}
     units = [(name, partial(check_model, **options, name=robot or (name if several else None)),
               (str(path),)) for path, robot, name in valid]
     engines = tuple(i for i in implementations(tuple(args.impl) or None) if i != "reference")

@@ -30,7 +30,7 @@ import numpy as np
 
 from dyncheck.adapters import MODELS, Registration
 from dyncheck.adapters.model_files import ModelFile
-from dyncheck.adapters.model_tree import Dynamics, ModelTree
+from dyncheck.adapters.model_tree import Derivatives, Dynamics, ModelTree
 from dyncheck.confinement import confine
 from dyncheck.errors import DyncheckError, EngineError, Unsupported
 from dyncheck.workers import start_method
@@ -151,13 +151,19 @@ def _serve(name: str, spec: Registration, source: ModelFile, conn: Connection, p
         conn.send(loaded)
         return
     conn.send(loaded.tree)
-    while (batch := conn.recv()) is not None:
+    while (request := conn.recv()) is not None:
+        kind, *batch = request
         try:
             t0 = time.perf_counter()
-            answer = loaded.dynamics(*batch)
+            method = getattr(loaded, kind, None)
+            if method is None:
+                raise Unsupported(f"{name} offers no {kind}")
+            answer = method(*batch)
             conn.send((answer, time.perf_counter() - t0))
         except MemoryError:
             conn.send(EngineError(_out_of_memory(name, memory_mib)))
+        except Unsupported as exc:
+            conn.send(exc)
         except Exception as exc:
             conn.send(EngineError(f"{type(exc).__name__}: {' '.join(str(exc).split())}"))
 
@@ -224,16 +230,29 @@ class Isolated:
     def submit(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
         """Hand the engine a batch of states; :meth:`collect` waits for its answer (the
         caller computes meanwhile: the engines and the referee side by side)."""
-        self._batch_seconds = self.limits.batch_seconds(len(q), v.shape[1] if v.ndim > 1 else 1)
+        self._request("dynamics", q, v, a)
+
+    def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
+        """The engine's derivatives (:class:`Unsupported` where it offers none); a batch
+        costs about nv times its dynamics."""
+        nv = v.shape[1] if v.ndim > 1 else 1
+        self._request("derivatives", q, v, a, scale=nv)
+        return self.collect()[0]  # type: ignore[return-value]
+
+    def _request(self, kind: str, q: np.ndarray, v: np.ndarray, a: np.ndarray, *,
+                 scale: int = 1) -> None:
+        nv = v.shape[1] if v.ndim > 1 else 1
+        self._kind = kind
+        self._batch_seconds = self.limits.batch_seconds(len(q) * scale, nv)
         try:
-            self._conn.send((q, v, a))
+            self._conn.send((kind, q, v, a))
         except OSError:
             raise EngineError(f"{self.engine} crashed earlier "
                               f"({_death(self._proc.exitcode)})") from None
 
     def collect(self) -> tuple[Dynamics, float]:
         """The submitted batch's dynamics and the seconds the engine spent on them."""
-        answer = self._receive("computing the dynamics", self._batch_seconds)
+        answer = self._receive(f"computing the {self._kind}", self._batch_seconds)
         if isinstance(answer, Exception):
             raise answer
         return answer  # type: ignore[return-value]

@@ -24,6 +24,7 @@ from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials
 from dyncheck.adapters.model_tree import ModelTree, TreeJoint
 from dyncheck.check import describe, inputs, layout, partial, predicted
 from dyncheck.check import engines as engine_processes
+from dyncheck.check.derivatives import rows as derivative_rows
 from dyncheck.check.dynamics import States, compare, condition, sample
 from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
 from dyncheck.check.referee import ReferenceModel
@@ -101,12 +102,14 @@ def check_model(
     name: str | None = None,
     isolate: bool = True,
     limits: engine_processes.Limits | None = None,
+    derivatives: bool = False,
 ) -> CheckResult:
     """Check one model file (see the module's docstring); bad input raises
     :class:`~dyncheck.errors.InvalidInput` before any engine runs. With ``isolate`` (the
     default) each engine runs in its own process, within ``limits`` (memory, seconds scaled to
     the model), so that one crashing, hanging or growing on the file costs only its rows
-    (:mod:`dyncheck.check.engines`)."""
+    (:mod:`dyncheck.check.engines`). ``derivatives`` adds the derivatives' rows
+    (:mod:`dyncheck.check.derivatives`)."""
     source_path = inputs.model_path(str(path))
     against_path = inputs.model_path(str(against)) if against is not None else None
     inputs.states(states)
@@ -125,7 +128,8 @@ def check_model(
     try:  # an overflow is a non-finite value, reported as a row: never a warning on stderr
         with np.errstate(all="ignore"):
             return _check(model, source_path, source, engines, chosen, states, seed,
-                          floating, against_path, time.perf_counter() - t0)
+                          floating, against_path, time.perf_counter() - t0,
+                          derivatives=derivatives)
     finally:
         engine_processes.stop(engines)
 
@@ -133,11 +137,11 @@ def check_model(
 def _check(model: str, source_path: Path, source: ModelFile,
            engines: dict[str, engine_processes.ModelEngine | NotLoaded], chosen: tuple[str, ...],
            states: int, seed: int, floating: bool, against_path: Path | None,
-           load_seconds: float) -> CheckResult:
+           load_seconds: float, *, derivatives: bool = False) -> CheckResult:
     rows: list[CheckRow] = []
     notes = [*source.notes, SMOOTH_NOTE]
     seconds: dict[str, float] = {}
-    loaded = {}
+    loaded: dict[str, engine_processes.ModelEngine] = {}
     seconds["load"] = load_seconds
     for engine, result in engines.items():
         if isinstance(result, NotLoaded):
@@ -276,6 +280,12 @@ def _check(model: str, source_path: Path, source: ModelFile,
                 a, partial.restrict(results[a], partial.columns(dofs[a], common)),
                 b, partial.restrict(results[b], partial.columns(dofs[b], common)),
                 {}, cause, on, eps=max(trees[a].eps, trees[b].eps)))
+    if derivatives:
+        t0 = time.perf_counter()
+        whole = {e: loaded[e] for e in results if e in loaded and parts.get(e) is None}
+        rows.extend(derivative_rows(model, canon, canonical_tree, whole, batch,
+                                    with_referee=REFEREE in chosen))
+        seconds["derivatives"] = time.perf_counter() - t0
     frame = pd.DataFrame([vars(r) for r in rows], columns=COLUMNS)
     for column in ("section", "verdict"):
         frame[column] = frame[column].astype(str)

@@ -20,6 +20,7 @@ TITLES = {
     Section.DESCRIPTION: "Model reading (each engine's tree against MuJoCo's)",
     Section.VALIDITY: "Physical validity",
     Section.DYNAMICS: "Dynamics",
+    Section.DERIVATIVES: "Derivatives (canonical chart; MuJoCo's by its own finite differences)",
 }
 
 

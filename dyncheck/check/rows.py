@@ -15,6 +15,7 @@ class Section(StrEnum):
     DESCRIPTION = "description"
     VALIDITY = "validity"
     DYNAMICS = "dynamics"
+    DERIVATIVES = "derivatives"
 
 
 @dataclass(frozen=True, kw_only=True)

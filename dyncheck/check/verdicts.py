@@ -88,7 +88,7 @@ def _reading(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Reading, 
 def _agreement(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Agreement, str]:
     """Judged against the referee (MuJoCo where the referee was not run): a difference
     between two engines belongs to the one that differs from the judge."""
-    dynamics = rows[(rows["section"] == Section.DYNAMICS)
+    dynamics = rows[rows["section"].isin((Section.DYNAMICS, Section.DERIVATIVES))
                     & ((rows["impl_a"] == engine) | (rows["impl_b"] == engine))]
     for judge in (REFEREE, canonical):  # the referee judges; without it, the canonical engine
         against = dynamics[(dynamics["impl_a"] == judge) | (dynamics["impl_b"] == judge)]

@@ -1,0 +1,131 @@
+"""``check --derivatives``: the derivatives of the dynamics of every engine that offers them
+against the referee's and each other's. Expected values: the book's closed form of a simple
+pendulum (2.2.x: M = m l², τ = m l² θ̈ + m g l sin θ), and the other engines' independent
+computations (Pinocchio analytic, Drake automatic differentiation, MuJoCo finite
+differences, the referee's extrapolated differences of the general method)."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dyncheck.adapters import pinocchio_model
+from dyncheck.check.model_check import check_model
+
+MODELS = Path(__file__).parent / "models"
+DRAKE = importlib.util.find_spec("pydrake") is not None
+ENGINES = ("mujoco", "pinocchio", *(("drake",) if DRAKE else ()))
+PENDULUM = """<robot name="pendulum">
+  <link name="world"/>
+  <link name="bob"><inertial><origin xyz="0 0 -{l}"/><mass value="{m}"/>
+    <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+  <joint name="swing" type="continuous"><parent link="world"/><child link="bob"/>
+    <axis xyz="0 1 0"/></joint>
+</robot>
+"""
+ARMATURE = """<mujoco model="chain"><worldbody>
+  <body name="a"><joint name="j1" axis="0 1 0" armature="0.05"/>
+    <inertial pos="0.2 0 0" mass="1" diaginertia="0.01 0.02 0.02"/>
+    <body name="b" pos="0.4 0 0"><joint name="j2" axis="0 0.6 0.8" armature="0.02"/>
+      <inertial pos="0.15 0.02 0" mass="0.6" diaginertia="0.004 0.006 0.005"/>
+      <body name="c" pos="0.3 0 0"><joint name="j3" type="slide" axis="1 0 0"/>
+        <inertial pos="0.05 0 0" mass="0.3" diaginertia="0.001 0.001 0.001"/></body>
+    </body></body></worldbody>
+  <actuator><motor joint="j1"/><motor joint="j2"/><motor joint="j3"/></actuator>
+</mujoco>
+"""
+
+
+def _rows(result, **where):
+    frame = result.rows
+    for key, value in where.items():
+        frame = frame[frame[key] == value]
+    return frame
+
+
+@pytest.mark.parametrize("model", ["branches.urdf", "armature.xml"])
+def test_every_engine_and_the_referee_agree_on_the_derivatives(model, tmp_path):
+    """Hinges (one off-axis), a slide, armature, a continuous joint: every pair passes, each
+    engine's five derivatives compared with the referee's and every other engine's."""
+    path = MODELS / model
+    if model == "armature.xml":
+        path = tmp_path / model
+        path.write_text(ARMATURE)
+    result = check_model(path, impls=("reference", *ENGINES), states=20, derivatives=True)
+    assert result.ok, result.failures()
+    rows = _rows(result, section="derivatives")
+    pairs = len(ENGINES) * (len(ENGINES) + 1) // 2
+    assert len(rows) == 5 * pairs and set(rows["verdict"]) == {"passed"}
+
+
+def test_the_pendulum_derivatives_are_the_books_closed_form(tmp_path):
+    """θ̈ = −(g/l) sin θ + τ/(m l²): ∂θ̈/∂θ = −(g/l) cos θ, ∂θ̈/∂θ̇ = 0, ∂θ̈/∂τ = 1/(m l²);
+    ∂τ/∂θ = m g l cos θ — every engine's and the referee's, at the sampled states."""
+    m, length, g = 1.3, 0.7, 9.81
+    path = tmp_path / "pendulum.urdf"
+    path.write_text(PENDULUM.format(m=m, l=length))
+    from dyncheck.adapters.model_files import read
+    from dyncheck.adapters.pinocchio_model import PinocchioModel
+    from dyncheck.check import derivatives, layout
+    from dyncheck.check.dynamics import sample
+
+    model = PinocchioModel(read(path))
+    canon = layout.canonical(model.tree)
+    states = sample(canon, model.tree, 10, 0)
+    theta = states.q[:, 0]
+    ref = derivatives.referee(model.tree, states).derivatives
+    maps, q, v, a = layout.engine_states(canon, model.tree, states.q, states.v, states.a)
+    assert q.shape[1] == 2  # Pinocchio holds a continuous joint as (cos θ, sin θ)
+    for found in (ref, derivatives.to_canonical(maps, model.derivatives(q, v, a))):
+        np.testing.assert_allclose(found.forward_q[:, 0, 0], -(g / length) * np.cos(theta),
+                                   rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(found.forward_v[:, 0, 0], 0.0, atol=1e-12)
+        np.testing.assert_allclose(found.forward_tau[:, 0, 0], 1 / (m * length**2), rtol=1e-12)
+        np.testing.assert_allclose(found.inverse_q[:, 0, 0], m * g * length * np.cos(theta),
+                                   rtol=1e-9, atol=1e-12)
+
+
+def test_a_derivative_broken_by_one_part_in_a_million_fails_naming_engine_and_entry(
+        monkeypatch):
+    """A test double of Pinocchio whose ∂τ/∂q has one entry scaled by 1 + 1e-6: its rows
+    against the referee and the other engines fail, naming the engine and the entry."""
+    original = pinocchio_model.PinocchioModel.derivatives
+
+    def broken(self, q, v, a):
+        found = original(self, q, v, a)
+        found.inverse_q[:, 0, 0] *= 1 + 1e-6  # a diagonal term (∂τ₀/∂q₀ ≠ 0)
+        return found
+
+    monkeypatch.setattr(pinocchio_model.PinocchioModel, "derivatives", broken)
+    result = check_model(MODELS / "branches.urdf", impls=("reference", "mujoco", "pinocchio"),
+                         states=20, derivatives=True, isolate=False)
+    failed = _rows(result, section="derivatives", verdict="failed")
+    assert set(failed["subject"]) == {"d(inverse)/dq"}
+    row = failed[failed["impl_a"] == "reference"].iloc[0]
+    assert row["impl_b"] == "pinocchio" and result.model == "branches"
+    assert "entry (" in row["note"] and "pinocchio differs from reference" in row["note"]
+
+
+def test_mujoco_differs_by_its_predicted_finite_difference_error():
+    """MuJoCo's derivatives are one-sided differences: off the analytic ones by far more than
+    round-off, yet within the predicted truncation and round-off (the tolerance is not slack:
+    the error reaches a tenth of it)."""
+    result = check_model(MODELS / "branches.urdf", impls=("reference", "mujoco", "pinocchio"),
+                         states=20, derivatives=True)
+    rows = _rows(result, section="derivatives", impl_a="reference", impl_b="mujoco",
+                 subject="d(inverse)/dq").iloc[0]
+    assert rows["verdict"] == "passed" and rows["error"] > 1e-8
+    assert rows["error"] > 0.1 * rows["tolerance"]
+    assert "predicted finite-difference error" in rows["basis"]
+
+
+@pytest.mark.parametrize("model", ["mixed.xml", "floating_arm.xml"])
+def test_ball_and_free_joints_are_skipped_saying_why(model):
+    result = check_model(MODELS / model, impls=("reference", "mujoco", "pinocchio"), states=5,
+                         derivatives=True)
+    rows = _rows(result, section="derivatives")
+    assert set(rows["verdict"]) == {"skipped"}
+    assert rows["note"].str.contains("charts differ").all()
