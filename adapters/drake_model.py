@@ -39,6 +39,7 @@ from dyncheck.adapters.mjcf_copy import for_parser, inline
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
+    DerivativeChart,
     Derivatives,
     Dynamics,
     JointType,
@@ -297,7 +298,8 @@ class DrakeModel:
         ``CalcInverseDynamics`` with gravity (``CalcForceElementsContribution``) at v̇ = a
         for ∂τ/∂q, ∂τ/∂v, and at v̇ = its forward acceleration for the forward derivatives
         through ∂v̇/∂x = −M⁻¹ ∂τ/∂x; ∂v̇/∂τ = M⁻¹ of ``CalcMassMatrix``. With respect to
-        Drake's q (a hinge's or slide's coordinate)."""
+        Drake's q itself (a quaternion's four entries, roll-pitch-yaw: the chart
+        :attr:`DerivativeChart.COORDINATES`)."""
         from pydrake.autodiffutils import ExtractGradient, InitializeAutoDiff
 
         plant = self.plant
@@ -306,7 +308,7 @@ class DrakeModel:
             self._ad_context = self._ad.CreateDefaultContext()
         ad, ctx = self._ad, self._ad_context
         n, nq, nv = len(q), plant.num_positions(), plant.num_velocities()
-        out = {k: np.empty((n, nv, nv)) for k in
+        out = {k: np.empty((n, nv, nq if k.endswith("_q") else nv)) for k in
                ("forward_q", "forward_v", "forward_tau", "inverse_q", "inverse_v")}
         forces = MultibodyForces_[AutoDiffXd](ad)
         dynamics = self.dynamics(q, v, np.asarray(a))
@@ -329,4 +331,5 @@ class DrakeModel:
                     out["forward_q"][i] = -inverse_mass @ d_q
                     out["forward_v"][i] = -inverse_mass @ d_v
             out["forward_tau"][i] = inverse_mass
-        return _derivatives(out, method="automatic differentiation (AutoDiffXd)")
+        return _derivatives(out, method="automatic differentiation (AutoDiffXd)",
+                            chart=DerivativeChart.COORDINATES)

@@ -175,6 +175,17 @@ class Dynamics:
     potential: np.ndarray
 
 
+class DerivativeChart(StrEnum):
+    """With respect to which coordinates of q an engine's derivatives are taken."""
+
+    TANGENT = "tangent"
+    """Its velocity coordinates: δ moves q as its own integration of a velocity δ would (a
+    hinge's angle; a ball's or free body's rotation in the axes of its angular velocity)."""
+    COORDINATES = "coordinates"
+    """Its position coordinates themselves (a quaternion's four entries, roll-pitch-yaw):
+    Drake's automatic differentiation seeds q."""
+
+
 @dataclass(frozen=True, kw_only=True)
 class Derivatives:
     """An engine's derivatives of the smooth dynamics at a batch of states, in its own layout
@@ -191,10 +202,12 @@ class Derivatives:
     inverse_v: np.ndarray
     method: str
     step: float = 0.0
+    chart: DerivativeChart = DerivativeChart.TANGENT
 
 
-def derivatives(found: dict[str, np.ndarray], *, method: str, step: float = 0.0) -> Derivatives:
+def derivatives(found: dict[str, np.ndarray], *, method: str, step: float = 0.0,
+                chart: DerivativeChart = DerivativeChart.TANGENT) -> Derivatives:
     """:class:`Derivatives` from a dict of its five matrices (the engines fill one)."""
     return Derivatives(forward_q=found["forward_q"], forward_v=found["forward_v"],
                        forward_tau=found["forward_tau"], inverse_q=found["inverse_q"],
-                       inverse_v=found["inverse_v"], method=method, step=step)
+                       inverse_v=found["inverse_v"], method=method, step=step, chart=chart)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -167,20 +167,24 @@ def _one_quat_to_matrix(q: np.ndarray, norm: np.ndarray) -> np.ndarray:
             "quaternion", tuple(float(x) for x in q[0]), "a unit quaternion (w, x, y, z)"
         )
     w, x, y, z = (float(c) for c in (q / norm)[0])
-    return np.array(
-        [
-            [
-                [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-            ]
-        ]
-    )
+    return np.array([_entries(w, x, y, z)])
+
+
+def _entries(w: Any, x: Any, y: Any, z: Any) -> list[list[Any]]:  # floats or arrays alike
+    """The rotation matrix of (w, x, y, z), entry by entry."""
+    return [
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ]
 
 
 def quat_to_matrix(q: np.ndarray) -> np.ndarray:
     """Rotation matrices (n, 3, 3) of unit quaternions (n, 4) in (w, x, y, z) order; q and −q
     give the same rotation. A zero, non-finite or non-unit quaternion is refused."""
+    if np.iscomplexobj(q):  # a complex step (derivatives of a map): first order exact, as is
+        w, x, y, z = np.asarray(q).T
+        return np.moveaxis(np.array(_entries(w, x, y, z)), (0, 1), (1, 2))
     q = np.asarray(q, float)
     norm = np.linalg.norm(q, axis=1, keepdims=True)
     if q.shape[0] == 1:  # one state per integrator stage: the same IEEE operations on floats

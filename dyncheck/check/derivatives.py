@@ -3,13 +3,18 @@
 dynamics at the sampled v̇ — of every engine that offers them and of the referee, in the
 canonical chart, compared pair by pair.
 
-The chart: a hinge's or slide's coordinate (q ⊕ δ = q + δ; every engine's, so an engine's
-matrices map by the layout's permutation T: Tᵀ J T). Ball and free joints, whose charts
-differ between engines, are not compared yet (a skipped row says so).
+The chart (MuJoCo's, ``mj_integratePos``): q ⊕ δ moves a hinge or slide by δ, turns a ball
+or free body by exp(δ) in its body axes (quat ⊗ (cos ½|δ|, sin ½|δ| δ/|δ|)) and moves a free
+body's origin by δ in world axes. An engine's derivatives come in its own layout and chart
+(:class:`~dyncheck.adapters.model_tree.DerivativeChart`); they are mapped by the chain rule
+through the check's state map (:func:`~dyncheck.check.layout.state_map`: q_e(q), v_e = T v,
+v̇_e = T v̇ + Ṫv), whose own derivatives are taken by a complex step (exact to round-off:
+the map is analytic), :func:`to_canonical`.
 
 The referee: the book's general method (:mod:`dyncheck.reference.tree`, M(q) and h(q, v)),
-differentiated in q by central differences at h, h/2, h/4 extrapolated twice (Richardson:
-error O(h⁶)), its error estimated by the two first extrapolations' difference; in v exactly
+differentiated in q (along q ⊕ δ) by central differences at h, h/2, h/4 extrapolated twice
+(Richardson: error O(h⁶)), its error estimated by the two first extrapolations' difference;
+in v exactly
 (h is quadratic in v: a central difference of any step is exact but for round-off); the
 forward derivatives through ∂v̇/∂x = −M⁻¹ ∂τ/∂x at v̇ = FD(q, v, 0), which follows from
 differentiating τ = ID(q, v, FD(q, v, τ)).
@@ -24,12 +29,20 @@ step s: s/2 |∂²τ/∂x²| + 2 δτ/s, δτ the round-off of τ, ∂²τ/∂x�
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from dyncheck.adapters.model_tree import Derivatives, JointType, ModelTree
+from dyncheck.adapters.model_tree import (
+    Axes,
+    DerivativeChart,
+    Derivatives,
+    Dynamics,
+    JointType,
+    ModelTree,
+)
 from dyncheck.adapters.model_tree import derivatives as collect
+from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.check.describe import depth
 from dyncheck.check.dynamics import States, condition
 from dyncheck.check.layout import Canonical, StateMap
@@ -46,14 +59,33 @@ SUBJECTS = {
 STEP = 4e-3
 """The referee's largest central-difference step in q (then /2, /4): its extrapolated error
 O(h⁶ τ⁽⁷⁾) stays below the round-off 2 δτ/(h/4) ≈ 1e-12 × depth of τ's scale."""
-UNSUPPORTED = "{types} joints: their charts differ between engines and are not mapped yet"
+COMPLEX_STEP = 1e-20
+"""The complex step of the state map's derivatives (any step ≪ √ε works: no cancellation)."""
 
 
-def unsupported(canon: Canonical) -> str | None:
-    """Why the derivatives of this tree are not compared, or None."""
-    kinds = sorted({str(t) for t in canon.types
-                    if t not in (JointType.HINGE, JointType.SLIDE)})
-    return UNSUPPORTED.format(types=" and ".join(kinds)) if kinds else None
+def perturb(canon: Canonical, q: np.ndarray, k: int, step: complex) -> np.ndarray:
+    """q ⊕ step·e_k for every state (rows of ``q``), in the canonical chart; ``step`` may be
+    imaginary (a complex step: cos and sin of i h/2 are analytic)."""
+    out = q.astype(np.result_type(q, step, float), copy=True)
+    joint = max(j for j in range(len(canon.types)) if canon.v_start[j] <= k)
+    kind, qs, offset = canon.types[joint], canon.q_start[joint], k - canon.v_start[joint]
+    if kind in (JointType.HINGE, JointType.SLIDE):
+        out[:, qs] += step
+        return out
+    if kind is JointType.FREE and offset < 3:
+        out[:, qs + offset] += step
+        return out
+    axis = offset - 3 if kind is JointType.FREE else offset
+    at = qs + 3 if kind is JointType.FREE else qs
+    turn = np.zeros(4, out.dtype)
+    turn[0], turn[1 + axis] = np.cos(step / 2), np.sin(step / 2)
+    w, x, y, z = out[:, at : at + 4].T
+    tw, tx, ty, tz = turn
+    out[:, at : at + 4] = np.stack([w * tw - x * tx - y * ty - z * tz,
+                                    w * tx + x * tw + y * tz - z * ty,
+                                    w * ty - x * tz + y * tw + z * tx,
+                                    w * tz + x * ty - y * tx + z * tw], axis=1)
+    return out
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -70,7 +102,10 @@ class Referee:
 
 
 def referee(tree: ModelTree, states: States) -> Referee:
-    """The referee's derivatives at ``states`` (canonical layout, hinges and slides)."""
+    """The referee's derivatives at ``states`` (canonical layout and chart)."""
+    from dyncheck.check.layout import canonical
+
+    canon = canonical(tree)
     solver = ReferenceModel(tree).solver
     q, v, a = states.q, states.v, states.a
     n, nv = v.shape
@@ -83,16 +118,15 @@ def referee(tree: ModelTree, states: States) -> Referee:
         steps = STEP / np.array([1.0, 2.0, 4.0])
         # every perturbed state at once: (step, sign, k, state)
         signs = np.array([1.0, -1.0])
-        offsets = (steps[:, None, None, None, None] * signs[None, :, None, None, None]
-                   * eye[None, None, :, None, :])  # (step, sign, k, 1, nv)
-        q_p = (q[None, None, None] + offsets).reshape(-1, q.shape[1])
+        q_p = np.stack([np.stack([np.stack([perturb(canon, q, k, sign * h) for k in range(nv)])
+                                  for sign in signs]) for h in steps]).reshape(-1, q.shape[1])
         v_p = np.broadcast_to(v, (3, 2, nv, n, nv)).reshape(-1, nv)
         m_p, h_p, _, _ = solver.at_states(q_p, v_p)
         m_p, h_p = m_p.reshape(3, 2, nv, n, nv, nv), h_p.reshape(3, 2, nv, n, nv)
         spread = max(1.0, float(np.abs(v).max()))
         v_w = (v[None, None] + spread * signs[:, None, None, None]
                * eye[None, :, None, :]).reshape(-1, nv)
-        _, h_w, _, _ = solver.at_states(np.broadcast_to(q, (2, nv, n, q.shape[1])).reshape(
+        _, h_w, _, _ = solver.at_states(np.broadcast_to(q, (2, nv, *q.shape)).reshape(
             -1, q.shape[1]), v_w)
         h_w = h_w.reshape(2, nv, n, nv)
     depth_ = depth(tree)
@@ -134,11 +168,120 @@ def referee(tree: ModelTree, states: States) -> Referee:
         roundoff=roundoff)
 
 
-def to_canonical(maps: list[StateMap], found: Derivatives) -> Derivatives:
-    """An engine's derivatives in the canonical layout: Tᵀ J T (T a permutation here)."""
-    t = np.array([s.t for s in maps])
-    mapped = {f: np.einsum("sji,sjk,skl->sil", t, getattr(found, f), t) for f in FIELDS}
-    return collect(mapped, method=found.method, step=found.step)
+def _chart(tree: ModelTree, chart: DerivativeChart, q_e: np.ndarray,
+           dq_e: np.ndarray) -> np.ndarray:
+    """A displacement dq_e of the engine's q in the coordinates its derivatives are taken
+    in: q itself (COORDINATES), or its velocity coordinates (TANGENT: a rotation's as the
+    engine's angular velocity is resolved, a free body's origin as its linear velocity)."""
+    if chart is DerivativeChart.COORDINATES:
+        return dq_e
+    out = np.zeros(tree.nv)
+    for joint in tree.joints:
+        lay = joint.layout
+        qs, vs = lay.q_start, lay.v_start
+        if lay.nq == 1:
+            out[vs] = dq_e[qs]
+        elif lay.cos_sin:  # (cos θ, sin θ): dθ = cos d(sin) − sin d(cos)
+            out[vs] = q_e[qs] * dq_e[qs + 1] - q_e[qs + 1] * dq_e[qs]
+        elif lay.quat == "rpy" or lay.point is not None:
+            raise ValueError(f"{tree.engine}: no tangent chart for {joint.name!r}")
+        else:
+            at = qs + (0 if joint.type is JointType.BALL or lay.quat_first else 3)
+            quat, dquat = _wxyz(q_e[at : at + 4], lay.quat), _wxyz(dq_e[at : at + 4], lay.quat)
+            local = lay.angular_axes is Axes.LOCAL
+            omega = 2 * (_mul(_conj(quat), dquat) if local else _mul(dquat, _conj(quat)))[1:]
+            if joint.type is JointType.BALL:
+                out[vs : vs + 3] = omega
+                continue
+            p = qs + (4 if lay.quat_first else 0)
+            dp = dq_e[p : p + 3]
+            if lay.linear_axes is Axes.LOCAL:
+                dp = quat_to_matrix(quat[None])[0].T @ dp
+            lin, ang = (vs + 3, vs) if lay.angular_first else (vs, vs + 3)
+            out[lin : lin + 3], out[ang : ang + 3] = dp, omega
+    return out
+
+
+def _wxyz(quat: np.ndarray, order: str) -> np.ndarray:
+    return quat if order == "wxyz" else np.concatenate([quat[3:], quat[:3]])
+
+
+def _conj(quat: np.ndarray) -> np.ndarray:
+    return np.array([quat[0], -quat[1], -quat[2], -quat[3]])
+
+
+def _mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+def _turning(canon: Canonical) -> set[int]:
+    """The velocity indices of ball and free joints: the state map depends on their q
+    nonlinearly (T, Ṫv); a hinge's or slide's q enters only its own coordinate."""
+    return {canon.v_start[j] + i for j, kind in enumerate(canon.types)
+            if kind in (JointType.BALL, JointType.FREE) for i in range(6 if kind is
+                                                                       JointType.FREE else 3)}
+
+
+def _moved(canon: Canonical, tree: ModelTree, base: StateMap, q: np.ndarray, v: np.ndarray,
+           k: int, h: float) -> StateMap:
+    """The complex-stepped map along a hinge or slide ``k`` without mapping every joint:
+    only that joint's engine coordinates move (T and Ṫv do not)."""
+    from dyncheck.check.layout import state_map
+
+    joint = max(j for j in range(len(canon.types)) if canon.v_start[j] <= k)
+    single = Canonical(names=(canon.names[joint],), types=(canon.types[joint],),
+                       q_start=(0,), v_start=(0,), nq=1, nv=1, zeros=(canon.zeros[joint],))
+    mine = tree.joint(canon.names[joint])
+    one = replace(tree, joints=(replace(mine, layout=replace(mine.layout, q_start=0,
+                                                             v_start=0)),),
+                  nq=mine.layout.nq, nv=1)
+    step = state_map(single, one, np.array([q[canon.q_start[joint]] + 1j * h]), v[k : k + 1])
+    q_e = base.q.astype(complex)
+    at = mine.layout.q_start
+    q_e[at : at + mine.layout.nq] = step.q
+    return StateMap(q=q_e, t=base.t.astype(complex), tdot_v=base.tdot_v.astype(complex))
+
+
+def to_canonical(canon: Canonical, tree: ModelTree, states: States, found: Derivatives,
+                 dynamics: Dynamics) -> Derivatives:
+    """An engine's derivatives (its layout and chart; ``dynamics`` its own values at the same
+    states: M, forward and inverse dynamics) in the canonical layout and chart, by the chain
+    rule through the state map — τ = Tᵀ τ_e(q_e(q), T v, T v̇ + Ṫv) and
+    v̇ = T⁻¹ (v̇_e(q_e(q), T v) − Ṫv) differentiated —, the map's own derivatives (dq_e, dT,
+    d(Ṫv)) by a complex step."""
+    from dyncheck.check.layout import state_map
+
+    n, nv = states.v.shape
+    out = {f: np.zeros((n, nv, nv)) for f in FIELDS}
+    h = COMPLEX_STEP
+    turning = _turning(canon)
+    for s in range(n):
+        q, v, a = states.q[s : s + 1], states.v[s], states.a[s]
+        base = state_map(canon, tree, q[0], v)
+        t, t_inv = base.t, np.linalg.inv(base.t)
+        mass, tau_e, f_e = (dynamics.mass_matrix[s], dynamics.inverse[s], dynamics.forward[s])
+        f_c = t_inv @ (f_e - base.tdot_v)
+        for k in range(nv):
+            moved = state_map(canon, tree, perturb(canon, q, k, 1j * h)[0], v) \
+                if k in turning else _moved(canon, tree, base, q[0], v, k, h)
+            chi = _chart(tree, found.chart, base.q, moved.q.imag / h)
+            d_t, d_tdot = moved.t.imag / h, moved.tdot_v.imag / h
+            out["inverse_q"][s, :, k] = d_t.T @ tau_e + t.T @ (
+                found.inverse_q[s] @ chi + found.inverse_v[s] @ (d_t @ v)
+                + mass @ (d_t @ a + d_tdot))
+            out["forward_q"][s, :, k] = -t_inv @ d_t @ f_c + t_inv @ (
+                found.forward_q[s] @ chi + found.forward_v[s] @ (d_t @ v) - d_tdot)
+            d_tdot_v = np.zeros(len(base.tdot_v))
+            if k in turning:  # Ṫv depends on a free joint's own velocities only
+                pushed = state_map(canon, tree, q[0], v + 1j * h * np.eye(nv)[k])
+                d_tdot_v = pushed.tdot_v.imag / h
+            out["inverse_v"][s, :, k] = t.T @ (found.inverse_v[s] @ t[:, k] + mass @ d_tdot_v)
+            out["forward_v"][s, :, k] = t_inv @ (found.forward_v[s] @ t[:, k] - d_tdot_v)
+        out["forward_tau"][s] = t_inv @ found.forward_tau[s] @ t_inv.T
+    return collect(out, method=found.method, step=found.step)
 
 
 def _predicted(found: Derivatives, ref: Referee, field: str) -> np.ndarray:
@@ -208,17 +351,16 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
     from dyncheck.errors import Unsupported
 
     names = (["reference"] if with_referee else []) + list(engines)
-    why = unsupported(canon)
-    if why is not None:
-        return [_row(model, name, Verdict.SKIPPED, why) for name in names]
     ref = referee(tree, states)
     found: dict[str, Derivatives] = {"reference": ref.derivatives} if with_referee else {}
     out: list[CheckRow] = []
     for name, engine in engines.items():
-        maps, q, v, a = layout.engine_states(canon, engine.tree,  # type: ignore[attr-defined]
-                                             states.q, states.v, states.a)
+        mine: ModelTree = engine.tree  # type: ignore[attr-defined]
+        _, q, v, a = layout.engine_states(canon, mine, states.q, states.v, states.a)
         try:
-            found[name] = to_canonical(maps, engine.derivatives(q, v, a))  # type: ignore[attr-defined]
+            own = engine.derivatives(q, v, a)  # type: ignore[attr-defined]
+            values = engine.dynamics(q, v, a)  # type: ignore[attr-defined]
+            found[name] = to_canonical(canon, mine, states, own, values)
         except Unsupported as exc:
             out.append(_row(model, name, Verdict.SKIPPED, str(exc)))
         except AttributeError:

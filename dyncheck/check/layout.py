@@ -63,10 +63,29 @@ def canonical(tree: ModelTree) -> Canonical:
 def rpy_from_matrix(rot: np.ndarray) -> np.ndarray:
     """Roll, pitch, yaw with R = R_z(yaw) R_y(pitch) R_x(roll) (any of the two solutions
     gives the same R; at pitch ±π/2 roll and yaw share one angle, chosen with roll 0)."""
-    pitch = np.arcsin(np.clip(-rot[2, 0], -1.0, 1.0))
-    if abs(rot[2, 0]) > 1 - 1e-12:
-        return np.array([0.0, pitch, np.arctan2(-rot[0, 1], rot[1, 1])])
-    return np.array([np.arctan2(rot[2, 1], rot[2, 2]), pitch, np.arctan2(rot[1, 0], rot[0, 0])])
+    pitch = _asin(-rot[2, 0])
+    if abs(rot[2, 0].real) > 1 - 1e-12:
+        return np.array([0.0 * pitch, pitch, _atan2(-rot[0, 1], rot[1, 1])])
+    return np.array([_atan2(rot[2, 1], rot[2, 2]), pitch, _atan2(rot[1, 0], rot[0, 0])])
+
+
+def _atan2(y: complex, x: complex) -> complex:
+    """arctan2, and under a complex step (tiny imaginary parts) its first-order extension
+    (x dy − y dx)/(x² + y²): numpy's arctan2 takes no complex numbers."""
+    yr, xr = float(np.real(y)), float(np.real(x))
+    angle = np.arctan2(yr, xr)
+    if not (np.iscomplexobj(y) or np.iscomplexobj(x)):
+        return angle
+    return angle + 1j * (xr * np.imag(y) - yr * np.imag(x)) / (xr * xr + yr * yr)
+
+
+def _asin(z: complex) -> complex:
+    """arcsin clipped to [−1, 1], with its first-order complex-step extension."""
+    zr = float(np.clip(np.real(z), -1.0, 1.0))
+    angle = np.arcsin(zr)
+    if not np.iscomplexobj(z):
+        return angle
+    return angle + 1j * np.imag(z) / np.sqrt(max(1.0 - zr * zr, 1e-300))
 
 
 def _quat_out(quat_wxyz: np.ndarray, order: str) -> np.ndarray:
@@ -88,9 +107,10 @@ def _state_map(
 ) -> StateMap:
     """One state; ``joints`` are the engine's joints in canonical order, ``placements`` the
     quaternion of each free joint's placement inverse (None for other joints)."""
-    q_e = np.zeros(tree.nq)
-    t = np.zeros((tree.nv, canon.nv))
-    tdot_v = np.zeros(tree.nv)
+    kind_of = np.result_type(q_c, v_c, float)  # complex under a complex step (derivatives)
+    q_e = np.zeros(tree.nq, kind_of)
+    t = np.zeros((tree.nv, canon.nv), kind_of)
+    tdot_v = np.zeros(tree.nv, kind_of)
     for joint, place_quat, kind, qs, vs, zero in zip(
         joints, placements, canon.types, canon.q_start, canon.v_start, canon.zeros, strict=True
     ):
@@ -139,8 +159,9 @@ def _free(lay: Layout, place_quat: np.ndarray, q_c: np.ndarray,
     p_o = lay.offset[:3, 3] if lay.point is None else np.asarray(lay.point, float)
     quat_e = _quat_out(quat_mul(place_quat, quat_mul(quat_w, quat_o)), lay.quat)
     q_e = np.concatenate([quat_e, p_e]) if lay.quat_first else np.concatenate([p_e, quat_e])
-    t = np.zeros((6, 6))
-    tdot_v = np.zeros(6)
+    kind_of = np.result_type(q_c, v_c, float)
+    t = np.zeros((6, 6), kind_of)
+    tdot_v = np.zeros(6, kind_of)
     lin = slice(3, 6) if lay.angular_first else slice(0, 3)
     ang = slice(0, 3) if lay.angular_first else slice(3, 6)
     omega = v_c[3:6]
@@ -157,6 +178,18 @@ def _free(lay: Layout, place_quat: np.ndarray, q_c: np.ndarray,
         tdot_v[lin] = rot @ centripetal
     t[ang, 3:6] = rot if lay.angular_axes is Axes.WORLD else r_o.T
     return q_e, t, tdot_v
+
+
+def state_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray,
+              v_c: np.ndarray) -> StateMap:
+    """One state's map into ``tree``'s layout (real, or complex under a complex step)."""
+    joints = [tree.joint(name) for name in canon.names]
+    placements = [
+        quat_from_matrix(j.layout.placement[:3, :3].T[None])[0]
+        if kind is JointType.FREE else None
+        for j, kind in zip(joints, canon.types, strict=True)
+    ]
+    return _state_map(canon, joints, placements, tree, q_c, v_c)
 
 
 def engine_states(
