@@ -146,9 +146,9 @@ MODELS: dict[str, Registration] = dict(sorted(
 others in :data:`REGISTRY`'s order."""
 COUPLINGS_ONLY: frozenset[str] = frozenset(n for n, r in REGISTRY.items() if r.couplings_only)
 """Implementations run on cases with couplings only (:attr:`Registration.couplings_only`)."""
-LABELS: dict[str, str] = {n: r.label for n, r in REGISTRY.items() if r.label}
+LABELS: dict[str, str] = {n: r.label for n, r in MODELS.items() if r.label}
 """Implementation whose adapter reports its engine's version → the engine's name in a
-report's provenance."""
+report's provenance (in the check's order: the canonical engine first)."""
 
 _ADAPTERS: dict[str, type[Adapter]] = {}
 _MISSING: dict[str, str] = {}

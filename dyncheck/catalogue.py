@@ -16,6 +16,7 @@ from functools import partial
 import numpy as np
 
 from dyncheck.errors import EngineNotInstalled, UnknownName
+from dyncheck.explain.charts import derivative_chart
 from dyncheck.explain.constraints import (
     drake_equality,
     multiplier_sign,
@@ -77,6 +78,7 @@ DEMOS: dict[str, tuple[Callable[[], Entry], Origin]] = {
     "mjx-integrator-definitions": (port_integrators, Origin.ENGINE),
     "pybullet-inertia-source": (pybullet_inertia_source, Origin.ENGINE),
     "newton-free-joint-velocity": (newton_free_velocity, Origin.ENGINE),
+    "derivative-chart": (derivative_chart, Origin.MATHEMATICS),
 }
 """Conventions demonstrated by a run of their own, with whose property each is; the others
 (point-mass inertia floor, MJCF gravity, held forces, soft constraints: :mod:`.explanations`)
@@ -91,6 +93,7 @@ TUTORIALS: dict[str, str] = {
     "pinocchio-mjcf-options": "06_what_parsers_read",
     "drake-mjcf-options": "06_what_parsers_read",
     "rk4-on-the-rotation-group": "07_integrators_on_rotations",
+    "derivative-chart": "09_derivatives_in_charts",
 }
 """The executed tutorial (``reports/tutorials/NAME.md``) that teaches an entry step by step."""
 
@@ -115,7 +118,10 @@ def not_selected(name: str, selected: Collection[str]) -> Entry | None:
     """The entry ``name`` skipped when it needs an optional engine that a run leaves out
     (``dyncheck run --impl ...`` without it), else None: a run of the core engines loads
     neither JAX nor Drake for its catalogue, as on a machine without them."""
-    left_out = [engine for engine in REQUIRES.get(name, ()) if engine not in selected]
+    from dyncheck.adapters import RUN
+
+    left_out = [engine for engine in REQUIRES.get(name, ())  # an engine of the check only
+                if engine in RUN and engine not in selected]  # is not chosen by --impl
     if not left_out:
         return None
     return _skipped(name, f"{', '.join(left_out)} not selected (--impl)")
