@@ -40,7 +40,7 @@ def pybullet_inertia_source() -> Entry:
 
     from dyncheck.confinement import c_output_dropped
 
-    with c_output_dropped():  # its import prints a line of its own
+    with c_output_dropped():  # its import prints a line of its own (on stderr)
         import pybullet as pb
 
     q = [0.4, -0.9]
