@@ -245,6 +245,21 @@ def _moved(canon: Canonical, tree: ModelTree, base: StateMap, q: np.ndarray, v: 
     return StateMap(q=q_e, t=base.t.astype(complex), tdot_v=base.tdot_v.astype(complex))
 
 
+def _same_layout(canon: Canonical, tree: ModelTree, states: States) -> bool:
+    """Whether ``tree``'s layout is the canonical one at these states (q the same, T = I,
+    Ṫv = 0: MuJoCo's own): then its tangent chart is the canonical chart."""
+    from dyncheck.check.layout import state_map
+
+    if tree.nq != canon.nq or tree.nv != canon.nv:
+        return False
+    for q, v in zip(states.q, states.v, strict=True):
+        mapped = state_map(canon, tree, q, v)
+        if not (np.array_equal(mapped.q, q) and np.array_equal(mapped.t, np.eye(canon.nv))
+                and not np.any(mapped.tdot_v)):
+            return False
+    return True
+
+
 def to_canonical(canon: Canonical, tree: ModelTree, states: States, found: Derivatives,
                  dynamics: Dynamics) -> Derivatives:
     """An engine's derivatives (its layout and chart; ``dynamics`` its own values at the same
@@ -344,23 +359,49 @@ def _row(model: str, engine: str, verdict: Verdict, note: str) -> CheckRow:
 
 
 def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, object],
-         states: States, *, with_referee: bool) -> list[CheckRow]:
+         states: States, *, with_referee: bool,
+         seconds: dict[str, float] | None = None) -> list[CheckRow]:
     """Every pair's derivative rows: ``engines`` are the loaded engines (name → the engine,
-    whole trees only) in the canonical order; the referee is a side when ``with_referee``."""
+    whole trees only) in the canonical order; the referee is a side when ``with_referee``.
+    Engines in processes of their own differentiate while the referee does; ``seconds``
+    receives each one's own time ("d <name>") and the mapping's ("d map")."""
+    import time
+
     from dyncheck.check import layout
     from dyncheck.errors import Unsupported
 
+    seconds = {} if seconds is None else seconds
     names = (["reference"] if with_referee else []) + list(engines)
-    ref = referee(tree, states)
-    found: dict[str, Derivatives] = {"reference": ref.derivatives} if with_referee else {}
     out: list[CheckRow] = []
+    inputs = {}
     for name, engine in engines.items():
         mine: ModelTree = engine.tree  # type: ignore[attr-defined]
-        _, q, v, a = layout.engine_states(canon, mine, states.q, states.v, states.a)
+        inputs[name] = layout.engine_states(canon, mine, states.q, states.v, states.a)[1:]
+        if hasattr(engine, "submit"):
+            engine.submit(*inputs[name], kind="derivatives")
+    t0 = time.perf_counter()
+    ref = referee(tree, states)
+    seconds["d reference"] = time.perf_counter() - t0
+    found: dict[str, Derivatives] = {"reference": ref.derivatives} if with_referee else {}
+    for name, engine in engines.items():
+        q, v, a = inputs[name]
         try:
-            own = engine.derivatives(q, v, a)  # type: ignore[attr-defined]
-            values = engine.dynamics(q, v, a)  # type: ignore[attr-defined]
-            found[name] = to_canonical(canon, mine, states, own, values)
+            t0 = time.perf_counter()
+            if hasattr(engine, "submit"):
+                own, took = engine.collect()  # type: ignore[attr-defined]
+            else:
+                own = engine.derivatives(q, v, a)  # type: ignore[attr-defined]
+                took = time.perf_counter() - t0
+            seconds[f"d {name}"] = took
+            t0 = time.perf_counter()
+            if own.chart is DerivativeChart.TANGENT and _same_layout(canon, engine.tree,  # type: ignore[attr-defined]
+                                                                       states):
+                found[name] = own  # its layout is the canonical one: nothing to map
+            else:
+                values = engine.dynamics(q, v, a)  # type: ignore[attr-defined]
+                found[name] = to_canonical(canon, engine.tree,  # type: ignore[attr-defined]
+                                           states, own, values)
+            seconds["d map"] = seconds.get("d map", 0.0) + time.perf_counter() - t0
         except Unsupported as exc:
             out.append(_row(model, name, Verdict.SKIPPED, str(exc)))
         except AttributeError:

@@ -227,31 +227,30 @@ class Isolated:
         self.submit(q, v, a)
         return self.collect()[0]
 
-    def submit(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
-        """Hand the engine a batch of states; :meth:`collect` waits for its answer (the
-        caller computes meanwhile: the engines and the referee side by side)."""
-        self._request("dynamics", q, v, a)
-
-    def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
-        """The engine's derivatives (:class:`Unsupported` where it offers none); a batch
-        costs about nv times its dynamics."""
-        nv = v.shape[1] if v.ndim > 1 else 1
-        self._request("derivatives", q, v, a, scale=nv)
-        return self.collect()[0]  # type: ignore[return-value]
-
-    def _request(self, kind: str, q: np.ndarray, v: np.ndarray, a: np.ndarray, *,
-                 scale: int = 1) -> None:
+    def submit(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, *,
+               kind: str = "dynamics") -> None:
+        """Hand the engine a batch of states, for its ``dynamics`` or its ``derivatives``
+        (a batch of these costs about nv times the dynamics: its time limit scales so);
+        :meth:`collect` waits for its answer (the caller computes meanwhile: the engines and
+        the referee side by side)."""
         nv = v.shape[1] if v.ndim > 1 else 1
         self._kind = kind
-        self._batch_seconds = self.limits.batch_seconds(len(q) * scale, nv)
+        self._batch_seconds = self.limits.batch_seconds(
+            len(q) * (nv if kind == "derivatives" else 1), nv)
         try:
             self._conn.send((kind, q, v, a))
         except OSError:
             raise EngineError(f"{self.engine} crashed earlier "
                               f"({_death(self._proc.exitcode)})") from None
 
+    def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
+        """The engine's derivatives (:class:`Unsupported` where it offers none)."""
+        self.submit(q, v, a, kind="derivatives")
+        return self.collect()[0]  # type: ignore[return-value]
+
     def collect(self) -> tuple[Dynamics, float]:
-        """The submitted batch's dynamics and the seconds the engine spent on them."""
+        """The submitted batch's answer (dynamics or derivatives) and the seconds the engine
+        spent on it."""
         answer = self._receive(f"computing the {self._kind}", self._batch_seconds)
         if isinstance(answer, Exception):
             raise answer

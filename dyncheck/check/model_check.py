@@ -284,7 +284,7 @@ def _check(model: str, source_path: Path, source: ModelFile,
         t0 = time.perf_counter()
         whole = {e: loaded[e] for e in results if e in loaded and parts.get(e) is None}
         rows.extend(derivative_rows(model, canon, canonical_tree, whole, batch,
-                                    with_referee=REFEREE in chosen))
+                                    with_referee=REFEREE in chosen, seconds=seconds))
         seconds["derivatives"] = time.perf_counter() - t0
     frame = pd.DataFrame([vars(r) for r in rows], columns=COLUMNS)
     for column in ("section", "verdict"):
