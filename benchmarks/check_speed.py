@@ -6,8 +6,10 @@ per-implementation seconds: the referee against the slowest engine).
 
 Models: a 29-joint floating humanoid (example-robot-data's ``g1_29dof_rev_1_0``, extra
 ``robots``) at 1000 states; a chain of 200 hinges (written here) at 10 states; every book
-case's MJCF at 100 states (``--case all``). Targets from the issues: the humanoid's whole
-command ≤ 2 s, its referee ≤ 5× the slowest engine; the chain ≤ 10 s.
+case's MJCF at 100 states (``--case all``); the humanoid with ``--derivatives`` at 100 states.
+Targets from the issues: the humanoid's whole command ≤ 2 s, its referee ≤ 5× the slowest
+engine; the chain ≤ 10 s; with derivatives ≤ 5 s, the derivative rows ≤ 3× the engines' own
+derivative calls (#46).
 """
 
 from __future__ import annotations
@@ -52,6 +54,9 @@ def measure(repeats: int) -> pd.DataFrame:
             "200-hinge chain, 10 states": ([f"{tmp}/chain200.xml", "--states", "10"],
                                            "chain200", 10.0),
             "every book case, 100 states": (["--case", "all"], "", 30.0),
+            "29-joint floating humanoid with --derivatives, 100 states": (
+                ["--robot", "g1_29dof_rev_1_0", "--floating", "--states", "100",
+                 "--derivatives"], "g1_29dof_rev_1_0", 5.0),
         }
         for what, (args, page, target) in commands.items():
             seconds = []
@@ -65,10 +70,18 @@ def measure(repeats: int) -> pd.DataFrame:
                                       "target_s": target, "exit": done.returncode}
             if page and (Path(tmp) / "out" / f"{page}.md").is_file():
                 parts = _page_seconds(Path(tmp) / "out" / f"{page}.md")
-                engines = [v for k, v in parts.items() if k not in ("load", "reference")]
+                engines = [v for k, v in parts.items() if k not in ("load", "reference")
+                           and not k.startswith("d") and k != "derivatives"]
                 row |= {"referee_s": parts.get("reference"),
                         "slowest_engine_s": max(engines),
                         "referee_over_engine": round(parts.get("reference", 0) / max(engines), 1)}
+                own = [v for k, v in parts.items() if k.startswith("d ")
+                       and k not in ("d reference", "d map")]
+                if own:  # the derivative rows against the engines' own derivative calls
+                    row |= {"derivatives_s": parts["derivatives"],
+                            "engines_own_derivatives_s": round(sum(own), 3),
+                            "derivatives_over_engines": round(parts["derivatives"] / sum(own),
+                                                              1)}
             rows.append(row)
     return pd.DataFrame(rows)
 

@@ -33,6 +33,8 @@ from dyncheck.adapters.model_tree import (
 )
 from dyncheck.cases.coordinate_maps import quat_from_matrix, quat_to_matrix
 
+IDENTITY = np.eye(4)
+
 
 @dataclass(frozen=True, kw_only=True)
 class Canonical:
@@ -153,11 +155,13 @@ def _free(lay: Layout, place_quat: np.ndarray, q_c: np.ndarray,
     p_w, quat_w = q_c[:3], q_c[3:7]
     rot = quat_to_matrix(quat_w[None])[0]
     r_o = lay.offset[:3, :3]
-    quat_o = quat_from_matrix(r_o[None])[0]
+    offset = not np.array_equal(lay.offset, IDENTITY)  # most engines: q holds the body frame
     place_r, place_p = lay.placement[:3, :3], lay.placement[:3, 3]
-    p_e = place_r.T @ (p_w + rot @ lay.offset[:3, 3] - place_p)
+    p_e = place_r.T @ (p_w + rot @ lay.offset[:3, 3] - place_p) if offset else \
+        place_r.T @ (p_w - place_p)
     p_o = lay.offset[:3, 3] if lay.point is None else np.asarray(lay.point, float)
-    quat_e = _quat_out(quat_mul(place_quat, quat_mul(quat_w, quat_o)), lay.quat)
+    turned = quat_mul(quat_w, quat_from_matrix(r_o[None])[0]) if offset else quat_w
+    quat_e = _quat_out(quat_mul(place_quat, turned), lay.quat)
     q_e = np.concatenate([quat_e, p_e]) if lay.quat_first else np.concatenate([p_e, quat_e])
     kind_of = np.result_type(q_c, v_c, float)
     t = np.zeros((6, 6), kind_of)
