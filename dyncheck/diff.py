@@ -33,7 +33,7 @@ import pandas as pd
 from dyncheck.errors import InvalidInput
 from dyncheck.escaping import markdown_code, markdown_table
 from dyncheck.provenance import NOT_USED
-from dyncheck.results import DISCREPANCY_KEY, PROVENANCE, VERDICTS, texts
+from dyncheck.results import DISCREPANCY_KEY, PROVENANCE, SEVERITY, VERDICTS, texts
 
 FACTOR = 10.0
 """Default factor an error must grow or shrink by, above its tolerance, to count as moved."""
@@ -65,7 +65,7 @@ KEYS = {
     RunKind.CHECK: ["model", "section", "subject", "field", "impl_a", "impl_b"],
 }
 ERROR = {RunKind.RUN: "max_rel_err", RunKind.CHECK: "error"}
-_RANK = {"passed": 0, "explained": 1, "skipped": 2, "failed": 3}
+_RANK = SEVERITY
 """Verdicts from best to worst: a verdict that moves right regressed."""
 
 

@@ -24,6 +24,11 @@ class Verdict(StrEnum):
 
 
 VERDICTS = tuple(v.value for v in Verdict)
+SEVERITY: dict[str, int] = {Verdict.PASSED: 0, Verdict.EXPLAINED: 1, Verdict.SKIPPED: 2,
+                            Verdict.FAILED: 3}
+"""The one order of the verdicts, best first: a row that passed, one whose difference is
+explained, one not checked (a check lost is worse than an explained difference), one that
+failed. A table cell shows its rows' worst; a change to a higher rank is a regression."""
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -7,6 +7,7 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.escaping import markdown_table
+from dyncheck.results import SEVERITY
 from dyncheck.run import RunResult
 from dyncheck.studies import (
     CONTROLLED,
@@ -22,20 +23,20 @@ def md(frame: pd.DataFrame) -> str:
     return markdown_table(frame, floatfmt=".3g") if len(frame) else "_(none)_"
 
 
-SEVERITY = ("failed", "explained", "passed", "skipped")
-"""Verdicts, worst first: a cell shows its rows' worst."""
+NAMES = {rank: str(verdict) for verdict, rank in SEVERITY.items()}
 
 
 def _cells(rows: pd.DataFrame, keys: list[str], sort: bool) -> pd.Series:
-    """Per group of ``keys``: its worst verdict and its worst relative error ("failed 1.2e-03";
-    the verdict alone where no row has a finite error)."""
-    severity = rows["verdict"].map({v: i for i, v in enumerate(SEVERITY)})
+    """Per group of ``keys``: its worst verdict (:data:`~dyncheck.results.SEVERITY`) and its
+    worst relative error ("failed 1.2e-03"; the verdict alone where no row has a finite
+    error)."""
+    severity = rows["verdict"].map(SEVERITY)
     if severity.isna().any():
         raise ValueError(f"unknown verdict {rows['verdict'][severity.isna()].iloc[0]!r}")
     groups = rows.assign(severity=severity).groupby(keys, sort=sort)
-    worst, first = groups["max_rel_err"].max(), groups["severity"].min()
+    worst, first = groups["max_rel_err"].max(), groups["severity"].max()
     return pd.Series(
-        [f"{SEVERITY[int(s)]} {w:.1e}" if np.isfinite(w) else SEVERITY[int(s)]
+        [f"{NAMES[int(s)]} {w:.1e}" if np.isfinite(w) else NAMES[int(s)]
          for s, w in zip(first, worst, strict=True)],
         index=worst.index,
     )
