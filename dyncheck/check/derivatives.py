@@ -33,6 +33,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from dyncheck.adapters.integrators import quat_mul
 from dyncheck.adapters.model_tree import (
     Axes,
     DerivativeChart,
@@ -77,14 +78,9 @@ def perturb(canon: Canonical, q: np.ndarray, k: int, step: complex) -> np.ndarra
         return out
     axis = offset - 3 if kind is JointType.FREE else offset
     at = qs + 3 if kind is JointType.FREE else qs
-    turn = np.zeros(4, out.dtype)
+    turn = np.zeros((4, 1), out.dtype)
     turn[0], turn[1 + axis] = np.cos(step / 2), np.sin(step / 2)
-    w, x, y, z = out[:, at : at + 4].T
-    tw, tx, ty, tz = turn
-    out[:, at : at + 4] = np.stack([w * tw - x * tx - y * ty - z * tz,
-                                    w * tx + x * tw + y * tz - z * ty,
-                                    w * ty - x * tz + y * tw + z * tx,
-                                    w * tz + x * ty - y * tx + z * tw], axis=1)
+    out[:, at : at + 4] = quat_mul(out[:, at : at + 4].T, turn).T
     return out
 
 
@@ -189,7 +185,8 @@ def _chart(tree: ModelTree, chart: DerivativeChart, q_e: np.ndarray,
             at = qs + (0 if joint.type is JointType.BALL or lay.quat_first else 3)
             quat, dquat = _wxyz(q_e[at : at + 4], lay.quat), _wxyz(dq_e[at : at + 4], lay.quat)
             local = lay.angular_axes is Axes.LOCAL
-            omega = 2 * (_mul(_conj(quat), dquat) if local else _mul(dquat, _conj(quat)))[1:]
+            turn = quat_mul(_conj(quat), dquat) if local else quat_mul(dquat, _conj(quat))
+            omega = 2 * turn[1:]
             if joint.type is JointType.BALL:
                 out[vs : vs + 3] = omega
                 continue
@@ -208,13 +205,6 @@ def _wxyz(quat: np.ndarray, order: str) -> np.ndarray:
 
 def _conj(quat: np.ndarray) -> np.ndarray:
     return np.array([quat[0], -quat[1], -quat[2], -quat[3]])
-
-
-def _mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
 
 
 def _turning(canon: Canonical) -> set[int]:
