@@ -245,13 +245,26 @@ class MujocoModel:
         ∂τ/∂q, ∂τ/∂v; MuJoCo has no derivative of its forward dynamics, so those are the
         same differences at v̇ = its forward acceleration at τ = 0, through the identity
         ∂v̇/∂x = −M⁻¹ ∂τ/∂x (τ = ID(q, v, FD(q, v, τ)) differentiated), and ∂v̇/∂τ = M⁻¹."""
-        m, d = self.model, self.data
+        m = self.model
         n, nv = len(q), m.nv
         out = {k: np.empty((n, nv, nv)) for k in
                ("forward_q", "forward_v", "forward_tau", "inverse_q", "inverse_v")}
         dq, dv = np.empty((nv, nv)), np.empty((nv, nv))
         mass = np.empty((nv, nv))
-        for i in range(n):
+        integrator = m.opt.integrator  # mjd_inverseFD refuses RK4 (the differences of
+        m.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER  # mj_inverse do not depend on it)
+        try:
+            self._differences(q, v, a, out, dq, dv, mass)
+        finally:
+            m.opt.integrator = integrator
+        return _derivatives(out, method=f"finite differences (mjd_inverseFD, one-sided, "
+                            f"step {FD_STEP:g})", step=FD_STEP)
+
+    def _differences(self, q: np.ndarray, v: np.ndarray, a: np.ndarray,
+                     out: dict[str, np.ndarray], dq: np.ndarray, dv: np.ndarray,
+                     mass: np.ndarray) -> None:
+        m, d = self.model, self.data
+        for i in range(len(q)):
             d.qpos[:], d.qvel[:] = q[i], v[i]
             d.qfrc_applied[:] = 0.0
             mujoco.mj_forward(m, d)
@@ -267,5 +280,3 @@ class MujocoModel:
                     out["forward_q"][i] = -inverse_mass @ dq.T
                     out["forward_v"][i] = -inverse_mass @ dv.T
             out["forward_tau"][i] = inverse_mass
-        return _derivatives(out, method=f"finite differences (mjd_inverseFD, one-sided, "
-                            f"step {FD_STEP:g})", step=FD_STEP)

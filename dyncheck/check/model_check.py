@@ -32,6 +32,13 @@ from dyncheck.check.rows import COLUMNS, CheckRow, Section
 from dyncheck.errors import InvalidInput, UnknownName
 from dyncheck.results import Verdict
 
+DERIVATIVES_NOTE = (
+    "derivatives (the per-engine lines above include them): d(forward)/d(q, v, tau) at tau = 0 "
+    "and d(inverse)/d(q, v) at the sampled accelerations, in MuJoCo's chart (a free body's "
+    "origin moved in world axes, a rotation in body axes), each engine's own chart mapped by "
+    "the chain rule; the referee's are the general method's, differentiated with an error "
+    "estimate of their own (dyncheck/check/derivatives.py)"
+)
 SMOOTH_NOTE = (
     "smooth dynamics only: contacts, joint limits, equality constraints, actuators and passive "
     "forces (springs, damping) are left out of M, h, forward and inverse dynamics; damping and "
@@ -285,6 +292,7 @@ def _check(model: str, source_path: Path, source: ModelFile,
         whole = {e: loaded[e] for e in results if e in loaded and parts.get(e) is None}
         rows.extend(derivative_rows(model, canon, canonical_tree, whole, batch,
                                     with_referee=REFEREE in chosen, seconds=seconds))
+        notes.append(DERIVATIVES_NOTE)
         seconds["derivatives"] = time.perf_counter() - t0
     frame = pd.DataFrame([vars(r) for r in rows], columns=COLUMNS)
     for column in ("section", "verdict"):

@@ -166,3 +166,16 @@ def test_the_chain_rule_is_needed():
                              states=10, derivatives=True, isolate=False)
     failed = _rows(result, section="derivatives", verdict="failed")
     assert "d(inverse)/dq" in set(failed["subject"])
+
+
+def test_a_model_stepped_by_rk4_still_gets_mujocos_derivatives(tmp_path):
+    """mjd_inverseFD refuses a model whose integrator is RK4 (MuJoCo's own check), though
+    the differences of mj_inverse do not depend on it: MuJoCo's rows are there and pass."""
+    path = tmp_path / "rk4.xml"
+    path.write_text('<mujoco model="rk4"><option integrator="RK4"/><worldbody><body name="a">'
+                    '<joint name="j" axis="0 1 0"/><inertial pos="0.2 0 0" mass="1" '
+                    'diaginertia="0.01 0.02 0.02"/></body></worldbody></mujoco>')
+    result = check_model(path, impls=("reference", "mujoco", "pinocchio"), states=5,
+                         derivatives=True)
+    rows = _rows(result, section="derivatives", impl_b="mujoco")
+    assert len(rows) == 5 and set(rows["verdict"]) == {"passed"}
