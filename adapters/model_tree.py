@@ -211,3 +211,16 @@ def derivatives(found: dict[str, np.ndarray], *, method: str, step: float = 0.0,
     return Derivatives(forward_q=found["forward_q"], forward_v=found["forward_v"],
                        forward_tau=found["forward_tau"], inverse_q=found["inverse_q"],
                        inverse_v=found["inverse_v"], method=method, step=step, chart=chart)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Transition:
+    """An engine's Jacobian of one integrator step, x₊ = step(x), x = (δq, v) in its chart
+    (n, 2 nv, 2 nv), by finite differences of step ``fd_step`` and, for their error, of
+    twice that step (``coarse``)."""
+
+    matrix: np.ndarray
+    coarse: np.ndarray
+    time_step: float
+    fd_step: float
+    integrator: str

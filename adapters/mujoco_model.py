@@ -26,6 +26,7 @@ from dyncheck.adapters.model_tree import (
     JointType,
     Layout,
     ModelTree,
+    Transition,
     TreeJoint,
     lump,
 )
@@ -280,3 +281,28 @@ class MujocoModel:
                     out["forward_q"][i] = -inverse_mass @ dq.T
                     out["forward_v"][i] = -inverse_mass @ dv.T
             out["forward_tau"][i] = inverse_mass
+
+    def transition(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Transition:
+        """``mjd_transitionFD`` (centered differences of ``mj_step``, MuJoCo's chart) of one
+        semi-implicit Euler step at the file's time step, at steps :data:`FD_STEP` and twice
+        that; no actuation, the smooth dynamics only (as everywhere in the check)."""
+        m, d = self.model, self.data
+        n, nv = len(q), m.nv
+        size = 2 * nv + m.na
+        fine, coarse = np.zeros((n, 2 * nv, 2 * nv)), np.zeros((n, 2 * nv, 2 * nv))
+        matrix = np.zeros((size, size))
+        integrator = m.opt.integrator
+        m.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+        try:
+            for i in range(n):
+                for out, step in ((fine, FD_STEP), (coarse, 2 * FD_STEP)):
+                    d.qpos[:], d.qvel[:] = q[i], v[i]
+                    d.qfrc_applied[:] = 0.0
+                    d.ctrl[:] = 0.0
+                    mujoco.mj_forward(m, d)
+                    mujoco.mjd_transitionFD(m, d, step, True, matrix, None, None, None)
+                    out[i] = matrix[: 2 * nv, : 2 * nv]
+        finally:
+            m.opt.integrator = integrator
+        return Transition(matrix=fine, coarse=coarse, time_step=float(m.opt.timestep),
+                          fd_step=FD_STEP, integrator="euler")

@@ -30,7 +30,7 @@ import numpy as np
 
 from dyncheck.adapters import MODELS, Registration
 from dyncheck.adapters.model_files import ModelFile
-from dyncheck.adapters.model_tree import Derivatives, Dynamics, ModelTree
+from dyncheck.adapters.model_tree import Derivatives, Dynamics, ModelTree, Transition
 from dyncheck.confinement import confine
 from dyncheck.errors import DyncheckError, EngineError, Unsupported
 from dyncheck.workers import start_method
@@ -236,7 +236,7 @@ class Isolated:
         nv = v.shape[1] if v.ndim > 1 else 1
         self._kind = kind
         self._batch_seconds = self.limits.batch_seconds(
-            len(q) * (nv if kind == "derivatives" else 1), nv)
+            len(q) * (1 if kind == "dynamics" else 4 * nv), nv)
         try:
             self._conn.send((kind, q, v, a))
         except OSError:
@@ -246,6 +246,12 @@ class Isolated:
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
         """The engine's derivatives (:class:`Unsupported` where it offers none)."""
         self.submit(q, v, a, kind="derivatives")
+        return self.collect()[0]  # type: ignore[return-value]
+
+    def transition(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Transition:
+        """The engine's Jacobian of one integrator step (:class:`Unsupported` where it
+        offers none)."""
+        self.submit(q, v, a, kind="transition")
         return self.collect()[0]  # type: ignore[return-value]
 
     def collect(self) -> tuple[Dynamics, float]:
