@@ -282,27 +282,35 @@ class MujocoModel:
                     out["forward_v"][i] = -inverse_mass @ dv.T
             out["forward_tau"][i] = inverse_mass
 
-    def transition(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Transition:
+    def transition(self, q: np.ndarray, v: np.ndarray,
+                   a: np.ndarray) -> tuple[Transition, ...]:
         """``mjd_transitionFD`` (centered differences of ``mj_step``, MuJoCo's chart) of one
-        semi-implicit Euler step at the file's time step, at steps :data:`FD_STEP` and twice
-        that; no actuation, the smooth dynamics only (as everywhere in the check)."""
+        step at the file's time step, at steps :data:`FD_STEP` and twice that, for the
+        semi-implicit Euler and implicitfast integrators (the smooth dynamics only, as
+        everywhere in the check: no damping, no actuation, so implicitfast's implicit term
+        (M − h ∂f/∂v with f's passive and actuator forces) is M, and its step Euler's)."""
         m, d = self.model, self.data
         n, nv = len(q), m.nv
         size = 2 * nv + m.na
-        fine, coarse = np.zeros((n, 2 * nv, 2 * nv)), np.zeros((n, 2 * nv, 2 * nv))
         matrix = np.zeros((size, size))
         integrator = m.opt.integrator
-        m.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+        out = []
         try:
-            for i in range(n):
-                for out, step in ((fine, FD_STEP), (coarse, 2 * FD_STEP)):
-                    d.qpos[:], d.qvel[:] = q[i], v[i]
-                    d.qfrc_applied[:] = 0.0
-                    d.ctrl[:] = 0.0
-                    mujoco.mj_forward(m, d)
-                    mujoco.mjd_transitionFD(m, d, step, True, matrix, None, None, None)
-                    out[i] = matrix[: 2 * nv, : 2 * nv]
+            for name, kind in (("euler", mujoco.mjtIntegrator.mjINT_EULER),
+                               ("implicitfast", mujoco.mjtIntegrator.mjINT_IMPLICITFAST)):
+                m.opt.integrator = kind
+                fine, coarse = np.zeros((n, 2 * nv, 2 * nv)), np.zeros((n, 2 * nv, 2 * nv))
+                for i in range(n):
+                    for found, step in ((fine, FD_STEP), (coarse, 2 * FD_STEP)):
+                        d.qpos[:], d.qvel[:] = q[i], v[i]
+                        d.qfrc_applied[:] = 0.0
+                        d.ctrl[:] = 0.0
+                        mujoco.mj_forward(m, d)
+                        mujoco.mjd_transitionFD(m, d, step, True, matrix, None, None, None)
+                        found[i] = matrix[: 2 * nv, : 2 * nv]
+                out.append(Transition(matrix=fine, coarse=coarse,
+                                      time_step=float(m.opt.timestep), fd_step=FD_STEP,
+                                      integrator=name))
         finally:
             m.opt.integrator = integrator
-        return Transition(matrix=fine, coarse=coarse, time_step=float(m.opt.timestep),
-                          fd_step=FD_STEP, integrator="euler")
+        return tuple(out)

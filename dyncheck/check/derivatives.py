@@ -19,9 +19,10 @@ in v exactly
 forward derivatives through ∂v̇/∂x = −M⁻¹ ∂τ/∂x at v̇ = FD(q, v, 0), which follows from
 differentiating τ = ID(q, v, FD(q, v, τ)).
 
-The step: MuJoCo's Jacobian of one semi-implicit Euler step (``mjd_transitionFD``, centered
-differences) against the same step differentiated by the chain rule from the referee's
-continuous derivatives (:func:`euler_step`: exact for this integrator).
+The step: MuJoCo's Jacobian of one semi-implicit Euler step and one implicitfast step
+(``mjd_transitionFD``, centered differences) against the same step differentiated by the
+chain rule from the referee's continuous derivatives (:func:`euler_step`: exact for Euler,
+and for implicitfast without damping or actuators, whose implicit term is then M).
 
 Tolerances: round-off, 64 ε × tree depth of each matrix's scale (× κ(M) for the forward
 ones), plus per entry the referee's estimated error where it is one side, plus an engine's
@@ -410,13 +411,14 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
         if not with_referee or not _same_layout(canon, mine, states):
             continue  # (in the canonical layout only: MuJoCo's, whose step it is)
         try:
-            step = engine.transition(*inputs[name])  # type: ignore[attr-defined]
+            steps = engine.transition(*inputs[name])  # type: ignore[attr-defined]
         except (Unsupported, AttributeError):
             continue
         except Exception as exc:  # costs its own row
             out.append(_row(model, name, Verdict.FAILED, f"{type(exc).__name__}: {exc}"))
             continue
-        out.extend(step_rows(model, canon, tree, states, ref, name, step))
+        for step in steps:  # Euler's, and implicitfast's (Euler's here: no damping)
+            out.extend(step_rows(model, canon, tree, states, ref, name, step))
     order = [n for n in names if n in found]
     for i, a_name in enumerate(order):
         for b_name in order[i + 1 :]:

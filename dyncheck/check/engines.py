@@ -248,9 +248,10 @@ class Isolated:
         self.submit(q, v, a, kind="derivatives")
         return self.collect()[0]  # type: ignore[return-value]
 
-    def transition(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Transition:
-        """The engine's Jacobian of one integrator step (:class:`Unsupported` where it
-        offers none)."""
+    def transition(self, q: np.ndarray, v: np.ndarray,
+                   a: np.ndarray) -> tuple[Transition, ...]:
+        """The engine's Jacobians of one step of its integrators (:class:`Unsupported`
+        where it offers none)."""
         self.submit(q, v, a, kind="transition")
         return self.collect()[0]  # type: ignore[return-value]
 

@@ -58,7 +58,7 @@ def test_every_engine_and_the_referee_agree_on_the_derivatives(model, tmp_path):
     assert result.ok, result.failures()
     rows = _rows(result, section="derivatives")
     pairs = len(ENGINES) * (len(ENGINES) + 1) // 2
-    assert len(rows) == 5 * pairs + 1 and set(rows["verdict"]) == {"passed"}  # + MuJoCo's step
+    assert len(rows) == 5 * pairs + 2 and set(rows["verdict"]) == {"passed"}  # + MuJoCo's steps
 
 
 def test_the_pendulum_derivatives_are_the_books_closed_form(tmp_path):
@@ -138,7 +138,7 @@ def test_ball_and_free_joints_agree_in_the_canonical_chart(model, floating):
     assert result.ok, result.failures()
     rows = _rows(result, section="derivatives")
     assert set(rows["verdict"]) == {"passed"} and len(rows) == 5 * len(impls) * (
-        len(impls) - 1) // 2 + 1  # + MuJoCo's step Jacobian
+        len(impls) - 1) // 2 + 2  # + MuJoCo's step Jacobians (Euler, implicitfast)
     if DRAKE:
         exact = _rows(result, section="derivatives", impl_a="pinocchio", impl_b="drake")
         assert (exact["error"] < 1e-12).all(), exact[["subject", "error"]]
@@ -178,7 +178,7 @@ def test_a_model_stepped_by_rk4_still_gets_mujocos_derivatives(tmp_path):
     result = check_model(path, impls=("reference", "mujoco", "pinocchio"), states=5,
                          derivatives=True)
     rows = _rows(result, section="derivatives", impl_b="mujoco")
-    assert len(rows) == 6 and set(rows["verdict"]) == {"passed"}  # five and its Euler step
+    assert len(rows) == 7 and set(rows["verdict"]) == {"passed"}  # five and two steps
 
 
 @pytest.mark.parametrize(("model", "floating"), [("mixed.xml", False), ("branches.urdf", True)])
@@ -189,9 +189,11 @@ def test_mujocos_euler_step_jacobian_is_the_chain_rule_of_the_continuous_derivat
     δθ carried by exp(−h ω₊) and J_r(h ω₊)): they agree far below the predicted bound."""
     result = check_model(MODELS / model, impls=("reference", "mujoco"), floating=floating,
                          states=10, derivatives=True)
-    row = _rows(result, section="derivatives", impl_b="mujoco")
-    row = row[row["subject"].str.startswith("step Jacobian (euler")].iloc[0]
-    assert row["verdict"] == "passed" and row["error"] < 1e-8
+    rows = _rows(result, section="derivatives", impl_b="mujoco")
+    rows = rows[rows["subject"].str.startswith("step Jacobian")]
+    assert [s.split(",")[0] for s in rows["subject"]] == ["step Jacobian (euler",
+                                                          "step Jacobian (implicitfast"]
+    assert set(rows["verdict"]) == {"passed"} and (rows["error"] < 1e-8).all()
 
 
 def test_a_step_jacobian_off_by_one_part_in_ten_thousand_fails(monkeypatch):
@@ -204,11 +206,11 @@ def test_a_step_jacobian_off_by_one_part_in_ten_thousand_fails(monkeypatch):
     original = mujoco_model.MujocoModel.transition
 
     def broken(self, q, v, a):
-        found = original(self, q, v, a)
-        matrix, coarse = found.matrix.copy(), found.coarse.copy()
+        euler, *others = original(self, q, v, a)
+        matrix, coarse = euler.matrix.copy(), euler.coarse.copy()
         matrix[:, 0, 0] *= 1 + 1e-4
         coarse[:, 0, 0] *= 1 + 1e-4
-        return replace(found, matrix=matrix, coarse=coarse)
+        return (replace(euler, matrix=matrix, coarse=coarse), *others)
 
     monkeypatch.setattr(mujoco_model.MujocoModel, "transition", broken)
     result = check_model(MODELS / "mixed.xml", impls=("reference", "mujoco"), states=5,
