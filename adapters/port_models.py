@@ -19,8 +19,9 @@ from typing import ClassVar
 import numpy as np
 
 from dyncheck.adapters.model_files import ModelFile
-from dyncheck.adapters.model_tree import Dynamics
+from dyncheck.adapters.model_tree import Derivatives, Dynamics
 from dyncheck.adapters.mujoco_model import MujocoModel
+from dyncheck.errors import Unsupported
 
 
 class PortModel(MujocoModel):
@@ -53,6 +54,16 @@ class PortModel(MujocoModel):
         potential = -np.einsum("b,nb->n", masses, raw["xipos"][:, 1:] @ gravity)
         return Dynamics(mass_matrix=mass, bias=raw["bias"], forward=raw["qacc"],
                         inverse=raw["qfrc_inverse"], kinetic=kinetic, potential=potential)
+
+
+    def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
+        """Not the C engine's (which this class would inherit): a port's own derivatives
+        (JAX's ``jacfwd`` through MJX) are not checked yet — a skipped row says so."""
+        raise Unsupported(f"{self.engine}: the port's own derivatives are not checked yet "
+                          "(MuJoCo C's are on MuJoCo's rows)")
+
+    def transition(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> tuple:
+        raise Unsupported(f"{self.engine}: the port's step Jacobian is not checked yet")
 
 
 class MjxModel(PortModel):

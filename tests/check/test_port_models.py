@@ -41,3 +41,16 @@ def test_a_port_agrees_with_mujoco_and_the_referee_within_its_precision(port):
     assert rows["basis"].str.contains(unit).all()
     if port != "mjx-f64":  # float32: errors at its round-off, far above float64's
         assert rows["error"].max() > 1e-9
+
+
+def test_a_port_never_passes_off_mujoco_cs_derivatives_as_its_own():
+    """A port's model class inherits MuJoCo C's loader, derivatives included: it must refuse
+    them (a skipped row) rather than answer with the C engine's under the port's name."""
+    from dyncheck.adapters.port_models import MjxModel
+    from dyncheck.errors import Unsupported
+
+    port = object.__new__(MjxModel)  # no port needed: the refusal comes before any work
+    with pytest.raises(Unsupported, match="mjx: the port's own derivatives"):
+        port.derivatives(None, None, None)
+    with pytest.raises(Unsupported, match="mjx: the port's step Jacobian"):
+        port.transition(None, None, None)
