@@ -3,12 +3,9 @@ compared as they come and mapped to one chart (:mod:`dyncheck.check.derivatives`
 
 from __future__ import annotations
 
-import tempfile
-from pathlib import Path
-
 import numpy as np
 
-from dyncheck.explain.entry import Entry
+from dyncheck.explain.entry import Entry, beside_mujoco
 
 FALLING = ("<mujoco><worldbody><body name='box' pos='0 0 1'><freejoint name='root'/>"
            "<inertial pos='0.2 -0.1 0.05' mass='1.5' diaginertia='0.1 0.2 0.3'/></body>"
@@ -23,19 +20,10 @@ def free_body_derivatives(states: int = 10) -> tuple[dict[str, float], dict[str,
     axes) and Pinocchio's (analytic, in its tangent: origin moved in body axes), first as
     they come, then with Pinocchio's mapped to MuJoCo's chart; and the referee's difference
     from Pinocchio's mapped ones."""
-    from dyncheck.adapters.model_files import read
-    from dyncheck.adapters.mujoco_model import MujocoModel
     from dyncheck.adapters.pinocchio_model import PinocchioModel
     from dyncheck.check import derivatives, layout
-    from dyncheck.check.dynamics import sample
 
-    with tempfile.TemporaryDirectory(prefix="dyncheck-explain-") as folder:
-        path = Path(folder) / "falling.xml"
-        path.write_text(FALLING, encoding="utf-8")
-        source = read(path)
-        mine, other = MujocoModel(source), PinocchioModel(source)
-    canon = layout.canonical(mine.tree)
-    batch = sample(canon, mine.tree, states, 0)
+    mine, other, canon, batch = beside_mujoco(FALLING, PinocchioModel, states)
     theirs = mine.derivatives(batch.q, batch.v, batch.a)
     _, q, v, a = layout.engine_states(canon, other.tree, batch.q, batch.v, batch.a)
     raw = other.derivatives(q, v, a)

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from dyncheck.explain.entry import Entry
+from dyncheck.explain.entry import Entry, beside_mujoco
 
 ARM = """<robot name="arm">
   <link name="base"><inertial><mass value="2"/><inertia ixx="0.02" ixy="0" ixz="0" iyy="0.03"
@@ -87,20 +87,11 @@ def newton_free_velocity() -> Entry:
     velocity read as its origin's (MuJoCo's convention) and as its centre of mass's (its own,
     declared in its tree), against the referee on MuJoCo's reading: the worst relative error
     over M, h, forward and inverse dynamics at 20 sampled states."""
-    from dyncheck.adapters.model_files import read
-    from dyncheck.adapters.mujoco_model import MujocoModel
     from dyncheck.adapters.newton_model import NewtonModel
     from dyncheck.check import layout
-    from dyncheck.check.dynamics import sample
     from dyncheck.check.referee import ReferenceModel
 
-    with tempfile.TemporaryDirectory(prefix="dyncheck-explain-") as folder:
-        path = Path(folder) / "free.xml"
-        path.write_text(FREE, encoding="utf-8")
-        source = read(path)
-        mine, newton = MujocoModel(source), NewtonModel(source)
-    canon = layout.canonical(mine.tree)
-    states = sample(canon, mine.tree, 20, 0)
+    mine, newton, canon, states = beside_mujoco(FREE, NewtonModel, 20)
     expected = ReferenceModel(mine.tree).dynamics(states.q, states.v, states.a)
     as_origin = replace(newton.tree, joints=tuple(
         replace(j, layout=replace(j.layout, point=None)) for j in newton.tree.joints))
