@@ -19,10 +19,7 @@ in v exactly
 forward derivatives through ∂v̇/∂x = −M⁻¹ ∂τ/∂x at v̇ = FD(q, v, 0), which follows from
 differentiating τ = ID(q, v, FD(q, v, τ)).
 
-The step: MuJoCo's Jacobian of one semi-implicit Euler step and one implicitfast step
-(``mjd_transitionFD``, centered differences) against the same step differentiated by the
-chain rule from the referee's continuous derivatives (:func:`euler_step`: exact for Euler,
-and for implicitfast without damping or actuators, whose implicit term is then M).
+The step's Jacobian against the chain rule of these derivatives: :mod:`dyncheck.check.steps`.
 
 Tolerances: round-off, 64 ε × tree depth of each matrix's scale (× κ(M) for the forward
 ones), plus per entry the referee's estimated error where it is one side, plus an engine's
@@ -37,7 +34,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from dyncheck.adapters.integrators import quat_mul
 from dyncheck.adapters.model_tree import (
@@ -47,7 +43,6 @@ from dyncheck.adapters.model_tree import (
     Dynamics,
     JointType,
     ModelTree,
-    Transition,
 )
 from dyncheck.adapters.model_tree import derivatives as collect
 from dyncheck.cases.coordinate_maps import quat_to_matrix
@@ -366,6 +361,7 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
     import time
 
     from dyncheck.check import layout
+    from dyncheck.check.steps import step_rows  # it imports this module (Referee)
     from dyncheck.errors import Unsupported
 
     seconds = {} if seconds is None else seconds
@@ -427,79 +423,3 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
             out.extend(compare(model, tree, a_name, found[a_name], b_name, found[b_name], ref,
                                eps=eps))
     return out
-
-
-def _right_jacobian(phi: np.ndarray) -> np.ndarray:
-    """SO(3)'s right Jacobian J_r(φ): exp(φ + δ) = exp(φ) exp(J_r(φ) δ) to first order."""
-    theta = float(np.linalg.norm(phi))
-    cross = np.array([[0.0, -phi[2], phi[1]], [phi[2], 0.0, -phi[0]], [-phi[1], phi[0], 0.0]])
-    if theta < 1e-8:
-        return np.eye(3) - 0.5 * cross
-    return (np.eye(3) - (1 - np.cos(theta)) / theta**2 * cross
-            + (theta - np.sin(theta)) / theta**3 * cross @ cross)
-
-
-def euler_step(canon: Canonical, ref: Referee, states: States, h: float) -> np.ndarray:
-    """The Jacobian of one semi-implicit Euler step — v₊ = v + h v̇(q, v), q₊ = q ⊕ h v₊ — in
-    the canonical chart (δq at q and at q₊, both as q ⊕ δ), by the chain rule from the
-    referee's continuous derivatives: exact for this integrator. A rotation turned by
-    exp(h ω₊) moves δθ to exp(−h ω₊) δθ and takes δω₊ through h J_r(h ω₊)."""
-    n, nv = states.v.shape
-    fq, fv = ref.derivatives.forward_q, ref.derivatives.forward_v
-    out = np.zeros((n, 2 * nv, 2 * nv))
-    eye = np.eye(nv)
-    for s in range(n):
-        v_next = states.v[s] + h * ref.forward[s]
-        dv_q, dv_v = h * fq[s], eye + h * fv[s]
-        dq_q, dq_v = eye + h * dv_q, h * dv_v
-        for j, kind in enumerate(canon.types):
-            vs = canon.v_start[j]
-            turning = range(vs + 3, vs + 6) if kind is JointType.FREE else \
-                range(vs, vs + 3) if kind is JointType.BALL else range(0)
-            if not len(turning):
-                continue
-            rows = slice(turning.start, turning.stop)
-            phi = h * v_next[rows]
-            turn = Rotation.from_rotvec(-phi).as_matrix()
-            jr = _right_jacobian(phi)
-            dq_q[rows] = turn @ eye[rows] + jr @ dv_q[rows] * h
-            dq_v[rows] = jr @ dv_v[rows] * h
-        out[s] = np.block([[dq_q, dq_v], [dv_q, dv_v]])
-    return out
-
-
-def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref: Referee,
-              engine: str, found: Transition) -> list[CheckRow]:
-    """The engine's step Jacobian against the referee's chain rule: one row. Tolerance:
-    round-off, + the engine's finite-difference error estimated from its two steps (centered
-    differences: error ≈ |A(2s) − A(s)| / 3) and their round-off 2 δx/(2 s), + the referee's
-    estimated error of its derivatives times h."""
-    h = found.time_step
-    expected = euler_step(canon, ref, states, h)
-    off = np.abs(found.matrix - expected)
-    scale = float(np.abs(expected).max())
-    x_scale = max(float(np.abs(states.q).max()), float(np.abs(states.v).max()), 1.0)
-    fd = np.abs(found.coarse - found.matrix) / 3 + \
-        2 * ROUNDOFF_FACTOR * EPS * depth(tree) * x_scale / (2 * found.fd_step)
-    nv = states.v.shape[1]
-    ref_error = np.zeros_like(expected)
-    ref_error[:, nv:, :nv] = h * ref.error["forward_q"]
-    ref_error[:, nv:, nv:] = h * ref.error["forward_v"]
-    ref_error[:, :nv] = np.concatenate([h * ref_error[:, nv:, :nv], h * ref_error[:, nv:, nv:]],
-                                       axis=2) * 2  # through q₊ = q ⊕ h v₊ (J_r ≤ 1 + h|ω|)
-    allowed = ROUNDOFF_FACTOR * EPS * depth(tree) * scale + fd + ref_error
-    worst = np.unravel_index(int(np.argmax(off / allowed)), off.shape)
-    within = bool(np.all(off <= allowed))
-    note = "" if within else (
-        f"{engine} differs from the chain rule at state {worst[0]}, entry ({worst[1]}, "
-        f"{worst[2]}): {off[worst]:.3g} beyond its predicted {allowed[worst]:.3g}")
-    return [CheckRow(
-        model=model, section=Section.DERIVATIVES,
-        subject=f"step Jacobian ({found.integrator}, h {h:g})", field="max rel error",
-        impl_a="reference", impl_b=engine, value_a="", value_b="",
-        error=float(off.max()) / scale, tolerance=float(allowed.max()) / scale,
-        basis=(f"round-off: {ROUNDOFF_FACTOR} eps x tree depth {depth(tree)}; + {engine}'s "
-               f"centered differences' error (steps {found.fd_step:g}, {2 * found.fd_step:g}); "
-               "+ the referee's estimated error x h"),
-        verdict=Verdict.PASSED if within else Verdict.FAILED, note=note,
-        worst_state=int(worst[0]))]
