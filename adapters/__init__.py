@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.model_files import Format
 from dyncheck.errors import EngineNotInstalled, UnknownName
 
 
@@ -52,6 +53,10 @@ class Registration:
     couplings_only: bool = False
     """Differs from another implementation only in how couplings are held: run on cases with
     couplings only (elsewhere it would repeat that one under a second name)."""
+    run: Format | None = None
+    """An engine without a run adapter of its own (``module``): the format a book case is
+    written in for its file loader (``model``), which then serves ``dyncheck run`` too
+    (:mod:`.model_adapter`); a loader given URDF takes the case's ``gravity=``."""
 
 
 _A = "dyncheck.adapters."
@@ -118,11 +123,11 @@ REGISTRY: dict[str, Registration] = {
 
     "newton": Registration(
         package="newton", extra="newton", model=_A + "newton_model:NewtonModel",
-        label="newton", on_request=True, float32=True,
+        label="newton", on_request=True, float32=True, run=Format.MJCF,
     ),
     "pybullet": Registration(
         package="pybullet", extra="pybullet", model=_A + "pybullet_model:PybulletModel",
-        label="pybullet", on_request=True,
+        label="pybullet", on_request=True, run=Format.URDF,
     ),
 }
 """Implementation name → its registration: the one line an engine adds, in the order of trust
@@ -130,7 +135,7 @@ the report lists them (after the reference and the book). A module is imported w
 adapter is first asked for — an engine's import (JAX and Warp take seconds) is paid only by
 the runs that use it."""
 
-RUN: tuple[str, ...] = tuple(n for n, r in REGISTRY.items() if r.module)
+RUN: tuple[str, ...] = tuple(n for n, r in REGISTRY.items() if r.module or r.run)
 """The implementations with an adapter of a book case (``dyncheck run``)."""
 ENGINE_PACKAGES: dict[str, str] = {name: r.package for name, r in REGISTRY.items()}
 """Every engine implementation dyncheck knows, installed or not → its pip package."""
@@ -159,8 +164,14 @@ def _load(name: str) -> None:
     if name in _ADAPTERS or name in _MISSING:
         return
     entry = REGISTRY[name]
-    assert entry.module is not None and entry.cls is not None, name
     try:
+        if entry.run is not None and entry.model is not None:
+            from dyncheck.adapters.model_adapter import for_engine
+
+            _ADAPTERS[name] = for_engine(name, entry.package, entry.model, entry.run,
+                                         entry.float32)
+            return
+        assert entry.module is not None and entry.cls is not None, name
         _ADAPTERS[name] = getattr(importlib.import_module(entry.module), entry.cls)
     except ImportError as exc:  # depends on the environment
         _MISSING[name] = str(exc)

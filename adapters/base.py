@@ -111,6 +111,10 @@ class Adapter(ABC):
     different map from semi-implicit Euler there)."""
     dtype: ClassVar[type[np.floating]] = np.float64
     """The floating-point type the engine computes in."""
+    inertia_rounded: bool = False
+    """Whether the engine's loader stores an inertia tensor rounded beyond round-off of its
+    read-back (PyBullet: principal moments of a Jacobi diagonalization stopped at 1e-6 of
+    the trace): a rigid body's tensor as held is then part of its model variant."""
     couplings_with_field: ClassVar[bool] = False
     """Whether the adapter holds couplings and an external field in one model (refused, before
     any work, where it does not)."""
@@ -232,6 +236,11 @@ class Adapter(ABC):
                 "constraint force", self.constraint_force(q, v, tau)
             )
         return out
+
+    def defects(self) -> tuple[str, ...]:
+        """What the engine is known (measured) to do wrong on this model, each in a sentence
+        a failed row cites as its evidence; none by default."""
+        return ()
 
     def definition(self, integrator: str) -> str:
         """The integrator's definition as a name: two names with the same definition give the

@@ -189,9 +189,12 @@ class PybulletModel:
 
     engine = ENGINE
 
-    def __init__(self, source: ModelFile) -> None:
+    def __init__(self, source: ModelFile, *, gravity: np.ndarray | None = None) -> None:
+        """``gravity``: what the user sets with ``setGravity`` (a URDF states none; PyBullet's
+        MJCF reader ignores the file's); None: (0, 0, −9.81)."""
         self.client = pb.connect(pb.DIRECT)
-        pb.setGravity(*GRAVITY, physicsClientId=self.client)
+        self.gravity = GRAVITY.copy() if gravity is None else np.asarray(gravity, float)
+        pb.setGravity(*self.gravity, physicsClientId=self.client)
         self.bodies = _load(self.client, source)
         self._movable: dict[int, list[int]] = {}
         self._floating = {body: self._moving_base(body) for body in self.bodies}
@@ -311,7 +314,7 @@ class PybulletModel:
             ))
             q_at, v_at = q_at + 1, v_at + 1
         self._masses = [(link.body, link.index, link.mass) for link in links]
-        return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=GRAVITY.copy(),
+        return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=self.gravity.copy(),
                          nq=q_at, nv=v_at, notes=notes, hints=hints,
                          inertia_accuracy=DIAGONALIZATION)
 
@@ -344,7 +347,7 @@ class PybulletModel:
                 mass[i, vs, vs], bias[i, vs], inverse[i, vs] = m, h, tau
                 for j, x in zip(movable, joints, strict=True):
                     pb.resetJointState(body, j, x, 0.0, physicsClientId=c)
-            potential[i] = -GRAVITY @ sum((m * self._com(b, j) for b, j, m in self._masses
+            potential[i] = -self.gravity @ sum((m * self._com(b, j) for b, j, m in self._masses
                                            if m > 0.0), np.zeros(3))
         forward = -np.linalg.solve(mass, bias[..., None])[..., 0]
         kinetic = 0.5 * np.einsum("ni,nij,nj->n", v, mass, v)

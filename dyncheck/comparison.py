@@ -25,6 +25,7 @@ from dyncheck.implementations import (
     GRAVITY_DEFAULT,
     IMPLEMENTATIONS,
     POINT_INERTIA,
+    EngineImplementation,
     Implementation,
     ReferenceImplementation,
     Variant,
@@ -55,7 +56,9 @@ def describe(v: Variant) -> str:
     if v.softness:
         tc, dr, *imp = v.softness
         soft = f", soft constraint solref {[tc, dr]} solimp {imp}"
-    return f"(point inertia {list(v.point_inertia)} kg m^2, gravity {list(v.gravity)} m/s^2{soft})"
+    held = f", inertia held {dict(v.inertia)} kg m^2" if v.inertia else ""
+    return (f"(point inertia {list(v.point_inertia)} kg m^2, gravity {list(v.gravity)} "
+            f"m/s^2{held}{soft})")
 
 
 def _per_state(x: np.ndarray) -> np.ndarray:
@@ -158,6 +161,13 @@ class Evaluator:
         """Unit round-off of the implementation's arithmetic (float64's when it failed)."""
         return EPS if isinstance(self.impl, Exception) else getattr(self.impl, "eps", EPS)
 
+    @property
+    def defects(self) -> tuple[str, ...]:
+        """An engine's declared defects on this model (none for the book's side)."""
+        if isinstance(self.impl, EngineImplementation):
+            return self.impl.adapter.defects()
+        return ()
+
     def __post_init__(self) -> None:
         if isinstance(self.impl, Exception):
             self.error = str(self.impl)
@@ -216,6 +226,9 @@ class Status:
     eps: float
     error: str
     skipped: bool
+    defects: tuple[str, ...] = ()
+    """What the implementation's engine is known to do wrong on this model (measured, named
+    by its adapter): the evidence a failed row cites."""
 
     @property
     def ok(self) -> bool:
@@ -284,6 +297,8 @@ def _row(
             verdict = "explained" if st.residual / scale <= tol.rtol else "failed"
         else:
             verdict, note = "failed", "unexplained: no convention predicts this difference"
+        if verdict == "failed" and (a.defects or b.defects):
+            note += "; " + "; ".join(f"{x.name}: {d}" for x in (a, b) for d in x.defects)
     return Discrepancy(
         **base,
         max_abs_err=st.max_abs,
@@ -353,7 +368,8 @@ def sweep(
                                           scale=scales[a, q])
         offset += len(s)
     status = {
-        n: Status(name=n, variant=e.variant, eps=e.eps, error=e.error, skipped=e.skipped)
+        n: Status(name=n, variant=e.variant, eps=e.eps, error=e.error, skipped=e.skipped,
+                  defects=e.defects)
         for n, e in evals.items()
     }
     return Sweep(case=case.name, stats=stats, condition=condition, status=status)

@@ -11,7 +11,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 
-from dyncheck.implementations import GRAVITY_DEFAULT, POINT_INERTIA, SOFT_CONSTRAINT
+from dyncheck.implementations import (
+    GRAVITY_DEFAULT,
+    INERTIA_STORED,
+    POINT_INERTIA,
+    SOFT_CONSTRAINT,
+)
 from dyncheck.studies import (
     CHARTS_DIFFER,
     GYROSCOPIC_IMPLICIT,
@@ -52,6 +57,17 @@ EXPLANATIONS: dict[str, Explanation] = {
         "ω = θ̇ for a pendulum bob with θ absolute, the rotation of the coordinate triad for a "
         "particle carried by coordinate joints). A row is `explained` only when observed − "
         "predicted is within round-off.",
+    ),
+    INERTIA_STORED: Explanation(
+        origin=Origin.ENGINE,
+        text="PyBullet's URDF importer stores a link's inertia as principal moments found by "
+        "a Jacobi diagonalization (`btMatrix3x3::diagonalize(basis, 1e-6, 30)`: rotations "
+        "until the off-diagonal terms are below 1e-6 of the trace, then one more), dropping "
+        "what is left: the tensor it holds differs from the file's beyond the round-off of a "
+        "read-back (measured on `rigid_body_free`: ~1e-14 of its largest entry). The tensor "
+        "is read back (`getDynamicsInfo`) and the reference predicts its effect exactly: the "
+        "general method with the held tensor's entries as the case's I11 … I23. A row is "
+        "`explained` only when observed − predicted is within round-off.",
     ),
     GRAVITY_DEFAULT: Explanation(
         origin=Origin.ENGINE,

@@ -93,7 +93,7 @@ def general_method(case: Case, variant: Variant | None = None):
     """The reference's general method for ``case``, on the book's model or on a model
     ``variant`` (the point-mass inertias and gravity an implementation actually holds)."""
     variant = variant or book_variant(case)
-    params = case.params() | {"g": -variant.gravity[2]}
+    params = case.params() | {"g": -variant.gravity[2]} | dict(variant.inertia)
     if case.multibody().couplings:
         params["rest"] = tuple(float(x) for x in case.rest())
         params["softness"] = Softness(*variant.softness) if variant.softness else None
@@ -116,12 +116,18 @@ class Variant:
     gravity: tuple[float, float, float]
     softness: tuple[float, ...] | None = None
     """None: couplings held exactly; else a soft constraint's (solref, solimp)."""
+    inertia: tuple[tuple[str, float], ...] = ()
+    """A rigid body's inertia tensor as the implementation holds it, where its loader stored
+    it rounded beyond a read-back's round-off (PyBullet: principal moments from a Jacobi
+    diagonalization): the case's parameters ``I11`` … ``I23`` it replaces (book: none)."""
 
     def conventions(self, other: Variant) -> list[str]:
         """Names of the conventions in which two variants differ."""
         out = []
         if self.point_inertia != other.point_inertia:
             out.append(POINT_INERTIA)
+        if self.inertia != other.inertia:
+            out.append(INERTIA_STORED)
         if self.gravity != other.gravity:
             out.append(GRAVITY_DEFAULT)
         if self.softness != other.softness:
@@ -130,6 +136,10 @@ class Variant:
 
 
 POINT_INERTIA = "point-mass inertia floor"
+INERTIA_STORED = "inertia tensor stored rounded by the loader"
+TENSOR = (("I11", 0, 0), ("I22", 1, 1), ("I33", 2, 2), ("I12", 0, 1), ("I13", 0, 2),
+          ("I23", 1, 2))
+"""A rigid body case's parameters naming its inertia tensor's entries."""
 GRAVITY_DEFAULT = "MJCF gravity option not read"
 SOFT_CONSTRAINT = "soft constraint (MuJoCo solref/solimp impedance model)"
 
@@ -292,10 +302,18 @@ class EngineImplementation(Implementation):
     def variant(self) -> Variant | None:
         spec = self.case.multibody()
         out = []
+        held: tuple[tuple[str, float], ...] = ()
+        params = self.case.params()
         for body, loaded in zip(spec.bodies, self.adapter.loaded_bodies(), strict=True):
             if loaded.mass != body.mass:
                 return None
             extra = loaded.inertia - np.asarray(body.inertia)
+            if self.adapter.inertia_rounded and len(spec.bodies) == 1 and \
+                    all(k in params for k, _, _ in TENSOR) and not body.is_point_mass:
+                # a rigid body's tensor is a parameter of the case: the one held predicts
+                held = tuple((k, float(loaded.inertia[i, j])) for k, i, j in TENSOR)
+                out.append(0.0)
+                continue
             floor = float(np.trace(extra) / 3)
             # an engine that stores inertia about the body origin recovers it about the centre
             # of mass by the parallel-axis theorem, rounding at the scale of m·|c|²
@@ -313,7 +331,7 @@ class EngineImplementation(Implementation):
         gravity = tuple(float(x) for x in self.adapter.loaded_gravity())
         if gravity[0] or gravity[1]:
             return None  # the reference models gravity along −z only
-        return Variant(tuple(out), gravity, self.adapter.softness())
+        return Variant(tuple(out), gravity, self.adapter.softness(), held)
 
     def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]:
         m = self.map

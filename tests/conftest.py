@@ -49,6 +49,23 @@ COUPLED_CASES = sorted(n for n in CASES if get_case(n).multibody().couplings)
 """Cases whose masses are held by cords (couplings between joints)."""
 NO_COUPLINGS: tuple[str, ...] = ()
 """Engines dyncheck does not run with couplings (skipped, with the reason)."""
+PORTS = ("mjx", "mjx-f64", "mujoco-warp")
+"""MuJoCo's ports: no passive-force callback, so no external field evaluated per stage."""
+FILE_LOADERS = tuple(n for n, r in adapters.REGISTRY.items() if r.run)
+"""Engines whose book cases go through their loader of a user's file (no couplings, no
+external field, no integrators stepped: refused with the reason)."""
+MULTI_JOINT_CASES = sorted(
+    n for n in CASES if any(len(b.joints) > 1 for b in get_case(n).multibody().bodies))
+"""Cases with a body moved by several joints (Newton's MJCF importer fuses them into a D6)."""
+BALL_JOINT_CASES = sorted(
+    n for n in CASES if any(j.type == "ball" for j in get_case(n).multibody().joints))
+"""Cases with a ball joint (PyBullet's loader is checked on hinges, slides and a moving base)."""
+LOADER_LIMITS = {"newton": (MULTI_JOINT_CASES, "D6"),
+                 "pybullet": (BALL_JOINT_CASES, "spherical")}
+"""A file loader's limit on the book's cases, and the word its refusal names it by."""
+FLOORED = ("mujoco", "pinocchio-mjcf", "drake", *PORTS, *FILE_LOADERS)
+"""Engines given the case as a file (MJCF, or URDF for PyBullet), whose point masses carry
+the file's small isotropic inertia (``Multibody.mjcf_point_inertia``)."""
 COUPLINGS_ONLY_ENGINES = ("mujoco-stiff",)
 """Engines that exist only for cases with couplings."""
 ENGINES = [e for e in ALL_ENGINES if e not in COUPLINGS_ONLY_ENGINES]
@@ -59,8 +76,6 @@ def supported(case: str, engine: str) -> bool:
     return unsupported_reason(case, engine) is None
 
 
-PORTS = ("mjx", "mjx-f64", "mujoco-warp")
-"""MuJoCo's ports: no passive-force callback, so no external field evaluated per stage."""
 FIELD_CASES = sorted(n for n in CASES if get_case(n).multibody().central_mu)
 """Cases with an external (central) field."""
 
@@ -75,6 +90,13 @@ def unsupported_reason(case: str, engine: str) -> str | None:
         return "ignores <tendon>"
     if case not in COUPLED_CASES and engine in COUPLINGS_ONLY_ENGINES:
         return "couplings"
+    if engine in FILE_LOADERS and case in COUPLED_CASES:
+        return "couplings"
+    if engine in FILE_LOADERS and case in FIELD_CASES:
+        return "external field"
+    cases, word = LOADER_LIMITS.get(engine, ((), ""))
+    if case in cases:
+        return word
     return None
 
 

@@ -7,7 +7,7 @@ The chart (MuJoCo's, ``mj_integratePos``): q ⊕ δ moves a hinge or slide by δ
 or free body by exp(δ) in its body axes (quat ⊗ (cos ½|δ|, sin ½|δ| δ/|δ|)) and moves a free
 body's origin by δ in world axes. An engine's derivatives come in its own layout and chart
 (:class:`~dyncheck.adapters.model_tree.DerivativeChart`); they are mapped by the chain rule
-through the check's state map (:func:`~dyncheck.check.layout.state_map`: q_e(q), v_e = T v,
+through the check's state map (:func:`~dyncheck.adapters.layout.state_map`: q_e(q), v_e = T v,
 v̇_e = T v̇ + Ṫv), whose own derivatives are taken by a complex step (exact to round-off:
 the map is analytic), :func:`to_canonical`.
 
@@ -36,6 +36,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from dyncheck.adapters.integrators import quat_mul
+from dyncheck.adapters.layout import Canonical, StateMap
 from dyncheck.adapters.model_tree import (
     Axes,
     DerivativeChart,
@@ -48,7 +49,6 @@ from dyncheck.adapters.model_tree import derivatives as collect
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.check.describe import depth
 from dyncheck.check.dynamics import States, condition
-from dyncheck.check.layout import Canonical, StateMap
 from dyncheck.check.referee import ReferenceModel
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
@@ -102,7 +102,7 @@ class Referee:
 
 def referee(tree: ModelTree, states: States) -> Referee:
     """The referee's derivatives at ``states`` (canonical layout and chart)."""
-    from dyncheck.check.layout import canonical
+    from dyncheck.adapters.layout import canonical
 
     canon = canonical(tree)
     solver = ReferenceModel(tree).solver
@@ -222,7 +222,7 @@ def _moved(canon: Canonical, tree: ModelTree, base: StateMap, q: np.ndarray, v: 
            k: int, h: float) -> StateMap:
     """The complex-stepped map along a hinge or slide ``k`` without mapping every joint:
     only that joint's engine coordinates move (T and Ṫv do not)."""
-    from dyncheck.check.layout import state_map
+    from dyncheck.adapters.layout import state_map
 
     joint = max(j for j in range(len(canon.types)) if canon.v_start[j] <= k)
     single = Canonical(names=(canon.names[joint],), types=(canon.types[joint],),
@@ -241,7 +241,7 @@ def _moved(canon: Canonical, tree: ModelTree, base: StateMap, q: np.ndarray, v: 
 def _same_layout(canon: Canonical, tree: ModelTree, states: States) -> bool:
     """Whether ``tree``'s layout is the canonical one at these states (q the same, T = I,
     Ṫv = 0: MuJoCo's own): then its tangent chart is the canonical chart."""
-    from dyncheck.check.layout import state_map
+    from dyncheck.adapters.layout import state_map
 
     if tree.nq != canon.nq or tree.nv != canon.nv:
         return False
@@ -260,7 +260,7 @@ def to_canonical(canon: Canonical, tree: ModelTree, states: States, found: Deriv
     rule through the state map — τ = Tᵀ τ_e(q_e(q), T v, T v̇ + Ṫv) and
     v̇ = T⁻¹ (v̇_e(q_e(q), T v) − Ṫv) differentiated —, the map's own derivatives (dq_e, dT,
     d(Ṫv)) by a complex step."""
-    from dyncheck.check.layout import state_map
+    from dyncheck.adapters.layout import state_map
 
     n, nv = states.v.shape
     out = {f: np.zeros((n, nv, nv)) for f in FIELDS}
@@ -360,7 +360,7 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
     receives each one's own time ("d <name>") and the mapping's ("d map")."""
     import time
 
-    from dyncheck.check import layout
+    from dyncheck.adapters import layout
     from dyncheck.check.steps import step_rows  # it imports this module (Referee)
     from dyncheck.errors import Unsupported
 

@@ -23,9 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import Dynamics, JointType, ModelTree
 from dyncheck.check.describe import depth, size
-from dyncheck.check.layout import Canonical
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
 from dyncheck.results import Verdict

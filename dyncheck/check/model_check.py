@@ -20,9 +20,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from dyncheck.adapters import layout
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials
 from dyncheck.adapters.model_tree import ModelTree, TreeJoint
-from dyncheck.check import describe, inputs, layout, partial, predicted
+from dyncheck.check import describe, inputs, partial, predicted
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.derivatives import rows as derivative_rows
 from dyncheck.check.dynamics import States, compare, condition, sample

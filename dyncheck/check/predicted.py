@@ -10,10 +10,10 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import Dynamics, GravityFrame, JointType, ModelTree
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.check.dynamics import Explanation, States
-from dyncheck.check.layout import Canonical
 from dyncheck.check.referee import ReferenceModel
 
 

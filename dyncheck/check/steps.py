@@ -9,11 +9,11 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import JointType, ModelTree, Transition
 from dyncheck.check.derivatives import Referee
 from dyncheck.check.describe import depth
 from dyncheck.check.dynamics import States
-from dyncheck.check.layout import Canonical
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.results import Verdict

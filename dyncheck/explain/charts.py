@@ -20,8 +20,9 @@ def free_body_derivatives(states: int = 10) -> tuple[dict[str, float], dict[str,
     axes) and Pinocchio's (analytic, in its tangent: origin moved in body axes), first as
     they come, then with Pinocchio's mapped to MuJoCo's chart; and the referee's difference
     from Pinocchio's mapped ones."""
+    from dyncheck.adapters import layout
     from dyncheck.adapters.pinocchio_model import PinocchioModel
-    from dyncheck.check import derivatives, layout
+    from dyncheck.check import derivatives
 
     mine, other, canon, batch = beside_mujoco(FALLING, PinocchioModel, states)
     theirs = mine.derivatives(batch.q, batch.v, batch.a)

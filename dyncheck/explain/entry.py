@@ -72,9 +72,9 @@ def beside_mujoco(mjcf: str, other: Any, states: int) -> tuple[Any, Any, Any, An
     import tempfile
     from pathlib import Path
 
+    from dyncheck.adapters import layout
     from dyncheck.adapters.model_files import read
     from dyncheck.adapters.mujoco_model import MujocoModel
-    from dyncheck.check import layout
     from dyncheck.check.dynamics import sample
 
     with tempfile.TemporaryDirectory(prefix="dyncheck-explain-") as folder:

@@ -87,8 +87,8 @@ def newton_free_velocity() -> Entry:
     velocity read as its origin's (MuJoCo's convention) and as its centre of mass's (its own,
     declared in its tree), against the referee on MuJoCo's reading: the worst relative error
     over M, h, forward and inverse dynamics at 20 sampled states."""
+    from dyncheck.adapters import layout
     from dyncheck.adapters.newton_model import NewtonModel
-    from dyncheck.check import layout
     from dyncheck.check.referee import ReferenceModel
 
     mine, newton, canon, states = beside_mujoco(FREE, NewtonModel, 20)

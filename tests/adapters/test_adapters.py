@@ -20,10 +20,17 @@ from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases import get_case
 from dyncheck.errors import UnknownName
 
-from ..conftest import ALL_ENGINES, BALL_CASES, CASE_NAMES, COUPLED_CASES, ENGINES, PORTS, supported
+from ..conftest import (
+    ALL_ENGINES,
+    BALL_CASES,
+    CASE_NAMES,
+    COUPLED_CASES,
+    ENGINES,
+    FLOORED,
+    supported,
+)
 
 EPS = np.finfo(float).eps
-MJCF_ENGINES = ("mujoco", "pinocchio-mjcf", "drake", *PORTS)
 """Engines that read the MJCF file, and with it the point-mass inertia floor."""
 
 
@@ -63,7 +70,10 @@ def ulps(adapter, bound: float) -> float:
 def test_mass_matrix_symmetric_positive_definite(adapter_and_states):
     adapter, (q, _, _) = adapter_and_states
     M = adapter.mass_matrix(q)
-    assert_allclose(M, np.swapaxes(M, 1, 2), rtol=0, atol=0)
+    # exactly symmetric in float64; a float32 engine (Newton) may compute the two triangles
+    # apart: symmetric to its round-off
+    atol = 0.0 if adapter.eps == EPS else 64 * adapter.eps * np.abs(M).max()
+    assert_allclose(M, np.swapaxes(M, 1, 2), rtol=0, atol=atol)
     assert (np.linalg.eigvalsh(M) > 0).all()
 
 
@@ -141,7 +151,7 @@ def test_simple_pendulum_in_engine_coordinates(engine):
     M = mℓ² (+ the MJCF's point inertia), h = mgℓ sin α."""
     case = get_case("simple_pendulum")
     adapter = _adapter("simple_pendulum", engine)
-    inertia = case.multibody().mjcf_point_inertia if engine in MJCF_ENGINES else 0.0
+    inertia = case.multibody().mjcf_point_inertia if engine in FLOORED else 0.0
     alpha = np.linspace(-3, 3, 13)[:, None]
     assert_allclose(
         adapter.mass_matrix(alpha)[:, 0, 0], case.m * case.l**2 + inertia, rtol=16 * adapter.eps
@@ -324,6 +334,9 @@ def test_registered_integrators_are_those_the_engine_maps(engine):
     from dyncheck.adapters.integrators import STEPPERS
 
     entry = REGISTRY[engine]
+    if entry.module is None:  # a file loader's run adapter: no integrator is stepped yet
+        assert get_adapter(engine).integrators == entry.integrators == ()
+        return
     module = importlib.import_module(entry.module)
     mapped = getattr(module, "_INTEGRATORS", STEPPERS)
     assert get_adapter(engine).integrators == entry.integrators

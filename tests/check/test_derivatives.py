@@ -67,9 +67,10 @@ def test_the_pendulum_derivatives_are_the_books_closed_form(tmp_path):
     m, length, g = 1.3, 0.7, 9.81
     path = tmp_path / "pendulum.urdf"
     path.write_text(PENDULUM.format(m=m, l=length))
+    from dyncheck.adapters import layout
     from dyncheck.adapters.model_files import read
     from dyncheck.adapters.pinocchio_model import PinocchioModel
-    from dyncheck.check import derivatives, layout
+    from dyncheck.check import derivatives
     from dyncheck.check.dynamics import sample
 
     model = PinocchioModel(read(path))
@@ -151,7 +152,7 @@ def test_the_chain_rule_is_needed():
     from dyncheck.check import derivatives
 
     def plain(canon, tree, states, found, dynamics):
-        from dyncheck.check.layout import engine_states
+        from dyncheck.adapters.layout import engine_states
 
         maps = engine_states(canon, tree, states.q, states.v, states.a)[0]
         t = np.array([m.t for m in maps])

@@ -31,6 +31,7 @@ from ..conftest import (
     COUPLED_CASES,
     COUPLINGS_ONLY_ENGINES,
     ENGINES,
+    FLOORED,
     PORTS,
     supported,
     unsupported_reason,
@@ -73,7 +74,7 @@ def test_against_reference(full_run, case, impl, quantity):
             assert (impl.startswith("mujoco") or impl in PORTS) and SOFT_CONSTRAINT in named
         else:
             # the MJCF readers; on a ball joint every engine carries the point-mass floor
-            assert impl in ("mujoco", "pinocchio-mjcf", "drake", *PORTS) or case in BALL_CASES
+            assert impl in FLOORED or case in BALL_CASES
     else:
         assert row.max_rel_err <= row.tolerance
 

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from dyncheck.adapters.layout import _free
 from dyncheck.adapters.model_tree import Axes, Layout
-from dyncheck.check.layout import _free
 
 H = 1e-5
 RNG = np.random.default_rng(7)

@@ -1,0 +1,182 @@
+"""A book case through an engine's loader of a user's file: a book case is a model in a file.
+
+An engine registered with ``run=`` (a file format) has no adapter of its own: the case's
+model is written in that format (:func:`.mjcf.to_mjcf` or :func:`.urdf.to_urdf`), read as a
+user's file is (:func:`.model_files.read`), loaded by the engine's ``model=`` class, and its
+dynamics mapped from the engine's layout to the canonical one (MuJoCo's, the layout the
+run's coordinate maps start from) by :mod:`.layout` — the same loader, tree and map
+``dyncheck check`` uses, so that one engine object serves both commands.
+
+Forward dynamics at τ is M⁻¹(τ − h) from the engine's M and h mapped to the canonical layout
+(these loaders offer M and h; the engine's own forward dynamics is M⁻¹(−h) likewise);
+T = ½ vᵀ M v and V as the loader computes them. A URDF states no gravity: the case's is
+given to the loader (``gravity=``), as its user would set it. What the loader cannot hold
+— couplings (constraints), an external field — is refused before any work (a skipped row
+naming it). Its integrators are not stepped here (``integrators`` empty: no order-study rows).
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.metadata
+import tempfile
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.layout import Canonical, engine_states, to_canonical
+from dyncheck.adapters.mjcf import to_mjcf
+from dyncheck.adapters.model_files import Format, read
+from dyncheck.adapters.model_tree import (
+    NQ,
+    NV,
+    Dynamics,
+    GravityFrame,
+    JointType,
+    ModelTree,
+    TreeJoint,
+)
+from dyncheck.adapters.urdf import root_is_free, to_urdf
+from dyncheck.cases.multibody import Multibody
+from dyncheck.errors import Unsupported
+
+
+class ModelAdapter(Adapter):
+    """The canonical form of a book case from an engine's file loader (see the module)."""
+
+    run_format: ClassVar[Format]
+    loader: ClassVar[type]
+    integrators: ClassVar[tuple[str, ...]] = ()
+
+    def __init__(self, model: Multibody) -> None:
+        super().__init__(model)
+        if model.couplings:
+            raise Unsupported(f"{self.name}: couplings (tendon equalities) are constraints; "
+                              "its file loader is checked on the smooth dynamics of a tree")
+        if model.central_mu:
+            raise Unsupported(f"{self.name}: an external field (a force on a body) is not an "
+                              "input of its file loader")
+        urdf = self.run_format is Format.URDF
+        text = to_urdf(model) if urdf else to_mjcf(model)
+        with tempfile.TemporaryDirectory(prefix="dyncheck-case-") as folder:
+            path = Path(folder) / f"{model.name}.{'urdf' if urdf else 'xml'}"
+            path.write_text(text, encoding="utf-8")
+            source = read(path, floating=urdf and root_is_free(model))
+            options: dict[str, Any] = {"gravity": np.asarray(model.gravity, float)} if urdf \
+                else {}
+            self.engine = self.loader(source, **options)
+        self.tree: ModelTree = self.engine.tree
+        self.inertia_rounded = self.tree.inertia_accuracy > 0.0
+        self.canon, self._carriers = self._canonical(model)
+
+    def _canonical(self, model: Multibody) -> tuple[Canonical, list[TreeJoint]]:
+        """The case's joints in MuJoCo's order, each matched to the engine's joint by name (a
+        free joint: the engine's free joint of that body), and each body's carrier: the
+        engine joint that moves its mass."""
+        names, types, q_start, v_start, nq, nv = [], [], [], [], 0, 0
+        carriers = []
+        for body in model.bodies:
+            for joint in body.joints:
+                kind = JointType(joint.type)
+                found = next((j for j in self.tree.joints if j.name == joint.name
+                              or (kind is JointType.FREE and j.type is kind
+                                  and j.body == body.name)), None)
+                if found is None:
+                    raise Unsupported(f"{self.name}: joint {joint.name!r} not found as loaded")
+                names.append(found.name)
+                types.append(kind)
+                q_start.append(nq)
+                v_start.append(nv)
+                nq, nv = nq + NQ[kind], nv + NV[kind]
+            carriers.append(next(j for j in self.tree.joints if j.name == names[-1]))
+        canon = Canonical(names=tuple(names), types=tuple(types), q_start=tuple(q_start),
+                          v_start=tuple(v_start), nq=nq, nv=nv, zeros=(0.0,) * len(names))
+        return canon, carriers
+
+    def defects(self) -> tuple[str, ...]:
+        """A free joint whose engine resolves gravity in its frame through another rotation
+        than the state's (:class:`~.model_tree.GravityFrame`, declared on the tree)."""
+        return tuple(
+            f"its dynamics resolve gravity in the frame of {j.name!r} through Rx(r) Ry(p) "
+            "Rz(y) of the orientation's roll, pitch, yaw, the state's Rz(y) Ry(p) Rx(r) in "
+            f"reverse order (GravityFrame.{j.gravity_frame.name}, measured; `dyncheck check "
+            f"--impl {self.name}` predicts it per state)"
+            for j in self.tree.joints if j.gravity_frame is not GravityFrame.STATE)
+
+    @classmethod
+    def version(cls) -> str:
+        return importlib.metadata.version(cls.package)
+
+    def _held(self, loaded: np.ndarray, stated: np.ndarray) -> np.ndarray:
+        """The loaded value, or the stated one where they agree to the engine's rounding
+        (rounding a parameter to float32 is round-off the tolerances bound, not a different
+        model)."""
+        scale = max(float(np.abs(stated).max()), 1e-300)
+        return stated if np.abs(loaded - stated).max() <= self.eps * scale else loaded
+
+    def loaded_bodies(self) -> list[LoadedBody]:
+        """Each body's mass and inertia as its carrier holds them (the case's bodies are
+        unrotated at the reference configuration: world axes are body axes)."""
+        out = []
+        for body, carrier in zip(self.spec.bodies, self._carriers, strict=True):
+            stated = np.asarray(body.inertia, float)
+            if body.is_point_mass:
+                stated = self.spec.mjcf_point_inertia * np.eye(3)
+            mass = self._held(np.array(carrier.mass), np.array(body.mass))
+            out.append(LoadedBody(body.name, float(mass),
+                                  self._held(np.asarray(carrier.inertia, float), stated)))
+        return out
+
+    def loaded_gravity(self) -> np.ndarray:
+        return self._held(np.asarray(self.tree.gravity, float),
+                          np.asarray(self.spec.gravity, float))
+
+    def _dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
+        maps, qe, ve, ae = engine_states(self.canon, self.tree, q, v, a)
+        return to_canonical(maps, self.engine.dynamics(qe, ve, ae))
+
+    def evaluate_all(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
+    ) -> dict[str, np.ndarray]:
+        d = self._dynamics(q, v, a)
+        forward = np.linalg.solve(d.mass_matrix, (tau - d.bias)[..., None])[..., 0]
+        return self._outputs(d.mass_matrix, d.bias, forward, d.inverse, d.kinetic,
+                             d.potential)
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        zero = np.zeros((len(q), self.canon.nv))
+        return self._dynamics(q, zero, zero).mass_matrix
+
+    def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return self._dynamics(q, v, np.zeros_like(v)).bias
+
+    def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        return self.evaluate_all(q, v, tau, np.zeros_like(v))["forward_dynamics"]
+
+    def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        return self._dynamics(q, v, a).inverse
+
+    def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return self._dynamics(q, v, np.zeros_like(v)).kinetic
+
+    def potential_energy(self, q: np.ndarray) -> np.ndarray:
+        zero = np.zeros((len(q), self.canon.nv))
+        return self._dynamics(q, zero, zero).potential
+
+    def simulate(
+        self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
+    ) -> Trajectory:
+        raise Unsupported(f"{self.name}: its integrators are not stepped by dyncheck yet")
+
+
+def for_engine(name: str, package: str, model: str, run: Format,
+               float32: bool) -> type[Adapter]:
+    """The run adapter of the engine registered as ``name`` (its loader ``module:class``
+    imported here: an ImportError says the engine is missing)."""
+    module, cls = model.split(":")
+    loader = getattr(importlib.import_module(module), cls)
+    attrs = {"name": name, "package": package, "loader": loader, "run_format": run,
+             "dtype": np.float32 if float32 else np.float64, "__module__": __name__}
+    return type(f"{cls}Adapter", (ModelAdapter,), attrs)

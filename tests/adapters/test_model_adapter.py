@@ -1,0 +1,76 @@
+"""Book cases through an engine's file loader (``Registration.run``): the bodies it reads back,
+the held-inertia variant the reference predicts from, and the evidence a failed row cites.
+Expected values: the case's own parameters, the reference's general method (on the tensor
+PyBullet holds), and the gravity defect measured in tests/adapters/test_pybullet_model.py."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from dyncheck.adapters import get_adapter
+from dyncheck.cases import get_case
+from dyncheck.errors import EngineNotInstalled
+from dyncheck.implementations import (
+    INERTIA_STORED,
+    book_variant,
+    general_method,
+    make_implementation,
+)
+
+from ..conftest import CASE_NAMES, FILE_LOADERS, supported
+
+
+def _adapter_class(engine: str):
+    try:
+        return get_adapter(engine)
+    except EngineNotInstalled as exc:
+        pytest.skip(str(exc))
+
+
+@pytest.mark.parametrize(("case", "engine"), [
+    (c, e) for c in CASE_NAMES for e in FILE_LOADERS if supported(c, e)])
+def test_the_bodies_read_back_are_the_cases(case, engine):
+    """Each body's mass and inertia as the loader holds it: the case's (the file's point
+    inertia for a point mass), to the engine's rounding of a stored parameter."""
+    spec = get_case(case).multibody()
+    adapter = _adapter_class(engine)(spec)
+    for body, loaded in zip(spec.bodies, adapter.loaded_bodies(), strict=True):
+        stated = spec.mjcf_point_inertia * np.eye(3) if body.is_point_mass else \
+            np.asarray(body.inertia, float)
+        assert loaded.mass == body.mass
+        assert np.abs(loaded.inertia - stated).max() <= 64 * adapter.eps * np.abs(stated).max()
+    assert np.array_equal(adapter.loaded_gravity(), np.asarray(spec.gravity, float))
+
+
+def test_pybullets_held_tensor_is_its_variant_and_predicts_its_mass_matrix():
+    """PyBullet stores a rigid body's tensor through a diagonalization: its variant holds the
+    tensor read back, and the general method on it gives PyBullet's M to round-off — tighter
+    than the book's model does."""
+    _adapter_class("pybullet")
+    case = get_case("rigid_body_free")
+    impl = make_implementation("pybullet", case)
+    variant = impl.variant()
+    assert variant is not None and variant.inertia
+    assert INERTIA_STORED in variant.conventions(book_variant(case))
+    s = case.sample_states(16)
+    engine = impl.evaluate(s)["mass_matrix"]
+    held = general_method(case, variant).mass_matrix(s.q)
+    book = general_method(case).mass_matrix(s.q)
+    scale = np.abs(engine).max()
+    assert np.abs(engine - held).max() <= 16 * np.finfo(float).eps * scale
+    assert np.abs(engine - held).max() < np.abs(engine - book).max()
+
+
+def test_a_failed_row_cites_the_engines_declared_defect():
+    """PyBullet's floating-base dynamics resolve gravity through the reversed roll-pitch-yaw
+    (measured against a closed form in test_pybullet_model.py): the run's failed rows name it
+    as their evidence, and only on the quantities it moves."""
+    _adapter_class("pybullet")
+    from dyncheck.run import run
+
+    rows = run([get_case("rigid_body_free")], ["reference", "pybullet"]).discrepancies
+    failed = rows[rows.verdict == "failed"]
+    assert set(failed.quantity) == {"bias_forces", "forward_dynamics", "inverse_dynamics"}
+    assert failed.note.str.contains("GravityFrame.RPY_REVERSED").all()
+    assert not rows[rows.verdict != "failed"].note.str.contains("GravityFrame").any()
