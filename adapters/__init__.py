@@ -53,6 +53,9 @@ class Registration:
     couplings_only: bool = False
     """Differs from another implementation only in how couplings are held: run on cases with
     couplings only (elsewhere it would repeat that one under a second name)."""
+    releases: tuple[str, ...] = ()
+    """The releases the committed version matrix runs (``dyncheck versions``), for an engine
+    the matrix knows through its registration alone (one package, its implementation)."""
     run: Format | None = None
     """An engine without a run adapter of its own (``module``): the format a book case is
     written in for its file loader (``model``), which then serves ``dyncheck run`` too
@@ -124,10 +127,11 @@ REGISTRY: dict[str, Registration] = {
     "newton": Registration(
         package="newton", extra="newton", model=_A + "newton_model:NewtonModel",
         label="newton", on_request=True, float32=True, run=Format.MJCF,
+        releases=("1.7.0", "1.8.0"),
     ),
     "pybullet": Registration(
         package="pybullet", extra="pybullet", model=_A + "pybullet_model:PybulletModel",
-        label="pybullet", on_request=True, run=Format.URDF,
+        label="pybullet", on_request=True, run=Format.URDF, releases=("3.2.6", "3.2.7"),
     ),
 }
 """Implementation name → its registration: the one line an engine adds, in the order of trust

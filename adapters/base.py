@@ -242,6 +242,13 @@ class Adapter(ABC):
         a failed row cites as its evidence; none by default."""
         return ()
 
+    def defect_effects(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray,
+                       a: np.ndarray) -> dict[str, np.ndarray]:
+        """Quantity → what :meth:`defects` add to the engine's values at each state (its
+        layout, as :meth:`evaluate_all` at the same arguments): the predicted size a failed
+        row's difference is checked against. None by default."""
+        return {}
+
     def definition(self, integrator: str) -> str:
         """The integrator's definition as a name: two names with the same definition give the
         same run (dyncheck's own ``implicitfast`` is ``euler`` where nothing is damped)."""

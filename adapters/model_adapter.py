@@ -37,8 +37,10 @@ from dyncheck.adapters.model_tree import (
     JointType,
     ModelTree,
     TreeJoint,
+    reversed_rpy,
 )
 from dyncheck.adapters.urdf import root_is_free, to_urdf
+from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import Unsupported
 
@@ -95,14 +97,42 @@ class ModelAdapter(Adapter):
                           v_start=tuple(v_start), nq=nq, nv=nv, zeros=(0.0,) * len(names))
         return canon, carriers
 
+    def defect_effects(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray,
+                       a: np.ndarray) -> dict[str, np.ndarray]:
+        """What the declared defects add to the engine's values (canonical layout): a free
+        joint whose gravity is resolved through R′ instead of R computes h, inverse dynamics
+        under g′ = R R′ᵀ g, so they err by G(g′) − G(g) = h_e(g) − h_e(R′ Rᵀ g) at v = 0
+        (G linear in g; h_e(y) = G(R R′ᵀ y)), and forward dynamics by −M⁻¹ that."""
+        frees = [(k, j) for k, j in enumerate(self.tree.joint(n) for n in self.canon.names)
+                 if j.type is JointType.FREE and j.gravity_frame is GravityFrame.RPY_REVERSED]
+        if not frees:
+            return {}
+        gravity = np.asarray(self.tree.gravity, float)
+        zero = np.zeros((1, self.canon.nv))
+        delta = np.zeros((len(q), self.canon.nv))
+        mass = np.zeros((len(q), self.canon.nv, self.canon.nv))
+        for i in range(len(q)):
+            maps, qe, ve, ae = engine_states(self.canon, self.tree, q[i : i + 1], zero, zero)
+            here = to_canonical(maps, self.engine.dynamics(qe, ve, ae))
+            mass[i] = here.mass_matrix[0]
+            for k, joint in frees:
+                qs = self.canon.q_start[k]
+                rotation = quat_to_matrix(q[i : i + 1, qs + 3 : qs + 7])[0] @ \
+                    joint.layout.offset[:3, :3]
+                undone = reversed_rpy(rotation) @ rotation.T @ gravity
+                under = to_canonical(maps, self.engine.dynamics(qe, ve, ae, gravity=undone))
+                delta[i] += here.bias[0] - under.bias[0]
+        forward = -np.linalg.solve(mass, delta[..., None])[..., 0]
+        return {"bias_forces": delta, "inverse_dynamics": delta, "forward_dynamics": forward}
+
     def defects(self) -> tuple[str, ...]:
         """A free joint whose engine resolves gravity in its frame through another rotation
         than the state's (:class:`~.model_tree.GravityFrame`, declared on the tree)."""
         return tuple(
             f"its dynamics resolve gravity in the frame of {j.name!r} through Rx(r) Ry(p) "
             "Rz(y) of the orientation's roll, pitch, yaw, the state's Rz(y) Ry(p) Rx(r) in "
-            f"reverse order (GravityFrame.{j.gravity_frame.name}, measured; `dyncheck check "
-            f"--impl {self.name}` predicts it per state)"
+            f"reverse order (GravityFrame.{j.gravity_frame.name}, measured; predicted per "
+            "state as G(g′) − G(g), g′ = R R′ᵀ g)"
             for j in self.tree.joints if j.gravity_frame is not GravityFrame.STATE)
 
     @classmethod

@@ -49,6 +49,15 @@ class GravityFrame(StrEnum):
     ``calculateInverseDynamics`` of a floating base, measured)."""
 
 
+def reversed_rpy(rotation: np.ndarray) -> np.ndarray:
+    """R′ = Rx(r) Ry(p) Rz(y) where ``rotation`` = Rz(y) Ry(p) Rx(r), p in [−π/2, π/2]
+    (:attr:`GravityFrame.RPY_REVERSED`)."""
+    from scipy.spatial.transform import Rotation
+
+    rpy = Rotation.from_matrix(rotation).as_euler("xyz")
+    return Rotation.from_euler("XYZ", rpy).as_matrix()
+
+
 NQ = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 4, JointType.FREE: 7}
 NV = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 3, JointType.FREE: 6}
 

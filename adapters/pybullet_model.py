@@ -318,7 +318,17 @@ class PybulletModel:
                          nq=q_at, nv=v_at, notes=notes, hints=hints,
                          inertia_accuracy=DIAGONALIZATION)
 
-    def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
+    def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, *,
+                 gravity: np.ndarray | None = None) -> Dynamics:
+        """``gravity``: another gravity vector for this call (its potential energy too)."""
+        if gravity is not None:
+            held, self.gravity = self.gravity, np.asarray(gravity, float)
+            pb.setGravity(*self.gravity, physicsClientId=self.client)
+            try:
+                return self.dynamics(q, v, a)
+            finally:
+                self.gravity = held
+                pb.setGravity(*held, physicsClientId=self.client)
         c, n, nv = self.client, len(q), self.tree.nv
         mass = np.zeros((n, nv, nv))
         bias, inverse = np.zeros((n, nv)), np.zeros((n, nv))

@@ -210,7 +210,8 @@ def _parser() -> argparse.ArgumentParser:
     v = sub.add_parser(
         "versions", help="the version matrix: each engine release in its own environment")
     v.add_argument("--engine", action="append", default=[], metavar="NAME",
-                   help="mujoco, pinocchio, drake (repeatable; default: all)")
+                   help="mujoco, pinocchio, drake, newton, pybullet (repeatable; default: "
+                   "all)")
     v.add_argument("--case", action="append", default=[], metavar="CASE",
                    help="cases to run (repeatable; default: all)")
     v.add_argument("--jobs", type=int, default=2, metavar="N")

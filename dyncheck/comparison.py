@@ -22,10 +22,10 @@ import numpy as np
 from dyncheck.cases import Case, StateSample
 from dyncheck.errors import EngineNotInstalled, Unsupported
 from dyncheck.implementations import (
+    ENGINE_DEFECT,
     GRAVITY_DEFAULT,
     IMPLEMENTATIONS,
     POINT_INERTIA,
-    EngineImplementation,
     Implementation,
     ReferenceImplementation,
     Variant,
@@ -91,6 +91,8 @@ class PairStats:
     scale: float = 0.0
     residual: float = 0.0
     predicted: float = 0.0
+    effects: bool = False
+    """Whether an engine's declared defect entered the prediction."""
     records: list[tuple[int, float, str]] = field(default_factory=list)
     """(state index, error, state values) of each prefix maximum of the error, in order."""
 
@@ -132,6 +134,7 @@ class PairStats:
             scale=max(self.scale, later.scale),
             residual=max(self.residual, later.residual),
             predicted=max(self.predicted, later.predicted),
+            effects=self.effects or later.effects,
             records=[*self.records, *(r for r in later.records if r[1] > top or not self.records)],
         )
 
@@ -161,12 +164,13 @@ class Evaluator:
         """Unit round-off of the implementation's arithmetic (float64's when it failed)."""
         return EPS if isinstance(self.impl, Exception) else getattr(self.impl, "eps", EPS)
 
+    effects: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
+    """What its declared defects add to ``values`` (the chunk's states)."""
+
     @property
     def defects(self) -> tuple[str, ...]:
         """An engine's declared defects on this model (none for the book's side)."""
-        if isinstance(self.impl, EngineImplementation):
-            return self.impl.adapter.defects()
-        return ()
+        return self.impl.defects() if isinstance(self.impl, Implementation) else ()
 
     def __post_init__(self) -> None:
         if isinstance(self.impl, Exception):
@@ -192,6 +196,8 @@ class Evaluator:
                 if not np.all(np.isfinite(x)):
                     raise FloatingPointError(f"non-finite {q}")
             self.values = values
+            if isinstance(self.impl, Implementation):
+                self.effects = self.impl.effects(s)
         except Exception as exc:  # a report run survives one implementation crashing
             self.error = f"{type(exc).__name__}: {exc}"
 
@@ -286,19 +292,23 @@ def _row(
     rel = st.max_abs / scale
     verdict, convention, note = "passed", "", ""
     if rel > tol.rtol:
-        if a.variant is not None and b.variant is not None and a.variant != b.variant:
-            convention = "; ".join(a.variant.conventions(b.variant))
+        va, vb = a.variant, b.variant
+        named = [f"{x.name}: {d}" for x in (a, b) for d in x.defects] if st.effects else []
+        conventions: list[str] = []
+        said: list[str] = []
+        if va is not None and vb is not None and va != vb:
+            conventions = va.conventions(vb)
+            said = [f"{b.name} {describe(vb)} vs {a.name} {describe(va)}"]
+        if said or named:
+            convention = "; ".join(conventions + [ENGINE_DEFECT] * bool(named))
             note = (
-                f"{convention}: {b.name} {describe(b.variant)} vs {a.name} "
-                f"{describe(a.variant)}; predicted rel. difference "
+                f"{convention}: {'; '.join(said + named)}; predicted rel. difference "
                 f"{st.predicted / scale:.3g}, residual after prediction "
                 f"{st.residual / scale:.3g}"
             )
             verdict = "explained" if st.residual / scale <= tol.rtol else "failed"
         else:
             verdict, note = "failed", "unexplained: no convention predicts this difference"
-        if verdict == "failed" and (a.defects or b.defects):
-            note += "; " + "; ".join(f"{x.name}: {d}" for x in (a, b) for d in x.defects)
     return Discrepancy(
         **base,
         max_abs_err=st.max_abs,
@@ -356,16 +366,22 @@ def sweep(
             ea, eb = evals[a], evals[b]
             if ea.values is None or eb.values is None:
                 continue
-            differ = ea.variant is not None and eb.variant is not None and ea.variant != eb.variant
-            pa, pb = (predict(ea.variant), predict(eb.variant)) if differ else (None, None)
+            va, vb = ea.variant, eb.variant
+            pa = pb = None
+            if va is not None and vb is not None and va != vb:
+                pa, pb = predict(va), predict(vb)
             for q in qs:
                 if (q, a, b) in stats:
                     desired = ea.values[q]
                     if (a, q) not in scales:
                         scales[a, q] = float(np.abs(desired).max())
-                    predicted = pb[q] - pa[q] if differ else None
+                    predicted = pb[q] - pa[q] if pa is not None and pb is not None else None
+                    if q in eb.effects or q in ea.effects:  # declared defects, predicted
+                        predicted = (0.0 if predicted is None else predicted) \
+                            + eb.effects.get(q, 0.0) - ea.effects.get(q, 0.0)
                     stats[q, a, b].update(offset, s, eb.values[q], desired, predicted,
                                           scale=scales[a, q])
+                    stats[q, a, b].effects |= q in eb.effects or q in ea.effects
         offset += len(s)
     status = {
         n: Status(name=n, variant=e.variant, eps=e.eps, error=e.error, skipped=e.skipped,

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from enum import Enum
 
 from dyncheck.implementations import (
+    ENGINE_DEFECT,
     GRAVITY_DEFAULT,
     INERTIA_STORED,
     POINT_INERTIA,
@@ -57,6 +58,17 @@ EXPLANATIONS: dict[str, Explanation] = {
         "ω = θ̇ for a pendulum bob with θ absolute, the rotation of the coordinate triad for a "
         "particle carried by coordinate joints). A row is `explained` only when observed − "
         "predicted is within round-off.",
+    ),
+    ENGINE_DEFECT: Explanation(
+        origin=Origin.ENGINE,
+        text="A defect of an engine, measured and declared by its adapter with the form of "
+        "its effect (PyBullet 3.2.7's floating-base dynamics resolve gravity in the base "
+        "frame through Rx(r) Ry(p) Rz(y) of the orientation's roll, pitch, yaw — the "
+        "state's Rz(y) Ry(p) Rx(r) in reverse order; measured against a closed form in "
+        "tests/adapters/test_pybullet_model.py): its h and inverse dynamics are those of "
+        "g′ = R R′ᵀ g, predicted per state as G(g′) − G(g), and its forward dynamics by −M⁻¹ "
+        "that. A row is `explained` only when observed − predicted is within round-off; "
+        "it stays a finding about the engine, named on the page.",
     ),
     INERTIA_STORED: Explanation(
         origin=Origin.ENGINE,

@@ -137,6 +137,7 @@ class Variant:
 
 POINT_INERTIA = "point-mass inertia floor"
 INERTIA_STORED = "inertia tensor stored rounded by the loader"
+ENGINE_DEFECT = "engine defect declared by its adapter"
 TENSOR = (("I11", 0, 0), ("I22", 1, 1), ("I33", 2, 2), ("I12", 0, 1), ("I13", 0, 2),
           ("I23", 1, 2))
 """A rigid body case's parameters naming its inertia tensor's entries."""
@@ -174,6 +175,15 @@ class Implementation(ABC):
     def provides(self, quantity: str) -> bool:
         """Whether this implementation computes ``quantity`` (all of the case's, by default)."""
         return quantity in quantities(self.case)
+
+    def defects(self) -> tuple[str, ...]:
+        """What the implementation's engine is known to do wrong on this case (none for the
+        book's side)."""
+        return ()
+
+    def effects(self, s: StateSample) -> dict[str, np.ndarray]:
+        """Quantity → what :meth:`defects` add to :meth:`evaluate`'s values at each state."""
+        return {}
 
     def evaluate(self, s: StateSample) -> dict[str, np.ndarray]:
         """Every quantity at every state; potential energy relative to the case's rest state."""
@@ -354,6 +364,27 @@ class EngineImplementation(Implementation):
 
     def _potential(self, q: np.ndarray) -> np.ndarray:
         return self.adapter.potential_energy(self.map.to_engine(q))
+
+    def defects(self) -> tuple[str, ...]:
+        return self.adapter.defects()
+
+    def effects(self, s: StateSample) -> dict[str, np.ndarray]:
+        """The adapter's predicted defect effects, in the book's coordinates (a force by Jᵀ,
+        an acceleration by the linear part of its map)."""
+        if not self.defects():
+            return {}
+        m, q = self.map, s.q
+        qe, ve = m.to_engine(q), co.velocity_to_engine(m, q, s.v)
+        raw = self.adapter.defect_effects(
+            qe, ve, co.force_to_engine(m, q, s.tau), co.acceleration_to_engine(m, q, s.v, s.a))
+        out = {}
+        for quantity, delta in raw.items():
+            if quantity == "forward_dynamics":
+                out[quantity] = (co.acceleration_to_book(m, q, s.v, delta)
+                                 - co.acceleration_to_book(m, q, s.v, np.zeros_like(delta)))
+            else:
+                out[quantity] = co.force_to_book(m, q, delta)
+        return out
 
     def _engine_start(self) -> tuple[np.ndarray, np.ndarray]:
         """The case's initial state in engine coordinates (q, v)."""

@@ -28,6 +28,7 @@ from pathlib import Path
 import pandas as pd
 
 from dyncheck import diff
+from dyncheck.adapters import REGISTRY
 from dyncheck.errors import DyncheckError, InvalidInput, UnknownName
 from dyncheck.reference.derivations import cache_root
 
@@ -106,7 +107,14 @@ ENGINES = {
             extra=("drake",),
         ),
     )
+} | {
+    name: Engine(name=name, package=r.package, family=(r.package,), impls=(name,),
+                 releases=r.releases, extra=(r.extra,) if r.extra else ())
+    for name, r in REGISTRY.items() if r.releases
 }
+"""The engines of the matrix: those written out above (several implementations, packages
+released together, environments that need more), and every registration that names its
+releases (:attr:`~dyncheck.adapters.Registration.releases`)."""
 
 
 EXPLANATIONS: dict[tuple[str, str, str], str] = {

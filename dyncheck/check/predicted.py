@@ -8,10 +8,15 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from dyncheck.adapters.layout import Canonical
-from dyncheck.adapters.model_tree import Dynamics, GravityFrame, JointType, ModelTree
+from dyncheck.adapters.model_tree import (
+    Dynamics,
+    GravityFrame,
+    JointType,
+    ModelTree,
+    reversed_rpy,
+)
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.check.dynamics import Explanation, States
 from dyncheck.check.referee import ReferenceModel
@@ -53,12 +58,6 @@ def rotor_energy(canon: Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
     )
 
 
-def _reversed_rpy(rotation: np.ndarray) -> np.ndarray:
-    """Rx(r) Ry(p) Rz(y) where ``rotation`` = Rz(y) Ry(p) Rx(r), p in [−π/2, π/2]."""
-    rpy = Rotation.from_matrix(rotation).as_euler("xyz")
-    return Rotation.from_euler("XYZ", rpy).as_matrix()
-
-
 def base_gravity(canon: Canonical, canonical_tree: ModelTree, tree: ModelTree,
                  states: States, dyn_a: Dynamics, sign: float) -> dict[str, Explanation]:
     """Where ``tree``'s engine resolves gravity in a free body's frame through another
@@ -80,7 +79,7 @@ def base_gravity(canon: Canonical, canonical_tree: ModelTree, tree: ModelTree,
         qs = canon.q_start[k]
         rotation = quat_to_matrix(states.q[:, qs + 3 : qs + 7]) @ joint.layout.offset[:3, :3]
         for i, r in enumerate(rotation):
-            shift = r @ _reversed_rpy(r).T @ gravity - gravity
+            shift = r @ reversed_rpy(r).T @ gravity - gravity
             delta[i] += sum(shift[c] * unit[c][i] for c in range(3))
     delta *= sign
     forward = -np.linalg.solve(dyn_a.mass_matrix, delta[..., None])[..., 0]

@@ -12,6 +12,7 @@ from dyncheck.adapters import get_adapter
 from dyncheck.cases import get_case
 from dyncheck.errors import EngineNotInstalled
 from dyncheck.implementations import (
+    ENGINE_DEFECT,
     INERTIA_STORED,
     book_variant,
     general_method,
@@ -62,15 +63,24 @@ def test_pybullets_held_tensor_is_its_variant_and_predicts_its_mass_matrix():
     assert np.abs(engine - held).max() < np.abs(engine - book).max()
 
 
-def test_a_failed_row_cites_the_engines_declared_defect():
+def test_a_declared_defect_explains_only_the_rows_it_predicts(monkeypatch):
     """PyBullet's floating-base dynamics resolve gravity through the reversed roll-pitch-yaw
-    (measured against a closed form in test_pybullet_model.py): the run's failed rows name it
-    as their evidence, and only on the quantities it moves."""
+    (measured against a closed form in test_pybullet_model.py): its adapter predicts the
+    effect per state, the run's rows are explained by it to round-off, on the quantities it
+    moves only; withdrawn, the same rows fail — the declaration is what explains them."""
     _adapter_class("pybullet")
+    from dyncheck.adapters.model_adapter import ModelAdapter
     from dyncheck.run import run
 
-    rows = run([get_case("rigid_body_free")], ["reference", "pybullet"]).discrepancies
-    failed = rows[rows.verdict == "failed"]
-    assert set(failed.quantity) == {"bias_forces", "forward_dynamics", "inverse_dynamics"}
-    assert failed.note.str.contains("GravityFrame.RPY_REVERSED").all()
-    assert not rows[rows.verdict != "failed"].note.str.contains("GravityFrame").any()
+    def rows():
+        return run([get_case("rigid_body_free")], ["reference", "pybullet"]).discrepancies
+
+    found = rows()
+    by_defect = found[found.convention.str.contains(ENGINE_DEFECT, regex=False)]
+    assert set(by_defect.quantity) == {"bias_forces", "forward_dynamics", "inverse_dynamics"}
+    assert (by_defect.verdict == "explained").all()
+    assert by_defect.note.str.contains("GravityFrame.RPY_REVERSED").all()
+    monkeypatch.setattr(ModelAdapter, "defects", lambda self: ())
+    withdrawn = rows()
+    failed = withdrawn[withdrawn.verdict == "failed"]
+    assert set(failed.quantity) == set(by_defect.quantity)

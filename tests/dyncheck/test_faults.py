@@ -446,7 +446,7 @@ FAULTS: tuple[Fault, ...] = (
           argv=("diff", "{tmp}/a", str(REPORTS)), answer=r"RUN_A .*<tmp>/a"),
     # --- versions
     Fault(kind="unknown engine", area="versions", argv=("versions", "--engine", "bullet"),
-          answer=r"unknown engine 'bullet'; valid: drake, mujoco, pinocchio$"),
+          answer=r"unknown engine 'bullet'; valid: drake, mujoco, newton, pinocchio, pybullet$"),
     Fault(kind="unknown case", area="versions", argv=("versions", "--case", "nope"),
           answer=r"unknown case 'nope'"),
     Fault(kind="--jobs 0", area="versions", argv=("versions", "--jobs", "0"),

@@ -12,7 +12,9 @@ import pandas as pd
 import pytest
 
 from dyncheck import diff, matrix
+from dyncheck.adapters import REGISTRY
 from dyncheck.errors import InvalidInput, UnknownName
+from dyncheck.matrix import ENGINES, constraints
 from dyncheck.results import PROVENANCE, to_csv
 
 CONSTRAINTS = "numpy==2.4.6\nmujoco==4.0.0\nmujoco-core==4.0.0\nPyOpenGL==3.1.10\npin==4.1.0\n" \
@@ -153,3 +155,15 @@ def test_a_run_of_some_cases_is_cached_apart_from_the_run_of_all(tmp_path, monke
     assert some != every
     assert every.name == "mujoco-1.0"
     assert matrix.run_release(eng, "1.0", cases=["pendulum"], log=lambda m: None) == some
+
+
+@pytest.mark.parametrize("name", [n for n, r in REGISTRY.items() if r.releases])
+def test_an_engine_registered_with_releases_is_in_the_matrix(name):
+    """An engine known through its registration alone (#47): the matrix runs its releases on
+    its implementation, and its environment unpins its package only."""
+    eng = ENGINES[name]
+    reg = REGISTRY[name]
+    assert eng.releases == reg.releases and len(reg.releases) >= 2
+    assert eng.impls == (name,)
+    pins = f"{reg.package}==0.0\nnumpy==2.0\n"
+    assert constraints(eng, pins) == "numpy==2.0\n"
