@@ -126,12 +126,13 @@ REGISTRY: dict[str, Registration] = {
 
     "newton": Registration(
         package="newton", extra="newton", model=_A + "newton_model:NewtonModel",
-        label="newton", on_request=True, float32=True, run=Format.MJCF,
+        label="newton", on_request=True, float32=True, run=Format.MJCF, integrators=("euler",),
         releases=("1.7.0", "1.8.0"),
     ),
     "pybullet": Registration(
         package="pybullet", extra="pybullet", model=_A + "pybullet_model:PybulletModel",
         label="pybullet", on_request=True, run=Format.URDF, releases=("3.2.6", "3.2.7"),
+        integrators=("euler",),
     ),
 }
 """Implementation name → its registration: the one line an engine adds, in the order of trust
@@ -172,8 +173,9 @@ def _load(name: str) -> None:
         if entry.run is not None and entry.model is not None:
             from dyncheck.adapters.model_adapter import for_engine
 
-            _ADAPTERS[name] = for_engine(name, entry.package, entry.model, entry.run,
-                                         entry.float32)
+            _ADAPTERS[name] = for_engine(name, package=entry.package, model=entry.model,
+                                         run=entry.run, float32=entry.float32,
+                                         integrators=entry.integrators)
             return
         assert entry.module is not None and entry.cls is not None, name
         _ADAPTERS[name] = getattr(importlib.import_module(entry.module), entry.cls)

@@ -12,7 +12,10 @@ Forward dynamics at τ is M⁻¹(τ − h) from the engine's M and h mapped to t
 T = ½ vᵀ M v and V as the loader computes them. A URDF states no gravity: the case's is
 given to the loader (``gravity=``), as its user would set it. What the loader cannot hold
 — couplings (constraints), an external field — is refused before any work (a skipped row
-naming it). Its integrators are not stepped here (``integrators`` empty: no order-study rows).
+naming it). Its ``integrators`` are the registration's: the engine's own stepping, named by
+the definition it is (Newton's Featherstone solver and PyBullet's ``stepSimulation`` are
+semi-implicit Euler, MuJoCo's ``euler``, on hinges and slides; measured by the order studies
+against the reference's discrete map of that definition).
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.c_output import c_output_dropped
 from dyncheck.adapters.layout import Canonical, engine_states, to_canonical
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.model_files import Format, read
@@ -50,7 +54,6 @@ class ModelAdapter(Adapter):
 
     run_format: ClassVar[Format]
     loader: ClassVar[type]
-    integrators: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
@@ -68,7 +71,8 @@ class ModelAdapter(Adapter):
             source = read(path, floating=urdf and root_is_free(model))
             options: dict[str, Any] = {"gravity": np.asarray(model.gravity, float)} if urdf \
                 else {}
-            self.engine = self.loader(source, **options)
+            with c_output_dropped():  # an engine's banner and importer warnings (C)
+                self.engine = self.loader(source, **options)
         self.tree: ModelTree = self.engine.tree
         self.inertia_rounded = self.tree.inertia_accuracy > 0.0
         self.canon, self._carriers = self._canonical(model)
@@ -198,15 +202,31 @@ class ModelAdapter(Adapter):
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:
-        raise Unsupported(f"{self.name}: its integrators are not stepped by dyncheck yet")
+        """The loader's own stepping (``simulate(q0, v0, dt, steps)`` in its layout), for
+        hinges and slides (whose coordinates map one to one)."""
+        if integrator not in self.integrators:
+            raise Unsupported(f"{self.name} offers no integrator {integrator!r}")
+        if any(t not in (JointType.HINGE, JointType.SLIDE) for t in self.canon.types):
+            raise Unsupported(f"{self.name}: a ball or free joint's trajectory is not mapped "
+                              "back from its layout yet")
+        _, qe, ve, _ = engine_states(self.canon, self.tree, q0[None], v0[None],
+                                     np.zeros_like(v0)[None])
+        steps = round(duration / dt)
+        q_e, v_e = self.engine.simulate(qe[0], ve[0], dt, steps)
+        at = [self.tree.joint(n).layout.q_start for n in self.canon.names]
+        dof = [self.tree.joint(n).layout.v_start for n in self.canon.names]
+        return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", q_e[:, at]),
+                          v_e[:, dof])
 
 
-def for_engine(name: str, package: str, model: str, run: Format,
-               float32: bool) -> type[Adapter]:
+def for_engine(name: str, *, package: str, model: str, run: Format, float32: bool,
+               integrators: tuple[str, ...]) -> type[Adapter]:
     """The run adapter of the engine registered as ``name`` (its loader ``module:class``
     imported here: an ImportError says the engine is missing)."""
     module, cls = model.split(":")
-    loader = getattr(importlib.import_module(module), cls)
+    with c_output_dropped():  # an engine's import may print a banner of its own (C)
+        loader = getattr(importlib.import_module(module), cls)
     attrs = {"name": name, "package": package, "loader": loader, "run_format": run,
-             "dtype": np.float32 if float32 else np.float64, "__module__": __name__}
+             "dtype": np.float32 if float32 else np.float64, "integrators": integrators,
+             "__module__": __name__}
     return type(f"{cls}Adapter", (ModelAdapter,), attrs)

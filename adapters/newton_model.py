@@ -275,6 +275,28 @@ class NewtonModel:
         return Dynamics(mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
                         kinetic=kinetic, potential=potential)
 
+    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float,
+                 steps: int) -> tuple[np.ndarray, np.ndarray]:
+        """``steps`` steps of Newton's Featherstone solver (``SolverFeatherstone``: forward
+        dynamics by the articulated-body algorithm, then semi-implicit Euler, v₊ = v + h v̇,
+        q₊ = q + h v₊ on hinges and slides), from (q0, v0), no control, no contacts: q and v
+        at every step, the start included (float64 from Newton's float32)."""
+        model, newton = self.model, self.newton
+        solver = newton.solvers.SolverFeatherstone(model)
+        now, after, control = model.state(), model.state(), model.control()
+        now.joint_q.assign(np.asarray(q0, np.float32))
+        now.joint_qd.assign(np.asarray(v0, np.float32))
+        newton.eval_fk(model, now.joint_q, now.joint_qd, now)
+        qs = np.zeros((steps + 1, len(q0)))
+        vs = np.zeros((steps + 1, len(v0)))
+        qs[0], vs[0] = now.joint_q.numpy(), now.joint_qd.numpy()
+        for k in range(1, steps + 1):
+            now.clear_forces()
+            solver.step(now, after, control, None, dt)
+            now, after = after, now
+            qs[k], vs[k] = now.joint_q.numpy(), now.joint_qd.numpy()
+        return qs, vs
+
     def _articulation_dofs(self) -> list[np.ndarray]:
         """Each articulation's velocity indices, in Newton's order."""
         m = self.model

@@ -364,6 +364,46 @@ class PybulletModel:
         return Dynamics(mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
                         kinetic=kinetic, potential=potential)
 
+    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float,
+                 steps: int) -> tuple[np.ndarray, np.ndarray]:
+        """``steps`` calls of ``stepSimulation`` at ``setTimeStep(dt)`` from (q0, v0): q and v
+        at every step, the start included. Stated as a PyBullet user writes it for free
+        motion: each joint's default velocity motor switched off
+        (``setJointMotorControl2(VELOCITY_CONTROL, force=0)`` — it holds the joints
+        otherwise) and the multibody's default linear and angular damping (0.04) set to 0
+        (``changeDynamics``): what is left is its integrator, semi-implicit Euler
+        (v₊ = v + h v̇, q₊ = q + h v₊) of its articulated-body forward dynamics. Hinges and
+        slides on a fixed base."""
+        c = self.client
+        if any(self._floating.values()):
+            raise Unsupported("pybullet: a moving base is not stepped by dyncheck yet")
+        pb.setTimeStep(dt, physicsClientId=c)
+        at = 0
+        for body in self.bodies:
+            pb.changeDynamics(body, -1, linearDamping=0.0, angularDamping=0.0,
+                              physicsClientId=c)
+            for j in self._movable.get(body, []):
+                pb.setJointMotorControl2(body, j, pb.VELOCITY_CONTROL, force=0.0,
+                                         physicsClientId=c)
+                pb.changeDynamics(body, j, linearDamping=0.0, angularDamping=0.0,
+                                  physicsClientId=c)
+                pb.resetJointState(body, j, float(q0[at]), float(v0[at]), physicsClientId=c)
+                at += 1
+        qs = np.zeros((steps + 1, len(q0)))
+        vs = np.zeros((steps + 1, len(v0)))
+
+        def read(k: int) -> None:
+            states = [pb.getJointState(body, j, physicsClientId=c) for body in self.bodies
+                      for j in self._movable.get(body, [])]
+            qs[k] = [x[0] for x in states]
+            vs[k] = [x[1] for x in states]
+
+        read(0)
+        for k in range(1, steps + 1):
+            pb.stepSimulation(physicsClientId=c)
+            read(k)
+        return qs, vs
+
     def _com(self, body: int, link: int) -> np.ndarray:
         c = self.client
         if link < 0:

@@ -38,7 +38,7 @@ def pybullet_inertia_source() -> Entry:
     ``URDF_USE_INERTIA_FROM_FILE``, against Pinocchio's M of the same file."""
     import pinocchio as pin
 
-    from dyncheck.confinement import c_output_dropped
+    from dyncheck.adapters.c_output import c_output_dropped
 
     with c_output_dropped():  # its import prints a line of its own (on stderr)
         import pybullet as pb

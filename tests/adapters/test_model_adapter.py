@@ -10,7 +10,7 @@ import pytest
 
 from dyncheck.adapters import get_adapter
 from dyncheck.cases import get_case
-from dyncheck.errors import EngineNotInstalled
+from dyncheck.errors import EngineNotInstalled, Unsupported
 from dyncheck.implementations import (
     ENGINE_DEFECT,
     INERTIA_STORED,
@@ -84,3 +84,27 @@ def test_a_declared_defect_explains_only_the_rows_it_predicts(monkeypatch):
     withdrawn = rows()
     failed = withdrawn[withdrawn.verdict == "failed"]
     assert set(failed.quantity) == set(by_defect.quantity)
+
+
+@pytest.mark.parametrize("engine", FILE_LOADERS)
+def test_the_engines_own_step_is_mujocos_euler(engine):
+    """Newton's Featherstone solver and PyBullet's stepSimulation (motors off, damping 0) are
+    semi-implicit Euler on hinges: the same run as MuJoCo's ``euler`` (another engine, the
+    expected values), to the accumulated round-off of the less precise (ε per step)."""
+    cls = _adapter_class(engine)
+    case = get_case("compound_pendulum")
+    spec = case.multibody()
+    q0, v0 = np.array([0.5, -0.3]), np.array([0.2, 0.1])
+    ours = cls(spec).simulate(q0, v0, 0.5, 1e-3, "euler")
+    theirs = get_adapter("mujoco")(spec).simulate(q0, v0, 0.5, 1e-3, "euler")
+    steps = len(ours.t) - 1
+    eps = np.finfo(cls.dtype).eps
+    assert np.abs(ours.q - theirs.q).max() <= 64 * eps * steps * np.abs(theirs.q).max()
+    assert np.abs(ours.q - theirs.q).max() > 0 or engine != "newton"  # float32: not bitwise
+
+
+def test_a_free_body_is_not_stepped_without_its_map_back():
+    cls = _adapter_class("newton")
+    adapter = cls(get_case("rigid_body_free").multibody())
+    with pytest.raises(Unsupported, match="not mapped back"):
+        adapter.simulate(np.r_[0, 0, 0, 1, 0, 0, 0.0], np.zeros(6), 0.01, 1e-3, "euler")
