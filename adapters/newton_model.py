@@ -117,6 +117,11 @@ class NewtonModel:
                  int(newton.JointType.FREE): JointType.FREE}
         fixed = int(newton.JointType.FIXED)
         for j, t in enumerate(self.types):
+            if int(t) == int(newton.JointType.D6):
+                raise Unsupported(
+                    f"newton fused the joints of one body into a D6 joint ({self._name(j)!r}), "
+                    "which applies their slides first whatever the written order: not checked "
+                    "(dyncheck explain newton-several-joints-on-a-body)")
             if int(t) not in kinds and int(t) != fixed:
                 raise Unsupported(f"newton joint type {newton.JointType(int(t)).name} "
                                   f"({self._name(j)!r}) is not checked")

@@ -41,7 +41,12 @@ from dyncheck.explain.engine_defaults import (
 )
 from dyncheck.explain.entry import Entry
 from dyncheck.explain.integrators import drake_fsal_caching, group_rk4, port_integrators
-from dyncheck.explain.moving import newton_free_velocity, pybullet_inertia_source
+from dyncheck.explain.moving import (
+    newton_free_velocity,
+    newton_joint_order,
+    pybullet_default_motors,
+    pybullet_inertia_source,
+)
 from dyncheck.explain.parsers import (
     drake_mjcf_options,
     pinocchio_mjcf_options,
@@ -78,6 +83,8 @@ DEMOS: dict[str, tuple[Callable[[], Entry], Origin]] = {
     "mjx-integrator-definitions": (port_integrators, Origin.ENGINE),
     "pybullet-inertia-source": (pybullet_inertia_source, Origin.ENGINE),
     "newton-free-joint-velocity": (newton_free_velocity, Origin.ENGINE),
+    "pybullet-default-motors": (pybullet_default_motors, Origin.ENGINE),
+    "newton-several-joints-on-a-body": (newton_joint_order, Origin.ENGINE),
     "derivative-chart": (derivative_chart, Origin.MATHEMATICS),
 }
 """Conventions demonstrated by a run of their own, with whose property each is; the others
@@ -105,6 +112,8 @@ REQUIRES: dict[str, tuple[str, ...]] = {
     "mjx-integrator-definitions": ("mjx-f64",),
     "pybullet-inertia-source": ("pybullet",),
     "newton-free-joint-velocity": ("newton",),
+    "pybullet-default-motors": ("pybullet",),
+    "newton-several-joints-on-a-body": ("newton",),
 }
 """Demonstrations that need an optional engine (MuJoCo and Pinocchio are core dependencies)."""
 

@@ -25,10 +25,11 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from dyncheck.adapters import layout
 from dyncheck.adapters.model_files import read
 from dyncheck.adapters.mujoco_model import MujocoModel
 from dyncheck.adapters.pinocchio_model import PinocchioModel
-from dyncheck.check import derivatives, layout
+from dyncheck.check import derivatives
 from dyncheck.check.dynamics import sample
 from dyncheck.explain.charts import FALLING
 

@@ -115,3 +115,143 @@ def newton_free_velocity() -> Entry:
         errors[1],
         "worst relative error of M, h, forward and inverse dynamics",
     )
+
+
+def pybullet_default_motors() -> Entry:
+    """A compound pendulum (the book's case, written as URDF) stepped 1 s by PyBullet at
+    h = 1e-3 as loaded and with its defaults switched off, against MuJoCo's ``euler`` (the
+    same definition, semi-implicit Euler): the largest angle difference."""
+    import mujoco
+
+    from dyncheck.adapters.c_output import c_output_dropped
+    from dyncheck.adapters.mjcf import to_mjcf
+    from dyncheck.adapters.urdf import to_urdf
+    from dyncheck.cases import get_case
+
+    with c_output_dropped():  # its import prints a line of its own (on stderr)
+        import pybullet as pb
+
+    spec = get_case("compound_pendulum").multibody()
+    q0, v0, h, steps = (0.5, -0.3), (0.2, 0.1), 1e-3, 1000
+    model = mujoco.MjModel.from_xml_string(to_mjcf(spec, timestep=h))
+    data = mujoco.MjData(model)
+    data.qpos[:], data.qvel[:] = q0, v0
+    for _ in range(steps):
+        mujoco.mj_step(model, data)
+    expected = np.array(data.qpos)
+    found = []
+    with tempfile.TemporaryDirectory(prefix="dyncheck-explain-") as folder:
+        path = Path(folder) / "pendulum.urdf"
+        path.write_text(to_urdf(spec), encoding="utf-8")
+        for defaults in (True, False):
+            client = pb.connect(pb.DIRECT)
+            try:
+                pb.setGravity(*spec.gravity, physicsClientId=client)
+                pb.setTimeStep(h, physicsClientId=client)
+                body = pb.loadURDF(str(path), useFixedBase=True,
+                                   flags=pb.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client)
+                for j in range(2):
+                    pb.resetJointState(body, j, q0[j], v0[j], physicsClientId=client)
+                    if not defaults:
+                        pb.setJointMotorControl2(body, j, pb.VELOCITY_CONTROL, force=0.0,
+                                                 physicsClientId=client)
+                        pb.changeDynamics(body, j, linearDamping=0.0, angularDamping=0.0,
+                                          physicsClientId=client)
+                for _ in range(steps):
+                    pb.stepSimulation(physicsClientId=client)
+                q = [pb.getJointState(body, j, physicsClientId=client)[0] for j in range(2)]
+            finally:
+                pb.disconnect(client)
+            found.append(float(np.abs(np.array(q) - expected).max()))
+    return Entry(
+        "pybullet-default-motors",
+        "A model with no actuator swings freely under gravity; a simulator adds nothing to "
+        "its equations of motion unless asked. The book's compound pendulum, 1 s at "
+        "h = 1e-3.",
+        "PyBullet's loadURDF gives every revolute and prismatic joint a velocity motor with "
+        "target 0 (it holds the joint: the first stays where it started) and every link a "
+        "linear and angular damping of 0.04; switched off (setJointMotorControl2("
+        "VELOCITY_CONTROL, force=0), changeDynamics(linearDamping=0, angularDamping=0)) its "
+        "stepSimulation is semi-implicit Euler, MuJoCo's euler, to round-off. MuJoCo, "
+        "Pinocchio, Drake and Newton add no motor. dyncheck run switches both off and says so.",
+        "PyBullet's stepSimulation with its defaults",
+        found[0],
+        found[1],
+        "max angle difference (rad) from MuJoCo's euler after 1 s",
+    )
+
+
+CYLINDRICAL = ("<mujoco><option gravity='0 0 -9.81'/><worldbody><body name='particle'>"
+               "<joint name='theta' type='hinge' axis='0 0 1'/>"
+               "<joint name='z' type='slide' axis='0 0 1'/>"
+               "<joint name='r' type='slide' axis='1 0 0'/>"
+               "<inertial pos='0 0 0' mass='1.5' diaginertia='1e-3 1e-3 1e-3'/>"
+               "</body></worldbody></mujoco>")
+"""A particle in cylindrical coordinates: three joints on one body, the hinge first."""
+NESTED = ("<mujoco><option gravity='0 0 -9.81'/><worldbody>"
+          "<body name='turn'><joint name='theta' type='hinge' axis='0 0 1'/>"
+          "<inertial pos='0 0 0' mass='1e-6' diaginertia='1e-9 1e-9 1e-9'/>"
+          "<body name='lift'><joint name='z' type='slide' axis='0 0 1'/>"
+          "<inertial pos='0 0 0' mass='1e-6' diaginertia='1e-9 1e-9 1e-9'/>"
+          "<body name='particle'><joint name='r' type='slide' axis='1 0 0'/>"
+          "<inertial pos='0 0 0' mass='1.5' diaginertia='1e-3 1e-3 1e-3'/>"
+          "</body></body></body></worldbody></mujoco>")
+"""The same particle with one joint per body (two nearly massless carrier bodies)."""
+
+
+def newton_joint_order() -> Entry:
+    """The particle's world position for (θ, z, r) at 16 sampled coordinates, in Newton 1.8
+    (its MJCF importer, forward kinematics ``eval_fk``) and in MuJoCo, from
+    :data:`CYLINDRICAL` (several joints on one body) and :data:`NESTED` (one per body)."""
+    import mujoco
+
+    from dyncheck.adapters.c_output import c_output_dropped
+
+    with c_output_dropped():
+        import warp as wp
+
+        wp.config.log_level = wp.LOG_ERROR
+        import newton
+
+    rng = np.random.default_rng(0)
+    coords = rng.uniform(-1.0, 1.0, size=(16, 3))  # (θ, z, r) in MJCF order
+    errors = []
+    for xml in (CYLINDRICAL, NESTED):
+        model = mujoco.MjModel.from_xml_string(xml)
+        data = mujoco.MjData(model)
+        with tempfile.TemporaryDirectory(prefix="dyncheck-explain-") as folder, \
+                c_output_dropped():
+            path = Path(folder) / "particle.xml"
+            path.write_text(xml, encoding="utf-8")
+            builder = newton.ModelBuilder()
+            builder.add_mjcf(str(path))
+            built = builder.finalize(device="cpu")
+        state = built.state()
+        # Newton's coordinates of the MJCF joints: a body's joints fused into one D6 hold
+        # its slides first, then its hinges (its importer's order); one joint per body: as
+        # written
+        order = [1, 2, 0] if built.joint_count == 1 else [0, 1, 2]
+        worst = 0.0
+        for c in coords:
+            data.qpos[:] = c
+            mujoco.mj_kinematics(model, data)
+            state.joint_q.assign(np.asarray(c[order], np.float32))
+            newton.eval_fk(built, state.joint_q, state.joint_qd, state)
+            where = np.asarray(state.body_q.numpy()[-1][:3], float)
+            worst = max(worst, float(np.abs(where - data.xpos[-1]).max()))
+        errors.append(worst)
+    return Entry(
+        "newton-several-joints-on-a-body",
+        "MJCF applies a body's joints in the order written, each in the frame the ones "
+        "before it moved: a hinge then a slide along x is a slide along the turned x "
+        "(cylindrical coordinates).",
+        "Newton 1.8's MJCF importer fuses a body's joints into one D6 joint whose slides come "
+        "first (applied in the parent's frame) and hinges after, whatever the written order: "
+        "a hinge written before a slide no longer turns it. MuJoCo, Pinocchio and Drake "
+        "apply them as written; dyncheck check names Newton's D6 and skips it. Fix: one "
+        "joint per body (or the slides written first).",
+        "Newton's reading of three joints on one body",
+        errors[0],
+        errors[1],
+        "max position difference (m) from MuJoCo",
+    )
