@@ -101,6 +101,9 @@ TUTORIALS: dict[str, str] = {
     "drake-mjcf-options": "06_what_parsers_read",
     "rk4-on-the-rotation-group": "07_integrators_on_rotations",
     "derivative-chart": "09_derivatives_in_charts",
+    "pybullet-inertia-source": "10_moving_to_pybullet",
+    "pybullet-default-motors": "10_moving_to_pybullet",
+    "newton-several-joints-on-a-body": "11_moving_to_newton",
 }
 """The executed tutorial (``reports/tutorials/NAME.md``) that teaches an entry step by step."""
 
