@@ -86,7 +86,8 @@ def _load(source: ModelFile):  # -> (newton.Model, names of the bodies whose ine
         else:  # the file's text without geometry and <mimic> (model_files.read), as for all
             builder.add_urdf(source.text, floating=source.floating)
         with warnings.catch_warnings():  # its count of corrected bodies: named below instead
-            warnings.simplefilter("ignore", newton.NewtonWarning)
+            # (a NewtonWarning since 1.8, a UserWarning before: its parent class)
+            warnings.simplefilter("ignore", UserWarning)
             model = builder.finalize(device=DEVICE)
     except (ValueError, KeyError, IndexError, TypeError, RuntimeError, OSError) as exc:
         message = " ".join(str(exc).split()) or type(exc).__name__

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from dyncheck.adapters import ENGINE_PORTS
+from dyncheck.adapters import ENGINE_PORTS, REGISTRY
 from dyncheck.cases import Case, get_case
 from dyncheck.errors import EngineError
 from dyncheck.implementations import (
@@ -121,12 +121,22 @@ def _raw_drake(adapter, qe, ve, te, ae) -> Callable[[], None]:
     return loop
 
 
+def _raw_loader(adapter, qe, ve, te, ae) -> Callable[[], None]:
+    """An engine served by its file loader (:mod:`dyncheck.adapters.model_adapter`): the
+    loader's own per-state engine calls on states already in its layout (the map to it is
+    dyncheck's, timed in the adapter's row)."""
+    from dyncheck.adapters.layout import engine_states
+
+    _, q, v, a = engine_states(adapter.canon, adapter.tree, qe, ve, ae)
+    return partial(adapter.engine.dynamics, q, v, a)
+
+
 RAW = {
     "mujoco": _raw_mujoco,
     "pinocchio": _raw_pinocchio,
     "pinocchio-mjcf": _raw_pinocchio,
     "drake": _raw_drake,
-}
+} | {name: _raw_loader for name, r in REGISTRY.items() if r.run}
 """The engines' plainest loops (sympy-mechanics is dyncheck's own symbolic peer: no raw
 engine call to compare with)."""
 
