@@ -285,7 +285,25 @@ def run_release(
     )
     if result.returncode not in (0, 1) or not (out / "discrepancies.csv").exists():
         raise ReleaseFailed(eng.name, release, _last_line(result.stderr))
+    missing = _not_importable(out / "discrepancies.csv", eng.impls)
+    if missing:
+        raise ReleaseFailed(eng.name, release, f"the engine does not import there: {missing}")
     return out
+
+
+def _not_importable(path: Path, impls: Sequence[str]) -> str:
+    """The reason the run gives, where every row of the engine's implementations is skipped
+    because it could not be imported in the release's environment (e.g. a wheel built
+    against numpy 1 beside constraints.txt's numpy 2); else empty."""
+    rows = pd.read_csv(path)
+    own = rows[rows.impl_b.isin(impls) | rows.impl_a.isin(impls)]
+    marker = "which is not installed ("
+    if own.empty or not (own.verdict == "skipped").all():
+        return ""
+    notes = own.note.dropna()
+    if notes.empty or not notes.str.contains(marker, regex=False).all():
+        return ""
+    return str(notes.iloc[0]).split(marker, 1)[1].split(")", 1)[0]
 
 
 class ReleaseFailed(DyncheckError):

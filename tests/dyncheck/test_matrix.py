@@ -167,3 +167,20 @@ def test_an_engine_registered_with_releases_is_in_the_matrix(name):
     assert eng.impls == (name,)
     pins = f"{reg.package}==0.0\nnumpy==2.0\n"
     assert constraints(eng, pins) == "numpy==2.0\n"
+
+
+def test_a_release_whose_engine_does_not_import_is_named_not_compared(tmp_path):
+    """Every row of the engine skipped for want of its import (a wheel built against numpy 1
+    beside numpy 2): the release is a problem stated on the page, not a step of skipped rows
+    — other skips (a case it cannot load) leave it compared."""
+    rows = pd.DataFrame({
+        "impl_a": ["reference", "reference"], "impl_b": ["eng", "eng"],
+        "verdict": ["skipped", "skipped"],
+        "note": ["eng: implementation 'eng' needs 'eng', which is not installed (numpy.core."
+                 "multiarray failed to import); pip install ..."] * 2})
+    path = tmp_path / "discrepancies.csv"
+    rows.to_csv(path, index=False)
+    assert matrix._not_importable(path, ("eng",)) == "numpy.core.multiarray failed to import"
+    rows.loc[1, "note"] = "eng: couplings are not held"
+    rows.to_csv(path, index=False)
+    assert matrix._not_importable(path, ("eng",)) == ""
