@@ -233,3 +233,6 @@ class Transition:
     time_step: float
     fd_step: float
     integrator: str
+    beyond_euler: str = ""
+    """Why this integrator's step is not semi-implicit Euler's on this model (then the chain
+    rule of Euler's step is no referee for it: a skipped row saying this); empty: it is."""

@@ -33,7 +33,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
-from dyncheck.adapters.mujoco_api import full_inertia
+from dyncheck.adapters.mujoco_api import GYROSCOPIC_IMPLICIT, full_inertia
 from dyncheck.errors import EngineError
 
 ENGINE = "mujoco"
@@ -308,9 +308,13 @@ class MujocoModel:
                         mujoco.mj_forward(m, d)
                         mujoco.mjd_transitionFD(m, d, step, True, matrix, None, None, None)
                         found[i] = matrix[: 2 * nv, : 2 * nv]
+                free = bool(np.any(m.jnt_type == mujoco.mjtJoint.mjJNT_FREE))
+                beyond = ("MuJoCo's implicitfast differentiates a free body's gyroscopic "
+                          "force (since 3.11): its step is not Euler's on a free joint"
+                          ) if name == "implicitfast" and free and GYROSCOPIC_IMPLICIT else ""
                 out.append(Transition(matrix=fine, coarse=coarse,
                                       time_step=float(m.opt.timestep), fd_step=FD_STEP,
-                                      integrator=name))
+                                      integrator=name, beyond_euler=beyond))
         finally:
             m.opt.integrator = integrator
         return tuple(out)

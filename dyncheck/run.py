@@ -30,6 +30,7 @@ from dyncheck.results import (
     table,
 )
 from dyncheck.studies import TrajectoryFigures, study
+from dyncheck.studies.derivatives import derivative_rows
 from dyncheck.workers import Unit, run_units
 
 
@@ -132,6 +133,8 @@ def _run_case(
     notes: dict[str, set[str]] = {}
     impls = _implementations(case, impl_names, notes)
     rows = [] if sliced else rows_of(sweep(case, impls, case.iter_states(states)))
+    n = case.n_states if states is None else min(states, case.n_states)
+    rows += derivative_rows(case, impl_names, n)  # at the case's own states (or fewer)
     points, trajectory_rows, figures = study(case, impls)
     pngs = {} if render is None else render(
         case, figures, table(points, ConvergencePoint, CONVERGENCE_KEY))

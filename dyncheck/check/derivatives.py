@@ -94,6 +94,7 @@ class Referee:
     derivatives: Derivatives
     error: dict[str, np.ndarray]
     second_q: dict[str, np.ndarray]  # ∂²τᵢ/∂q_k² at v̇ = a ("inverse") and v̇ = FD ("forward")
+    third_q: dict[str, np.ndarray]  # ∂³τᵢ/∂q_k³, likewise: the next term of a one-sided step
     second_v: np.ndarray  # ∂²τᵢ/∂v_k²
     inverse_mass: np.ndarray
     roundoff: np.ndarray  # δτ per state: the round-off of τ
@@ -135,6 +136,7 @@ def referee(tree: ModelTree, states: States) -> Referee:
     out: dict[str, np.ndarray] = {}
     error: dict[str, np.ndarray] = {}
     second_q: dict[str, np.ndarray] = {}
+    third_q: dict[str, np.ndarray] = {}
     for key, acc in accelerations.items():
         tau_p = np.einsum("abksij,sj->abksi", m_p, acc) + h_p  # (step, sign, k, s, i)
         central = (tau_p[:, 0] - tau_p[:, 1]) / (2 * steps[:, None, None, None])
@@ -147,6 +149,10 @@ def referee(tree: ModelTree, states: States) -> Referee:
         tau_0 = np.einsum("sij,sj->si", mass, acc) + bias
         curvature = (tau_p[2, 0] + tau_p[2, 1] - 2 * tau_0[None]) / steps[2] ** 2
         second_q[key] = np.transpose(curvature, (1, 2, 0))
+        # τ(q ± 2h), τ(q ± h) with h = steps[1] (steps[0] = 2h): the third derivative
+        third = (tau_p[0, 0] - 2 * tau_p[1, 0] + 2 * tau_p[1, 1] - tau_p[0, 1]) \
+            / (2 * steps[1] ** 3)
+        third_q[key] = np.transpose(third, (1, 2, 0))
         if key == "inverse":
             out["inverse_q"], error["inverse_q"] = jacobian, estimate
         else:
@@ -163,7 +169,8 @@ def referee(tree: ModelTree, states: States) -> Referee:
     return Referee(
         derivatives=collect(out, method="the general method differentiated: central "
                             "differences in q extrapolated (Richardson), exact in v"),
-        error=error, second_q=second_q, second_v=second_v, inverse_mass=inverse_mass,
+        error=error, second_q=second_q, third_q=third_q, second_v=second_v,
+        inverse_mass=inverse_mass,
         roundoff=roundoff, forward=forward)
 
 
@@ -294,18 +301,34 @@ def to_canonical(canon: Canonical, tree: ModelTree, states: States, found: Deriv
 
 def _predicted(found: Derivatives, ref: Referee, field: str) -> np.ndarray:
     """An engine's predicted finite-difference error per entry (zero for analytic ones):
-    one-sided differences of step s, s/2 |∂²τ/∂x²| + 2 δτ/s (through |M⁻¹| for the forward
-    derivatives, which it forms from its inverse ones)."""
+    one-sided differences of step s, s/2 |∂²τ/∂x²| + s²/6 |∂³τ/∂x³| + 2 δτ/s (the Taylor
+    remainder's next term matters where the curvature vanishes; in v, τ is quadratic: no
+    third term) through |M⁻¹| for the forward derivatives, which it forms from its inverse
+    ones."""
     if not found.step:
         return np.zeros_like(getattr(found, field))
     s = found.step
     roundoff = 2 * ref.roundoff[:, None, None] / s
     if field == "forward_tau":
         return np.zeros_like(found.forward_tau)
-    curvature = ref.second_v if field.endswith("_v") else \
-        ref.second_q["inverse" if field.startswith("inverse") else "forward"]
-    inverse = s / 2 * np.abs(curvature) + roundoff
+    key = "inverse" if field.startswith("inverse") else "forward"
+    if field.endswith("_v"):
+        inverse = s / 2 * np.abs(ref.second_v) + roundoff
+    else:
+        inverse = s / 2 * np.abs(ref.second_q[key]) + s**2 / 6 * np.abs(ref.third_q[key]) \
+            + roundoff
     return inverse if field.startswith("inverse") else np.abs(ref.inverse_mass) @ inverse
+
+
+def _floor(ref: Referee, field: str) -> np.ndarray:
+    """The round-off of an entry computed from terms of τ's size (per state), per unit of
+    q (δτ) or of v (δτ / the velocities' spread): what an entry that is zero in exact
+    arithmetic (a ball joint's ∂τ/∂q without gravity torque) carries; through |M⁻¹| for
+    the forward derivatives."""
+    per_q = ref.roundoff[:, None, None]
+    per = {"q": per_q, "v": ref.error["inverse_v"] / 2, "tau": np.zeros_like(per_q)}
+    bound = np.broadcast_to(per[field.split("_", 1)[1]], ref.inverse_mass.shape)
+    return np.abs(ref.inverse_mass) @ bound if field.startswith("forward") else bound
 
 
 def compare(model: str, tree: ModelTree, name_a: str, da: Derivatives, name_b: str,
@@ -319,10 +342,11 @@ def compare(model: str, tree: ModelTree, name_a: str, da: Derivatives, name_b: s
         desired, actual = getattr(da, field), getattr(db, field)
         scale = max(float(np.abs(desired).max()), float(np.abs(actual).max()), 1e-300)
         rtol = ROUNDOFF_FACTOR * eps * d * (kappa if field.startswith("forward") else 1.0)
-        allowed = np.full(desired.shape, rtol * scale)
+        allowed = np.full(desired.shape, rtol * scale) + _floor(ref, field) * eps / EPS
         basis = f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth {d}"
         if field.startswith("forward"):
             basis += f" x cond(M) {kappa:.3g}"
+        basis += " (of the largest entry, and of tau's terms per unit of q or v)"
         for name, found in ((name_a, da), (name_b, db)):
             if found is ref.derivatives:
                 allowed = allowed + ref.error[field]

@@ -159,7 +159,7 @@ def _check(model: str, source_path: Path, source: ModelFile,
                 raise inputs.ModelFileError(source_path, result.message)
             continue
         if loaded:
-            result.tree, renamed = _align_by_body(next(iter(loaded.values())).tree,
+            result.tree, renamed = align_by_body(next(iter(loaded.values())).tree,
                                                   result.tree)
             notes.extend(renamed)
         loaded[engine] = result
@@ -310,7 +310,7 @@ def _parent(joint: TreeJoint, renames: dict[str, str]) -> str | None:
     return renames.get(joint.parent, joint.parent) if joint.parent else None
 
 
-def _align_by_body(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree, list[str]]:
+def align_by_body(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree, list[str]]:
     """Joints an engine names otherwise matched to the canonical engine's by their body and
     their order in it, where the types agree: Drake names an MJCF ``<freejoint>`` after its
     body; Pinocchio's MJCF parser makes a body's several joints one composite joint whose

@@ -232,12 +232,15 @@ def newton_joint_order() -> Entry:
         # written
         order = [1, 2, 0] if built.joint_count == 1 else [0, 1, 2]
         worst = 0.0
+        joint_q, joint_qd = state.joint_q, state.joint_qd
+        assert joint_q is not None and joint_qd is not None  # an articulated model's state
         for c in coords:
             data.qpos[:] = c
             mujoco.mj_kinematics(model, data)
-            state.joint_q.assign(np.asarray(c[order], np.float32))
-            newton.eval_fk(built, state.joint_q, state.joint_qd, state)
-            where = np.asarray(state.body_q.numpy()[-1][:3], float)
+            joint_q.assign(np.asarray(c[order], np.float32))
+            newton.eval_fk(built, joint_q, joint_qd, state)
+            assert state.body_q is not None
+            where = np.array(state.body_q.numpy()[-1][:3], dtype=np.float64)
             worst = max(worst, float(np.abs(where - data.xpos[-1]).max()))
         errors.append(worst)
     return Entry(

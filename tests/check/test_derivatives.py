@@ -138,7 +138,10 @@ def test_ball_and_free_joints_agree_in_the_canonical_chart(model, floating):
                          derivatives=True)
     assert result.ok, result.failures()
     rows = _rows(result, section="derivatives")
-    assert set(rows["verdict"]) == {"passed"} and len(rows) == 5 * len(impls) * (
+    gyroscopic = rows["note"].str.contains("gyroscopic")  # implicitfast on a free joint
+    assert (rows["verdict"][~gyroscopic] == "passed").all()
+    assert (rows["verdict"][gyroscopic] == "skipped").all() and gyroscopic.sum() <= 1
+    assert len(rows) == 5 * len(impls) * (
         len(impls) - 1) // 2 + 2  # + MuJoCo's step Jacobians (Euler, implicitfast)
     if DRAKE:
         exact = _rows(result, section="derivatives", impl_a="pinocchio", impl_b="drake")

@@ -1,0 +1,123 @@
+"""Derivative rows of a book case (#46): ∂v̇/∂(q, v, τ) and ∂τ/∂(q, v) of the case's smooth
+tree dynamics, every engine that differentiates its dynamics against the others and the
+referee, at the case's sampled states — the check's derivative rows
+(:mod:`dyncheck.check.derivatives`: one chart, each engine's chart mapped to it exactly, the
+referee the general method differentiated with an error estimate of its own, tolerances
+derived) on the case's MJCF, a book case being a model in a file.
+
+The model differentiated is the MJCF's tree: a case's couplings (tendon equalities) and
+external field are not part of its smooth dynamics (stated on every row). States are the
+case's own, mapped from the book's coordinates to MuJoCo's, the canonical layout.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+
+from dyncheck import coordinates as co
+from dyncheck.adapters import MODELS, RUN, get_adapter
+from dyncheck.adapters.mjcf import to_mjcf
+from dyncheck.cases import Case
+from dyncheck.errors import EngineNotInstalled
+from dyncheck.implementations import NativeMap
+from dyncheck.results import Discrepancy
+
+REFEREE = "reference"
+TREE_ONLY = ("the smooth dynamics of the case's MJCF tree (its couplings and external field "
+             "are not part of them)")
+
+
+def _load(entry: str, path: Path) -> object:
+    import importlib
+
+    from dyncheck.adapters.model_files import read
+
+    module, cls = entry.split(":")
+    return getattr(importlib.import_module(module), cls)(read(path))
+
+
+def _differentiates(entry: str) -> bool:
+    """Whether the loader ``module:class`` offers its engine's derivatives (a port's refuses
+    them itself: a skipped row naming it)."""
+    import importlib
+
+    module, cls = entry.split(":")
+    try:
+        return hasattr(getattr(importlib.import_module(module), cls), "derivatives")
+    except ImportError:
+        return True  # its load reports the missing engine
+
+
+def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[Discrepancy]:
+    """The case's derivative rows for the implementations of ``impl_names`` that load a file
+    (:data:`~dyncheck.adapters.MODELS`) and the referee (where ``reference`` is named)."""
+    from dyncheck.adapters import layout
+    from dyncheck.check import derivatives
+    from dyncheck.check.dynamics import States
+    from dyncheck.check.model_check import align_by_body
+
+    names = [n for n in MODELS if n in impl_names]
+    if not names:
+        return []
+    spec = case.multibody()
+    sample = case.sample_states(states)
+    first = next(iter(MODELS))  # the canonical engine, whose layout the states are put in
+    cmap = NativeMap(case.engine_map(), first, spec)
+    q = cmap.to_engine(sample.q)
+    on = States(q=q, v=co.velocity_to_engine(cmap, sample.q, sample.v),
+                a=co.acceleration_to_engine(cmap, sample.q, sample.v, sample.a))
+    loaded: dict[str, object] = {}
+    failed: list[Discrepancy] = []
+    with tempfile.TemporaryDirectory(prefix="dyncheck-case-") as folder:
+        path = Path(folder) / f"{case.name}.xml"
+        path.write_text(to_mjcf(spec), encoding="utf-8")
+        canonical = _load(MODELS[first].model or "", path)
+        for name in names:
+            if name in RUN:  # not installed: skipped rows with the pip hint, as in the run
+                try:
+                    get_adapter(name)
+                except EngineNotInstalled as exc:
+                    failed.append(_row(case, "derivatives", name, "", "skipped", str(exc)))
+                    continue
+            if not _differentiates(MODELS[name].model or ""):
+                failed.append(_row(case, "derivatives", name, "", "skipped",
+                                   f"{name} offers no derivatives"))
+                continue
+            try:
+                loaded[name] = _load(MODELS[name].model or "", path)
+            except Exception as exc:  # an engine that cannot load costs its own row
+                failed.append(_row(case, "derivatives", name, "", "skipped",
+                                   f"{name}: {type(exc).__name__}: {exc}"))
+    tree = canonical.tree  # type: ignore[attr-defined]
+    canon = layout.canonical(tree)
+    for engine in loaded.values():  # Drake names a <freejoint> after its body, Pinocchio
+        engine.tree = align_by_body(tree, engine.tree)[0]  # type: ignore[attr-defined]
+    for name in list(loaded):
+        theirs = {j.name for j in loaded[name].tree.joints}  # type: ignore[attr-defined]
+        missing = [n for n in canon.names if n not in theirs]
+        if missing:  # e.g. Pinocchio's composite joint for several joints on one body
+            del loaded[name]
+            failed.append(_row(case, "derivatives", name, "", "skipped",
+                               f"{name} holds no joint {missing[0]!r} as such (its reading "
+                               "of the file joins joints the others keep apart): its "
+                               "derivatives are not mapped joint by joint"))
+    found = derivatives.rows(case.name, canon, tree, loaded, on,
+                             with_referee=REFEREE in impl_names)
+    return failed + [_row(case, r.subject, r.impl_a, r.impl_b, str(r.verdict), r.note,
+                          error=r.error, tolerance=r.tolerance, basis=r.basis,
+                          worst=r.worst_state) for r in found]
+
+
+def _row(case: Case, quantity: str, a: str, b: str, verdict: str, note: str, *,
+         error: float = float("nan"), tolerance: float = float("nan"), basis: str = "",
+         worst: int = -1) -> Discrepancy:
+    spec = case.multibody()
+    said = "; ".join(x for x in (note, TREE_ONLY if spec.couplings or spec.central_mu else "")
+                     if x)
+    return Discrepancy(case=case.name, quantity=quantity, impl_a=a, impl_b=b, integrator="",
+                       dt=float("nan"), max_abs_err=float("nan"), max_rel_err=error,
+                       tolerance=tolerance, tolerance_basis=basis, verdict=verdict,
+                       convention="", note=said, worst_state=worst)
+

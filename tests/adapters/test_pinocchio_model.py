@@ -1,0 +1,52 @@
+"""Pinocchio on users' files: the composite joint its MJCF parser makes of a body's several
+joints, whose derivatives it does not compute. Expected values: Pinocchio's own central
+differences of ``rnea`` (an independent computation of the same derivative)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from dyncheck.adapters.mjcf import to_mjcf
+from dyncheck.adapters.model_files import read
+from dyncheck.adapters.pinocchio_model import PinocchioModel
+from dyncheck.cases import get_case
+from dyncheck.errors import Unsupported
+
+
+@pytest.fixture
+def several_joints_on_a_body(tmp_path: Path) -> Path:
+    path = tmp_path / "cylindrical.xml"
+    path.write_text(to_mjcf(get_case("cylindrical_coordinates").multibody()))
+    return path
+
+
+def test_a_composite_joints_derivative_in_q_is_not_computed(several_joints_on_a_body):
+    """The fact the refusal rests on: Pinocchio's analytic ∂τ/∂q of a composite joint is zero
+    where its own finite differences are not. When a release computes it, this fails: lift
+    the refusal in ``PinocchioModel.derivatives``."""
+    model = pin.buildModelFromMJCF(str(several_joints_on_a_body))
+    assert any(j.shortname() == "JointModelComposite" for j in model.joints)
+    data = model.createData()
+    rng = np.random.default_rng(1)
+    q, v, a = (rng.normal(size=n) for n in (model.nq, model.nv, model.nv))
+    pin.computeRNEADerivatives(model, data, q, v, a)
+    analytic = np.array(data.dtau_dq)
+    h = 1e-6
+    fd = np.column_stack([
+        (pin.rnea(model, data, pin.integrate(model, q, h * e), v, a)
+         - pin.rnea(model, data, pin.integrate(model, q, -h * e), v, a)) / (2 * h)
+        for e in np.eye(model.nv)])
+    assert np.abs(fd).max() > 1.0
+    assert np.abs(analytic - fd).max() > 0.5 * np.abs(fd).max()
+
+
+def test_its_derivatives_are_refused_with_the_reason(several_joints_on_a_body):
+    loaded = PinocchioModel(read(several_joints_on_a_body))
+    q = np.zeros((1, loaded.tree.nq))
+    v = np.zeros((1, loaded.tree.nv))
+    with pytest.raises(Unsupported, match="composite joint"):
+        loaded.derivatives(q, v, v)

@@ -1,0 +1,55 @@
+"""Derivative rows of the book's cases in ``dyncheck run`` (#46). Expected values: the
+referee (the general method differentiated, with its own error estimate) and the other
+engines; a test double breaks one engine's derivative on purpose."""
+
+from __future__ import annotations
+
+import pytest
+
+from dyncheck.cases import get_case
+from dyncheck.studies.derivatives import derivative_rows
+
+from ...conftest import CASE_NAMES
+
+CORE = ["reference", "mujoco", "pinocchio"]
+
+
+@pytest.mark.parametrize("case", CASE_NAMES)
+def test_every_case_has_derivative_rows_that_pass_or_say_why_not(case):
+    """Every pair of the core engines and the referee on all five derivatives, passed; a
+    skipped row only with Pinocchio's composite joint (an MJCF body with several joints)."""
+    rows = derivative_rows(get_case(case), CORE, 8)
+    verdicts = {r.verdict for r in rows}
+    assert "failed" not in verdicts, [r.note for r in rows if r.verdict == "failed"]
+    skipped = [r for r in rows if r.verdict == "skipped"]
+    assert all("composite joint" in r.note or "gyroscopic" in r.note for r in skipped)
+    derivative = [r for r in rows if r.quantity.startswith("d(")]
+    pairs = {(r.impl_a, r.impl_b) for r in derivative}
+    expected = 5 * (len(CORE) - 1) * len(CORE) // 2 if not skipped or all(
+        "gyroscopic" in r.note for r in skipped) else 5
+    assert len(derivative) == expected, pairs
+
+
+def test_a_derivative_off_by_one_part_in_a_million_fails_naming_engine_case_and_entry(
+        monkeypatch):
+    """A test double of Pinocchio whose ∂τ/∂q has one entry scaled by 1 + 1e-6: its rows
+    against the referee and MuJoCo fail, naming Pinocchio and the entry; nothing else."""
+    from dataclasses import replace
+
+    from dyncheck.adapters import pinocchio_model
+
+    original = pinocchio_model.PinocchioModel.derivatives
+
+    def broken(self, q, v, a):
+        found = original(self, q, v, a)
+        inverse_q = found.inverse_q.copy()
+        inverse_q[:, 0, 0] *= 1 + 1e-6
+        return replace(found, inverse_q=inverse_q)
+
+    monkeypatch.setattr(pinocchio_model.PinocchioModel, "derivatives", broken)
+    rows = derivative_rows(get_case("compound_pendulum"), CORE, 8)
+    failed = [r for r in rows if r.verdict == "failed"]
+    assert {(r.quantity, r.impl_a, r.impl_b) for r in failed} == {
+        ("d(inverse)/dq", "reference", "pinocchio"), ("d(inverse)/dq", "mujoco", "pinocchio")}
+    assert all(r.case == "compound_pendulum" and "pinocchio differs" in r.note
+               and "entry (0, 0)" in r.note for r in failed)
