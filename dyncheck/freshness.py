@@ -90,6 +90,7 @@ PAGES_NOT_COMPARED = (
     "benchmark-ports.md",
     "benchmark-check.md",
     "versions.md",
+    "versions-newton-pybullet.md",
     "reliability.md",
     "errata.md",
 )

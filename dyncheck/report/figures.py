@@ -60,14 +60,19 @@ class Margins:
 MARGINS = Margins()
 
 
-def _layout(fig: Figure, rows: int = 1, title_lines: int = 1) -> None:
+LEGEND = 1.9
+"""Inches to the right of the axes for a legend placed outside the data."""
+
+
+def _layout(fig: Figure, rows: int = 1, title_lines: int = 1, legend: bool = False) -> None:
     """Place ``fig``'s ``rows`` stacked axes within :data:`MARGINS`, below a title of
-    ``title_lines`` lines."""
+    ``title_lines`` lines (``legend``: room on the right for legends outside the axes)."""
     w, h = fig.get_size_inches()
     m = MARGINS
     top = m.top + (title_lines - 1) * m.title_line
     height = (h - top - m.bottom - (rows - 1) * m.between) / rows
-    fig.subplots_adjust(left=m.left / w, right=1 - m.right / w, top=1 - top / h,
+    right = m.right + (LEGEND if legend else 0.0)
+    fig.subplots_adjust(left=m.left / w, right=1 - right / w, top=1 - top / h,
                         bottom=m.bottom / h, hspace=m.between / height)
 
 
@@ -105,22 +110,46 @@ def _png(fig: Figure) -> bytes:
     return buf.getvalue()
 
 
+def _periodic(case: Case, i: int) -> bool:
+    return i < len(case.periodic) and case.periodic[i]
+
+
+def _on_branch(angle: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """An angle an engine wraps to (−π, π] drawn on the reference's branch: shifted by the
+    multiple of 2π that brings each sample nearest the reference's (the same angle: no
+    jump of 2π shown as a divergence)."""
+    return angle + 2 * np.pi * np.round((reference - angle) / (2 * np.pi))
+
+
+MARKERS = ("o", "s", "^", "v", "D", "P", "X", "*", "<", ">")
+
+
+def _styles(n: int) -> list[tuple[str, str]]:
+    """``n`` (colour, marker) pairs, no two alike: tab10's colours, then its colours again
+    with the next marker."""
+    return [(f"C{k % 10}", MARKERS[(k // 10) % len(MARKERS)]) for k in range(n)]
+
+
 def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str, bytes]:
     """Deterministic PNGs: trajectory, error against time, error against step size."""
     plt = _pyplot()
     plt.rcParams.update({"font.family": "DejaVu Sans", "font.size": 9})
     out = {}
-    fig, axes = plt.subplots(case.ndof, 1, figsize=(7, 2.2 * case.ndof), squeeze=False, dpi=DPI)
+    fig, axes = plt.subplots(case.ndof, 1, figsize=(8.5, 2.2 * case.ndof), squeeze=False,
+                             dpi=DPI)
+    rk4 = [(impl, q) for (impl, integ), q in sorted(data.runs.items()) if integ == "rk4"]
+    styles = _styles(len(rk4))
     for i, ax in enumerate(axes[:, 0]):
-        ax.plot(data.t, data.reference[:, i], "k-", lw=2, label="reference (DOP853)")
-        for (impl, integ), q in sorted(data.runs.items()):
-            if integ == "rk4":
-                ax.plot(data.t, q[:, i], "--", lw=1, label=f"{impl} rk4")
+        ax.plot(data.t, data.reference[:, i], "k-", lw=2.5, label="reference (DOP853)")
+        for (impl, q), (colour, marker) in zip(rk4, styles, strict=True):
+            y = _on_branch(q[:, i], data.reference[:, i]) if _periodic(case, i) else q[:, i]
+            ax.plot(data.t, y, "--", color=colour, marker=marker, markevery=0.1, ms=3, lw=1,
+                    label=f"{impl} rk4")
         ax.set_ylabel(case.coordinates[i])  # the book's coordinate: a length or an angle
     axes[-1, 0].set_xlabel("t (s)")
-    axes[0, 0].legend(fontsize=7, loc="best")
+    axes[0, 0].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     _title(axes[0, 0], f"{case.title}\ntrajectory in the book's coordinates")
-    _layout(fig, rows=case.ndof, title_lines=2)
+    _layout(fig, rows=case.ndof, title_lines=2, legend=True)
     out["trajectory"] = _png(fig)
 
     fig, ax = plt.subplots(figsize=(7, 3.2), dpi=DPI)
@@ -140,23 +169,29 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     _layout(fig)
     out["error_time"] = _png(fig)
 
-    fig, ax = plt.subplots(figsize=(7, 4), dpi=DPI)
     c = conv[conv["case"] == case.name]
-    for (impl, integ), g in c.groupby(["impl", "integrator"]):
-        ax.loglog(g["dt"], g["error"], "o-", ms=3, lw=1, label=f"{impl} {integ}")
-    for _integ, g in c.groupby("integrator"):
-        p = int(g["nominal_order"].iloc[0])
-        dts = np.sort(g["dt"].unique())
-        anchor = g[g["dt"] == dts[-1]]["error"].max()
-        ax.loglog(dts, anchor * (dts / dts[-1]) ** p, "k:", lw=1)
-        ax.annotate(f"slope {p}", (dts[0], anchor * (dts[0] / dts[-1]) ** p), fontsize=7)
-    ax.set_xlabel("dt (s)")
-    ax.set_ylabel("max error (m, rad)")
-    _title(ax, "Error against step size (dotted: nominal slopes)")
-    _log_labels(ax.xaxis, ax.yaxis)
-    if len(c):
-        ax.legend(fontsize=6, ncol=2)
-    _layout(fig)
+    integrators = sorted(c["integrator"].unique()) or [""]
+    fig, axes = plt.subplots(len(integrators), 1, figsize=(8.5, 2.4 * len(integrators)),
+                             squeeze=False, dpi=DPI)
+    for ax, integ in zip(axes[:, 0], integrators, strict=True):
+        g_all = c[c["integrator"] == integ]
+        groups = list(g_all.groupby("impl"))
+        for (impl, g), (colour, marker) in zip(groups, _styles(len(groups)), strict=True):
+            ax.loglog(g["dt"], g["error"], "-", color=colour, marker=marker, ms=4, lw=1,
+                      label=str(impl))
+        if len(g_all):
+            p = int(g_all["nominal_order"].iloc[0])
+            dts = np.sort(g_all["dt"].unique())
+            anchor = g_all[g_all["dt"] == dts[-1]]["error"].median()
+            ax.loglog(dts, anchor * (dts / dts[-1]) ** p, "k:", lw=1,
+                      label=f"slope {p} (nominal)")
+            ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+        ax.set_ylabel(f"{integ}: max error")
+        _log_labels(ax.xaxis, ax.yaxis)
+    axes[-1, 0].set_xlabel("dt (s)")
+    _title(axes[0, 0], "Error against step size, one panel per integrator (m or rad, as the "
+           "case's coordinates)")
+    _layout(fig, rows=len(integrators), legend=True)
     out["convergence"] = _png(fig)
 
     fig, ax = plt.subplots(figsize=(7, 3.2), dpi=DPI)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dyncheck.adapters import REGISTRY
+from dyncheck.adapters import FLOAT32, REGISTRY
 from dyncheck.cases import NOMINAL_ORDER, get_case
 from dyncheck.comparison import GRAVITY_DEFAULT
 from dyncheck.implementations import SOFT_CONSTRAINT
@@ -24,6 +24,7 @@ from ..conftest import (
     CASE_NAMES,
     COUPLED_CASES,
     ENGINES,
+    FILE_LOADERS,
     FREE_CASES,
     PORTS,
     supported,
@@ -64,6 +65,10 @@ def test_observed_order(full_run, case, engine, integrator):
         # exact cords: ẍ is constant, q(t) quadratic, which RK2, RK3 and RK4 integrate exactly
         assert row.verdict == "passed" and "polynomial of degree 2" in row.note
         assert g.error.max() <= 1e-13 * 10
+        return
+    if row.verdict == "skipped" and engine in FILE_LOADERS:
+        # a file loader's stepping is read back on hinges and slides only, said up front
+        assert case in BALL_CASES and "not mapped back" in row.note, row.note
         return
     if row.verdict == "skipped":
         # Warp's CPU device: ~10-40 ms a step; longer runs are left to a GPU, said up front
@@ -125,7 +130,10 @@ def test_engine_pairs_on_different_models_are_predicted(full_run):
     rows = d[(d.quantity == "trajectory") & (d.impl_a == "pinocchio")]
     assert set(rows.verdict) <= {"passed", "explained"}
     pend = rows[rows.case.isin(["simple_pendulum", "compound_pendulum"])]
-    assert (pend.verdict == "explained").all() and len(pend) > 0
+    # a float32 engine's accumulated round-off bound exceeds the floor's effect: passed
+    coarse = pend.impl_b.isin(FLOAT32)
+    assert (pend[~coarse].verdict == "explained").all() and (~coarse).sum() > 0
+    assert (pend[coarse].verdict == "passed").all()
 
 
 def test_observed_orders_formula():
