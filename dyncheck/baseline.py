@@ -74,7 +74,8 @@ def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
             frame[col] = frame[col].astype(float)
     except ValueError as exc:
         raise InvalidInput(flag, str(path), f"numeric errors and steps ({exc})") from None
-    frame["integrator"] = texts(frame["integrator"])
+    for col in ("integrator", "impl_b"):  # empty cells: a row of one implementation
+        frame[col] = texts(frame[col])
     diff.checked_signs(frame, ["max_rel_err", "tolerance"], flag=flag, path=path)
     diff.checked_keys(frame, DISCREPANCY_KEY, flag=flag, path=path)
     judged = frame["verdict"].isin(["passed", "explained"])

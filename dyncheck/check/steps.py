@@ -69,7 +69,7 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
     if found.beyond_euler:
         return [CheckRow(
             model=model, section=Section.DERIVATIVES,
-            subject=f"step Jacobian ({found.integrator}, h {h:g})", field="max rel error",
+            subject=f"step Jacobian ({found.integrator} at h = {h:g})", field="max rel error",
             impl_a="reference", impl_b=engine, value_a="", value_b="", error=float("nan"),
             tolerance=float("nan"), basis="", verdict=Verdict.SKIPPED,
             note=f"{found.beyond_euler}; the chain rule of Euler's step is no referee for it")]
@@ -101,7 +101,7 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
         f"{worst[2]}): {off[worst]:.3g} beyond its predicted {allowed[worst]:.3g}")
     return [CheckRow(
         model=model, section=Section.DERIVATIVES,
-        subject=f"step Jacobian ({found.integrator}, h {h:g})", field="max rel error",
+        subject=f"step Jacobian ({found.integrator} at h = {h:g})", field="max rel error",
         impl_a="reference", impl_b=engine, value_a="", value_b="",
         error=float(off.max()) / scale, tolerance=float(allowed.max()) / scale,
         basis=(f"round-off: {ROUNDOFF_FACTOR} eps x tree depth {depth(tree)}; + {engine}'s "

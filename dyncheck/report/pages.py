@@ -70,11 +70,30 @@ def case_page(case: Case, result: RunResult) -> str:
         "",
         f"![trajectory](figures/{case.name}_trajectory.png)",
         "",
+        "*Trajectory.* The book's coordinates against time: the reference (DOP853 at "
+        "rtol 1e-13, black) and every engine's RK4 at its finest step (dashed, its own "
+        "colour and marker). An angle an engine wraps into (−π, π] is drawn on the "
+        "reference's branch. What to see: the curves on top of one another; a curve that "
+        "leaves the black one is a different model (its rows say which, and why).",
+        "",
         f"![error against time](figures/{case.name}_error_time.png)",
+        "",
+        "*Error against time.* max |q − q_ref| of each integrator at its finest step, log "
+        "scale. What to see: errors that grow smoothly (truncation accumulating); a jump or "
+        "an error flat at 1 is a model difference, not a step-size effect.",
         "",
         f"![error against step](figures/{case.name}_convergence.png)",
         "",
+        "*Error against step size*, one panel per integrator, with the nominal slope "
+        "(dotted). What to see: each engine's points parallel to the slope (the observed "
+        "order in the table above); points that flatten sit at a round-off or model floor.",
+        "",
         f"![conservation drift](figures/{case.name}_energy.png)",
+        "",
+        "*Conservation drift.* |E(t) − E(0)| / max |E| of the energy (2.2.36) in each "
+        "integrator's run at its finest step. What to see: drift that falls with the "
+        "integrator's order; semi-implicit Euler's bounded oscillation (a symplectic map) "
+        "against an explicit method's steady growth.",
         "",
     ]
     return "\n".join(lines)

@@ -30,7 +30,7 @@ def test_mujocos_euler_step_jacobian_is_the_chain_rule_of_the_continuous_derivat
                          states=10, derivatives=True)
     rows = _rows(result, section="derivatives", impl_b="mujoco")
     rows = rows[rows["subject"].str.startswith("step Jacobian")]
-    assert [s.split(",")[0] for s in rows["subject"]] == ["step Jacobian (euler",
+    assert [s.split(" at ")[0] for s in rows["subject"]] == ["step Jacobian (euler",
                                                           "step Jacobian (implicitfast"]
     euler, implicit = rows.iloc[0], rows.iloc[1]
     assert euler["verdict"] == "passed" and euler["error"] < 1e-8
