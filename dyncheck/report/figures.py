@@ -152,22 +152,10 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     _layout(fig, rows=case.ndof, title_lines=2, legend=True)
     out["trajectory"] = _png(fig)
 
-    fig, ax = plt.subplots(figsize=(7, 3.2), dpi=DPI)
-    for (impl, integ), err in sorted(data.errors.items()):
-        ax.semilogy(
-            data.t,
-            np.maximum(err, 1e-17),
-            lw=1,
-            label=f"{impl} {integ} dt={data.steps[impl, integ]:g}",
-        )
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("max |q - q_ref| (m, rad)")
-    _title(ax, "Error against time (finest step of each integrator)")
-    _log_labels(ax.yaxis)
-    if data.errors:
-        ax.legend(fontsize=6, ncol=2)
-    _layout(fig)
-    out["error_time"] = _png(fig)
+    out["error_time"] = _per_integrator(
+        plt, data.t, {k: np.maximum(e, 1e-17) for k, e in data.errors.items()},
+        {k: f"{k[0]} (dt={data.steps[k]:g})" for k in data.errors},
+        "max |q − q_ref| (m or rad)", "Error against time (finest step of each integrator)")
 
     c = conv[conv["case"] == case.name]
     integrators = sorted(c["integrator"].unique()) or [""]
@@ -194,23 +182,35 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     _layout(fig, rows=len(integrators), legend=True)
     out["convergence"] = _png(fig)
 
-    fig, ax = plt.subplots(figsize=(7, 3.2), dpi=DPI)
-    for (impl, integ), drift in sorted(data.energy.items()):
-        ax.semilogy(
-            data.t,
-            np.maximum(drift[:: (len(drift) - 1) // (len(data.t) - 1)], 1e-17),
-            lw=1,
-            label=f"{impl} {integ}",
-        )
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("|E(t) − E(0)| / max|E|")
-    _title(ax, "Conservation drift (finest step of each integrator)")
-    _log_labels(ax.yaxis)
-    if data.energy:
-        ax.legend(fontsize=6, ncol=2)
-    _layout(fig)
-    out["energy"] = _png(fig)
+    out["energy"] = _per_integrator(
+        plt, data.t,
+        {k: np.maximum(d[:: (len(d) - 1) // (len(data.t) - 1)], 1e-17)
+         for k, d in data.energy.items()},
+        {k: k[0] for k in data.energy}, "|E(t) − E(0)| / max|E|",
+        "Conservation drift (finest step of each integrator)")
     return out
+
+
+def _per_integrator(plt: ModuleType, t: np.ndarray, series: dict[tuple[str, str], np.ndarray],
+                    labels: dict[tuple[str, str], str], ylabel: str, title: str) -> bytes:
+    """One log-scale panel per integrator of ``series`` ((implementation, integrator) →
+    values at ``t``), each implementation its own colour and marker, the legend outside."""
+    integrators = sorted({integ for _, integ in series}) or [""]
+    fig, axes = plt.subplots(len(integrators), 1, figsize=(8.5, 2.2 * len(integrators)),
+                             squeeze=False, dpi=DPI)
+    for ax, integ in zip(axes[:, 0], integrators, strict=True):
+        keys = sorted(k for k in series if k[1] == integ)
+        for k, (colour, marker) in zip(keys, _styles(len(keys)), strict=True):
+            ax.semilogy(t, series[k], "-", color=colour, marker=marker, markevery=0.1, ms=3,
+                        lw=1, label=labels[k])
+        ax.set_ylabel(f"{integ}\n{ylabel}" if integ else ylabel, fontsize=8)
+        _log_labels(ax.yaxis)
+        if keys:
+            ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    axes[-1, 0].set_xlabel("t (s)")
+    _title(axes[0, 0], title)
+    _layout(fig, rows=len(integrators), legend=True)
+    return _png(fig)
 
 
 def cached_figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str, bytes]:
