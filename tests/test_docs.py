@@ -109,3 +109,24 @@ def test_every_explained_row_gives_its_reason():
         rows = pd.read_csv(csv, keep_default_na=False)
         explained = rows[rows["verdict"] == "explained"]
         assert (explained["note"] != "").all(), csv.name
+
+
+def test_the_readmes_counts_are_the_committed_reports():
+    """The counts the README quotes for the main command (and without MuJoCo's ports) are
+    those of the committed report's rows (#48: numbers in prose come from the data)."""
+    from dyncheck.adapters import ENGINE_PORTS
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    counts = r"(\d+) passed, (\d+) explained, (\d+) failed, (\d+) skipped"
+    whole = re.search(counts + r"; report in reports/README\.md", text)
+    without = re.search(r"Without the extras `mjx`\s+and `warp`: " + counts, text)
+    assert whole and without
+    rows = pd.read_csv(ROOT / "reports" / "discrepancies.csv")
+    ports = rows.impl_a.isin(list(ENGINE_PORTS)) | rows.impl_b.isin(list(ENGINE_PORTS))
+
+    def said(frame: pd.DataFrame) -> tuple[int, ...]:
+        got = frame.verdict.value_counts()
+        return tuple(int(got.get(v, 0)) for v in ("passed", "explained", "failed", "skipped"))
+
+    assert tuple(map(int, whole.groups())) == said(rows)
+    assert tuple(map(int, without.groups())) == said(rows[~ports])
