@@ -107,8 +107,7 @@ class ModelAdapter(Adapter):
         joint whose gravity is resolved through R′ instead of R computes h, inverse dynamics
         under g′ = R R′ᵀ g, so they err by G(g′) − G(g) = h_e(g) − h_e(R′ Rᵀ g) at v = 0
         (G linear in g; h_e(y) = G(R R′ᵀ y)), and forward dynamics by −M⁻¹ that."""
-        frees = [(k, j) for k, j in enumerate(self.tree.joint(n) for n in self.canon.names)
-                 if j.type is JointType.FREE and j.gravity_frame is GravityFrame.RPY_REVERSED]
+        frees = self._reversed_gravity()
         if not frees:
             return {}
         gravity = np.asarray(self.tree.gravity, float)
@@ -137,7 +136,13 @@ class ModelAdapter(Adapter):
             "Rz(y) of the orientation's roll, pitch, yaw, the state's Rz(y) Ry(p) Rx(r) in "
             f"reverse order (GravityFrame.{j.gravity_frame.name}, measured; predicted per "
             "state as G(g′) − G(g), g′ = R R′ᵀ g)"
-            for j in self.tree.joints if j.gravity_frame is not GravityFrame.STATE)
+            for _, j in self._reversed_gravity())
+
+    def _reversed_gravity(self) -> list[tuple[int, TreeJoint]]:
+        """(canonical index, joint) of each free joint whose gravity the engine resolves
+        through the reversed roll-pitch-yaw (:attr:`GravityFrame.RPY_REVERSED`)."""
+        return [(k, j) for k, j in enumerate(self.tree.joint(n) for n in self.canon.names)
+                if j.type is JointType.FREE and j.gravity_frame is GravityFrame.RPY_REVERSED]
 
     @classmethod
     def version(cls) -> str:

@@ -29,15 +29,6 @@ TREE_ONLY = ("the smooth dynamics of the case's MJCF tree (its couplings and ext
              "are not part of them)")
 
 
-def _load(entry: str, path: Path) -> object:
-    import importlib
-
-    from dyncheck.adapters.model_files import read
-
-    module, cls = entry.split(":")
-    return getattr(importlib.import_module(module), cls)(read(path))
-
-
 def _differentiates(entry: str) -> bool:
     """Whether the loader ``module:class`` offers its engine's derivatives (a port's refuses
     them itself: a skipped row naming it)."""
@@ -54,7 +45,8 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
     """The case's derivative rows for the implementations of ``impl_names`` that load a file
     (:data:`~dyncheck.adapters.MODELS`) and the referee (where ``reference`` is named)."""
     from dyncheck.adapters import layout
-    from dyncheck.check import derivatives
+    from dyncheck.adapters.model_files import read
+    from dyncheck.check import derivatives, engines
     from dyncheck.check.dynamics import States
     from dyncheck.check.model_check import align_by_body
 
@@ -68,12 +60,15 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
     q = cmap.to_engine(sample.q)
     on = States(q=q, v=co.velocity_to_engine(cmap, sample.q, sample.v),
                 a=co.acceleration_to_engine(cmap, sample.q, sample.v, sample.a))
-    loaded: dict[str, object] = {}
+    loaded: dict[str, engines.ModelEngine] = {}
     failed: list[Discrepancy] = []
     with tempfile.TemporaryDirectory(prefix="dyncheck-case-") as folder:
         path = Path(folder) / f"{case.name}.xml"
         path.write_text(to_mjcf(spec), encoding="utf-8")
-        canonical = _load(MODELS[first].model or "", path)
+        source = read(path)
+        canonical = engines.load(first, source)
+        if isinstance(canonical, engines.NotLoaded):
+            return [_row(case, "derivatives", first, "", "failed", canonical.message)]
         for name in names:
             if name in RUN:  # not installed: skipped rows with the pip hint, as in the run
                 try:
@@ -85,17 +80,18 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
                 failed.append(_row(case, "derivatives", name, "", "skipped",
                                    f"{name} offers no derivatives"))
                 continue
-            try:
-                loaded[name] = _load(MODELS[name].model or "", path)
-            except Exception as exc:  # an engine that cannot load costs its own row
-                failed.append(_row(case, "derivatives", name, "", "skipped",
-                                   f"{name}: {type(exc).__name__}: {exc}"))
-    tree = canonical.tree  # type: ignore[attr-defined]
+            engine = canonical if name == first else engines.load(name, source)
+            if isinstance(engine, engines.NotLoaded):  # costs its own row
+                failed.append(_row(case, "derivatives", name, "",
+                                   "skipped" if engine.skip else "failed", engine.message))
+            else:
+                loaded[name] = engine
+    tree = canonical.tree
     canon = layout.canonical(tree)
     for engine in loaded.values():  # Drake names a <freejoint> after its body, Pinocchio
-        engine.tree = align_by_body(tree, engine.tree)[0]  # type: ignore[attr-defined]
+        engine.tree = align_by_body(tree, engine.tree)[0]
     for name in list(loaded):
-        theirs = {j.name for j in loaded[name].tree.joints}  # type: ignore[attr-defined]
+        theirs = {j.name for j in loaded[name].tree.joints}
         missing = [n for n in canon.names if n not in theirs]
         if missing:  # e.g. Pinocchio's composite joint for several joints on one body
             del loaded[name]
