@@ -21,6 +21,7 @@ world).
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import numpy as np
@@ -139,15 +140,27 @@ def _first_of_several(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
 
 
 def _summary(warnings: list[str]) -> list[str]:
-    """Drake's parser warnings for the report, each distinct one once with its count (an
-    inertia warning by its first line: the rest is the matrix)."""
+    """Drake's parser warnings for the report, in Drake's own words: each distinct one once
+    with its count, messages that differ only in their numbers (an inertia warning's matrix)
+    counted as one and shown by the first in full (whitespace collapsed; capped at
+    :data:`MESSAGE_CHARS` against a hostile file's flood)."""
+    first: dict[str, str] = {}
     counts: dict[str, int] = {}
     for message in warnings:
-        key = " ".join(message.split())
-        if "MakeFromMomentsAndProducts" in key:
-            key = key.split(":", 1)[0]
+        text = " ".join(message.split())
+        key = re.sub(r"[-+]?\d[\d.eE+-]*", "#", text).replace(" ", "")
+        first.setdefault(key, text)
         counts[key] = counts.get(key, 0) + 1
-    return [f"drake parser warning ({n}x): {m[:300]}" for m, n in counts.items()]
+    out = []
+    for key, text in first.items():
+        shown = text if len(text) <= MESSAGE_CHARS else text[:MESSAGE_CHARS] + " […]"
+        n = counts[key]
+        out.append(f"drake parser warning ({n}x{', the first' if n > 1 else ''}): {shown}")
+    return out
+
+
+MESSAGE_CHARS = 1000
+"""The longest engine message a page quotes whole."""
 
 
 def _urdf_root(plant: MultibodyPlant):

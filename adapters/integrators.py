@@ -13,7 +13,7 @@ one step of a ball and a free joint, tests/adapters/test_integrators.py):
 - ``euler``: semi-implicit Euler, v' = v + h·v̇(q, v), then q' = q ⊕ h·v'.
 - ``implicitfast``: v' = v + h·(M − h·D)⁻¹(τ − h(q, v) + f_passive) with D = ∂f/∂v of the
   passive and actuator forces; with no damping and no actuators D = 0 and it is ``euler``.
-  (MuJoCo ≥ 3.12 also applies a free body's gyroscopic derivative here; dyncheck's does not.)
+  (MuJoCo ≥ 3.11.0 also applies a free body's gyroscopic derivative here; dyncheck's does not.)
 - ``rk4``: the classic four-stage tableau on x = (q, v) with stage positions
   q₀ ⊕ h·Σⱼ aᵢⱼ kⱼ. On a ball or free joint's rotation the stage velocities kⱼ are the
   Runge–Kutta–Munthe-Kaas ones, kⱼ = dexp⁻¹(θⱼ) ωⱼ with θⱼ the stage's own increment and

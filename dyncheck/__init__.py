@@ -1,9 +1,12 @@
-"""dyncheck: a textbook's dynamics checked against MuJoCo and Pinocchio.
+"""dyncheck: a textbook's dynamics checked against MuJoCo, its ports, Pinocchio, Drake,
+Newton, PyBullet and sympy.physics.mechanics.
 
-Subpackages: ``dyncheck.cases`` (systems, defined once), ``dyncheck.reference`` (the book,
-clean-room), ``dyncheck.adapters`` (engines, one interface). The comparison layer
-(``dyncheck.comparison``, ``dyncheck.trajectories``) is the only code that sees both the
-reference and the engines.
+Subpackages: ``dyncheck.cases`` (systems, defined once; the top-level ``cases/``),
+``dyncheck.reference`` (§2.2 of Heinbockel's *Introduction to Tensor Calculus and Continuum
+Mechanics*, clean-room; ``reference/``), ``dyncheck.adapters`` (engines, one interface;
+``adapters/``). The comparison layer (``dyncheck.comparison``,
+``dyncheck.studies``, ``dyncheck.check``) is the only code that sees both the reference and
+the engines.
 """
 
 __version__ = "0.1.0"

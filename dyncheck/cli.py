@@ -158,7 +158,11 @@ def _parser() -> argparse.ArgumentParser:
     )
     _ci(r)
     _quiet(r)
-    k = sub.add_parser("check", help="do the engines read and simulate YOUR model alike?")
+    k = sub.add_parser(
+        "check",
+        help="do the engines read YOUR model alike and compute the same dynamics (and "
+        "derivatives)?",
+    )
     k.add_argument("paths", nargs="*", type=_path, metavar="PATH",
                    help="MJCF (.xml) or URDF files, or folders (every model file under "
                    "them; files another one includes left out); several: an index page too")

@@ -23,6 +23,20 @@ class Verdict(StrEnum):
     SKIPPED = "skipped"
 
 
+MEANINGS: dict[str, str] = {
+    Verdict.PASSED: "the two sides agree within the row's tolerance, derived from its basis "
+    "(round-off scaled by conditioning, an integrator's order, a finite difference's "
+    "truncation, float32's ε)",
+    Verdict.EXPLAINED: "the two sides differ by more than the tolerance, and the difference "
+    "is a named property of an engine, of the book or of the mathematics (the row's "
+    "`convention` and `note`) whose predicted size leaves a residual within the tolerance",
+    Verdict.FAILED: "the two sides differ by more than the tolerance and nothing known "
+    "predicts it: a finding",
+    Verdict.SKIPPED: "not compared: an engine or extra is missing, refuses the model or does "
+    "not offer the quantity (the `note` says which); never counted as passed",
+}
+"""What each verdict means, for the report's glossary and ``--help``."""
+
 VERDICTS = tuple(v.value for v in Verdict)
 SEVERITY: dict[str, int] = {Verdict.PASSED: 0, Verdict.EXPLAINED: 1, Verdict.SKIPPED: 2,
                             Verdict.FAILED: 3}

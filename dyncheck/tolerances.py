@@ -105,3 +105,54 @@ def check_coverage() -> None:
 
 
 check_coverage()
+
+
+@dataclass(frozen=True, kw_only=True)
+class BasisTerm:
+    """One kind of tolerance basis (the start of a row's ``tolerance_basis``) and what it
+    means, for the report's glossary."""
+
+    starts: str
+    meaning: str
+
+
+BASES = (
+    BasisTerm(starts="round-off", meaning="an instantaneous quantity computed two ways in "
+              "floating point: c ε (c = 64; ε of float64, or of float32 for a port) relative "
+              "to the quantity's largest entry, times κ(M) where a solve with M amplifies it, "
+              "times the tree depth for derivatives accumulated along a chain, times a soft "
+              "constraint's Hessian condition 1 + d/(1 − d); '+' terms add a finite "
+              "difference's predicted truncation and round-off error and the referee's own "
+              "error estimate"),
+    BasisTerm(starts="accumulated round-off", meaning="two runs of the same integrator on "
+              "the same model: c ε per step times the number of steps (round-off accumulates "
+              "at most linearly)"),
+    BasisTerm(starts="below the precision's round-off", meaning="a run whose truncation "
+              "error is below what its precision resolves: judged by its accumulated "
+              "round-off, not by an order"),
+    BasisTerm(starts="exact for a polynomial q(t)", meaning="a case whose exact motion is a "
+              "polynomial the integrator reproduces exactly (the pulleys' constant "
+              "acceleration): accumulated round-off"),
+    BasisTerm(starts="order study", meaning="a run against the reference at a sequence of "
+              "steps: the observed order log(e(2h)/e(h))/log 2 at the finest pair in the "
+              "asymptotic range within the integrator's nominal order ± 0.1"),
+    BasisTerm(starts="difference of two order-", meaning="two different order-p maps (two "
+              "engines' integrators that differ at O(h^p)): their difference must shrink at "
+              "order p − 0.1 or faster"),
+    BasisTerm(starts="tolerance proportionality", meaning="an error-controlled integrator at "
+              "a decade sequence of accuracies ε: its global error must shrink ∝ ε (slope 1 "
+              "± 0.1)"),
+    BasisTerm(starts="2 x (reference error estimate", meaning="scipy's DOP853 on an "
+              "engine's dynamics against the reference's DOP853: twice the sum of the two "
+              "runs' own error estimates"),
+    BasisTerm(starts="4 x DOP853 error estimate", meaning="the reference's run against the "
+              "book's closed form (Kepler): four times DOP853's error estimate plus the closed "
+              "form's own round-off"),
+)
+"""The glossary of tolerance bases; every row's basis starts with one of these (a test)."""
+
+
+def basis_term(basis: str) -> BasisTerm | None:
+    """The glossary term a row's ``tolerance_basis`` belongs to (the longest match)."""
+    found = [t for t in BASES if basis.startswith(t.starts)]
+    return max(found, key=lambda t: len(t.starts)) if found else None

@@ -130,3 +130,97 @@ def test_the_readmes_counts_are_the_committed_reports():
 
     assert tuple(map(int, whole.groups())) == said(rows)
     assert tuple(map(int, without.groups())) == said(rows[~ports])
+
+
+def _number(pattern: str, text: str) -> list[float]:
+    return [float(x) for x in re.findall(pattern, text)]
+
+
+def _guide_quotes() -> list[tuple[str, str]]:
+    """Each number the guide's "What the committed report shows" quotes, as the guide must
+    write it, computed here from the committed report's rows (discrepancies.csv,
+    convergence.csv, the order table the report prints, the conventions the run measured)."""
+    from dyncheck.adapters import FLOAT32
+    from dyncheck.report.tables import order_table
+
+    reports = ROOT / "reports"
+    d = pd.read_csv(reports / "discrepancies.csv")
+    orders = order_table(pd.read_csv(reports / "convergence.csv"), d)
+    measured = (reports / "conventions.md").read_text(encoding="utf-8")
+    dynamics = d[d.quantity.isin(["mass_matrix", "bias_forces", "forward_dynamics",
+                                  "inverse_dynamics", "kinetic_energy", "potential_energy",
+                                  "constraint_force"])]
+    passed = dynamics[dynamics.verdict == "passed"]
+    f32 = passed.impl_a.isin(list(FLOAT32)) | passed.impl_b.isin(list(FLOAT32))
+
+    def span(values: pd.Series) -> str:
+        return f"{values.min():.3f}–{values.max():.3f}"
+
+    rotations = orders[orders.case.isin(["rigid_body_ball", "rigid_body_free", "torque_free"])
+                       & orders.implementation.isin(["mujoco", "pinocchio"])
+                       & (orders.integrator == "rk4")]
+    gyroscopic = d[(d.case == "rigid_body_free") & (d.quantity == "trajectory")
+                   & (d.integrator == "implicitfast") & (d.impl_a == "pinocchio")
+                   & (d.impl_b == "mujoco") & (d.dt == 0.002)]
+    atwood = dynamics[(dynamics.case == "atwood") & (dynamics.impl_a == "reference")]
+
+    def soft(quantity: str, impl: str) -> float:
+        return float(atwood[(atwood.quantity == quantity) & (atwood.impl_b == impl)]
+                     .max_rel_err.iloc[0]) * 100
+
+    soft_rows = dynamics[dynamics.convention.fillna("").str.contains("soft constraint")
+                         & dynamics.impl_b.isin(["mujoco", "mujoco-stiff"])]  # MuJoCo C
+    residual = max(_number(r"residual after prediction ([\d.e+-]+)", " ".join(soft_rows.note)))
+    drift = d[d.quantity == "constraint_drift"]
+
+    def stretch(cases: list[str], impl: str) -> float:
+        rows = drift[drift.case.isin(cases) & (drift.impl_b == impl)]
+        return max(_number(r"observed ([\d.e+-]+) m", " ".join(rows.note)))
+
+    exact = dynamics[dynamics.case.isin(["atwood", "compound_pulley"])
+                     & (dynamics.impl_a == "reference")
+                     & dynamics.impl_b.isin(["pinocchio", "sympy-mechanics", "drake"])]
+    controlled = d[d.integrator.fillna("").str.startswith("rk3-controlled")]
+    slopes = _number(r"observed slope ([\d.]+)", " ".join(controlled.note))
+    fsal = re.search(r"runge_kutta5 at ε = 1e-10: \d+ steps, (\d+) shrunk, error ([\d.e+-]+) "
+                     r"cached; \d+, (\d+), ([\d.e+-]+) uncached", measured)
+    sap = _number(r"Correct mapping: [^\n]*\(correct: Drake's SAP coupler, first step\) "
+                  r"([\d.e+-]+)", measured)
+    sympy = orders[orders.implementation == "sympy-mechanics"]
+    rigid = passed[passed.case.isin(["rigid_body_ball", "rigid_body_free", "torque_free"])
+                   & (passed.impl_a == "reference") & passed.impl_b.isin(["mujoco", "pinocchio"])]
+    closed = d[d.quantity == "closed_form"].max_rel_err.max()
+    assert fsal and sap
+    return [
+        ("float64 pairs", f"≤ {passed[~f32].max_rel_err.max():.1e} relative between float64"),
+        ("float32 pairs", f"≤ {passed[f32].max_rel_err.max():.1e} with a float32 port"),
+        ("RK4 on rotations", f"RK4 {span(rotations['observed order'])} for MuJoCo and Pinocchio"),
+        ("implicitfast", f"{gyroscopic.max_abs_err.max():.1e} rad apart at h = 2 ms"),
+        ("soft tension", f"tension is {soft('constraint_force', 'mujoco'):.0f} % low"),
+        ("soft acceleration", f"acceleration {soft('forward_dynamics', 'mujoco'):.1f} % off"),
+        ("stiff", f"d = 0.9999, {soft('constraint_force', 'mujoco-stiff'):.2f} % and "
+                  f"{soft('forward_dynamics', 'mujoco-stiff'):.4f} %"),
+        ("soft residual", f"residual ≤ {residual:.1e} relative"),
+        ("stretch", f"up to {1e3 * stretch(['atwood'], 'mujoco'):.2f} mm\n  (Atwood) and "
+                    f"{1e3 * stretch(['compound_pulley'], 'mujoco'):.2f} mm (exercise 17)"),
+        ("stiff stretch", f"up to "
+         f"{1e6 * stretch(['atwood', 'compound_pulley'], 'mujoco-stiff'):.1f} µm with the stiff"),
+        ("exact cords", f"exact (≤ {exact.max_rel_err.max():.1e} relative"),
+        ("Drake's cords", f"≤ {drift[drift.impl_b == 'drake'].max_abs_err.max():.1e} m)"),
+        ("SAP coupler", f"off by {sap[0]:g} on Example 6's first step"),
+        ("RK3 controlled", f"finest slope {min(slopes):.3f}–{max(slopes):.3f}"),
+        ("FSAL", f"{fsal[2]} vs {fsal[4]}\n  rad for RK5 at ε = 1e-10 on the compound pendulum, "
+                 f"with {fsal[1]} vs {fsal[3]} step shrinkages"),
+        ("sympy orders", f"Euler order {span(sympy[sympy.integrator == 'euler']['observed order'])}"
+                         f" and RK4 {span(sympy[sympy.integrator == 'rk4']['observed order'])}"),
+        ("rigid bodies", f"agree to ≤ {rigid.max_rel_err.max():.1e} relative"),
+        ("closed form", f"torque-free closed form to {closed:.1e}"),
+    ]
+
+
+@pytest.mark.parametrize(("claim", "quote"), _guide_quotes(), ids=lambda x: x[:20])
+def test_the_guides_numbers_are_the_committed_reports(claim, quote):
+    """#48: every number the guide quotes about results is the committed report's (computed
+    from its rows here, written there); a regenerated report that moves one fails here."""
+    guide = (ROOT / "docs" / "guide.md").read_text(encoding="utf-8")
+    assert quote in guide, f"{claim}: the data say {quote!r}"

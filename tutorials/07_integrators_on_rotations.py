@@ -9,7 +9,8 @@
 # Munthe-Kaas's correction (dexp⁻¹ of each stage) restores order 4. MuJoCo 3.x's RK4 summed
 # naively; dyncheck measured it (`dyncheck explain rk4-on-the-rotation-group`).
 #
-# **The book.** Euler's equations, the torque-free case of (2.2.41)–(2.2.45):
+# **The book.** Euler's equations (2.2.70)–(2.2.72) (principal axes: (2.2.72)) with no moment,
+# the angular momentum (2.2.42) conserved:
 # I ω̇ = −ω × I ω in body axes, with the orientation q̇ = ½ q ⊗ (0, ω).
 #
 # The code: [`adapters/integrators.py`](../../adapters/integrators.py) (`integrate`, `Layout`, `dexp_inv`).

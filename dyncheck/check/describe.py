@@ -14,7 +14,7 @@ parallel-axis term: 1e-8 kg m² of a point mass 1 m from its pivot to ~1e-16 abs
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import replace
 
 import numpy as np
@@ -119,10 +119,13 @@ def shift(a: ModelTree, b: ModelTree, tol: float) -> np.ndarray | None:
     return t
 
 
-def diff(model: str, a: ModelTree, b: ModelTree) -> list[CheckRow]:
+def diff(model: str, a: ModelTree, b: ModelTree,
+         invalid: Mapping[str, str] | None = None) -> list[CheckRow]:
     """Every difference between two engines' trees (one row each), or one passed row. A model
     placed elsewhere as a whole (:func:`shift`) is one explained row, its fields compared
-    after the shift."""
+    after the shift. ``invalid``: the bodies whose inertia a validity row failed (body → that
+    row's note); a body field read differently there names it as its cause."""
+    invalid = invalid or {}
     eps = max(a.eps, b.eps)  # a float32 engine's numbers are rounded to float32
     rtol = ROUNDOFF_FACTOR * eps * max(depth(a), depth(b))
     basis = f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth {max(depth(a), depth(b))}"
@@ -180,6 +183,9 @@ def diff(model: str, a: ModelTree, b: ModelTree) -> list[CheckRow]:
                     f"{stored[1]}: predicted up to {stored[0] / scale:.3g} of the scale")
             elif err > rtol * scale:
                 known = b.hint(ja.name, field) or a.hint(ja.name, field)
+                if not known and field in BODY_FIELDS and ja.body in invalid:
+                    known = FOLLOWS_FROM_INVALID.format(body=ja.body, why=invalid[ja.body],
+                                                        a=a.engine, b=b.engine)
                 row(ja.name, field, va, vb, err / scale, rtol, Verdict.FAILED,
                     known or f"{a.engine} and {b.engine} read {ja.name!r} ({ja.body}) "
                     "differently")
@@ -194,6 +200,26 @@ def diff(model: str, a: ModelTree, b: ModelTree) -> list[CheckRow]:
         row("model", "all fields", f"{len(a.joints)} joints", f"{len(b.joints)} joints", 0.0,
             rtol, Verdict.PASSED, f"{compared} fields agree to round-off")
     return rows
+
+
+BODY_FIELDS = frozenset({"mass", "com", "inertia"})
+"""The fields of a joint's body: what an invalid inertia can make engines read differently."""
+
+FOLLOWS_FROM_INVALID = (
+    "follows from {body}'s invalid inertia (its validity row: {why}): {a} and {b} repair or "
+    "keep an impossible tensor differently; fix the file's inertia and this row goes with it"
+)
+
+FIXES = {
+    "mass": "fix: give the body a positive mass, or merge a massless link into its parent",
+    "finite": "fix: write finite numbers for the mass and the inertia",
+    "inertia": "fix: a physical inertia tensor has non-negative principal moments (check the "
+    "signs of the products of inertia: URDF's ixy is +∫xy dm, some exporters write −)",
+    "triangle": "fix: raise the smaller principal moments until I1 + I2 >= I3 (MuJoCo's "
+    "<compiler balanceinertia=\"true\"/> does this), or recompute the tensor from the "
+    "link's geometry",
+}
+"""A fix hint for each violated condition of :func:`validity` (the page shows it first)."""
 
 
 def _violation(mass: float, inertia: np.ndarray,
@@ -236,6 +262,7 @@ def validity(
         found = _violation(mass, inertia, eps)
         if found is not None:
             field, value, err, tol, note = found
+            note = f"{note}; {FIXES[field]}"
             rows.append(
                 CheckRow(
                     model=model, section=Section.VALIDITY, subject=name, field=field,

@@ -187,9 +187,14 @@ def _check(model: str, source_path: Path, source: ModelFile,
     for engine, m in loaded.items():
         rows.extend(describe.validity(model, engine, describe.tree_bodies(m.tree),
                                       eps=m.tree.eps))
+    invalid: dict[str, str] = {}  # body -> its first failed validity row (the file's first)
+    for r in rows:
+        if r.section is Section.VALIDITY and r.verdict is Verdict.FAILED:
+            invalid.setdefault(r.subject, f"{r.impl_a}: {r.field}")
+    for engine, m in loaded.items():
         if m is first:
             continue
-        found = describe.diff(model, canonical_tree, m.tree)
+        found = describe.diff(model, canonical_tree, m.tree, invalid)
         rows.extend(found)
         fields = sorted({r.field for r in found if r.verdict is Verdict.FAILED})
         if fields:

@@ -7,7 +7,7 @@ import io
 import math
 from dataclasses import dataclass
 from types import ModuleType
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 import pandas as pd
@@ -130,26 +130,49 @@ def _styles(n: int) -> list[tuple[str, str]]:
     return [(f"C{k % 10}", MARKERS[(k // 10) % len(MARKERS)]) for k in range(n)]
 
 
+K = TypeVar("K")
+
+PER_PANEL = 5
+"""Series of implementations in one panel at most (a reference curve or slope guide makes
+six): more share a panel's colours and hide one another."""
+
+
+def _panels(groups: list[tuple[str, list[K]]]) -> list[tuple[str, list[K]]]:
+    """Each ``(label, keys)`` group split into panels of at most :data:`PER_PANEL` keys,
+    labelled ``label (1/2)``, ``label (2/2)`` where a group needs several."""
+    out = []
+    for label, keys in groups:
+        n = max(1, math.ceil(len(keys) / PER_PANEL))
+        size = math.ceil(len(keys) / n) if keys else 0  # balanced: 6 → 3 + 3, not 5 + 1
+        for i in range(n):
+            part = keys[i * size:(i + 1) * size] if keys else []
+            out.append((f"{label} ({i + 1}/{n})" if n > 1 else label, part))
+    return out
+
+
 def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str, bytes]:
     """Deterministic PNGs: trajectory, error against time, error against step size."""
     plt = _pyplot()
     plt.rcParams.update({"font.family": "DejaVu Sans", "font.size": 9})
     out = {}
-    fig, axes = plt.subplots(case.ndof, 1, figsize=(8.5, 2.2 * case.ndof), squeeze=False,
-                             dpi=DPI)
     rk4 = [(impl, q) for (impl, integ), q in sorted(data.runs.items()) if integ == "rk4"]
-    styles = _styles(len(rk4))
-    for i, ax in enumerate(axes[:, 0]):
+    styles = dict(zip([impl for impl, _ in rk4], _styles(len(rk4)), strict=True))
+    panels = [(i, label, part) for i in range(case.ndof)
+              for label, part in _panels([(case.coordinates[i], rk4)])]
+    fig, axes = plt.subplots(len(panels), 1, figsize=(8.5, 2.2 * len(panels)), squeeze=False,
+                             dpi=DPI)
+    for ax, (i, label, part) in zip(axes[:, 0], panels, strict=True):
         ax.plot(data.t, data.reference[:, i], "k-", lw=2.5, label="reference (DOP853)")
-        for (impl, q), (colour, marker) in zip(rk4, styles, strict=True):
+        for impl, q in part:
+            colour, marker = styles[impl]
             y = _on_branch(q[:, i], data.reference[:, i]) if _periodic(case, i) else q[:, i]
             ax.plot(data.t, y, "--", color=colour, marker=marker, markevery=0.1, ms=3, lw=1,
                     label=f"{impl} rk4")
-        ax.set_ylabel(case.coordinates[i])  # the book's coordinate: a length or an angle
+        ax.set_ylabel(label)  # the book's coordinate: a length or an angle
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     axes[-1, 0].set_xlabel("t (s)")
-    axes[0, 0].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     _title(axes[0, 0], f"{case.title}\ntrajectory in the book's coordinates")
-    _layout(fig, rows=case.ndof, title_lines=2, legend=True)
+    _layout(fig, rows=len(panels), title_lines=2, legend=True)
     out["trajectory"] = _png(fig)
 
     out["error_time"] = _per_integrator(
@@ -159,12 +182,17 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
 
     c = conv[conv["case"] == case.name]
     integrators = sorted(c["integrator"].unique()) or [""]
-    fig, axes = plt.subplots(len(integrators), 1, figsize=(8.5, 2.4 * len(integrators)),
+    impls = sorted(c["impl"].unique())
+    styles = dict(zip(impls, _styles(len(impls)), strict=True))
+    panels = _panels([(integ, sorted(c.loc[c["integrator"] == integ, "impl"].unique()))
+                      for integ in integrators])
+    fig, axes = plt.subplots(len(panels), 1, figsize=(8.5, 2.4 * len(panels)),
                              squeeze=False, dpi=DPI)
-    for ax, integ in zip(axes[:, 0], integrators, strict=True):
-        g_all = c[c["integrator"] == integ]
-        groups = list(g_all.groupby("impl"))
-        for (impl, g), (colour, marker) in zip(groups, _styles(len(groups)), strict=True):
+    for ax, (label, part) in zip(axes[:, 0], panels, strict=True):
+        integ = label.split(" (")[0]
+        g_all = c[(c["integrator"] == integ) & c["impl"].isin(part)]
+        for impl, g in g_all.groupby("impl"):
+            colour, marker = styles[str(impl)]
             ax.loglog(g["dt"], g["error"], "-", color=colour, marker=marker, ms=4, lw=1,
                       label=str(impl))
         if len(g_all):
@@ -174,12 +202,12 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
             ax.loglog(dts, anchor * (dts / dts[-1]) ** p, "k:", lw=1,
                       label=f"slope {p} (nominal)")
             ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-        ax.set_ylabel(f"{integ}: max error")
+        ax.set_ylabel(f"{label}: max error")
         _log_labels(ax.xaxis, ax.yaxis)
     axes[-1, 0].set_xlabel("dt (s)")
     _title(axes[0, 0], "Error against step size, one panel per integrator (m or rad, as the "
            "case's coordinates)")
-    _layout(fig, rows=len(integrators), legend=True)
+    _layout(fig, rows=len(panels), legend=True)
     out["convergence"] = _png(fig)
 
     out["energy"] = _per_integrator(
@@ -196,20 +224,24 @@ def _per_integrator(plt: ModuleType, t: np.ndarray, series: dict[tuple[str, str]
     """One log-scale panel per integrator of ``series`` ((implementation, integrator) →
     values at ``t``), each implementation its own colour and marker, the legend outside."""
     integrators = sorted({integ for _, integ in series}) or [""]
-    fig, axes = plt.subplots(len(integrators), 1, figsize=(8.5, 2.2 * len(integrators)),
+    impls = sorted({impl for impl, _ in series})
+    styles = dict(zip(impls, _styles(len(impls)), strict=True))
+    panels = _panels([(integ, sorted(k for k in series if k[1] == integ))
+                      for integ in integrators])
+    fig, axes = plt.subplots(len(panels), 1, figsize=(8.5, 2.2 * len(panels)),
                              squeeze=False, dpi=DPI)
-    for ax, integ in zip(axes[:, 0], integrators, strict=True):
-        keys = sorted(k for k in series if k[1] == integ)
-        for k, (colour, marker) in zip(keys, _styles(len(keys)), strict=True):
+    for ax, (label, keys) in zip(axes[:, 0], panels, strict=True):
+        for k in keys:
+            colour, marker = styles[k[0]]
             ax.semilogy(t, series[k], "-", color=colour, marker=marker, markevery=0.1, ms=3,
                         lw=1, label=labels[k])
-        ax.set_ylabel(f"{integ}\n{ylabel}" if integ else ylabel, fontsize=8)
+        ax.set_ylabel(f"{label}\n{ylabel}" if label else ylabel, fontsize=8)
         _log_labels(ax.yaxis)
         if keys:
             ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     axes[-1, 0].set_xlabel("t (s)")
     _title(axes[0, 0], title)
-    _layout(fig, rows=len(integrators), legend=True)
+    _layout(fig, rows=len(panels), legend=True)
     return _png(fig)
 
 

@@ -26,26 +26,35 @@ def md(frame: pd.DataFrame) -> str:
 NAMES = {rank: str(verdict) for verdict, rank in SEVERITY.items()}
 
 
-def _cells(rows: pd.DataFrame, keys: list[str], sort: bool) -> pd.Series:
+def _cells(rows: pd.DataFrame, keys: list[str], sort: bool, tolerance: bool) -> pd.Series:
     """Per group of ``keys``: its worst verdict (:data:`~dyncheck.results.SEVERITY`) and its
     worst relative error ("failed 1.2e-03"; the verdict alone where no row has a finite
-    error)."""
+    error; a skipped row's error is none). With ``tolerance``: the worst row's tolerance
+    beside it ("passed 1.1e-15 (tol 2.8e-14)"), for families whose tolerance is relative."""
     severity = rows["verdict"].map(SEVERITY)
     if severity.isna().any():
         raise ValueError(f"unknown verdict {rows['verdict'][severity.isna()].iloc[0]!r}")
-    groups = rows.assign(severity=severity).groupby(keys, sort=sort)
-    worst, first = groups["max_rel_err"].max(), groups["severity"].max()
-    return pd.Series(
-        [f"{NAMES[int(s)]} {w:.1e}" if np.isfinite(w) else NAMES[int(s)]
-         for s, w in zip(first, worst, strict=True)],
-        index=worst.index,
-    )
+    error = rows["max_rel_err"].where(rows["verdict"] != "skipped")
+    tol = rows["tolerance"] if tolerance else pd.Series(np.nan, index=rows.index)
+    frame = rows.assign(severity=severity, error=error, tol=tol)
+    cells = {}
+    for key, g in frame.groupby(keys, sort=sort):
+        name = NAMES[int(g["severity"].max())]
+        finite = g[np.isfinite(g["error"])]
+        if not len(finite):
+            cells[key] = name
+            continue
+        worst = finite.loc[finite["error"].idxmax()]
+        cell = f"{name} {worst['error']:.1e}"
+        cells[key] = cell + (f" (tol {worst['tol']:.1e})" if np.isfinite(worst["tol"]) else "")
+    return pd.Series(cells).rename_axis(keys)
 
 
 def instantaneous_matrix(d: pd.DataFrame, case: str) -> pd.DataFrame:
     rows = d[(d["case"] == case) & ~d["quantity"].isin(TRAJECTORY_QUANTITIES)].copy()
-    rows["pair"] = rows["impl_a"] + " vs " + rows["impl_b"]
-    return _cells(rows, ["quantity", "pair"], sort=False).unstack("pair").reset_index()
+    rows["pair"] = _pair(rows)
+    cells = _cells(rows, ["quantity", "pair"], sort=False, tolerance=True)
+    return cells.unstack("pair").reindex(rows["quantity"].unique()).reset_index()
 
 
 def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) -> pd.DataFrame:
@@ -83,8 +92,17 @@ def family_matrix(d: pd.DataFrame, trajectories: bool) -> pd.DataFrame:
     rows = d[d.quantity.isin(TRAJECTORY_QUANTITIES) == trajectories].copy()
     if not len(rows):
         return pd.DataFrame()
-    rows["pair"] = rows["impl_a"] + " vs " + rows["impl_b"]
-    return _cells(rows, ["pair", "case"], sort=True).unstack("case", fill_value="").reset_index()
+    rows["pair"] = _pair(rows)
+    cells = _cells(rows, ["pair", "case"], sort=True, tolerance=not trajectories)
+    return cells.unstack("case", fill_value="").reset_index()
+
+
+def _pair(rows: pd.DataFrame) -> pd.Series:
+    """``impl_a vs impl_b``; a row about one implementation alone (its own derivatives not
+    checked, say) is ``impl_a alone``."""
+    alone = rows["impl_b"].isna() | (rows["impl_b"].astype(str) == "")
+    return (rows["impl_a"] + " vs " + rows["impl_b"].fillna("")).where(
+        ~alone, rows["impl_a"] + " alone")
 
 
 def controlled_matrix(d: pd.DataFrame) -> pd.DataFrame:

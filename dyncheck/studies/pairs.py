@@ -70,7 +70,7 @@ def _maps_differ(
     Drake and sympy-mechanics step a rotating body in their own chart (roll-pitch-yaw or
     Example 9's angles, a free joint's quaternion components) where the others apply the
     exponential map; MuJoCo's ``implicitfast`` adds a free body's gyroscopic derivative (MuJoCo
-    ≥ 3.12, changelog f0fa3d82), which semi-implicit Euler does not."""
+    ≥ 3.11.0, changelog f0fa3d82), which semi-implicit Euler does not."""
     types = {j.type for j in case.multibody().joints}
     if not types & set(ROTATING):
         return None

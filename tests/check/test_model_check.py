@@ -139,6 +139,29 @@ def test_indefinite_inertia_fails_naming_the_link(tmp_path):
     assert ((failed["impl_a"] == "pinocchio") & (failed["field"] == "inertia")).any()
 
 
+def test_a_triangle_breaking_inertia_gives_its_fix_and_what_follows_from_it_names_it(tmp_path):
+    """#48: a failure that follows from another names it, every known cause has a fix, an
+    engine's message is quoted whole. Principal moments 0.03, 0.03, 0.07 break I1 + I2 >= I3
+    ((2.2.39)); which engines then read the link differently is theirs to decide."""
+    corrupted = _corrupt(
+        tmp_path,
+        '<inertia ixx="0.03" ixy="0.001" ixz="0" iyy="0.03" iyz="0" izz="0.01"/>',
+        '<inertia ixx="0.03" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.07"/>',
+    )
+    result = check_model(corrupted, floating=True, states=10)
+    broken = _rows(result, verdict="failed", section="validity", subject="aa_leg",
+                   field="triangle")
+    assert len(broken) and broken["note"].str.contains("fix: raise the smaller").all()
+    read = _rows(result, verdict="failed", section="description")
+    leg = read[read["note"].str.contains("aa_leg")]
+    assert (leg["note"].str.startswith("follows from aa_leg's invalid inertia")).all()
+    assert len(read) == len(leg)  # nothing else is read differently
+    if DRAKE:  # Drake repairs the tensor (Pinocchio keeps it): the leg's inertia differs
+        assert len(leg) and leg["note"].str.contains("validity row: file: triangle").all()  # Drake's parser warns; its words reach the page whole, past their first colon
+        assert any("did not pass the test CouldBePhysicallyValid()" in n
+                   and "triangle inequality" in n for n in result.notes), result.notes
+
+
 def test_check_model_is_deterministic():
     a = check_model(MODELS / "mixed.xml", states=10, impls=("reference", "mujoco"))
     b = check_model(MODELS / "mixed.xml", states=10, impls=("reference", "mujoco"))

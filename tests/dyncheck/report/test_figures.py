@@ -110,3 +110,40 @@ def test_log_axes_label_decades_in_plain_text(value, label):
     """A log axis's major labels: 10ⁿ written with Unicode superscripts at each decade (the
     expected strings typed here), nothing between decades or at zero."""
     assert module._decade(value) == label
+
+
+def test_no_panel_holds_more_than_six_series_and_an_engine_keeps_its_style(monkeypatch):
+    """#48: eleven implementations on one case (as a full run has) are spread over panels of
+    at most five, plus the reference curve or the slope guide; an implementation has one
+    colour and marker in every panel. Expected: counts of the synthetic series drawn."""
+    from dyncheck.studies import TrajectoryFigures
+
+    impls = [f"engine{k:02d}" for k in range(11)]
+    t = np.linspace(0.0, 1.0, 11)
+    ref = np.column_stack([np.sin(t)])
+    keys = [(impl, integ) for impl in impls for integ in ("euler", "rk4")]
+    data = TrajectoryFigures(
+        t=t, reference=ref, runs={k: ref + 1e-3 for k in keys},
+        errors={k: np.full(t.size, 1e-3) for k in keys}, steps={k: 0.01 for k in keys},
+        energy={k: np.full(t.size, 1e-6) for k in keys})
+    conv = table([ConvergencePoint(case=CASE.name, impl=impl, integrator=integ, dt=dt,
+                                   error=dt, observed_order=1.0, nominal_order=1,
+                                   reference_error=0.0, asymptotic=True)
+                  for impl, integ in keys for dt in (0.01, 0.02)],
+                 ConvergencePoint, CONVERGENCE_KEY)
+    drawn = []
+    monkeypatch.setattr(module, "_png", lambda fig: drawn.append(fig) or b"")
+    module.figures(CASE, data, conv)
+    assert len(drawn) == 4
+    styles: dict[str, set] = {}
+    for fig in drawn:
+        for ax in fig.axes:
+            lines = ax.get_lines()
+            assert 2 <= len(lines) <= 6, (ax.get_ylabel(), len(lines))
+            for line in lines:
+                name = line.get_label().split()[0]
+                if name in impls:
+                    styles.setdefault(name, set()).add((line.get_color(), line.get_marker()))
+    assert set(styles) == set(impls)  # every series drawn somewhere
+    assert all(len(s) == 1 for s in styles.values()), styles
+    assert len({next(iter(s)) for s in styles.values()}) == len(impls)  # none alike

@@ -63,15 +63,15 @@ def test_one_case_only():
     assert t["case"].tolist() == ["b"] and t["verdict"].tolist() == ["failed"]
 
 
-def _inst(case, quantity, a, b, verdict, err):
+def _inst(case, quantity, a, b, verdict, err, tol=1e-14):
     return {"case": case, "quantity": quantity, "impl_a": a, "impl_b": b, "integrator": "",
-            "verdict": verdict, "max_rel_err": err}
+            "verdict": verdict, "max_rel_err": err, "tolerance": tol}
 
 
 INSTANT = pd.DataFrame([
     _inst("a", "mass_matrix", "reference", "mujoco", "passed", 1e-15),
     _inst("a", "mass_matrix", "reference", "mujoco", "failed", 2e-3),   # one bad row: failed
-    _inst("a", "mass_matrix", "reference", "mujoco", "passed", 4e-3),   # worst error any row's
+    _inst("a", "mass_matrix", "reference", "mujoco", "passed", 4e-3, 5e-3),  # worst: any row's
     _inst("a", "bias", "reference", "mujoco", "explained", float("nan")),
     _inst("a", "bias", "reference", "mujoco", "passed", float("nan")),  # no error: verdict only
     _inst("a", "mass_matrix", "reference", "pinocchio", "skipped", float("nan")),
@@ -82,7 +82,8 @@ INSTANT = pd.DataFrame([
 
 def test_a_cell_is_its_rows_worst_verdict_and_worst_error():
     m = instantaneous_matrix(INSTANT, "a").set_index("quantity")
-    assert m.loc["mass_matrix", "reference vs mujoco"] == "failed 4.0e-03"
+    # the worst verdict, and the worst error with that row's own tolerance (relative)
+    assert m.loc["mass_matrix", "reference vs mujoco"] == "failed 4.0e-03 (tol 5.0e-03)"
     assert m.loc["bias", "reference vs mujoco"] == "explained"
     assert m.loc["mass_matrix", "reference vs pinocchio"] == "skipped"
     assert list(m.index) == ["mass_matrix", "bias"]  # in the rows' order; no trajectory row
@@ -90,11 +91,25 @@ def test_a_cell_is_its_rows_worst_verdict_and_worst_error():
 
 def test_the_family_matrix_has_a_column_per_case_and_blanks_where_a_pair_is_absent():
     m = family_matrix(INSTANT, trajectories=False).set_index("pair")
-    assert m.loc["reference vs mujoco", "a"] == "failed 4.0e-03"
-    assert m.loc["reference vs mujoco", "b"] == "explained 3.0e-09"
+    assert m.loc["reference vs mujoco", "a"] == "failed 4.0e-03 (tol 5.0e-03)"
+    assert m.loc["reference vs mujoco", "b"] == "explained 3.0e-09 (tol 1.0e-14)"
     assert m.loc["reference vs pinocchio", "b"] == ""
+    # a trajectory row's tolerance is not relative (an order study's, an absolute drift):
+    # its cell gives the error alone
     t = family_matrix(INSTANT, trajectories=True).set_index("pair")
     assert t.loc["reference vs mujoco", "a"] == "failed 1.0e+00"
+
+
+def test_a_skipped_row_has_no_error_and_a_row_about_one_implementation_says_alone():
+    rows = pd.DataFrame([
+        _inst("a", "derivatives", "mjx", float("nan"), "skipped", 0.0, 0.0),
+        _inst("a", "mass_matrix", "reference", "mujoco", "skipped", 0.0, 0.0),
+        _inst("a", "mass_matrix", "reference", "mujoco", "passed", 1e-16),
+    ])
+    m = family_matrix(rows, trajectories=False).set_index("pair")
+    assert m.loc["mjx alone", "a"] == "skipped"  # not "skipped 0.0e+00", not "mjx vs "
+    # the skipped row is the worst verdict; the error is the checked row's
+    assert m.loc["reference vs mujoco", "a"] == "skipped 1.0e-16 (tol 1.0e-14)"
 
 
 def test_an_unknown_verdict_is_an_error_not_a_cell():
