@@ -114,8 +114,64 @@ def _stretch(mx: Any, d: Any) -> tuple[Any, tuple[Any, Any]]:
     return jax.lax.scan(one, d, None, length=STEPS)
 
 
+def _quat_times_small(quat: Any, w: Any) -> Any:
+    """quat ⊗ (1, w/2): a rotation by w in the quaternion's own (body) axes to first order —
+    MuJoCo's ``mj_integratePos`` chart for ball and free joints; its derivative at w = 0,
+    quat ⊗ (0, ·/2), is the exponential map's, which is all ``jacfwd`` takes."""
+    w0, x0, y0, z0 = quat[0], quat[1], quat[2], quat[3]
+    x1, y1, z1 = 0.5 * w[0], 0.5 * w[1], 0.5 * w[2]
+    return jnp.stack([
+        w0 - x0 * x1 - y0 * y1 - z0 * z1,
+        w0 * x1 + x0 + y0 * z1 - z0 * y1,
+        w0 * y1 - x0 * z1 + y0 + z0 * x1,
+        w0 * z1 + x0 * y1 - y0 * x1 + z0,
+    ])
+
+
+def _plus(mx: Any, q: Any, dq: Any) -> Any:
+    """q moved by a tangent vector dq in MuJoCo's chart (hinge and slide: added; ball: its
+    rotation in body axes; free: translation in world axes, rotation in body axes)."""
+    parts, qi, vi = [], 0, 0
+    for kind in np.asarray(mx.jnt_type):
+        if kind == mujoco.mjtJoint.mjJNT_FREE:
+            parts += [q[qi:qi + 3] + dq[vi:vi + 3], _quat_times_small(q[qi + 3:qi + 7],
+                                                                      dq[vi + 3:vi + 6])]
+            qi, vi = qi + 7, vi + 6
+        elif kind == mujoco.mjtJoint.mjJNT_BALL:
+            parts.append(_quat_times_small(q[qi:qi + 4], dq[vi:vi + 3]))
+            qi, vi = qi + 4, vi + 3
+        else:
+            parts.append(q[qi:qi + 1] + dq[vi:vi + 1])
+            qi, vi = qi + 1, vi + 1
+    return jnp.concatenate(parts)
+
+
+def _derivatives(mx: Any, q: Any, v: Any, a: Any) -> dict[str, Any]:
+    """JAX's forward-mode derivatives (``jacfwd``) of MJX's forward dynamics at τ = 0 with
+    respect to q (MuJoCo's chart), v and τ, and of its inverse dynamics at v̇ = a with respect
+    to q and v, at one state (vmapped)."""
+    zero = jnp.zeros_like(v)
+
+    def forward(qq: Any, vv: Any, tau: Any) -> Any:
+        d = mjx.make_data(mx).replace(qpos=qq, qvel=vv, qfrc_applied=tau)
+        return mjx.forward(mx, d).qacc
+
+    def inverse(qq: Any, vv: Any) -> Any:
+        d = mjx.forward(mx, mjx.make_data(mx).replace(qpos=qq, qvel=vv))
+        return mjx.inverse(mx, d.replace(qacc=a)).qfrc_inverse
+
+    return {
+        "forward_q": jax.jacfwd(lambda dq: forward(_plus(mx, q, dq), v, zero))(zero),
+        "forward_v": jax.jacfwd(lambda vv: forward(q, vv, zero))(v),
+        "forward_tau": jax.jacfwd(lambda tau: forward(q, v, tau))(zero),
+        "inverse_q": jax.jacfwd(lambda dq: inverse(_plus(mx, q, dq), v))(zero),
+        "inverse_v": jax.jacfwd(lambda vv: inverse(q, vv))(v),
+    }
+
+
 _EVALUATE = jax.jit(jax.vmap(_evaluate, in_axes=(None, 0, 0, 0, 0)))
 _STRETCH = jax.jit(_stretch)
+_DERIVATIVES = jax.jit(jax.vmap(_derivatives, in_axes=(None, 0, 0, 0)))
 """Compiled once per model structure and precision, shared by every adapter: the model is an
 argument, so a second adapter of the same structure (other masses, other step) reuses it."""
 
@@ -146,7 +202,7 @@ class MJXAdapter(PortAdapter):
         static fields key the cache) and batch shape: left alone, a run of every case in one
         process reached the kernel's limit of 65 530 memory maps and died in XLA's LLVM
         ("Cannot allocate memory", then SIGSEGV)."""
-        for jitted in (_EVALUATE, _STRETCH):
+        for jitted in (_EVALUATE, _STRETCH, _DERIVATIVES):
             cast(Any, jitted).clear_cache()  # a method of jit's wrapper its stubs do not declare
 
     @staticmethod
@@ -193,6 +249,15 @@ class MJXAdapter(PortAdapter):
             args = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, tau, a))
             out = _EVALUATE(self.mx, *args)
             return {k: np.asarray(x) for k, x in out.items()}
+
+    def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, np.ndarray]:
+        """The port's own derivatives at a batch of states (:func:`_derivatives`: JAX's
+        ``jacfwd`` through ``mjx.forward`` and ``mjx.inverse``), in MuJoCo's layout and
+        chart, computed in the adapter's precision."""
+        with self._precision():
+            args = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, a))
+            out = _DERIVATIVES(self.mx, *args)
+            return {k: np.asarray(x, dtype=float) for k, x in out.items()}
 
     def _run(
         self, q0: np.ndarray, v0: np.ndarray, steps: int, dt: float, integrator: str

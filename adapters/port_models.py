@@ -19,7 +19,7 @@ from typing import ClassVar
 import numpy as np
 
 from dyncheck.adapters.model_files import ModelFile
-from dyncheck.adapters.model_tree import Derivatives, Dynamics
+from dyncheck.adapters.model_tree import Derivatives, Dynamics, derivatives
 from dyncheck.adapters.mujoco_model import MujocoModel
 from dyncheck.errors import Unsupported
 
@@ -57,10 +57,17 @@ class PortModel(MujocoModel):
 
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
-        """Not the C engine's (which this class would inherit): a port's own derivatives
-        (JAX's ``jacfwd`` through MJX) are not checked yet — a skipped row says so."""
-        raise Unsupported(f"{self.engine}: the port's own derivatives are not checked yet "
-                          "(MuJoCo C's are on MuJoCo's rows)")
+        """The port's own derivatives, never the C engine's (which this class would inherit):
+        MJX's by JAX's automatic differentiation (``jacfwd``, exact to the port's round-off,
+        in MuJoCo's chart); a port without them (MuJoCo Warp's kernels are not
+        differentiated) is a skipped row that says so."""
+        own = getattr(self.adapter, "derivatives", None)
+        if own is None:
+            raise Unsupported(f"{self.engine} offers no derivatives of its dynamics (its "
+                              "kernels are not differentiated; MuJoCo C's are on MuJoCo's "
+                              "rows)")
+        return derivatives(own(q, v, a), method=f"automatic differentiation (JAX jacfwd, "
+                           f"{np.dtype(self.adapter.dtype).name})")
 
     def transition(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> tuple:
         raise Unsupported(f"{self.engine}: the port's step Jacobian is not checked yet")

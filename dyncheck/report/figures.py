@@ -184,12 +184,18 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     integrators = sorted(c["integrator"].unique()) or [""]
     impls = sorted(c["impl"].unique())
     styles = dict(zip(impls, _styles(len(impls)), strict=True))
-    panels = _panels([(integ, sorted(c.loc[c["integrator"] == integ, "impl"].unique()))
-                      for integ in integrators])
+    groups = []  # an integrator's implementations with different nominal orders (RK4 summed
+    for integ in integrators:  # across tangent spaces: 2) get panels and slopes of their own
+        runs = c[c["integrator"] == integ]
+        orders = sorted(runs["nominal_order"].unique())
+        for p in orders:
+            label = integ if len(orders) == 1 else f"{integ}, order {p}"
+            groups.append((label, sorted(runs.loc[runs["nominal_order"] == p, "impl"].unique())))
+    panels = _panels(groups) if groups else [("", [])]
     fig, axes = plt.subplots(len(panels), 1, figsize=(8.5, 2.4 * len(panels)),
                              squeeze=False, dpi=DPI)
     for ax, (label, part) in zip(axes[:, 0], panels, strict=True):
-        integ = label.split(" (")[0]
+        integ = label.split(" (")[0].split(",")[0]
         g_all = c[(c["integrator"] == integ) & c["impl"].isin(part)]
         for impl, g in g_all.groupby("impl"):
             colour, marker = styles[str(impl)]

@@ -157,7 +157,8 @@ def test_a_triangle_breaking_inertia_gives_its_fix_and_what_follows_from_it_name
     assert (leg["note"].str.startswith("follows from aa_leg's invalid inertia")).all()
     assert len(read) == len(leg)  # nothing else is read differently
     if DRAKE:  # Drake repairs the tensor (Pinocchio keeps it): the leg's inertia differs
-        assert len(leg) and leg["note"].str.contains("validity row: file: triangle").all()  # Drake's parser warns; its words reach the page whole, past their first colon
+        assert len(leg) and leg["note"].str.contains("validity row: file: triangle").all()
+        # and its parser warns: its words reach the page whole, past their first colon
         assert any("did not pass the test CouldBePhysicallyValid()" in n
                    and "triangle inequality" in n for n in result.notes), result.notes
 

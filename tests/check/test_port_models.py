@@ -44,13 +44,37 @@ def test_a_port_agrees_with_mujoco_and_the_referee_within_its_precision(port):
 
 
 def test_a_port_never_passes_off_mujoco_cs_derivatives_as_its_own():
-    """A port's model class inherits MuJoCo C's loader, derivatives included: it must refuse
-    them (a skipped row) rather than answer with the C engine's under the port's name."""
-    from dyncheck.adapters.port_models import MjxModel
+    """A port's model class inherits MuJoCo C's loader, derivatives included: a port without
+    derivatives of its own (MuJoCo Warp) must refuse them (a skipped row) rather than answer
+    with the C engine's under the port's name; no port's step Jacobian is checked."""
+    from types import SimpleNamespace
+
+    from dyncheck.adapters.port_models import MjxModel, MujocoWarpModel
     from dyncheck.errors import Unsupported
 
-    port = object.__new__(MjxModel)  # no port needed: the refusal comes before any work
-    with pytest.raises(Unsupported, match="mjx: the port's own derivatives"):
+    port = object.__new__(MujocoWarpModel)  # no port needed: the refusal comes before any work
+    port.adapter = SimpleNamespace()  # an adapter without derivatives of its own
+    with pytest.raises(Unsupported, match="mujoco-warp offers no derivatives"):
         port.derivatives(None, None, None)
     with pytest.raises(Unsupported, match="mjx: the port's step Jacobian"):
-        port.transition(None, None, None)
+        object.__new__(MjxModel).transition(None, None, None)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("port", ["mjx", "mjx-f64"])
+def test_mjxs_own_derivatives_agree_with_mujoco_c_and_the_referee(port):
+    """#46 item 8: MJX differentiated by JAX (``jacfwd`` through ``mjx.forward`` and
+    ``mjx.inverse``, in MuJoCo's chart) against MuJoCo C's finite differences and the
+    referee (the general method differentiated: an independent computation), on hinges,
+    a slide, a ball and a free body; float32 within its own round-off bound."""
+    if not _installed(port):
+        pytest.skip(f"needs the extra that installs {port}")
+    result = check_model(MODELS / "mixed.xml", impls=("reference", "mujoco", port), states=6,
+                         derivatives=True)
+    rows = result.rows[result.rows["subject"].str.startswith("d(")
+                       & (result.rows["impl_b"] == port)]
+    assert set(rows["impl_a"]) == {"reference", "mujoco"} and len(rows) == 10
+    assert (rows["verdict"] == "passed").all(), rows[["subject", "impl_a", "error", "note"]]
+    if port == "mjx":  # float32: the bound is float32's, and the errors are float32's
+        assert rows["basis"].str.contains("float32 eps").all()
+        assert rows["error"].max() > 1e-9

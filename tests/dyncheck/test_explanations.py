@@ -31,7 +31,7 @@ def test_every_catalogue_entry_is_a_property_of_engine_book_or_mathematics(name)
 def test_full_default_run_has_no_failed_row_and_skips_only_with_a_stated_reason(full_run):
     """Nothing fails; every skipped row states a limit of an engine or of its loader: the
     ports' (a field evaluated at every stage — no mjcb_passive in MJX or MuJoCo Warp —, Warp's
-    CPU step budget, their own derivatives not yet checked), the file loaders' (Newton,
+    CPU step budget, Warp's derivatives: none), the file loaders' (Newton,
     PyBullet: couplings, an external field, Newton's D6, PyBullet's spherical joint, a
     rotation's trajectory not mapped back, no derivatives), and the derivatives' (Pinocchio's
     composite joint, MuJoCo's gyroscopic implicitfast on a free joint)."""
@@ -41,7 +41,6 @@ def test_full_default_run_has_no_failed_row_and_skips_only_with_a_stated_reason(
     reasons = {
         "field": "mjcb_passive",
         "budget": "more than the 400 this engine makes here (cpu)",
-        "port derivatives": "the port's own derivatives are not checked yet",
         "couplings": "couplings (tendon equalities) are constraints",
         "external field": "an external field (a force on a body) is not an input",
         "D6": "fused the joints of one body into a D6 joint",

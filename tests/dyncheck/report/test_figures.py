@@ -126,8 +126,12 @@ def test_no_panel_holds_more_than_six_series_and_an_engine_keeps_its_style(monke
         t=t, reference=ref, runs={k: ref + 1e-3 for k in keys},
         errors={k: np.full(t.size, 1e-3) for k in keys}, steps={k: 0.01 for k in keys},
         energy={k: np.full(t.size, 1e-6) for k in keys})
+    def nominal(impl, integ):  # two engines' RK4 of order 2 (stages summed across tangents)
+        return 1 if integ == "euler" else 2 if impl in impls[:2] else 4
+
     conv = table([ConvergencePoint(case=CASE.name, impl=impl, integrator=integ, dt=dt,
-                                   error=dt, observed_order=1.0, nominal_order=1,
+                                   error=dt, observed_order=1.0,
+                                   nominal_order=nominal(impl, integ),
                                    reference_error=0.0, asymptotic=True)
                   for impl, integ in keys for dt in (0.01, 0.02)],
                  ConvergencePoint, CONVERGENCE_KEY)
@@ -135,6 +139,11 @@ def test_no_panel_holds_more_than_six_series_and_an_engine_keeps_its_style(monke
     monkeypatch.setattr(module, "_png", lambda fig: drawn.append(fig) or b"")
     module.figures(CASE, data, conv)
     assert len(drawn) == 4
+    # convergence: a panel's slope guide is its engines' nominal order, never a neighbour's
+    panels = [ax.get_ylabel() for ax in drawn[2].axes]
+    assert panels == ["euler (1/3): max error", "euler (2/3): max error",
+                      "euler (3/3): max error", "rk4, order 2: max error",
+                      "rk4, order 4 (1/2): max error", "rk4, order 4 (2/2): max error"]
     styles: dict[str, set] = {}
     for fig in drawn:
         for ax in fig.axes:
