@@ -284,7 +284,8 @@ def _row(
             max_rel_err=float("nan"),
             verdict="skipped" if bad.skipped else "failed",
             convention="",
-            note=f"{bad.name}: {bad.error}",
+            # the engine named once: its own message may already start with its name
+            note=bad.error if bad.error.startswith(f"{bad.name}: ") else f"{bad.name}: {bad.error}",
             worst_state=-1,
             worst_state_values="",
         )

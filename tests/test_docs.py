@@ -224,3 +224,10 @@ def test_the_guides_numbers_are_the_committed_reports(claim, quote):
     from its rows here, written there); a regenerated report that moves one fails here."""
     guide = (ROOT / "docs" / "guide.md").read_text(encoding="utf-8")
     assert quote in guide, f"{claim}: the data say {quote!r}"
+
+
+def test_no_note_names_its_engine_twice():
+    """#48: a skipped row's note said "mjx: mjx: …" (the engine's own message already named
+    it); the committed rows name each engine once."""
+    notes = pd.read_csv(ROOT / "reports" / "discrepancies.csv", keep_default_na=False)["note"]
+    assert not notes.str.contains(r"^([\w-]+): \1: ", regex=True).any()
