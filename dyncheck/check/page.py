@@ -104,6 +104,8 @@ def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
     ]
     for section in Section:
         part = rows[rows["section"] == section.value]
+        if section is Section.DERIVATIVES and not len(part):
+            continue  # not asked for (--derivatives): no section that reads "none"
         lines += [f"## {TITLES[section]}", "",
                   _table(part, ["subject", "field", "impl_a", "impl_b", "error", "tolerance",
                                 "verdict", "note"]), ""]

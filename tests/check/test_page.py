@@ -25,6 +25,15 @@ def test_versions_name_the_engines_used(tmp_path):
     assert versions["mujoco"] == mujoco.__version__  # as MuJoCo itself reports it
     for unused in ("pinocchio", "drake", "mujoco-mjx", "mujoco-warp"):
         assert versions[unused] == NOT_USED, unused
+    assert "## Derivatives" not in md  # not asked for: no section at all, not "none"
+
+
+def test_derivatives_asked_for_have_their_section(tmp_path):
+    result = check_model(MODELS / "mixed.xml", impls=("reference", "mujoco"), states=3,
+                         derivatives=True)
+    md = next(p for p in write(result, tmp_path) if p.suffix == ".md").read_text()
+    section = md.split("## Derivatives")[1].split("\n## ")[0]
+    assert "d(forward)/dq" in section and "_none_" not in section
 
 
 HOSTILE = {
