@@ -169,7 +169,7 @@ class DrakeAdapter(Adapter):
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
         self.xml = to_mjcf(model)
-        self.plant, self.parser_warnings = self._parse(self.xml)
+        self.plant, self.parser_warnings = self.parse_xml(self.xml)
         self.context = self.plant.CreateDefaultContext()
         self._bodies = [self.plant.GetBodyByName(b.name) for b in model.bodies]
         # the field's constants, read once (:meth:`_field_forces` runs at every stage): each
@@ -215,7 +215,7 @@ class DrakeAdapter(Adapter):
         raise EngineError(f"drake: no floating joint for body {body!r}")
 
     @staticmethod
-    def _parse(xml: str, time_step: float = 0.0) -> tuple[MultibodyPlant, list[str]]:
+    def parse_xml(xml: str, time_step: float = 0.0) -> tuple[MultibodyPlant, list[str]]:
         plant = MultibodyPlant(time_step)
         with parser_warnings() as warnings:
             Parser(plant).AddModelsFromString(xml, "xml")
@@ -461,7 +461,7 @@ class DrakeAdapter(Adapter):
         fixed step ``dt``, or error-controlled at ``accuracy`` (``dt`` None; steps then end at
         the logging times, so none is longer than ``period``)."""
         builder = DiagramBuilder()
-        plant = builder.AddSystem(self._parse(self.xml)[0])
+        plant = builder.AddSystem(self.parse_xml(self.xml)[0])
         if self.spec.central_mu:
             field = builder.AddSystem(_Field(self))
             builder.Connect(plant.get_state_output_port(), field.get_input_port(0))

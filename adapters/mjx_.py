@@ -38,6 +38,7 @@ import numpy as np
 from mujoco import mjx
 
 from dyncheck.adapters import REGISTRY
+from dyncheck.adapters.mujoco_api import INTEGRATORS
 from dyncheck.adapters.mujoco_port import STEPS, PortAdapter
 from dyncheck.cases.multibody import Multibody
 
@@ -80,11 +81,6 @@ _STALE = re.compile(r"function (trace_to_jaxpr|_infer_params_cached) ")
 _MODE: bool | None = None
 """The 64-bit mode of the last call into JAX (None before the first)."""
 
-_INTEGRATORS = {
-    "euler": mujoco.mjtIntegrator.mjINT_EULER,
-    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
-    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
-}
 
 
 def _evaluate(mx: Any, q: Any, v: Any, tau: Any, a: Any) -> dict[str, Any]:
@@ -264,7 +260,7 @@ class MJXAdapter(PortAdapter):
     ) -> tuple[np.ndarray, np.ndarray]:
         with self._precision():
             opt = self.mx.opt.replace(
-                integrator=mjx.IntegratorType(int(_INTEGRATORS[integrator])),
+                integrator=mjx.IntegratorType(int(INTEGRATORS[integrator])),
                 timestep=jnp.asarray(dt, dtype=self.dtype),
             )
             mx = self.mx.replace(opt=opt)

@@ -29,7 +29,7 @@ import numpy as np
 from dyncheck.adapters import REGISTRY, mujoco_api
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
-from dyncheck.adapters.mujoco_api import full_inertia
+from dyncheck.adapters.mujoco_api import INTEGRATORS, full_inertia
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import EngineError, Unsupported
 
@@ -39,12 +39,6 @@ _DIVERGED = (
     mujoco.mjtWarning.mjWARN_BADQACC,
 )
 
-_INTEGRATORS = {
-    "euler": mujoco.mjtIntegrator.mjINT_EULER,
-    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
-    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
-    "rk4-held-force": mujoco.mjtIntegrator.mjINT_RK4,
-}
 
 
 class MuJoCoAdapter(Adapter):
@@ -242,7 +236,7 @@ class MuJoCoAdapter(Adapter):
         m, d = self.model, self.data
         steps = round(duration / dt)
         m.opt.timestep = dt
-        m.opt.integrator = _INTEGRATORS[integrator]
+        m.opt.integrator = INTEGRATORS[integrator]
         mujoco.mj_resetData(m, d)
         d.qpos[:], d.qvel[:] = q0, v0
         qs = np.empty((steps + 1, m.nq))

@@ -16,6 +16,14 @@ def _release(text: str) -> tuple[int, ...]:
 
 RELEASE = _release(mujoco.__version__)
 
+INTEGRATORS: dict[str, mujoco.mjtIntegrator] = {
+    "euler": mujoco.mjtIntegrator.mjINT_EULER,
+    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+    "rk4-held-force": mujoco.mjtIntegrator.mjINT_RK4,  # the same RK4, a force held over it
+}
+"""dyncheck's integrator names → MuJoCo's (the C engine and its ports alike)."""
+
 FULLM_READS_DATA = RELEASE >= (3, 10, 0)
 """MuJoCo 3.10.0 changed ``mj_fullM(m, dst, M)`` (M: ``d.qM``) to ``mj_fullM(m, d, dst)``
 (changelog 3.10.0, item 14, commit 7b9b8806)."""

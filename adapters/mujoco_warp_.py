@@ -34,15 +34,10 @@ import mujoco_warp as mjw  # noqa: E402  (after silencing Warp's log)
 
 from dyncheck.adapters import REGISTRY  # noqa: E402
 from dyncheck.adapters.base import Trajectory  # noqa: E402
+from dyncheck.adapters.mujoco_api import INTEGRATORS  # noqa: E402
 from dyncheck.adapters.mujoco_port import CHUNK, PortAdapter  # noqa: E402
 from dyncheck.cases.multibody import Multibody  # noqa: E402
 from dyncheck.errors import Unsupported  # noqa: E402
-
-_INTEGRATORS = {
-    "euler": mujoco.mjtIntegrator.mjINT_EULER,
-    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
-    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
-}
 
 CPU_STEPS = 400
 """The longest run the adapter makes on Warp's CPU device (~16 s of RK4 steps)."""
@@ -197,7 +192,7 @@ class MuJoCoWarpAdapter(PortAdapter):
         if self.max_steps is not None and longest > self.max_steps:
             raise Unsupported(too_long(longest))
         self.model.opt.timestep = dts[0]
-        self.model.opt.integrator = _INTEGRATORS[integrator]
+        self.model.opt.integrator = INTEGRATORS[integrator]
         with wp.ScopedDevice(self.device):
             m = mjw.put_model(self.model)
             m.opt.timestep = wp.array(np.asarray(dts, np.float32), dtype=float)

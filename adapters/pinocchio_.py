@@ -228,7 +228,7 @@ class PinocchioAdapter(Adapter):
         """dyncheck's ``implicitfast`` has D = 0 here (no damping, no actuators): ``euler``."""
         return "euler" if integrator == "implicitfast" else integrator
 
-    def _to_mujoco(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def to_mujoco(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pinocchio's state → MuJoCo's layout: quaternions (x, y, z, w) → (w, x, y, z), a
         free joint's body-frame linear velocity v_b → v_w = R v_b."""
         q, v = np.asarray(q, float)[self._to_mj], np.array(v, float)
@@ -236,8 +236,8 @@ class PinocchioAdapter(Adapter):
             v[va : va + 3] = quat_to_matrix(q[None, qa + 3 : qa + 7])[0] @ v[va : va + 3]
         return q, v
 
-    def _from_mujoco(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The inverse of :meth:`_to_mujoco`."""
+    def from_mujoco(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The inverse of :meth:`to_mujoco`."""
         if not self.layout.rotating:  # the same layout: each stage's state as it is
             return np.asarray(q, float), np.asarray(v, float)
         q = np.asarray(q, float)
@@ -247,10 +247,10 @@ class PinocchioAdapter(Adapter):
                 v[va : va + 3] = quat_to_matrix(q[None, qa + 3 : qa + 7])[0].T @ v[va : va + 3]
         return q[self._to_pin], np.asarray(v, float)
 
-    def _mujoco_acceleration(self, q: np.ndarray, v: np.ndarray, held=None) -> np.ndarray:
+    def mujoco_acceleration(self, q: np.ndarray, v: np.ndarray, held=None) -> np.ndarray:
         """v̇ in MuJoCo's layout: Pinocchio's ABA, a free joint's v̇_b turned into
         R (v̇_b + ω × v_b), the rate of v_w = R v_b."""
-        qp, vp = self._from_mujoco(q, v)
+        qp, vp = self.from_mujoco(q, v)
         a = self._aba(qp, vp, self._zero_tau, held)
         if not self.layout.rotating:
             return a
@@ -261,11 +261,11 @@ class PinocchioAdapter(Adapter):
         return a
 
     def _stage_acceleration(self) -> Callable[..., np.ndarray]:
-        """:meth:`_mujoco_acceleration`; where the layouts agree and there is neither a cord
+        """:meth:`mujoco_acceleration`; where the layouts agree and there is neither a cord
         nor a field, the very call it comes down to (ABA at τ = 0), bound once: a stage's cost
         on a small model is Python's calls around the dynamics, not the dynamics."""
         if self.layout.rotating or self._C is not None or self.spec.central_mu:
-            return self._mujoco_acceleration
+            return self.mujoco_acceleration
         aba, m, d, zero = pin.aba, self.model, self.data, self._zero_tau
 
         def acc(q: np.ndarray, v: np.ndarray, held: object = None) -> np.ndarray:
@@ -274,11 +274,11 @@ class PinocchioAdapter(Adapter):
         return acc
 
     def _states_from_mujoco(self, qs: np.ndarray, vs: np.ndarray) -> tuple:
-        """:meth:`_from_mujoco` of every state of a run: at once where no free joint turns a
+        """:meth:`from_mujoco` of every state of a run: at once where no free joint turns a
         velocity (moving values only), state by state otherwise."""
         if not self._free:
             return qs[:, self._to_pin], vs
-        pairs = [self._from_mujoco(q, v) for q, v in zip(qs, vs, strict=True)]
+        pairs = [self.from_mujoco(q, v) for q, v in zip(qs, vs, strict=True)]
         return np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
 
     def simulate(
@@ -288,11 +288,11 @@ class PinocchioAdapter(Adapter):
         steps = round(duration / dt)
         qs, vs = integrate(
             self._stage_acceleration(),
-            *self._to_mujoco(q0, v0),
+            *self.to_mujoco(q0, v0),
             dt,
             steps,
             integrator,
-            freeze=lambda q, v: self._fext(self._from_mujoco(q, v)[0]),
+            freeze=lambda q, v: self._fext(self.from_mujoco(q, v)[0]),
             layout=self.layout,
         )
         qs, vs = self._states_from_mujoco(qs, vs)
@@ -347,8 +347,8 @@ class PinocchioAdapter(Adapter):
     def solve(self, q0: np.ndarray, v0: np.ndarray, t_eval: np.ndarray, rtol: float) -> Trajectory:
         """scipy's DOP853 at rtol = atol = ``rtol`` (:func:`.integrators.solve_on_group`)."""
         qs, vs = solve_on_group(
-            self._mujoco_acceleration,
-            *self._to_mujoco(q0, v0),
+            self.mujoco_acceleration,
+            *self.to_mujoco(q0, v0),
             t_eval,
             rtol,
             layout=self.layout,

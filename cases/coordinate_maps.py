@@ -227,7 +227,7 @@ class SphericalPendulumMap:
     description: str = "ball joint: R = Rz(θ+π) Rx(φ), ω = Rᵀ(r̂ × ṙ̂) (no spin)"
 
     @staticmethod
-    def _rotation(q: np.ndarray) -> np.ndarray:
+    def rotation(q: np.ndarray) -> np.ndarray:
         phi, th = q.T
         a = th + np.pi
         ca, sa, cp, sp_ = np.cos(a), np.sin(a), np.cos(phi), np.sin(phi)
@@ -254,7 +254,7 @@ class SphericalPendulumMap:
         return r, r_p, r_t, -r, r_pt, r_tt
 
     def to_engine(self, q: np.ndarray) -> np.ndarray:
-        return quat_from_matrix(self._rotation(q))
+        return quat_from_matrix(self.rotation(q))
 
     def to_book(self, qe: np.ndarray) -> np.ndarray:
         """(φ, θ) of the bob's direction r̂ = R (0, 0, −1), whatever the spin."""
@@ -264,14 +264,14 @@ class SphericalPendulumMap:
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         r, r_p, r_t, *_ = self._rhat(q)
         Jw = np.stack([np.cross(r, r_p), np.cross(r, r_t)], -1)
-        return np.swapaxes(self._rotation(q), 1, 2) @ Jw
+        return np.swapaxes(self.rotation(q), 1, 2) @ Jw
 
     def hessian_term(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         r, _, _, r_pp, r_pt, r_tt = self._rhat(q)
         pd, td = v[:, :1], v[:, 1:]
         second = r_pp * pd**2 + 2 * r_pt * pd * td + r_tt * td**2
         Hw = np.cross(r, second)
-        return np.einsum("nji,nj->ni", self._rotation(q), Hw)
+        return np.einsum("nji,nj->ni", self.rotation(q), Hw)
 
 
 @dataclass(frozen=True)
@@ -290,7 +290,7 @@ class EulerAngleMap:
     description: str = "ball joint: R = ℓ(φ, θ, ψ) of Example 9, ω̄ of exercise 23 (body frame)"
 
     @staticmethod
-    def _rotation(q: np.ndarray) -> np.ndarray:
+    def rotation(q: np.ndarray) -> np.ndarray:
         """ℓ(q) = (R₃(ψ) R₁(θ) R₃(φ))ᵀ, batched (n, 3, 3)."""
 
         def r3(a: np.ndarray) -> np.ndarray:
@@ -309,7 +309,7 @@ class EulerAngleMap:
         return np.swapaxes(r3(psi) @ r1(theta) @ r3(phi), -1, -2)
 
     def to_engine(self, q: np.ndarray) -> np.ndarray:
-        return quat_from_matrix(self._rotation(q))
+        return quat_from_matrix(self.rotation(q))
 
     def to_book(self, qe: np.ndarray) -> np.ndarray:
         """θ = arccos A₃₃, φ = atan2(A₃₁, −A₃₂), ψ = atan2(A₁₃, A₂₃) with A = ℓᵀ."""

@@ -15,7 +15,7 @@ Measured in one process, one run, medians of repeats (time.perf_counter):
 Peak memory of a sweep is measured in a fresh child process per size (its max RSS).
 
 With ``--jobs N`` or ``--dask ADDRESS`` the sweep is also run as a run cuts a large one: in
-slices of states (units of work, :func:`dyncheck.run.run`'s ``_sweep_slice``) on this process
+slices of states (units of work, :func:`dyncheck.run.run`'s ``sweep_slice``) on this process
 and on the workers, timed whole (the workers' start-up and their implementations' builds
 included, as a run pays them), its merged rows required to be the same CSV bytes in both.
 Timings are not test assertions; they go to ``benchmark.csv`` and ``benchmark.md``.
@@ -312,12 +312,12 @@ def sliced_sweep(
     from dyncheck.comparison import Sweep
     from dyncheck.comparison import rows as rows_of
     from dyncheck.results import DISCREPANCY_KEY, Discrepancy, table
-    from dyncheck.run import STATES_PER_UNIT, _sweep_slice
+    from dyncheck.run import STATES_PER_UNIT, sweep_slice
     from dyncheck.workers import LOCAL, run_units
 
     per_unit = min(STATES_PER_UNIT, -(-states // (2 * max(jobs, 1))))
     units = [
-        (f"states {start}..", _sweep_slice,
+        (f"states {start}..", sweep_slice,
          (case, list(impl_names), states, start, min(states, start + per_unit)))
         for start in range(0, states, per_unit)
     ]

@@ -386,7 +386,7 @@ class EngineImplementation(Implementation):
                 out[quantity] = co.force_to_book(m, q, delta)
         return out
 
-    def _engine_start(self) -> tuple[np.ndarray, np.ndarray]:
+    def engine_start(self) -> tuple[np.ndarray, np.ndarray]:
         """The case's initial state in engine coordinates (q, v)."""
         spec = self.case.trajectory
         q0 = np.asarray(spec.q0)[None]
@@ -396,7 +396,7 @@ class EngineImplementation(Implementation):
     def simulate(self, dt: float, integrator: str) -> tuple[np.ndarray, np.ndarray]:
         """Times and book-coordinate configurations of a fixed-step run, shapes (k,), (k, N)."""
         spec = self.case.trajectory
-        qe0, ve0 = self._engine_start()
+        qe0, ve0 = self.engine_start()
         key = (dt, self.adapter.definition(integrator))
         if key not in self._runs:  # two names for one map (implicitfast = euler, D = 0) run once
             self._keep(key, self.adapter.simulate(qe0, ve0, spec.duration, dt, integrator))
@@ -418,7 +418,7 @@ class EngineImplementation(Implementation):
         if not self.adapter.batches_steps or len(missing) < 2:
             return
         spec = self.case.trajectory
-        qe0, ve0 = self._engine_start()
+        qe0, ve0 = self.engine_start()
         try:
             runs = self.adapter.simulate_many(qe0, ve0, spec.duration, missing, integrator)
         except Exception:  # reported by the one-by-one runs that follow
@@ -438,7 +438,7 @@ class EngineImplementation(Implementation):
         """Book-coordinate configurations on the case's comparison grid of a run of the
         engine's own error-controlled integrator at ``accuracy``, and its number of steps."""
         spec = self.case.trajectory
-        qe0, ve0 = self._engine_start()
+        qe0, ve0 = self.engine_start()
         traj, steps = self.adapter.simulate_controlled(  # type: ignore[attr-defined]
             qe0, ve0, spec.duration, spec.grid_step, accuracy
         )
@@ -446,7 +446,7 @@ class EngineImplementation(Implementation):
 
     def solve(self, t: np.ndarray, rtol: float) -> np.ndarray:
         """Book-coordinate configurations of an error-controlled run at times ``t``."""
-        qe0, ve0 = self._engine_start()
+        qe0, ve0 = self.engine_start()
         return self.map.to_book(self.adapter.solve(qe0, ve0, t, rtol).q)
 
 

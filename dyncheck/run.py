@@ -112,7 +112,7 @@ def _implementations(
     return impls
 
 
-def _sweep_slice(case: Case, impl_names: Sequence[str], n: int, start: int, stop: int) -> Sweep:
+def sweep_slice(case: Case, impl_names: Sequence[str], n: int, start: int, stop: int) -> Sweep:
     """The instantaneous comparison over states [start, stop) of ``n`` (a unit of work)."""
     impls = _implementations(case, impl_names)
     return sweep(case, impls, case.iter_states(n, start=start, stop=stop), offset=start)
@@ -129,7 +129,7 @@ def _run_case(
            dict[str, bytes], dict[str, str]]:
     """Everything for one case (a unit of work for a worker process), its figures drawn by
     ``render`` where given, and the versions of the engines it used; ``sliced``: the
-    instantaneous comparison is left to :func:`_sweep_slice` units."""
+    instantaneous comparison is left to :func:`sweep_slice` units."""
     notes: dict[str, set[str]] = {}
     impls = _implementations(case, impl_names, notes)
     rows = [] if sliced else rows_of(sweep(case, impls, case.iter_states(states)))
@@ -185,7 +185,7 @@ def run(
             for start in range(0, n, states_per_unit):
                 stop = min(n, start + states_per_unit)
                 slices[case.name].append(len(units))
-                units.append((f"{case.name} states {start}..{stop - 1}", _sweep_slice,
+                units.append((f"{case.name} states {start}..{stop - 1}", sweep_slice,
                               (case, list(impl_names), n, start, stop)))
     if conventions:
         units += [(f"conventions: {name}", _convention, (name, list(impl_names)))
@@ -202,7 +202,7 @@ def run(
         if fn is _convention:
             entries += out[0]
             engines |= out[1]
-        elif fn is not _sweep_slice:  # a case; its slices' sweeps merged in order
+        elif fn is not sweep_slice:  # a case; its slices' sweeps merged in order
             r, p, f, said, drawn, used = out
             engines |= used
             if what in slices:

@@ -112,7 +112,7 @@ class Curve:
         dB = self.intrinsic_ds(B)  # = −τ N (2.2.14)
         return T, dT, kappa, N, B, dN, tau, dB
 
-    def _eval(self, expr, t0: float) -> np.ndarray:
+    def evaluate(self, expr, t0: float) -> np.ndarray:
         """``expr`` at t = t0, its repeated subexpressions computed once (``cse``: the frame's
         derivatives repeat the curve's, and printing them whole cost seconds a frame)."""
         f = sp.lambdify(self.t, expr, "numpy", cse=True)
@@ -122,35 +122,35 @@ class Curve:
 
     def tangent(self, t0: float) -> np.ndarray:
         """The unit tangent Tⁱ = dxⁱ/ds (2.2.6) at t0."""
-        if float(self._eval(self.speed, t0)) == 0.0:
+        if float(self.evaluate(self.speed, t0)) == 0.0:
             raise DegenerateCurve(f"speed is zero at t={t0}: no tangent")
-        return self._eval(self.velocity / self.speed, t0).ravel()
+        return self.evaluate(self.velocity / self.speed, t0).ravel()
 
     def frame(self, t0: float, *, tol: float = 1e-12) -> FrenetFrame:
         """T, N, B, κ, τ at t0; raises :class:`DegenerateCurve` where κ ≤ tol·(scale)."""
         T, dT, _, N, B, _, tau, _ = self._frame_exprs
-        speed = float(self._eval(self.speed, t0))
+        speed = float(self.evaluate(self.speed, t0))
         if speed == 0.0:
             raise DegenerateCurve(f"speed is zero at t={t0}: no Frenet frame")
-        k = float(np.sqrt(max(float(self._eval(self._dot(dT, dT), t0)), 0.0)))
+        k = float(np.sqrt(max(float(self.evaluate(self._dot(dT, dT), t0)), 0.0)))
         if k <= tol:
             raise DegenerateCurve(
                 f"curvature is zero at t={t0} (a straight line): the normal "
                 "N and binormal B are undefined"
             )
         return FrenetFrame(
-            self._eval(T, t0).ravel(),
-            self._eval(N, t0).ravel(),
-            self._eval(B, t0).ravel(),
+            self.evaluate(T, t0).ravel(),
+            self.evaluate(N, t0).ravel(),
+            self.evaluate(B, t0).ravel(),
             k,
-            float(self._eval(tau, t0)),
+            float(self.evaluate(tau, t0)),
         )
 
     def frenet_residuals(self, t0: float) -> dict[str, float]:
         """Max |·| of δT/δs − κN, δN/δs − (τB − κT), δB/δs + τN (2.2.15) at t0."""
         T, dT, kappa, N, B, dN, tau, dB = self._frame_exprs
         e = {"dT": dT - kappa * N, "dN": dN - (tau * B - kappa * T), "dB": dB + tau * N}
-        return {k: float(np.abs(self._eval(v, t0)).max()) for k, v in e.items()}
+        return {k: float(np.abs(self.evaluate(v, t0)).max()) for k, v in e.items()}
 
     def darboux(self, t0: float) -> np.ndarray:
         """D = τ T + κ B (exercise 29): δA/δs = D × A for A = T, N, B."""
@@ -174,13 +174,13 @@ class Curve:
             ]
         )
         return (
-            float(self._eval(sp.diff(self.speed, self.t), t0)),
-            float(self._eval(kappa * self.speed**2, t0)),
-            self._eval(f, t0).ravel(),
+            float(self.evaluate(sp.diff(self.speed, self.t), t0)),
+            float(self.evaluate(kappa * self.speed**2, t0)),
+            self.evaluate(f, t0).ravel(),
         )
 
     def position(self, t0: float) -> np.ndarray:
-        return self._eval(sp.Matrix(self.x), t0).ravel()
+        return self.evaluate(sp.Matrix(self.x), t0).ravel()
 
 
 def line_through(p1: np.ndarray, p2: np.ndarray, t: sp.Symbol) -> Curve:

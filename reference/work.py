@@ -33,7 +33,7 @@ def conservative_force(V: sp.Expr, q: tuple[sp.Symbol, ...]) -> Callable[..., li
 
 def kinetic_energy(curve: Curve, mass: float, t0: float) -> float:
     """T = ½ M g_mn ẋᵐ ẋⁿ (2.2.21) at t0."""
-    return float(0.5 * mass * curve._eval(curve.speed**2, t0))
+    return float(0.5 * mass * curve.evaluate(curve.speed**2, t0))
 
 
 def energy_drift(T: np.ndarray, V: np.ndarray) -> float:

@@ -133,3 +133,55 @@ def test_no_cycle_between_layers():
         visit(node, ())
     assert order.index("errors") < order.index("comparison")
     assert "comparison" not in edges.get("adapters", set())
+
+
+def _package_files() -> list[Path]:
+    """Every module of the package: dyncheck/ and the top-level folders it maps."""
+    return sorted(p for folder in ("dyncheck", "adapters", "cases", "reference")
+                  for p in (ROOT / folder).rglob("*.py"))
+
+
+def _private_definitions() -> dict[str, set[str]]:
+    """Every private name (``_x``) a module of the package defines — functions, classes,
+    methods, module and class attributes — by module."""
+    defined: dict[str, set[str]] = {}
+    for path in _package_files():
+        names = defined.setdefault(path.as_posix(), set())
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+                names.add(node.name)
+            elif isinstance(node, ast.Assign | ast.AnnAssign):
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                for target in targets:
+                    for leaf in ast.walk(target):
+                        if isinstance(leaf, ast.Name):
+                            names.add(leaf.id)
+                        elif isinstance(leaf, ast.Attribute):
+                            names.add(leaf.attr)
+        defined[path.as_posix()] = {n for n in names if _private(n)}
+    return defined
+
+
+def _private(name: str) -> bool:
+    return name.startswith("_") and not name.startswith("__")
+
+
+def test_no_module_reaches_into_another_modules_private_names():
+    """#43: a private name (``_x``) is used only in the module that defines it — imported by
+    no other, read on no other's object. Another module needing it is a sign it is public API
+    (rename it) or that the work belongs in its home. Third-party privates (JAX's, MJX's) are
+    not ours to police here."""
+    defined = _private_definitions()
+    ours = set().union(*defined.values())
+    reaches = []
+    for path in _package_files():
+        mine, where = defined[path.as_posix()], path.relative_to(ROOT)
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("dyncheck"):
+                reaches += [f"{where}:{node.lineno}: imports {a.name}" for a in node.names
+                            if _private(a.name)]
+            elif (isinstance(node, ast.Attribute) and _private(node.attr)
+                  and node.attr in ours and node.attr not in mine
+                  and not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"))):
+                reaches.append(f"{where}:{node.lineno}: reads .{node.attr}")
+    assert not reaches, "\n".join(reaches)

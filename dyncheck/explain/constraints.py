@@ -108,7 +108,7 @@ def drake_equality() -> Entry:
 
     (m1, m2, g), h = ATWOOD, 1e-3
     book = (m1 - m2) * g / (m1 + m2)  # Example 6
-    loaded, warnings = DrakeAdapter._parse(atwood_xml())  # continuous plant
+    loaded, warnings = DrakeAdapter.parse_xml(atwood_xml())  # continuous plant
     ctx = loaded.CreateDefaultContext()
     free_fall = float(loaded.get_generalized_acceleration_output_port().Eval(ctx)[0])
     ignored = sum("tendon" in w for w in warnings)

@@ -92,10 +92,10 @@ def velocity_frame() -> Entry:
             return base.to_book(qe)
 
         def jacobian(self, q):
-            return base._rotation(q) @ base.jacobian(q)
+            return base.rotation(q) @ base.jacobian(q)
 
         def hessian_term(self, q, v):
-            return np.einsum("nij,nj->ni", base._rotation(q), base.hessian_term(q, v))
+            return np.einsum("nij,nj->ni", base.rotation(q), base.hessian_term(q, v))
 
     return Entry(
         "ball-joint-velocity-frame",

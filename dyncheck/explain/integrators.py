@@ -53,7 +53,7 @@ def drake_fsal_caching() -> Entry:
     impl = make_implementation("drake", case)
     assert isinstance(impl, EngineImplementation)
     spec = case.trajectory
-    qe0, ve0 = impl._engine_start()
+    qe0, ve0 = impl.engine_start()
     ref = References(case)(impl.variant())[0][-1]  # the reference at the last grid time
     runs = {}
     for scheme, eps in FSAL_EPS.items():
@@ -123,7 +123,7 @@ def group_rk4() -> Entry:
     case = get_case("rigid_body_ball")
     impl = make_implementation("pinocchio", case)
     adapter = impl.adapter  # type: ignore[attr-defined]
-    q0, v0 = adapter._to_mujoco(*impl._engine_start())  # type: ignore[attr-defined]
+    q0, v0 = adapter.to_mujoco(*impl.engine_start())  # type: ignore[attr-defined]
     duration = case.trajectory.duration
     dts = case.trajectory.steps["rk4"][1:]
 
@@ -131,7 +131,7 @@ def group_rk4() -> Entry:
         ends = []
         for dt in dts:
             qs, _ = integrate(
-                adapter._mujoco_acceleration,
+                adapter.mujoco_acceleration,
                 q0,
                 v0,
                 dt,

@@ -86,7 +86,7 @@ def drake_mjcf_options() -> Entry:
         "</worldbody></mujoco>"
     )
     m = mujoco.MjModel.from_xml_string(xml)
-    plant, warnings = DrakeAdapter._parse(xml)
+    plant, warnings = DrakeAdapter.parse_xml(xml)
     joint = plant.GetJointByName("j")
     X = joint.frame_on_parent().CalcPoseInBodyFrame(plant.CreateDefaultContext())
     R_dk = RigidTransform(X).rotation().matrix()

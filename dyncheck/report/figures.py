@@ -184,19 +184,21 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     integrators = sorted(c["integrator"].unique()) or [""]
     impls = sorted(c["impl"].unique())
     styles = dict(zip(impls, _styles(len(impls)), strict=True))
-    groups = []  # an integrator's implementations with different nominal orders (RK4 summed
-    for integ in integrators:  # across tangent spaces: 2) get panels and slopes of their own
+    # an integrator's implementations with different nominal orders (RK4 summed across
+    # tangent spaces: 2) get panels and slopes of their own
+    groups: list[tuple[str, list[str]]] = []
+    for integ in integrators:
         runs = c[c["integrator"] == integ]
         orders = sorted(runs["nominal_order"].unique())
         for p in orders:
             label = integ if len(orders) == 1 else f"{integ}, order {p}"
             groups.append((label, sorted(runs.loc[runs["nominal_order"] == p, "impl"].unique())))
-    panels = _panels(groups) if groups else [("", [])]
-    fig, axes = plt.subplots(len(panels), 1, figsize=(8.5, 2.4 * len(panels)),
+    orders_panels = _panels(groups) if groups else [("", [])]
+    fig, axes = plt.subplots(len(orders_panels), 1, figsize=(8.5, 2.4 * len(orders_panels)),
                              squeeze=False, dpi=DPI)
-    for ax, (label, part) in zip(axes[:, 0], panels, strict=True):
+    for ax, (label, chosen) in zip(axes[:, 0], orders_panels, strict=True):
         integ = label.split(" (")[0].split(",")[0]
-        g_all = c[(c["integrator"] == integ) & c["impl"].isin(part)]
+        g_all = c[(c["integrator"] == integ) & c["impl"].isin(chosen)]
         for impl, g in g_all.groupby("impl"):
             colour, marker = styles[str(impl)]
             ax.loglog(g["dt"], g["error"], "-", color=colour, marker=marker, ms=4, lw=1,
@@ -213,7 +215,7 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     axes[-1, 0].set_xlabel("dt (s)")
     _title(axes[0, 0], "Error against step size, one panel per integrator (m or rad, as the "
            "case's coordinates)")
-    _layout(fig, rows=len(panels), legend=True)
+    _layout(fig, rows=len(orders_panels), legend=True)
     out["convergence"] = _png(fig)
 
     out["energy"] = _per_integrator(

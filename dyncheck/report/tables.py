@@ -66,6 +66,9 @@ def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) ->
     first = d[(d["quantity"] == "trajectory") & (d["impl_a"] == "reference")].drop_duplicates(run)
     verdicts = dict(zip(first[run].itertuples(index=False, name=None), first["verdict"],
                         strict=True))  # each run's first row's verdict
+    conventions = first["convention"].fillna("") if "convention" in first else \
+        pd.Series("", index=first.index)
+    why = dict(zip(first[run].itertuples(index=False, name=None), conventions, strict=True))
     for (c, impl, integ), g in conv.groupby(["case", "impl", "integrator"]):
         g = g.sort_values("dt", ascending=False)
         i = finest_pair(list(g["asymptotic"]))
@@ -81,6 +84,9 @@ def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) ->
                 "finest dt": g["dt"].min(),
                 "error at finest dt": g["error"].iloc[-1],
                 "verdict": verdict,
+                # an explained run's reason (a held force makes RK4 order 1: "nominal 1,
+                # observed 0.999, explained" reads as a contradiction without it)
+                "why": why[c, impl, integ] if verdict == "explained" else "",
             }
         )
     return pd.DataFrame(rows)

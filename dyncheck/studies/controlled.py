@@ -22,7 +22,7 @@ def attainable_rtol(impl: Implementation) -> float:
     accelerations (relative ε κ(M)), and the step size collapses chasing noise. It binds only
     for the spherical pendulum's quaternion state, whose spin about the rod carries the
     inertia floor alone (κ(M) ≈ 1e8); every other case keeps 1e-13."""
-    qe0, _ = impl._engine_start()  # type: ignore[attr-defined]
+    qe0, _ = impl.engine_start()  # type: ignore[attr-defined]
     mass = impl.adapter.mass_matrix(qe0[None])[0]  # type: ignore[attr-defined]
     return max(ADAPTIVE_RTOL, float(np.finfo(float).eps * np.linalg.cond(mass)))
 

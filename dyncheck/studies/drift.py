@@ -49,7 +49,7 @@ def momentum_drift(
     angles, rates = q[:, -3:], v[:, -3:]
     euler = EulerAngleMap()
     w = np.einsum("nij,nj->ni", euler.jacobian(angles), rates)
-    H = np.einsum("nij,nj->ni", euler._rotation(angles), rigid.angular_momentum(case.inertia(), w))
+    H = np.einsum("nij,nj->ni", euler.rotation(angles), rigid.angular_momentum(case.inertia(), w))
     return np.linalg.norm(H - H[0], axis=1) / np.linalg.norm(H[0])
 
 

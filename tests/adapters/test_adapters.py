@@ -309,7 +309,7 @@ def test_drake_parser_ignores_the_tendon_equality():
     Drake's M and h)."""
     from dyncheck.adapters.drake_ import DrakeAdapter
 
-    plant, warnings = DrakeAdapter._parse(to_mjcf(get_case("atwood").multibody()))
+    plant, warnings = DrakeAdapter.parse_xml(to_mjcf(get_case("atwood").multibody()))
     assert plant.num_velocities() == 2 and plant.num_constraints() == 0
     assert any("'tendon' found as a child of 'equality'" in w for w in warnings)
 

@@ -178,7 +178,7 @@ def test_warp_worlds_with_their_own_step_are_the_runs_one_by_one(case_name):
     case = get_case(case_name)
     spec, impl = case.trajectory, make_implementation("mujoco-warp", case)
     assert isinstance(impl, EngineImplementation) and impl.adapter.batches_steps
-    qe0, ve0 = impl._engine_start()
+    qe0, ve0 = impl.engine_start()
     dts = spec.steps["rk4"]
     many = impl.adapter.simulate_many(qe0, ve0, spec.duration, dts, "rk4")
     for dt, run in zip(dts, many, strict=True):

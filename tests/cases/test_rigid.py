@@ -47,8 +47,8 @@ def test_euler_map_velocity_is_body_frame_angular_velocity(states):
     A world-frame ω = R ω̄ differs (what a wrong-frame map would feed an engine)."""
     q, v = states
     m, h = EulerAngleMap(), 1e-6
-    R = m._rotation(q)
-    Rd = (m._rotation(q + h * v) - m._rotation(q - h * v)) / (2 * h)
+    R = m.rotation(q)
+    Rd = (m.rotation(q + h * v) - m.rotation(q - h * v)) / (2 * h)
     W = np.swapaxes(R, 1, 2) @ Rd
     w_body = np.stack([W[:, 2, 1], W[:, 0, 2], W[:, 1, 0]], -1)
     Jv = np.einsum("nij,nj->ni", m.jacobian(q), v)

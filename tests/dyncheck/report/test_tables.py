@@ -58,6 +58,19 @@ def test_each_run_gets_its_finest_asymptotic_order_and_its_trajectory_verdict():
     assert b["observed order"] == 3.0 and b["verdict"] == "failed"
 
 
+def test_an_explained_run_gives_its_reason_beside_its_order():
+    """#48: "rk4-held-force | nominal 1 | observed 0.999 | explained" needs its why."""
+    conv = pd.DataFrame([_point("k", "mujoco", "rk4-held-force", 0.01, 1e-3, 0.999, True,
+                                nominal=1),
+                         _point("k", "mujoco", "rk4-held-force", 0.02, 2e-3, float("nan"), True,
+                                nominal=1)])
+    rows = pd.DataFrame([{**_row("k", "mujoco", "rk4-held-force", "explained"),
+                          "convention": "state-dependent force held over RK4 stages"}])
+    t = order_table(conv, rows)
+    assert t["why"].tolist() == ["state-dependent force held over RK4 stages"]
+    assert order_table(CONV, ROWS)["why"].eq("").all()  # passed or failed: no reason given
+
+
 def test_one_case_only():
     t = order_table(CONV, ROWS, case="b")
     assert t["case"].tolist() == ["b"] and t["verdict"].tolist() == ["failed"]
