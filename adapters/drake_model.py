@@ -22,6 +22,7 @@ world).
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -137,6 +138,20 @@ def _first_of_several(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
                                           body=body.get("name", "(unnamed)"))
             out += [(named[0], field, why) for field in ("anchor", "axis")]
     return tuple(out)
+
+
+IGNORED_FRAME = (
+    "Drake's MJCF parser ignores <frame> (its own warning: 'currently unsupported and will be "
+    "ignored'): the bodies and joints inside a frame are not in its model (fix: move the "
+    "frame's pos and orientation onto the bodies it holds)"
+)
+
+
+def _ignored_frames(notes: Sequence[str]) -> tuple[tuple[str, str, str], ...]:
+    """A model-wide hint for a joint Drake lacks, where its parser said it ignored a
+    <frame>: the missing joint's row then names the cause and the fix."""
+    said = any("'frame'" in n and "ignored" in n for n in notes)
+    return (("model", "joint", IGNORED_FRAME),) if said else ()
 
 
 def _summary(warnings: list[str]) -> list[str]:
@@ -269,7 +284,7 @@ class DrakeModel:
             for j in joints
             if j.type is not JointType.FREE and j.name not in reflected
             and self._source.format is Format.MJCF
-        ) + _first_of_several(self._source)
+        ) + _first_of_several(self._source) + _ignored_frames(notes)
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
                          nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,
                          hints=hints)

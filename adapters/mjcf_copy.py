@@ -51,10 +51,11 @@ def _read(path: Path, including: Path) -> ET.Element:
     except OSError as exc:
         raise EngineError(f"{including}: <include file={path.name!r}>: cannot be read "
                           f"({exc.strerror})") from None
+    info = os.fstat(fd)  # before fdopen, which refuses a folder with its fd for a name
+    if not stat.S_ISREG(info.st_mode):
+        os.close(fd)
+        raise EngineError(f"{including}: <include file={path.name!r}>: not a regular file")
     with os.fdopen(fd, "rb") as handle:
-        info = os.fstat(handle.fileno())
-        if not stat.S_ISREG(info.st_mode):
-            raise EngineError(f"{including}: <include file={path.name!r}>: not a regular file")
         if info.st_size > MAX_INCLUDE_BYTES:
             raise EngineError(f"{including}: <include file={path.name!r}>: larger than "
                               f"{MAX_INCLUDE_BYTES // 2**20} MiB")
@@ -78,6 +79,8 @@ def inline(path: Path) -> ET.Element:
                 expand(child, chain)
                 continue
             name = child.get("file", "")
+            if not name.strip():
+                raise EngineError(f"{chain[-1]}: <include> has no file attribute")
             target = (main.parent / name).resolve()
             if not target.exists():  # older files: relative to the including file
                 target = (chain[-1].parent / name).resolve()

@@ -6,6 +6,9 @@ Every adapter and study calls MuJoCo through these where the API changed within 
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+
 import mujoco
 import numpy as np
 
@@ -47,3 +50,18 @@ RK4_ON_GROUP = RELEASE >= (4, 0, 0)
 dexp⁻¹, commit 9a7f240f0): order 4 on ball and free joints. Before, the stages' angular
 velocities were summed as if in one tangent space: order 2 there (measured by the version
 matrix, ``reports/versions.md``)."""
+
+
+@contextmanager
+def mujoco_warnings() -> Iterator[list[str]]:
+    """MuJoCo's warnings while the block runs, kept in the yielded list (whitespace
+    collapsed) for the page: without a handler MuJoCo prints them and appends them to
+    ``MUJOCO_LOG.TXT`` in the working directory — a file left in the user's repository by a
+    check of a model with a NaN in it. The previous handler is restored."""
+    found: list[str] = []
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: found.append(" ".join(str(message).split())))
+    try:
+        yield found
+    finally:
+        mujoco.set_mju_user_warning(previous)

@@ -33,7 +33,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
-from dyncheck.adapters.mujoco_api import GYROSCOPIC_IMPLICIT, full_inertia
+from dyncheck.adapters.mujoco_api import GYROSCOPIC_IMPLICIT, full_inertia, mujoco_warnings
 from dyncheck.errors import EngineError
 
 ENGINE = "mujoco"
@@ -62,6 +62,12 @@ is ≈ step/2 × |∂²τ| + 2 × (τ's round-off) / step — the check predicts
 
 
 def _compile(source: ModelFile) -> tuple[mujoco.MjModel, tuple[str, ...]]:
+    with mujoco_warnings() as said:  # to the page, never to MUJOCO_LOG.TXT in the user's cwd
+        model, notes = _compile_quietly(source)
+    return model, (*notes, *(f"mujoco warning: {m}" for m in said))
+
+
+def _compile_quietly(source: ModelFile) -> tuple[mujoco.MjModel, tuple[str, ...]]:
     notes: list[str] = []
     try:
         if source.format is Format.MJCF:
@@ -195,13 +201,9 @@ class MujocoModel:
             limited = bool(m.jnt_limited[j]) and kind in (JointType.HINGE, JointType.SLIDE)
             joints.append(
                 TreeJoint(
-                    name=m.joint(j).name or f"{m.body(b).name}:{kind}",
+                    name=_joint_name(m, j),
                     type=kind,
-                    parent=None if parent is None else (
-                        m.joint(parent).name
-                        or f"{m.body(int(m.jnt_bodyid[parent])).name}:"
-                        f"{_TYPES[int(m.jnt_type[parent])]}"
-                    ),
+                    parent=None if parent is None else _joint_name(m, parent),
                     body=m.body(b).name,
                     axis=axis,
                     anchor=d.xanchor[j].copy() if kind is not JointType.FREE else d.xpos[b].copy(),
@@ -318,3 +320,18 @@ class MujocoModel:
         finally:
             m.opt.integrator = integrator
         return tuple(out)
+
+
+def _joint_name(m: mujoco.MjModel, j: int) -> str:
+    """Joint ``j``'s name, or for a joint the file leaves unnamed one of its own that no
+    other joint has: ``body:type`` (``body`` its body's name, or ``body 3`` by MuJoCo's id
+    where that is unnamed too), with the joint's place among its body's joints where the
+    body has several of that type."""
+    if m.joint(j).name:
+        return m.joint(j).name
+    b = int(m.jnt_bodyid[j])
+    kind = _TYPES[int(m.jnt_type[j])]
+    same = [k for k in range(m.njnt) if int(m.jnt_bodyid[k]) == b
+            and _TYPES[int(m.jnt_type[k])] == kind]
+    body = m.body(b).name or f"body {b}"
+    return f"{body}:{kind}" if len(same) == 1 else f"{body}:{kind}{same.index(j)}"

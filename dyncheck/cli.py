@@ -13,6 +13,7 @@ so that every flag, its check (exit 2) and its example are read in one place.
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import re
 import sys
@@ -43,6 +44,11 @@ def _path(text: str) -> Path:
     """A path argument; an empty one is refused (it would silently mean this folder)."""
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path is not a folder or file name")
+    try:
+        os.stat(text)
+    except OSError as exc:  # a missing path is each command's to name; a loop is no path
+        if exc.errno == errno.ELOOP:
+            raise argparse.ArgumentTypeError(f"{text!r} is a symlink loop") from None
     return Path(text)
 
 
@@ -96,6 +102,13 @@ def _ci_files(args: argparse.Namespace) -> None:
     for flag, path in (("--junit", args.junit), ("--json", args.json)):
         if path is not None:
             _check_out_file(flag, path)
+            out = getattr(args, "out", None)
+            if out is not None and path.resolve() == Path(out).resolve():
+                raise InvalidInput(flag, str(path), "a file path other than the --out folder")
+    if args.junit is not None and args.json is not None \
+            and args.junit.resolve() == args.json.resolve():
+        raise InvalidInput("--json", str(args.json), "a file other than --junit's (one would "
+                           "overwrite the other)")
 
 
 def _write_ci(args: argparse.Namespace, tables: dict[str, pd.DataFrame], columns: Columns,

@@ -229,9 +229,10 @@ def version_changes(a: dict[str, str], b: dict[str, str]) -> list[str]:
 
 
 def check_factor(factor: float) -> None:
-    """``--tolerance`` must be a factor > 1 (NaN is not)."""
-    if not factor > 1.0:
-        raise InvalidInput("--tolerance", factor, "a factor > 1")
+    """``--tolerance`` must be a finite factor > 1 (NaN is not; infinity would let nothing
+    move, a silent pass)."""
+    if not 1.0 < factor < float("inf"):
+        raise InvalidInput("--tolerance", factor, "a finite factor > 1")
 
 
 def diff(a: RunTables, b: RunTables, *, factor: float = FACTOR) -> pd.DataFrame:

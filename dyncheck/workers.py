@@ -65,6 +65,31 @@ def executor(jobs: int = 1, dask: str | None = None) -> Iterator[Executor | None
         raise InvalidInput(
             "--dask", dask, "used with the extra 'dask' installed (pip install 'dyncheck[dask]')"
         ) from None
+    with _quiet_distributed():
+        yield from _dask_executor(jobs, dask, Client, LocalCluster)
+
+
+@contextmanager
+def _quiet_distributed() -> Iterator[None]:
+    """distributed's own log records above CRITICAL while its client is ours: a cluster
+    that loses a unit logs its tracebacks (``distributed.client - ERROR``) to stderr before
+    :func:`_result` turns the loss into one line. Restored afterwards."""
+    import logging
+
+    names = ["distributed", *(n for n in logging.root.manager.loggerDict
+                              if n.startswith("distributed."))]  # each has its own handler
+    levels = {n: logging.getLogger(n).level for n in names}
+    for name in names:
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        for name, level in levels.items():
+            logging.getLogger(name).setLevel(level)
+
+
+def _dask_executor(jobs: int, dask: str, Client: Any,
+                   LocalCluster: Any) -> Iterator[Executor]:
     if dask == LOCAL:
         import dask as dask_config
 
@@ -137,10 +162,31 @@ def run_units(
             return done
         futures = [pool.submit(fn, *args) for _what, fn, args in units]
         for (what, _fn, _args), future in zip(units, futures, strict=True):
-            done.append(future.result())
+            done.append(_result(future, what, dask))
             if progress is not None:
                 progress.done(what)
         return done
+
+
+def _result(future: Any, what: str, dask: str | None) -> Any:
+    """A unit's result, or — where the pool lost it — an error naming the unit and why,
+    never an exception of the pool's own (a dask scheduler that died mid-run raised
+    ``CancelledError``, which ended the command with exit 1 as if a check had failed; a
+    lost connection, an ``OSError``, read as a failed write)."""
+    from concurrent.futures import CancelledError
+    from concurrent.futures.process import BrokenProcessPool
+
+    try:
+        return future.result()
+    except BrokenProcessPool:
+        raise EngineError(f"{what}: its worker process died (a crash in an engine outside "
+                          "its own process, or out of memory); nothing was written") from None
+    except (CancelledError, TimeoutError, OSError) as exc:
+        if dask is None:
+            raise
+        raise InvalidInput("--dask", dask, f"a cluster that keeps its scheduler and workers "
+                           f"for the whole run: it lost {what!r} ({type(exc).__name__}); "
+                           "nothing was written") from None
 
 
 def each_unit(

@@ -38,18 +38,21 @@ def _root(path: Path) -> ET.Element | None:
 
 def in_folder(folder: Path) -> list[Path]:
     """The model files under ``folder``: MJCF and URDF roots, MJCF files that another one
-    includes left out (fragments: materials, assets, shared bodies). Each file parsed once."""
-    candidates: list[tuple[Path, ET.Element]] = []
+    includes left out (fragments: materials, assets, shared bodies), and files with a model's
+    suffix that are not XML at all — a broken model is refused on its own line, never
+    skipped without a word (well-formed XML of another kind, a launch file, is no model).
+    Each file parsed once."""
+    candidates: list[tuple[Path, ET.Element | None]] = []
     for path in sorted(folder.rglob("*")):
         if path.suffix.lower() in MODEL_SUFFIXES and path.is_file() and not path.is_symlink():
             root = _root(path)
-            if root is not None and root.tag in ("mujoco", "robot"):
+            if root is None or root.tag in ("mujoco", "robot"):
                 candidates.append((path, root))
             if len(candidates) > MAX_MODELS:
                 raise InvalidInput("PATH", str(folder), f"a folder of at most {MAX_MODELS} "
                                    "model files")
     included = {(path.parent / i.get("file", "")).resolve() for path, root in candidates
-                if root.tag == "mujoco" for i in root.iter("include")}
+                if root is not None and root.tag == "mujoco" for i in root.iter("include")}
     return [p for p, _ in candidates if p.resolve() not in included]
 
 

@@ -43,11 +43,18 @@ def model_path(text: str) -> Path:
     except ET.ParseError as exc:
         line, column = exc.position
         raise ModelFileError(path, f"not XML (line {line}, column {column})") from None
+    except LookupError as exc:  # <?xml encoding="..."?> that Python does not know
+        raise ModelFileError(path, f"not XML: it declares an encoding no parser knows "
+                             f"({exc})") from None
     if root.tag == "robot":
         _check_urdf(path, root)
     elif root.tag != "mujoco":
         raise ModelFileError(path, f"root element <{root.tag}> is neither <mujoco> nor <robot>")
     else:  # an include cycle or a FIFO would hang a parser: refused before any engine runs
+        if path.suffix != ".xml":  # MuJoCo picks its decoder by the suffix, case and all
+            raise ModelFileError(path, f"an MJCF must be named *.xml for MuJoCo, which picks "
+                                 f"its parser by the file's suffix (rename it; got "
+                                 f"{path.suffix or 'no suffix'!r})")
         _utf8(path, raw)
         try:
             inline(path)
@@ -69,7 +76,18 @@ def _utf8(path: Path, raw: bytes) -> None:
                              "UTF-8 only (save the file as UTF-8)") from None
 
 
+XACRO = "{http://www.ros.org/wiki/xacro}"
+"""xacro's XML namespace: its elements in a file mean the file is a template, not a URDF."""
+
+
 def _check_urdf(path: Path, root: ET.Element) -> None:
+    xacro = next((e.tag.removeprefix(XACRO) for e in root.iter()
+                  if isinstance(e.tag, str) and e.tag.startswith(XACRO)), None)
+    if xacro is not None or any("${" in value for e in root.iter() for value in e.attrib.values()):
+        what = f"<xacro:{xacro}>" if xacro else "a ${…} expression"
+        raise ModelFileError(path, f"is an unexpanded xacro file ({what}): the engines would "
+                             "read its plain parts only; expand it first (xacro FILE > "
+                             "robot.urdf)")
     for joint in root.findall("joint"):  # not <transmission>'s <joint> references
         kind = joint.get("type", "")
         if kind not in URDF_JOINTS:

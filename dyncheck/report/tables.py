@@ -47,7 +47,8 @@ def _cells(rows: pd.DataFrame, keys: list[str], sort: bool, tolerance: bool) -> 
         worst = finite.loc[finite["error"].idxmax()]
         cell = f"{name} {worst['error']:.1e}"
         cells[key] = cell + (f" (tol {worst['tol']:.1e})" if np.isfinite(worst["tol"]) else "")
-    return pd.Series(cells).rename_axis(keys)
+    index = pd.MultiIndex.from_tuples(list(cells), names=keys)  # empty too: no pair
+    return pd.Series(list(cells.values()), index=index, dtype=object)
 
 
 def instantaneous_matrix(d: pd.DataFrame, case: str) -> pd.DataFrame:

@@ -302,6 +302,18 @@ def test_joints_and_bodies_without_names_are_matched_by_place(tmp_path):
     assert ("reference", "drake") in pairs
 
 
+def test_unnamed_joints_of_one_type_in_unnamed_bodies_stay_apart(tmp_path):
+    """Three unnamed hinges in three unnamed nested bodies: MuJoCo's reading named each
+    ':hinge' — one name for three joints, matched to one another, 12 false 'parent' and 'com'
+    failures. Each now has a name of its own (by MuJoCo's body id) and the engines agree
+    (expected: MuJoCo's, Pinocchio's and Drake's readings of the same file)."""
+    body = "".join('<body pos="0 0 0.1"><joint type="hinge"/><geom size="0.01"/>'
+                   for _ in range(3)) + "</body>" * 3
+    result = check_model(_write(tmp_path, "nested", body), states=5)
+    assert result.ok, result.failures()
+    assert len(_rows(result, "description", "failed")) == 0
+
+
 def test_floating_on_an_mjcf_is_said_not_silently_ignored(tmp_path):
     """``--floating`` frees a URDF's root link; an MJCF states its own free joints: the flag
     is not applied, and the notes say so (it was ignored without a word)."""
@@ -310,3 +322,18 @@ def test_floating_on_an_mjcf_is_said_not_silently_ignored(tmp_path):
     result = check_model(path, floating=True, states=3, impls=("reference", "mujoco"))
     assert result.ok and any("--floating not applied" in n for n in result.notes)
     assert {j for j in _rows(result, "load")["note"]} == {"nq=1 nv=1"}
+
+
+def test_a_body_in_a_frame_drake_ignores_names_the_frame_and_the_fix(tmp_path):
+    """MuJoCo reads <frame>; Drake's MJCF parser ignores it (its own warning) and with it
+    the bodies inside: the missing joint's row says why and how to write the file instead.
+    Expected: Drake's reading (no joint) and its parser's warning, read from Drake itself."""
+    pytest.importorskip("pydrake")
+    body = ('<frame pos="0 0 1"><body name="b"><joint name="j" type="hinge"/>'
+            '<geom size="0.1"/></body></frame>')
+    result = check_model(_write(tmp_path, "framed", body), states=3,
+                         impls=("reference", "mujoco", "drake"))
+    missing = _rows(result, "description", "failed")
+    assert list(missing["subject"]) == ["j"]
+    assert missing["note"].str.contains("ignores <frame>").all()
+    assert missing["note"].str.contains("fix: move the frame's pos").all()

@@ -433,10 +433,10 @@ FAULTS: tuple[Fault, ...] = (
           answer=r"RUN_B must be the output of `run`, like RUN_A"),
     Fault(kind="--tolerance below 1", area="diff",
           argv=("diff", str(REPORTS), str(REPORTS), "--tolerance", "0.5"),
-          answer=r"--tolerance must be a factor > 1, got 0.5$"),
+          answer=r"--tolerance must be a finite factor > 1, got 0.5$"),
     Fault(kind="--tolerance NaN", area="diff",
           argv=("diff", str(REPORTS), str(REPORTS), "--tolerance", "nan"),
-          answer=r"--tolerance must be a factor > 1, got nan$"),
+          answer=r"--tolerance must be a finite factor > 1, got nan$"),
     Fault(kind="--markdown a folder", area="diff", prepare=_folder("md"),
           argv=("diff", str(REPORTS), str(REPORTS), "--markdown", "{tmp}/md"),
           answer=r"--markdown must be a file path, not a folder, got '<tmp>/md'$"),
@@ -584,6 +584,894 @@ FAULTS: tuple[Fault, ...] = (
           answer=r"^g must be a positive finite number, got 0\.0$"),
 )
 
+# --- the second probe (#44): MJCF and URDF files other people write, every command's options
+REPORTS_DIR = str(REPORTS)
+
+
+def mj(body: str, extra: str = "") -> str:
+    return f"<mujoco>{extra}<worldbody>{body}</worldbody></mujoco>"
+
+
+HINGE = (
+    "<body name='b'><joint name='j' type='hinge' axis='0 1 0'/><geom size='0.1' mass='1'/></body>"
+)
+
+
+def chk(kind, name, content, *more, exit=2, answer="."):
+    return Fault(
+        kind=kind,
+        area="check",
+        prepare=_file(name, content),
+        argv=("check", "{tmp}/" + name, "--states", "3", *more, "--out", OUT),
+        answer=answer,
+        exit=exit,
+    )
+
+
+HOSTILE_MODELS: tuple[Fault, ...] = (
+    chk(
+        "MJCF joint range with min above max",
+        "a.xml",
+        mj("<body><joint type='hinge' range='1 -1'/><geom size='0.1'/></body>"),
+        exit=1,
+        answer=r"^a: \d+ passed, \d+ explained, [1-9]\d* failed",
+    ),
+    chk(
+        "MJCF free joint inside a child body",
+        "a.xml",
+        mj(
+            "<body><joint type='hinge'/><geom size='0.1'/><body><freejoint/><geom size='0.1'/>"
+            "</body></body>"
+        ),
+        exit=2,
+        answer=r"<tmp>/a\.xml: mujoco refused <tmp>/a\.xml: Error: free joint can only be",
+    ),
+    chk(
+        "MJCF inertial mass negative",
+        "a.xml",
+        mj(
+            "<body><joint type='hinge'/><inertial pos='0 0 0' mass='-1' diaginertia='1 1 1'/>"
+            "</body>"
+        ),
+        exit=2,
+        answer=r"<tmp>/a\.xml: mujoco refused <tmp>/a\.xml: Error: mass and inertia of mo",
+    ),
+    chk(
+        "MJCF inertial mass NaN",
+        "a.xml",
+        mj(
+            "<body><joint type='hinge'/><inertial pos='0 0 0' mass='nan' diaginertia='1 1 1'/>"
+            "</body>"
+        ),
+        exit=2,
+        answer=r"<tmp>/a\.xml: mujoco refused <tmp>/a\.xml: Error: mass and inertia of mo",
+    ),
+    chk(
+        "MJCF diaginertia negative",
+        "a.xml",
+        mj(
+            "<body><joint type='hinge'/><inertial pos='0 0 0' mass='1' diaginertia='-1 1 1'/>"
+            "</body>"
+        ),
+        exit=2,
+        answer=r"<tmp>/a\.xml: mujoco refused <tmp>/a\.xml: Error: mass and inertia of mo",
+    ),
+    chk(
+        "MJCF fullinertia not positive definite",
+        "a.xml",
+        mj(
+            "<body><joint type='hinge'/>"
+            "<inertial pos='0 0 0' mass='1' fullinertia='1 1 1 2 0 0'/></body>"
+        ),
+        exit=2,
+        answer=r"<tmp>/a\.xml: mujoco refused <tmp>/a\.xml: Error: error 'inertia must ha",
+    ),
+    chk(
+        "MJCF hinge axis zero",
+        "a.xml",
+        mj("<body><joint type='hinge' axis='0 0 0'/><geom size='0.1'/></body>"),
+        exit=2,
+        answer=r"<tmp>/a\.xml: mujoco refused <tmp>/a\.xml: Error: axis too small in join",
+    ),
+    chk(
+        "MJCF two joints with one name",
+        "a.xml",
+        mj(
+            "<body><joint name='j' type='hinge'/><geom size='0.1'/><body pos='0 0 1'>"
+            "<joint name='j' type='hinge'/><geom size='0.1'/></body></body>"
+        ),
+        exit=2,
+        answer=r"<tmp>/a\.xml: mujoco refused <tmp>/a\.xml: XML Error: Error: repeated na",
+    ),
+    chk(
+        "MJCF gravity NaN",
+        "a.xml",
+        mj(HINGE, "<option gravity='nan 0 0'/>"),
+        exit=1,
+        answer=r"^a: \d+ passed, \d+ explained, [1-9]\d* failed",
+    ),
+    chk(
+        "MJCF time step negative",
+        "a.xml",
+        mj(HINGE, "<option timestep='-1'/>"),
+        exit=0,
+        answer=r"^a: \d+ passed, \d+ explained, 0 failed",
+    ),
+    chk(
+        "MJCF unknown attribute",
+        "a.xml",
+        mj("<body><joint type='hinge' colour='red'/><geom size='0.1'/></body>"),
+        exit=2,
+        answer=r"<tmp>/a\.xml: mujoco refused <tmp>/a\.xml: XML Error: Schema violation: ",
+    ),
+    chk(
+        "MJCF moving body with no mass",
+        "a.xml",
+        mj("<body><joint type='hinge'/><site/></body>"),
+        exit=2,
+        answer=r"<tmp>/a\.xml: mujoco refused <tmp>/a\.xml: Error: mass and inertia of mo",
+    ),
+    chk(
+        "MJCF mesh file missing",
+        "a.xml",
+        "<mujoco><asset><mesh name='m' file='gone.stl'/></asset><worldbody><body>"
+        "<joint type='hinge'/><geom type='mesh' mesh='m'/></body></worldbody></mujoco>",
+        exit=2,
+        answer=r"<tmp>/a\.xml: mujoco refused <tmp>/a\.xml: Error: Error opening file 'go",
+    ),
+    chk(
+        "MJCF include of /etc/passwd",
+        "a.xml",
+        "<mujoco><include file='/etc/passwd'/></mujoco>",
+        exit=2,
+        answer=r"<tmp>/a\.xml: /etc/passwd: not XML \(not well-formed \(invalid token\): li",
+    ),
+    chk(
+        "MJCF include of /dev/zero",
+        "a.xml",
+        "<mujoco><include file='/dev/zero'/></mujoco>",
+        exit=2,
+        answer=r"<tmp>/a\.xml: <include file='zero'>: not a regular file",
+    ),
+    chk(
+        "MJCF include with no file attribute",
+        "a.xml",
+        "<mujoco><include/></mujoco>",
+        exit=2,
+        answer=r"<tmp>/a\.xml: <include> has no file attribute",
+    ),
+    chk(
+        "XML external entity (XXE) reading /etc/passwd",
+        "a.xml",
+        "<?xml version='1.0'?><!DOCTYPE m [<!ENTITY x SYSTEM 'file:///etc/passwd'>]>"
+        "<mujoco model='&x;'><worldbody/></mujoco>",
+        exit=2,
+        answer=r"<tmp>/a\.xml: not XML \(line 1, column 90\)",
+    ),
+    chk(
+        "XML billion laughs",
+        "a.xml",
+        "<?xml version='1.0'?><!DOCTYPE l [<!ENTITY a 'aaaaaaaaaa'>"
+        "<!ENTITY b '&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;'><!ENTITY c '&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;'>"
+        "<!ENTITY d '&c;&c;&c;&c;&c;&c;&c;&c;&c;&c;'><!ENTITY e '&d;&d;&d;&d;&d;&d;&d;&d;&d;&d;'>"
+        "<!ENTITY f '&e;&e;&e;&e;&e;&e;&e;&e;&e;&e;'><!ENTITY g '&f;&f;&f;&f;&f;&f;&f;&f;&f;&f;'>"
+        "<!ENTITY h '&g;&g;&g;&g;&g;&g;&g;&g;&g;&g;'>]><mujoco model='&h;'/>",
+        exit=2,
+        answer=r"<tmp>/a\.xml: not XML \(line 1, column 368\)",
+    ),
+    chk(
+        "MJCF in UTF-8 with a byte-order mark",
+        "a.xml",
+        ("\ufeff" + mj(HINGE)).encode("utf-8"),
+        exit=0,
+        answer=r"^a: \d+ passed, \d+ explained, 0 failed",
+    ),
+    chk(
+        "MJCF in UTF-16 (declared)",
+        "a.xml",
+        ("<?xml version='1.0' encoding='UTF-16'?>" + mj(HINGE)).encode("utf-16"),
+        exit=2,
+        answer=r"<tmp>/a\.xml: is encoded as UTF-16; the engines' MJCF parsers read UTF-",
+    ),
+    chk(
+        "MJCF in Latin-1 with an accented name (declared)",
+        "a.xml",
+        (
+            "<?xml version='1.0' encoding='ISO-8859-1'?>"
+            + mj(HINGE.replace("name='b'", "name='bé'"))
+        ).encode("latin-1"),
+        exit=2,
+        answer=r"<tmp>/a\.xml: is encoded as ISO-8859-1; the engines' MJCF parsers read ",
+    ),
+    chk(
+        "MJCF declaring an encoding it is not in",
+        "a.xml",
+        ("<?xml version='1.0' encoding='UTF-16'?>" + mj(HINGE)).encode("utf-8"),
+        exit=2,
+        answer=r"<tmp>/a\.xml: not XML \(line 1, column 30\)",
+    ),
+    chk(
+        "MJCF declaring an unknown encoding",
+        "a.xml",
+        ("<?xml version='1.0' encoding='klingon'?>" + mj(HINGE)).encode("utf-8"),
+        exit=2,
+        answer=r"<tmp>/a\.xml: not XML: it declares an encoding no parser knows \(unknown",
+    ),
+    chk(
+        "MJCF joint name of 10000 characters",
+        "a.xml",
+        mj(HINGE.replace("name='j'", "name='" + "j" * 10000 + "'")),
+        exit=0,
+        answer=r"^a: \d+ passed, \d+ explained, 0 failed",
+    ),
+    chk(
+        "MJCF joint name with Markdown and HTML",
+        "a.xml",
+        mj(HINGE.replace("name='j'", "name='&lt;b&gt;|x|&#10;# h'")),
+        exit=0,
+        answer=r"^a: \d+ passed, \d+ explained, 0 failed",
+    ),
+    chk(
+        "MJCF with springs (stiffness) and damping",
+        "a.xml",
+        mj(HINGE.replace("axis='0 1 0'", "axis='0 1 0' stiffness='10' damping='1'")),
+        exit=0,
+        answer=r"^a: \d+ passed, \d+ explained, 0 failed",
+    ),
+    chk(
+        "MJCF with an actuator and a sensor",
+        "a.xml",
+        mj(HINGE, "").replace(
+            "</mujoco>",
+            "<actuator><motor joint='j'/></actuator><sensor><jointpos joint='j'/></sensor>"
+            "</mujoco>",
+        ),
+        exit=0,
+        answer=r"^a: \d+ passed, \d+ explained, 0 failed",
+    ),
+    chk(
+        "MJCF with a weld equality",
+        "a.xml",
+        mj(
+            HINGE + "<body name='c' pos='1 0 0'><joint type='slide'/><geom size='0.1'/></body>"
+        ).replace("</mujoco>", "<equality><weld body1='b' body2='c'/></equality></mujoco>"),
+        exit=1,
+        answer=r"^a: \d+ passed, \d+ explained, [1-9]\d* failed",
+    ),
+    chk(
+        "MJCF with angles in degrees (compiler)",
+        "a.xml",
+        mj(
+            "<body euler='90 0 0'><joint type='hinge'/><geom size='0.1'/></body>",
+            "<compiler angle='degree'/>",
+        ),
+        exit=0,
+        answer=r"^a: \d+ passed, \d+ explained, 0 failed",
+    ),
+    chk(
+        "MJCF with 300 nested bodies",
+        "a.xml",
+        mj(
+            "".join(
+                "<body pos='0 0 0.1'><joint type='hinge'/><geom size='0.01'/>" for _ in range(300)
+            )
+            + "</body>" * 300
+        ),
+        exit=0,
+        answer=r"^a: \d+ passed, \d+ explained, 0 failed",
+    ),
+    chk(
+        "MJCF mujoco root with no worldbody",
+        "a.xml",
+        "<mujoco/>",
+        exit=2,
+        answer=r"<tmp>/a\.xml: has no degrees of freedom \(nothing moves\)",
+    ),
+    chk(
+        "URDF with two root links",
+        "a.urdf",
+        URDF.replace(
+            "</robot>",
+            '<link name="stray"><inertial><mass value="1"/>'
+            '<inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link></robot>',
+        ),
+        exit=1,
+        answer=r"^a: \d+ passed, \d+ explained, [1-9]\d* failed",
+    ),
+    chk(
+        "URDF with a joint to a missing link",
+        "a.urdf",
+        URDF.replace(
+            "</robot>",
+            '<joint name="x" type="revolute"><parent link="base"/><child link="ghost"/>'
+            '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+            '</robot>',
+        ),
+        exit=2,
+        answer=r"<tmp>/a\.urdf: no engine could load it: mujoco refused <tmp>/a\.urdf: XM",
+    ),
+    chk(
+        "URDF with two links of one name",
+        "a.urdf",
+        URDF.replace("</robot>", '<link name="base"/></robot>'),
+        exit=2,
+        answer=r"<tmp>/a\.urdf: no engine could load it: mujoco refused <tmp>/a\.urdf: XM",
+    ),
+    chk(
+        "URDF joint axis zero",
+        "a.urdf",
+        URDF.replace('<axis xyz="0 1 0"/>', '<axis xyz="0 0 0"/>', 1),
+        exit=1,
+        answer=r"^a: \d+ passed, \d+ explained, [1-9]\d* failed",
+    ),
+    chk(
+        "URDF inertia NaN",
+        "a.urdf",
+        URDF.replace('ixx="0.02"', 'ixx="nan"', 1),
+        exit=1,
+        answer=r"^a: \d+ passed, \d+ explained, [1-9]\d* failed",
+    ),
+    chk(
+        "URDF mass not a number",
+        "a.urdf",
+        URDF.replace('<mass value="1.5"/>', '<mass value="heavy"/>'),
+        exit=2,
+        answer=r"<tmp>/a\.urdf: link 'aa_leg': <mass value='heavy'> is not a number",
+    ),
+    chk(
+        "URDF origin with two numbers",
+        "a.urdf",
+        URDF.replace('rpy="0.1 0.2 0.3"', 'rpy="0.1 0.2"', 1),
+        exit=2,
+        answer=r"<tmp>/a\.urdf: no engine could load it: mujoco refused <tmp>/a\.urdf: XM",
+    ),
+    chk(
+        "URDF floating joint type",
+        "a.urdf",
+        URDF.replace('type="continuous"', 'type="floating"'),
+        exit=2,
+        answer=r"<tmp>/a\.urdf: joint 'leg_joint' has type 'floating', which is not chec",
+    ),
+    chk(
+        "URDF with no links",
+        "a.urdf",
+        '<robot name="r"/>',
+        exit=2,
+        answer=r"<tmp>/a\.urdf: has no degrees of freedom \(nothing moves\)",
+    ),
+    chk(
+        "URDF with xacro macros (not expanded)",
+        "a.urdf",
+        URDF.replace(
+            "</robot>",
+            '<xacro:macro name="m" xmlns:xacro="http://www.ros.org/wiki/xacro"/></robot>',
+        ),
+        exit=2,
+        answer=r"<tmp>/a\.urdf: is an unexpanded xacro file \(<xacro:macro>\): the engines",
+    ),
+    chk(
+        "URDF with transmission and gazebo tags",
+        "a.urdf",
+        URDF.replace("</robot>", '<transmission name="t"/><gazebo reference="base"/></robot>'),
+        exit=1,
+        answer=r"^a: \d+ passed, \d+ explained, [1-9]\d* failed",
+    ),
+    chk(
+        "URDF robot without a name",
+        "a.urdf",
+        URDF.replace('<robot name="branches">', "<robot>"),
+        exit=1,
+        answer=r"^a: \d+ passed, \d+ explained, [1-9]\d* failed",
+    ),
+)
+
+
+def twofiles(a, ca, b, cb):
+    def make(tmp):
+        _file(a, ca)(tmp)
+        _file(b, cb)(tmp)
+
+    return make
+
+
+def sub_folder(tmp):
+    (tmp / "sub").mkdir()
+    _file("a.xml", "<mujoco><include file='sub'/></mujoco>")(tmp)
+
+
+def symloop(tmp):
+    os.symlink(tmp / "l2.xml", tmp / "l1.xml")
+    os.symlink(tmp / "l1.xml", tmp / "l2.xml")
+
+
+def dangling(tmp):
+    os.symlink(tmp / "gone.xml", tmp / "d.xml")
+
+
+MJ = mj(HINGE)
+MORE_FAULTS: tuple[Fault, ...] = (
+    Fault(
+        kind="MJCF include of a folder",
+        area="check",
+        prepare=sub_folder,
+        argv=("check", "{tmp}/a.xml", "--out", OUT),
+        exit=2,
+        answer=r"<tmp>/a\.xml: <include file='sub'>: not a regular file",
+    ),
+    Fault(
+        kind="model path a symlink loop",
+        area="check",
+        prepare=symloop,
+        argv=("check", "{tmp}/l1.xml", "--out", OUT),
+        exit=2,
+        answer=r"argument PATH: '<tmp>/l1\.xml' is a symlink loop",
+    ),
+    Fault(
+        kind="model path a dangling symlink",
+        area="check",
+        prepare=dangling,
+        argv=("check", "{tmp}/d.xml", "--out", OUT),
+        exit=2,
+        answer=r"<tmp>/d\.xml: no such file",
+    ),
+    Fault(
+        kind="model path /dev/zero",
+        area="check",
+        argv=("check", "/dev/zero", "--out", OUT),
+        exit=2,
+        answer=r"/dev/zero: not a file",
+    ),
+    Fault(
+        kind="model path /dev/stdin (a terminal or pipe)",
+        area="check",
+        argv=("check", "/dev/stdin", "--out", OUT),
+        exit=2,
+        answer=r"/dev/stdin: not a file",
+    ),
+    Fault(
+        kind="model with an unknown suffix (.txt)",
+        area="check",
+        prepare=_file("m.txt", MJ),
+        argv=("check", "{tmp}/m.txt", "--out", OUT),
+        exit=2,
+        answer=r"<tmp>/m\.txt: an MJCF must be named \*\.xml for MuJoCo, which picks its p",
+    ),
+    Fault(
+        kind="model suffix in capitals (.XML)",
+        area="check",
+        prepare=_file("m.XML", MJ),
+        argv=("check", "{tmp}/m.XML", "--states", "3", "--out", OUT),
+        exit=2,
+        answer=r"<tmp>/m\.XML: an MJCF must be named \*\.xml for MuJoCo, which picks its p",
+    ),
+    Fault(
+        kind="model file name with spaces and accents",
+        area="check",
+        prepare=_file("mé del.xml", MJ),
+        argv=("check", "{tmp}/mé del.xml", "--states", "3", "--out", OUT),
+        exit=0,
+        answer=r"^mé\ del: \d+ passed, \d+ explained, 0 failed",
+    ),
+    Fault(
+        kind="model file name starting with = (a CSV formula)",
+        area="check",
+        prepare=_file("=cmd.xml", MJ),
+        argv=("check", "{tmp}/=cmd.xml", "--states", "3", "--out", OUT),
+        exit=0,
+        answer=r"^=cmd: \d+ passed, \d+ explained, 0 failed",
+    ),
+    Fault(
+        kind="--robot empty",
+        area="check",
+        argv=("check", "--robot", "", "--out", OUT),
+        exit=2,
+        answer=r"unknown robot ''; valid: TwoDofs, a1, alex_nub_hands, alex_psyonic_han",
+    ),
+    Fault(
+        kind="--case unknown",
+        area="check",
+        argv=("check", "--case", "nope", "--out", OUT),
+        exit=2,
+        answer=r"unknown case 'nope'; valid: atwood, compound_pendulum, compound_pulley",
+    ),
+    Fault(
+        kind="--impl given twice",
+        area="check",
+        prepare=_file("a.xml", MJ),
+        argv=(
+            "check",
+            "{tmp}/a.xml",
+            "--impl",
+            "mujoco",
+            "--impl",
+            "mujoco",
+            "--states",
+            "3",
+            "--out",
+            OUT,
+        ),
+        exit=0,
+        answer=r"^a: \d+ passed, \d+ explained, 0 failed",
+    ),
+    Fault(
+        kind="--impl empty",
+        area="check",
+        argv=("check", BRANCHES, "--impl", "", "--out", OUT),
+        exit=2,
+        answer=r"unknown implementation ''; valid: drake, mjx, mjx-f64, mujoco, mujoco-",
+    ),
+    Fault(
+        kind="--against a folder",
+        area="check",
+        prepare=_folder("old"),
+        argv=("check", BRANCHES, "--against", "{tmp}/old", "--out", OUT),
+        exit=2,
+        answer=r"<tmp>/old: not a file",
+    ),
+    Fault(
+        kind="--against a file that is not a model",
+        area="check",
+        prepare=_file("old.xml", "<svg/>"),
+        argv=("check", BRANCHES, "--against", "{tmp}/old.xml", "--out", OUT),
+        exit=2,
+        answer=r"<tmp>/old\.xml: root element <svg> is neither <mujoco> nor <robot>",
+    ),
+    Fault(
+        kind="--json below a file",
+        area="check",
+        prepare=_file("f", "x"),
+        argv=("check", BRANCHES, "--json", "{tmp}/f/out.json", "--out", OUT),
+        exit=2,
+        answer=r"--json must be a directory, got '<tmp>/f'",
+    ),
+    Fault(
+        kind="--junit below a file",
+        area="check",
+        prepare=_file("f", "x"),
+        argv=("check", BRANCHES, "--junit", "{tmp}/f/out.xml", "--out", OUT),
+        exit=2,
+        answer=r"--junit must be a directory, got '<tmp>/f'",
+    ),
+    Fault(
+        kind="--json and --junit the same file",
+        area="check",
+        argv=("check", BRANCHES, "--json", "{tmp}/r", "--junit", "{tmp}/r", "--out", OUT),
+        exit=2,
+        answer=r"--json must be a file other than --junit's \(one would overwrite the ot",
+    ),
+    Fault(
+        kind="--engine-memory negative",
+        area="check",
+        argv=("check", BRANCHES, "--engine-memory", "-5", "--out", OUT),
+        exit=2,
+        answer=r"--engine-memory must be 0 \(no cap\) or a size in MiB in \[256, 1048576\],",
+    ),
+    Fault(
+        kind="--engine-memory not a number",
+        area="check",
+        argv=("check", BRANCHES, "--engine-memory", "lots", "--out", OUT),
+        exit=2,
+        answer=r"argument --engine-memory: invalid int value: 'lots'",
+    ),
+    Fault(
+        kind="--engine-seconds negative",
+        area="check",
+        argv=("check", BRANCHES, "--engine-seconds", "-1", "--out", OUT),
+        exit=2,
+        answer=r"--engine-seconds must be a number of seconds in \[1, 86400\], got -1\.0",
+    ),
+    Fault(
+        kind="--engine-seconds NaN",
+        area="check",
+        argv=("check", BRANCHES, "--engine-seconds", "nan", "--out", OUT),
+        exit=2,
+        answer=r"--engine-seconds must be a number of seconds in \[1, 86400\], got nan",
+    ),
+    Fault(
+        kind="--engine-seconds infinite",
+        area="check",
+        argv=("check", BRANCHES, "--engine-seconds", "inf", "--out", OUT),
+        exit=2,
+        answer=r"--engine-seconds must be a number of seconds in \[1, 86400\], got inf",
+    ),
+    Fault(
+        kind="--jobs 0 (check)",
+        area="check",
+        argv=("check", BRANCHES, "--jobs", "0", "--out", OUT),
+        exit=2,
+        answer=r"--jobs must be a positive integer at most 256, got 0",
+    ),
+    Fault(
+        kind="--states negative (check)",
+        area="check",
+        argv=("check", BRANCHES, "--states", "-3", "--out", OUT),
+        exit=2,
+        answer=r"--states must be an integer in \[1, 100000\], got -3",
+    ),
+    Fault(
+        kind="--states in float notation (check)",
+        area="check",
+        argv=("check", BRANCHES, "--states", "2.5", "--out", OUT),
+        exit=2,
+        answer=r"argument --states: invalid int value: '2\.5'",
+    ),
+    Fault(
+        kind="--floating on an MJCF only",
+        area="check",
+        prepare=_file("a.xml", MJ),
+        argv=("check", "{tmp}/a.xml", "--floating", "--states", "3", "--out", OUT),
+        exit=0,
+        answer=r"^a: \d+ passed, \d+ explained, 0 failed",
+    ),
+    Fault(
+        kind="--out an existing file (check)",
+        area="check",
+        prepare=_file("f", "x"),
+        argv=("check", BRANCHES, "--out", "{tmp}/f"),
+        exit=2,
+        answer=r"--out must be a directory, got '<tmp>/f'",
+    ),
+    Fault(
+        kind="--out empty (check)",
+        area="check",
+        argv=("check", BRANCHES, "--out", ""),
+        exit=2,
+        answer=r"argument --out: an empty path is not a folder or file name",
+    ),
+    # diff
+    Fault(
+        kind="RUN_B missing",
+        area="diff",
+        argv=("diff", REPORTS_DIR, "{tmp}/none"),
+        exit=2,
+        answer=r"RUN_B must be an existing output folder of `run` or `check`, got '<tmp",
+    ),
+    Fault(
+        kind="RUN_A a file, not a folder",
+        area="diff",
+        prepare=_file("f.csv", "x"),
+        argv=("diff", "{tmp}/f.csv", REPORTS_DIR),
+        exit=2,
+        answer=r"RUN_A must be a discrepancies\.csv of `run` or a CSV of `check`, got '<",
+    ),
+    Fault(
+        kind="--tolerance negative",
+        area="diff",
+        argv=("diff", REPORTS_DIR, REPORTS_DIR, "--tolerance", "-2"),
+        exit=2,
+        answer=r"--tolerance must be a finite factor > 1, got -2\.0",
+    ),
+    Fault(
+        kind="--tolerance infinite",
+        area="diff",
+        argv=("diff", REPORTS_DIR, REPORTS_DIR, "--tolerance", "inf"),
+        exit=2,
+        answer=r"--tolerance must be a finite factor > 1, got inf",
+    ),
+    Fault(
+        kind="--tolerance not a number",
+        area="diff",
+        argv=("diff", REPORTS_DIR, REPORTS_DIR, "--tolerance", "ten"),
+        exit=2,
+        answer=r"argument --tolerance: invalid float value: 'ten'",
+    ),
+    Fault(
+        kind="--markdown below a file",
+        area="diff",
+        prepare=_file("f", "x"),
+        argv=("diff", REPORTS_DIR, REPORTS_DIR, "--markdown", "{tmp}/f/d.md"),
+        exit=2,
+        answer=r"--markdown must be a directory, got '<tmp>/f'",
+    ),
+    # explain / errata / list / tutorials
+    Fault(
+        kind="explain an empty name",
+        area="explain",
+        argv=("explain", ""),
+        exit=2,
+        answer=r"unknown convention ''; valid: ball-joint-velocity-frame, coordinate-or",
+    ),
+    Fault(
+        kind="explain two names, one unknown",
+        area="explain",
+        argv=("explain", "quaternion-order", "nope"),
+        exit=2,
+        answer=r"unrecognized arguments: nope",
+    ),
+    Fault(
+        kind="errata unknown formula",
+        area="errata",
+        argv=("errata", "nope"),
+        exit=2,
+        answer=r"unrecognized arguments: nope",
+    ),
+    Fault(
+        kind="list with an unknown option",
+        area="list",
+        argv=("list", "--bogus"),
+        exit=2,
+        answer=r"unrecognized arguments: --bogus",
+    ),
+    Fault(
+        kind="tutorial name a path (../)",
+        area="tutorials",
+        argv=("tutorials", "../etc/passwd", "--out", OUT),
+        exit=2,
+        answer=r"unknown tutorial '\.\./etc/passwd'; valid: 01_quaternion_order, 02_free_",
+    ),
+    Fault(
+        kind="--out an existing file (tutorials)",
+        area="tutorials",
+        prepare=_file("f", "x"),
+        argv=("tutorials", "01_quaternion_order", "--out", "{tmp}/f"),
+        exit=2,
+        answer=r"--out must be a directory, got '<tmp>/f'",
+    ),
+    # versions / bench / baseline / report
+    Fault(
+        kind="--bisect an unknown release",
+        area="versions",
+        argv=("versions", "--bisect", "mujoco", "99.0.0", "99.1.0", "--out", "{tmp}/v.md"),
+        exit=2,
+        answer=r"--bisect must be a published release of mujoco, got '99\.0\.0'",
+    ),
+    Fault(
+        kind="--bisect a release that is not a version",
+        area="versions",
+        argv=("versions", "--bisect", "mujoco", "latest", "3.1.0", "--out", "{tmp}/v.md"),
+        exit=2,
+        answer=r"--bisect must be a published release of mujoco, got 'latest'",
+    ),
+    Fault(
+        kind="--out below a file (versions)",
+        area="versions",
+        prepare=_file("f", "x"),
+        argv=("versions", "--out", "{tmp}/f/v.md"),
+        exit=2,
+        answer=r"--out must be a directory, got '<tmp>/f'",
+    ),
+    Fault(
+        kind="--jobs 0 (bench)",
+        area="bench",
+        argv=("bench", "--jobs", "0"),
+        exit=2,
+        answer=r"--jobs must be a positive integer at most 256, got 0",
+    ),
+    Fault(
+        kind="--memory 0",
+        area="bench",
+        argv=("bench", "--memory", "0"),
+        exit=2,
+        answer=r"--memory must be a positive integer at most 100000000, got 0",
+    ),
+    Fault(
+        kind="--states not a number (bench)",
+        area="bench",
+        argv=("bench", "--states", "many"),
+        exit=2,
+        answer=r"argument --states: invalid int value: 'many'",
+    ),
+    Fault(
+        kind="--out below a file (bench)",
+        area="bench",
+        prepare=_file("f", "x"),
+        argv=("bench", "--out", "{tmp}/f/b"),
+        exit=2,
+        answer=r"--out must be a folder path \(<tmp>/f is a file\), got '<tmp>/f/b'",
+    ),
+    Fault(
+        kind="unknown implementation (baseline)",
+        area="baseline",
+        argv=("baseline", "--impl", "bullet", "--out", "{tmp}/b.csv"),
+        exit=2,
+        answer=r"unknown implementation 'bullet'; valid: book, drake, mjx, mjx-f64, muj",
+    ),
+    Fault(
+        kind="--out in a read-only system folder (baseline)",
+        area="baseline",
+        argv=("baseline", "--out", "/proc/b.csv"),
+        exit=2,
+        answer=r"--out must be a writable directory \(No such file or directory\), got '/",
+    ),
+    Fault(
+        kind="--from missing",
+        area="report",
+        argv=("report", "--check", "--from", "{tmp}/none"),
+        exit=2,
+        answer=r"--out must be an existing report folder, got 'reports'",
+    ),
+    # run
+    Fault(
+        kind="--impl empty (run)",
+        area="run",
+        argv=("run", "simple_pendulum", "--impl", "", "--out", OUT),
+        exit=2,
+        answer=r"unknown implementation ''; valid: book, drake, mjx, mjx-f64, mujoco, m",
+    ),
+    Fault(
+        kind="--device bogus",
+        area="run",
+        argv=("run", "simple_pendulum", "--device", "tpu9", "--out", OUT),
+        exit=2,
+        answer=r"argument --device: invalid choice: 'tpu9' \(choose from 'cpu', 'cuda'\)",
+    ),
+    Fault(
+        kind="--device cuda without a GPU",
+        area="run",
+        argv=("run", "simple_pendulum", "--impl", "mjx", "--device", "cuda", "--out", OUT),
+        exit=2,
+        answer=r"--device must be cpu on this machine \(no NVIDIA driver found\), got 'cu",
+    ),
+    Fault(
+        kind="--junit a folder (run)",
+        area="run",
+        prepare=_folder("j"),
+        argv=("run", "simple_pendulum", "--junit", "{tmp}/j", "--out", OUT),
+        exit=2,
+        answer=r"--junit must be a file path, not a folder, got '<tmp>/j'",
+    ),
+    Fault(
+        kind="--json and --junit the same file (run)",
+        area="run",
+        argv=("run", "simple_pendulum", "--json", "{tmp}/r", "--junit", "{tmp}/r", "--out", OUT),
+        exit=2,
+        answer=r"--json must be a file other than --junit's \(one would overwrite the ot",
+    ),
+    Fault(
+        kind="--out the same as --json (run)",
+        area="run",
+        argv=("run", "simple_pendulum", "--json", "{tmp}/o", "--out", "{tmp}/o"),
+        exit=2,
+        answer=r"--json must be a file path other than the --out folder, got '<tmp>/o'",
+    ),
+    Fault(
+        kind="case named twice",
+        area="run",
+        argv=("run", "simple_pendulum", "simple_pendulum", "--impl", "reference", "--out", OUT),
+        exit=0,
+        answer=r"0 passed, 0 explained, 0 failed, 0 skipped; report in <tmp>/",
+    ),
+)
+
+EXTRA_FAULTS: tuple[Fault, ...] = (
+    chk("URDF joint limits with lower above upper", "a.urdf",
+        URDF.replace('lower="-2" upper="2"', 'lower="2" upper="-2"'),
+            exit=1, answer=r"^a: \d+ passed, \d+ explained, [1-9]\d* failed"),
+    chk("URDF inertia with a negative diagonal", "a.urdf",
+        URDF.replace('ixx="0.02"', 'ixx="-0.02"', 1),
+            exit=1, answer=r"^a: \d+ passed, \d+ explained, [1-9]\d* failed"),
+    chk("URDF moving link of zero mass", "a.urdf",
+        URDF.replace('<mass value="1.5"/>', '<mass value="0"/>'),
+            exit=1, answer=r"^a: \d+ passed, \d+ explained, [1-9]\d* failed"),
+    chk("MJCF moving body whose geoms give no mass (inertiafromgeom false)", "a.xml",
+        mj("<body><joint type='hinge'/><geom size='0.1'/></body>",
+           "<compiler inertiafromgeom='false'/>"),
+        exit=2, answer=r"mujoco refused <tmp>/a\.xml: Error: mass and inertia of moving"),
+    chk("MJCF ball joint (valid)", "a.xml",
+        mj("<body><joint type='ball'/><geom size='0.1' pos='0 0 -0.3'/></body>"),
+            exit=1, answer=r"^a: \d+ passed, \d+ explained, 1 failed"),
+    chk("MJCF with a frame element", "a.xml",
+        mj("<frame pos='0 0 1'><body><joint type='hinge'/><geom size='0.1'/></body></frame>"),
+        exit=1, answer=r"^a: \d+ passed, \d+ explained, [1-9]\d* failed"),
+    chk("URDF continuous joint with a limit element (valid)", "a.urdf",
+        URDF.replace('type="continuous"><parent link="base"/><child link="aa_leg"/>',
+                     'type="continuous"><parent link="base"/><child link="aa_leg"/>'
+                     '<limit effort="1" velocity="1"/>'),
+                         exit=0, answer=r"^a: \d+ passed, \d+ explained, 0 failed"),
+    Fault(kind="unknown option (explain)", area="explain", argv=("explain", "--bogus"),
+          exit=2, answer=r"unrecognized arguments: --bogus$"),
+    Fault(kind="unknown option (tutorials)", area="tutorials", argv=("tutorials", "--bogus"),
+          exit=2, answer=r"unrecognized arguments: --bogus$"),
+    Fault(kind="--out a missing folder (report --check)", area="report",
+          argv=("report", "--check", "--out", "{tmp}/none"),
+              exit=2, answer=r"--out must be an existing report folder, got '<tmp>/none'$"),
+    Fault(kind="--states negative (bench)", area="bench", argv=("bench", "--states", "-1"),
+          exit=2, answer=r"--states must be a positive integer at most 10000000, got -1$"),
+)
+
+FAULTS = (*FAULTS, *HOSTILE_MODELS, *MORE_FAULTS, *EXTRA_FAULTS)
+
+
 DEDICATED = (
     ("a run killed with SIGKILL", "the previous report byte-identical, no temp file",
      "tests/dyncheck/test_reliability.py::test_killed_run_leaves_previous_report_intact"),
@@ -605,6 +1493,10 @@ DEDICATED = (
      "tests/check/test_model_check.py::test_an_engine_that_crashes_or_hangs_costs_only_its_rows"),
     ("a model file unreadable (permissions)", "`cannot be read (Permission denied)`, exit 2",
      "tests/check/test_inputs.py::test_unreadable_file"),
+    ("a dask scheduler that dies mid-run", "one line naming `--dask` and the unit it lost, "
+     "no traceback (distributed's own log silenced), exit 2 — it was `CancelledError`, exit 1",
+     "tests/dyncheck/test_workers.py::"
+     "test_a_scheduler_that_dies_mid_run_is_one_line_naming_dask_not_a_failed_check"),
     ("1000 mutated MJCF and URDF files", "each a one-line error or a report, within a time "
      "limit", "tests/check/test_fuzz.py::test_mutated_models_never_traceback_or_hang"),
 )
@@ -721,5 +1613,5 @@ def test_reliability_page_lists_the_answers_given(tmp_path):
     page = render(OBSERVED)
     if os.environ.get("DYNCHECK_WRITE_PAGES") == "1":
         PAGE.write_text(page)
-    assert len(FAULTS) + len(DEDICATED) >= 80
+    assert len(FAULTS) + len(DEDICATED) >= 250  # #44: at least 250 kinds, each answered
     assert PAGE.read_text() == page, "reports/reliability.md is stale: DYNCHECK_WRITE_PAGES=1"

@@ -222,3 +222,30 @@ def test_a_pool_forked_from_a_process_without_jax_gives_the_same_csv_bytes():
     assert forked["rows"] == to_csv(here.discrepancies)
     assert forked["points"] == to_csv(here.convergence)
     assert len(here.discrepancies) > 100
+
+
+def _slow_unit(i: int) -> int:
+    import time
+
+    time.sleep(1.5)
+    return i
+
+
+def test_a_scheduler_that_dies_mid_run_is_one_line_naming_dask_not_a_failed_check(capfd):
+    """#44: a dask scheduler that went away mid-run raised ``CancelledError`` (exit 1, as if
+    a check had failed) after distributed's own tracebacks on stderr. Now: an error naming
+    ``--dask`` and the unit lost, nothing else on stderr. The cluster is closed by a timer
+    while the first unit runs."""
+    pytest.importorskip("distributed", reason="the extra 'dask' (pip install 'dyncheck[dask]')")
+    import threading
+
+    from distributed import LocalCluster
+
+    cluster = LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                           dashboard_address=None)
+    threading.Timer(1.0, cluster.close).start()
+    with pytest.raises(InvalidInput, match=r"--dask must be a cluster that keeps its scheduler "
+                       r"and workers for the whole run: it lost 'u0'"):
+        workers.run_units([(f"u{i}", _slow_unit, (i,)) for i in range(3)], jobs=2,
+                          dask=cluster.scheduler_address)
+    assert "Traceback" not in capfd.readouterr().err

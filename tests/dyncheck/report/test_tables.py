@@ -129,3 +129,11 @@ def test_an_unknown_verdict_is_an_error_not_a_cell():
     with pytest.raises(ValueError, match="unknown verdict 'great'"):
         instantaneous_matrix(pd.concat([INSTANT, pd.DataFrame(
             [_inst("a", "bias", "reference", "mujoco", "great", 0.0)])]), "a")
+
+
+def test_a_case_without_instantaneous_rows_has_an_empty_matrix_not_an_error():
+    """`run CASE --impl reference` compares nothing instantaneous: the page says none (the
+    first version of the tolerance cells raised on an empty group)."""
+    only_runs = INSTANT[INSTANT["quantity"] == "trajectory"]
+    assert instantaneous_matrix(only_runs, "a").empty
+    assert family_matrix(only_runs, trajectories=False).empty
