@@ -41,9 +41,6 @@ system, and Drake's own integrators.
 
 from __future__ import annotations
 
-import logging
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -59,6 +56,7 @@ from pydrake.systems.primitives import LogVectorOutput
 
 from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.base import Adapter, Chart, Frame, LoadedBody, StateLayout, Trajectory
+from dyncheck.adapters.drake_model import parser_warnings
 from dyncheck.adapters.linalg import solve
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Joint, Multibody
@@ -70,30 +68,6 @@ _INTEGRATORS = {
     "rk3": "runge_kutta3",
 }
 """dyncheck's name → Drake's scheme name for ``ResetIntegratorFromFlags``."""
-
-
-class _Capture(logging.Handler):
-    def __init__(self) -> None:
-        super().__init__()
-        self.messages: list[str] = []
-
-    def emit(self, record: logging.LogRecord) -> None:
-        self.messages.append(record.getMessage().split("warning: ", 1)[-1])
-
-
-@contextmanager
-def parser_warnings() -> Iterator[list[str]]:
-    """Drake's log messages while the block runs (its parser's warnings: what it ignores or
-    changes), kept in the yielded list instead of printed."""
-    capture = _Capture()
-    log = logging.getLogger("drake")
-    log.addHandler(capture)
-    propagate, log.propagate = log.propagate, False
-    try:
-        yield capture.messages
-    finally:
-        log.removeHandler(capture)
-        log.propagate = propagate
 
 
 class _Field(LeafSystem):

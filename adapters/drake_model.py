@@ -21,8 +21,10 @@ world).
 
 from __future__ import annotations
 
+import logging
 import re
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
@@ -36,7 +38,6 @@ from pydrake.multibody.tree import (
     QuaternionFloatingJoint,
 )
 
-from dyncheck.adapters.drake_ import parser_warnings
 from dyncheck.adapters.mjcf_copy import for_parser, inline
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
@@ -75,6 +76,30 @@ BALL_ARMATURE = (
     "only a one-degree-of-freedom joint carries one: Drake's M leaves out the armature of "
     "ball joint {joint!r} (fix: model the rotor as body inertia)"
 )
+
+
+class _Capture(logging.Handler):
+    def __init__(self) -> None:
+        super().__init__()
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.messages.append(record.getMessage().split("warning: ", 1)[-1])
+
+
+@contextmanager
+def parser_warnings() -> Iterator[list[str]]:
+    """Drake's log messages while the block runs (its parser's warnings: what it ignores or
+    changes), kept in the yielded list instead of printed."""
+    capture = _Capture()
+    log = logging.getLogger("drake")
+    log.addHandler(capture)
+    propagate, log.propagate = log.propagate, False
+    try:
+        yield capture.messages
+    finally:
+        log.removeHandler(capture)
+        log.propagate = propagate
 
 
 def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str, tuple]]:

@@ -185,3 +185,15 @@ def test_no_module_reaches_into_another_modules_private_names():
                   and not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"))):
                 reaches.append(f"{where}:{node.lineno}: reads .{node.attr}")
     assert not reaches, "\n".join(reaches)
+
+
+MAX_LINES = 500
+"""#43: a module a reader holds in mind at once; a longer one is split where its parts have
+names of their own (the commands from the command line, the Cayley frame from the checks on
+it)."""
+
+
+@pytest.mark.parametrize("path", _package_files(), ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_no_module_of_the_package_is_over_500_lines(path):
+    lines = path.read_text(encoding="utf-8").count("\n")
+    assert lines <= MAX_LINES, f"{path.relative_to(ROOT)}: {lines} lines"

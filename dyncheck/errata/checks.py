@@ -14,6 +14,7 @@ from dyncheck.errata import (  # noqa: F401  (each registers its checks on impor
     lagrange,
     rigid,
     rotation,
+    triads,
     variational,
 )
 from dyncheck.errata.registry import CHECKS, Finding, Method, Verdict, findings

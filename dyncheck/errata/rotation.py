@@ -7,9 +7,8 @@ angular velocity changes in size and direction — so that every identity is dec
 rational arithmetic. ℓ_ij = ê_i · ē_j: column j of ℓ is the body axis ē_j on the space axes,
 x = ℓ x̄ (2.2.50).
 
-Why one module of ~600 lines: every formula of (2.2.50)–(2.2.69) and exercises 23 and 30 is
-decided on the same exact direction cosines (the Cayley transform below); splitting them
-would split one derivation's shared setup across files.
+Every formula is decided on the same exact direction cosines, the Cayley frame of
+:mod:`.cayley`; exercise 30's triads are in :mod:`.triads`.
 """
 
 from __future__ import annotations
@@ -17,88 +16,26 @@ from __future__ import annotations
 from functools import cache
 
 import sympy as sp
-from sympy.core.function import AppliedUndef
 
+from dyncheck.errata.cayley import R3, dual, frame, generic, instant, nil, vee
 from dyncheck.errata.registry import (
-    DIGITS,
     POINTS,
     Finding,
     Method,
     Verdict,
     check,
     derived,
-    negligible,
     zero,
 )
 from dyncheck.errata.rigid import levi_civita
 
-R3 = range(3)
-
-
-def _nil(m: sp.Matrix | sp.Expr) -> bool:
-    """Every entry is 0 at each instant of POINTS, exactly: ℓ and its rates take the Cayley
-    frame's values there; a path's values x_i(t) and rates ẋ_i(t) are free (independent
-    symbols). The differentiation before it is symbolic."""
-    entries = list(m) if isinstance(m, sp.MatrixBase) else [m]
-    t = _frame()[0]
-    for at in POINTS:
-        for e in entries:
-            e = e.xreplace(_instant(at))
-            e = e.xreplace({d: sp.Dummy() for d in e.atoms(sp.Derivative)})
-            e = e.xreplace({f: sp.Dummy() for f in e.atoms(AppliedUndef)})
-            if sp.expand(e.subs(t, at)) != 0:
-                return False
-    return True
-
-
-@cache
-def _frame() -> tuple[sp.Symbol, sp.Matrix]:
-    t = sp.Symbol("t", real=True)
-    a, b, c = t, t**2 / 2, 1 - t / 3
-    S = sp.Matrix([[0, -a, b], [a, 0, -c], [-b, c, 0]])
-    return t, ((sp.eye(3) - S).inv() * (sp.eye(3) + S)).applyfunc(sp.cancel)
-
-
-@cache
-def _generic() -> sp.Matrix:
-    """ℓ(t) as nine undefined functions ℓ_ij(t): expressions are built and differentiated on
-    these (sympy's product rule, fast) and evaluated on the Cayley frame at an instant."""
-    t = _frame()[0]
-    return sp.Matrix(3, 3, lambda i, j: sp.Function(f"l{i + 1}{j + 1}")(t))
-
-
-@cache
-def _instant(at: sp.Expr) -> dict[sp.Expr, sp.Expr]:
-    """ℓ_ij, ℓ̇_ij, ℓ̈_ij of the Cayley frame at t = ``at``, keyed by the generic ℓ's terms."""
-    t, ell = _frame()
-    gen = _generic()
-    out: dict[sp.Expr, sp.Expr] = {}
-    for order in (2, 1, 0):
-        rate = ell.diff(t, order) if order else ell
-        for i in R3:
-            for j in R3:
-                key = gen[i, j].diff(t, order) if order else gen[i, j]
-                out[key] = sp.cancel(rate[i, j]).subs(t, at)
-    return out
-
-
-def _vee(skew: sp.Matrix) -> sp.Matrix:
-    """ω_i = ½ e_ijk ω_jk (relative-motion.d13)."""
-    return sp.Matrix([sum(levi_civita(i, j, k) * skew[j, k] for j in R3 for k in R3) / 2
-                      for i in R3])
-
-
-def _dual(w: sp.Matrix) -> sp.Matrix:
-    """ω_mn = e_imn ω_i (2.2.61)."""
-    return sp.Matrix(3, 3, lambda m, n: sum(levi_civita(i, m, n) * w[i] for i in R3))
-
 
 @check("2.2.50", "2.2.51")
 def _direction_cosines() -> Finding:
-    t, ell = _frame()
+    t, ell = frame()
     x = sp.Matrix([sp.Function(f"x{i}")(t) for i in (1, 2, 3)])
-    ok = _nil(ell.T * ell - sp.eye(3)) and _nil(ell * ell.T - sp.eye(3))
-    ok &= _nil(x - ell * (ell.T * x)) and sp.cancel(ell.det()) == 1
+    ok = nil(ell.T * ell - sp.eye(3)) and nil(ell * ell.T - sp.eye(3))
+    ok &= nil(x - ell * (ell.T * x)) and sp.cancel(ell.det()) == 1
     return derived(
         ok, method=Method.SYMPY,
         evidence="for ℓ(t) the Cayley transform of a skew S(t) (entries t, t²/2, 1 − t/3): "
@@ -190,7 +127,7 @@ def _velocity_names() -> Finding:
 def _motion() -> dict[str, sp.Matrix | sp.Symbol]:
     """A point moving in S (general functions x_i(t)) seen from the rotating S̄, every vector
     on the space axes ê_i (the body axes ē_j are ℓ's columns)."""
-    t, ell = _frame()[0], _generic()
+    t, ell = frame()[0], generic()
     x = sp.Matrix([sp.Function(f"x{i}")(t) for i in (1, 2, 3)])
     xbar = ell.T * x
     return {"t": t, "ell": ell, "dell": ell.diff(t), "x": x, "xbar": xbar,
@@ -237,7 +174,7 @@ def _sample(vec: sp.Matrix) -> sp.Expr:
     t = k["t"]
     path = {sp.Function(f"x{i}")(t): p for i, p in zip((1, 2, 3), (1 + t, t**2, 2 - t),
                                                          strict=True)}
-    at = vec.subs(path).doit().xreplace(_instant(sp.Integer(1))).subs(t, 1)
+    at = vec.subs(path).doit().xreplace(instant(sp.Integer(1))).subs(t, 1)
     return sp.nsimplify(sum(e**2 for e in at))
 
 
@@ -294,13 +231,13 @@ def _velocity_transformations() -> Finding:
     ebar = [ell[:, j] for j in R3]
     vbar_s = sp.Matrix([(ebar[i].T * xd)[0] for i in R3])  # v's components on ē_i
     v_sbar = sum((xbd[j] * ebar[j] for j in R3), sp.zeros(3, 1))  # V on ê_i
-    ok = _nil(vbar_s - sp.Matrix([sum(ell[j, i] * xd[j] for j in R3) for i in R3]))  # 2.2.56
-    ok &= _nil(v_sbar - sp.Matrix([sum(ell[i, j] * xbd[j] for j in R3) for i in R3]))
-    ok &= _nil(xbd - (ell.T * xd + dell.T * x))  # (2.2.57)
+    ok = nil(vbar_s - sp.Matrix([sum(ell[j, i] * xd[j] for j in R3) for i in R3]))  # 2.2.56
+    ok &= nil(v_sbar - sp.Matrix([sum(ell[i, j] * xbd[j] for j in R3) for i in R3]))
+    ok &= nil(xbd - (ell.T * xd + dell.T * x))  # (2.2.57)
     xb = sp.Matrix([sp.Function(f"xb{i}")(t) for i in (1, 2, 3)])  # a general x̄(t)
-    ok &= _nil((ell * xb).diff(t) - (ell * xb.diff(t) + dell * xb))  # (2.2.58)
-    ok &= _nil(v_sbar - (xd + ell * dell.T * x))  # (2.2.59): ℓ_mi ℓ̇_ji x_j
-    ok &= _nil(vbar_s - (xbd + ell.T * dell * xbar))  # (2.2.60): ℓ_im ℓ̇_ij x̄_j
+    ok &= nil((ell * xb).diff(t) - (ell * xb.diff(t) + dell * xb))  # (2.2.58)
+    ok &= nil(v_sbar - (xd + ell * dell.T * x))  # (2.2.59): ℓ_mi ℓ̇_ji x_j
+    ok &= nil(vbar_s - (xbd + ell.T * dell * xbar))  # (2.2.60): ℓ_im ℓ̇_ij x̄_j
     return derived(
         ok, method=Method.SYMPY, uses=("2.2.50", "2.2.51"),
         evidence="for ℓ(t) rotating and a point on a general path x(t) (sympy, exact): the "
@@ -315,8 +252,8 @@ def _duality() -> Finding:
     w = sp.Matrix(sp.symbols("w1:4"))
     a, b, c = sp.symbols("a b c")
     skew = sp.Matrix([[0, a, b], [-a, 0, c], [-b, -c, 0]])
-    ok = all(zero(e) for e in _vee(_dual(w)) - w) and all(zero(e) for e in
-                                                            _dual(_vee(skew)) - skew)
+    ok = all(zero(e) for e in vee(dual(w)) - w) and all(zero(e) for e in
+                                                            dual(vee(skew)) - skew)
     return derived(
         ok, method=Method.SYMPY, uses=("2.2.61",),
         evidence="ω_mn = e_imn ω_i and ω_i = ½ e_ijk ω_jk are inverse maps between vectors and "
@@ -329,31 +266,31 @@ def _duality() -> Finding:
 @check("relative-motion.i4", "relative-motion.i5", "relative-motion.i6", "relative-motion.i7",
        "relative-motion.d14", "2.2.62", "2.2.63")
 def _angular_velocity() -> Finding:
-    t, ell = _frame()[0], _generic()
+    t, ell = frame()[0], generic()
     dell = ell.diff(t)
     omega = ell * dell.T  # ω_mj = ℓ_mi ℓ̇_ji (relative-motion.d14)
-    ok = _nil(omega + omega.T)  # skew, by differentiating (2.2.51)
-    w = _vee(omega)
-    ok &= _nil(_dual(w) - omega)
+    ok = nil(omega + omega.T)  # skew, by differentiating (2.2.51)
+    w = vee(omega)
+    ok &= nil(dual(w) - omega)
     xbar = sp.Matrix(sp.symbols("c1:4"))  # a point fixed in the body
     x = ell * xbar
     xd = x.diff(t)
     eps = levi_civita
-    ok &= _nil(xd - sp.Matrix([sum(eps(i, j, k) * w[j] * x[k] for j in R3 for k in R3)
+    ok &= nil(xd - sp.Matrix([sum(eps(i, j, k) * w[j] * x[k] for j in R3 for k in R3)
                                for i in R3]))  # i4
-    ok &= _nil(xd + omega * x)  # i5 and d14
-    ok &= _nil(ell * xbar.diff(t))  # i6: v(S̄) = ℓ dx̄/dt = 0
-    ok &= _nil(xd + ell * dell.T * x)  # i7
+    ok &= nil(xd + omega * x)  # i5 and d14
+    ok &= nil(ell * xbar.diff(t))  # i6: v(S̄) = ℓ dx̄/dt = 0
+    ok &= nil(xd + ell * dell.T * x)  # i7
     bar = ell.T * omega * ell  # first line of (2.2.62)
     lines = [sp.Matrix(3, 3, lambda m, n: sum(ell[i, m] * ell[j, n] * ell[i, s] * dell[j, s]
                                                for i in R3 for j in R3 for s in R3)),
              sp.Matrix(3, 3, lambda m, n: sum(int(m == s) * ell[j, n] * dell[j, s]
                                                for j in R3 for s in R3)),
              sp.Matrix(3, 3, lambda m, n: sum(ell[j, n] * dell[j, m] for j in R3))]
-    ok &= all(_nil(bar - line) for line in lines)
+    ok &= all(nil(bar - line) for line in lines)
     k = _motion()  # (2.2.63) for a point on a general path
-    ok &= _nil(k["V"] - (k["v"] + omega * k["x"]))
-    ok &= _nil(ell.T * k["v"] - (k["xbar"].diff(t) + bar.T * k["xbar"]))
+    ok &= nil(k["V"] - (k["v"] + omega * k["x"]))
+    ok &= nil(ell.T * k["v"] - (k["xbar"].diff(t) + bar.T * k["xbar"]))
     return derived(
         ok, method=Method.SYMPY, uses=("2.2.51", "2.2.59", "2.2.60", "2.2.61"),
         evidence="with ω_mj = ℓ_mi ℓ̇_ji for the rotating ℓ(t) (sympy, exact): ω is skew; for "
@@ -393,11 +330,11 @@ def _tensor_forms() -> Finding:
     ok = all(zero(x) for x in back - inertia)
     w = sp.Matrix(sp.symbols("w1:4"))
     H = inertia.T * w  # (2.2.42): H_i = ω_j I_ji
-    ok &= all(zero(x) for x in _dual(H) - _contract(four, _dual(w)))  # d5
+    ok &= all(zero(x) for x in dual(H) - _contract(four, dual(w)))  # d5
     t = sp.Symbol("t")
     Hf = sp.Matrix([sp.Function(f"H{i}")(t) for i in (1, 2, 3)])
     Mf = sp.Matrix([sp.Function(f"M{i}")(t) for i in (1, 2, 3)])
-    ok &= all(zero(x) for x in _dual(Hf).diff(t) - _dual(Mf) - _dual(Hf.diff(t) - Mf))
+    ok &= all(zero(x) for x in dual(Hf).diff(t) - dual(Mf) - dual(Hf.diff(t) - Mf))
     return derived(
         ok, method=Method.SYMPY, uses=("2.2.42", "2.2.49", "2.2.61", "2.2.65", "2.2.66"),
         evidence="for a general symmetric I (sympy): the second form of (2.2.64) recovers I_ij "
@@ -423,7 +360,7 @@ def _get(four: list, idx: tuple[int, ...]) -> sp.Expr:
 
 @check("euler-equations.d7", "euler-equations.d8", "2.2.69")
 def _body_axes() -> Finding:
-    t, ell = _frame()[0], _generic()
+    t, ell = frame()[0], generic()
     dell = ell.diff(t)
     ibar = _inertia()  # constant in the body axes
     four_bar = _four(ibar)
@@ -434,7 +371,7 @@ def _body_axes() -> Finding:
     delta = sp.KroneckerDelta
     ok = True
     for at in POINTS:
-        L, dL, W, dW, inner_at, rate_at = (m.xreplace(_instant(at)) for m in (
+        L, dL, W, dW, inner_at, rate_at = (m.xreplace(instant(at)) for m in (
             ell, dell, wbar, dwbar, inner, rate))
         w = L * dL.T  # ω_mj = ℓ_mi ℓ̇_ji
         four = _four(L * ibar * L.T)  # (2.2.64) in the space axes
@@ -482,7 +419,7 @@ def _euler_rates() -> Finding:
     (t, ph, th, ps), _, product = _euler()
     ell = product.T  # x̄ = ℓᵀx (2.2.50)
     wbar = ell.diff(t).T * ell  # (2.2.62)
-    body = _vee(wbar)
+    body = vee(wbar)
     independent = ell.T * ell.diff(t)  # ℓᵀℓ̇ = [ω]× on the body axes
     c, s = sp.cos, sp.sin
     printed = sp.Matrix([th.diff(t) * c(ps) + ph.diff(t) * s(th) * s(ps),
@@ -495,114 +432,4 @@ def _euler_rates() -> Finding:
         evidence="from Example 9's matrix with ϕ, θ, ψ functions of t: the body components "
                  "ω̄_i = ½ e_ijk ω̄_jk of ω̄_mn = ℓ_jn ℓ̇_jm (2.2.62), and independently the "
                  "entries of ℓᵀℓ̇ = [ω]×, are the three printed ω_x, ω_y, ω_z (sympy)",
-    )
-
-
-@check("ex30.i1", "ex30.i2", "ex30.i7", "ex30.i11", "ex30.i15")
-def _exercise_30_givens() -> Finding:
-    return Finding(
-        verdict=Verdict.NOT_CHECKABLE, method=Method.NONE,
-        evidence="the exercise's definitions (the position on the fixed axis, ω = dθ/dt, "
-                 "ê₃ = ê₁ × ê₂, ω = αê₃ − βê₁, a point's components x, y, z); their "
-                 "consequences are checked",
-    )
-
-
-@check("ex30.i3", "ex30.i4", "ex30.i5")
-def _fixed_axis() -> Finding:
-    t = sp.Symbol("t")
-    theta = sp.Function("theta")(t)
-    h, r0, th = sp.symbols("h r_0 th")
-    e = sp.Matrix([0, 0, 1])
-    e_r = sp.Matrix([sp.cos(th), sp.sin(th), 0])  # ⊥ ê, turned by θ about it
-    ok = all(zero(x) for x in e_r.diff(th) - e.cross(e_r))  # (a)
-    r = (h * e + r0 * e_r).subs(th, theta)
-    w = theta.diff(t) * e  # i3: d(θê)/dt with ê constant
-    ok &= all(zero(x) for x in (theta * e).diff(t) - w)
-    ok &= all(zero(x) for x in r.diff(t) - r0 * e_r.diff(th).subs(th, theta) * theta.diff(t))
-    ok &= all(zero(x) for x in r.diff(t) - w.cross(r))  # (b): ω × hê = 0
-    return derived(
-        ok, method=Method.SYMPY,
-        evidence="ê_R = cosθ ê_a + sinθ ê_b ⊥ ê: dê_R/dθ = ê × ê_R, d(θê)/dt = θ̇ê, and each "
-                 "link of the printed chain to ω × r (ω × hê = 0) (sympy)",
-    )
-
-
-@cache
-def _triad() -> dict[str, sp.Expr | sp.Matrix]:
-    """Case 2 of exercise 30 built on the rotating ℓ(t): ê₁ fixed in the body, ê₂ along
-    dê₁/dt, ê₃ = ê₁ × ê₂; ω of the exercise and the body's angular velocity ω_b (ℓ̇ℓᵀ)."""
-    t, ell = _frame()
-    e1 = ell[:, 0]
-    d1 = e1.diff(t)
-    alpha = sp.sqrt((d1.T * d1)[0])
-    e2 = d1 / alpha
-    e3 = e1.cross(e2)
-    beta = (e2.T * e3.diff(t))[0]
-    body = _vee(ell * ell.diff(t).T)  # ω_b: ẋ = ω_b × x for body points (relative-motion.i4)
-    r = ell * sp.Matrix([sp.Rational(1, 2), 2, -1])  # a point fixed in the body
-    return {"t": t, "e1": e1, "e2": e2, "e3": e3, "alpha": alpha, "beta": beta,
-            "w": alpha * e3 - beta * e1, "body": body, "r": r}
-
-
-def _small(vec: sp.Matrix | sp.Expr, at: sp.Expr) -> sp.Expr:
-    """|vec|² at t = ``at`` to DIGITS digits, 0 when negligible (the entries are algebraic)."""
-    k = _triad()
-    entries = vec if isinstance(vec, sp.MatrixBase) else sp.Matrix([vec])
-    value = sp.N(sum(e**2 for e in entries.subs(k["t"], at)), DIGITS)
-    return sp.Integer(0) if negligible(value) else value
-
-
-@check("ex30.i6", "ex30.i8", "ex30.i9", "ex30.i10", "ex30.i12", "ex30.i13", "ex30.i14")
-def _moving_triad() -> Finding:
-    k = _triad()
-    t, e1, e2, e3, w = k["t"], k["e1"], k["e2"], k["e3"], k["w"]
-    relations = [e1.diff(t) - k["alpha"] * e2, e3.diff(t) - k["beta"] * e2,
-                 e2 - e3.cross(e1), e2.diff(t) - (k["alpha"] * e3 - k["beta"] * e1).cross(e2),
-                 e1.diff(t) - w.cross(e1), e2.diff(t) - w.cross(e2), e3.diff(t) - w.cross(e3)]
-    ok = all(_small(rel, at) == 0 for rel in relations for at in POINTS)
-    alphas = [sp.N(k["alpha"].subs(t, at), 4) for at in POINTS]
-    betas = [sp.N(k["beta"].subs(t, at), 4) for at in POINTS]
-    return derived(
-        ok, method=Method.NUMERIC,
-        evidence="ê₁ a body axis of the rotating ℓ(t), ê₂ = (dê₁/dt)/α, ê₃ = ê₁ × ê₂: each "
-                 "relation's residual is below 1e-40 at t = 1/3, 1, 2 (50 digits). The "
-                 "exercise's words 'for some constant α' and 'constant β' are too strong: "
-                 f"here α = {', '.join(map(str, alphas))} and β = "
-                 f"{', '.join(map(str, betas))} at those instants; nothing in (a)–(d) uses "
-                 "constancy",
-    )
-
-
-@check("ex30.i16")
-def _triad_is_not_the_body() -> Finding:
-    k = _triad()
-    t, r, w, e1 = k["t"], k["r"], k["w"], k["e1"]
-    spin = (k["body"].T * e1)[0] + k["beta"]  # λ: the body's spin about ê₁ less −β
-
-    def printed() -> sp.Expr:
-        return _small(r.diff(t) - w.cross(r), sp.Integer(1))
-
-    def corrected() -> sp.Expr:
-        return _small(r.diff(t) - (w + spin * e1).cross(r), sp.Integer(1))
-
-    return Finding(
-        verdict=Verdict.ERRATUM, method=Method.NUMERIC, uses=("ex30.i12", "ex30.i15"),
-        evidence="ω = αê₃ − βê₁ is the angular velocity of the triad (ê₁, ê₂, ê₃), and ê₂, "
-                 "defined by the motion of ê₁, is not fixed in the body unless the body "
-                 "turns about an axis fixed in it: dr/dt = ω × r holds for x, y, z constant "
-                 "on the triad, not for 'an arbitrary point within the rigid body'. For a "
-                 "point fixed in the body of the rotating ℓ(t), |dr/dt − ω × r|² ≠ 0 at t = 1 "
-                 "(50 digits); the motion of ê₁ cannot see the spin about ê₁, and the body's "
-                 "angular velocity is ω + λê₁ with λ = ω_b·ê₁ + β — with it the residual is "
-                 "0 (below 1e-40)",
-        corrected=r"\frac{d\vec{r}}{dt} = (\vec{\omega} + \lambda\hat{e}_1) \times \vec{r}, "
-                  r"\quad \lambda = \vec{\omega}_b\cdot\hat{e}_1 + \beta "
-                  r"\text{ (}\lambda = 0\text{ when } \hat{e}_2, \hat{e}_3 \text{ are fixed in "
-                  r"the body)}",
-        effect="a body point's velocity from the printed ω misses the spin about ê₁: for the "
-               "point (½, 2, −1) of the rotating ℓ(t) at t = 1, |dr/dt − ω × r| = "
-               f"{sp.N(sp.sqrt(printed()), 3)} against |dr/dt| = "
-               f"{sp.N(sp.sqrt(_small(r.diff(t), sp.Integer(1))), 3)}",
-        printed_residual=printed, corrected_residual=corrected,
     )

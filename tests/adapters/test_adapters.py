@@ -339,9 +339,11 @@ def test_registered_integrators_are_those_the_engine_maps(engine):
         assert set(entry.integrators) <= set(STEPPERS)
         return
     module = importlib.import_module(entry.module)
-    mapped = getattr(module, "_INTEGRATORS", STEPPERS)
+    # the engine's own table (Drake's scheme names), MuJoCo's one table for the C engine
+    # and its ports (adapters/mujoco_api.INTEGRATORS), or the steppers Pinocchio is run with
+    mapped = getattr(module, "_INTEGRATORS", getattr(module, "INTEGRATORS", STEPPERS))
     assert get_adapter(engine).integrators == entry.integrators
     if engine == "sympy-mechanics":
         assert set(entry.integrators) < set(STEPPERS)
-    else:
-        assert entry.integrators == tuple(mapped)
+    else:  # every registered integrator mapped to one of the engine's own
+        assert set(entry.integrators) <= set(mapped), set(entry.integrators) - set(mapped)

@@ -370,7 +370,7 @@ FAULTS: tuple[Fault, ...] = (
           answer=r"--json must be a directory, got '<tmp>/f.txt'$"),
     Fault(kind="--device cuda on a machine without an NVIDIA driver (a JAX traceback before)",
           area="run", argv=("run", "simple_pendulum", "--device", "cuda", "--out", OUT),
-          patch=lambda mp, tmp: mp.setattr("dyncheck.cli._has_cuda", lambda: False),
+          patch=lambda mp, tmp: mp.setattr("dyncheck.commands.options.has_cuda", lambda: False),
           answer=r"--device must be cpu on this machine \(no NVIDIA driver found\), "
                  r"got 'cuda'$"),
     Fault(kind="a bogus DYNCHECK_DEVICE in the environment (a Warp traceback before)",

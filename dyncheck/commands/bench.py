@@ -1,0 +1,36 @@
+"""``dyncheck bench``: speed against the engines."""
+
+from __future__ import annotations
+
+import argparse
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+
+    pass
+from dyncheck.commands.options import (
+    BENCH_MAX,
+    check_out,
+    positive,
+)
+
+
+def bench_command(args: argparse.Namespace) -> int:
+    from dyncheck import bench
+    from dyncheck.cases import get_case
+
+    check_out(args.out)
+    if args.suite:
+        from dyncheck import bench_suite
+
+        print(bench_suite.main(args.out))
+        return 0
+    get_case(args.case)
+    positive("--states", args.states, BENCH_MAX["--states"])
+    positive("--repeats", args.repeats, BENCH_MAX["--repeats"])
+    for n in args.memory:
+        positive("--memory", n, BENCH_MAX["--memory"])
+    positive("--jobs", args.jobs)
+    print(bench.main(args.case, args.states, args.repeats, args.memory, args.out,
+                     jobs=args.jobs, dask=args.dask))
+    return 0

@@ -1,0 +1,177 @@
+"""``dyncheck check``: the user's models, one page each."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from dyncheck.errors import DyncheckError, InvalidInput
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from dyncheck.check.engines import Limits
+from dyncheck.commands.options import (
+    check_out,
+    ci_files,
+    device_env,
+    positive,
+    write_ci,
+)
+
+
+def _case_files(names: list[str], folder: Path) -> list[tuple[Path, str | None]]:
+    """Each book case's MJCF (:func:`~dyncheck.adapters.mjcf.to_mjcf`, what ``run`` gives
+    MuJoCo) written into ``folder``."""
+    from dyncheck.adapters.mjcf import to_mjcf
+    from dyncheck.cases import CASES, get_case
+
+    chosen = list(CASES) if "all" in names else names
+    out: list[tuple[Path, str | None]] = []
+    for name in chosen:
+        case = get_case(name)  # an unknown name: one line, exit 2, before any work
+        path = folder / f"{name}.xml"
+        path.write_text(to_mjcf(case.multibody()))
+        out.append((path, None))
+    return out
+
+
+def _check_targets(args: argparse.Namespace, cases: Path) -> list[tuple[Path, str | None]]:
+    """The files to check: PATHs (a folder: every model file under it), ``--robot``s, then
+    ``--case``s (written into ``cases``)."""
+    from dyncheck.check import index, inputs
+
+    targets: list[tuple[Path, str | None]] = []
+    for path in args.paths:
+        if path.is_dir():
+            found = index.in_folder(path)
+            if not found:
+                raise InvalidInput("PATH", str(path), "a folder holding MJCF or URDF files")
+            targets += [(p, None) for p in found]
+        else:
+            targets.append((path, None))
+    robots = list(inputs.robots()) if "all" in args.robot else args.robot
+    targets += [(inputs.robot(name), name) for name in robots]
+    targets += _case_files(args.case, cases)
+    if not targets:
+        raise InvalidInput("PATH", "", "at least one model file, folder, --robot or --case")
+    return targets
+
+
+MAX_ENGINE_MIB = 1 << 20
+
+
+MAX_ENGINE_SECONDS = 86_400.0
+
+
+def _limits(args: argparse.Namespace) -> Limits:
+    """The engines' limits from ``--engine-memory`` and ``--engine-seconds`` (checked)."""
+    from dyncheck.check.engines import MEMORY_MIB, Limits
+
+    memory = MEMORY_MIB if args.engine_memory is None else args.engine_memory
+    if not (memory == 0 or 256 <= memory <= MAX_ENGINE_MIB):
+        raise InvalidInput("--engine-memory", memory,
+                           f"0 (no cap) or a size in MiB in [256, {MAX_ENGINE_MIB}]")
+    if args.engine_seconds is not None and not (
+            1.0 <= args.engine_seconds <= MAX_ENGINE_SECONDS):
+        raise InvalidInput("--engine-seconds", args.engine_seconds,
+                           f"a number of seconds in [1, {MAX_ENGINE_SECONDS:g}]")
+    return Limits(memory_mib=memory or None, seconds=args.engine_seconds)
+
+
+def _without(message: str, path: Path) -> str:
+    """``message`` with the model's path as its file name: no machine path on a page."""
+    for text in (str(path.resolve()), str(path)):
+        message = message.replace(text, path.name)
+    return message
+
+
+def check_command(args: argparse.Namespace) -> int:
+    with tempfile.TemporaryDirectory(prefix="dyncheck-cases-") as cases:
+        return _check_all(args, _check_targets(args, Path(cases)), Path(cases))
+
+
+def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
+               cases: Path) -> int:
+    from functools import partial
+
+    from dyncheck.check import index, inputs
+    from dyncheck.check.model_check import check_model, implementations
+    from dyncheck.check.page import summary_line, write
+    from dyncheck.progress import Progress
+    from dyncheck.workers import each_unit
+
+    names = index.page_names([p for p, _ in targets])
+    names = [robot.replace("/", "__") if robot else name
+             for (_, robot), name in zip(targets, names, strict=True)]
+    several = len(targets) > 1
+    base = index.common_folder([p for p, _ in targets])
+    files = {name: f"robot {robot}" if robot else f"book case {p.stem}" if p.parent == cases
+             else str(p.resolve().relative_to(base))
+             for (p, robot), name in zip(targets, names, strict=True)}
+    entries: list[index.Entry] = []
+    valid = []
+    for (path, robot), name in zip(targets, names, strict=True):  # all before any engine runs
+        try:
+            inputs.model_path(str(path))
+        except DyncheckError as exc:
+            if not several:
+                raise
+            print(f"dyncheck: error: {exc}", file=sys.stderr)
+            entries.append(index.refused(name, files[name], _without(str(exc), path)))
+            continue
+        valid.append((path, robot, name))
+    if args.against is not None:
+        inputs.model_path(str(args.against))
+    inputs.states(args.states)
+    if args.seed < 0:
+        raise InvalidInput("--seed", args.seed, "a non-negative integer")
+    check_out(args.out)
+    ci_files(args)
+    device_env()
+    positive("--jobs", args.jobs)
+    options = {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
+               "floating": args.floating, "against": args.against,
+               "isolate": not args.in_process, "limits": _limits(args),
+               "derivatives": args.derivatives}
+    units = [(name, partial(check_model, **options, name=robot or (name if several else None)),
+              (str(path),)) for path, robot, name in valid]
+    engines = tuple(i for i in implementations(tuple(args.impl) or None) if i != "reference")
+    failed, refusals = False, len(entries)
+    tables: dict[str, pd.DataFrame] = {}
+    refused: dict[str, str] = {}
+    progress = Progress("check", len(units) if several else None, quiet=args.quiet or not several)
+    for name, result in each_unit(units, jobs=args.jobs, dask=args.dask):
+        progress.done(name)
+        if isinstance(result, DyncheckError):
+            if not several:
+                raise result
+            print(f"dyncheck: error: {name}: {result}", file=sys.stderr)
+            path = next(p for p, _, n in valid if n == name)
+            entries.append(index.refused(name, files[name], _without(str(result), path)))
+            refused[name] = _without(str(result), path)
+            refusals += 1
+        else:
+            written = write(result, args.out, name=name)
+            print(f"{summary_line(result)} -> {written[1]}")
+            entries.append(index.entry(result, name, files[name]))
+            tables[name] = result.rows
+            if not result.ok:
+                failed = True
+                print(result.failures())
+        if several:
+            index.write(entries, engines, args.out)
+    progress.close()
+    if several:
+        print(f"{len(entries)} models: index -> {args.out / (index.INDEX + '.md')}")
+    refused |= {e.model: e.refused for e in entries if e.refused}
+    if args.junit is not None or args.json is not None:
+        from dyncheck.check.page import engine_versions_of
+        from dyncheck.ci_outputs import CHECK
+
+        write_ci(args, tables, CHECK, engine_versions_of(implementations(
+            tuple(args.impl) or None)), refused)
+    return 2 if refusals else 1 if failed else 0

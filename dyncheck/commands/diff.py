@@ -1,0 +1,39 @@
+"""``dyncheck diff``: what moved between two runs."""
+
+from __future__ import annotations
+
+import argparse
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+
+    pass
+from dyncheck.commands.options import (
+    check_out_file,
+)
+
+
+def diff_command(args: argparse.Namespace) -> int:
+    """Exit 1 when any row moved; 0 when every row is unchanged."""
+    import dataclasses
+
+    from dyncheck import baseline, diff
+    from dyncheck.results import write_atomic
+
+    factor = diff.FACTOR if args.tolerance is None else args.tolerance
+    diff.check_factor(factor)
+    if args.markdown is not None:
+        check_out_file("--markdown", args.markdown)
+    sides = []
+    for flag, path in (("RUN_A", args.run_a), ("RUN_B", args.run_b)):
+        side = diff.load(path, flag)
+        if path.is_file() and not side.versions:
+            side = dataclasses.replace(side, versions=baseline.versions_of(path))
+        sides.append(side)
+    a, b = sides
+    table = diff.diff(a, b, factor=factor)
+    counts = diff.summary(table)
+    print(diff.text(a, b, table, factor=factor, every=args.all).rstrip())
+    if args.markdown is not None:
+        write_atomic(args.markdown, diff.markdown(a, b, table, factor=factor, every=args.all))
+    return 0 if counts[diff.Move.UNCHANGED] == len(table) else 1

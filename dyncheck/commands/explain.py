@@ -1,0 +1,41 @@
+"""``dyncheck explain`` and ``dyncheck errata``: the conventions catalogue and the
+book's formulas."""
+
+from __future__ import annotations
+
+import argparse
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+
+    pass
+from dyncheck.commands.options import (
+    check_out_file,
+)
+
+
+def explain_command(args: argparse.Namespace) -> int:
+    from dyncheck.catalogue import explain_cached, render
+
+    if args.name is not None and args.name.startswith("erratum-"):
+        from dyncheck.errata import page
+
+        print(page.explain(args.name.removeprefix("erratum-")))
+        return 0
+    entries, read_back = explain_cached(args.name)
+    print(render(entries))
+    if read_back:
+        print(f"({read_back} of {len(entries)} measured by an earlier `dyncheck explain` with "
+              "the same dyncheck, engines and machine, read from the cache; --no-cache "
+              "measures afresh)")
+    return 1 if any(e.failed for e in entries) else 0
+
+
+def errata_command(args: argparse.Namespace) -> int:
+    from dyncheck.errata import page
+    from dyncheck.results import write_atomic
+
+    check_out_file("--out", args.out)
+    write_atomic(args.out, page.page())
+    print(f"errata page written to {args.out}")
+    return 0

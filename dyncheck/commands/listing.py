@@ -1,0 +1,74 @@
+"""``dyncheck list``: cases, implementations with their versions, robots."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from dyncheck.errors import EngineNotInstalled
+
+if TYPE_CHECKING:
+
+    pass
+
+
+def installed_version(package: str) -> str | None:
+    """An installed distribution's version, read from its metadata (nothing imported)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version(package)
+    except PackageNotFoundError:
+        return None
+
+
+def engine_line(name: str) -> str:
+    """An engine imported: its version (and device, for a port) and its integrators."""
+    from dyncheck.adapters import ENGINE_PACKAGES, get_adapter
+
+    try:
+        adapter = get_adapter(name)
+    except EngineNotInstalled as exc:  # the hint names the package or the extra
+        return f"not installed: {exc.hint}"
+    steps = list(adapter.integrators)
+    if adapter.adaptive:
+        steps.append("dop853 (scipy, error-controlled)")
+    if hasattr(adapter, "simulate_controlled"):
+        steps.append("rk3-controlled (its own runge_kutta3, error-controlled)")
+    return f"{ENGINE_PACKAGES[name]} {adapter.version()}; integrators: {', '.join(steps)}"
+
+
+def list_command(*, integrators: bool = False) -> int:
+    """Cases, implementations and robots. Engines are named with their installed version from
+    the package metadata — fast, nothing imported — or, with ``integrators``, imported."""
+    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES
+    from dyncheck.cases import CASES
+    from dyncheck.roster import IMPLEMENTATIONS
+
+    print("cases:")
+    for name, cls in CASES.items():
+        print(f"  {name:24s} {cls.title}")
+    print("implementations:")
+    for name in IMPLEMENTATIONS:
+        if name == "book":
+            what = "dyncheck.reference (book printed equations)"
+        elif name not in ENGINE_PACKAGES:
+            what = "dyncheck.reference (general method, (2.2.23)-(2.2.26))"
+        elif integrators:
+            what = engine_line(name)
+        elif (version := installed_version(ENGINE_PACKAGES[name])) is not None:
+            what = f"{ENGINE_PACKAGES[name]} {version}"
+        elif name in ENGINE_EXTRAS:
+            what = f"not installed: pip install 'dyncheck[{ENGINE_EXTRAS[name]}]'"
+        else:
+            what = f"not installed: pip install {ENGINE_PACKAGES[name]}"
+        print(f"  {name:24s} {what}")
+    from dyncheck.check.inputs import robots
+
+    found = robots()
+    if found:
+        print(f"robots (example-robot-data, for `dyncheck check --robot NAME`): {len(found)}")
+        for name, path in found.items():
+            print(f"  {name:32s} {path.name}")
+    else:
+        print("robots: the 'robots' extra is not installed (pip install 'dyncheck[robots]')")
+    return 0

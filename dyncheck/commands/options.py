@@ -1,0 +1,158 @@
+"""What the commands share: their path arguments, the checks of an output folder or file
+(before any work), numeric bounds, the ports' device, the CI files."""
+
+from __future__ import annotations
+
+import argparse
+import errno
+import os
+import re
+import sys
+import tempfile
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from dyncheck.errors import InvalidInput
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from dyncheck.ci_outputs import Columns
+
+
+def path_arg(text: str) -> Path:
+    """A path argument; an empty one is refused (it would silently mean this folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path is not a folder or file name")
+    try:
+        os.stat(text)
+    except OSError as exc:  # a missing path is each command's to name; a loop is no path
+        if exc.errno == errno.ELOOP:
+            raise argparse.ArgumentTypeError(f"{text!r} is a symlink loop") from None
+    return Path(text)
+
+
+def ci_files(args: argparse.Namespace) -> None:
+    """The ``--junit`` and ``--json`` files writable, checked before any work."""
+    for flag, path in (("--junit", args.junit), ("--json", args.json)):
+        if path is not None:
+            check_out_file(flag, path)
+            out = getattr(args, "out", None)
+            if out is not None and path.resolve() == Path(out).resolve():
+                raise InvalidInput(flag, str(path), "a file path other than the --out folder")
+    if args.junit is not None and args.json is not None \
+            and args.junit.resolve() == args.json.resolve():
+        raise InvalidInput("--json", str(args.json), "a file other than --junit's (one would "
+                           "overwrite the other)")
+
+
+def write_ci(args: argparse.Namespace, tables: dict[str, pd.DataFrame], columns: Columns,
+              versions: dict[str, str], refused: dict[str, str] | None = None) -> None:
+    from dyncheck import ci_outputs
+
+    if args.junit is not None:
+        ci_outputs.write_junit(args.junit, tables, columns)
+    if args.json is not None:
+        ci_outputs.write_json(args.json, tables, versions, refused)
+
+
+def check_out(out: Path, flag: str = "--out") -> None:
+    """--out must be a directory, or creatable, and writable — tried for real (a probe file
+    created and removed, any folder made for it removed again) before any work, so bad usage
+    changes nothing. ``flag``: the option the folder comes from."""
+    if out.exists() and not out.is_dir():
+        raise InvalidInput(flag, str(out), "a directory")
+    bad = next((p for p in out.parents if p.exists() and not p.is_dir()), None)
+    if bad is not None:
+        raise InvalidInput(flag, str(out), f"a folder path ({bad} is a file)")
+    missing = [p for p in (out, *out.parents) if not p.exists()]
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=out, prefix=".dyncheck-probe-"):
+            pass
+    except OSError as exc:
+        raise InvalidInput(flag, str(out), f"a writable directory ({exc.strerror})") from None
+    finally:
+        for p in missing:  # innermost first: leave no trace of the probe
+            if p.is_dir() and not any(p.iterdir()):
+                p.rmdir()
+
+
+def check_out_file(flag: str, path: Path) -> None:
+    """A file to write: not a folder, and its folder writable (:func:`check_out`)."""
+    if path.is_dir():
+        raise InvalidInput(flag, str(path), "a file path, not a folder")
+    check_out(path.parent, flag)
+
+
+MAX_STATES = 10**9
+"""More sampled states than this would take over half a day at ~50 µs per state: refused."""
+
+
+STATE_SECONDS = 50e-6
+"""Measured cost of one sampled state through every implementation (reports/benchmark.md)."""
+
+
+def warn_cost(states: int, jobs: int) -> None:
+    """Say up front what a large sweep will cost (more than a minute), before it starts."""
+    seconds = states * STATE_SECONDS / jobs
+    if seconds > 60:
+        took = f"{seconds / 3600:.1f} h" if seconds >= 3600 else f"{seconds / 60:.0f} min"
+        print(f"dyncheck: {states} sampled states: about {took} on this machine with --jobs "
+              f"{jobs} (~50 µs per state); the states are drawn and compared in chunks, so "
+              "memory stays flat", file=sys.stderr, flush=True)
+
+
+MAX_JOBS = 256
+"""More local processes than this: refused (each holds the engines, ~0.3 GB)."""
+
+
+BENCH_MAX = {"--states": 10**7, "--repeats": 100, "--memory": 10**8}
+"""``bench``'s bounds: its sweeps hold every state's arrays in memory (10⁷ states of a
+six-dof case: ~4 GB)."""
+
+
+def positive(name: str, value: int | None, most: int | None = None) -> None:
+    """A positive integer (at most ``most``; ``--jobs`` at most :data:`MAX_JOBS`)."""
+    most = MAX_JOBS if most is None and name == "--jobs" else most
+    if value is not None and (value < 1 or (most is not None and value > most)):
+        expected = "a positive integer" + (f" at most {most}" if most is not None else "")
+        raise InvalidInput(name, value, expected)
+
+
+DEVICE = re.compile(r"cpu|cuda(:\d+)?")
+
+
+def device_env() -> None:
+    """``DYNCHECK_DEVICE`` from the environment, checked before any work."""
+    value = os.environ.get("DYNCHECK_DEVICE")
+    if value is not None and not DEVICE.fullmatch(value):
+        raise InvalidInput("DYNCHECK_DEVICE", value, "cpu, cuda or cuda:N (the environment)")
+
+
+def has_cuda() -> bool:
+    """An NVIDIA driver on this machine (its library or its /proc entry)."""
+    import ctypes.util
+
+    return Path("/proc/driver/nvidia/version").exists() or \
+        ctypes.util.find_library("cuda") is not None
+
+
+def use_device(device: str) -> None:
+    """The ports' device, for this process and the workers it starts: Warp reads
+    ``DYNCHECK_DEVICE``, JAX its platform (set before its first computation). ``cuda`` on a
+    machine without an NVIDIA driver is refused here, before any work."""
+    if device == "cuda" and not has_cuda():
+        raise InvalidInput("--device", device, "cpu on this machine (no NVIDIA driver found)")
+    os.environ["DYNCHECK_DEVICE"] = device
+    os.environ["JAX_PLATFORMS"] = device
+    if "jax" in sys.modules:
+        sys.modules["jax"].config.update("jax_platforms", device)
+
+
+def log(message: str) -> None:
+    print(f"dyncheck: {message}", file=sys.stderr, flush=True)
+
+
+def one_line(text: str) -> str:
+    return " ".join(text.split())

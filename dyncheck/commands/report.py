@@ -1,0 +1,48 @@
+"""``dyncheck report --check``: the committed report against the code."""
+
+from __future__ import annotations
+
+import argparse
+from typing import TYPE_CHECKING
+
+from dyncheck.errors import InvalidInput
+
+if TYPE_CHECKING:
+
+    pass
+from dyncheck.commands.options import (
+    positive,
+)
+
+SHOWN = 20
+"""Moved results listed by `report --check` (the rest counted)."""
+
+
+def report_command(args: argparse.Namespace) -> int:
+    from dyncheck import freshness, report
+    from dyncheck.run import resolve, run
+
+    positive("--jobs", args.jobs)
+    for flag, folder in (("--out", args.out), ("--from", args.run_dir)):
+        if folder is not None and not folder.is_dir():
+            raise InvalidInput(flag, str(folder), "an existing report folder")
+        if folder is not None and not (folder / "discrepancies.csv").is_file():
+            raise InvalidInput(flag, str(folder), "a report folder written by `dyncheck run` "
+                               "(it has no discrepancies.csv)")
+    committed = freshness.read_report(args.out)
+    if args.run_dir is not None:
+        moved = freshness.compare(committed, freshness.read_report(args.run_dir))
+    else:
+        cases, impls = resolve([], [])
+        result = run(cases, impls, jobs=args.jobs, dask=args.dask, conventions=True)
+        moved = report.check(result, args.out)
+    for m in moved[:SHOWN]:
+        print(f"moved: {m}")
+    if len(moved) > SHOWN:
+        print(f"moved: ... and {len(moved) - SHOWN} more")
+    print(
+        "report up to date (results equal beyond round-off)"
+        if not moved
+        else f"{len(moved)} results moved: run `dyncheck run --out {args.out}` and commit"
+    )
+    return 1 if moved else 0

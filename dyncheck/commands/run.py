@@ -1,0 +1,75 @@
+"""``dyncheck run``: every case compared, the report written."""
+
+from __future__ import annotations
+
+import argparse
+from typing import TYPE_CHECKING
+
+from dyncheck.errors import InvalidInput
+
+if TYPE_CHECKING:
+
+    pass
+from dyncheck.commands.options import (
+    MAX_STATES,
+    check_out,
+    ci_files,
+    device_env,
+    positive,
+    use_device,
+    warn_cost,
+    write_ci,
+)
+
+
+def run_command(args: argparse.Namespace) -> int:
+    from dyncheck import baseline, report
+    from dyncheck.report.figures import cached_figures as draw_figures
+    from dyncheck.run import resolve, run
+
+    check_out(args.out)
+    ci_files(args)
+    device_env()
+    if args.device is not None:
+        use_device(args.device)
+    positive("--states", args.states)
+    if args.states is not None and args.states > MAX_STATES:
+        raise InvalidInput("--states", args.states, f"at most {MAX_STATES} (~50 µs per state)")
+    positive("--jobs", args.jobs)
+    reference = baseline.load(args.baseline) if args.baseline is not None else None
+    cases, impls = resolve(args.cases, args.impl)
+    if args.states is not None:
+        warn_cost(args.states * len(cases), args.jobs)
+    # the conventions catalogue does not depend on the cases: it runs with the full report
+    from dyncheck.progress import Progress
+
+    with Progress("run", quiet=args.quiet) as progress:
+        result = run(cases, impls, states=args.states, jobs=args.jobs, dask=args.dask,
+                     conventions=not args.cases, progress=progress, render=draw_figures)
+    report.write(result, args.out)
+    from dyncheck.ci_outputs import RUN, split
+
+    write_ci(args, split(result.discrepancies, RUN), RUN, report.versions(result.engines))
+    counts = result.discrepancies["verdict"].value_counts()
+    print(
+        ", ".join(f"{counts.get(v, 0)} {v}" for v in ("passed", "explained", "failed", "skipped"))
+        + f"; report in {args.out}/README.md"
+    )
+    regressed = False
+    if reference is not None:
+        changes = baseline.compare(result.discrepancies, reference, cases=[c.name for c in cases])
+        regressed = len(changes) > 0
+        print(
+            f"{len(changes)} rows regressed against {args.baseline}"
+            if regressed
+            else f"no regression against {args.baseline}"
+        )
+        moved = baseline.version_changes(args.baseline, report.versions(result.engines))
+        print(
+            "versions changed since the baseline: " + ", ".join(moved)
+            if moved
+            else "same engine versions as the baseline (a regression is a change of code)"
+        )
+        if regressed:
+            print(changes.to_string(index=False))
+    return 1 if result.failed or regressed else 0

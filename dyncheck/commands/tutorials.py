@@ -1,0 +1,41 @@
+"""``dyncheck tutorials``: the lessons executed and rendered."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import TYPE_CHECKING
+
+from dyncheck.errors import UnknownName
+
+if TYPE_CHECKING:
+
+    pass
+from dyncheck.commands.options import (
+    check_out,
+)
+
+
+def tutorials_command(args: argparse.Namespace) -> int:
+    """Execute each tutorial (its own checks must hold) and render it; exit 1 if one fails."""
+    from dyncheck import tutorials
+
+    known = tutorials.available()
+    names = args.names or list(known)
+    for name in names:
+        if name not in known:
+            raise UnknownName("tutorial", name, known)
+    check_out(args.out)
+    failed = 0
+    for name in names:
+        try:
+            nb = tutorials.execute(name)
+        except tutorials.TutorialFailed as exc:
+            print(f"dyncheck: {exc}", file=sys.stderr)
+            failed += 1
+            continue
+        written = tutorials.render(name, nb, args.out)
+        print(f"{name}: executed -> {written[0]}")
+    if not args.names:
+        tutorials.index(args.out)
+    return 1 if failed else 0
