@@ -24,6 +24,7 @@ import numpy as np
 
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import EngineError, Unsupported
+from dyncheck.vocabulary import Quantity
 
 _T = TypeVar("_T")
 
@@ -223,16 +224,16 @@ class Adapter(ABC):
         ``forward_dynamics`` (at τ), ``inverse_dynamics`` (at v̇ = a), ``kinetic_energy``,
         ``potential_energy`` and, with couplings, ``constraint_force`` (at τ). Engines
         override this with their cheapest batched path."""
-        out = {
-            "mass_matrix": self.mass_matrix(q),
-            "bias_forces": self.bias(q, v),
-            "forward_dynamics": self.forward(q, v, tau),
-            "inverse_dynamics": self.inverse(q, v, a),
-            "kinetic_energy": self.kinetic_energy(q, v),
-            "potential_energy": self.potential_energy(q),
+        out: dict[str, np.ndarray] = {
+            Quantity.MASS_MATRIX: self.mass_matrix(q),
+            Quantity.BIAS_FORCES: self.bias(q, v),
+            Quantity.FORWARD_DYNAMICS: self.forward(q, v, tau),
+            Quantity.INVERSE_DYNAMICS: self.inverse(q, v, a),
+            Quantity.KINETIC_ENERGY: self.kinetic_energy(q, v),
+            Quantity.POTENTIAL_ENERGY: self.potential_energy(q),
         }
         if self.spec.couplings:
-            out["constraint_force"] = self._check(
+            out[Quantity.CONSTRAINT_FORCE] = self._check(
                 "constraint force", self.constraint_force(q, v, tau)
             )
         return out
@@ -270,15 +271,15 @@ class Adapter(ABC):
     ) -> dict[str, np.ndarray]:
         """The batched quantities under their canonical names, each checked finite."""
         out = {
-            "mass_matrix": M,
-            "bias_forces": bias,
-            "forward_dynamics": fwd,
-            "inverse_dynamics": inv,
-            "kinetic_energy": kin,
-            "potential_energy": pot,
+            Quantity.MASS_MATRIX: M,
+            Quantity.BIAS_FORCES: bias,
+            Quantity.FORWARD_DYNAMICS: fwd,
+            Quantity.INVERSE_DYNAMICS: inv,
+            Quantity.KINETIC_ENERGY: kin,
+            Quantity.POTENTIAL_ENERGY: pot,
         }
         if constraint is not None:
-            out["constraint_force"] = constraint
+            out[Quantity.CONSTRAINT_FORCE] = constraint
         return {key: self._check(key, val) for key, val in out.items()}
 
     def _check(self, what: str, value: np.ndarray) -> np.ndarray:

@@ -47,6 +47,7 @@ from dyncheck.adapters.urdf import root_is_free, to_urdf
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import Unsupported
+from dyncheck.vocabulary import Quantity
 
 
 class ModelAdapter(Adapter):
@@ -126,7 +127,8 @@ class ModelAdapter(Adapter):
                 under = to_canonical(maps, self.engine.dynamics(qe, ve, ae, gravity=undone))
                 delta[i] += here.bias[0] - under.bias[0]
         forward = -np.linalg.solve(mass, delta[..., None])[..., 0]
-        return {"bias_forces": delta, "inverse_dynamics": delta, "forward_dynamics": forward}
+        return {Quantity.BIAS_FORCES: delta, Quantity.INVERSE_DYNAMICS: delta,
+                Quantity.FORWARD_DYNAMICS: forward}
 
     def defects(self) -> tuple[str, ...]:
         """A free joint whose engine resolves gravity in its frame through another rotation
@@ -192,7 +194,7 @@ class ModelAdapter(Adapter):
         return self._dynamics(q, v, np.zeros_like(v)).bias
 
     def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        return self.evaluate_all(q, v, tau, np.zeros_like(v))["forward_dynamics"]
+        return self.evaluate_all(q, v, tau, np.zeros_like(v))[Quantity.FORWARD_DYNAMICS]
 
     def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         return self._dynamics(q, v, a).inverse

@@ -27,6 +27,7 @@ from dyncheck.adapters.base import LoadedBody, Trajectory
 from dyncheck.adapters.mujoco_ import MuJoCoAdapter
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import EngineError, Unsupported
+from dyncheck.vocabulary import Quantity
 
 CHUNK = 256
 """States per batched call: every call has this shape (the last chunk padded), so that a port
@@ -180,25 +181,25 @@ class PortAdapter(MuJoCoAdapter):
         )
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        return self._all(q)["mass_matrix"]
+        return self._all(q)[Quantity.MASS_MATRIX]
 
     def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        return self._all(q, v)["bias_forces"]
+        return self._all(q, v)[Quantity.BIAS_FORCES]
 
     def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        return self._all(q, v, tau)["forward_dynamics"]
+        return self._all(q, v, tau)[Quantity.FORWARD_DYNAMICS]
 
     def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        return self._all(q, v, a=a)["inverse_dynamics"]
+        return self._all(q, v, a=a)[Quantity.INVERSE_DYNAMICS]
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        return self._all(q, v)["kinetic_energy"]
+        return self._all(q, v)[Quantity.KINETIC_ENERGY]
 
     def potential_energy(self, q: np.ndarray) -> np.ndarray:
-        return self._all(q)["potential_energy"]
+        return self._all(q)[Quantity.POTENTIAL_ENERGY]
 
     def constraint_force(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        return self._all(q, v, tau)["constraint_force"]
+        return self._all(q, v, tau)[Quantity.CONSTRAINT_FORCE]
 
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str

@@ -17,6 +17,7 @@ import pandas as pd
 from dyncheck import diff
 from dyncheck.errors import InvalidInput
 from dyncheck.results import DISCREPANCY_KEY, texts, to_csv, write_atomic
+from dyncheck.vocabulary import Verdict
 
 COLUMNS = [*DISCREPANCY_KEY, "max_rel_err", "tolerance", "verdict"]
 FACTOR = diff.FACTOR
@@ -78,7 +79,7 @@ def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
         frame[col] = texts(frame[col])
     diff.checked_signs(frame, ["max_rel_err", "tolerance"], flag=flag, path=path)
     diff.checked_keys(frame, DISCREPANCY_KEY, flag=flag, path=path)
-    judged = frame["verdict"].isin(["passed", "explained"])
+    judged = frame["verdict"].isin([Verdict.PASSED, Verdict.EXPLAINED])
     nan = judged & ~np.isfinite(frame["max_rel_err"].to_numpy())
     if nan.any():
         row = int(np.flatnonzero(nan.to_numpy())[0]) + 1

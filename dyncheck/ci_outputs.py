@@ -63,7 +63,7 @@ def _case(name: str, suite: str, rows: pd.DataFrame, columns: Columns) -> TestCa
         case.result[0].text = "\n".join(lines)
     elif (rows["verdict"] == Verdict.SKIPPED.value).all():
         reason = "; ".join(dict.fromkeys(_text(n) for n in rows["note"] if _text(n)))
-        case.result = [Skipped(reason or "skipped")]
+        case.result = [Skipped(reason or Verdict.SKIPPED)]
     return case
 
 

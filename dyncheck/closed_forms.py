@@ -20,6 +20,7 @@ from dyncheck.reference import rigid
 from dyncheck.reference.trajectory import solve
 from dyncheck.results import Discrepancy, Verdict
 from dyncheck.tolerances import first_near_max
+from dyncheck.vocabulary import Quantity
 
 
 def closed_form_rows(case: Case) -> list[Discrepancy]:
@@ -43,7 +44,7 @@ def closed_form_rows(case: Case) -> list[Discrepancy]:
     return [
         Discrepancy(
             case=case.name,
-            quantity="closed_form",
+            quantity=Quantity.CLOSED_FORM,
             impl_a="book",
             impl_b="reference",
             integrator="dop853",

@@ -38,6 +38,7 @@ from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.reference.constraints import MAX_IMPEDANCE
 from dyncheck.results import Discrepancy
 from dyncheck.tolerances import instantaneous, soft_condition
+from dyncheck.vocabulary import Quantity, Verdict
 
 __all__ = ["GRAVITY_DEFAULT", "POINT_INERTIA", "compare_instantaneous", "soft_factor"]
 
@@ -282,7 +283,7 @@ def _row(
             **base,
             max_abs_err=float("nan"),
             max_rel_err=float("nan"),
-            verdict="skipped" if bad.skipped else "failed",
+            verdict=Verdict.SKIPPED if bad.skipped else Verdict.FAILED,
             convention="",
             # the engine named once: its own message may already start with its name
             note=bad.error if bad.error.startswith(f"{bad.name}: ") else f"{bad.name}: {bad.error}",
@@ -291,7 +292,7 @@ def _row(
         )
     scale = st.scale or 1.0
     rel = st.max_abs / scale
-    verdict, convention, note = "passed", "", ""
+    verdict, convention, note = Verdict.PASSED, "", ""
     if rel > tol.rtol:
         va, vb = a.variant, b.variant
         named = [f"{x.name}: {d}" for x in (a, b) for d in x.defects] if st.effects else []
@@ -307,9 +308,9 @@ def _row(
                 f"{st.predicted / scale:.3g}, residual after prediction "
                 f"{st.residual / scale:.3g}"
             )
-            verdict = "explained" if st.residual / scale <= tol.rtol else "failed"
+            verdict = Verdict.EXPLAINED if st.residual / scale <= tol.rtol else Verdict.FAILED
         else:
-            verdict, note = "failed", "unexplained: no convention predicts this difference"
+            verdict, note = Verdict.FAILED, "unexplained: no convention predicts this difference"
     return Discrepancy(
         **base,
         max_abs_err=st.max_abs,
@@ -359,7 +360,7 @@ def sweep(
     condition = 1.0
     for s in chunks:
         predict.new_chunk(s)
-        condition = max(condition, float(np.linalg.cond(predict(book)["mass_matrix"]).max()))
+        condition = max(condition, float(np.linalg.cond(predict(book)[Quantity.MASS_MATRIX]).max()))
         for ev in evals.values():
             ev.step(s)
         scales: dict[tuple[str, str], float] = {}  # (a, quantity) → max |a's values|

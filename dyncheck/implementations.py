@@ -40,6 +40,7 @@ from dyncheck.reference.derivations import derived, lambdified
 from dyncheck.reference.systems import SYSTEMS
 from dyncheck.reference.trajectory import solve
 from dyncheck.roster import IMPLEMENTATIONS
+from dyncheck.vocabulary import INSTANTANEOUS, Quantity
 
 # adapters that derive their equations symbolically (sympy-mechanics) keep them in the
 # reference's disk cache of derivations — the cache, not the derivation, is shared; adapters
@@ -47,15 +48,7 @@ from dyncheck.roster import IMPLEMENTATIONS
 Adapter.derive = staticmethod(derived)  # type: ignore[method-assign]
 Adapter.lambdify = staticmethod(lambdified)  # type: ignore[method-assign]
 
-QUANTITIES: tuple[str, ...] = (
-    "mass_matrix",
-    "bias_forces",
-    "forward_dynamics",
-    "inverse_dynamics",
-    "kinetic_energy",
-    "potential_energy",
-    "constraint_force",
-)
+QUANTITIES: tuple[str, ...] = INSTANTANEOUS
 """``constraint_force`` exists only for cases with couplings: the cords' tensions (N), from
 the forward-dynamics solve at the sampled τ."""
 
@@ -64,7 +57,7 @@ def quantities(case: Case) -> tuple[str, ...]:
     """The quantities compared for ``case``."""
     if case.multibody().couplings:
         return QUANTITIES
-    return tuple(q for q in QUANTITIES if q != "constraint_force")
+    return tuple(q for q in QUANTITIES if q != Quantity.CONSTRAINT_FORCE)
 
 
 
@@ -188,9 +181,10 @@ class Implementation(ABC):
     def evaluate(self, s: StateSample) -> dict[str, np.ndarray]:
         """Every quantity at every state; potential energy relative to the case's rest state."""
         out = self._dynamics(s.q, s)
-        if "potential_energy" not in out:
-            out["potential_energy"] = self._potential(s.q)
-        out["potential_energy"] = out["potential_energy"] - self._potential(self.case.rest()[None])
+        if Quantity.POTENTIAL_ENERGY not in out:
+            out[Quantity.POTENTIAL_ENERGY] = self._potential(s.q)
+        rest = self._potential(self.case.rest()[None])
+        out[Quantity.POTENTIAL_ENERGY] = out[Quantity.POTENTIAL_ENERGY] - rest
         return out
 
     def simulate(self, dt: float, integrator: str) -> tuple[np.ndarray, np.ndarray]:
@@ -212,15 +206,15 @@ class _Equations(Implementation):
 
     def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]:
         d = self.dyn
-        out = {
-            "mass_matrix": d.mass_matrix(q),
-            "bias_forces": d.bias(q, s.v),
-            "forward_dynamics": d.forward(q, s.v, s.tau),
-            "inverse_dynamics": d.inverse(q, s.v, s.a),
-            "kinetic_energy": d.kinetic_energy(q, s.v),
+        out: dict[str, np.ndarray] = {
+            Quantity.MASS_MATRIX: d.mass_matrix(q),
+            Quantity.BIAS_FORCES: d.bias(q, s.v),
+            Quantity.FORWARD_DYNAMICS: d.forward(q, s.v, s.tau),
+            Quantity.INVERSE_DYNAMICS: d.inverse(q, s.v, s.a),
+            Quantity.KINETIC_ENERGY: d.kinetic_energy(q, s.v),
         }
-        if self.provides("constraint_force"):
-            out["constraint_force"] = d.constraint_force(q, s.v, s.tau)
+        if self.provides(Quantity.CONSTRAINT_FORCE):
+            out[Quantity.CONSTRAINT_FORCE] = d.constraint_force(q, s.v, s.tau)
         return out
 
     def _potential(self, q: np.ndarray) -> np.ndarray:
@@ -232,7 +226,7 @@ class BookImplementation(_Equations):
 
     def provides(self, quantity: str) -> bool:
         """The book prints no cord tension (Example 6, exercise 17)."""
-        return quantity != "constraint_force" and super().provides(quantity)
+        return quantity != Quantity.CONSTRAINT_FORCE and super().provides(quantity)
 
     def _build(self, case: Case) -> Any:
         return printed_equations(case)
@@ -349,17 +343,18 @@ class EngineImplementation(Implementation):
         raw = self.adapter.evaluate_all(
             qe, ve, co.force_to_engine(m, q, s.tau), co.acceleration_to_engine(m, q, s.v, s.a)
         )
-        Me = raw["mass_matrix"]
-        out = {
-            "mass_matrix": co.mass_matrix_to_book(m, q, Me),
-            "bias_forces": co.bias_to_book(m, q, s.v, Me, raw["bias_forces"]),
-            "forward_dynamics": co.acceleration_to_book(m, q, s.v, raw["forward_dynamics"]),
-            "inverse_dynamics": co.force_to_book(m, q, raw["inverse_dynamics"]),
-            "kinetic_energy": raw["kinetic_energy"],
-            "potential_energy": raw["potential_energy"],
+        Me = raw[Quantity.MASS_MATRIX]
+        out: dict[str, np.ndarray] = {
+            Quantity.MASS_MATRIX: co.mass_matrix_to_book(m, q, Me),
+            Quantity.BIAS_FORCES: co.bias_to_book(m, q, s.v, Me, raw[Quantity.BIAS_FORCES]),
+            Quantity.FORWARD_DYNAMICS: co.acceleration_to_book(m, q, s.v,
+                                                               raw[Quantity.FORWARD_DYNAMICS]),
+            Quantity.INVERSE_DYNAMICS: co.force_to_book(m, q, raw[Quantity.INVERSE_DYNAMICS]),
+            Quantity.KINETIC_ENERGY: raw[Quantity.KINETIC_ENERGY],
+            Quantity.POTENTIAL_ENERGY: raw[Quantity.POTENTIAL_ENERGY],
         }
-        if "constraint_force" in raw:  # a coupling's multiplier is minus its cord's tension
-            out["constraint_force"] = -raw["constraint_force"]
+        if Quantity.CONSTRAINT_FORCE in raw:  # a coupling's multiplier is minus its cord's tension
+            out[Quantity.CONSTRAINT_FORCE] = -raw[Quantity.CONSTRAINT_FORCE]
         return out
 
     def _potential(self, q: np.ndarray) -> np.ndarray:
@@ -379,7 +374,7 @@ class EngineImplementation(Implementation):
             qe, ve, co.force_to_engine(m, q, s.tau), co.acceleration_to_engine(m, q, s.v, s.a))
         out = {}
         for quantity, delta in raw.items():
-            if quantity == "forward_dynamics":
+            if quantity == Quantity.FORWARD_DYNAMICS:
                 out[quantity] = (co.acceleration_to_book(m, q, s.v, delta)
                                  - co.acceleration_to_book(m, q, s.v, np.zeros_like(delta)))
             else:

@@ -31,6 +31,7 @@ from dyncheck import diff
 from dyncheck.adapters import REGISTRY
 from dyncheck.errors import DyncheckError, InvalidInput, UnknownName
 from dyncheck.reference.derivations import cache_root
+from dyncheck.vocabulary import Verdict
 
 ROOT = Path(__file__).resolve().parents[1]
 CORE = ("numpy", "scipy", "sympy", "pandas", "tabulate", "matplotlib", "mujoco", "pin")
@@ -298,7 +299,7 @@ def _not_importable(path: Path, impls: Sequence[str]) -> str:
     rows = pd.read_csv(path)
     own = rows[rows.impl_b.isin(impls) | rows.impl_a.isin(impls)]
     marker = "which is not installed ("
-    if own.empty or not (own.verdict == "skipped").all():
+    if own.empty or not (own.verdict == Verdict.SKIPPED).all():
         return ""
     notes = own.note.dropna()
     if notes.empty or not notes.str.contains(marker, regex=False).all():

@@ -7,21 +7,12 @@ import os
 import tempfile
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, fields
-from enum import StrEnum
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
-
-class Verdict(StrEnum):
-    """What a row concluded (a ``str``: compares equal to its value, in tables and CSV)."""
-
-    PASSED = "passed"
-    EXPLAINED = "explained"
-    FAILED = "failed"
-    SKIPPED = "skipped"
-
+from dyncheck.vocabulary import SEVERITY, Verdict  # noqa: F401  (re-exported)
 
 MEANINGS: dict[str, str] = {
     Verdict.PASSED: "the two sides agree within the row's tolerance, derived from its basis "
@@ -38,11 +29,6 @@ MEANINGS: dict[str, str] = {
 """What each verdict means, for the report's glossary and ``--help``."""
 
 VERDICTS = tuple(v.value for v in Verdict)
-SEVERITY: dict[str, int] = {Verdict.PASSED: 0, Verdict.EXPLAINED: 1, Verdict.SKIPPED: 2,
-                            Verdict.FAILED: 3}
-"""The one order of the verdicts, best first: a row that passed, one whose difference is
-explained, one not checked (a check lost is worse than an explained difference), one that
-failed. A table cell shows its rows' worst; a change to a higher rank is a regression."""
 
 
 @dataclass(frozen=True, kw_only=True)

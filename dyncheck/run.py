@@ -31,6 +31,7 @@ from dyncheck.results import (
 )
 from dyncheck.studies import TrajectoryFigures, study
 from dyncheck.studies.derivatives import derivative_rows
+from dyncheck.vocabulary import Verdict
 from dyncheck.workers import Unit, run_units
 
 
@@ -55,7 +56,7 @@ class RunResult:
     def failed(self) -> bool:
         """A row failed, or a conventions demonstration raised."""
         lost = any(e.failed for e in self.conventions or ())
-        return lost or bool((self.discrepancies["verdict"] == "failed").any())
+        return lost or bool((self.discrepancies["verdict"] == Verdict.FAILED).any())
 
 
 def resolve(case_names: Sequence[str], impl_names: Sequence[str]) -> tuple[list[Case], list[str]]:

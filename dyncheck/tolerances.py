@@ -23,6 +23,7 @@ import numpy as np
 
 from dyncheck.implementations import QUANTITIES
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
+from dyncheck.vocabulary import Quantity
 
 
 @dataclass(frozen=True)
@@ -50,7 +51,7 @@ def instantaneous(
     if quantity not in QUANTITIES:
         raise KeyError(quantity)
     unit = eps_name(eps)
-    if quantity in ("forward_dynamics", "constraint_force"):
+    if quantity in (Quantity.FORWARD_DYNAMICS, Quantity.CONSTRAINT_FORCE):
         basis = f"round-off: {ROUNDOFF_FACTOR} {unit} x cond(M) = {condition:.3g}"
         if soft > 1.0:
             basis += f" x soft-constraint Hessian 1 + d/(1-d) = {soft:.3g}"

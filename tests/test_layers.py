@@ -48,7 +48,8 @@ def test_reference_imports_numpy_scipy_sympy_only(path):
 def test_adapters_never_import_the_reference_or_the_comparison_layer(path):
     for name in _imports(path):
         if name.startswith("dyncheck."):
-            allowed = ("dyncheck.adapters", "dyncheck.cases", "dyncheck.errors")
+            allowed = ("dyncheck.adapters", "dyncheck.cases", "dyncheck.errors",
+                       "dyncheck.vocabulary")
             assert name.startswith(allowed), f"{path.name} imports {name}"
 
 
@@ -57,9 +58,8 @@ def test_cases_import_no_engine_no_adapter_no_reference(path):
     for name in _imports(path):
         assert _top(name) not in ENGINES, f"{path.name} imports {name}"
         if name.startswith("dyncheck."):
-            assert name.startswith(("dyncheck.cases", "dyncheck.errors")), (
-                f"{path.name} imports {name}"
-            )
+            assert name.startswith(("dyncheck.cases", "dyncheck.errors",
+                                    "dyncheck.vocabulary")), f"{path.name} imports {name}"
 
 
 @pytest.mark.parametrize("path", _modules("dyncheck/errata"), ids=lambda p: p.name)
@@ -85,14 +85,15 @@ def test_the_rule_reader_sees_function_level_imports(tmp_path):
 
 
 def _layer(module: str) -> str | None:
-    """The layer of a dyncheck module name: errors (the bottom), reference, cases, adapters,
-    or the comparison layer (everything else under dyncheck/)."""
+    """The layer of a dyncheck module name: errors and the vocabulary (the bottom: they import
+    nothing of dyncheck), reference, cases, adapters, or the comparison layer (everything
+    else under dyncheck/)."""
     if not module.startswith("dyncheck"):
         return None
     parts = module.split(".")
     if len(parts) == 1:
         return "comparison"
-    if parts[1] == "errors":
+    if parts[1] in ("errors", "vocabulary"):
         return "errors"
     return parts[1] if parts[1] in ("reference", "cases", "adapters") else "comparison"
 
@@ -101,7 +102,8 @@ def _layer_of_path(path: Path) -> str:
     rel = path.relative_to(ROOT).parts
     if rel[0] in ("reference", "cases", "adapters"):
         return rel[0]
-    return "errors" if path.name == "errors.py" and len(rel) == 2 else "comparison"
+    bottom = path.name in ("errors.py", "vocabulary.py") and len(rel) == 2
+    return "errors" if bottom else "comparison"
 
 
 def test_no_cycle_between_layers():
@@ -197,3 +199,36 @@ it)."""
 def test_no_module_of_the_package_is_over_500_lines(path):
     lines = path.read_text(encoding="utf-8").count("\n")
     assert lines <= MAX_LINES, f"{path.relative_to(ROOT)}: {lines} lines"
+
+
+LITERAL_ELSEWHERE = {
+    ("adapters/integrators.py", "failed"): "scipy's solve_ivp status, not a verdict",
+    ("dyncheck/report/figures.py", "trajectory"): "a figure's file name, not a quantity",
+    ("dyncheck/check/dynamics.py", "mass_matrix"): "a field of Dynamics, not the quantity",
+}
+"""Strings spelled like a member of the vocabulary that mean something else."""
+
+
+def test_no_quantity_or_verdict_is_written_as_a_string_outside_the_vocabulary():
+    """#43: the closed sets have one home (dyncheck/vocabulary.py); a quantity or a verdict
+    written as a string literal elsewhere is a second definition that can drift (``diff``
+    and the report's tables once ranked ``skipped`` in two different orders)."""
+    import io
+    import tokenize
+
+    from dyncheck.vocabulary import Quantity, Verdict
+
+    words = {m.value for m in Quantity} | {m.value for m in Verdict}
+    found = []
+    for path in _package_files():
+        where = path.relative_to(ROOT).as_posix()
+        if where == "dyncheck/vocabulary.py":
+            continue
+        text = path.read_text(encoding="utf-8")
+        for token in tokenize.generate_tokens(io.StringIO(text).readline):
+            value = token.string[1:-1]
+            if (token.type == tokenize.STRING and token.string[:1] in "\"'"
+                    and token.string[-1:] == token.string[:1] and value in words
+                    and (where, value) not in LITERAL_ELSEWHERE):
+                found.append(f"{where}:{token.start[0]}: {token.string}")
+    assert not found, "\n".join(found)

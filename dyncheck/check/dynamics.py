@@ -29,14 +29,15 @@ from dyncheck.check.describe import depth, size
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
 from dyncheck.results import Verdict
+from dyncheck.vocabulary import Quantity
 
-QUANTITIES = {
-    "mass_matrix": "mass_matrix",
-    "bias_forces": "bias",
-    "forward_dynamics": "forward",
-    "inverse_dynamics": "inverse",
-    "kinetic_energy": "kinetic",
-    "potential_energy": "potential",
+QUANTITIES: dict[str, str] = {  # the quantity → the field of Dynamics holding it
+    Quantity.MASS_MATRIX: "mass_matrix",
+    Quantity.BIAS_FORCES: "bias",
+    Quantity.FORWARD_DYNAMICS: "forward",
+    Quantity.INVERSE_DYNAMICS: "inverse",
+    Quantity.KINETIC_ENERGY: "kinetic",
+    Quantity.POTENTIAL_ENERGY: "potential",
 }
 
 
@@ -81,10 +82,11 @@ def floors(tree: ModelTree, dyn: Dynamics, states: States) -> dict[str, tuple[fl
     mgl = sum(j.mass for j in tree.joints) * float(np.linalg.norm(tree.gravity)) * size(tree)
     energy = max(float(np.nanmax(np.abs(dyn.kinetic), initial=0.0)), mgl)
     return {
-        "mass_matrix": (0.0, ""),
-        "bias_forces": (force, "|M a|"), "inverse_dynamics": (force, "|M a|"),
-        "forward_dynamics": (accel, "|a|"),
-        "kinetic_energy": (energy, "max(T, m g L)"), "potential_energy": (energy, "max(T, m g L)"),
+        Quantity.MASS_MATRIX: (0.0, ""),
+        Quantity.BIAS_FORCES: (force, "|M a|"), Quantity.INVERSE_DYNAMICS: (force, "|M a|"),
+        Quantity.FORWARD_DYNAMICS: (accel, "|a|"),
+        Quantity.KINETIC_ENERGY: (energy, "max(T, m g L)"),
+        Quantity.POTENTIAL_ENERGY: (energy, "max(T, m g L)"),
     }
 
 
@@ -103,7 +105,7 @@ def condition(mass: np.ndarray) -> float:
 
 def _values(dyn: Dynamics, quantity: str) -> np.ndarray:
     value = getattr(dyn, QUANTITIES[quantity])
-    if quantity == "potential_energy":
+    if quantity == Quantity.POTENTIAL_ENERGY:
         value = value - value[0]
     return value.reshape(len(value), -1)
 
@@ -166,7 +168,7 @@ def compare(
         basis = f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth {d}"
         if floor >= float(np.abs(desired).max()) and floor_name:
             basis += f"; scale {floor_name} {floor:.3g} (the value's own is smaller)"
-        if quantity == "forward_dynamics":
+        if quantity == Quantity.FORWARD_DYNAMICS:
             rtol *= kappa
             basis += f" x cond(M) {kappa:.3g}"
         error = float(errors[worst]) / scale

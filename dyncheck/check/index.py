@@ -17,6 +17,7 @@ from dyncheck.check.verdicts import Agreement, EngineVerdict, Reading, per_engin
 from dyncheck.errors import InvalidInput
 from dyncheck.escaping import markdown, markdown_link, markdown_table
 from dyncheck.results import to_csv, write_atomic
+from dyncheck.vocabulary import Verdict
 
 MODEL_SUFFIXES = (".xml", ".urdf", ".mjcf")
 MAX_MODELS = 10_000
@@ -106,7 +107,7 @@ class Entry:
     def outcome(self) -> str:
         if self.refused:
             return "refused"
-        return "differences found" if self.counts.get("failed", 0) else "engines agree"
+        return "differences found" if self.counts.get(Verdict.FAILED, 0) else "engines agree"
 
 
 def entry(result: CheckResult, page: str, file: str) -> Entry:

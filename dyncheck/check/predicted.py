@@ -20,15 +20,16 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.check.dynamics import Explanation, States
 from dyncheck.check.referee import ReferenceModel
+from dyncheck.vocabulary import Quantity
 
 
 def differences(canon: Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
                 tree_b: ModelTree, states: States, dyn_a: Dynamics) -> dict[str, Explanation]:
     """Quantity → the predicted difference b − a, for the pair (a, b)."""
-    out = {}
+    out: dict[str, Explanation] = {}
     rotor = rotor_energy(canon, canonical_tree, tree_a, tree_b, states.v)
     if rotor is not None:
-        out["kinetic_energy"] = rotor
+        out[Quantity.KINETIC_ENERGY] = rotor
     for tree, sign in ((tree_b, 1.0), (tree_a, -1.0)):
         out |= base_gravity(canon, canonical_tree, tree, states, dyn_a, sign)
     return out
@@ -87,5 +88,6 @@ def base_gravity(canon: Canonical, canonical_tree: ModelTree, tree: ModelTree,
             "through Rx(r) Ry(p) Rz(y) of the orientation's roll, pitch, yaw — the state's "
             "Rz(y) Ry(p) Rx(r) composed in reverse order (measured): predicted per state as "
             "G(g′) − G(g), g′ = R R′ᵀ g")
-    return {"bias_forces": Explanation(delta, note), "inverse_dynamics": Explanation(delta, note),
-            "forward_dynamics": Explanation(forward, note)}
+    return {Quantity.BIAS_FORCES: Explanation(delta, note),
+            Quantity.INVERSE_DYNAMICS: Explanation(delta, note),
+            Quantity.FORWARD_DYNAMICS: Explanation(forward, note)}

@@ -20,6 +20,7 @@ from dyncheck.commands.options import (
     warn_cost,
     write_ci,
 )
+from dyncheck.vocabulary import Verdict
 
 
 def run_command(args: argparse.Namespace) -> int:
@@ -52,7 +53,7 @@ def run_command(args: argparse.Namespace) -> int:
     write_ci(args, split(result.discrepancies, RUN), RUN, report.versions(result.engines))
     counts = result.discrepancies["verdict"].value_counts()
     print(
-        ", ".join(f"{counts.get(v, 0)} {v}" for v in ("passed", "explained", "failed", "skipped"))
+        ", ".join(f"{counts.get(v, 0)} {v}" for v in Verdict)
         + f"; report in {args.out}/README.md"
     )
     regressed = False

@@ -14,6 +14,7 @@ from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.comparison import compare_instantaneous
 from dyncheck.explanations import Origin
 from dyncheck.implementations import EngineImplementation, NativeMap, make_implementation
+from dyncheck.vocabulary import Verdict
 
 
 @dataclass(frozen=True)
@@ -45,8 +46,9 @@ def worst(case_name: str, engine: str, cmap=None) -> float:
         impl.map = NativeMap(cmap, engine, case.multibody())
     impls = {"reference": make_implementation("reference", case), engine: impl}
     rows = compare_instantaneous(case, impls, case.sample_states())
-    errors = [r.max_rel_err for r in rows if r.verdict != "explained" or cmap is not None]
-    if cmap is not None and any(r.verdict == "failed" and np.isnan(r.max_rel_err) for r in rows):
+    errors = [r.max_rel_err for r in rows if r.verdict != Verdict.EXPLAINED or cmap is not None]
+    if cmap is not None and any(r.verdict == Verdict.FAILED and np.isnan(r.max_rel_err)
+                                for r in rows):
         return float("inf")  # the naive map made a quantity fail outright (singular, NaN)
     return float(np.nanmax(errors))
 

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from dyncheck.explain.entry import Entry, beside_mujoco
+from dyncheck.vocabulary import Quantity
 
 ARM = """<robot name="arm">
   <link name="base"><inertial><mass value="2"/><inertia ixx="0.02" ixy="0" ixz="0" iyy="0.03"
@@ -102,7 +103,7 @@ def newton_free_velocity() -> Entry:
         errors.append(max(
             float(np.abs(getattr(got, f) - getattr(expected, f)).max())
             / float(np.abs(getattr(expected, f)).max())
-            for f in ("mass_matrix", "bias", "forward", "inverse")))
+            for f in (Quantity.MASS_MATRIX, "bias", "forward", "inverse")))
     return Entry(
         "newton-free-joint-velocity",
         "A free body's six velocities: the linear three are the velocity of *some* point of "

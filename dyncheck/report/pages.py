@@ -27,6 +27,7 @@ from dyncheck.studies import (
     TRUNCATION,
 )
 from dyncheck.tolerances import BASES, ORDER_SLACK
+from dyncheck.vocabulary import Quantity, Verdict
 
 BOOK = (
     '§2.2 "Dynamics" of J. H. Heinbockel, *Introduction to Tensor Calculus and Continuum '
@@ -62,7 +63,8 @@ def case_page(case: Case, result: RunResult) -> str:
     params = pd.DataFrame({"parameter": list(case.params()), "value": list(case.params().values())})
     cmap = case.engine_map()
     mb = case.multibody()
-    pairs = d[(d.case == case.name) & (d.quantity == "trajectory") & (d.impl_a != "reference")]
+    pairs = d[(d.case == case.name) & (d.quantity == Quantity.TRAJECTORY)
+              & (d.impl_a != "reference")]
     lines = [
         f"# {case.title}",
         "",
@@ -159,9 +161,9 @@ def _constraint_section(case: Case, d: pd.DataFrame) -> list[str]:
     inst = d[
         (d.case == case.name)
         & (d.impl_a == "reference")
-        & d.quantity.isin(["forward_dynamics", "constraint_force"])
+        & d.quantity.isin([Quantity.FORWARD_DYNAMICS, Quantity.CONSTRAINT_FORCE])
     ]
-    drift = d[(d.case == case.name) & (d.quantity == "constraint_drift")]
+    drift = d[(d.case == case.name) & (d.quantity == Quantity.CONSTRAINT_DRIFT)]
     return [
         "### Constraints: exact (KKT) and soft (MuJoCo's impedance model)",
         "",
@@ -192,7 +194,7 @@ def errata(d: pd.DataFrame) -> tuple[str, pd.DataFrame]:
     """The book's printed equations (``book``) against the general method (``reference``)."""
     rows = d[(d.impl_a == "reference") & (d.impl_b == "book")]
     table = rows[["case", "quantity", "max_rel_err", "tolerance", "verdict"]]
-    bad = rows[rows.verdict != "passed"]
+    bad = rows[rows.verdict != Verdict.PASSED]
     if len(bad):
         lead = (
             f"**{len(bad)} printed quantities disagree with the general method** — errata "
@@ -212,8 +214,8 @@ def index_page(result: RunResult, *, date: str) -> str:
     d, conv = result.discrepancies, result.convergence
     made_with = versions(result.engines)
     prov = pd.DataFrame({"item": ["date (UTC)", *made_with], "value": [date, *made_with.values()]})
-    failed = d[d.verdict.isin(["failed", "skipped"])]
-    explained = d.loc[d.verdict == "explained", "convention"]
+    failed = d[d.verdict.isin([Verdict.FAILED, Verdict.SKIPPED])]
+    explained = d.loc[d.verdict == Verdict.EXPLAINED, "convention"]
     used = sorted({c for cell in explained for c in cell.split("; ") if c} | {TRUNCATION})
     lines = [
         "# dyncheck verification report",

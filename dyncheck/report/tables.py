@@ -14,9 +14,10 @@ from dyncheck.studies import (
     CONTROLLED_ACCURACIES,
     finest_pair,
 )
+from dyncheck.vocabulary import ALONG_RUNS, Quantity, Verdict
 
-TRAJECTORY_QUANTITIES = ("trajectory", "constraint_drift", "closed_form")
-"""Row quantities that come from runs (the rest are instantaneous)."""
+TRAJECTORY_QUANTITIES = ALONG_RUNS
+"""Row quantities that come from runs (the rest are instantaneous): the vocabulary's."""
 
 
 def md(frame: pd.DataFrame) -> str:
@@ -34,7 +35,7 @@ def _cells(rows: pd.DataFrame, keys: list[str], sort: bool, tolerance: bool) -> 
     severity = rows["verdict"].map(SEVERITY)
     if severity.isna().any():
         raise ValueError(f"unknown verdict {rows['verdict'][severity.isna()].iloc[0]!r}")
-    error = rows["max_rel_err"].where(rows["verdict"] != "skipped")
+    error = rows["max_rel_err"].where(rows["verdict"] != Verdict.SKIPPED)
     tol = rows["tolerance"] if tolerance else pd.Series(np.nan, index=rows.index)
     frame = rows.assign(severity=severity, error=error, tol=tol)
     cells = {}
@@ -64,7 +65,8 @@ def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) ->
     if case is not None:
         conv, d = conv[conv["case"] == case], d[d["case"] == case]
     run = ["case", "impl_b", "integrator"]
-    first = d[(d["quantity"] == "trajectory") & (d["impl_a"] == "reference")].drop_duplicates(run)
+    first = d[(d["quantity"] == Quantity.TRAJECTORY)
+              & (d["impl_a"] == "reference")].drop_duplicates(run)
     verdicts = dict(zip(first[run].itertuples(index=False, name=None), first["verdict"],
                         strict=True))  # each run's first row's verdict
     conventions = first["convention"].fillna("") if "convention" in first else \
@@ -87,7 +89,7 @@ def order_table(conv: pd.DataFrame, d: pd.DataFrame, case: str | None = None) ->
                 "verdict": verdict,
                 # an explained run's reason (a held force makes RK4 order 1: "nominal 1,
                 # observed 0.999, explained" reads as a contradiction without it)
-                "why": why[c, impl, integ] if verdict == "explained" else "",
+                "why": why[c, impl, integ] if verdict == Verdict.EXPLAINED else "",
             }
         )
     return pd.DataFrame(rows)
@@ -173,7 +175,7 @@ def conservation_matrix(result: RunResult) -> pd.DataFrame:
 
 def summary(d: pd.DataFrame) -> pd.DataFrame:
     counts = d.groupby(["case", "verdict"]).size().unstack("verdict", fill_value=0)
-    for v in ("passed", "explained", "failed", "skipped"):
+    for v in (Verdict.PASSED, Verdict.EXPLAINED, Verdict.FAILED, Verdict.SKIPPED):
         if v not in counts:
             counts[v] = 0
-    return counts[["passed", "explained", "failed", "skipped"]].reset_index()
+    return counts[list(Verdict)].reset_index()

@@ -12,6 +12,7 @@ from dyncheck.results import Discrepancy, Verdict
 from dyncheck.studies.order import finest_pair, observed_orders
 from dyncheck.studies.references import References, difference
 from dyncheck.tolerances import ORDER_SLACK, REFERENCE_MARGIN, accumulated, first_near_max
+from dyncheck.vocabulary import Quantity
 
 ADAPTIVE_RTOL = 1e-13
 
@@ -45,7 +46,7 @@ def adaptive(
     verdict = Verdict.PASSED if variant is not None and err <= allowed else Verdict.FAILED
     return Discrepancy(
         case=case.name,
-        quantity="trajectory",
+        quantity=Quantity.TRAJECTORY,
         impl_a="reference",
         impl_b=impl.name,
         integrator="dop853",
@@ -122,7 +123,7 @@ def controlled(
     return [
         Discrepancy(
             case=case.name,
-            quantity="trajectory",
+            quantity=Quantity.TRAJECTORY,
             impl_a="reference",
             impl_b=impl.name,
             integrator=f"{CONTROLLED} eps={eps:g}",

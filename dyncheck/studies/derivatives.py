@@ -23,6 +23,7 @@ from dyncheck.cases import Case
 from dyncheck.errors import EngineNotInstalled
 from dyncheck.implementations import NativeMap
 from dyncheck.results import Discrepancy
+from dyncheck.vocabulary import Verdict
 
 REFEREE = "reference"
 TREE_ONLY = ("the smooth dynamics of the case's MJCF tree (its couplings and external field "
@@ -68,22 +69,23 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
         source = read(path)
         canonical = engines.load(first, source)
         if isinstance(canonical, engines.NotLoaded):
-            return [_row(case, "derivatives", first, "", "failed", canonical.message)]
+            return [_row(case, "derivatives", first, "", Verdict.FAILED, canonical.message)]
         for name in names:
             if name in RUN:  # not installed: skipped rows with the pip hint, as in the run
                 try:
                     get_adapter(name)
                 except EngineNotInstalled as exc:
-                    failed.append(_row(case, "derivatives", name, "", "skipped", str(exc)))
+                    failed.append(_row(case, "derivatives", name, "", Verdict.SKIPPED, str(exc)))
                     continue
             if not _differentiates(MODELS[name].model or ""):
-                failed.append(_row(case, "derivatives", name, "", "skipped",
+                failed.append(_row(case, "derivatives", name, "", Verdict.SKIPPED,
                                    f"{name} offers no derivatives"))
                 continue
             engine = canonical if name == first else engines.load(name, source)
             if isinstance(engine, engines.NotLoaded):  # costs its own row
                 failed.append(_row(case, "derivatives", name, "",
-                                   "skipped" if engine.skip else "failed", engine.message))
+                                   Verdict.SKIPPED if engine.skip else Verdict.FAILED,
+                                   engine.message))
             else:
                 loaded[name] = engine
     tree = canonical.tree
@@ -95,7 +97,7 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
         missing = [n for n in canon.names if n not in theirs]
         if missing:  # e.g. Pinocchio's composite joint for several joints on one body
             del loaded[name]
-            failed.append(_row(case, "derivatives", name, "", "skipped",
+            failed.append(_row(case, "derivatives", name, "", Verdict.SKIPPED,
                                f"{name} holds no joint {missing[0]!r} as such (its reading "
                                "of the file joins joints the others keep apart): its "
                                "derivatives are not mapped joint by joint"))

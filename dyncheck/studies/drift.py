@@ -16,6 +16,7 @@ from dyncheck.reference import rigid
 from dyncheck.results import Discrepancy, Verdict
 from dyncheck.studies.references import References
 from dyncheck.tolerances import accumulated, first_near_max
+from dyncheck.vocabulary import Quantity
 
 
 def energy_drift(
@@ -70,7 +71,7 @@ def drift_row(
     tol = accumulated(steps, soft_factor(variant), impl.eps)
     base: dict[str, Any] = dict(
         case=case.name,
-        quantity="constraint_drift",
+        quantity=Quantity.CONSTRAINT_DRIFT,
         impl_a="reference",
         impl_b=impl.name,
         integrator=integrator,

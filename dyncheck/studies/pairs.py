@@ -26,6 +26,7 @@ from dyncheck.tolerances import (
     first_near_max,
     roundoff_floor,
 )
+from dyncheck.vocabulary import Quantity
 
 
 def _no_numbers(
@@ -35,7 +36,7 @@ def _no_numbers(
     nan = float("nan")
     return Discrepancy(
         case=case.name,
-        quantity="trajectory",
+        quantity=Quantity.TRAJECTORY,
         impl_a=a,
         impl_b=b,
         integrator=integrator,
@@ -126,7 +127,7 @@ def _frame_pair(
             tol = accumulated(round(case.trajectory.duration / dts[0]), eps=eps)
             return Discrepancy(
                 case=case.name,
-                quantity="trajectory",
+                quantity=Quantity.TRAJECTORY,
                 impl_a=a,
                 impl_b=b,
                 integrator=integrator,
@@ -146,7 +147,7 @@ def _frame_pair(
     ok = p >= nominal - ORDER_SLACK  # two order-p maps differ by O(hᵖ) or less
     return Discrepancy(
         case=case.name,
-        quantity="trajectory",
+        quantity=Quantity.TRAJECTORY,
         impl_a=a,
         impl_b=b,
         integrator=integrator,
@@ -205,7 +206,7 @@ def engine_pairs(
                 err = float(diff[worst])
                 row: dict[str, Any] = dict(
                     case=case.name,
-                    quantity="trajectory",
+                    quantity=Quantity.TRAJECTORY,
                     impl_a=a,
                     impl_b=b,
                     integrator=integrator,

@@ -41,6 +41,7 @@ from dyncheck.tolerances import (
     first_near_max,
     roundoff_floor,
 )
+from dyncheck.vocabulary import Quantity
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -311,7 +312,7 @@ def _rows(case: Case, name: str, integrator: str, dts: tuple[float, ...], sweep:
             case=case.name, impl=name, integrator=integrator, dt=dt, error=err,
             observed_order=p, nominal_order=nominal, reference_error=ref_err, asymptotic=a))
         rows.append(Discrepancy(
-            case=case.name, quantity="trajectory", impl_a="reference", impl_b=name,
+            case=case.name, quantity=Quantity.TRAJECTORY, impl_a="reference", impl_b=name,
             integrator=integrator, dt=dt, max_abs_err=err, max_rel_err=err / scale_q,
             tolerance=float("nan"), tolerance_basis=basis, verdict=judged.verdict,
             convention=convention, note=judged.note, worst_state=w))

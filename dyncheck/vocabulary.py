@@ -1,0 +1,54 @@
+"""dyncheck's closed sets, one home each (#43): the quantities compared and the verdicts a
+row can reach, with the verdicts' one order of severity. ``StrEnum``: a member compares equal
+to its value and is written as it in tables and CSV, so the files' bytes do not depend on
+it. Imports nothing of dyncheck: every layer (the adapters and cases included) may use it."""
+
+from __future__ import annotations
+
+from enum import StrEnum
+
+
+class Quantity(StrEnum):
+    """What a row compares: the smooth dynamics at sampled states (M, h, forward and inverse
+    dynamics, T, V; the cords' tension where a case has couplings), and along runs (the
+    trajectory, a constraint's drift, a closed form)."""
+
+    MASS_MATRIX = "mass_matrix"
+    BIAS_FORCES = "bias_forces"
+    FORWARD_DYNAMICS = "forward_dynamics"
+    INVERSE_DYNAMICS = "inverse_dynamics"
+    KINETIC_ENERGY = "kinetic_energy"
+    POTENTIAL_ENERGY = "potential_energy"
+    CONSTRAINT_FORCE = "constraint_force"
+    TRAJECTORY = "trajectory"
+    CONSTRAINT_DRIFT = "constraint_drift"
+    CLOSED_FORM = "closed_form"
+
+
+INSTANTANEOUS: tuple[Quantity, ...] = (
+    Quantity.MASS_MATRIX, Quantity.BIAS_FORCES, Quantity.FORWARD_DYNAMICS,
+    Quantity.INVERSE_DYNAMICS, Quantity.KINETIC_ENERGY, Quantity.POTENTIAL_ENERGY,
+    Quantity.CONSTRAINT_FORCE,
+)
+"""The quantities at sampled states, in the order tables list them (``constraint_force``
+only for cases with couplings: the cords' tensions, N)."""
+
+ALONG_RUNS: tuple[Quantity, ...] = (
+    Quantity.TRAJECTORY, Quantity.CONSTRAINT_DRIFT, Quantity.CLOSED_FORM)
+"""The quantities that come from runs."""
+
+
+class Verdict(StrEnum):
+    """What a row concluded."""
+
+    PASSED = "passed"
+    EXPLAINED = "explained"
+    FAILED = "failed"
+    SKIPPED = "skipped"
+
+
+SEVERITY: dict[str, int] = {Verdict.PASSED: 0, Verdict.EXPLAINED: 1, Verdict.SKIPPED: 2,
+                            Verdict.FAILED: 3}
+"""The one order of the verdicts, best first: a row that passed, one whose difference is
+explained, one not checked (a check lost is worse than an explained difference), one that
+failed. A table cell shows its rows' worst; a change to a higher rank is a regression."""
