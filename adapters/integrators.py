@@ -40,6 +40,7 @@ import numpy as np
 
 from dyncheck.cases.multibody import NQ, NV, ROTATING
 from dyncheck.errors import EngineError
+from dyncheck.vocabulary import Integrator
 
 Acceleration = Callable[..., np.ndarray]
 """v̇(q, v[, held]) for one state in the :class:`Layout`, shapes (nq,), (nv,) → (nv,): called
@@ -249,7 +250,7 @@ def integrate(
     qs = np.empty((steps + 1, q.shape[0]))
     vs = np.empty((steps + 1, v.shape[0]))
     qs[0], vs[0] = q, v
-    hold = freeze if integrator == "rk4-held-force" else None
+    hold = freeze if integrator == Integrator.RK4_HELD_FORCE else None
     for k in range(1, steps + 1):
         stage = acc if hold is None else partial(_held, acc, hold(q, v))
         q, v = step(stage, q, v, dt, layout, naive_group)

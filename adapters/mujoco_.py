@@ -32,6 +32,7 @@ from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.mujoco_api import INTEGRATORS, full_inertia
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import EngineError, Unsupported
+from dyncheck.vocabulary import Integrator
 
 _DIVERGED = (
     mujoco.mjtWarning.mjWARN_BADQPOS,
@@ -242,7 +243,7 @@ class MuJoCoAdapter(Adapter):
         qs = np.empty((steps + 1, m.nq))
         vs = np.empty((steps + 1, m.nv))
         qs[0], vs[0] = d.qpos, d.qvel
-        held = integrator == "rk4-held-force"
+        held = integrator == Integrator.RK4_HELD_FORCE
         field = bool(self.spec.central_mu)
         if field and not held:
             mujoco.set_mjcb_passive(self._passive)

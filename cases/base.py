@@ -15,21 +15,16 @@ from dyncheck.cases.coordinate_maps import CoordinateMap
 from dyncheck.cases.multibody import Multibody
 from dyncheck.cases.validate import finite_array, integer, positive
 from dyncheck.errors import InvalidInput
+from dyncheck.vocabulary import Integrator
 
-INTEGRATORS: tuple[str, ...] = ("euler", "implicitfast", "rk2", "rk3", "rk4", "rk4-held-force")
+INTEGRATORS: tuple[str, ...] = tuple(Integrator)
 """Fixed-step integrators as MuJoCo defines them; nominal orders 1, 1, 4. ``rk4-held-force``
 is RK4 with a state-dependent external force evaluated once per step and held over the
 stages (what setting MuJoCo's ``xfrc_applied`` before ``mj_step`` does): its predicted
 order is 1. ``rk2`` and ``rk3`` are Drake's fixed-step Runge–Kutta integrators."""
 
-NOMINAL_ORDER: dict[str, int] = {
-    "euler": 1,
-    "implicitfast": 1,
-    "rk2": 2,
-    "rk3": 3,
-    "rk4": 4,
-    "rk4-held-force": 1,
-}
+NOMINAL_ORDER: dict[str, int] = {i: i.nominal_order for i in Integrator}
+"""Each integrator's nominal order (the vocabulary's)."""
 
 
 STEPS: dict[str, tuple[float, ...]] = {

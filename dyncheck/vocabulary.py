@@ -52,3 +52,39 @@ SEVERITY: dict[str, int] = {Verdict.PASSED: 0, Verdict.EXPLAINED: 1, Verdict.SKI
 """The one order of the verdicts, best first: a row that passed, one whose difference is
 explained, one not checked (a check lost is worse than an explained difference), one that
 failed. A table cell shows its rows' worst; a change to a higher rank is a regression."""
+
+
+class Integrator(StrEnum):
+    """The fixed-step integrators, as MuJoCo (Euler, implicitfast, RK4) and Drake (RK2, RK3)
+    define them; ``rk4-held-force`` is RK4 with a state-dependent external force evaluated
+    once per step and held over the stages (what MuJoCo's ``xfrc_applied`` set before
+    ``mj_step`` does)."""
+
+    EULER = "euler"
+    IMPLICITFAST = "implicitfast"
+    RK2 = "rk2"
+    RK3 = "rk3"
+    RK4 = "rk4"
+    RK4_HELD_FORCE = "rk4-held-force"
+
+    @property
+    def nominal_order(self) -> int:
+        """The global order of accuracy on a smooth vector field (the held force makes RK4's
+        order 1: its error over a step is O(h²))."""
+        return _ORDERS[self]
+
+    @property
+    def is_rk4(self) -> bool:
+        """RK4 or RK4 with a held force: the stages an engine may combine across tangent
+        spaces on a rotating joint."""
+        return self in (Integrator.RK4, Integrator.RK4_HELD_FORCE)
+
+
+_ORDERS = {Integrator.EULER: 1, Integrator.IMPLICITFAST: 1, Integrator.RK2: 2,
+           Integrator.RK3: 3, Integrator.RK4: 4, Integrator.RK4_HELD_FORCE: 1}
+
+
+def is_rk4(name: str) -> bool:
+    """:attr:`Integrator.is_rk4` of a row's integrator name (error-controlled runs and
+    ``dop853`` are none)."""
+    return name in (Integrator.RK4, Integrator.RK4_HELD_FORCE)

@@ -26,7 +26,7 @@ from dyncheck.tolerances import (
     first_near_max,
     roundoff_floor,
 )
-from dyncheck.vocabulary import Quantity
+from dyncheck.vocabulary import Quantity, is_rk4
 
 
 def _no_numbers(
@@ -77,7 +77,7 @@ def _maps_differ(
         return None
     if any(is_chart(e) for e in (a, b)) and a != b:
         return CHARTS_DIFFER
-    if integrator.startswith("rk4") and len({_group_order(impls[e]) for e in (a, b)}) == 2:
+    if is_rk4(integrator) and len({_group_order(impls[e]) for e in (a, b)}) == 2:
         return NAIVE_GROUP_RK4
     if integrator == "implicitfast" and "free" in types:
         facts = {

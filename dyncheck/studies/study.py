@@ -41,7 +41,7 @@ from dyncheck.tolerances import (
     first_near_max,
     roundoff_floor,
 )
-from dyncheck.vocabulary import Quantity
+from dyncheck.vocabulary import Integrator, Quantity, is_rk4
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -138,9 +138,9 @@ def _expected(impl: Implementation, integrator: str, rotating: bool) -> tuple[in
     integrator's nominal one: a force held over RK4's stages (order 1), RK4's stages summed
     across tangent spaces on a rotating joint (the engine's declared order)."""
     nominal = NOMINAL_ORDER[integrator]
-    convention = HELD_FORCE if integrator == "rk4-held-force" else ""
+    convention = HELD_FORCE if integrator == Integrator.RK4_HELD_FORCE else ""
     group_order = getattr(getattr(impl, "adapter", None), "rk4_group_order", nominal)
-    if integrator.startswith("rk4") and rotating and group_order < nominal:
+    if is_rk4(integrator) and rotating and group_order < nominal:
         nominal, convention = group_order, NAIVE_GROUP_RK4
     return nominal, convention
 
