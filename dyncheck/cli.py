@@ -17,7 +17,7 @@ import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import NoReturn
+from typing import NoReturn, TextIO
 
 from dyncheck.commands.baseline import baseline_command
 from dyncheck.commands.bench import bench_command
@@ -323,11 +323,47 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def console() -> int:
     """The ``dyncheck`` command: :func:`main` in a process that exits without a last garbage
-    collection (:func:`dyncheck.workers.exit_without_collecting`)."""
+    collection (:func:`dyncheck.workers.exit_without_collecting`), its output to a reader
+    that may leave (:class:`_LeavingReader`)."""
     from dyncheck.workers import exit_without_collecting
 
     exit_without_collecting()
+    sys.stdout = _LeavingReader(sys.stdout)
     return main()
+
+
+class _LeavingReader:
+    """``sys.stdout`` for a reader that may go away — ``dyncheck check FOLDER | head``: a
+    write to the closed pipe raised ``BrokenPipeError``, which ended the check after the
+    first model ('cannot write output: Broken pipe', exit 2, the other pages never
+    written). Now the rest of the output goes to /dev/null and the command finishes with
+    its own exit status."""
+
+    def __init__(self, stream: TextIO) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            self._drop()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            self._drop()
+
+    def _drop(self) -> None:
+        """The stream's file descriptor pointed at /dev/null: what is buffered, and the
+        interpreter's last flush, go nowhere without an error."""
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, self._stream.fileno())
+        os.close(devnull)
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(self._stream, name)
 
 
 if __name__ == "__main__":

@@ -201,3 +201,28 @@ def test_help_lists_every_command_in_full_with_an_example(capsys):
         assert command in EXAMPLES
         assert main([command, "--help"]) == 0
         assert "example: dyncheck " + command in " ".join(capsys.readouterr().out.split())
+
+
+def test_a_reader_that_leaves_costs_no_page_and_no_error(tmp_path):
+    """``dyncheck check A B | head -c 5``: the reader closes the pipe after the first line;
+    the check went on writing to it, got ``BrokenPipeError`` and ended with exit 2 ('cannot
+    write output: Broken pipe') before B's page. Now both pages are written, exit 0, and
+    stderr has no error. (Expected: the command's own result without a reader.)"""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    models = Path(__file__).resolve().parents[1] / "check" / "models"
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "dyncheck", "check", str(models / "mixed.xml"),
+         str(models / "branches.urdf"), "--states", "3", "--impl", "reference", "--impl",
+         "mujoco", "--out", str(out)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    assert proc.stdout is not None and proc.stderr is not None
+    proc.stdout.read(5)
+    proc.stdout.close()  # the reader leaves, as `head -c 5` does
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=300) == 0, err
+    assert (out / "mixed.md").is_file() and (out / "branches.md").is_file()
+    assert "error" not in err and "Traceback" not in err
