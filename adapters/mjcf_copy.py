@@ -1,7 +1,8 @@
 """An MJCF file as a parser that cannot read all of it is given it: ``<include>`` inlined (a
 cycle, a missing or special file found here, never handed to a parser that can loop or block
 on it), mesh geoms the parser cannot read removed where they carry no inertia, a missing
-model name supplied.
+model name supplied; a file in another encoding than UTF-8 (which every engine's MJCF parser
+assumes) given as a UTF-8 copy, decoded as its XML declaration or byte-order mark says.
 
 Removing a geom is safe for the dynamics exactly when MuJoCo's compiler takes no inertia from
 it: ``<compiler inertiafromgeom="false">``; or ``"auto"`` (the default) and its body states an
@@ -13,8 +14,12 @@ the mesh, and the copy is refused naming the mesh and the conversion that would 
 from __future__ import annotations
 
 import os
+import re
 import stat
+import tempfile
 import xml.etree.ElementTree as ET
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
@@ -253,12 +258,65 @@ def for_parser(path: Path, engine: str, readable: tuple[str, ...]) -> Copy:
         root.set("model", path.stem)
         notes.append(f"{engine}: the model has no name (<mujoco model=...>); "
                      f"given the copy the name {path.stem!r}")
-    if not notes:
+    if not notes and encoding(path) is None:  # a UTF-8 copy is said once, by model_files
         return Copy(text="", notes=())
-    for element in root.iter():  # what stays is read from absolute paths
-        if element.tag in (*ASSET_DIRS, "model") and (file := _asset_file(root, folder, element)):
-            element.set("file", str(file))
+    return Copy(text=_standalone(root, folder), notes=tuple(notes))
+
+
+TEXTURE_FILES = ("file", "fileright", "fileleft", "fileup", "filedown", "filefront",
+                 "fileback")
+"""The attributes that name a file on an asset (a cube texture names one per face)."""
+
+
+def _standalone(root: ET.Element, folder: Path) -> str:
+    """The (inlined) model as text whose asset files are absolute paths, so that it reads the
+    same from anywhere: the compiler's asset folders folded into them."""
+    for element in root.iter():
+        if element.tag not in (*ASSET_DIRS, "model"):
+            continue
+        base = _compiler(root, ASSET_DIRS.get(element.tag, "assetdir"),
+                         _compiler(root, "assetdir", ""))
+        for key in TEXTURE_FILES:
+            if file := element.get(key):
+                element.set(key, str((folder / base / file).resolve()))
     for compiler in root.iter("compiler"):
         for key in ("meshdir", "texturedir", "assetdir"):
             compiler.attrib.pop(key, None)
-    return Copy(text=ET.tostring(root, encoding="unicode"), notes=tuple(notes))
+    return ET.tostring(root, encoding="unicode")
+
+
+def encoding(path: Path) -> str | None:
+    """The encoding an MJCF file declares, where it is not UTF-8 (None for a UTF-8 file)."""
+    raw = path.read_bytes()
+    try:
+        raw.decode("utf-8")
+    except UnicodeDecodeError:
+        pass
+    else:
+        return None
+    declared = re.search(rb"encoding\s*=\s*[\"']([^\"']+)", raw[:400].replace(b"\0", b""))
+    if declared:
+        return declared.group(1).decode("ascii", "replace")
+    return "UTF-16" if raw[:2] in (b"\xff\xfe", b"\xfe\xff") else "not UTF-8"
+
+
+def transcoded(declared: str) -> str:
+    """The page's note for a file every engine was given as a UTF-8 copy."""
+    return (f"the file is encoded as {declared}, and every engine's MJCF parser reads UTF-8: "
+            "each was given a UTF-8 copy decoded as the file declares (includes inlined, "
+            "asset paths made absolute)")
+
+
+@contextmanager
+def utf8_file(path: Path) -> Iterator[Path]:
+    """The file a parser should be given: the file itself where it is UTF-8; else a UTF-8
+    copy (:func:`_standalone`) in a private temporary folder, removed once the parser is
+    done."""
+    if encoding(path) is None:
+        yield path
+        return
+    text = _standalone(inline(path), path.resolve().parent)
+    with tempfile.TemporaryDirectory(prefix="dyncheck-mjcf-") as folder:
+        copy = Path(folder) / path.name
+        copy.write_text(text, encoding="utf-8")
+        yield copy

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
 
+from dyncheck.adapters.mjcf_copy import encoding, transcoded
+
 
 class Format(StrEnum):
     MJCF = "mjcf"
@@ -80,6 +82,8 @@ def read(path: Path, *, floating: bool = False) -> ModelFile:
             path=path, format=Format.URDF, text=text, floating=floating, notes=tuple(notes)
         )
     said: tuple[str, ...] = (FLOATING_MJCF,) if floating else ()
+    if declared := encoding(path):
+        said += (transcoded(declared),)
     return ModelFile(path=path, format=Format.MJCF, text=_decoded(path.read_bytes()),
                      floating=False, notes=said)
 

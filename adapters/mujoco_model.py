@@ -15,7 +15,7 @@ import warnings
 import mujoco
 import numpy as np
 
-from dyncheck.adapters.mjcf_copy import inline
+from dyncheck.adapters.mjcf_copy import inline, utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     NQ,
@@ -71,7 +71,8 @@ def _compile_quietly(source: ModelFile) -> tuple[mujoco.MjModel, tuple[str, ...]
     notes: list[str] = []
     try:
         if source.format is Format.MJCF:
-            spec = mujoco.MjSpec.from_file(str(source.path))
+            with utf8_file(source.path) as file:
+                spec = mujoco.MjSpec.from_file(str(file))
         else:
             spec = mujoco.MjSpec.from_string(source.text)
         if source.floating and source.format is Format.URDF:

@@ -23,6 +23,7 @@ import warnings
 
 import numpy as np
 
+from dyncheck.adapters.mjcf_copy import utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -82,7 +83,8 @@ def _load(source: ModelFile):  # -> (newton.Model, names of the bodies whose ine
     builder = newton.ModelBuilder()
     try:
         if source.format is Format.MJCF:
-            builder.add_mjcf(str(source.path))
+            with utf8_file(source.path) as file:
+                builder.add_mjcf(str(file))
         else:  # the file's text without geometry and <mimic> (model_files.read), as for all
             builder.add_urdf(source.text, floating=source.floating)
         with warnings.catch_warnings():  # its count of corrected bodies: named below instead

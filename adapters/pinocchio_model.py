@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from dyncheck.adapters.mjcf_copy import geom_defaults, geoms, inline
+from dyncheck.adapters.mjcf_copy import geom_defaults, geoms, inline, utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -57,7 +57,8 @@ def _type(shortname: str) -> JointType:
 def _load(source: ModelFile) -> pin.Model:
     try:
         if source.format is Format.MJCF:
-            return pin.buildModelFromMJCF(str(source.path))
+            with utf8_file(source.path) as file:
+                return pin.buildModelFromMJCF(str(file))
         if source.floating:
             return pin.buildModelFromXML(source.text, pin.JointModelFreeFlyer())
         return pin.buildModelFromXML(source.text)
@@ -66,6 +67,8 @@ def _load(source: ModelFile) -> pin.Model:
         # Pinocchio's C++ exceptions: "From file: … in function: … message:\n<the reason>"
         text = text.split("message:", 1)[1] if "message:" in text else text
         message = " ".join(text.split()) or type(exc).__name__
+        if source.format is Format.MJCF and (count := _bare_bodies(source)):
+            message += f" ({BARE_BODY.format(count=count)})"
         raise EngineError(f"pinocchio refused {source.path}: {message}") from None
 
 
@@ -74,6 +77,18 @@ FIRST_BODY_ONLY = (
     "other top-level bodies ({others}) and their joints are not in its model (fix: put the "
     "robot in one tree under one top-level body, or check its URDF)"
 )
+
+
+BARE_BODY = (
+    "Pinocchio's MJCF parser skips a <body> with no attributes at all ({count} in the file): "
+    "its joints are not in its model, and the bodies below it hang from its parent (measured: "
+    "<body> skipped, <body pos=\"0 0 0\"> read) (fix: name every body)"
+)
+
+
+def _bare_bodies(source: ModelFile) -> int:
+    """How many ``<body>`` elements carry no attribute (Pinocchio's parser skips them)."""
+    return sum(1 for body in inline(source.path).iter("body") if not body.attrib)
 
 
 GRAVITY_IGNORED = (
@@ -94,17 +109,21 @@ DEFAULT_MASS = (
 
 def _hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
     """Why Pinocchio's reading of an MJCF differs, where the file shows the cause (read as
-    XML, includes inlined): joints missing when there are several top-level bodies; masses
-    from default classes."""
+    XML, includes inlined): joints missing where a body has no attributes or there are
+    several top-level bodies; masses from default classes."""
     if source.format is not Format.MJCF:
         return ()
     root = inline(source.path)
     out = []
     bodies = [b.get("name", "(unnamed)") for world in root.findall("worldbody")
               for b in world.findall("body")]
+    count = _bare_bodies(source)
+    missing = [BARE_BODY.format(count=count)] if count else []
     if len(bodies) > 1:
         others = ", ".join(repr(b) for b in bodies[1:6]) + (" …" if len(bodies) > 6 else "")
-        out.append(("model", "joint", FIRST_BODY_ONLY.format(first=bodies[0], others=others)))
+        missing.append(FIRST_BODY_ONLY.format(first=bodies[0], others=others))
+    if missing:
+        out.append(("model", "joint", "; ".join(missing)))
     stated = [o.get("gravity", "") for o in root.iter("option") if o.get("gravity")]
     if stated and not np.allclose([float(x) for x in stated[-1].split()], (0.0, 0.0, -9.81)):
         out.append(("model", "gravity", GRAVITY_IGNORED.format(gravity=stated[-1])))

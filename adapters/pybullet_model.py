@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 
+from dyncheck.adapters.mjcf_copy import utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile, urdf_inertials
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -134,7 +135,8 @@ def _load(client: int, source: ModelFile) -> list[int]:
     (``loadURDF`` reads files only), removed once loaded."""
     try:
         if source.format is Format.MJCF:
-            bodies = list(pb.loadMJCF(str(source.path), physicsClientId=client))
+            with utf8_file(source.path) as file:
+                bodies = list(pb.loadMJCF(str(file), physicsClientId=client))
         else:
             with tempfile.TemporaryDirectory(prefix="dyncheck-pybullet-") as folder:
                 copy = Path(folder) / "model.urdf"

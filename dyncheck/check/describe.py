@@ -167,7 +167,10 @@ def diff(model: str, a: ModelTree, b: ModelTree,
             row(ja.name, "type", ja.type, jb.type, np.inf, 0.0, Verdict.FAILED)
             continue
         if ja.parent != jb.parent:
-            row(ja.name, "parent", ja.parent, jb.parent, np.inf, 0.0, Verdict.FAILED)
+            gone = ja.parent is not None and ja.parent not in names_b
+            row(ja.name, "parent", ja.parent, jb.parent, np.inf, 0.0, Verdict.FAILED,
+                f"follows from joint {ja.parent!r}, which {b.engine} has not" if gone else
+                b.hint(ja.name, "parent") or "")
         if (ja.range is None) != (jb.range is None) or (
             ja.range is not None and jb.range is not None
             and np.abs(np.subtract(ja.range, jb.range)).max() > rtol * max(1.0, *map(abs, ja.range))

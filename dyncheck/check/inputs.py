@@ -4,7 +4,6 @@ naming the file (and the element, line or engine where known)."""
 from __future__ import annotations
 
 import importlib.metadata
-import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -55,25 +54,11 @@ def model_path(text: str) -> Path:
             raise ModelFileError(path, f"an MJCF must be named *.xml for MuJoCo, which picks "
                                  f"its parser by the file's suffix (rename it; got "
                                  f"{path.suffix or 'no suffix'!r})")
-        _utf8(path, raw)
         try:
             inline(path)
         except EngineError as exc:
             raise ModelFileError(path, str(exc).removeprefix(f"{path.resolve()}: ")) from None
     return path
-
-
-def _utf8(path: Path, raw: bytes) -> None:
-    """MuJoCo's, Pinocchio's and Drake's MJCF parsers read the file's bytes as UTF-8: another
-    encoding is refused, naming the one the file declares (a URDF is handed to the engines as
-    text, decoded as it declares)."""
-    try:
-        raw.decode("utf-8")
-    except UnicodeDecodeError:
-        declared = re.search(rb"encoding\s*=\s*[\"']([^\"']+)", raw[:200].replace(b"\0", b""))
-        what = declared.group(1).decode("ascii", "replace") if declared else "not UTF-8"
-        raise ModelFileError(path, f"is encoded as {what}; the engines' MJCF parsers read "
-                             "UTF-8 only (save the file as UTF-8)") from None
 
 
 XACRO = "{http://www.ros.org/wiki/xacro}"

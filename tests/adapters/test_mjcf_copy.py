@@ -10,9 +10,12 @@ from __future__ import annotations
 import os
 import xml.etree.ElementTree as ET
 
+import numpy as np
 import pytest
 
-from dyncheck.adapters.mjcf_copy import for_parser, inline
+from dyncheck.adapters.mjcf_copy import encoding, for_parser, inline, utf8_file
+from dyncheck.adapters.model_files import read
+from dyncheck.check.engines import ENGINES, NotLoaded, load
 from dyncheck.errors import EngineError, Unsupported
 
 OBJ = (".obj",)
@@ -112,3 +115,82 @@ def test_a_bad_include_is_refused_at_once(tmp_path, kind):
                 "fifo": "not a regular file", "missing": "cannot be read"}[kind]
     with pytest.raises(EngineError, match=expected):
         inline(path)
+
+
+TRANSCODED = ("<?xml version='1.0' encoding='{enc}'?><mujoco model='modèle'>"
+              "<compiler meshdir='meshes/'/>{assets}<worldbody>"
+              "<body name='bödy' pos='0 0 1'><joint name='jé' type='hinge' axis='0 1 0'/>"
+              "<inertial pos='0 0 -0.3' mass='2' diaginertia='0.1 0.2 0.3'/>"
+              "<geom type='mesh' mesh='part'/><body name='çhild' pos='0 0 -0.5'>"
+              "<joint name='glissière' type='slide'/><geom type='box' size='0.1 0.2 0.3'/></body>"
+              "</body></worldbody></mujoco>")
+
+
+ASSET = "<asset><mesh name='part' file='part.stl'/></asset>"
+
+
+def _twins(tmp_path, enc: str, *, include: bool = True):
+    """The same model twice: ``enc`` and UTF-8, each naming a mesh through the compiler's
+    ``meshdir`` (a relative path a copy must keep pointing at), in a UTF-8 part it includes
+    where ``include`` (PyBullet's MJCF parser reads no ``<include>``: not for its test). The
+    folder ends in ``/``: PyBullet joins ``meshdir`` and ``file`` without one (``meshes`` +
+    ``part.stl`` → "cannot find 'meshespart.stl'"), which the copy's absolute path would
+    mend."""
+    _stl((tmp_path / "meshes").joinpath("part.stl"))
+    (tmp_path / "parts.xml").write_text(f"<mujoco>{ASSET}</mujoco>")
+    assets = "<include file='parts.xml'/>" if include else ASSET
+    twin, utf8 = tmp_path / "twin.xml", tmp_path / "utf8.xml"
+    twin.write_bytes(TRANSCODED.format(enc=enc, assets=assets).encode(enc))
+    utf8.write_bytes(TRANSCODED.format(enc="UTF-8", assets=assets).encode("utf-8"))
+    return twin, utf8
+
+
+def _stl(path, half: float = 0.05) -> None:
+    """A closed tetrahedron as a binary STL."""
+    import struct
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    v = [(0, 0, 0), (half, 0, 0), (0, half, 0), (0, 0, half)]
+    faces = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+    data = b"\0" * 80 + struct.pack("<I", len(faces))
+    for face in faces:
+        data += struct.pack("<3f", 0, 0, 0) + b"".join(struct.pack("<3f", *v[i]) for i in face)
+        data += b"\0\0"
+    path.write_bytes(data)
+
+
+@pytest.mark.parametrize("enc", ["ISO-8859-1", "UTF-16", "cp1252"])
+def test_a_file_in_another_encoding_is_copied_as_utf8_with_its_paths_kept(tmp_path, enc):
+    """The copy every parser is given holds the names as the file declares them and points at
+    the same mesh from anywhere (expected: the UTF-8 twin's own text, parsed)."""
+    twin, utf8 = _twins(tmp_path, enc)
+    assert encoding(twin) == enc and encoding(utf8) is None
+    with utf8_file(twin) as copy:
+        assert copy != twin and copy.suffix == ".xml"
+        root = ET.fromstring(copy.read_bytes().decode("utf-8"))
+        folder = copy.parent
+    assert not folder.exists()  # removed once the parser is done
+    with utf8_file(utf8) as same:
+        assert same == utf8  # a UTF-8 file is read as it is
+    mesh = next(root.iter("mesh"))
+    assert mesh.get("file") == str(tmp_path / "meshes" / "part.stl")
+    assert [b.get("name") for b in root.iter("body")] == ["bödy", "çhild"]
+
+
+@pytest.mark.parametrize("engine", [e for e, r in ENGINES.items() if not r.ports])
+def test_every_engine_reads_a_file_in_another_encoding_as_its_utf8_twin(tmp_path, engine):
+    """Expected: the engine's own reading of the same model saved as UTF-8 — the same joints
+    (accented names included) and the same dynamics, bit for bit. MuJoCo's ports read the file
+    through MuJoCo C (:mod:`adapters.mujoco_port`)."""
+    twin, utf8 = _twins(tmp_path, "ISO-8859-1", include=False)
+    read_twin, read_utf8 = (load(engine, read(path)) for path in (twin, utf8))
+    if isinstance(read_utf8, NotLoaded):
+        pytest.skip(read_utf8.message)
+    assert not isinstance(read_twin, NotLoaded), read_twin.message
+    assert [j.name for j in read_twin.tree.joints] == [j.name for j in read_utf8.tree.joints]
+    nv = read_utf8.tree.nv  # hinge and slide: q lives in ℝⁿᵛ in every engine
+    state = (np.full((2, nv), 0.2), np.full((2, nv), 0.3), np.full((2, nv), 0.1))
+    a, b = read_twin.dynamics(*state), read_utf8.dynamics(*state)
+    for name in ("mass_matrix", "bias", "forward", "inverse"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    assert nv == 2 and np.abs(a.mass_matrix).max() > 0

@@ -90,6 +90,34 @@ def test_top_level_bodies_pinocchio_drops_leave_the_rest_compared(tmp_path):
     assert list(absent["subject"]) == ["box_j"] or "box_j" in set(absent["subject"])
 
 
+@pytest.mark.parametrize("where", ["root with child", "root alone", "nested"])
+def test_a_body_without_attributes_pinocchio_skips_is_named_with_its_fix(tmp_path, where):
+    """Pinocchio's MJCF parser skips a ``<body>`` with no attributes (measured: ``<body>``
+    skipped, ``<body pos="0 0 0">`` read; the bodies below hang from its parent; a file of
+    that body alone is refused): the missing joint's row, or the refusal, says so and how to
+    mend it; a child's parent row follows from it. Expected: MuJoCo's reading of the same
+    file (every joint, the child below its body)."""
+    joints = "<joint name='{j}' type='hinge'/><geom size='0.1' mass='1'/>"
+    inner = "<body>" + joints.format(j="jc") + "</body>"
+    outer = {"root with child": "<body>" + joints.format(j="jr") + "<body pos='0 0 -1'>"
+             + joints.format(j="jc") + "</body></body>",
+             "root alone": inner,
+             "nested": "<body name='r'>" + joints.format(j="jr") + inner + "</body>"}[where]
+    result = check_model(_write(tmp_path, "bare", outer), states=3)
+    failed = _rows(result, verdict="failed")
+    notes = " ".join(failed["note"])
+    assert "skips a <body> with no attributes at all (1 in the file)" in notes
+    assert "name every body" in notes
+    if where == "root with child":
+        parent = failed[failed["field"] == "parent"]
+        assert list(parent["subject"]) == ["jc"]
+        assert "follows from joint 'jr', which pinocchio has not" in parent["note"].iloc[0]
+    elif where == "root alone":
+        assert "pinocchio refused" in notes
+    else:
+        assert list(failed[failed["field"] == "joint"]["subject"]) == ["jc"]
+
+
 def test_armature_in_a_default_class_on_actuated_and_unactuated_joints(tmp_path):
     """Drake holds an actuated joint's armature as reflected inertia (read back: agrees with
     MuJoCo); an unactuated joint loses it in Drake — a failed row naming the joint and the
