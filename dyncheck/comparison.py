@@ -13,7 +13,7 @@ prediction, and the state where the error peaked), so memory stays flat however 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import combinations
 from typing import Any
 
@@ -37,7 +37,7 @@ from dyncheck.implementations import (
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.reference.constraints import MAX_IMPEDANCE
 from dyncheck.results import Discrepancy
-from dyncheck.tolerances import instantaneous, soft_condition
+from dyncheck.tolerances import conditioned, instantaneous, soft_condition
 from dyncheck.vocabulary import Quantity, Verdict
 
 __all__ = ["GRAVITY_DEFAULT", "POINT_INERTIA", "compare_instantaneous", "soft_factor"]
@@ -92,6 +92,8 @@ class PairStats:
     scale: float = 0.0
     residual: float = 0.0
     predicted: float = 0.0
+    sensitivity: float = 0.0
+    """Max over states and entries of Σⱼ |∂f/∂xⱼ| |xⱼ| (:meth:`VariantPredictor.sensitivity`)."""
     effects: bool = False
     """Whether an engine's declared defect entered the prediction."""
     records: list[tuple[int, float, str]] = field(default_factory=list)
@@ -135,6 +137,7 @@ class PairStats:
             scale=max(self.scale, later.scale),
             residual=max(self.residual, later.residual),
             predicted=max(self.predicted, later.predicted),
+            sensitivity=max(self.sensitivity, later.sensitivity),
             effects=self.effects or later.effects,
             records=[*self.records, *(r for r in later.records if r[1] > top or not self.records)],
         )
@@ -203,6 +206,10 @@ class Evaluator:
             self.error = f"{type(exc).__name__}: {exc}"
 
 
+RELATIVE_STEP = 1e-6
+"""The relative step of :meth:`VariantPredictor.sensitivity`'s central differences."""
+
+
 class VariantPredictor:
     """The general method evaluated on model variants for the current chunk."""
 
@@ -222,6 +229,30 @@ class VariantPredictor:
                 self._impls[variant] = impl
             self._values[variant] = self._impls[variant].evaluate(self.sample)
         return self._values[variant]
+
+    def sensitivity(self, variant: Variant) -> dict[str, float]:
+        """Each quantity's first-order response to relative perturbations of its inputs: max
+        over the chunk's states and the quantity's entries of Σⱼ |∂f/∂xⱼ| |xⱼ| over the
+        components xⱼ of q, v, τ and v̇ — the componentwise condition number times |f|
+        (:func:`~dyncheck.tolerances.conditioned`). Each term by a central difference at
+        relative step :data:`RELATIVE_STEP` (truncation ~1e-12 of the term, round-off
+        ε₆₄/1e-6 of |f|: both far below the bound's factor c)."""
+        self(variant)
+        impl = self._impls[variant]
+        total: dict[str, np.ndarray] = {}
+        for name in ("q", "v", "tau", "a"):
+            x = getattr(self.sample, name)
+            for j in range(x.shape[1]):
+                step = np.zeros_like(x)
+                step[:, j] = RELATIVE_STEP * x[:, j]
+                if not step.any():
+                    continue  # rounding an exact zero changes nothing
+                up = impl.evaluate(replace(self.sample, **{name: x + step}))
+                down = impl.evaluate(replace(self.sample, **{name: x - step}))
+                for q, value in up.items():
+                    term = np.abs(value - down[q]) / (2 * RELATIVE_STEP)
+                    total[q] = total.get(q, 0.0) + term
+        return {q: float(t.max()) for q, t in total.items()}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -267,6 +298,8 @@ def _row(
 ) -> Discrepancy:
     soft = max(soft_factor(a.variant), soft_factor(b.variant))
     tol = instantaneous(quantity, condition, soft, max(a.eps, b.eps))
+    if st.sensitivity and st.scale:
+        tol = conditioned(tol, st.sensitivity / st.scale, max(a.eps, b.eps))
     base: dict[str, Any] = dict(
         case=case,
         quantity=quantity,
@@ -361,6 +394,7 @@ def sweep(
     for s in chunks:
         predict.new_chunk(s)
         condition = max(condition, float(np.linalg.cond(predict(book)[Quantity.MASS_MATRIX]).max()))
+        sensitivity = predict.sensitivity(book)
         for ev in evals.values():
             ev.step(s)
         scales: dict[tuple[str, str], float] = {}  # (a, quantity) → max |a's values|
@@ -383,6 +417,8 @@ def sweep(
                             + eb.effects.get(q, 0.0) - ea.effects.get(q, 0.0)
                     stats[q, a, b].update(offset, s, eb.values[q], desired, predicted,
                                           scale=scales[a, q])
+                    stats[q, a, b].sensitivity = max(stats[q, a, b].sensitivity,
+                                                     sensitivity.get(q, 0.0))
                     stats[q, a, b].effects |= q in eb.effects or q in ea.effects
         offset += len(s)
     status = {

@@ -13,6 +13,10 @@ A pair with a float32 implementation (MJX, MuJoCo Warp) is held to the same boun
 perturbation ε₃₂ of q, v, τ, whose effect on M, h and τ is a few ε₃₂ at these states' scales)
 and evaluates in float32; c = 64 covers both, as it covers the float64 evaluations. Forward
 dynamics keeps its factor κ(M) (the solve amplifies the relative error of M and of τ − h).
+
+Every instantaneous bound adds the quantity's conditioning, c ε Σⱼ |∂f/∂xⱼ||xⱼ| relative to
+its scale (:func:`conditioned`): where the terms of a quantity cancel, round-off is relative
+to the terms, not to the result.
 """
 
 from __future__ import annotations
@@ -57,6 +61,21 @@ def instantaneous(
             basis += f" x soft-constraint Hessian 1 + d/(1-d) = {soft:.3g}"
         return Tolerance(ROUNDOFF_FACTOR * eps * condition * soft, basis)
     return Tolerance(ROUNDOFF_FACTOR * eps, f"round-off: {ROUNDOFF_FACTOR} {unit}")
+
+
+def conditioned(tol: Tolerance, relative: float, eps: float) -> Tolerance:
+    """``tol`` widened by the quantity's conditioning: c ε Σⱼ |∂f/∂xⱼ||xⱼ| over the state's
+    components, relative to the quantity's scale (``relative``). An evaluation that is
+    backward stable — exact for inputs perturbed by a few ε relative, as sums and products
+    are — errs by up to that much (forward error ≤ condition × backward error; Higham,
+    *Accuracy and Stability of Numerical Algorithms*, 2002, §1.6), and an engine that rounds
+    the state it is given (float32) moves f by it to first order. Where a quantity cancels
+    (g sin θ at θ ≈ π; the Atwood machine's potential with nearly equal masses), its terms
+    are far larger than the result, and a bound relative to the result alone would fail an
+    exact computation."""
+    return Tolerance(tol.rtol + ROUNDOFF_FACTOR * eps * relative,
+                     f"{tol.basis} + conditioning: {ROUNDOFF_FACTOR} {eps_name(eps)} x "
+                     f"sum|df/dx||x| / max|f| = {relative:.3g}")
 
 
 def accumulated(steps: int, soft: float = 1.0, eps: float = EPS) -> Tolerance:
@@ -122,9 +141,11 @@ BASES = (
               "floating point: c ε (c = 64; ε of float64, or of float32 for a port) relative "
               "to the quantity's largest entry, times κ(M) where a solve with M amplifies it, "
               "times the tree depth for derivatives accumulated along a chain, times a soft "
-              "constraint's Hessian condition 1 + d/(1 − d); '+' terms add a finite "
-              "difference's predicted truncation and round-off error and the referee's own "
-              "error estimate"),
+              "constraint's Hessian condition 1 + d/(1 − d); '+' terms add the quantity's "
+              "conditioning c ε Σ|∂f/∂x||x| / max|f| (what a backward-stable evaluation, or "
+              "rounding the state to float32, moves it by: large where its terms cancel), a "
+              "finite difference's predicted truncation and round-off error and the referee's "
+              "own error estimate"),
     BasisTerm(starts="accumulated round-off", meaning="two runs of the same integrator on "
               "the same model: c ε per step times the number of steps (round-off accumulates "
               "at most linearly)"),
