@@ -89,6 +89,33 @@ class StateLayout:
     """A free joint's velocity is (ω, v)."""
 
 
+def _computed(kind: str, inputs: object, compute: Callable[[], _T]) -> _T:
+    return compute()
+
+
+def _lambdified(args: Sequence[Any], exprs: Any, modules: str) -> Callable[..., Any]:
+    import sympy as sp
+
+    return sp.lambdify(args, exprs, modules=modules, cse=True)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Symbolic:
+    """How an adapter that derives its equations symbolically keeps them — ``derive(kind,
+    inputs, compute)``: ``compute()``'s result, keyed by ``kind`` and ``inputs`` — and makes
+    numeric functions of them — ``lambdify(args, exprs, modules)``, as ``sympy.lambdify``
+    with ``cse=True``. The default computes both afresh; the comparison layer, which may see
+    the reference, hands in the reference's disk caches (``dyncheck.implementations.CACHED``):
+    adapters never import the reference, and nothing is patched in at import."""
+
+    derive: Callable[[str, object, Callable[[], Any]], Any] = _computed
+    lambdify: Callable[[Sequence[Any], Any, str], Callable[..., Any]] = _lambdified
+
+
+AFRESH = Symbolic()
+"""Equations derived and compiled afresh (no cache)."""
+
+
 class Adapter(ABC):
     """One engine behind the canonical form ``M(q) v̇ + h(q, v) = τ``."""
 
@@ -120,23 +147,11 @@ class Adapter(ABC):
     """Whether the adapter holds couplings and an external field in one model (refused, before
     any work, where it does not)."""
 
-    @staticmethod
-    def derive(kind: str, inputs: object, compute: Callable[[], _T]) -> _T:
-        """How an adapter that derives its equations symbolically keeps them: ``compute()``
-        here; the comparison layer, which may see the reference, plugs in its disk cache
-        of derivations (:func:`dyncheck.reference.derivations.derived`, same signature:
-        ``kind``, the ``inputs`` that key the result, and how to compute it)."""
-        return compute()
-
-    @staticmethod
-    def lambdify(args: Sequence[Any], exprs: Any, modules: str) -> Callable[..., Any]:
-        """How such an adapter makes numeric functions of its expressions:
-        ``sympy.lambdify(args, exprs, modules=modules, cse=True)`` here; the comparison layer
-        plugs in the reference's disk cache of their compiled code
-        (:func:`dyncheck.reference.derivations.lambdified`, same signature)."""
-        import sympy as sp
-
-        return sp.lambdify(args, exprs, modules=modules, cse=True)
+    @classmethod
+    def create(cls, model: Multibody, *, symbolic: Symbolic) -> Adapter:
+        """The adapter of ``model``, handed how to keep symbolic equations (used only by an
+        adapter that derives them: it overrides this)."""
+        return cls(model)
 
     def __init__(self, model: Multibody) -> None:
         if model.couplings and model.central_mu and not self.couplings_with_field:

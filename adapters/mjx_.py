@@ -56,9 +56,14 @@ def _private(folder: Path) -> bool:
     return stat.S_ISDIR(info.st_mode) and info.st_uid == os.getuid() and not info.st_mode & 0o022
 
 
-if os.environ.get("DYNCHECK_NO_CACHE", "") in ("", "0") and _private(_CACHE):
-    jax.config.update("jax_compilation_cache_dir", str(_CACHE))
-    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
+def _compile_cache() -> None:
+    """JAX's persistent compilation cache in :data:`_CACHE`, where that folder is private and
+    the cache is on. The setting is JAX's, process-wide: made when an MJX model is first put
+    on the device (before anything compiles), never by importing this module."""
+    if os.environ.get("DYNCHECK_NO_CACHE", "") in ("", "0") and _private(_CACHE) \
+            and getattr(jax.config, "jax_compilation_cache_dir", None) != str(_CACHE):
+        jax.config.update("jax_compilation_cache_dir", str(_CACHE))
+        jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
 
 
 def _clear_trace_caches() -> None:
@@ -187,6 +192,7 @@ class MJXAdapter(PortAdapter):
         self._put()
 
     def _put(self) -> None:
+        _compile_cache()
         # MJX has no energy flag (put_model refuses it): energies come from M and xipos
         self.model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_ENERGY)
         with self._precision():

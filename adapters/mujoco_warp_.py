@@ -26,27 +26,28 @@ from operator import attrgetter
 from typing import ClassVar
 
 import mujoco
+import mujoco_warp as mjw
 import numpy as np
 import warp as wp
 
-wp.config.log_level = wp.LOG_ERROR  # no banner, no line per kernel module loaded
-import mujoco_warp as mjw  # noqa: E402  (after silencing Warp's log)
-
-from dyncheck.adapters import REGISTRY  # noqa: E402
-from dyncheck.adapters.base import Trajectory  # noqa: E402
-from dyncheck.adapters.mujoco_api import INTEGRATORS  # noqa: E402
-from dyncheck.adapters.mujoco_port import CHUNK, PortAdapter  # noqa: E402
-from dyncheck.cases.multibody import Multibody  # noqa: E402
-from dyncheck.errors import Unsupported  # noqa: E402
+from dyncheck.adapters import REGISTRY
+from dyncheck.adapters.base import Trajectory
+from dyncheck.adapters.mujoco_api import INTEGRATORS
+from dyncheck.adapters.mujoco_port import CHUNK, PortAdapter
+from dyncheck.cases.multibody import Multibody
+from dyncheck.errors import Unsupported
 
 CPU_STEPS = 400
 """The longest run the adapter makes on Warp's CPU device (~16 s of RK4 steps)."""
 
 
 def _init_quietly() -> None:
-    """``wp.init()`` with its native library's stderr held back: on a machine without a CUDA
-    driver it prints a warning line on every start, which says nothing here (the CPU is
-    Warp's device unless ``--device cuda``); shown if initialisation fails."""
+    """Warp started when the adapter first uses it (never by importing this module): its log
+    at errors only (no banner, no line per kernel module loaded — Warp's setting, for the
+    process), and ``wp.init()`` with its native library's stderr held back: on a machine
+    without a CUDA driver it prints a warning line on every start, which says nothing here
+    (the CPU is Warp's device unless ``--device cuda``); shown if initialisation fails."""
+    wp.config.log_level = wp.LOG_ERROR
     sys.stderr.flush()
     saved = os.dup(2)
     with tempfile.TemporaryFile() as held:
@@ -62,8 +63,6 @@ def _init_quietly() -> None:
             os.dup2(saved, 2)
             os.close(saved)
 
-
-_init_quietly()
 
 
 def too_long(steps: int) -> str:
@@ -94,6 +93,7 @@ class MuJoCoWarpAdapter(PortAdapter):
         self._put()
 
     def _put(self) -> None:
+        _init_quietly()  # wp.init() returns at once when Warp has started
         self.model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_ENERGY)
         self.device = device()
         self.max_steps = CPU_STEPS if self.device == "cpu" else None
@@ -103,6 +103,7 @@ class MuJoCoWarpAdapter(PortAdapter):
 
     @staticmethod
     def version() -> str:
+        _init_quietly()
         where = wp.get_device(device())
         warp = f"warp-lang {wp.__version__}"
         return f"{_version('mujoco-warp')} ({warp}, device {where.alias}: {where.name})"

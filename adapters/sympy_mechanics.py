@@ -29,7 +29,16 @@ import sympy as sp
 import sympy.physics.mechanics as me
 
 from dyncheck.adapters import REGISTRY
-from dyncheck.adapters.base import Adapter, Chart, Frame, LoadedBody, StateLayout, Trajectory
+from dyncheck.adapters.base import (
+    AFRESH,
+    Adapter,
+    Chart,
+    Frame,
+    LoadedBody,
+    StateLayout,
+    Symbolic,
+    Trajectory,
+)
 from dyncheck.adapters.integrators import integrate
 from dyncheck.adapters.linalg import solve
 from dyncheck.cases.multibody import ROTATING, Multibody
@@ -195,14 +204,19 @@ class SympyMechanicsAdapter(Adapter):
     engine including Drake, and RK4. Each step costs Python-level evaluations of the
     lambdified equations."""
 
-    def __init__(self, model: Multibody) -> None:
+    @classmethod
+    def create(cls, model: Multibody, *, symbolic: Symbolic) -> Adapter:
+        return cls(model, symbolic=symbolic)
+
+    def __init__(self, model: Multibody, *, symbolic: Symbolic = AFRESH) -> None:
         super().__init__(model)
         n = model.nv
-        eq = self.derive("sympy_mechanics", (repr(model), _SOURCE), lambda: _derive(model))
+        self._symbolic = symbolic
+        eq = symbolic.derive("sympy_mechanics", (repr(model), _SOURCE), lambda: _derive(model))
         args = [*sp.symbols(f"x0:{n}"), *sp.symbols(f"v0:{n}")]
 
         def batched(exprs: list[sp.Expr]) -> Callable[..., np.ndarray]:
-            return _batched(exprs, args, self.lambdify)
+            return _batched(exprs, args, symbolic.lambdify)
 
         self._kkt = None
         if model.couplings:
@@ -282,7 +296,7 @@ class SympyMechanicsAdapter(Adapter):
         n = self._n
         if self._step_fn is None:  # lambdified on first use: only trajectories need it
             args, exprs = self._stepping
-            self._step_fn = self.lambdify(args, exprs, "math")
+            self._step_fn = self._symbolic.lambdify(args, exprs, "math")
         values = np.array(self._step_fn(*q.tolist(), *v.tolist()), float)
         if self._kkt is not None:
             size = n + self._kkt[2]

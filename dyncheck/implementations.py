@@ -27,6 +27,7 @@ from dyncheck.adapters import (
     Trajectory,
     get_adapter,
 )
+from dyncheck.adapters.base import Symbolic
 from dyncheck.cases import Case, StateSample
 from dyncheck.conventions import (
     from_native,
@@ -42,11 +43,10 @@ from dyncheck.reference.trajectory import solve
 from dyncheck.roster import IMPLEMENTATIONS
 from dyncheck.vocabulary import INSTANTANEOUS, Quantity
 
-# adapters that derive their equations symbolically (sympy-mechanics) keep them in the
-# reference's disk cache of derivations — the cache, not the derivation, is shared; adapters
-# cannot import the reference, so this layer plugs it in (Adapter.derive)
-Adapter.derive = staticmethod(derived)  # type: ignore[method-assign]
-Adapter.lambdify = staticmethod(lambdified)  # type: ignore[method-assign]
+CACHED = Symbolic(derive=derived, lambdify=lambdified)
+"""What an adapter that derives its equations symbolically (sympy-mechanics) is handed: the
+reference's disk caches of derivations and of their compiled code — the cache, not the
+derivation, is shared (adapters cannot import the reference)."""
 
 QUANTITIES: tuple[str, ...] = INSTANTANEOUS
 """``constraint_force`` exists only for cases with couplings: the cords' tensions (N), from
@@ -295,7 +295,7 @@ class EngineImplementation(Implementation):
     def __init__(self, case: Case, adapter: type[Adapter]) -> None:
         super().__init__(case)
         self.name = adapter.name  # type: ignore[misc]
-        self.adapter = adapter(case.multibody())
+        self.adapter = adapter.create(case.multibody(), symbolic=CACHED)
         self.map = NativeMap(case.engine_map(), adapter.name, case.multibody())
         self.integrators = adapter.integrators
         self.eps = self.adapter.eps

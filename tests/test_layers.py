@@ -232,3 +232,114 @@ def test_no_quantity_or_verdict_is_written_as_a_string_outside_the_vocabulary():
                     and (where, value) not in LITERAL_ELSEWHERE):
                 found.append(f"{where}:{token.start[0]}: {token.string}")
     assert not found, "\n".join(found)
+
+
+def _module_level(body: list[ast.stmt]):
+    """The statements a module runs when imported (inside top-level ``if``/``try``/``with``
+    blocks too; not function or class bodies)."""
+    for node in body:
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+            continue
+        yield node
+        for name in ("body", "orelse", "finalbody"):
+            yield from _module_level(getattr(node, name, []))
+        for handler in getattr(node, "handlers", []):
+            yield from _module_level(handler.body)
+
+
+def _root(node: ast.expr) -> str | None:
+    while isinstance(node, ast.Attribute | ast.Subscript | ast.Call):
+        node = node.func if isinstance(node, ast.Call) else node.value
+    return node.id if isinstance(node, ast.Name) else None
+
+
+REGISTERING = {"dyncheck/errata/frenet.py": "check"}
+"""Module-level calls that register a definition in the module's own table (a decorator
+applied by hand), by module: not a side effect on anything imported."""
+
+
+@pytest.mark.parametrize("path", _package_files(), ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_importing_a_module_changes_nothing_outside_it(path):
+    """#43: importing a module sets no attribute of anything it imported (``Adapter.derive =
+    …``, ``wp.config.log_level = …``), writes no item of another module's table or of
+    ``os.environ``, and calls nothing for its effect on another module (``jax.config.update``,
+    ``wp.init()``): engines' and libraries' process-wide settings are made where the engine is
+    first used. Allowed: assigning to the module's own names and tables, calling its own
+    functions (a self-check), and :data:`REGISTERING`."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    own = {t.id for node in _module_level(tree.body)
+           if isinstance(node, ast.Assign | ast.AnnAssign)
+           for target in (node.targets if isinstance(node, ast.Assign) else [node.target])
+           for t in ([target] if isinstance(target, ast.Name) else
+                     target.elts if isinstance(target, ast.Tuple) else [])
+           if isinstance(t, ast.Name)}
+    own |= {n.name for n in tree.body
+            if isinstance(n, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef)}
+    where = path.relative_to(ROOT).as_posix()
+    found = []
+    for node in _module_level(tree.body):
+        targets = node.targets if isinstance(node, ast.Assign) else \
+            [node.target] if isinstance(node, ast.AugAssign | ast.AnnAssign) else []
+        for target in targets:
+            if isinstance(target, ast.Attribute | ast.Subscript) and _root(target) not in own:
+                found.append(f"{where}:{node.lineno}: sets {ast.unparse(target)}")
+        if isinstance(node, ast.Expr) and isinstance(node.value, ast.Call):
+            root = _root(node.value)
+            if root not in own and REGISTERING.get(where) != root:
+                found.append(f"{where}:{node.lineno}: calls {ast.unparse(node.value)[:60]}")
+    assert not found, "\n".join(found)
+
+
+def test_the_rule_on_import_effects_sees_a_patch(tmp_path):
+    """The reader of :func:`test_importing_a_module_changes_nothing_outside_it` finds the two
+    kinds it forbids (a patched class, a library's setting) and lets a module's own table
+    be filled."""
+    source = ("import jax\nfrom x import Adapter\nTABLE = {}\nTABLE['a'] = 1\n"
+              "Adapter.derive = staticmethod(len)\nif True:\n    jax.config.update('k', 1)\n")
+    tree = ast.parse(source)
+    kinds = [type(n).__name__ for n in _module_level(tree.body)]
+    assert kinds.count("Assign") == 3 and kinds.count("Expr") == 1
+    assert _root(ast.parse("jax.config.update('k', 1)").body[0].value) == "jax"  # type: ignore[attr-defined]
+
+
+def test_a_fresh_interpreter_importing_every_module_finds_nothing_patched():
+    """#43: in a fresh interpreter, importing every module of the package (those whose
+    engines are installed) leaves the adapter base class without a plugged-in cache, JAX
+    without a compilation cache or 64-bit mode, and Warp uninitialised at its default log
+    level — the settings each engine makes when first used."""
+    import subprocess
+
+    script = """
+import importlib, pkgutil, sys
+count = 0
+for top in ("dyncheck", "dyncheck.adapters", "dyncheck.cases", "dyncheck.reference"):
+    package = importlib.import_module(top)
+    for info in pkgutil.walk_packages(package.__path__, top + "."):
+        if info.name.endswith("__main__"):
+            continue
+        try:
+            importlib.import_module(info.name)
+            count += 1
+        except ImportError:
+            pass
+print("modules", count)
+from dyncheck.adapters.base import Adapter
+print("adapter", sorted(k for k in ("derive", "lambdify") if k in vars(Adapter)))
+if "jax" in sys.modules:
+    import jax
+    print("jax", jax.config.jax_compilation_cache_dir, jax.config.jax_enable_x64)
+if "warp" in sys.modules:
+    import warp as wp
+    from warp._src import context
+    print("warp", wp.config.log_level, context.runtime is None)
+"""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=300, cwd=ROOT)
+    assert done.returncode == 0, done.stderr[-2000:]
+    lines = dict(line.split(" ", 1) for line in done.stdout.splitlines())
+    assert int(lines["modules"]) >= len(_package_files()) // 2  # mapped folders included
+    assert lines["adapter"] == "[]"
+    if "jax" in lines:
+        assert lines["jax"] == "None False"
+    if "warp" in lines:
+        assert lines["warp"] == "20 True"  # logging.INFO, Warp's default

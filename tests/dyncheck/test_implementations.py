@@ -1,6 +1,7 @@
 """The comparison layer's wiring (dyncheck/implementations.py): sympy-mechanics, an adapter
 that derives its equations with sympy, keeps them in the reference's disk cache of
-derivations, which the adapter cannot import itself.
+derivations, which the adapter cannot import itself: the comparison layer hands it in
+(``CACHED``), and importing it patches nothing.
 
 Expected values: the adapter's equations derived afresh (LagrangesMethod) — those read back
 must give the same forward dynamics, with no derivation run.
@@ -8,13 +9,15 @@ must give the same forward dynamics, with no derivation run.
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 import pytest
 
-import dyncheck.implementations  # noqa: F401 — plugs the cache into the adapters
 from dyncheck.adapters import get_adapter
 from dyncheck.adapters import sympy_mechanics as sm
 from dyncheck.cases import get_case
+from dyncheck.implementations import CACHED
 from dyncheck.reference import derivations
 
 
@@ -25,7 +28,7 @@ def test_sympy_mechanics_reads_its_equations_back_without_deriving(
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
     monkeypatch.delenv(derivations.NO_CACHE, raising=False)
     model = get_case(case_name).multibody()
-    adapter = get_adapter("sympy-mechanics")
+    adapter = partial(get_adapter("sympy-mechanics"), symbolic=CACHED)
     first = adapter(model)
     assert list((tmp_path / "derivations").rglob("sympy_mechanics-*.pickle"))
 
@@ -43,6 +46,20 @@ def test_sympy_mechanics_reads_its_equations_back_without_deriving(
 def test_sympy_mechanics_without_the_cache_derives(tmp_path, monkeypatch):
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
     monkeypatch.setenv(derivations.NO_CACHE, "1")
+    calls = []
+    derive = sm._derive
+    monkeypatch.setattr(sm, "_derive", lambda model: calls.append(1) or derive(model))
+    model = get_case("simple_pendulum").multibody()
+    get_adapter("sympy-mechanics")(model, symbolic=CACHED)
+    get_adapter("sympy-mechanics")(model, symbolic=CACHED)
+    assert len(calls) == 2 and not (tmp_path / "derivations").exists()
+
+
+def test_the_adapter_left_to_itself_derives_afresh(tmp_path, monkeypatch):
+    """Without the comparison layer's caches (the default, ``AFRESH``) the adapter derives
+    every time and writes nothing, whether or not the comparison layer was imported."""
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
+    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
     calls = []
     derive = sm._derive
     monkeypatch.setattr(sm, "_derive", lambda model: calls.append(1) or derive(model))
