@@ -35,6 +35,7 @@ from dyncheck.adapters.model_tree import (
 )
 from dyncheck.adapters.mujoco_api import GYROSCOPIC_IMPLICIT, full_inertia, mujoco_warnings
 from dyncheck.errors import EngineError
+from dyncheck.vocabulary import Integrator
 
 ENGINE = "mujoco"
 _TYPES = {
@@ -289,9 +290,11 @@ class MujocoModel:
                    a: np.ndarray) -> tuple[Transition, ...]:
         """``mjd_transitionFD`` (centered differences of ``mj_step``, MuJoCo's chart) of one
         step at the file's time step, at steps :data:`FD_STEP` and twice that, for the
-        semi-implicit Euler and implicitfast integrators (the smooth dynamics only, as
-        everywhere in the check: no damping, no actuation, so implicitfast's implicit term
-        (M − h ∂f/∂v with f's passive and actuator forces) is M, and its step Euler's)."""
+        semi-implicit Euler and implicitfast integrators, and the same differences of RK4's
+        step, which ``mjd_transitionFD`` refuses ("RK4 integrator is not supported", MuJoCo
+        4.0): :func:`_step_differences` (the smooth dynamics only, as everywhere in the
+        check: no damping, no actuation, so implicitfast's implicit term (M − h ∂f/∂v with
+        f's passive and actuator forces) is M, and its step Euler's)."""
         m, d = self.model, self.data
         n, nv = len(q), m.nv
         size = 2 * nv + m.na
@@ -299,8 +302,9 @@ class MujocoModel:
         integrator = m.opt.integrator
         out = []
         try:
-            for name, kind in (("euler", mujoco.mjtIntegrator.mjINT_EULER),
-                               ("implicitfast", mujoco.mjtIntegrator.mjINT_IMPLICITFAST)):
+            for name, kind in ((Integrator.EULER, mujoco.mjtIntegrator.mjINT_EULER),
+                               (Integrator.IMPLICITFAST, mujoco.mjtIntegrator.mjINT_IMPLICITFAST),
+                               (Integrator.RK4, mujoco.mjtIntegrator.mjINT_RK4)):
                 m.opt.integrator = kind
                 fine, coarse = np.zeros((n, 2 * nv, 2 * nv)), np.zeros((n, 2 * nv, 2 * nv))
                 for i in range(n):
@@ -308,19 +312,55 @@ class MujocoModel:
                         d.qpos[:], d.qvel[:] = q[i], v[i]
                         d.qfrc_applied[:] = 0.0
                         d.ctrl[:] = 0.0
+                        if name is Integrator.RK4:
+                            found[i] = _step_differences(m, d, q[i], v[i], step)
+                            continue
                         mujoco.mj_forward(m, d)
                         mujoco.mjd_transitionFD(m, d, step, True, matrix, None, None, None)
                         found[i] = matrix[: 2 * nv, : 2 * nv]
                 free = bool(np.any(m.jnt_type == mujoco.mjtJoint.mjJNT_FREE))
                 beyond = ("MuJoCo's implicitfast differentiates a free body's gyroscopic "
                           "force (since 3.11): its step is not Euler's on a free joint"
-                          ) if name == "implicitfast" and free and GYROSCOPIC_IMPLICIT else ""
+                          ) if name is Integrator.IMPLICITFAST and free and GYROSCOPIC_IMPLICIT \
+                    else ""
                 out.append(Transition(matrix=fine, coarse=coarse,
                                       time_step=float(m.opt.timestep), fd_step=FD_STEP,
                                       integrator=name, beyond_euler=beyond))
         finally:
             m.opt.integrator = integrator
         return tuple(out)
+
+
+def _step_differences(m: mujoco.MjModel, d: mujoco.MjData, q: np.ndarray, v: np.ndarray,
+                      step: float) -> np.ndarray:
+    """∂x₊/∂x of one ``mj_step`` from (q, v) by centered differences of ``step`` in MuJoCo's
+    chart — q nudged by ``mj_integratePos``, q₊ compared by ``mj_differentiatePos`` —, the
+    scheme of ``mjd_transitionFD`` (``engine_derivative_fd.c``), for a step it refuses."""
+    nv = m.nv
+
+    def stepped(nudge: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        d.qpos[:] = q
+        mujoco.mj_integratePos(m, d.qpos, nudge[:nv], 1.0)
+        d.qvel[:] = v + nudge[nv:]
+        d.qfrc_applied[:] = 0.0
+        d.ctrl[:] = 0.0
+        d.time = 0.0
+        mujoco.mj_step(m, d)
+        return d.qpos.copy(), d.qvel.copy()
+
+    centre, _ = stepped(np.zeros(2 * nv))
+    out = np.zeros((2 * nv, 2 * nv))
+    tangent = np.zeros(nv)
+    for k in range(2 * nv):
+        nudge = np.zeros(2 * nv)
+        nudge[k] = step
+        ends = []
+        for sign in (1.0, -1.0):
+            q_next, v_next = stepped(sign * nudge)
+            mujoco.mj_differentiatePos(m, tangent, 1.0, centre, q_next)
+            ends.append(np.concatenate([tangent, v_next]))
+        out[:, k] = (ends[0] - ends[1]) / (2 * step)
+    return out
 
 
 def _joint_name(m: mujoco.MjModel, j: int) -> str:

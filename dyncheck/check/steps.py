@@ -1,8 +1,9 @@
 """The step's Jacobian in a model check (``--derivatives``): MuJoCo's Jacobian of one
-semi-implicit Euler step and one implicitfast step (``mjd_transitionFD``, centered
-differences) against the same step differentiated by the chain rule from the referee's
-continuous derivatives (:func:`euler_step`: exact for Euler, and for implicitfast without
-damping or actuators, whose implicit term is then M)."""
+semi-implicit Euler, implicitfast and RK4 step (``mjd_transitionFD``, centered differences)
+against the same step differentiated by the chain rule from the referee's continuous
+derivatives — :func:`euler_step`: exact for Euler, and for implicitfast without damping or
+actuators, whose implicit term is then M; :func:`rk4_step`: exact for RK4 through its four
+stages, each with the referee's derivatives at the stage's state."""
 
 from __future__ import annotations
 
@@ -11,12 +12,13 @@ from scipy.spatial.transform import Rotation
 
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import JointType, ModelTree, Transition
-from dyncheck.check.derivatives import Referee
+from dyncheck.check.derivatives import Referee, referee
 from dyncheck.check.describe import depth
 from dyncheck.check.dynamics import States
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.results import Verdict
+from dyncheck.vocabulary import Integrator
 
 
 def _right_jacobian(phi: np.ndarray) -> np.ndarray:
@@ -58,6 +60,50 @@ def euler_step(canon: Canonical, ref: Referee, states: States, h: float) -> np.n
     return out
 
 
+RK4_STAGES = ((0.0, 1.0 / 6), (0.5, 1.0 / 3), (0.5, 1.0 / 3), (1.0, 1.0 / 6))
+"""RK4's tableau as (cᵢ: the stage's offset along the previous stage's slope, bᵢ: its
+weight) — the classical method, as MuJoCo's ``mj_RungeKutta`` with N = 4."""
+
+
+def rk4_stages(tree: ModelTree, states: States, ref: Referee,
+               h: float) -> list[tuple[States, Referee]]:
+    """The four stage states Xᵢ = x + cᵢ h Kᵢ₋₁ of one RK4 step (hinge and slide joints: q
+    adds), each with the referee at it (its v̇ and derivatives; ``ref``: at x itself)."""
+    out = [(states, ref)]
+    for c, _ in RK4_STAGES[1:]:
+        prev_states, prev = out[-1]
+        at = States(q=states.q + c * h * prev_states.v, v=states.v + c * h * prev.forward,
+                    a=states.a)
+        out.append((at, referee(tree, at)))
+    return out
+
+
+def rk4_step(stages: list[tuple[States, Referee]], h: float) -> np.ndarray:
+    """The Jacobian of one classical RK4 step of x = (q, v), ẋ = (v, v̇(q, v)), by the chain
+    rule through its stages: dXᵢ = I + cᵢ h dKᵢ₋₁, dKᵢ = J(Xᵢ) dXᵢ with J = [[0, I], [∂v̇/∂q,
+    ∂v̇/∂v]], dx₊ = I + h Σ bᵢ dKᵢ — exact for the step (hinge and slide joints, where q ⊕ δ
+    = q + δ at every stage)."""
+    n, nv = stages[0][0].v.shape
+    eye = np.eye(2 * nv)
+    total = np.zeros((n, 2 * nv, 2 * nv))
+    slope = np.zeros((n, 2 * nv, 2 * nv))
+    for (c, b), (_, ref) in zip(RK4_STAGES, stages, strict=True):
+        jac = np.zeros((n, 2 * nv, 2 * nv))
+        jac[:, :nv, nv:] = np.eye(nv)
+        jac[:, nv:, :nv] = ref.derivatives.forward_q
+        jac[:, nv:, nv:] = ref.derivatives.forward_v
+        slope = jac @ (eye + c * h * slope)
+        total += b * slope
+    return eye + h * total
+
+
+ROTATING_RK4 = (
+    "RK4's stages on a ball or free joint each turn the rotation by an exponential map: "
+    "their chain rule is not built, so the referee checks RK4's step on hinge and slide "
+    "joints only"
+)
+
+
 def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref: Referee,
               engine: str, found: Transition) -> list[CheckRow]:
     """The engine's step Jacobian against the referee's chain rule: one row. Tolerance:
@@ -66,14 +112,26 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
     h v̇'s round-off, κ(M) times its own —, + the referee's estimated error of its
     derivatives times h."""
     h = found.time_step
-    if found.beyond_euler:
+    rk4 = found.integrator == Integrator.RK4
+    rotating = any(kind in (JointType.BALL, JointType.FREE) for kind in canon.types)
+    why = found.beyond_euler or (ROTATING_RK4 if rk4 and rotating else "")
+    if why:
         return [CheckRow(
             model=model, section=Section.DERIVATIVES,
             subject=f"step Jacobian ({found.integrator} at h = {h:g})", field="max rel error",
             impl_a="reference", impl_b=engine, value_a="", value_b="", error=float("nan"),
             tolerance=float("nan"), basis="", verdict=Verdict.SKIPPED,
-            note=f"{found.beyond_euler}; the chain rule of Euler's step is no referee for it")]
-    expected = euler_step(canon, ref, states, h)
+            note=why if rk4 else f"{why}; the chain rule of Euler's step is no referee for it")]
+    if rk4:
+        stages = rk4_stages(tree, states, ref, h)
+        expected = rk4_step(stages, h)
+        ref_q = np.max([r.error["forward_q"] for _, r in stages], axis=0)
+        ref_v = np.max([r.error["forward_v"] for _, r in stages], axis=0)
+        rule = "RK4's chain rule through its 4 stages"
+    else:
+        expected = euler_step(canon, ref, states, h)
+        ref_q, ref_v = ref.error["forward_q"], ref.error["forward_v"]
+        rule = "the chain rule"
     off = np.abs(found.matrix - expected)
     scale = float(np.abs(expected).max())
     x_scale = max(float(np.abs(states.q).max()), float(np.abs(states.v).max()), 1.0)
@@ -89,15 +147,15 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
     fd[:, nv:] += amplified
     fd[:, :nv] += 2 * h * amplified  # q₊ = q ⊕ h v₊ (J_r ≤ 1 + h|ω|)
     ref_error = np.zeros_like(expected)
-    ref_error[:, nv:, :nv] = h * ref.error["forward_q"]
-    ref_error[:, nv:, nv:] = h * ref.error["forward_v"]
+    ref_error[:, nv:, :nv] = h * ref_q  # RK4: Σ bᵢ = 1 of the stages' (largest) errors
+    ref_error[:, nv:, nv:] = h * ref_v
     ref_error[:, :nv] = np.concatenate([h * ref_error[:, nv:, :nv], h * ref_error[:, nv:, nv:]],
                                        axis=2) * 2  # through q₊ = q ⊕ h v₊ (J_r ≤ 1 + h|ω|)
     allowed = ROUNDOFF_FACTOR * EPS * depth(tree) * scale + fd + ref_error
     worst = np.unravel_index(int(np.argmax(off / allowed)), off.shape)
     within = bool(np.all(off <= allowed))
     note = "" if within else (
-        f"{engine} differs from the chain rule at state {worst[0]}, entry ({worst[1]}, "
+        f"{engine} differs from {rule} at state {worst[0]}, entry ({worst[1]}, "
         f"{worst[2]}): {off[worst]:.3g} beyond its predicted {allowed[worst]:.3g}")
     return [CheckRow(
         model=model, section=Section.DERIVATIVES,

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from dyncheck.check.model_check import check_model
@@ -30,32 +31,66 @@ def test_mujocos_euler_step_jacobian_is_the_chain_rule_of_the_continuous_derivat
                          states=10, derivatives=True)
     rows = _rows(result, section="derivatives", impl_b="mujoco")
     rows = rows[rows["subject"].str.startswith("step Jacobian")]
-    assert [s.split(" at ")[0] for s in rows["subject"]] == ["step Jacobian (euler",
-                                                          "step Jacobian (implicitfast"]
-    euler, implicit = rows.iloc[0], rows.iloc[1]
+    assert [s.split(" at ")[0] for s in rows["subject"]] == [
+        "step Jacobian (euler", "step Jacobian (implicitfast", "step Jacobian (rk4"]
+    euler, implicit, rk4 = rows.iloc[0], rows.iloc[1], rows.iloc[2]
     assert euler["verdict"] == "passed" and euler["error"] < 1e-8
     # a free joint (both models have one): MuJoCo's implicitfast differentiates its
     # gyroscopic force (≥ 3.11), no longer Euler's step: not refereed by Euler's chain rule
     assert implicit["verdict"] == "skipped" and "gyroscopic" in implicit["note"]
+    # RK4's stages turn the rotations by exponential maps: no chain rule built for them
+    assert rk4["verdict"] == "skipped" and "hinge and slide joints only" in rk4["note"]
 
 
 def test_implicitfast_is_eulers_step_without_a_free_joint(tmp_path):
     """Hinges only, undamped: implicitfast's implicit term is M, its step Euler's — the
     same chain rule referees it, far below the bound."""
-    from dyncheck.adapters.mjcf import to_mjcf
-    from dyncheck.cases import get_case
-
-    path = tmp_path / "pendulum.xml"
-    path.write_text(to_mjcf(get_case("compound_pendulum").multibody()))
+    path = _pendulum(tmp_path)
     result = check_model(path, impls=("reference", "mujoco"), states=10, derivatives=True)
     rows = _rows(result, section="derivatives", impl_b="mujoco")
     rows = rows[rows["subject"].str.startswith("step Jacobian (implicitfast")]
     assert list(rows["verdict"]) == ["passed"] and (rows["error"] < 1e-8).all()
 
 
-def test_a_step_jacobian_off_by_one_part_in_ten_thousand_fails(monkeypatch):
+def _pendulum(tmp_path, case: str = "compound_pendulum") -> Path:
+    from dyncheck.adapters.mjcf import to_mjcf
+    from dyncheck.cases import get_case
+
+    path = tmp_path / f"{case}.xml"
+    path.write_text(to_mjcf(get_case(case).multibody()))
+    return path
+
+
+@pytest.mark.parametrize("case", ["compound_pendulum", "simple_pendulum"])
+def test_rk4_step_jacobian_is_the_chain_rule_through_its_four_stages(tmp_path, case):
+    """MuJoCo's RK4 step (which ``mjd_transitionFD`` refuses: differenced the same way by the
+    adapter) against the chain rule through RK4's stages, each with the referee's derivatives
+    at the stage's state: they agree far below the bound — and the bound tells the
+    integrators apart: MuJoCo's Euler and RK4 Jacobians at the same states (expected: the
+    engine's own two steps) differ by more than the RK4 row allows, so a step differentiated
+    as Euler's would fail it."""
+    from dyncheck.adapters.model_files import read
+    from dyncheck.check.engines import load
+
+    path = _pendulum(tmp_path, case)
+    result = check_model(path, impls=("reference", "mujoco"), states=10, derivatives=True)
+    rows = _rows(result, section="derivatives", impl_b="mujoco")
+    rk4 = rows[rows["subject"].str.startswith("step Jacobian (rk4")]
+    assert list(rk4["verdict"]) == ["passed"] and (rk4["error"] < 1e-8).all()
+    engine = load("mujoco", read(path))
+    nv = engine.tree.nv
+    q = np.linspace(0.2, 1.0, 3 * nv).reshape(3, nv)
+    euler, _, runge = engine.transition(q, 0.5 * q, np.zeros_like(q))
+    apart = np.abs(runge.matrix - euler.matrix).max() / np.abs(runge.matrix).max()
+    assert apart > 10 * rk4["tolerance"].iloc[0]
+
+
+@pytest.mark.parametrize("integrator", ["euler", "rk4"])
+def test_a_step_jacobian_off_by_one_part_in_ten_thousand_fails(monkeypatch, tmp_path,
+                                                               integrator):
     """A test double of MuJoCo whose step Jacobian has one entry off by 1e-4 (relative): the
-    row fails, naming MuJoCo and the entry."""
+    row fails, naming MuJoCo, the rule and the entry (Euler's on a model with a free and a
+    ball joint; RK4's on a double pendulum, whose stages the referee follows)."""
     from dataclasses import replace
 
     from dyncheck.adapters import mujoco_model
@@ -63,15 +98,20 @@ def test_a_step_jacobian_off_by_one_part_in_ten_thousand_fails(monkeypatch):
     original = mujoco_model.MujocoModel.transition
 
     def broken(self, q, v, a):
-        euler, *others = original(self, q, v, a)
-        matrix, coarse = euler.matrix.copy(), euler.coarse.copy()
+        steps = list(original(self, q, v, a))
+        k = [s.integrator for s in steps].index(integrator)
+        matrix, coarse = steps[k].matrix.copy(), steps[k].coarse.copy()
         matrix[:, 0, 0] *= 1 + 1e-4
         coarse[:, 0, 0] *= 1 + 1e-4
-        return (replace(euler, matrix=matrix, coarse=coarse), *others)
+        steps[k] = replace(steps[k], matrix=matrix, coarse=coarse)
+        return tuple(steps)
 
     monkeypatch.setattr(mujoco_model.MujocoModel, "transition", broken)
-    result = check_model(MODELS / "mixed.xml", impls=("reference", "mujoco"), states=5,
-                         derivatives=True, isolate=False)
+    path = MODELS / "mixed.xml" if integrator == "euler" else _pendulum(tmp_path)
+    result = check_model(path, impls=("reference", "mujoco"), states=5, derivatives=True,
+                         isolate=False)
     row = _rows(result, section="derivatives", impl_b="mujoco", verdict="failed")
-    assert len(row) == 1 and row["subject"].iloc[0].startswith("step Jacobian")
-    assert "mujoco differs from the chain rule" in row["note"].iloc[0]
+    assert len(row) == 1 and row["subject"].iloc[0].startswith(f"step Jacobian ({integrator}")
+    rule = "RK4's chain rule through its 4 stages" if integrator == "rk4" else "the chain rule"
+    assert f"mujoco differs from {rule} at state" in row["note"].iloc[0]
+    assert "entry (0, 0)" in row["note"].iloc[0]
