@@ -203,9 +203,11 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--reuse", action="store_true",
                    help="reuse each release's newest cached run, whatever code made it")
     v.add_argument("--out", type=path_arg, default=Path("reports/versions.md"), metavar="FILE")
+    _quiet(v)
     t = sub.add_parser("tutorials", help="execute the tutorials and render them to Markdown")
     t.add_argument("names", nargs="*", metavar="NAME", help="tutorials (default: all)")
     t.add_argument("--out", type=path_arg, default=Path("reports/tutorials"), help="output folder")
+    _quiet(t)
     c = sub.add_parser("report", help="check that the committed report matches the code")
     c.add_argument(
         "--check",

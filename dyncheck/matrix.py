@@ -30,6 +30,7 @@ import pandas as pd
 from dyncheck import diff
 from dyncheck.adapters import REGISTRY
 from dyncheck.errors import DyncheckError, InvalidInput, UnknownName
+from dyncheck.progress import Progress
 from dyncheck.reference.derivations import cache_root
 from dyncheck.vocabulary import Verdict
 
@@ -332,10 +333,11 @@ class Step:
 
 def matrix(
     names: Sequence[str], *, cases: Sequence[str] = (), jobs: int = 2, log: Log,
-    reuse: bool = False,
+    reuse: bool = False, progress: Progress | None = None,
 ) -> list[Step]:
     """Every consecutive pair of each engine's releases, diffed (a release that cannot be
-    installed or run is a step with its ``problem`` stated, not an abort)."""
+    installed or run is a step with its ``problem`` stated, not an abort); ``progress``
+    told of each release done."""
     steps = []
     for name in names:
         eng = engine(name)
@@ -347,6 +349,8 @@ def matrix(
             except (ReleaseUnavailable, ReleaseFailed) as exc:
                 log(str(exc))
                 runs.append((release, None, str(exc)))
+            if progress is not None:
+                progress.done(f"{name} {release}")
         for (old, a, pa), (new, b, pb) in itertools.pairwise(runs):
             if a is None or b is None:
                 steps.append(Step(engine=name, old=old, new=new, table=None,

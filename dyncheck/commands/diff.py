@@ -3,11 +3,7 @@
 from __future__ import annotations
 
 import argparse
-from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:
-
-    pass
 from dyncheck.commands.options import (
     check_out_file,
 )

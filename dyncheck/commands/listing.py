@@ -2,13 +2,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 from dyncheck.errors import EngineNotInstalled
-
-if TYPE_CHECKING:
-
-    pass
 
 
 def installed_version(package: str) -> str | None:

@@ -3,16 +3,11 @@
 from __future__ import annotations
 
 import argparse
-from typing import TYPE_CHECKING
 
-from dyncheck.errors import InvalidInput
-
-if TYPE_CHECKING:
-
-    pass
 from dyncheck.commands.options import (
     positive,
 )
+from dyncheck.errors import InvalidInput
 
 SHOWN = 20
 """Moved results listed by `report --check` (the rest counted)."""

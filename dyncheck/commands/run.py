@@ -3,13 +3,7 @@
 from __future__ import annotations
 
 import argparse
-from typing import TYPE_CHECKING
 
-from dyncheck.errors import InvalidInput
-
-if TYPE_CHECKING:
-
-    pass
 from dyncheck.commands.options import (
     MAX_STATES,
     check_out,
@@ -20,6 +14,7 @@ from dyncheck.commands.options import (
     warn_cost,
     write_ci,
 )
+from dyncheck.errors import InvalidInput
 from dyncheck.vocabulary import Verdict
 
 

@@ -4,16 +4,10 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import TYPE_CHECKING
 
+from dyncheck.commands.options import check_out
 from dyncheck.errors import UnknownName
-
-if TYPE_CHECKING:
-
-    pass
-from dyncheck.commands.options import (
-    check_out,
-)
+from dyncheck.progress import Progress
 
 
 def tutorials_command(args: argparse.Namespace) -> int:
@@ -27,15 +21,18 @@ def tutorials_command(args: argparse.Namespace) -> int:
             raise UnknownName("tutorial", name, known)
     check_out(args.out)
     failed = 0
-    for name in names:
-        try:
-            nb = tutorials.execute(name)
-        except tutorials.TutorialFailed as exc:
-            print(f"dyncheck: {exc}", file=sys.stderr)
-            failed += 1
-            continue
-        written = tutorials.render(name, nb, args.out)
-        print(f"{name}: executed -> {written[0]}")
+    with Progress("tutorials", len(names), quiet=args.quiet) as progress:
+        for name in names:
+            try:
+                nb = tutorials.execute(name)
+            except tutorials.TutorialFailed as exc:
+                print(f"dyncheck: {exc}", file=sys.stderr)
+                failed += 1
+                progress.done(f"{name} (failed)")
+                continue
+            written = tutorials.render(name, nb, args.out)
+            print(f"{name}: executed -> {written[0]}")
+            progress.done(name)
     if not args.names:
         tutorials.index(args.out)
     return 1 if failed else 0

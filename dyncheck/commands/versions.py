@@ -3,16 +3,9 @@
 from __future__ import annotations
 
 import argparse
-from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:
-
-    pass
-from dyncheck.commands.options import (
-    check_out_file,
-    log,
-    positive,
-)
+from dyncheck.commands.options import check_out_file, log, positive
+from dyncheck.progress import Progress
 
 
 def versions_command(args: argparse.Namespace) -> int:
@@ -35,7 +28,10 @@ def versions_command(args: argparse.Namespace) -> int:
     for name in names:
         matrix.engine(name)
     check_out_file("--out", args.out)
-    steps = matrix.matrix(names, cases=args.case, jobs=args.jobs, log=log, reuse=args.reuse)
+    releases = sum(len(matrix.engine(name).releases) for name in names)
+    with Progress("versions", releases, quiet=args.quiet) as progress:
+        steps = matrix.matrix(names, cases=args.case, jobs=args.jobs, log=log,
+                              reuse=args.reuse, progress=progress)
     write_atomic(args.out, matrix.page(steps, notes=matrix.EXPLANATIONS))
     print(f"version matrix written to {args.out}")
     return 0

@@ -49,3 +49,41 @@ def test_check_reports_progress_on_stderr_only_and_quiet_silences_it(tmp_path, c
     assert "dyncheck check: [2/2]" in err and "dyncheck check: [" not in out
     assert main([*args, "--quiet"]) == 0
     assert capsys.readouterr().err == ""
+
+
+def test_versions_reports_one_line_per_release_and_quiet_silences_it(tmp_path, capsys,
+                                                                     monkeypatch):
+    """Each engine release run (faked here: the matrix's own diffing on two stored runs)
+    is a unit of ``versions``' progress, on stderr; the page on stdout only names the file."""
+    from dyncheck import matrix
+
+    from .test_matrix import _run
+
+    runs = {r: _run(tmp_path / r, 1e-16, r) for r in ("1.0", "1.1")}
+    engine = matrix.engine("mujoco")
+    monkeypatch.setattr(matrix, "engine", lambda name: type(engine)(
+        **{**engine.__dict__, "releases": ("1.0", "1.1")}))
+    monkeypatch.setattr(matrix, "run_release", lambda eng, r, **kw: runs[r])
+    args = ["versions", "--engine", "mujoco", "--out", str(tmp_path / "v.md")]
+    assert main(args) == 0
+    out, err = capsys.readouterr()
+    assert re.findall(r"dyncheck versions: \[(\d/2)\] mujoco (1\.\d)", err) == [
+        ("1/2", "1.0"), ("2/2", "1.1")]
+    assert "dyncheck versions: [" not in out
+    assert main([*args, "--quiet"]) == 0
+    assert "dyncheck versions" not in capsys.readouterr().err
+
+
+def test_tutorials_report_each_lesson_done(tmp_path, capsys, monkeypatch):
+    """Each tutorial executed is a unit of ``tutorials``' progress (execution faked: the
+    command's loop is under test, not the lessons)."""
+    from dyncheck import tutorials
+
+    names = list(tutorials.available())[:2]
+    monkeypatch.setattr(tutorials, "execute", lambda name: name)
+    monkeypatch.setattr(tutorials, "render", lambda name, nb, out: [out / f"{name}.md"])
+    assert main(["tutorials", *names, "--out", str(tmp_path)]) == 0
+    out, err = capsys.readouterr()
+    assert [f"[{k + 1}/2] {n} done" for k, n in enumerate(names)] == re.findall(
+        r"\[\d/2\] \S+ done", err)
+    assert "dyncheck tutorials:" not in out
