@@ -20,12 +20,7 @@ from enum import StrEnum
 
 import numpy as np
 
-
-class JointType(StrEnum):
-    HINGE = "hinge"
-    SLIDE = "slide"
-    BALL = "ball"
-    FREE = "free"
+from dyncheck.vocabulary import JointType
 
 
 class Axes(StrEnum):
@@ -58,8 +53,9 @@ def reversed_rpy(rotation: np.ndarray) -> np.ndarray:
     return Rotation.from_euler("XYZ", rpy).as_matrix()
 
 
-NQ = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 4, JointType.FREE: 7}
-NV = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 3, JointType.FREE: 6}
+NQ = {t: t.nq for t in JointType}
+NV = {t: t.nv for t in JointType}
+"""Coordinates per joint type, from :class:`~dyncheck.vocabulary.JointType`."""
 
 
 @dataclass(frozen=True, kw_only=True)

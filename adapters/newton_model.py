@@ -205,8 +205,7 @@ class NewtonModel:
             total, centre, tensor = lump(masses, coms, tensors)
             frame = bodies[child[j]] @ _pose(x_c[j])
             qs, vs = int(self.q_start[j]), int(self.v_start[j])
-            nv = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 3,
-                  JointType.FREE: 6}[kind]
+            nv = kind.nv
             dofs = slice(vs, vs + nv)
             above = mover(int(parent[j]))
             limited = nv == 1 and abs(lower[vs]) < NO_LIMIT and abs(upper[vs]) < NO_LIMIT

@@ -14,20 +14,20 @@ import numpy as np
 
 from dyncheck.cases.validate import finite_array, inertia_tensor, positive
 from dyncheck.errors import InvalidInput
+from dyncheck.vocabulary import JointType
 
 Vec3 = tuple[float, float, float]
 Mat3 = tuple[Vec3, Vec3, Vec3]
 ZERO3: Mat3 = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
-JOINT_TYPES = ("hinge", "slide", "ball", "free")
-NQ = {"hinge": 1, "slide": 1, "ball": 4, "free": 7}
-"""Position coordinates per joint type: a ball joint's orientation is a unit quaternion; a
-free joint's the position of the body frame's origin, then a unit quaternion."""
-NV = {"hinge": 1, "slide": 1, "ball": 3, "free": 6}
-"""Velocity coordinates per joint type: a ball joint's is an angular velocity; a free joint's
-a linear velocity of the body frame's origin, then an angular velocity."""
-ROTATING = ("ball", "free")
+JOINT_TYPES = tuple(t.value for t in JointType)
+"""A joint's ``type``, as text (:class:`~dyncheck.vocabulary.JointType` defines them)."""
+NQ = {t.value: t.nq for t in JointType}
+"""Position coordinates per joint type."""
+NV = {t.value: t.nv for t in JointType}
+"""Velocity coordinates per joint type."""
+ROTATING = tuple(t.value for t in JointType if t.rotating)
 """Joint types whose orientation is a quaternion."""
 
 

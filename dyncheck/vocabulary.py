@@ -54,6 +54,39 @@ explained, one not checked (a check lost is worse than an explained difference),
 failed. A table cell shows its rows' worst; a change to a higher rank is a regression."""
 
 
+class JointType(StrEnum):
+    """The joint types every engine here holds alike, as MuJoCo names them."""
+
+    HINGE = "hinge"
+    """An angle about an axis (rad)."""
+    SLIDE = "slide"
+    """A displacement along an axis (m)."""
+    BALL = "ball"
+    """A rotation about a point: a unit quaternion, an angular velocity."""
+    FREE = "free"
+    """The body frame's origin, then a unit quaternion; a linear velocity, then an angular
+    one."""
+
+    @property
+    def nq(self) -> int:
+        """Its position coordinates."""
+        return _NQ[self]
+
+    @property
+    def nv(self) -> int:
+        """Its velocity coordinates."""
+        return _NV[self]
+
+    @property
+    def rotating(self) -> bool:
+        """Whether its orientation is a quaternion (ball, free)."""
+        return self in (JointType.BALL, JointType.FREE)
+
+
+_NQ = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 4, JointType.FREE: 7}
+_NV = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 3, JointType.FREE: 6}
+
+
 class Integrator(StrEnum):
     """The fixed-step integrators, as MuJoCo (Euler, implicitfast, RK4) and Drake (RK2, RK3)
     define them; ``rk4-held-force`` is RK4 with a state-dependent external force evaluated

@@ -15,6 +15,7 @@ from dyncheck.vocabulary import (
     INSTANTANEOUS,
     SEVERITY,
     Integrator,
+    JointType,
     Quantity,
     Verdict,
     is_rk4,
@@ -44,3 +45,38 @@ def test_the_verdicts_one_order_puts_a_lost_check_between_explained_and_failed()
     assert sorted(Verdict, key=SEVERITY.__getitem__) == [
         Verdict.PASSED, Verdict.EXPLAINED, Verdict.SKIPPED, Verdict.FAILED]
     assert str(Verdict.PASSED) == "passed" and f"{Quantity.TRAJECTORY}" == "trajectory"
+
+
+@pytest.mark.parametrize("kind", list(JointType))
+def test_each_joint_type_has_the_coordinates_mujoco_gives_it(kind):
+    """Expected: MuJoCo's own sizes of each joint type (``mj_nq``/``mj_nv`` of a one-joint
+    model), not the table under test."""
+    mujoco = pytest.importorskip("mujoco")
+    joint = "<freejoint/>" if kind is JointType.FREE else f"<joint type='{kind}'/>"
+    model = mujoco.MjModel.from_xml_string(
+        f"<mujoco><worldbody><body>{joint}<geom size='0.1'/></body></worldbody></mujoco>")
+    assert (kind.nq, kind.nv) == (model.nq, model.nv)
+    assert kind.rotating == (model.nq != model.nv)
+
+
+def test_one_home_for_each_closed_set():
+    """#43: no two enumerations of the package spell the same set of values (a second
+    definition of a vocabulary set), outside the clean-room reference, which may import
+    nothing of dyncheck's."""
+    import ast
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    seen: dict[frozenset[str], str] = {}
+    for path in sorted(p for f in ("dyncheck", "adapters", "cases") for p in
+                       (root / f).rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not isinstance(node, ast.ClassDef) or not any(
+                    getattr(b, "id", "").endswith("Enum") for b in node.bases):
+                continue
+            values = frozenset(v.value.value for v in node.body if isinstance(v, ast.Assign)
+                               and isinstance(v.value, ast.Constant)
+                               and isinstance(v.value.value, str))
+            where = f"{path.relative_to(root)}:{node.name}"
+            assert values not in seen or not values, f"{where} repeats {seen[values]}"
+            seen[values] = where
