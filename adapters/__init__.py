@@ -16,6 +16,7 @@ from typing import Any
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.model_files import Format
 from dyncheck.errors import EngineNotInstalled, UnknownName
+from dyncheck.vocabulary import Integrator
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -63,15 +64,15 @@ class Registration:
 
 
 _A = "dyncheck.adapters."
-_MUJOCO_C = ("euler", "implicitfast", "rk4", "rk4-held-force")
+_MUJOCO_C = (Integrator.EULER, Integrator.IMPLICITFAST, Integrator.RK4, Integrator.RK4_HELD_FORCE)
 """MuJoCo's integrators, ``rk4-held-force`` being RK4 with a force held in ``xfrc_applied``;
 Pinocchio is stepped by the same definitions (:mod:`.integrators`)."""
-_PORTS = ("euler", "implicitfast", "rk4")
+_PORTS = (Integrator.EULER, Integrator.IMPLICITFAST, Integrator.RK4)
 """The integrators of MuJoCo's ports (which have no external field to hold)."""
 REGISTRY: dict[str, Registration] = {
     "sympy-mechanics": Registration(
         module=_A + "sympy_mechanics", cls="SympyMechanicsAdapter", package="sympy",
-        integrators=("euler", "rk4"),
+        integrators=(Integrator.EULER, Integrator.RK4),
     ),
     "pinocchio": Registration(
         module=_A + "pinocchio_", cls="PinocchioAdapter", package="pin", integrators=_MUJOCO_C,
@@ -86,7 +87,7 @@ REGISTRY: dict[str, Registration] = {
         cls="DrakeAdapter",
         package="drake",
         extra="drake",
-        integrators=("euler", "rk2", "rk3"),
+        integrators=(Integrator.EULER, Integrator.RK2, Integrator.RK3),
         model=_A + "drake_model:DrakeModel",
         label="drake",
     ),
@@ -126,13 +127,14 @@ REGISTRY: dict[str, Registration] = {
 
     "newton": Registration(
         package="newton", extra="newton", model=_A + "newton_model:NewtonModel",
-        label="newton", on_request=True, float32=True, run=Format.MJCF, integrators=("euler",),
+        label="newton", on_request=True, float32=True, run=Format.MJCF,
+        integrators=(Integrator.EULER,),
         releases=("1.7.0", "1.8.0"),
     ),
     "pybullet": Registration(
         package="pybullet", extra="pybullet", model=_A + "pybullet_model:PybulletModel",
         label="pybullet", on_request=True, run=Format.URDF, releases=("3.2.6", "3.2.7"),
-        integrators=("euler",),
+        integrators=(Integrator.EULER,),
     ),
 }
 """Implementation name → its registration: the one line an engine adds, in the order of trust

@@ -61,11 +61,12 @@ from dyncheck.adapters.linalg import solve
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Joint, Multibody
 from dyncheck.errors import EngineError
+from dyncheck.vocabulary import Integrator
 
 _INTEGRATORS = {
-    "euler": "semi_explicit_euler",
-    "rk2": "runge_kutta2",
-    "rk3": "runge_kutta3",
+    Integrator.EULER: "semi_explicit_euler",
+    Integrator.RK2: "runge_kutta2",
+    Integrator.RK3: "runge_kutta3",
 }
 """dyncheck's name → Drake's scheme name for ``ResetIntegratorFromFlags``."""
 

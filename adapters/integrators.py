@@ -218,10 +218,10 @@ def _held(acc: Acceleration, held: object, q: np.ndarray, v: np.ndarray) -> np.n
 
 
 STEPPERS: dict[str, Callable[..., tuple]] = {
-    "euler": _euler,
-    "implicitfast": _euler,  # D = 0: no damping, no actuators (see module docstring)
-    "rk4": _rk4,
-    "rk4-held-force": _rk4,
+    Integrator.EULER: _euler,
+    Integrator.IMPLICITFAST: _euler,  # D = 0: no damping, no actuators (see module docstring)
+    Integrator.RK4: _rk4,
+    Integrator.RK4_HELD_FORCE: _rk4,
 }
 
 

@@ -12,6 +12,8 @@ from contextlib import contextmanager
 import mujoco
 import numpy as np
 
+from dyncheck.vocabulary import Integrator
+
 
 def _release(text: str) -> tuple[int, ...]:
     return tuple(int(p) for p in text.split(".")[:3] if p.isdigit())
@@ -20,10 +22,10 @@ def _release(text: str) -> tuple[int, ...]:
 RELEASE = _release(mujoco.__version__)
 
 INTEGRATORS: dict[str, mujoco.mjtIntegrator] = {
-    "euler": mujoco.mjtIntegrator.mjINT_EULER,
-    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
-    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
-    "rk4-held-force": mujoco.mjtIntegrator.mjINT_RK4,  # the same RK4, a force held over it
+    Integrator.EULER: mujoco.mjtIntegrator.mjINT_EULER,
+    Integrator.IMPLICITFAST: mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+    Integrator.RK4: mujoco.mjtIntegrator.mjINT_RK4,
+    Integrator.RK4_HELD_FORCE: mujoco.mjtIntegrator.mjINT_RK4,  # the same RK4, a force held over it
 }
 """dyncheck's integrator names → MuJoCo's (the C engine and its ports alike)."""
 

@@ -34,6 +34,7 @@ from dyncheck.adapters.integrators import Layout, cross, integrate, solve_on_gro
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.cases.multibody import Joint, Multibody
+from dyncheck.vocabulary import Integrator
 
 THREADS = max(1, min(2, os.cpu_count() or 1))
 """Threads for Pinocchio's batched ABA/RNEA (the machines this runs on have 2 cores)."""
@@ -226,7 +227,7 @@ class PinocchioAdapter(Adapter):
 
     def definition(self, integrator: str) -> str:
         """dyncheck's ``implicitfast`` has D = 0 here (no damping, no actuators): ``euler``."""
-        return "euler" if integrator == "implicitfast" else integrator
+        return Integrator.EULER if integrator == Integrator.IMPLICITFAST else integrator
 
     def to_mujoco(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pinocchio's state → MuJoCo's layout: quaternions (x, y, z, w) → (w, x, y, z), a

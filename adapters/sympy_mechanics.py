@@ -42,6 +42,7 @@ from dyncheck.adapters.base import (
 from dyncheck.adapters.integrators import integrate
 from dyncheck.adapters.linalg import solve
 from dyncheck.cases.multibody import ROTATING, Multibody
+from dyncheck.vocabulary import Integrator
 
 
 def _vec(frame: me.ReferenceFrame, xyz) -> me.Vector:
@@ -308,7 +309,7 @@ class SympyMechanicsAdapter(Adapter):
 
     def definition(self, integrator: str) -> str:
         """dyncheck's ``implicitfast`` has D = 0 here (no damping, no actuators): ``euler``."""
-        return "euler" if integrator == "implicitfast" else integrator
+        return Integrator.EULER if integrator == Integrator.IMPLICITFAST else integrator
 
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str

@@ -28,11 +28,11 @@ NOMINAL_ORDER: dict[str, int] = {i: i.nominal_order for i in Integrator}
 
 
 STEPS: dict[str, tuple[float, ...]] = {
-    "euler": (2e-3, 1e-3, 5e-4, 2.5e-4),
-    "implicitfast": (2e-3, 1e-3, 5e-4, 2.5e-4),
-    "rk2": (1e-2, 5e-3, 2.5e-3, 1.25e-3),
-    "rk3": (1e-2, 5e-3, 2.5e-3, 1.25e-3),
-    "rk4": (1e-2, 5e-3, 2.5e-3, 1.25e-3),
+    Integrator.EULER: (2e-3, 1e-3, 5e-4, 2.5e-4),
+    Integrator.IMPLICITFAST: (2e-3, 1e-3, 5e-4, 2.5e-4),
+    Integrator.RK2: (1e-2, 5e-3, 2.5e-3, 1.25e-3),
+    Integrator.RK3: (1e-2, 5e-3, 2.5e-3, 1.25e-3),
+    Integrator.RK4: (1e-2, 5e-3, 2.5e-3, 1.25e-3),
 }
 """Default halving sequences (s): coarse enough that each integrator's error stands well above
 the reference's (~1e-13), fine enough to be in the asymptotic range on these cases."""

@@ -17,9 +17,10 @@ from dyncheck.cases.base import STEPS, Case, TrajectorySpec
 from dyncheck.cases.coordinate_maps import LinearMap, SphericalToCartesian
 from dyncheck.cases.multibody import Body, Joint, Multibody
 from dyncheck.cases.validate import positive
+from dyncheck.vocabulary import Integrator
 
 X, Y, Z = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
-COARSE_RK4 = {**STEPS, "rk4": (1e-1, 5e-2, 2.5e-2, 1.25e-2)}
+COARSE_RK4 = {**STEPS, Integrator.RK4: (1e-1, 5e-2, 2.5e-2, 1.25e-2)}
 """The cylindrical particle's free fall is so smooth in (r, θ, z) that RK4 reaches the
 reference's accuracy at 1e-2 already: its study starts coarser."""
 PERMUTE_REVERSE = ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0), (1.0, 0.0, 0.0))
@@ -186,12 +187,12 @@ class Kepler(_SphericalChart, Case):
             *_kepler_initial_state(1.0, 1.2, 0.3, np.pi / 6),
             duration=4.0,
             steps={
-                "euler": (4e-3, 2e-3, 1e-3, 5e-4),
-                "implicitfast": (4e-3, 2e-3, 1e-3, 5e-4),
-                "rk2": (1e-2, 5e-3, 2.5e-3, 1.25e-3),
-                "rk3": (1e-2, 5e-3, 2.5e-3, 1.25e-3),
-                "rk4": (4e-2, 2e-2, 1e-2, 5e-3),
-                "rk4-held-force": (4e-3, 2e-3, 1e-3, 5e-4),
+                Integrator.EULER: (4e-3, 2e-3, 1e-3, 5e-4),
+                Integrator.IMPLICITFAST: (4e-3, 2e-3, 1e-3, 5e-4),
+                Integrator.RK2: (1e-2, 5e-3, 2.5e-3, 1.25e-3),
+                Integrator.RK3: (1e-2, 5e-3, 2.5e-3, 1.25e-3),
+                Integrator.RK4: (4e-2, 2e-2, 1e-2, 5e-3),
+                Integrator.RK4_HELD_FORCE: (4e-3, 2e-3, 1e-3, 5e-4),
             },
         )
     )

@@ -18,12 +18,13 @@ from dyncheck.cases.base import STEPS, Case, TrajectorySpec
 from dyncheck.cases.coordinate_maps import EulerAngleMap, FreeBodyMap
 from dyncheck.cases.multibody import Body, Joint, Multibody
 from dyncheck.cases.validate import inertia_tensor, positive
+from dyncheck.vocabulary import Integrator
 
 RIGID_STEPS = {
     **STEPS,
-    "rk2": (2e-2, 1e-2, 5e-3, 2.5e-3),
-    "rk3": (4e-2, 2e-2, 1e-2, 5e-3),
-    "rk4": (8e-2, 4e-2, 2e-2, 1e-2),
+    Integrator.RK2: (2e-2, 1e-2, 5e-3, 2.5e-3),
+    Integrator.RK3: (4e-2, 2e-2, 1e-2, 5e-3),
+    Integrator.RK4: (8e-2, 4e-2, 2e-2, 1e-2),
 }
 """A free rotation is smooth enough that MuJoCo's RK4 reaches the reference's accuracy below
 1e-2: its study starts coarser; Drake's RK2 and RK3 likewise (Euler keeps the default)."""

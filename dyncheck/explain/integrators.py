@@ -7,6 +7,7 @@ import numpy as np
 from dyncheck.cases import get_case
 from dyncheck.explain.entry import Entry
 from dyncheck.implementations import EngineImplementation, make_implementation
+from dyncheck.vocabulary import Integrator
 
 
 def leaf_system_run(
@@ -125,7 +126,7 @@ def group_rk4() -> Entry:
     adapter = impl.adapter  # type: ignore[attr-defined]
     q0, v0 = adapter.to_mujoco(*impl.engine_start())  # type: ignore[attr-defined]
     duration = case.trajectory.duration
-    dts = case.trajectory.steps["rk4"][1:]
+    dts = case.trajectory.steps[Integrator.RK4][1:]
 
     def order(naive: bool) -> float:
         ends = []
@@ -136,7 +137,7 @@ def group_rk4() -> Entry:
                 v0,
                 dt,
                 round(duration / dt),
-                "rk4",
+                Integrator.RK4,
                 layout=adapter.layout,
                 naive_group=naive,
             )
@@ -164,11 +165,11 @@ def port_integrators() -> Entry:
     Example 9's body on a ball joint (the same MJCF), self-convergence orders at the case's
     three finest RK4 steps; MJX in 64-bit mode, so that round-off does not hide the order."""
     case = get_case("rigid_body_ball")
-    dts = case.trajectory.steps["rk4"][1:]
+    dts = case.trajectory.steps[Integrator.RK4][1:]
 
     def order(engine: str) -> float:
         impl = make_implementation(engine, case)
-        return self_convergence([impl.simulate(dt, "rk4")[1][-1] for dt in dts])
+        return self_convergence([impl.simulate(dt, Integrator.RK4)[1][-1] for dt in dts])
 
     return Entry(
         "mjx-integrator-definitions",

@@ -19,6 +19,7 @@ from dyncheck.results import to_csv
 from dyncheck.studies import (
     TrajectoryFigures,
 )
+from dyncheck.vocabulary import Integrator
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -155,7 +156,7 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     plt = _pyplot()
     plt.rcParams.update({"font.family": "DejaVu Sans", "font.size": 9})
     out = {}
-    rk4 = [(impl, q) for (impl, integ), q in sorted(data.runs.items()) if integ == "rk4"]
+    rk4 = [(impl, q) for (impl, integ), q in sorted(data.runs.items()) if integ == Integrator.RK4]
     styles = dict(zip([impl for impl, _ in rk4], _styles(len(rk4)), strict=True))
     panels = [(i, label, part) for i in range(case.ndof)
               for label, part in _panels([(case.coordinates[i], rk4)])]

@@ -26,7 +26,7 @@ from dyncheck.tolerances import (
     first_near_max,
     roundoff_floor,
 )
-from dyncheck.vocabulary import Quantity, is_rk4
+from dyncheck.vocabulary import Integrator, Quantity, is_rk4
 
 
 def _no_numbers(
@@ -79,7 +79,7 @@ def _maps_differ(
         return CHARTS_DIFFER
     if is_rk4(integrator) and len({_group_order(impls[e]) for e in (a, b)}) == 2:
         return NAIVE_GROUP_RK4
-    if integrator == "implicitfast" and "free" in types:
+    if integrator == Integrator.IMPLICITFAST and "free" in types:
         facts = {
             getattr(getattr(impls[e], "adapter", None), "gyroscopic_implicit", False)
             for e in (a, b)
@@ -91,7 +91,8 @@ def _maps_differ(
 
 def _group_order(impl: Implementation | Exception) -> int:
     """RK4's order on the rotation group as the engine defines it (4 unless it says less)."""
-    return int(getattr(getattr(impl, "adapter", None), "rk4_group_order", NOMINAL_ORDER["rk4"]))
+    return int(getattr(getattr(impl, "adapter", None), "rk4_group_order",
+                       NOMINAL_ORDER[Integrator.RK4]))
 
 
 def _frame_pair(

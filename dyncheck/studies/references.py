@@ -14,6 +14,7 @@ from dyncheck.cases import Case
 from dyncheck.cases.coordinate_maps import CoordinateMap
 from dyncheck.implementations import Variant, general_method, reference_trajectory
 from dyncheck.measured_cache import reused
+from dyncheck.vocabulary import Integrator
 
 T = TypeVar("T")
 
@@ -70,7 +71,8 @@ class References:
         """:meth:`discrete` as (book q, engine q) at every step. A soft-constraint model is
         stepped on the free masses themselves — the engine's coordinates are the reference's
         free coordinates (the same s = A x + b, checked here) — as they leave the cords."""
-        integrator = "euler" if integrator == "implicitfast" else integrator  # same map, D = 0
+        if integrator == Integrator.IMPLICITFAST:  # the same map: D = 0
+            integrator = Integrator.EULER
         key = (variant, integrator, dt)
         if key not in self._discrete:
             self._discrete[key] = self._stored(
