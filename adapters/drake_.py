@@ -63,7 +63,7 @@ from dyncheck.cases.multibody import Joint, Multibody
 from dyncheck.errors import EngineError
 from dyncheck.vocabulary import Integrator
 
-_INTEGRATORS = {
+_INTEGRATORS: dict[str, str] = {
     Integrator.EULER: "semi_explicit_euler",
     Integrator.RK2: "runge_kutta2",
     Integrator.RK3: "runge_kutta3",

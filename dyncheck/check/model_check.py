@@ -22,7 +22,7 @@ import pandas as pd
 
 from dyncheck.adapters import layout
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials
-from dyncheck.adapters.model_tree import ModelTree, TreeJoint
+from dyncheck.adapters.model_tree import Dynamics, ModelTree, TreeJoint
 from dyncheck.check import describe, inputs, partial, predicted
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.derivatives import rows as derivative_rows
@@ -135,22 +135,63 @@ def check_model(
                                      isolate=isolate, limits=limits)
     try:  # an overflow is a non-finite value, reported as a row: never a warning on stderr
         with np.errstate(all="ignore"):
-            return _check(model, source_path, source, engines, chosen, states, seed,
-                          floating, against_path, time.perf_counter() - t0,
+            return _check(model, source_path, source, engines=engines, chosen=chosen,
+                          states=states, seed=seed, floating=floating,
+                          against_path=against_path, load_seconds=time.perf_counter() - t0,
                           derivatives=derivatives)
     finally:
         engine_processes.stop(engines)
 
 
-def _check(model: str, source_path: Path, source: ModelFile,
+def _check(model: str, source_path: Path, source: ModelFile, *,
            engines: dict[str, engine_processes.ModelEngine | NotLoaded], chosen: tuple[str, ...],
            states: int, seed: int, floating: bool, against_path: Path | None,
-           load_seconds: float, *, derivatives: bool = False) -> CheckResult:
+           load_seconds: float, derivatives: bool = False) -> CheckResult:
+    """The check's steps in order: what loaded, what each engine read and whether it is
+    physically possible, the dynamics at the same states, every pair compared, and the
+    derivatives where asked for."""
     rows: list[CheckRow] = []
     notes = [*source.notes, SMOOTH_NOTE]
-    seconds: dict[str, float] = {}
+    seconds: dict[str, float] = {"load": load_seconds}
+    loaded = _loaded(model, source_path, source, engines, rows, notes)
+    first = next(iter(loaded.values()))
+    canonical_tree: ModelTree = first.tree
+    if canonical_tree.nv == 0:
+        raise inputs.ModelFileError(source_path, "has no degrees of freedom (nothing moves)")
+    notes.append(
+        f"canonical layout and joint order: {first.engine}'s; the reference reads "
+        f"{first.engine}'s tree"
+    )
+    differing = _readings(model, source, loaded, rows)
+    if against_path is not None:
+        rows.extend(_against(model, canonical_tree, read(against_path, floating=floating)))
+    canon = layout.canonical(canonical_tree)
+    parts, unmatched = _parts(canon, canonical_tree, loaded, notes)
+    batch = sample(canon, canonical_tree, states, seed)
+    results = _dynamics(model, canon, canonical_tree, batch, loaded, parts, unmatched,
+                        with_referee=REFEREE in chosen, rows=rows, seconds=seconds)
+    seconds = {k: seconds[k] for k in ("load", REFEREE, *loaded) if k in seconds}
+    rows.extend(_pairs(model, canon, canonical_tree, batch, loaded, parts, results, differing))
+    if derivatives:
+        t0 = time.perf_counter()
+        whole = {e: loaded[e] for e in results if e in loaded and parts.get(e) is None}
+        rows.extend(derivative_rows(model, canon, canonical_tree, whole, batch,
+                                    with_referee=REFEREE in chosen, seconds=seconds))
+        notes.append(DERIVATIVES_NOTE)
+        seconds["derivatives"] = time.perf_counter() - t0
+    frame = pd.DataFrame([vars(r) for r in rows], columns=COLUMNS)
+    for column in ("section", "verdict"):
+        frame[column] = frame[column].astype(str)
+    return CheckResult(model=model, path=source_path, rows=frame, notes=tuple(notes),
+                       seconds=seconds, states=states, impls=chosen)
+
+
+def _loaded(model: str, source_path: Path, source: ModelFile,
+            engines: dict[str, engine_processes.ModelEngine | NotLoaded], rows: list[CheckRow],
+            notes: list[str]) -> dict[str, engine_processes.ModelEngine]:
+    """Step 1: the engines that loaded the file, each tree aligned with the first's (a load
+    row each; MuJoCo refusing an MJCF, or no engine loading it, is the file's fault)."""
     loaded: dict[str, engine_processes.ModelEngine] = {}
-    seconds["load"] = load_seconds
     for engine, result in engines.items():
         if isinstance(result, NotLoaded):
             verdict = Verdict.SKIPPED if result.skip else Verdict.FAILED
@@ -170,20 +211,18 @@ def _check(model: str, source_path: Path, source: ModelFile,
         raise inputs.ModelFileError(
             source_path, "no engine could load it: " + "; ".join(r.note for r in rows)
         )
-    first = next(iter(loaded.values()))
-    canonical_tree: ModelTree = first.tree
-    if canonical_tree.nv == 0:
-        raise inputs.ModelFileError(source_path, "has no degrees of freedom (nothing moves)")
-    notes.append(
-        f"canonical layout and joint order: {first.engine}'s; the reference reads "
-        f"{first.engine}'s tree"
-    )
-    # Step 3: what each engine read; step 4: is it physically possible.
+    return loaded
+
+
+def _readings(model: str, source: ModelFile, loaded: dict[str, engine_processes.ModelEngine],
+              rows: list[CheckRow]) -> dict[str, str]:
+    """Steps 3 and 4: whether each body is physically possible (the file's URDF inertials
+    and every engine's reading), and each engine's tree against the first's, field by field;
+    returns the fields each engine read differently."""
     stated = urdf_inertials(source)
     if stated:
         rows.extend(describe.validity(model, "file", [
             (i.link, i.mass, np.array(i.inertia)) for i in stated]))
-    differing: dict[str, str] = {}
     for engine, m in loaded.items():
         rows.extend(describe.validity(model, engine, describe.tree_bodies(m.tree),
                                       eps=m.tree.eps))
@@ -191,19 +230,25 @@ def _check(model: str, source_path: Path, source: ModelFile,
     for r in rows:
         if r.section is Section.VALIDITY and r.verdict is Verdict.FAILED:
             invalid.setdefault(r.subject, f"{r.impl_a}: {r.field}")
+    first = next(iter(loaded.values()))
+    differing: dict[str, str] = {}
     for engine, m in loaded.items():
         if m is first:
             continue
-        found = describe.diff(model, canonical_tree, m.tree, invalid)
+        found = describe.diff(model, first.tree, m.tree, invalid)
         rows.extend(found)
         fields = sorted({r.field for r in found if r.verdict is Verdict.FAILED})
         if fields:
             differing[engine] = ", ".join(fields)
-    if against_path is not None:
-        rows.extend(_against(model, canonical_tree, read(against_path, floating=floating)))
-    # Step 5 and 6: dynamics at the same states, every pair.
-    canon = layout.canonical(canonical_tree)
-    parts: dict[str, partial.Part | None] = {}  # None: the engine holds the whole tree
+    return differing
+
+
+def _parts(canon: layout.Canonical, canonical_tree: ModelTree,
+           loaded: dict[str, engine_processes.ModelEngine],
+           notes: list[str]) -> tuple[dict[str, partial.Part | None], list[str]]:
+    """Which joints each engine holds: all (None), a common part of whole subtrees (its
+    dynamics compared there), or joints that match nothing (the engine's dynamics skipped)."""
+    parts: dict[str, partial.Part | None] = {}
     unmatched = []
     for e, m in loaded.items():
         if {j.name for j in m.tree.joints} == set(canon.names) and all(
@@ -218,9 +263,19 @@ def _check(model: str, source_path: Path, source: ModelFile,
                 "joints it holds; its energies, sums over every body, are not")
         else:
             unmatched.append(e)
-    batch = sample(canon, canonical_tree, states, seed)
-    results = {}
-    pending = {}  # engines in processes of their own compute while the referee does
+    return parts, unmatched
+
+
+def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch: States,
+              loaded: dict[str, engine_processes.ModelEngine],
+              parts: dict[str, partial.Part | None], unmatched: list[str], *,
+              with_referee: bool, rows: list[CheckRow],
+              seconds: dict[str, float]) -> dict[str, Dynamics]:
+    """Step 5: every engine's dynamics at the same states, in the canonical layout (engines
+    in processes of their own compute while the referee does); a failing engine, or one
+    returning a non-finite value, costs its own row."""
+    results: dict[str, Dynamics] = {}
+    pending = {}
     for engine, m in loaded.items():
         if engine in unmatched:
             rows.append(_row(model, Section.DYNAMICS, engine, Verdict.SKIPPED,
@@ -242,7 +297,7 @@ def _check(model: str, source_path: Path, source: ModelFile,
             rows.append(_row(model, Section.DYNAMICS, engine, Verdict.FAILED,
                              f"{type(exc).__name__}: {exc}", field="dynamics"))
         seconds[engine] = seconds.get(engine, 0.0) + time.perf_counter() - t0
-    if REFEREE in chosen:
+    if with_referee:
         t0 = time.perf_counter()
         try:
             results[REFEREE] = ReferenceModel(canonical_tree).dynamics(batch.q, batch.v, batch.a)
@@ -259,13 +314,22 @@ def _check(model: str, source_path: Path, source: ModelFile,
             rows.append(_row(model, Section.DYNAMICS, engine, Verdict.FAILED,
                              f"{type(exc).__name__}: {exc}", field="dynamics"))
     results = {name: results[name] for name in (REFEREE, *loaded) if name in results}
-    seconds = {k: seconds[k] for k in ("load", REFEREE, *loaded) if k in seconds}
     for name in list(results):
         bad = [f for f, value in vars(results[name]).items() if not np.all(np.isfinite(value))]
         if bad:
             rows.append(_row(model, Section.DYNAMICS, name, Verdict.FAILED,
                              f"{name} returned a non-finite {', '.join(bad)}", field="dynamics"))
             del results[name]
+    return results
+
+
+def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch: States,
+           loaded: dict[str, engine_processes.ModelEngine],
+           parts: dict[str, partial.Part | None], results: dict[str, Dynamics],
+           differing: dict[str, str]) -> list[CheckRow]:
+    """Step 6: every pair's dynamics compared — on the whole tree with the differences the
+    engines' readings predict, or on the joints both hold."""
+    rows: list[CheckRow] = []
     referee_tree = replace(canonical_tree, joints=tuple(  # the referee counts every rotor
         replace(j, rotor_in_kinetic=True) for j in canonical_tree.joints))
     trees = {name: loaded[name].tree if name in loaded else referee_tree for name in results}
@@ -293,18 +357,7 @@ def _check(model: str, source_path: Path, source: ModelFile,
                 a, partial.restrict(results[a], partial.columns(dofs[a], common)),
                 b, partial.restrict(results[b], partial.columns(dofs[b], common)),
                 {}, cause, on, eps=max(trees[a].eps, trees[b].eps)))
-    if derivatives:
-        t0 = time.perf_counter()
-        whole = {e: loaded[e] for e in results if e in loaded and parts.get(e) is None}
-        rows.extend(derivative_rows(model, canon, canonical_tree, whole, batch,
-                                    with_referee=REFEREE in chosen, seconds=seconds))
-        notes.append(DERIVATIVES_NOTE)
-        seconds["derivatives"] = time.perf_counter() - t0
-    frame = pd.DataFrame([vars(r) for r in rows], columns=COLUMNS)
-    for column in ("section", "verdict"):
-        frame[column] = frame[column].astype(str)
-    return CheckResult(model=model, path=source_path, rows=frame, notes=tuple(notes),
-                       seconds=seconds, states=states, impls=chosen)
+    return rows
 
 
 def _held(part: partial.Part | None) -> np.ndarray | None:
