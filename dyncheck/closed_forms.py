@@ -42,20 +42,18 @@ def closed_form_rows(case: Case) -> list[Discrepancy]:
     rate = abs(tf.rate)
     allowed = 4 * estimate + 64 * EPS * (1 + rate * spec.duration) * scale
     return [
-        Discrepancy(
+        Discrepancy.measured(
             case=case.name,
             quantity=Quantity.CLOSED_FORM,
             impl_a="book",
             impl_b="reference",
             integrator="dop853",
-            dt=float("nan"),
-            max_abs_err=float(err.max()),
-            max_rel_err=float(err.max()) / scale,
+            error=float(err.max()),
+            scale=scale,
             tolerance=allowed / scale,
-            tolerance_basis=f"4 x DOP853 error estimate {estimate:.1e} + closed form round-off "
+            basis=f"4 x DOP853 error estimate {estimate:.1e} + closed form round-off "
             "64 eps (1 + abs(du/dt) T)",
             verdict=Verdict.PASSED if err.max() <= allowed else Verdict.FAILED,
-            convention="",
             note=f"body angular velocity: Jacobi elliptic closed form (m = {tf.parameter:.4f}) "
             "against Lagrange's equations in Euler angles integrated by DOP853",
             worst_state=first_near_max(err, 64 * EPS * (1 + rate * spec.duration) * scale),

@@ -300,28 +300,15 @@ def _row(
     tol = instantaneous(quantity, condition, soft, max(a.eps, b.eps))
     if st.sensitivity and st.scale:
         tol = conditioned(tol, st.sensitivity / st.scale, max(a.eps, b.eps))
-    base: dict[str, Any] = dict(
-        case=case,
-        quantity=quantity,
-        impl_a=a.name,
-        impl_b=b.name,
-        integrator="",
-        dt=float("nan"),
-        tolerance=tol.rtol,
-        tolerance_basis=tol.basis,
-    )
+    base: dict[str, Any] = dict(case=case, quantity=quantity, impl_a=a.name, impl_b=b.name,
+                                tolerance=tol.rtol, basis=tol.basis)
     if not (a.ok and b.ok):
         bad = a if not a.ok else b
-        return Discrepancy(
+        return Discrepancy.unmeasured(
             **base,
-            max_abs_err=float("nan"),
-            max_rel_err=float("nan"),
             verdict=Verdict.SKIPPED if bad.skipped else Verdict.FAILED,
-            convention="",
             # the engine named once: its own message may already start with its name
             note=bad.error if bad.error.startswith(f"{bad.name}: ") else f"{bad.name}: {bad.error}",
-            worst_state=-1,
-            worst_state_values="",
         )
     scale = st.scale or 1.0
     rel = st.max_abs / scale
@@ -344,15 +331,9 @@ def _row(
             verdict = Verdict.EXPLAINED if st.residual / scale <= tol.rtol else Verdict.FAILED
         else:
             verdict, note = Verdict.FAILED, "unexplained: no convention predicts this difference"
-    return Discrepancy(
-        **base,
-        max_abs_err=st.max_abs,
-        max_rel_err=rel,
-        verdict=verdict,
-        convention=convention,
-        note=note,
-        worst_state=st.worst[0],
-        worst_state_values=st.worst[1],
+    return Discrepancy.measured(
+        **base, error=st.max_abs, scale=scale, verdict=verdict, convention=convention,
+        note=note, worst_state=st.worst[0], worst_state_values=st.worst[1],
     )
 
 

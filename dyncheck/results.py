@@ -29,6 +29,7 @@ MEANINGS: dict[str, str] = {
 """What each verdict means, for the report's glossary and ``--help``."""
 
 VERDICTS = tuple(v.value for v in Verdict)
+NAN = float("nan")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -61,6 +62,31 @@ class Discrepancy:
     def __post_init__(self) -> None:
         if self.verdict not in VERDICTS:
             raise ValueError(f"verdict must be one of {VERDICTS}, got {self.verdict!r}")
+
+    @classmethod
+    def measured(cls, *, case: str, quantity: str, impl_a: str, impl_b: str, error: float,
+                 scale: float, tolerance: float, basis: str, verdict: str,
+                 convention: str = "", note: str = "", integrator: str = "",
+                 dt: float = NAN, worst_state: int = -1,
+                 worst_state_values: str = "") -> Discrepancy:
+        """A row with its error: ``error`` in the quantity's units, relative to ``scale``
+        (its ``max_rel_err``); an instantaneous quantity has no integrator or step."""
+        return cls(case=case, quantity=quantity, impl_a=impl_a, impl_b=impl_b,
+                   integrator=integrator, dt=dt, max_abs_err=error,
+                   max_rel_err=error / scale, tolerance=tolerance, tolerance_basis=basis,
+                   verdict=verdict, convention=convention, note=note,
+                   worst_state=worst_state, worst_state_values=worst_state_values)
+
+    @classmethod
+    def unmeasured(cls, *, case: str, quantity: str, impl_a: str, impl_b: str, verdict: str,
+                   note: str, convention: str = "", integrator: str = "", dt: float = NAN,
+                   tolerance: float = NAN, basis: str = "") -> Discrepancy:
+        """A row with no error to show: skipped (its ``note`` says why), or failed before
+        any number."""
+        return cls(case=case, quantity=quantity, impl_a=impl_a, impl_b=impl_b,
+                   integrator=integrator, dt=dt, max_abs_err=NAN, max_rel_err=NAN,
+                   tolerance=tolerance, tolerance_basis=basis, verdict=verdict,
+                   convention=convention, note=note, worst_state=-1)
 
 
 @dataclass(frozen=True, kw_only=True)

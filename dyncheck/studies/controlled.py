@@ -44,20 +44,18 @@ def adaptive(
     err = float(diff.max())
     allowed = 2 * (ref_err + own_err)
     verdict = Verdict.PASSED if variant is not None and err <= allowed else Verdict.FAILED
-    return Discrepancy(
+    return Discrepancy.measured(
         case=case.name,
         quantity=Quantity.TRAJECTORY,
         impl_a="reference",
         impl_b=impl.name,
         integrator="dop853",
-        dt=float("nan"),
-        max_abs_err=err,
-        max_rel_err=err / scale_q,
+        error=err,
+        scale=scale_q,
         tolerance=allowed / scale_q,
-        tolerance_basis=f"2 x (reference error estimate {ref_err:.1e} + own estimate "
+        basis=f"2 x (reference error estimate {ref_err:.1e} + own estimate "
         f"{own_err:.1e}) (DOP853 at rtol {rtol:.2g} against rtol/4)",
         verdict=verdict,
-        convention="",
         note="scipy solve_ivp on the engine's forward dynamics, same model"
         + (
             "; quaternions in re-centred exponential coordinates"
@@ -121,19 +119,17 @@ def controlled(
             f"; reference error estimate {ref_err:.1e}"
         )
     return [
-        Discrepancy(
+        Discrepancy.measured(
             case=case.name,
             quantity=Quantity.TRAJECTORY,
             impl_a="reference",
             impl_b=impl.name,
             integrator=f"{CONTROLLED} eps={eps:g}",
-            dt=float("nan"),
-            max_abs_err=err,
-            max_rel_err=err / scale,
+            error=err,
+            scale=scale,
             tolerance=float("nan"),
-            tolerance_basis=basis,
+            basis=basis,
             verdict=verdict,
-            convention="",
             note=f"{n} steps; {note}",
             worst_state=w,
         )

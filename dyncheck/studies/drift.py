@@ -77,18 +77,11 @@ def drift_row(
         integrator=integrator,
         dt=dt,
         tolerance=tol.rtol,
-        tolerance_basis=tol.basis + " (relative to the coordinates' scale)",
+        basis=tol.basis + " (relative to the coordinates' scale)",
     )
     if variant is None:
-        return Discrepancy(
-            **base,
-            max_abs_err=float("nan"),
-            max_rel_err=float("nan"),
-            verdict=Verdict.FAILED,
-            convention="",
-            note="model differs from the book in an unpredicted way",
-            worst_state=-1,
-        )
+        return Discrepancy.unmeasured(**base, verdict=Verdict.FAILED,
+                                      note="model differs from the book in an unpredicted way")
     how = f"the same model stepped by {integrator}"
     if integrator in STEPPERS:
         _, qe = refs.discrete_engine(variant, integrator, dt)
@@ -104,10 +97,10 @@ def drift_row(
     diff = np.abs(observed - predicted).max(axis=1)
     scale = float(np.abs(qe).max())
     err = float(diff.max())
-    return Discrepancy(
+    return Discrepancy.measured(
         **base,
-        max_abs_err=err,
-        max_rel_err=err / scale,
+        error=err,
+        scale=scale,
         verdict=Verdict.PASSED if err / scale <= tol.rtol else Verdict.FAILED,
         convention=SOFT_CONSTRAINT if variant.softness else "",
         note=f"max abs violation observed {np.abs(observed).max():.3g} m, predicted "

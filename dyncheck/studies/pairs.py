@@ -33,23 +33,9 @@ def _no_numbers(
     case: Case, a: str, b: str, integrator: str, dt: float, verdict: str, convention: str, note: str
 ) -> Discrepancy:
     """A trajectory row with no error to show (skipped, or failed before any number)."""
-    nan = float("nan")
-    return Discrepancy(
-        case=case.name,
-        quantity=Quantity.TRAJECTORY,
-        impl_a=a,
-        impl_b=b,
-        integrator=integrator,
-        dt=dt,
-        max_abs_err=nan,
-        max_rel_err=nan,
-        tolerance=nan,
-        tolerance_basis="",
-        verdict=verdict,
-        convention=convention,
-        note=note,
-        worst_state=-1,
-    )
+    return Discrepancy.unmeasured(case=case.name, quantity=Quantity.TRAJECTORY, impl_a=a,
+                                  impl_b=b, integrator=integrator, dt=dt, verdict=verdict,
+                                  convention=convention, note=note)
 
 
 def unavailable(
@@ -126,43 +112,26 @@ def _frame_pair(
             # the finer difference is round-off: no order to measure in this precision; the
             # difference must then lie within the pair's accumulated round-off
             tol = accumulated(round(case.trajectory.duration / dts[0]), eps=eps)
-            return Discrepancy(
-                case=case.name,
-                quantity=Quantity.TRAJECTORY,
-                impl_a=a,
-                impl_b=b,
-                integrator=integrator,
-                dt=dts[0],
-                max_abs_err=d[0],
-                max_rel_err=d[0] / scale_q,
-                tolerance=tol.rtol,
-                tolerance_basis=tol.basis,
+            return Discrepancy.measured(
+                case=case.name, quantity=Quantity.TRAJECTORY, impl_a=a, impl_b=b,
+                integrator=integrator, dt=dts[0], error=d[0], scale=scale_q,
+                tolerance=tol.rtol, basis=tol.basis,
                 verdict=Verdict.PASSED if d[0] / scale_q <= tol.rtol else Verdict.FAILED,
-                convention="",
                 note=f"{a} and {b} are different maps ({convention}); at dt={dts[1]:g} their "
                 f"difference is within the round-off of eps = {eps:.3g}, so its order cannot "
                 f"be measured; at dt={dts[0]:g} it lies within the accumulated round-off",
-                worst_state=-1,
             )
     p = float(np.log(d[0] / d[1]) / np.log(dts[0] / dts[1]))
     ok = p >= nominal - ORDER_SLACK  # two order-p maps differ by O(hᵖ) or less
-    return Discrepancy(
-        case=case.name,
-        quantity=Quantity.TRAJECTORY,
-        impl_a=a,
-        impl_b=b,
-        integrator=integrator,
-        dt=dts[0],
-        max_abs_err=d[0],
-        max_rel_err=d[0] / scale_q,
-        tolerance=float("nan"),
-        tolerance_basis=f"difference of two order-{nominal} maps: shrinks at order >= "
+    return Discrepancy.measured(
+        case=case.name, quantity=Quantity.TRAJECTORY, impl_a=a, impl_b=b,
+        integrator=integrator, dt=dts[0], error=d[0], scale=scale_q, tolerance=float("nan"),
+        basis=f"difference of two order-{nominal} maps: shrinks at order >= "
         f"{nominal} - {ORDER_SLACK}",
         verdict=Verdict.EXPLAINED if ok else Verdict.FAILED,
         convention=convention,
         note=f"{a} and {b} are different maps ({convention}); their difference shrinks at "
         f"order {p:.3f} from dt={dts[0]:g} to {dts[1]:g} (predicted {nominal})",
-        worst_state=-1,
     )
 
 
@@ -206,35 +175,23 @@ def engine_pairs(
                 worst = first_near_max(diff, accumulated(steps, soft).rtol * scale_q)
                 err = float(diff[worst])
                 row: dict[str, Any] = dict(
-                    case=case.name,
-                    quantity=Quantity.TRAJECTORY,
-                    impl_a=a,
-                    impl_b=b,
-                    integrator=integrator,
-                    dt=dt,
-                    max_abs_err=err,
-                    max_rel_err=err / scale_q,
-                    tolerance=tol.rtol,
-                    tolerance_basis=tol.basis,
-                    worst_state=worst,
+                    case=case.name, quantity=Quantity.TRAJECTORY, impl_a=a, impl_b=b,
+                    integrator=integrator, dt=dt, error=err, scale=scale_q,
+                    tolerance=tol.rtol, basis=tol.basis, worst_state=worst,
                 )
                 va, vb = variants[a], variants[b]
                 if err / scale_q <= tol.rtol:
-                    rows.append(Discrepancy(**row, verdict=Verdict.PASSED, convention="", note=""))
+                    rows.append(Discrepancy.measured(**row, verdict=Verdict.PASSED))
                 elif va is not None and vb is not None and va != vb:
                     try:
                         predicted = refs.discrete(vb, integrator, dt) - refs.discrete(
                             va, integrator, dt
                         )
                     except Exception as exc:  # no discrete prediction here: a failed row
-                        rows.append(
-                            Discrepancy(
-                                **row,
-                                verdict=Verdict.FAILED,
-                                convention="; ".join(va.conventions(vb)),
-                                note=f"no prediction: {type(exc).__name__}: {exc}",
-                            )
-                        )
+                        rows.append(Discrepancy.measured(
+                            **row, verdict=Verdict.FAILED,
+                            convention="; ".join(va.conventions(vb)),
+                            note=f"no prediction: {type(exc).__name__}: {exc}"))
                         continue
                     res_rel = float(difference(case, qb - qa, predicted).max()) / scale_q
                     note = (
@@ -243,21 +200,11 @@ def engine_pairs(
                         f"{res_rel:.3g}"
                     )
                     verdict = Verdict.EXPLAINED if res_rel <= tol.rtol else Verdict.FAILED
-                    rows.append(
-                        Discrepancy(
-                            **row,
-                            verdict=verdict,
-                            convention="; ".join(va.conventions(vb)),
-                            note=note,
-                        )
-                    )
+                    rows.append(Discrepancy.measured(
+                        **row, verdict=verdict, convention="; ".join(va.conventions(vb)),
+                        note=note))
                 else:
-                    rows.append(
-                        Discrepancy(
-                            **row,
-                            verdict=Verdict.FAILED,
-                            convention="",
-                            note="unexplained: no convention predicts this",
-                        )
-                    )
+                    rows.append(Discrepancy.measured(
+                        **row, verdict=Verdict.FAILED,
+                        note="unexplained: no convention predicts this"))
     return rows

@@ -311,9 +311,9 @@ def _rows(case: Case, name: str, integrator: str, dts: tuple[float, ...], sweep:
         points.append(ConvergencePoint(
             case=case.name, impl=name, integrator=integrator, dt=dt, error=err,
             observed_order=p, nominal_order=nominal, reference_error=ref_err, asymptotic=a))
-        rows.append(Discrepancy(
+        rows.append(Discrepancy.measured(
             case=case.name, quantity=Quantity.TRAJECTORY, impl_a="reference", impl_b=name,
-            integrator=integrator, dt=dt, max_abs_err=err, max_rel_err=err / scale_q,
-            tolerance=float("nan"), tolerance_basis=basis, verdict=judged.verdict,
-            convention=convention, note=judged.note, worst_state=w))
+            integrator=integrator, dt=dt, error=err, scale=scale_q, tolerance=float("nan"),
+            basis=basis, verdict=judged.verdict, convention=convention, note=judged.note,
+            worst_state=w))
     return points, rows

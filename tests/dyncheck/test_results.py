@@ -5,10 +5,11 @@ from __future__ import annotations
 import io
 import warnings
 
+import numpy as np
 import pandas as pd
 import pytest
 
-from dyncheck.results import texts
+from dyncheck.results import Discrepancy, texts
 
 CSV = "integrator,dt,label\n,0.001,rk4\n,,\n,2,x\n"
 """An integrator column empty in every row (pandas reads it as floats), a numeric column with
@@ -24,3 +25,38 @@ def test_texts_reads_empty_cells_as_empty_strings_without_a_pandas_warning(colum
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # pandas 3 warns (and pandas 4 raises) on fillna("")
         assert texts(frame[column]).tolist() == expected
+
+
+ROW_KINDS = {"dyncheck/results.py": "Discrepancy.measured and .unmeasured",
+             "dyncheck/studies/derivatives.py": "a derivative row: a relative error only"}
+"""Where a :class:`Discrepancy` is built field by field: its constructors, and the one kind
+of row whose error is only relative."""
+
+
+def test_rows_are_built_by_their_constructors():
+    """#43: a row is made by ``Discrepancy.measured`` (an error relative to a scale) or
+    ``Discrepancy.unmeasured`` (skipped, or failed before a number), so that the fields a
+    kind of row leaves empty are left empty alike everywhere."""
+    import ast
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    by_hand = []
+    for path in sorted(root.joinpath("dyncheck").rglob("*.py")):
+        where = path.relative_to(root).as_posix()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                    and node.func.id == "Discrepancy" and where not in ROW_KINDS):
+                by_hand.append(f"{where}:{node.lineno}")
+    assert not by_hand, by_hand
+
+
+def test_a_measured_row_is_relative_to_its_scale_and_an_unmeasured_one_has_no_numbers():
+    row = Discrepancy.measured(case="c", quantity="mass_matrix", impl_a="a", impl_b="b",
+                               error=2e-15, scale=4.0, tolerance=1e-14, basis="round-off",
+                               verdict="passed")
+    assert row.max_rel_err == 5e-16 and row.integrator == "" and row.worst_state == -1
+    gone = Discrepancy.unmeasured(case="c", quantity="trajectory", impl_a="a", impl_b="b",
+                                  verdict="skipped", note="needs the 'drake' extra")
+    assert np.isnan(gone.max_abs_err) and np.isnan(gone.max_rel_err)
+    assert gone.tolerance_basis == "" and gone.worst_state == -1
