@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 
+from dyncheck.check.predicted import BASE_GRAVITY, ROTOR_ENERGY
 from dyncheck.implementations import (
     ENGINE_DEFECT,
     GRAVITY_DEFAULT,
@@ -157,5 +158,22 @@ EXPLANATIONS: dict[str, Explanation] = {
         text="A fixed-step integrator's error against the exact solution of the same model. "
         "Judged by the order study: the error must shrink at the nominal order (1 for `euler` "
         "and `implicitfast`, 4 for `rk4`) within ±0.1 in the asymptotic range.",
+    ),
+    ROTOR_ENERGY: Explanation(
+        origin=Origin.ENGINE,
+        text="An engine holds a joint's armature (rotor inertia) in M but leaves the rotor's "
+        "energy ½ aᵢ vᵢ² out of its kinetic energy (measured per engine: `dyncheck check` "
+        "reads whether each counts it). The difference of two engines' T is predicted per "
+        "state as ½ Σ aᵢ vᵢ² over those joints; a row is `explained` only when observed − "
+        "predicted is within round-off.",
+    ),
+    BASE_GRAVITY: Explanation(
+        origin=Origin.ENGINE,
+        text="PyBullet 3.2.7's floating-base dynamics resolve gravity in the base frame "
+        "through Rx(r) Ry(p) Rz(y) of the orientation's roll, pitch, yaw — the state's "
+        "Rz(y) Ry(p) Rx(r) composed in reverse order (measured). In `dyncheck check` its h "
+        "and inverse dynamics are predicted per state as G(g′) − G(g), g′ = R R′ᵀ g, and its "
+        "forward dynamics by −M⁻¹ that; the same defect a run declares as "
+        f"`{ENGINE_DEFECT}`.",
     ),
 }

@@ -110,13 +110,15 @@ def _values(dyn: Dynamics, quantity: str) -> np.ndarray:
     return value.reshape(len(value), -1)
 
 
-@dataclass(frozen=True)
-class Explanation:
+@dataclass(frozen=True, kw_only=True)
+class Prediction:
     """A predicted difference and why, for a pair and a quantity: per state, its size (n,)
-    or the difference b − a itself (n, k), component by component."""
+    or the difference b − a itself (n, k), component by component; ``label`` the property
+    that predicts it, as :data:`dyncheck.explanations.EXPLANATIONS` registers it."""
 
     size: np.ndarray
     note: str
+    label: str
 
 
 def _as_predicted(difference: np.ndarray, errors: np.ndarray, predicted: np.ndarray,
@@ -136,7 +138,7 @@ def compare(
     dyn_a: Dynamics,
     name_b: str,
     dyn_b: Dynamics,
-    explanations: dict[str, Explanation],
+    explanations: dict[str, Prediction],
     caused_by: str,
     states: States,
     *,

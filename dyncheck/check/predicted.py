@@ -18,15 +18,22 @@ from dyncheck.adapters.model_tree import (
     reversed_rpy,
 )
 from dyncheck.cases.coordinate_maps import quat_to_matrix
-from dyncheck.check.dynamics import Explanation, States
+from dyncheck.check.dynamics import Prediction, States
 from dyncheck.check.referee import ReferenceModel
 from dyncheck.vocabulary import Quantity
 
+ROTOR_ENERGY = "rotor energy left out of the kinetic energy"
+"""An engine holds a joint's armature in M but leaves its rotor energy ½ a v² out of T."""
+BASE_GRAVITY = "floating base's gravity resolved through reversed roll-pitch-yaw"
+"""PyBullet 3.2.7 resolves gravity in a floating base's frame through Rx(r) Ry(p) Rz(y)."""
+PREDICTIONS = (ROTOR_ENERGY, BASE_GRAVITY)
+"""Every label a check's prediction carries (each registered in ``EXPLANATIONS``)."""
+
 
 def differences(canon: Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
-                tree_b: ModelTree, states: States, dyn_a: Dynamics) -> dict[str, Explanation]:
+                tree_b: ModelTree, states: States, dyn_a: Dynamics) -> dict[str, Prediction]:
     """Quantity → the predicted difference b − a, for the pair (a, b)."""
-    out: dict[str, Explanation] = {}
+    out: dict[str, Prediction] = {}
     rotor = rotor_energy(canon, canonical_tree, tree_a, tree_b, states.v)
     if rotor is not None:
         out[Quantity.KINETIC_ENERGY] = rotor
@@ -36,7 +43,7 @@ def differences(canon: Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
 
 
 def rotor_energy(canon: Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
-                 tree_b: ModelTree, v: np.ndarray) -> Explanation | None:
+                 tree_b: ModelTree, v: np.ndarray) -> Prediction | None:
     """The kinetic energies' predicted difference where one engine counts a joint's rotor
     energy ½ aᵢ vᵢ² and the other does not (both hold the armature in M): ½ Σ aᵢ vᵢ² over
     those joints, aᵢ as the canonical engine read it (a magnitude per state)."""
@@ -52,15 +59,17 @@ def rotor_energy(canon: Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
         weights[canon.v_start[k] : canon.v_start[k] + len(armature)] = armature
     without = [t.engine for t in (tree_a, tree_b)
                if not all(t.joint(n).rotor_in_kinetic for n in names)]
-    return Explanation(
-        0.5 * np.einsum("i,ni,ni->n", weights, v, v),
-        f"{' and '.join(without)}'s kinetic energy leaves out the rotor energy ½ Σ aᵢ vᵢ² of "
-        f"{', '.join(names)}, which its M holds (predicted per state from the armature)",
+    return Prediction(
+        size=0.5 * np.einsum("i,ni,ni->n", weights, v, v),
+        note=f"{' and '.join(without)}'s kinetic energy leaves out the rotor energy "
+        f"½ Σ aᵢ vᵢ² of {', '.join(names)}, which its M holds (predicted per state from the "
+        "armature)",
+        label=ROTOR_ENERGY,
     )
 
 
 def base_gravity(canon: Canonical, canonical_tree: ModelTree, tree: ModelTree,
-                 states: States, dyn_a: Dynamics, sign: float) -> dict[str, Explanation]:
+                 states: States, dyn_a: Dynamics, sign: float) -> dict[str, Prediction]:
     """Where ``tree``'s engine resolves gravity in a free body's frame through another
     rotation R′ than the state's R (:class:`GravityFrame`): its h and inverse dynamics are
     those of the gravity g′ = R R′ᵀ g, so they differ by G(g′) − G(g), G(g) the generalized
@@ -88,6 +97,6 @@ def base_gravity(canon: Canonical, canonical_tree: ModelTree, tree: ModelTree,
             "through Rx(r) Ry(p) Rz(y) of the orientation's roll, pitch, yaw — the state's "
             "Rz(y) Ry(p) Rx(r) composed in reverse order (measured): predicted per state as "
             "G(g′) − G(g), g′ = R R′ᵀ g")
-    return {Quantity.BIAS_FORCES: Explanation(delta, note),
-            Quantity.INVERSE_DYNAMICS: Explanation(delta, note),
-            Quantity.FORWARD_DYNAMICS: Explanation(forward, note)}
+    return {Quantity.BIAS_FORCES: Prediction(size=delta, note=note, label=BASE_GRAVITY),
+            Quantity.INVERSE_DYNAMICS: Prediction(size=delta, note=note, label=BASE_GRAVITY),
+            Quantity.FORWARD_DYNAMICS: Prediction(size=forward, note=note, label=BASE_GRAVITY)}

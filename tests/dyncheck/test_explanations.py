@@ -6,6 +6,7 @@ from __future__ import annotations
 import pytest
 
 from dyncheck import catalogue
+from dyncheck.check.predicted import PREDICTIONS
 from dyncheck.explanations import EXPLANATIONS, Origin
 
 from ..conftest import PORTS
@@ -22,6 +23,13 @@ def test_every_explained_row_names_a_registered_property(full_run):
     assert not own, f"rows explained by a defect of dyncheck's own code: {own}"
 
 
+@pytest.mark.parametrize("label", PREDICTIONS)
+def test_every_prediction_of_the_check_is_registered_as_an_engines_property(label):
+    """#43: the check's predicted differences (``dyncheck check``) are explanations too:
+    one registry holds them, each a property of an engine."""
+    assert EXPLANATIONS[label].origin is Origin.ENGINE
+
+
 @pytest.mark.parametrize("name", sorted(catalogue.DEMOS))
 def test_every_catalogue_entry_is_a_property_of_engine_book_or_mathematics(name):
     _, origin = catalogue.DEMOS[name]
@@ -34,7 +42,8 @@ def test_full_default_run_has_no_failed_row_and_skips_only_with_a_stated_reason(
     CPU step budget, Warp's derivatives: none), the file loaders' (Newton,
     PyBullet: couplings, an external field, Newton's D6, PyBullet's spherical joint, a
     rotation's trajectory not mapped back, no derivatives), and the derivatives' (Pinocchio's
-    composite joint, MuJoCo's gyroscopic implicitfast on a free joint)."""
+    composite joint, MuJoCo's gyroscopic implicitfast on a free joint, RK4's step on a
+    rotation, whose stages the referee's chain rule does not follow)."""
     d = full_run.discrepancies
     assert not (d.verdict == "failed").any(), d[d.verdict == "failed"]
     skipped = d[d.verdict == "skipped"]
@@ -49,6 +58,7 @@ def test_full_default_run_has_no_failed_row_and_skips_only_with_a_stated_reason(
         "no derivatives": "offers no derivatives",
         "composite": "derivatives of a composite joint",
         "gyroscopic": "gyroscopic force",
+        "rk4 stages": "RK4's stages on a ball or free joint",
     }
     found = {k: skipped.note.str.contains(v, regex=False) for k, v in reasons.items()}
     stated = sum(found.values()) > 0
@@ -56,6 +66,8 @@ def test_full_default_run_has_no_failed_row_and_skips_only_with_a_stated_reason(
     assert set(skipped[found["field"]].case) == {"kepler"}
     assert set(skipped[found["budget"]].impl_b) == {"mujoco-warp"}
     assert set(skipped[found["gyroscopic"]].case) == {"rigid_body_free"}
+    assert set(skipped[found["rk4 stages"]].case) == {
+        "rigid_body_ball", "rigid_body_free", "spherical_pendulum", "torque_free"}
 
 
 def test_rk4_keeps_order_four_in_every_engine_on_the_rotation_group(full_run):
