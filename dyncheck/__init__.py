@@ -7,14 +7,73 @@ Mechanics*, clean-room; ``reference/``), ``dyncheck.adapters`` (engines, one int
 ``adapters/``). The comparison layer (``dyncheck.comparison``,
 ``dyncheck.studies``, ``dyncheck.check``) is the only code that sees both the reference and
 the engines.
+
+The public API, importable from here: :func:`check_model` (a user's MJCF or URDF, as
+``dyncheck check``) and its :class:`CheckResult`; :func:`run_cases` (book cases, as
+``dyncheck run``; :func:`get_case` names them) and its :class:`RunResult` of
+:class:`Discrepancy` rows; the vocabulary (:class:`Quantity`, :class:`Verdict`,
+:class:`Integrator`, :class:`JointType`) and the errors. Importing ``dyncheck`` loads no
+engine: the functions and result types are imported on first use.
 """
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+from dyncheck.errors import (
+    DyncheckError,
+    EngineError,
+    EngineNotInstalled,
+    InvalidInput,
+    UnknownName,
+    Unsupported,
+)
+from dyncheck.vocabulary import Integrator, JointType, Quantity, Verdict
+
+if TYPE_CHECKING:
+    from dyncheck.cases import get_case
+    from dyncheck.check.model_check import CheckResult, check_model
+    from dyncheck.results import Discrepancy
+    from dyncheck.run import RunResult
+    from dyncheck.run import run as run_cases
 
 __version__ = "0.1.0"
 
+LAZY = {
+    "check_model": ("dyncheck.check.model_check", "check_model"),
+    "CheckResult": ("dyncheck.check.model_check", "CheckResult"),
+    "run_cases": ("dyncheck.run", "run"),
+    "RunResult": ("dyncheck.run", "RunResult"),
+    "get_case": ("dyncheck.cases", "get_case"),
+    "Discrepancy": ("dyncheck.results", "Discrepancy"),
+}
+"""The public names imported on first use: (module, name there). ``run_cases`` is
+``dyncheck.run.run`` (``dyncheck.run`` names the module)."""
 
-def check_model(*args, **kwargs):
-    """:func:`dyncheck.check.model_check.check_model` (imported on first use: the engines load
-    only when a model is checked)."""
-    from dyncheck.check.model_check import check_model as _check_model
+__all__ = [
+    "CheckResult",
+    "Discrepancy",
+    "DyncheckError",
+    "EngineError",
+    "EngineNotInstalled",
+    "Integrator",
+    "InvalidInput",
+    "JointType",
+    "Quantity",
+    "RunResult",
+    "UnknownName",
+    "Unsupported",
+    "Verdict",
+    "check_model",
+    "get_case",
+    "run_cases",
+]
 
-    return _check_model(*args, **kwargs)
+
+def __getattr__(name: str) -> Any:
+    """A public name of :data:`LAZY`, imported from its module on first use."""
+    if name in LAZY:
+        module, attr = LAZY[name]
+        return getattr(importlib.import_module(module), attr)
+    raise AttributeError(f"module 'dyncheck' has no attribute {name!r}")
