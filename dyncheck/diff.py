@@ -185,13 +185,15 @@ def checked_keys(frame: pd.DataFrame, key: list[str], *, flag: str, path: Path) 
 
 
 def keys(frame: pd.DataFrame, key: list[str]) -> pd.Series:
-    """One string per row joining its key columns (steps to 7 digits)."""
-    parts = []
-    for col in key:
-        if col == "dt":
-            parts.append(frame[col].map(lambda x: "" if pd.isna(x) else f"{x:.6e}"))
-        else:
-            parts.append(frame[col].astype(str))
+    """One string per row joining its key columns — a number column (a step) to 7 digits, a
+    text column as read, an empty cell as "" in either — the one key of a row for everything
+    that compares two tables (``diff``, ``baseline``, ``report --check``)."""
+    parts = [
+        frame[c].map(lambda x: "" if pd.isna(x) else f"{x:.6e}")
+        if frame[c].dtype.kind == "f"
+        else texts(frame[c])
+        for c in key
+    ]
     out = parts[0]
     for p in parts[1:]:
         out = out + "|" + p

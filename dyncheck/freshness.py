@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from dyncheck import diff
 from dyncheck.errors import InvalidInput
 from dyncheck.precision import EPS32
 from dyncheck.results import CONVERGENCE_KEY, DISCREPANCY_KEY, texts
@@ -226,19 +227,6 @@ def _read(text: str) -> pd.DataFrame:
     return pd.read_csv(io.StringIO(text), keep_default_na=False, na_values=[""])
 
 
-def _keys(frame: pd.DataFrame, key: list[str]) -> pd.Series:
-    parts = [
-        frame[c].map(lambda x: "" if pd.isna(x) else f"{x:.6e}")
-        if frame[c].dtype.kind == "f"
-        else texts(frame[c])
-        for c in key
-    ]
-    out = parts[0]
-    for p in parts[1:]:
-        out = out + "|" + p
-    return out
-
-
 def _joined(
     name: str, old: str, new: str, key: list[str]
 ) -> tuple[list[Moved], pd.DataFrame, pd.DataFrame]:
@@ -255,7 +243,7 @@ def _joined(
             )
         )
         return moved, a.iloc[:0], b.iloc[:0]
-    a.index, b.index = _keys(a, key), _keys(b, key)
+    a.index, b.index = diff.keys(a, key), diff.keys(b, key)
     for k in sorted(set(a.index) - set(b.index)):
         moved.append(Moved(file=name, key=k, field="row", old="present", new="vanished"))
     for k in sorted(set(b.index) - set(a.index)):
