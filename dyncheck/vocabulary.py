@@ -120,4 +120,7 @@ _ORDERS = {Integrator.EULER: 1, Integrator.IMPLICITFAST: 1, Integrator.RK2: 2,
 def is_rk4(name: str) -> bool:
     """:attr:`Integrator.is_rk4` of a row's integrator name (error-controlled runs and
     ``dop853`` are none)."""
-    return name in (Integrator.RK4, Integrator.RK4_HELD_FORCE)
+    try:
+        return Integrator(name).is_rk4
+    except ValueError:
+        return False
