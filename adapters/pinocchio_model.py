@@ -91,6 +91,14 @@ def _bare_bodies(source: ModelFile) -> int:
     return sum(1 for body in inline(source.path).iter("body") if not body.attrib)
 
 
+SLIDE_RANGE = (
+    "Pinocchio's MJCF parser converts a slide joint's range from degrees to radians as if it "
+    "were an angle (measured: dm_control's cartpole slider (-1.8, 1.8) m read as (-0.0314, "
+    "0.0314), × π/180), under <compiler angle=\"degree\">, MJCF's default (fix: none in the "
+    "file that keeps it the same model; the dynamics here leave limits out)"
+)
+
+
 GRAVITY_IGNORED = (
     "Pinocchio's MJCF parser does not read <option gravity=\"{gravity}\"> (its model keeps "
     "its default, 0 0 -9.81; measured) (fix: set model.gravity after loading)"
@@ -124,6 +132,10 @@ def _hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
         missing.append(FIRST_BODY_ONLY.format(first=bodies[0], others=others))
     if missing:
         out.append(("model", "joint", "; ".join(missing)))
+    angle = [c.get("angle") for c in root.iter("compiler") if c.get("angle")]
+    if (angle[-1] if angle else "degree") == "degree" and any(
+            j.get("type") == "slide" for j in root.iter("joint")):
+        out.append(("model", "slide range", SLIDE_RANGE))
     stated = [o.get("gravity", "") for o in root.iter("option") if o.get("gravity")]
     if stated and not np.allclose([float(x) for x in stated[-1].split()], (0.0, 0.0, -9.81)):
         out.append(("model", "gravity", GRAVITY_IGNORED.format(gravity=stated[-1])))

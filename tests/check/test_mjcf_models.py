@@ -365,3 +365,28 @@ def test_a_body_in_a_frame_drake_ignores_names_the_frame_and_the_fix(tmp_path):
     assert list(missing["subject"]) == ["j"]
     assert missing["note"].str.contains("ignores <frame>").all()
     assert missing["note"].str.contains("fix: move the frame's pos").all()
+
+
+@pytest.mark.parametrize("angle", ["degree", "radian"])
+def test_a_slide_range_pinocchio_reads_as_degrees_is_named(tmp_path, angle):
+    """Pinocchio's MJCF parser converts a slide joint's range by π/180 under the default
+    ``angle="degree"`` (measured on dm_control's cartpole): the range row fails naming it;
+    under ``angle="radian"`` nothing is converted and the range agrees. Expected: the file's
+    range (MuJoCo's reading), and that range × π/180 for Pinocchio's."""
+    import math
+
+    body = ('<body name="cart"><joint name="slider" type="slide" axis="1 0 0" limited="true" '
+            'range="-1.8 1.8"/><inertial pos="0 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>'
+            '</body>')
+    result = check_model(_write(tmp_path, "cart", body, head=f'<compiler angle="{angle}"/>'),
+                         states=3)
+    rows = _rows(result, "description")
+    ranged = rows[(rows["subject"] == "slider") & (rows["field"] == "range")
+                  & (rows["impl_b"] == "pinocchio")]
+    if angle == "radian":
+        assert ranged.empty
+        return
+    assert list(ranged["verdict"]) == ["failed"]
+    assert "converts a slide joint's range from degrees to radians" in ranged["note"].iloc[0]
+    low = float(ranged["value_b"].iloc[0].strip("()").split(",")[0])
+    assert math.isclose(low, -1.8 * math.pi / 180, rel_tol=1e-12)
