@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import logging
 import re
+import xml.etree.ElementTree as ET
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any
@@ -162,6 +163,63 @@ def _first_of_several(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
             why = FIRST_OF_SEVERAL.format(joint=named[0], n=len(named),
                                           body=body.get("name", "(unnamed)"))
             out += [(named[0], field, why) for field in ("anchor", "axis")]
+    return tuple(out)
+
+
+SKIPPED_CLASS = (
+    "{joint!r} takes its {fields} from default class {source!r} through class {gap!r}, "
+    "which sets no <joint> attribute: Drake's MJCF parser passes a class's joint defaults on "
+    "only through classes that have a <joint> element (measured: armature 0.01 read as 0), "
+    "so Drake reads the element's own default instead (fix: write the attribute on class "
+    "{gap!r}'s <joint>, or on the joint)"
+)
+
+
+def _skipped_classes(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
+    """Joint attributes Drake loses on their way down the default classes: a joint whose
+    class (``class``, else the nearest ``childclass``) inherits an attribute from an
+    ancestor class across a class without a ``<joint>`` element (read as XML, includes
+    inlined)."""
+    if source.format is not Format.MJCF:
+        return ()
+    root = inline(source.path)
+    chains: dict[str, list[ET.Element]] = {}  # class -> its default elements, top first
+
+    def walk(element: ET.Element, above: list[ET.Element]) -> None:
+        for child in element.findall("default"):
+            chain = [*above, child]
+            chains[child.get("class", "main")] = chain
+            walk(child, chain)
+
+    walk(root, [])
+    out: list[tuple[str, str, str]] = []
+
+    def visit(holder: ET.Element, childclass: str) -> None:
+        for joint in holder.findall("joint"):
+            chain = chains.get(joint.get("class", childclass), [])
+            if not joint.get("name") or len(chain) < 2:
+                continue
+            gaps = [d for d in chain[1:] if d.find("joint") is None]
+            for k, default in enumerate(chain[:-1]):
+                own = default.find("joint")
+                later = [d for d in chain[k + 1:] if d in gaps]
+                if own is None or not later:
+                    continue
+                below = [d.find("joint") for d in chain[k + 1:]]
+                fields = [f for f in ("armature",) if f in own.attrib
+                          and f not in joint.attrib
+                          and not any(e is not None and f in e.attrib for e in below)]
+                for field in fields:
+                    out.append((joint.get("name", ""), field, SKIPPED_CLASS.format(
+                        joint=joint.get("name"), fields=field,
+                        source=default.get("class", "main"), gap=later[0].get("class"))))
+        for body in holder.findall("body"):
+            visit(body, body.get("childclass", childclass))
+        for frame in holder.findall("frame"):
+            visit(frame, frame.get("childclass", childclass))
+
+    for world in root.findall("worldbody"):
+        visit(world, "main")
     return tuple(out)
 
 
@@ -309,7 +367,8 @@ class DrakeModel:
             for j in joints
             if j.type is not JointType.FREE and j.name not in reflected
             and self._source.format is Format.MJCF
-        ) + _first_of_several(self._source) + _ignored_frames(notes)
+        ) + _skipped_classes(self._source) + _first_of_several(self._source) \
+            + _ignored_frames(notes)
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
                          nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,
                          hints=hints)

@@ -390,3 +390,29 @@ def test_a_slide_range_pinocchio_reads_as_degrees_is_named(tmp_path, angle):
     assert "converts a slide joint's range from degrees to radians" in ranged["note"].iloc[0]
     low = float(ranged["value_b"].iloc[0].strip("()").split(",")[0])
     assert math.isclose(low, -1.8 * math.pi / 180, rel_tol=1e-12)
+
+
+@pytest.mark.parametrize("middle", ["", '<joint damping="0.5"/>'])
+def test_an_armature_drake_loses_across_a_class_without_a_joint_is_named(tmp_path, middle):
+    """Drake's MJCF parser passes a class's joint defaults on only through classes that have
+    a <joint> element (measured: dm_control's humanoid_CMU, main > humanoid > stiff_medium):
+    the armature row fails naming the class in between and the fix; with a <joint> in that
+    class Drake reads it. Expected: MuJoCo's armature, 0.01 on both joints (actuated, so
+    Drake holds it as reflected inertia when it reads it)."""
+    body = ('<body name="a" pos="0 0 1"><joint name="j1" axis="1 0 0" class="leaf"/>'
+            '<inertial pos="0 0 -0.2" mass="1" diaginertia="0.1 0.2 0.3"/></body>')
+    head = ('<default class="main"><joint armature="0.01"/>'
+            f'<default class="mid">{middle}<default class="leaf"><joint damping="1"/>'
+            '</default></default></default>')
+    result = check_model(_write(tmp_path, "classes", body, head=head,
+                                tail='<actuator><motor joint="j1" gear="2"/></actuator>'),
+                         states=3)
+    rows = _rows(result, "description")
+    armature = rows[(rows["field"] == "armature") & (rows["impl_b"] == "drake")]
+    if middle:
+        assert armature.empty
+        return
+    assert list(armature["verdict"]) == ["failed"]
+    note = armature["note"].iloc[0]
+    assert "from default class 'main' through class 'mid'" in note
+    assert "write the attribute on class 'mid'" in note
