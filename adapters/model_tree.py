@@ -229,6 +229,8 @@ class Transition:
     time_step: float
     fd_step: float
     integrator: str
-    beyond_euler: str = ""
-    """Why this integrator's step is not semi-implicit Euler's on this model (then the chain
-    rule of Euler's step is no referee for it: a skipped row saying this); empty: it is."""
+    unfollowed: str = ""
+    """Why the referee's chain rule does not follow this integrator's step on this model
+    (implicitfast's gyroscopic term on a free joint, RK4's exponential maps on a rotation):
+    then no differences are taken (``matrix`` and ``coarse`` empty) and the row is skipped,
+    saying this; empty: it does."""

@@ -97,13 +97,6 @@ def rk4_step(stages: list[tuple[States, Referee]], h: float) -> np.ndarray:
     return eye + h * total
 
 
-ROTATING_RK4 = (
-    "RK4's stages on a ball or free joint each turn the rotation by an exponential map: "
-    "their chain rule is not built, so the referee checks RK4's step on hinge and slide "
-    "joints only"
-)
-
-
 def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref: Referee,
               engine: str, found: Transition) -> list[CheckRow]:
     """The engine's step Jacobian against the referee's chain rule: one row. Tolerance:
@@ -113,15 +106,14 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
     derivatives times h."""
     h = found.time_step
     rk4 = found.integrator == Integrator.RK4
-    rotating = any(kind in (JointType.BALL, JointType.FREE) for kind in canon.types)
-    why = found.beyond_euler or (ROTATING_RK4 if rk4 and rotating else "")
+    why = found.unfollowed
     if why:
         return [CheckRow(
             model=model, section=Section.DERIVATIVES,
             subject=f"step Jacobian ({found.integrator} at h = {h:g})", field="max rel error",
             impl_a="reference", impl_b=engine, value_a="", value_b="", error=float("nan"),
             tolerance=float("nan"), basis="", verdict=Verdict.SKIPPED,
-            note=why if rk4 else f"{why}; the chain rule of Euler's step is no referee for it")]
+            note=why)]
     if rk4:
         stages = rk4_stages(tree, states, ref, h)
         expected = rk4_step(stages, h)
