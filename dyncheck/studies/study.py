@@ -221,16 +221,17 @@ def _judge(case: Case, impl: Implementation, variant: Variant | None, refs: Refe
     finest = finest_pair(asym)
     degree = getattr(general_method(case, variant), "polynomial_degree", None)
     exact = variant is not None and degree is not None and nominal >= degree > 1
+    # the bound where no order can be judged: the finest run's accumulated round-off
+    tol = accumulated(round(spec.duration / dts[-1]), eps=impl.eps)
+    within = Verdict.PASSED if max(errors) <= tol.rtol * scale else Verdict.FAILED
     if exact:
         # q(t) is a polynomial the integrator reproduces: only round-off remains
-        tol = accumulated(round(spec.duration / dts[-1]), eps=impl.eps)
-        verdict = Verdict.PASSED if max(errors) <= tol.rtol * scale else Verdict.FAILED
         note = (
             f"q(t) is a polynomial of degree {degree} in t, which {integrator} "
             f"(order {nominal}) integrates exactly: max error {max(errors):.2g} within "
             f"{tol.basis} (x scale {scale:.3g})"
         )
-        return Judgement(verdict=verdict, convention="", note=note, exact=True, limited=limited)
+        return Judgement(verdict=within, convention="", note=note, exact=True, limited=limited)
     if variant is None:
         return Judgement(verdict=Verdict.FAILED, convention=convention,
                          note="model differs from the book in an unpredicted way",
@@ -238,15 +239,13 @@ def _judge(case: Case, impl: Implementation, variant: Variant | None, refs: Refe
     if limited:
         # truncation below the precision's round-off: no order to observe; the runs must
         # still agree with the reference within accumulated round-off
-        tol = accumulated(round(spec.duration / dts[-1]), eps=impl.eps)
-        verdict = Verdict.PASSED if max(errors) <= tol.rtol * scale else Verdict.FAILED
         note = (
             f"errors {min(errors):.2g} to {max(errors):.2g}: fewer than two steps stand "
             f"clear of {ROUNDOFF_MARGIN:g} x the run's round-off eps sqrt(N) x scale "
             f"(eps = {impl.eps:.3g}): {integrator}'s order cannot be observed in this "
             f"precision; max error within {tol.basis} (x scale {scale:.3g})"
         )
-        return Judgement(verdict=verdict, convention=convention, note=note, exact=False,
+        return Judgement(verdict=within, convention=convention, note=note, exact=False,
                          limited=True)
     if finest is None:
         return Judgement(verdict=Verdict.FAILED, convention=convention,
