@@ -82,19 +82,13 @@ def read(path: Path, *, floating: bool = False) -> ModelFile:
             path=path, format=Format.URDF, text=text, floating=floating, notes=tuple(notes)
         )
     said: tuple[str, ...] = (FLOATING_MJCF,) if floating else ()
-    if declared := encoding(path):
+    # the text as the file declares it is encoded: the file's own where it is UTF-8,
+    # else the parsed document written out again
+    text = path.read_bytes().decode("utf-8") if (declared := encoding(path)) is None else \
+        ET.tostring(root, encoding="unicode")
+    if declared:
         said += (transcoded(declared),)
-    return ModelFile(path=path, format=Format.MJCF, text=_decoded(path.read_bytes()),
-                     floating=False, notes=said)
-
-
-def _decoded(raw: bytes) -> str:
-    """The file's text as its XML declaration (or byte-order mark) says it is encoded; UTF-8
-    where it says nothing."""
-    try:
-        return raw.decode("utf-8")
-    except UnicodeDecodeError:
-        return ET.tostring(ET.fromstring(raw), encoding="unicode")
+    return ModelFile(path=path, format=Format.MJCF, text=text, floating=False, notes=said)
 
 
 def missing_meshes(path: Path, root: ET.Element) -> list[str]:
