@@ -36,8 +36,11 @@ class Owner(Enum):
 
 MAX_INCLUDE_BYTES = 64 * 2**20
 MAX_INCLUDE_DEPTH = 32
-GEOM_INERTIA_KEYS = ("type", "mesh", "mass", "density", "group")
-"""The geom attributes (from defaults too) that decide whether a geom carries inertia."""
+GEOM_INERTIA_KEYS = ("type", "mesh", "mass", "density", "group", "contype", "conaffinity")
+"""The geom attributes (from defaults too) that decide whether, and how, a geom carries
+inertia (in MuJoCo; ``contype``/``conaffinity`` in Pinocchio's MJCF parser)."""
+JOINT_KEYS = ("pos", "springdamper", "damping", "stiffness")
+"""The joint attributes (from defaults too) that parsers are known to read differently."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -106,16 +109,18 @@ def inline(path: Path) -> ET.Element:
     return root
 
 
-def geom_defaults(root: ET.Element) -> dict[str, dict[str, str]]:
-    """Each default class's geom attributes that matter here, inherited from its parents."""
+def class_defaults(root: ET.Element, tag: str,
+                   keys: tuple[str, ...]) -> dict[str, dict[str, str]]:
+    """Each default class's ``keys`` of its ``<tag>`` element, inherited from its parents
+    (the top-level ``<default>``: class ``"main"``)."""
     out: dict[str, dict[str, str]] = {}
 
     def walk(element: ET.Element, inherited: dict[str, str], top: bool) -> None:
         name = "main" if top else element.get("class", "main")
         own = dict(inherited)
-        geom = element.find("geom")
-        if geom is not None:
-            own.update({k: v for k, v in geom.attrib.items() if k in GEOM_INERTIA_KEYS})
+        found = element.find(tag)
+        if found is not None:
+            own.update({k: v for k, v in found.attrib.items() if k in keys})
         out[name] = own
         for child in element.findall("default"):
             walk(child, own, False)
@@ -126,11 +131,12 @@ def geom_defaults(root: ET.Element) -> dict[str, dict[str, str]]:
 
 
 @dataclass(frozen=True, kw_only=True)
-class Geom:
-    """A geom as the compiler sees it: the element holding it (a body, a frame, the world),
-    the body it belongs to (the world's own: ``<worldbody>``), whether that body's inertia
-    moves and is stated, and its inertia attributes resolved through default classes (its
-    ``class``, else the nearest ``childclass``)."""
+class Placed:
+    """A geom or joint as the compiler sees it: the element holding it (a body, a frame, the
+    world), the body it belongs to (the world's own: ``<worldbody>``), whether that body's
+    inertia moves and is stated, and its attributes resolved through default classes (its
+    ``class``, else the nearest ``childclass``, else ``main``); ``stated``: those written on
+    the element itself."""
 
     element: ET.Element
     holder: ET.Element
@@ -138,23 +144,28 @@ class Geom:
     owner: Owner
     attrs: dict[str, str]
 
+    @property
+    def stated(self) -> frozenset[str]:
+        return frozenset(self.element.attrib)
 
-def geoms(root: ET.Element) -> list[Geom]:
-    """Every geom of the model, in document order."""
-    defaults = geom_defaults(root)
-    out: list[Geom] = []
+
+def placed(root: ET.Element, tag: str, keys: tuple[str, ...]) -> list[Placed]:
+    """Every ``<tag>`` element of the bodies (geoms, joints), in document order."""
+    defaults = class_defaults(root, tag, keys)
+    out: list[Placed] = []
 
     def walk(holder: ET.Element, body: ET.Element, childclass: str, owner: Owner) -> None:
-        for geom in holder.findall("geom"):
-            cls = geom.get("class", childclass)
+        for element in holder.findall(tag):
+            cls = element.get("class", childclass)
             attrs = {**defaults.get(cls, defaults.get("main", {})),
-                     **{k: v for k, v in geom.attrib.items() if k in GEOM_INERTIA_KEYS}}
-            out.append(Geom(element=geom, holder=holder, body=body, owner=owner, attrs=attrs))
-        for frame in holder.findall("frame"):  # a frame's geoms belong to its body
+                     **{k: v for k, v in element.attrib.items() if k in keys}}
+            out.append(Placed(element=element, holder=holder, body=body, owner=owner,
+                              attrs=attrs))
+        for frame in holder.findall("frame"):  # a frame's elements belong to its body
             walk(frame, body, frame.get("childclass", childclass), owner)
         for child in holder.findall("body"):
             if owner is Owner.WELDED and not any(
-                    child.findall(tag) for tag in ("joint", "freejoint")):
+                    child.findall(t) for t in ("joint", "freejoint")):
                 kind = Owner.WELDED
             elif child.find("inertial") is not None:
                 kind = Owner.STATES_INERTIA
@@ -165,6 +176,16 @@ def geoms(root: ET.Element) -> list[Geom]:
     for world in root.findall("worldbody"):
         walk(world, world, "main", Owner.WELDED)
     return out
+
+
+def geoms(root: ET.Element) -> list[Placed]:
+    """Every geom of the model with its inertia attributes, in document order."""
+    return placed(root, "geom", GEOM_INERTIA_KEYS)
+
+
+def joints(root: ET.Element) -> list[Placed]:
+    """Every ``<joint>`` of the model with the attributes of :data:`JOINT_KEYS`."""
+    return placed(root, "joint", JOINT_KEYS)
 
 
 def _compiler(root: ET.Element, key: str, default: str) -> str:

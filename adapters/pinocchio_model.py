@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from dyncheck.adapters.mjcf_copy import geom_defaults, geoms, inline, utf8_file
+from dyncheck.adapters.mjcf_copy import utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -32,6 +32,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
+from dyncheck.adapters.pinocchio_mjcf import BARE_BODY, bare_bodies, hints
 from dyncheck.errors import EngineError, Unsupported
 
 ENGINE = "pinocchio"
@@ -67,92 +68,9 @@ def _load(source: ModelFile) -> pin.Model:
         # Pinocchio's C++ exceptions: "From file: … in function: … message:\n<the reason>"
         text = text.split("message:", 1)[1] if "message:" in text else text
         message = " ".join(text.split()) or type(exc).__name__
-        if source.format is Format.MJCF and (count := _bare_bodies(source)):
+        if source.format is Format.MJCF and (count := bare_bodies(source)):
             message += f" ({BARE_BODY.format(count=count)})"
         raise EngineError(f"pinocchio refused {source.path}: {message}") from None
-
-
-FIRST_BODY_ONLY = (
-    "Pinocchio's MJCF parser reads only the first body under <worldbody> ({first!r}); the "
-    "other top-level bodies ({others}) and their joints are not in its model (fix: put the "
-    "robot in one tree under one top-level body, or check its URDF)"
-)
-
-
-BARE_BODY = (
-    "Pinocchio's MJCF parser skips a <body> with no attributes at all ({count} in the file): "
-    "its joints are not in its model, and the bodies below it hang from its parent (measured: "
-    "<body> skipped, <body pos=\"0 0 0\"> read) (fix: name every body)"
-)
-
-
-def _bare_bodies(source: ModelFile) -> int:
-    """How many ``<body>`` elements carry no attribute (Pinocchio's parser skips them)."""
-    return sum(1 for body in inline(source.path).iter("body") if not body.attrib)
-
-
-SLIDE_RANGE = (
-    "Pinocchio's MJCF parser converts a slide joint's range from degrees to radians as if it "
-    "were an angle (measured: dm_control's cartpole slider (-1.8, 1.8) m read as (-0.0314, "
-    "0.0314), × π/180), under <compiler angle=\"degree\">, MJCF's default (fix: none in the "
-    "file that keeps it the same model; the dynamics here leave limits out)"
-)
-
-
-GRAVITY_IGNORED = (
-    "Pinocchio's MJCF parser does not read <option gravity=\"{gravity}\"> (its model keeps "
-    "its default, 0 0 -9.81; measured) (fix: set model.gravity after loading)"
-)
-MESH_MASS = (
-    "mesh geoms on bodies {bodies} state their mass, which Pinocchio's MJCF parser ignores "
-    "(measured: a 0.1 m cube stated 2 kg read as 1 kg, density × volume) (fix: give those "
-    "bodies an <inertial>)"
-)
-DEFAULT_MASS = (
-    "the file sets geom masses in <default> classes ({classes}), which Pinocchio's MJCF "
-    "parser ignores (measured: it computes those geoms' mass from their density, 1000 unless "
-    "stated) (fix: write mass= on each geom, or give the bodies an <inertial>)"
-)
-
-
-def _hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
-    """Why Pinocchio's reading of an MJCF differs, where the file shows the cause (read as
-    XML, includes inlined): joints missing where a body has no attributes or there are
-    several top-level bodies; masses from default classes."""
-    if source.format is not Format.MJCF:
-        return ()
-    root = inline(source.path)
-    out = []
-    bodies = [b.get("name", "(unnamed)") for world in root.findall("worldbody")
-              for b in world.findall("body")]
-    count = _bare_bodies(source)
-    missing = [BARE_BODY.format(count=count)] if count else []
-    if len(bodies) > 1:
-        others = ", ".join(repr(b) for b in bodies[1:6]) + (" …" if len(bodies) > 6 else "")
-        missing.append(FIRST_BODY_ONLY.format(first=bodies[0], others=others))
-    if missing:
-        out.append(("model", "joint", "; ".join(missing)))
-    angle = [c.get("angle") for c in root.iter("compiler") if c.get("angle")]
-    if (angle[-1] if angle else "degree") == "degree" and any(
-            j.get("type") == "slide" for j in root.iter("joint")):
-        out.append(("model", "slide range", SLIDE_RANGE))
-    stated = [o.get("gravity", "") for o in root.iter("option") if o.get("gravity")]
-    if stated and not np.allclose([float(x) for x in stated[-1].split()], (0.0, 0.0, -9.81)):
-        out.append(("model", "gravity", GRAVITY_IGNORED.format(gravity=stated[-1])))
-    reasons = []
-    massed = [c for c, attrs in geom_defaults(root).items() if "mass" in attrs]
-    if massed:
-        reasons.append(DEFAULT_MASS.format(classes=", ".join(repr(c) for c in massed[:4])))
-    meshes = sorted({g.body.get("name", "(unnamed)") for g in geoms(root)
-                     if g.body.tag == "body" and "mesh" in g.attrs
-                     and g.attrs.get("type", "mesh") == "mesh" and "mass" in g.attrs
-                     and g.body.find("inertial") is None})
-    if meshes:
-        reasons.append(MESH_MASS.format(bodies=", ".join(repr(b) for b in meshes[:4])
-                                        + (" …" if len(meshes) > 4 else "")))
-    if reasons:
-        out += [("model", f, "; ".join(reasons)) for f in ("mass", "inertia", "com")]
-    return tuple(out)
 
 
 def _rotor_in_kinetic(m: pin.Model, q0: np.ndarray) -> dict[int, bool]:
@@ -210,7 +128,7 @@ class PinocchioModel:
         self.model = _load(source)
         self.data = self.model.createData()
         notes: tuple[str, ...] = ()
-        self._hints = _hints(source)
+        self._hints = hints(source)
         if source.floating and source.format is Format.URDF:
             notes = ("pinocchio: JointModelFreeFlyer 'root_joint' at the URDF root",)
         self.tree = self._tree(notes)

@@ -285,19 +285,88 @@ def test_the_first_of_several_joints_in_an_offset_body_is_drake_s_reading_named(
     assert "fix: one joint per body" in failed["note"].iloc[0]
 
 
-def test_a_mesh_geom_s_stated_mass_pinocchio_ignores_is_named(tmp_path):
-    """A mesh geom stating 7 kg on a body without <inertial>: Pinocchio's MJCF parser takes
-    density × volume instead (measured); MuJoCo and Drake read the stated mass."""
+@pytest.mark.parametrize("geom", ['mass="7"', 'density="500"'])
+def test_a_mesh_geom_pinocchio_counts_as_one_kilogram_is_named(tmp_path, geom):
+    """A 0.1 m cube mesh stating 7 kg, or of density 500 (0.5 kg), on a body without
+    <inertial>: Pinocchio's MJCF parser computes no inertia from a mesh and counts it 1 kg
+    (its source, mjcf-graph-geom.cpp, returns before computing one; measured). Expected:
+    MuJoCo's reading (the stated mass, density × volume) and 1 kg for Pinocchio's."""
     (tmp_path / "assets").mkdir()
     _stl(tmp_path / "assets" / "cube.stl")
-    body = MESHED.format(inertial="", geom='mass="7"').replace('<geom type="mesh" mesh="cube" '
-                                                               'class="visual"/>', "")
+    body = MESHED.format(inertial="", geom=geom).replace('<geom type="mesh" mesh="cube" '
+                                                         'class="visual"/>', "")
     result = check_model(_write(tmp_path, "mesh_mass", body, head=MESH_HEAD), states=5,
                          impls=("reference", "mujoco", "pinocchio"))
     mass = _rows(result, "description", "failed")
     mass = mass[(mass["field"] == "mass") & (mass["impl_b"] == "pinocchio")]
-    assert mass["value_a"].iloc[0] == "7"
-    assert "mesh geoms on bodies 'arm' state their mass" in mass["note"].iloc[0]
+    assert float(mass["value_a"].iloc[0]) == pytest.approx(7.0 if "mass" in geom else 0.5)
+    assert float(mass["value_b"].iloc[0]) == 1.0
+    assert "counts 1 kg with unit inertia" in mass["note"].iloc[0]
+    assert "(here: body 'arm' 1 geom)" in mass["note"].iloc[0]
+
+
+def test_a_visual_geom_s_mass_pinocchio_leaves_out_is_named(tmp_path):
+    """Two 0.1 m spheres of density 1000, one of them colliding with nothing: MuJoCo weighs
+    both, 2 × 4/3 π r³ ρ = 8.378 kg (closed form); Pinocchio's MJCF parser gives the visual
+    one no mass (4.189 kg). The mass row fails naming it; a copy whose visual geom has
+    density 0 reads alike in both (MuJoCo then weighs it nothing too)."""
+    import math
+
+    sphere = 4 / 3 * math.pi * 0.1**3 * 1000
+    body = ('<body name="b" pos="0 0 1"><joint name="j" type="hinge" axis="0 1 0"/>'
+            '<geom type="sphere" size="0.1" pos="0 0 -0.2"/><geom type="sphere" size="0.1" '
+            'pos="0 0 -0.4" contype="0" conaffinity="0"{density}/></body>')
+    result = check_model(_write(tmp_path, "visual", body.format(density="")), states=3,
+                         impls=("reference", "mujoco", "pinocchio"))
+    mass = _rows(result, "description", "failed")
+    mass = mass[(mass["field"] == "mass") & (mass["impl_b"] == "pinocchio")]
+    assert float(mass["value_a"].iloc[0]) == pytest.approx(2 * sphere, rel=1e-8)
+    assert float(mass["value_b"].iloc[0]) == pytest.approx(sphere, rel=1e-8)
+    assert "gives no mass to a geom that collides with nothing" in mass["note"].iloc[0]
+    weightless = check_model(_write(tmp_path, "weightless", body.format(density=' density="0"')),
+                             states=3, impls=("reference", "mujoco", "pinocchio"))
+    assert weightless.ok, weightless.failures()
+
+
+@pytest.mark.parametrize("where", ["class", "joint"])
+def test_a_joint_pos_from_a_default_class_pinocchio_ignores_is_named(tmp_path, where):
+    """A hinge's pos="0.1 0 0" from a default class (dm_control's dog: the lumbar joints):
+    Pinocchio's MJCF parser puts the joint at the body's origin; the same pos written on the
+    joint it reads. Expected: MuJoCo's anchor (the body's pos + 0.1 m along x) and the body's
+    origin for Pinocchio's."""
+    head = '<default><default class="offset"><joint pos="0.1 0 0"/></default></default>'
+    attrs = 'class="offset"' if where == "class" else 'pos="0.1 0 0"'
+    body = (f'<body name="b" pos="0 0 1"><joint name="j" type="hinge" axis="0 1 0" {attrs}/>'
+            '<inertial pos="0 0 -0.2" mass="1" diaginertia="0.02 0.02 0.002"/></body>')
+    result = check_model(_write(tmp_path, "offset", body, head=head), states=3,
+                         impls=("reference", "mujoco", "pinocchio"))
+    if where == "joint":
+        assert result.ok, result.failures()
+        return
+    failed = _rows(result, "description", "failed")
+    assert set(zip(failed["subject"], failed["field"], strict=True)) == {("j", "anchor")}
+    anchors = [[float(x) for x in failed[f"value_{k}"].iloc[0].strip("[]").split()]
+               for k in "ab"]
+    assert anchors == [[0.1, 0.0, 1.0], [0.0, 0.0, 1.0]]
+    assert "ignores a joint's pos set in a default class (here pos=\"0.1 0 0\" from class " \
+           "'offset')" in failed["note"].iloc[0]
+
+
+def test_a_springdamper_pinocchio_does_not_read_is_named(tmp_path):
+    """springdamper="0.1 1" (time constant, damping ratio): MuJoCo derives stiffness and
+    damping from it and the joint's inertia; Pinocchio's MJCF parser reads neither. The
+    damping row fails naming it. Expected: MuJoCo's damping, read from MuJoCo itself
+    (nonzero), and Pinocchio's 0."""
+    body = ('<body name="b" pos="0 0 1"><joint name="j" type="hinge" axis="0 1 0" '
+            'springdamper="0.1 1"/><inertial pos="0 0 -0.2" mass="1" '
+            'diaginertia="0.02 0.02 0.002"/></body>')
+    result = check_model(_write(tmp_path, "spring", body), states=3,
+                         impls=("reference", "mujoco", "pinocchio"))
+    failed = _rows(result, "description", "failed")
+    assert set(zip(failed["subject"], failed["field"], strict=True)) == {("j", "damping")}
+    assert float(failed["value_a"].iloc[0].strip("()[],")) > 0
+    assert float(failed["value_b"].iloc[0].strip("()[],")) == 0
+    assert 'does not read springdamper="0.1 1"' in failed["note"].iloc[0]
 
 
 def test_a_dropped_armature_fails_naming_the_joint_and_field(tmp_path):

@@ -1,0 +1,199 @@
+"""What Pinocchio's MJCF parser (4.1) reads differently from MuJoCo's compiler, found in the
+file itself (read as XML, includes inlined) so that a description row that finds a field
+read differently names the cause and the fix. Each behaviour was measured on a file written
+for it (``tests/check/test_mjcf_models.py``) and matches the parser's source
+(``src/parsers/mjcf/mjcf-graph-geom.cpp``: mesh geoms get no computed inertia, visual geoms
+none at all; a geom's own attributes overwrite its class's ``mass``).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from collections.abc import Iterable
+
+import numpy as np
+
+from dyncheck.adapters.mjcf_copy import Placed, geoms, inline, joints
+from dyncheck.adapters.model_files import Format, ModelFile
+
+Hint = tuple[str, str, str]
+"""(joint, field, why): see :attr:`dyncheck.adapters.model_tree.ModelTree.hints`."""
+
+FIRST_BODY_ONLY = (
+    "Pinocchio's MJCF parser reads only the first body under <worldbody> ({first!r}); the "
+    "other top-level bodies ({others}) and their joints are not in its model (fix: put the "
+    "robot in one tree under one top-level body, or check its URDF)"
+)
+BARE_BODY = (
+    "Pinocchio's MJCF parser skips a <body> with no attributes at all ({count} in the file): "
+    "its joints are not in its model, and the bodies below it hang from its parent (measured: "
+    "<body> skipped, <body pos=\"0 0 0\"> read) (fix: name every body)"
+)
+SLIDE_RANGE = (
+    "Pinocchio's MJCF parser converts a slide joint's range from degrees to radians as if it "
+    "were an angle (measured: dm_control's cartpole slider (-1.8, 1.8) m read as (-0.0314, "
+    "0.0314), × π/180), under <compiler angle=\"degree\">, MJCF's default (fix: none in the "
+    "file that keeps it the same model; the dynamics here leave limits out)"
+)
+GRAVITY_IGNORED = (
+    "Pinocchio's MJCF parser does not read <option gravity=\"{gravity}\"> (its model keeps "
+    "its default, 0 0 -9.81; measured) (fix: set model.gravity after loading)"
+)
+MESH_UNIT = (
+    "Pinocchio's MJCF parser computes no inertia from a mesh: each mesh geom that can "
+    "collide counts 1 kg with unit inertia (1 kg·m²) at the geom's origin, whatever its mass "
+    "or density (measured: a 0.2 m cube stated 7 kg, or of density 500, read as 1 kg) "
+    "(here: {where}) (fix: give the body an <inertial>)"
+)
+VISUAL_MASSLESS = (
+    "Pinocchio's MJCF parser gives no mass to a geom that collides with nothing (contype=\"0\" "
+    "conaffinity=\"0\"), which MuJoCo weighs like any other (measured: two 0.1 m spheres, one "
+    "of them visual, 4.19 kg against MuJoCo's 8.38 kg) (here: {where}) (fix: give the body an "
+    "<inertial>, or the visual geoms density=\"0\" if they should weigh nothing)"
+)
+DEFAULT_MASS = (
+    "Pinocchio's MJCF parser ignores a geom mass set in a default class (its geom's own "
+    "attributes overwrite the class's mass; measured: it computes the geom's mass from its "
+    "density, 1000 unless stated) (here: {where}) (fix: write mass= on each geom, or give the "
+    "body an <inertial>)"
+)
+DEFAULT_POS = (
+    "Pinocchio's MJCF parser ignores a joint's pos set in a default class (here pos=\"{pos}\" "
+    "from {cls}): it places the joint at its body's origin (measured: pos=\"0.012 0 0.01\" "
+    "from a class read as 0 0 0; the same pos written on the joint read as written) (fix: "
+    "write pos= on the joint)"
+)
+SPRINGDAMPER = (
+    "Pinocchio's MJCF parser does not read springdamper=\"{value}\", from which MuJoCo "
+    "derives the joint's stiffness and damping with the joint's inertia (measured: "
+    "springdamper=\"0.001 50\" on a 4.19 kg sphere: MuJoCo's damping 33.5, Pinocchio's 0) "
+    "(fix: state stiffness= and damping= on the joint)"
+)
+
+
+def bare_bodies(source: ModelFile) -> int:
+    """How many ``<body>`` elements carry no attribute (Pinocchio's parser skips them)."""
+    return sum(1 for body in inline(source.path).iter("body") if not body.attrib)
+
+
+def hints(source: ModelFile) -> tuple[Hint, ...]:
+    """Why Pinocchio's reading of an MJCF differs, where the file shows the cause: joints
+    missing; slide ranges, gravity; each body's mass, centre of mass and inertia on the
+    joints that carry it; joint positions and damping."""
+    if source.format is not Format.MJCF:
+        return ()
+    root = inline(source.path)
+    return (*_model_hints(root, bare_bodies(source)), *_body_hints(root),
+            *_joint_hints(root))
+
+
+def _model_hints(root: ET.Element, bare: int) -> Iterable[Hint]:
+    bodies = [b.get("name", "(unnamed)") for world in root.findall("worldbody")
+              for b in world.findall("body")]
+    missing = [BARE_BODY.format(count=bare)] if bare else []
+    if len(bodies) > 1:
+        others = ", ".join(repr(b) for b in bodies[1:6]) + (" …" if len(bodies) > 6 else "")
+        missing.append(FIRST_BODY_ONLY.format(first=bodies[0], others=others))
+    if missing:
+        yield "model", "joint", "; ".join(missing)
+    angle = [c.get("angle") for c in root.iter("compiler") if c.get("angle")]
+    if (angle[-1] if angle else "degree") == "degree" and any(
+            j.get("type") == "slide" for j in root.iter("joint")):
+        yield "model", "slide range", SLIDE_RANGE
+    stated = [o.get("gravity", "") for o in root.iter("option") if o.get("gravity")]
+    if stated and not np.allclose([float(x) for x in stated[-1].split()], (0.0, 0.0, -9.81)):
+        yield "model", "gravity", GRAVITY_IGNORED.format(gravity=stated[-1])
+
+
+def _weighs(geom: Placed) -> bool:
+    """Whether MuJoCo's compiler gives the geom mass (mass or density nonzero)."""
+    if "mass" in geom.attrs:
+        return float(geom.attrs["mass"]) != 0.0
+    return float(geom.attrs.get("density", "1000")) != 0.0
+
+
+def _visual(geom: Placed) -> bool:
+    return geom.attrs.get("contype", "1") == "0" and geom.attrs.get("conaffinity", "1") == "0"
+
+
+def _body_hints(root: ET.Element) -> Iterable[Hint]:
+    """Mass, centre of mass and inertia: per body without ``<inertial>``, on the joints that
+    carry its mass (its own, else those of the nearest moving ancestor it is welded to)."""
+    counts: dict[int, dict[str, int]] = {}  # body → reason → how many of its geoms
+    for geom in geoms(root):
+        if geom.body.tag != "body" or geom.body.find("inertial") is not None:
+            continue
+        mesh = geom.attrs.get("type") == "mesh"
+        for reason, applies in (
+            (MESH_UNIT, mesh and not _visual(geom)),
+            (VISUAL_MASSLESS, _visual(geom) and _weighs(geom)),
+            (DEFAULT_MASS, "mass" in geom.attrs and "mass" not in geom.stated
+             and not mesh and not _visual(geom)),
+        ):
+            if applies:
+                mine = counts.setdefault(id(geom.body), {})
+                mine[reason] = mine.get(reason, 0) + 1
+    if not counts:
+        return
+    for group, names in _carriers(root):
+        why = []
+        for reason in (MESH_UNIT, VISUAL_MASSLESS, DEFAULT_MASS):
+            where = [f"{b.get('name', '(unnamed)')!r} {n} geom{'s' * (n > 1)}"
+                     for b in group if (n := counts.get(id(b), {}).get(reason, 0))]
+            if where:
+                why.append(reason.format(where="body " + ", ".join(where)))
+        if why:
+            for name in names or ("model",):
+                for field in ("mass", "com", "inertia"):
+                    yield name, field, "; ".join(why)
+
+
+def _direct(holder: ET.Element, tag: str) -> list[ET.Element]:
+    """The ``tag`` children of a body, those in its ``<frame>``s (nested) included."""
+    found = holder.findall(tag)
+    for frame in holder.findall("frame"):
+        found += _direct(frame, tag)
+    return found
+
+
+def _carriers(root: ET.Element) -> Iterable[tuple[list[ET.Element], tuple[str, ...]]]:
+    """Each moving body with the bodies welded to it, and the names of its joints (a body
+    with an unnamed joint: none, so its hints apply model-wide)."""
+    out: list[tuple[list[ET.Element], tuple[str, ...]]] = []
+
+    def own_joints(body: ET.Element) -> list[ET.Element]:
+        return [*_direct(body, "joint"), *_direct(body, "freejoint")]
+
+    def walk(body: ET.Element, group: list[ET.Element]) -> None:
+        for child in _direct(body, "body"):
+            if own_joints(child):
+                start(child)
+            else:
+                group.append(child)
+                walk(child, group)
+
+    def start(body: ET.Element) -> None:
+        group = [body]
+        walk(body, group)
+        names = [j.get("name") for j in own_joints(body)]
+        if names:  # a body welded to the world carries no mass that moves
+            out.append((group, tuple(n for n in names if n) if all(names) else ()))
+
+    for world in root.findall("worldbody"):
+        for body in _direct(world, "body"):
+            start(body)
+    return out
+
+
+def _joint_hints(root: ET.Element) -> Iterable[Hint]:
+    """A joint's position from a default class; ``springdamper``."""
+    for joint in joints(root):
+        name = joint.element.get("name") or "model"
+        pos = joint.attrs.get("pos")
+        if pos and "pos" not in joint.stated and any(float(x) for x in pos.split()):
+            cls = joint.element.get("class")
+            yield name, "anchor", DEFAULT_POS.format(
+                pos=pos, cls=f"class {cls!r}" if cls else "a default class")
+        if "springdamper" in joint.attrs and any(
+                float(x) for x in joint.attrs["springdamper"].split()):
+            yield name, "damping", SPRINGDAMPER.format(value=joint.attrs["springdamper"])
