@@ -144,32 +144,36 @@ def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str
 
 
 FIRST_OF_SEVERAL = (
-    "{joint!r} is the first of {n} joints in body {body!r}: Drake's MJCF parser places that "
-    "joint's frame as if the body had no pos or orientation (measured: anchor and axis taken "
-    "in the parent's frame), so Drake's M and h differ wherever the body is offset or rotated "
-    "(fix: one joint per body, with massless bodies of your own between them)"
+    "{joint!r} is joint {k} of {n} in body {body!r}: Drake's MJCF parser places the frame of "
+    "every joint of a body but its last as if the body had no pos or orientation (measured: "
+    "joints 1 and 2 of 3 in a body at (0.3, 0, 1) turned 30° about z, anchor and axis taken in "
+    "the parent's frame; joint 3 read as MuJoCo reads it), so Drake's M and h differ wherever "
+    "the body is offset or rotated (fix: one joint per body, with massless bodies of your own "
+    "between them)"
 )
 
 
 def _first_of_several(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
-    """Why the first joint of a body with several reads differently in Drake (the MJCF
-    read as XML, includes inlined)."""
+    """Why every joint but the last of a body with several reads differently in Drake (the
+    MJCF read as XML, includes inlined)."""
     if source.format is not Format.MJCF:
         return ()
     out: list[tuple[str, str, str]] = []
     for body in inline(source.path).iter("body"):
         named = [j.get("name") for j in body.findall("joint")]
-        if len(named) > 1 and named[0]:
-            why = FIRST_OF_SEVERAL.format(joint=named[0], n=len(named),
-                                          body=body.get("name", "(unnamed)"))
-            out += [(named[0], field, why) for field in ("anchor", "axis")]
+        for k, name in enumerate(named[:-1], start=1):
+            if name:
+                why = FIRST_OF_SEVERAL.format(joint=name, k=k, n=len(named),
+                                              body=body.get("name", "(unnamed)"))
+                out += [(name, field, why) for field in ("anchor", "axis")]
     return tuple(out)
 
 
 SKIPPED_CLASS = (
     "{joint!r} takes its {fields} from default class {source!r} through class {gap!r}, "
     "which sets no <joint> attribute: Drake's MJCF parser passes a class's joint defaults on "
-    "only through classes that have a <joint> element (measured: armature 0.01 read as 0), "
+    "only through classes that have a <joint> element (measured: armature 0.01 and damping 3 "
+    "read as 0), "
     "so Drake reads the element's own default instead (fix: write the attribute on class "
     "{gap!r}'s <joint>, or on the joint)"
 )
@@ -206,7 +210,7 @@ def _skipped_classes(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
                 if own is None or not later:
                     continue
                 below = [d.find("joint") for d in chain[k + 1:]]
-                fields = [f for f in ("armature",) if f in own.attrib
+                fields = [f for f in ("armature", "damping") if f in own.attrib
                           and f not in joint.attrib
                           and not any(e is not None and f in e.attrib for e in below)]
                 for field in fields:

@@ -39,7 +39,7 @@ MAX_INCLUDE_DEPTH = 32
 GEOM_INERTIA_KEYS = ("type", "mesh", "mass", "density", "group", "contype", "conaffinity")
 """The geom attributes (from defaults too) that decide whether, and how, a geom carries
 inertia (in MuJoCo; ``contype``/``conaffinity`` in Pinocchio's MJCF parser)."""
-JOINT_KEYS = ("pos", "springdamper", "damping", "stiffness")
+JOINT_KEYS = ("pos", "springdamper", "damping", "stiffness", "range", "ref", "limited")
 """The joint attributes (from defaults too) that parsers are known to read differently."""
 
 

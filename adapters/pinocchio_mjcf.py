@@ -70,6 +70,18 @@ SPRINGDAMPER = (
     "(fix: state stiffness= and damping= on the joint)"
 )
 
+REF_RANGE = (
+    "Pinocchio's MJCF parser subtracts the joint's ref={ref} from its range while its "
+    "coordinate keeps ref (its qpos0 holds it): its limits are shifted by −ref (measured: "
+    "range=\"-110 110\" ref=\"-90\" read as (-20°, 200°)) (fix: none in the file that keeps "
+    "it the same model; the dynamics here leave limits out)"
+)
+UNLIMITED_RANGE = (
+    "Pinocchio's MJCF parser reads a joint's range even where limited=\"false\" tells MuJoCo "
+    "to apply none (measured) (fix: drop the range where the joint is unlimited; the dynamics "
+    "here leave limits out)"
+)
+
 
 def bare_bodies(source: ModelFile) -> int:
     """How many ``<body>`` elements carry no attribute (Pinocchio's parser skips them)."""
@@ -186,9 +198,12 @@ def _carriers(root: ET.Element) -> Iterable[tuple[list[ET.Element], tuple[str, .
 
 
 def _joint_hints(root: ET.Element) -> Iterable[Hint]:
-    """A joint's position from a default class; ``springdamper``."""
+    """A joint's position from a default class; ``springdamper``; its range where it has a
+    ``ref`` or is not limited."""
     for joint in joints(root):
-        name = joint.element.get("name") or "model"
+        name = joint.element.get("name")
+        if not name:  # matched by place under another name: no hint rather than a wrong one
+            continue
         pos = joint.attrs.get("pos")
         if pos and "pos" not in joint.stated and any(float(x) for x in pos.split()):
             cls = joint.element.get("class")
@@ -197,3 +212,8 @@ def _joint_hints(root: ET.Element) -> Iterable[Hint]:
         if "springdamper" in joint.attrs and any(
                 float(x) for x in joint.attrs["springdamper"].split()):
             yield name, "damping", SPRINGDAMPER.format(value=joint.attrs["springdamper"])
+        if "range" in joint.attrs:
+            if joint.attrs.get("limited") == "false":
+                yield name, "range", UNLIMITED_RANGE
+            elif float(joint.attrs.get("ref", "0")) != 0.0:
+                yield name, "range", REF_RANGE.format(ref=joint.attrs["ref"])

@@ -175,8 +175,9 @@ def diff(model: str, a: ModelTree, b: ModelTree,
             ja.range is not None and jb.range is not None
             and np.abs(np.subtract(ja.range, jb.range)).max() > rtol * max(1.0, *map(abs, ja.range))
         ):
-            known = (b.hint("model", "slide range") or a.hint("model", "slide range")) \
-                if ja.type is JointType.SLIDE else None
+            known = b.hint(ja.name, "range") or a.hint(ja.name, "range") or (
+                (b.hint("model", "slide range") or a.hint("model", "slide range"))
+                if ja.type is JointType.SLIDE else None)
             row(ja.name, "range", ja.range, jb.range, np.inf, 0.0, Verdict.FAILED,
                 "joint limits read differently (the dynamics leave limits out; states are "
                 f"sampled within {a.engine}'s)" + (f": {known}" if known else ""))

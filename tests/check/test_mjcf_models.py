@@ -270,19 +270,26 @@ def test_a_model_placed_elsewhere_as_a_whole_is_explained_not_failed(tmp_path):
     assert set(_rows(result, "dynamics")["verdict"]) == {"passed"}
 
 
-def test_the_first_of_several_joints_in_an_offset_body_is_drake_s_reading_named(tmp_path):
-    """Two joints in a body 1 m above the world: Drake's MJCF parser places the first one's
-    frame as if the body had no pos (measured: anchor (0.1, 0, 0) for MuJoCo's (0.1, 0, 1)).
-    A finding with its reason and fix; the second joint reads alike."""
-    body = ('<body name="b" pos="0 0 1"><joint name="j" type="hinge" axis="0 1 0" '
-            'pos="0.1 0 0"/><joint name="k" type="hinge" axis="1 0 0" pos="0.1 0 0"/>'
+def test_all_but_the_last_of_several_joints_in_an_offset_body_are_drake_s_reading_named(
+        tmp_path):
+    """Three joints in a body 1 m above the world and turned 30° about z (dm_control's
+    humanoid_CMU: rz, ry, rx in one body): Drake's MJCF parser places the first two as if the
+    body had no pos or orientation (measured: anchor (0.1, 0, 0) for MuJoCo's (0.1, 0, 1);
+    the second's axis (0, 1, 0) for MuJoCo's rotated one). Findings with their reason and
+    fix; the last joint reads alike."""
+    body = ('<body name="b" pos="0 0 1" euler="0 0 30"><joint name="j" type="hinge" axis="0 0 1" '
+            'pos="0.1 0 0"/><joint name="k" type="hinge" axis="0 1 0" pos="0.1 0 0"/>'
+            '<joint name="l" type="hinge" axis="1 0 0" pos="0.1 0 0"/>'
             '<inertial pos="0 0 -0.2" mass="1" diaginertia="0.02 0.02 0.002"/></body>')
-    result = check_model(_write(tmp_path, "two_joints", body), states=5)
+    result = check_model(_write(tmp_path, "three_joints", body), states=5)
     failed = _rows(result, "description", "failed")
     failed = failed[failed["impl_b"] == "drake"]
-    assert set(zip(failed["subject"], failed["field"], strict=True)) == {("j", "anchor")}
-    assert "'j' is the first of 2 joints in body 'b'" in failed["note"].iloc[0]
-    assert "fix: one joint per body" in failed["note"].iloc[0]
+    assert set(zip(failed["subject"], failed["field"], strict=True)) == {
+        ("j", "anchor"), ("k", "anchor"), ("k", "axis")}
+    for joint, k in (("j", 1), ("k", 2)):
+        note = failed[failed["subject"] == joint]["note"].iloc[0]
+        assert f"'{joint}' is joint {k} of 3 in body 'b'" in note
+        assert "fix: one joint per body" in note
 
 
 @pytest.mark.parametrize("geom", ['mass="7"', 'density="500"'])
@@ -461,27 +468,52 @@ def test_a_slide_range_pinocchio_reads_as_degrees_is_named(tmp_path, angle):
     assert math.isclose(low, -1.8 * math.pi / 180, rel_tol=1e-12)
 
 
+@pytest.mark.parametrize(("attrs", "expected", "cause"), [
+    ('range="-110 110" ref="-90"', (-20.0, 200.0), "subtracts the joint's ref=-90 from its range"),
+    ('range="-60 60" limited="false"', (-60.0, 60.0), "even where limited=\"false\""),
+])
+def test_a_range_pinocchio_reads_differently_is_named(tmp_path, attrs, expected, cause):
+    """dm_control's finger (ref="-90") and fish (limited="false" in a class): Pinocchio's MJCF
+    parser shifts a range by −ref while its coordinate keeps ref, and reads a range MuJoCo
+    does not apply. Expected: MuJoCo's reading ((-110°, 110°); no limit) and the measured
+    Pinocchio limits in degrees."""
+    import math
+
+    body = (f'<body name="b" pos="0 0 1"><joint name="j" type="hinge" axis="0 1 0" {attrs}/>'
+            '<inertial pos="0 0 -0.2" mass="1" diaginertia="0.02 0.02 0.002"/></body>')
+    result = check_model(_write(tmp_path, "ranged", body), states=3,
+                         impls=("reference", "mujoco", "pinocchio"))
+    failed = _rows(result, "description", "failed")
+    assert set(zip(failed["subject"], failed["field"], strict=True)) == {("j", "range")}
+    low, high = (math.degrees(float(x)) for x in failed["value_b"].iloc[0].strip("()").split(","))
+    assert (low, high) == pytest.approx(expected, abs=1e-9)
+    assert cause in failed["note"].iloc[0]
+
+
 @pytest.mark.parametrize("middle", ["", '<joint damping="0.5"/>'])
 def test_an_armature_drake_loses_across_a_class_without_a_joint_is_named(tmp_path, middle):
     """Drake's MJCF parser passes a class's joint defaults on only through classes that have
-    a <joint> element (measured: dm_control's humanoid_CMU, main > humanoid > stiff_medium):
-    the armature row fails naming the class in between and the fix; with a <joint> in that
-    class Drake reads it. Expected: MuJoCo's armature, 0.01 on both joints (actuated, so
-    Drake holds it as reflected inertia when it reads it)."""
+    a <joint> element (measured: dm_control's humanoid_CMU, main > humanoid > stiff_medium,
+    and quadruped's damping, body > hip > pitch): the armature and damping rows fail naming
+    the class in between and the fix; with a <joint> in that class Drake reads them.
+    Expected: MuJoCo's armature, 0.01 on both joints (actuated, so Drake holds it as
+    reflected inertia when it reads it), and MuJoCo's damping."""
     body = ('<body name="a" pos="0 0 1"><joint name="j1" axis="1 0 0" class="leaf"/>'
             '<inertial pos="0 0 -0.2" mass="1" diaginertia="0.1 0.2 0.3"/></body>')
-    head = ('<default class="main"><joint armature="0.01"/>'
-            f'<default class="mid">{middle}<default class="leaf"><joint damping="1"/>'
+    head = ('<default class="main"><joint armature="0.01" damping="2"/>'
+            f'<default class="mid">{middle}<default class="leaf"><joint stiffness="1"/>'
             '</default></default></default>')
     result = check_model(_write(tmp_path, "classes", body, head=head,
                                 tail='<actuator><motor joint="j1" gear="2"/></actuator>'),
                          states=3)
     rows = _rows(result, "description")
-    armature = rows[(rows["field"] == "armature") & (rows["impl_b"] == "drake")]
+    armature = rows[rows["field"].isin(("armature", "damping")) & (rows["impl_b"] == "drake")]
     if middle:
         assert armature.empty
         return
-    assert list(armature["verdict"]) == ["failed"]
+    assert list(armature["field"]) == ["armature", "damping"]
+    assert list(armature["verdict"]) == ["failed", "failed"]
+    assert "its damping from default class 'main'" in armature["note"].iloc[1]
     note = armature["note"].iloc[0]
     assert "from default class 'main' through class 'mid'" in note
     assert "write the attribute on class 'mid'" in note
