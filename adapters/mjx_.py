@@ -41,6 +41,7 @@ from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.mujoco_api import INTEGRATORS
 from dyncheck.adapters.mujoco_port import STEPS, PortAdapter
 from dyncheck.cases.multibody import Multibody
+from dyncheck.settings import current
 
 _CACHE = Path(os.environ.get("DYNCHECK_JAX_CACHE", Path.home() / ".cache" / "dyncheck" / "jax"))
 
@@ -57,10 +58,16 @@ def _private(folder: Path) -> bool:
 
 
 def _compile_cache() -> None:
-    """JAX's persistent compilation cache in :data:`_CACHE`, where that folder is private and
-    the cache is on. The setting is JAX's, process-wide: made when an MJX model is first put
-    on the device (before anything compiles), never by importing this module."""
-    if os.environ.get("DYNCHECK_NO_CACHE", "") in ("", "0") and _private(_CACHE) \
+    """JAX's settings for this work, made when an MJX model is first put on the device
+    (before anything compiles), never by importing this module: its platform where the
+    command names a device (``--device``), and its persistent compilation cache in
+    :data:`_CACHE` where that folder is private and the cache is on. Both are JAX's,
+    process-wide."""
+    settings = current()
+    platform = settings.device.split(":")[0] if settings.device else None
+    if platform and getattr(jax.config, "jax_platforms", None) != platform:
+        jax.config.update("jax_platforms", platform)
+    if settings.cache and _private(_CACHE) \
             and getattr(jax.config, "jax_compilation_cache_dir", None) != str(_CACHE):
         jax.config.update("jax_compilation_cache_dir", str(_CACHE))
         jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)

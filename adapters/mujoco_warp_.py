@@ -8,7 +8,7 @@ source (``mujoco_warp/_src/forward.py``, 4.0.0), share MuJoCo C 4.0's definition
 combines its stages on the rotation group (``_rk_correct_velocity``, Runge–Kutta–Munthe-Kaas)
 and ``implicitfast`` applies a free body's gyroscopic derivative (``implicit_free_body``).
 
-The device is Warp's: ``cpu`` unless ``DYNCHECK_DEVICE`` (or ``--device``) names a CUDA device.
+The device is Warp's: ``cpu`` unless ``--device`` (or ``DYNCHECK_DEVICE``) names a CUDA device.
 On the CPU every kernel launch costs ~0.1 ms, so a step costs ~10 ms (Euler) to ~40 ms (RK4)
 even on a pendulum (measured); runs longer than ``CPU_STEPS`` are left to a GPU, where one
 step is a captured CUDA graph. Warp's kernel cache (``~/.cache/warp``) keeps compiled kernels
@@ -36,6 +36,7 @@ from dyncheck.adapters.mujoco_api import INTEGRATORS
 from dyncheck.adapters.mujoco_port import CHUNK, PortAdapter
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import Unsupported
+from dyncheck.settings import current
 
 CPU_STEPS = 400
 """The longest run the adapter makes on Warp's CPU device (~16 s of RK4 steps)."""
@@ -73,9 +74,9 @@ def too_long(steps: int) -> str:
 
 
 def device() -> str:
-    """Warp's device for this process: ``DYNCHECK_DEVICE`` if set (``cpu``, ``cuda``,
-    ``cuda:0``, …), else ``cpu``."""
-    return os.environ.get("DYNCHECK_DEVICE", "cpu")
+    """Warp's device for this work: the command's ``--device`` (``cpu``, ``cuda``,
+    ``cuda:0``, …; :func:`dyncheck.settings.current`), else ``cpu``."""
+    return current().device or "cpu"
 
 
 class MuJoCoWarpAdapter(PortAdapter):

@@ -22,6 +22,7 @@ from pathlib import Path
 import pandas as pd
 
 from dyncheck.results import to_csv, write_atomic
+from dyncheck.settings import NO_CACHE
 
 CORE = (
     "reference",
@@ -127,7 +128,7 @@ def measure(steps: tuple[Step, ...] = STEPS) -> pd.DataFrame:
     rows = []
     with tempfile.TemporaryDirectory(prefix="dyncheck-suite-") as tmp:
         env = os.environ.copy()
-        env.pop("DYNCHECK_NO_CACHE", None)
+        env.pop(NO_CACHE, None)
         # Python's own bytecode cache as Python keeps it by default (a machine that sets
         # PYTHONDONTWRITEBYTECODE compiles dyncheck's sources again in every process)
         env.pop("PYTHONDONTWRITEBYTECODE", None)

@@ -297,15 +297,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = _parser().parse_args(argv)
     except SystemExit as exc:  # --help (0) or a one-line usage error (2), already printed
         return int(exc.code or 0)
-    from dyncheck.reference.derivations import NO_CACHE
+    from dyncheck.commands.options import settings_of
+    from dyncheck.workers import settled
 
-    before = os.environ.get(NO_CACHE)
-    if getattr(args, "no_cache", False):  # read by this process and the workers it starts
-        os.environ[NO_CACHE] = "1"
     try:
-        if args.command == "list":
-            return list_command(integrators=args.integrators)
-        return COMMANDS[args.command](args)
+        settings = settings_of(args)  # handed to every unit of work (dyncheck.settings)
+        with settled(settings):
+            if args.command == "list":
+                return list_command(integrators=args.integrators)
+            return COMMANDS[args.command](args)
     except DyncheckError as exc:
         print(f"dyncheck: error: {one_line(str(exc))}", file=sys.stderr)
         return 2
@@ -316,11 +316,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("dyncheck: interrupted (nothing half-written)", file=sys.stderr)
         return 130
-    finally:
-        if before is None:
-            os.environ.pop(NO_CACHE, None)
-        else:
-            os.environ[NO_CACHE] = before
 
 
 def console() -> int:

@@ -31,7 +31,8 @@ from dyncheck import diff
 from dyncheck.adapters import REGISTRY
 from dyncheck.errors import DyncheckError, InvalidInput, UnknownName
 from dyncheck.progress import Progress
-from dyncheck.reference.derivations import cache_root
+from dyncheck.settings import current
+from dyncheck.store import cache_root
 from dyncheck.vocabulary import Verdict
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -282,7 +283,7 @@ def run_release(
     log(f"running {eng.name} {release}")
     result = subprocess.run(
         [str(python), "-m", "dyncheck.cli", "run", *cases, *impls, "--jobs", str(jobs),
-         "--out", str(out)],
+         "--out", str(out), *(() if current().cache else ("--no-cache",))],
         capture_output=True, text=True, check=False,
     )
     if result.returncode not in (0, 1) or not (out / "discrepancies.csv").exists():

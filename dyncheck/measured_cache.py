@@ -3,13 +3,13 @@
 A demonstration of the conventions catalogue is a deterministic function of dyncheck's source
 and data, the installed engines and numerical libraries, the Python and the machine (the same
 inputs give the same numbers). :func:`measured` stores its result under the user's cache
-folder (:func:`~dyncheck.reference.derivations.cache_root`) keyed by a hash of all of them, so
+folder (:func:`~dyncheck.store.cache_root`) keyed by a hash of all of them, so
 that a second ``dyncheck explain`` prints without running the engines, while an upgrade of any
 engine, an edit of any file of dyncheck or another machine measures afresh. A case's figures
 are kept the same way (:func:`~dyncheck.report.figures.cached_figures`, the plotted data part
 of their name), and so are the studies' reference trajectories
 (:class:`~dyncheck.studies.references.References`, keyed by case, model variant and step).
-``--no-cache`` (``DYNCHECK_NO_CACHE``) neither reads nor writes. Files are
+``--no-cache`` (:class:`dyncheck.settings.Settings`) neither reads nor writes. Files are
 written whole (a temporary file, then a rename); one that cannot be read back is measured
 again and replaced.
 """
@@ -27,7 +27,8 @@ from pathlib import Path
 from typing import TypeVar
 
 from dyncheck.adapters import ENGINE_PACKAGES
-from dyncheck.reference.store import cache_root, cached, enabled
+from dyncheck.settings import current
+from dyncheck.store import cache_root, cached
 
 T = TypeVar("T")
 
@@ -100,8 +101,8 @@ def measured(
     is false (a demonstration that failed) is returned but never stored. ``latest_only``:
     storing a result removes what other fingerprints stored under ``kind`` (for large results
     — a case's figures — that would otherwise pile up with every edit of dyncheck). What is
-    read back must be an ``expect`` (:func:`~dyncheck.reference.store.cached`)."""
-    if not enabled():  # before the fingerprint: it reads every file of dyncheck
+    read back must be an ``expect`` (:func:`~dyncheck.store.cached`)."""
+    if not current().cache:  # before the fingerprint: it reads every file of dyncheck
         return measure(), False
     path = path_for(kind, name)
     result, found = cached(path, measure, keep, expect=expect)

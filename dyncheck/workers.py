@@ -19,6 +19,7 @@ from typing import Any
 
 from dyncheck.errors import DyncheckError, EngineError, InvalidInput
 from dyncheck.progress import Progress
+from dyncheck.settings import Settings, current, in_force
 
 LOCAL = "local"
 """``--dask local``: a ``LocalCluster`` of ``--jobs`` single-threaded worker processes."""
@@ -141,6 +142,29 @@ Unit = tuple[str, Callable[..., Any], tuple[Any, ...]]
 """A unit of work: what it is (for progress), a picklable function, its arguments."""
 
 
+@contextmanager
+def settled(settings: Settings) -> Iterator[None]:
+    """``settings`` in force for the work inside (:func:`dyncheck.settings.current`), and the
+    reference handed its store: the disk cache (:class:`dyncheck.store.DiskStore`), or none
+    under ``--no-cache``."""
+    from dyncheck.reference.derivations import STORE
+    from dyncheck.store import DiskStore
+
+    token = STORE.set(DiskStore() if settings.cache else None)
+    try:
+        with in_force(settings):
+            yield
+    finally:
+        STORE.reset(token)
+
+
+def _under(settings: Settings, fn: Callable[..., Any], *args: Any) -> Any:
+    """``fn(*args)`` with the submitting command's settings in force (in whatever process or
+    machine runs it: they travel as this argument)."""
+    with settled(settings):
+        return fn(*args)
+
+
 def run_units(
     units: Sequence[Unit],
     *,
@@ -160,7 +184,8 @@ def run_units(
                 if progress is not None:
                     progress.done(what)
             return done
-        futures = [pool.submit(fn, *args) for _what, fn, args in units]
+        settings = current()
+        futures = [pool.submit(_under, settings, fn, *args) for _what, fn, args in units]
         for (what, _fn, _args), future in zip(units, futures, strict=True):
             done.append(_result(future, what, dask))
             if progress is not None:
@@ -206,7 +231,8 @@ def each_unit(
                 except DyncheckError as exc:
                     yield what, exc
             return
-        futures = [pool.submit(fn, *args) for _what, fn, args in units]
+        settings = current()
+        futures = [pool.submit(_under, settings, fn, *args) for _what, fn, args in units]
         for (what, _fn, _args), future in zip(units, futures, strict=True):
             try:
                 yield what, future.result()

@@ -3,15 +3,15 @@
 A derivation (a metric, Christoffel symbols, the canonical form M, h of (2.2.26)) is stored
 as its sympy result under the user's cache folder, keyed by what it is derived from (the
 ``srepr`` of its inputs), sympy's version and the content of this package's source — an
-edit of any derivation, or another sympy, derives afresh. Entries are authenticated data
-(:mod:`dyncheck.reference.store`): a file placed in the cache folder by anyone else is never
-deserialized. ``DYNCHECK_NO_CACHE=1`` (the command line's ``--no-cache``) neither reads nor
-writes the cache.
+edit of any derivation, or another sympy, derives afresh. The store is the caller's:
+:data:`STORE`, set by the comparison layer (``dyncheck.store.DiskStore``, whose entries are
+authenticated data: a file placed in the cache folder by anyone else is never deserialized);
+unset (``--no-cache``, or this package used alone), everything is derived afresh.
 
 The numeric functions made from derived expressions are kept too (:func:`lambdified`): the
 code ``sympy.lambdify`` generates and compiles, stored as Python's code object, so that a
 second process builds the same function without printing the expressions again (only from
-an authenticated entry: see :mod:`dyncheck.reference.store`).
+an authenticated entry of the store).
 """
 
 from __future__ import annotations
@@ -23,23 +23,36 @@ import pickle
 import sys
 import types
 from collections.abc import Callable, Sequence
+from contextvars import ContextVar
 from functools import cache
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, Protocol, TypeVar
 
 import numpy as np
 
-from dyncheck.reference.store import NO_CACHE, cache_root, cached, enabled
-
-__all__ = ["NO_CACHE", "cache_root", "cached", "derived", "enabled", "lambdified", "value_bytes"]
+__all__ = ["STORE", "Store", "derived", "lambdified", "value_bytes"]
 
 T = TypeVar("T")
+
+
+class Store(Protocol):
+    """Where derivations are kept: the entry called ``name`` (a relative path), or
+    ``compute()`` kept under it when ``keep`` of it is true; what is read back is an
+    instance of ``expect``."""
+
+    def __call__(self, name: str, compute: Callable[[], T],
+                 keep: Callable[[T], bool] = ..., *,
+                 expect: type | tuple[type, ...] = ...) -> T: ...
+
+
+STORE: ContextVar[Store | None] = ContextVar("dyncheck_reference_store", default=None)
+"""The store derivations are kept in, set by the caller; None: derive everything afresh."""
 
 
 @cache
 def _source_key() -> str:
     """A hash of this package's source files and sympy's version."""
-    import sympy as sp  # here: `dyncheck list` reads NO_CACHE without importing sympy
+    import sympy as sp  # here: importing this module (`dyncheck list`) imports no sympy
 
     h = hashlib.sha256(sp.__version__.encode())
     for path in sorted(Path(__file__).parent.glob("*.py")):
@@ -51,13 +64,13 @@ def _source_key() -> str:
 def derived(kind: str, inputs: object, compute: Callable[[], T]) -> T:
     """``compute()``, or its result stored by an earlier call with the same ``kind`` and
     ``inputs`` (sympy objects, tuples of them, plain values)."""
-    if not enabled():
+    store = STORE.get()
+    if store is None:
         return compute()
     import sympy as sp
 
     key = hashlib.sha256(f"{kind}\n{sp.srepr(inputs)}".encode()).hexdigest()[:32]
-    path = cache_root() / "derivations" / _source_key() / f"{kind}-{key}.pickle"
-    return cached(path, compute)[0]
+    return store(f"derivations/{_source_key()}/{kind}-{key}.pickle", compute)
 
 
 class _Canonical(pickle.Pickler):
@@ -129,21 +142,22 @@ def lambdified(
     def make() -> Callable[..., Any]:
         return sp.lambdify(args, exprs, modules=modules, cse=cse)
 
-    if not enabled():
+    store = STORE.get()
+    if store is None:
         return make()
     h = hashlib.sha256(f"{modules}\n{cse}\n{sys.version}\n".encode())
     try:
         h.update(value_bytes((tuple(args), exprs)))
     except (pickle.PicklingError, AttributeError, TypeError, ValueError):  # no key: made anew
         return make()
-    path = cache_root() / "lambdified" / _source_key() / f"{h.hexdigest()[:32]}.pickle"
+    name = f"lambdified/{_source_key()}/{h.hexdigest()[:32]}.pickle"
     made: list[Callable[..., Any]] = []
 
     def code() -> bytes | None:
         made.append(make())
         return marshal.dumps(made[0].__code__) if _storable(made[0], modules) else None
 
-    stored = cached(path, code, keep=lambda c: c is not None, expect=bytes)[0]
+    stored = store(name, code, lambda c: c is not None, expect=bytes)
     if made:
         return made[0]
     assert stored is not None  # only a storable function's code is stored

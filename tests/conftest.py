@@ -151,14 +151,34 @@ def empty_cache(monkeypatch, tmp_path):
     """An empty cache folder (derivations, measured demonstrations, figures), read and written
     (``--no-cache`` off), with the fingerprint computed afresh before and after the test."""
     from dyncheck import measured_cache
-    from dyncheck.reference.derivations import NO_CACHE
 
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.delenv(NO_CACHE, raising=False)
     clear = measured_cache.fingerprint.cache_clear  # (a test may replace the function)
     clear()
     yield tmp_path
     clear()
+
+@pytest.fixture(autouse=True)
+def cache_on():
+    """Every test under the command line's default settings (the disk cache read and
+    written, the reference handed its store), as ``dyncheck`` runs: tests call the library
+    directly, not through :func:`dyncheck.cli.main`."""
+    from dyncheck.settings import Settings
+    from dyncheck.workers import settled
+
+    with settled(Settings()):
+        yield
+
+
+@pytest.fixture
+def no_cache(cache_on):
+    """``--no-cache`` in force for the test."""
+    from dyncheck.settings import Settings
+    from dyncheck.workers import settled
+
+    with settled(Settings(cache=False)):
+        yield
+
 
 # Property tests: a fast profile for CI (the default) and a larger one for a nightly run,
 # chosen with pytest's --hypothesis-profile=nightly.

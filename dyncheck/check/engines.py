@@ -33,6 +33,7 @@ from dyncheck.adapters.model_files import ModelFile
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, ModelTree, Transition
 from dyncheck.confinement import confine
 from dyncheck.errors import DyncheckError, EngineError, Unsupported
+from dyncheck.settings import Settings, current, in_force
 from dyncheck.workers import start_method
 
 
@@ -139,10 +140,16 @@ def load(name: str, source: ModelFile, spec: Registration | None = None,
 
 
 def _serve(name: str, spec: Registration, source: ModelFile, conn: Connection, parent: int,
-           memory_mib: int | None) -> None:
+           memory_mib: int | None, settings: Settings) -> None:
     """The isolated engine's process: confined (it dies with dyncheck, lets go of the
-    caller's output, its memory capped), it loads, sends the tree, then answers batches
-    until None."""
+    caller's output, its memory capped), the command's settings in force, it loads, sends
+    the tree, then answers batches until None."""
+    with in_force(settings):
+        _answer(name, spec, source, conn, parent, memory_mib)
+
+
+def _answer(name: str, spec: Registration, source: ModelFile, conn: Connection, parent: int,
+            memory_mib: int | None) -> None:
     faulthandler.disable()  # a crash here is reported by the parent, in one line
     confine(parent, memory_bytes=None if memory_mib is None else memory_mib * 2**20,
             quiet=True)
@@ -190,7 +197,8 @@ class Isolated:
         memory = None if name in PORTS else self.limits.memory_mib
         # the spec travels with the call: a spawned child would not see a patched ENGINES
         self._proc = ctx.Process(target=_serve, args=(name, ENGINES[name], source, child,
-                                                      os.getpid(), memory), daemon=True)
+                                                      os.getpid(), memory, current()),
+                                 daemon=True)
         self._proc.start()
         child.close()
 

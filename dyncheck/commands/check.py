@@ -17,7 +17,6 @@ if TYPE_CHECKING:
 from dyncheck.commands.options import (
     check_out,
     ci_files,
-    device_env,
     positive,
     write_ci,
 )
@@ -131,7 +130,6 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
         raise InvalidInput("--seed", args.seed, "a non-negative integer")
     check_out(args.out)
     ci_files(args)
-    device_env()
     positive("--jobs", args.jobs)
     options = {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
                "floating": args.floating, "against": args.against,

@@ -6,13 +6,13 @@ from __future__ import annotations
 import argparse
 import errno
 import os
-import re
 import sys
 import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from dyncheck.errors import InvalidInput
+from dyncheck.settings import Settings, from_environment
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -120,14 +120,14 @@ def positive(name: str, value: int | None, most: int | None = None) -> None:
         raise InvalidInput(name, value, expected)
 
 
-DEVICE = re.compile(r"cpu|cuda(:\d+)?")
-
-
-def device_env() -> None:
-    """``DYNCHECK_DEVICE`` from the environment, checked before any work."""
-    value = os.environ.get("DYNCHECK_DEVICE")
-    if value is not None and not DEVICE.fullmatch(value):
-        raise InvalidInput("DYNCHECK_DEVICE", value, "cpu, cuda or cuda:N (the environment)")
+def settings_of(args: argparse.Namespace) -> Settings:
+    """The command's :class:`~dyncheck.settings.Settings` (``--no-cache``, ``--device``,
+    their environment defaults), checked before any work: ``cuda`` on a machine without an
+    NVIDIA driver is refused here."""
+    device = getattr(args, "device", None)
+    if device == "cuda" and not has_cuda():
+        raise InvalidInput("--device", device, "cpu on this machine (no NVIDIA driver found)")
+    return from_environment(no_cache=getattr(args, "no_cache", False), device=device)
 
 
 def has_cuda() -> bool:
@@ -136,18 +136,6 @@ def has_cuda() -> bool:
 
     return Path("/proc/driver/nvidia/version").exists() or \
         ctypes.util.find_library("cuda") is not None
-
-
-def use_device(device: str) -> None:
-    """The ports' device, for this process and the workers it starts: Warp reads
-    ``DYNCHECK_DEVICE``, JAX its platform (set before its first computation). ``cuda`` on a
-    machine without an NVIDIA driver is refused here, before any work."""
-    if device == "cuda" and not has_cuda():
-        raise InvalidInput("--device", device, "cpu on this machine (no NVIDIA driver found)")
-    os.environ["DYNCHECK_DEVICE"] = device
-    os.environ["JAX_PLATFORMS"] = device
-    if "jax" in sys.modules:
-        sys.modules["jax"].config.update("jax_platforms", device)
 
 
 def log(message: str) -> None:

@@ -8,9 +8,7 @@ from dyncheck.commands.options import (
     MAX_STATES,
     check_out,
     ci_files,
-    device_env,
     positive,
-    use_device,
     warn_cost,
     write_ci,
 )
@@ -25,9 +23,6 @@ def run_command(args: argparse.Namespace) -> int:
 
     check_out(args.out)
     ci_files(args)
-    device_env()
-    if args.device is not None:
-        use_device(args.device)
     positive("--states", args.states)
     if args.states is not None and args.states > MAX_STATES:
         raise InvalidInput("--states", args.states, f"at most {MAX_STATES} (~50 µs per state)")

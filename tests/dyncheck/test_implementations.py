@@ -18,7 +18,6 @@ from dyncheck.adapters import get_adapter
 from dyncheck.adapters import sympy_mechanics as sm
 from dyncheck.cases import get_case
 from dyncheck.implementations import CACHED
-from dyncheck.reference import derivations
 
 
 @pytest.mark.parametrize("case_name", ["compound_pendulum", "atwood", "kepler"])
@@ -26,7 +25,6 @@ def test_sympy_mechanics_reads_its_equations_back_without_deriving(
     case_name, tmp_path, monkeypatch
 ):
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
     model = get_case(case_name).multibody()
     adapter = partial(get_adapter("sympy-mechanics"), symbolic=CACHED)
     first = adapter(model)
@@ -43,9 +41,8 @@ def test_sympy_mechanics_reads_its_equations_back_without_deriving(
     assert np.array_equal(again.forward(q, v, tau), first.forward(q, v, tau))
 
 
-def test_sympy_mechanics_without_the_cache_derives(tmp_path, monkeypatch):
+def test_sympy_mechanics_without_the_cache_derives(tmp_path, monkeypatch, no_cache):
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.setenv(derivations.NO_CACHE, "1")
     calls = []
     derive = sm._derive
     monkeypatch.setattr(sm, "_derive", lambda model: calls.append(1) or derive(model))
@@ -59,7 +56,6 @@ def test_the_adapter_left_to_itself_derives_afresh(tmp_path, monkeypatch):
     """Without the comparison layer's caches (the default, ``AFRESH``) the adapter derives
     every time and writes nothing, whether or not the comparison layer was imported."""
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
     calls = []
     derive = sm._derive
     monkeypatch.setattr(sm, "_derive", lambda model: calls.append(1) or derive(model))

@@ -11,7 +11,6 @@ import pytest
 
 from dyncheck import catalogue, measured_cache
 from dyncheck.cli import main
-from dyncheck.reference import derivations
 
 NAME = "hinge-axis-sign"
 
@@ -39,8 +38,7 @@ def test_a_second_explain_reads_the_entry_back_without_running_it(counted):
     assert (again, read, len(counted)) == ([live], 1, 2)
 
 
-def test_no_cache_measures_every_time(counted, monkeypatch):
-    monkeypatch.setenv(derivations.NO_CACHE, "1")
+def test_no_cache_measures_every_time(counted, no_cache):
     for _ in range(2):
         assert catalogue.explain_cached(NAME)[1] == 0
     assert len(counted) == 2

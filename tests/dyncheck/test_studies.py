@@ -292,8 +292,9 @@ def test_references_are_read_back_to_the_last_bit(empty_cache, monkeypatch):
     come from the cache equal to the first's to the last bit, without solving or stepping
     again (both refused here); ``--no-cache`` computes them (the refusal is met)."""
     from dyncheck.implementations import book_variant
-    from dyncheck.reference.derivations import NO_CACHE
+    from dyncheck.settings import Settings
     from dyncheck.studies import references
+    from dyncheck.workers import settled
 
     case = get_case("simple_pendulum")
     variant, dt = book_variant(case), case.trajectory.steps["rk4"][0]
@@ -309,6 +310,5 @@ def test_references_are_read_back_to_the_last_bit(empty_cache, monkeypatch):
     ref2, disc2 = again(variant), again.discrete_engine(variant, "rk4", dt)
     assert np.array_equal(ref[0], ref2[0]) and ref[1] == ref2[1]
     assert all(np.array_equal(a, b) for a, b in zip(disc, disc2, strict=True))
-    monkeypatch.setenv(NO_CACHE, "1")
-    with pytest.raises(AssertionError, match="computed again"):
+    with settled(Settings(cache=False)), pytest.raises(AssertionError, match="computed again"):
         references.References(case)(variant)

@@ -33,7 +33,6 @@ def _no_symbolic_work(monkeypatch):
 
 def test_a_second_derivation_is_read_back_without_symbolic_work(tmp_path, monkeypatch):
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
     first = _fresh()
     assert sp.simplify(first.metric - _book_metric(first)) == sp.zeros(3, 3)
     assert list((tmp_path / "derivations").rglob("metric-*.pickle"))
@@ -43,9 +42,8 @@ def test_a_second_derivation_is_read_back_without_symbolic_work(tmp_path, monkey
     assert again.metric.free_symbols == set(again.q) - {again.q[2]}  # ρ, θ: same symbols
 
 
-def test_no_cache_neither_reads_nor_writes(tmp_path, monkeypatch):
+def test_no_cache_neither_reads_nor_writes(tmp_path, monkeypatch, no_cache):
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.setenv(derivations.NO_CACHE, "1")
     calls = []
     assert derivations.derived("x", (1,), lambda: calls.append(1) or 5) == 5
     assert derivations.derived("x", (1,), lambda: calls.append(1) or 5) == 5
@@ -55,7 +53,6 @@ def test_no_cache_neither_reads_nor_writes(tmp_path, monkeypatch):
 
 def test_an_unreadable_file_is_derived_again_and_replaced(tmp_path, monkeypatch):
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
     x = sp.Symbol("x")
     assert derivations.derived("square", (x,), lambda: x**2) == x**2
     (path,) = (tmp_path / "derivations").rglob("square-*.pickle")
@@ -67,7 +64,6 @@ def test_an_unreadable_file_is_derived_again_and_replaced(tmp_path, monkeypatch)
 def test_the_key_is_what_a_derivation_is_made_from(tmp_path, monkeypatch):
     """Inputs that print alike but differ (a symbol's assumptions) are different keys."""
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
     plain, positive = sp.Symbol("r"), sp.Symbol("r", positive=True)
     assert derivations.derived("root", (plain,), lambda: "plain") == "plain"
     assert derivations.derived("root", (positive,), lambda: "positive") == "positive"
@@ -77,7 +73,6 @@ def test_the_key_is_what_a_derivation_is_made_from(tmp_path, monkeypatch):
 def _lambdified_twice(tmp_path, monkeypatch, args, exprs, modules):
     """``lambdified`` made afresh, then read back with ``sympy.lambdify`` refused."""
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
     first = derivations.lambdified(args, exprs, modules)
     assert list((tmp_path / "lambdified").rglob("*.pickle"))
 
@@ -110,7 +105,6 @@ def test_a_stored_function_computes_what_lambdify_makes_to_the_last_bit(
 
 def test_different_expressions_are_never_read_back_for_each_other(tmp_path, monkeypatch):
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
     x = sp.Symbol("x")
     assert derivations.lambdified((x,), x**2, "math")(3.0) == 9.0
     assert derivations.lambdified((x,), x**3, "math")(3.0) == 27.0
@@ -122,7 +116,6 @@ def test_a_function_reading_a_name_lambdify_adds_is_not_stored(tmp_path, monkeyp
     """A function whose code reads a global outside the module's names (an implemented
     function's callable) cannot be rebuilt from its code alone: made afresh, never stored."""
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
     x = sp.Symbol("x")
     twice = implemented_function("twice", lambda v: 2 * v)
     assert derivations.lambdified((x,), twice(x) + 1, "math")(3.0) == 7.0
@@ -188,7 +181,6 @@ def test_a_function_of_equal_expressions_built_apart_is_found_in_the_cache(
     the same expressions built apart (as a second run reads them from the derivations'
     cache), the function read back computing sin(1)·2 as sympy's own lambdify does."""
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.delenv(derivations.NO_CACHE, raising=False)
     x, y = sp.symbols("x y")
     s = sp.sin(x) * y
     first = derivations.lambdified((x, y), [s, s * x], "math")

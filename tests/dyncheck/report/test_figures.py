@@ -13,7 +13,6 @@ import pytest
 
 from dyncheck import measured_cache
 from dyncheck.cases import get_case
-from dyncheck.reference import derivations
 from dyncheck.report import figures as module
 from dyncheck.results import CONVERGENCE_KEY, ConvergencePoint, table
 from dyncheck.run import _run_case
@@ -74,8 +73,7 @@ def test_changed_data_is_drawn_afresh(study, drawn):
     assert len(drawn) == 3
 
 
-def test_no_cache_draws_every_time(study, drawn, monkeypatch):
-    monkeypatch.setenv(derivations.NO_CACHE, "1")
+def test_no_cache_draws_every_time(study, drawn, no_cache):
     for _ in range(2):
         module.cached_figures(CASE, *study)
     assert len(drawn) == 2

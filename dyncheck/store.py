@@ -15,7 +15,10 @@ computed afresh with a one-line note on stderr, never a traceback. Folders are c
 (0700), files are written whole (a temporary file, then a rename), and nothing is written
 through a folder that resolves outside the cache folder.
 
-``DYNCHECK_NO_CACHE=1`` (the command line's ``--no-cache``) neither reads nor writes.
+Whether the cache is used at all is a command's setting (``--no-cache``,
+:class:`dyncheck.settings.Settings`), handed to every unit of work as an argument; the
+reference's derivations are given a :class:`DiskStore` by the comparison layer
+(:func:`dyncheck.workers.settled`), never reach for one themselves.
 """
 
 from __future__ import annotations
@@ -36,8 +39,6 @@ from typing import Any, TypeVar
 
 T = TypeVar("T")
 
-NO_CACHE = "DYNCHECK_NO_CACHE"
-"""Environment variable: set (to anything but empty or 0), the cache is bypassed."""
 KEY = "DYNCHECK_CACHE_KEY"
 """Environment variable: the file holding the cache's secret key (outside the cache folder)."""
 MAGIC = b"dyncheck-cache-1\n"
@@ -55,10 +56,6 @@ SAFE_BUILTINS = frozenset({
 })
 """Builtins an entry may name: constructors of plain data, never ``eval``, ``exec``,
 ``getattr`` or ``__import__``."""
-
-
-def enabled() -> bool:
-    return os.environ.get(NO_CACHE, "") in ("", "0")
 
 
 def cache_root() -> Path:
@@ -271,3 +268,13 @@ def cached(
             return result, False
         write_entry(path, payload)
     return result, False
+
+
+class DiskStore:
+    """The cache folder as :class:`dyncheck.reference.derivations.Store`: an entry by its
+    name under :func:`cache_root`, computed where missing (see :func:`cached`)."""
+
+    def __call__(self, name: str, compute: Callable[[], T],
+                 keep: Callable[[T], bool] = lambda _result: True, *,
+                 expect: type | tuple[type, ...] = object) -> T:
+        return cached(cache_root() / name, compute, keep, expect=expect)[0]

@@ -1,4 +1,4 @@
-"""The cache's store (reference/store.py) on a hostile cache folder: nothing placed there by
+"""The cache's store (dyncheck/store.py) on a hostile cache folder: nothing placed there by
 anyone else is ever run, and what it holds costs a recomputation, never a wrong result.
 
 Expected values: the results computed without any cache (the ``compute`` functions), and a
@@ -16,7 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from dyncheck.reference import store
+from dyncheck import store
+from dyncheck.settings import NO_CACHE
 
 
 class _Runs:
@@ -35,7 +36,7 @@ def cache(tmp_path, monkeypatch):
     folder = tmp_path / "cache"
     monkeypatch.setenv("DYNCHECK_CACHE", str(folder))
     monkeypatch.setenv(store.KEY, str(tmp_path / "config" / "cache-key"))
-    monkeypatch.delenv(store.NO_CACHE, raising=False)
+    monkeypatch.delenv(NO_CACHE, raising=False)
     store._key.cache_clear()
     yield folder
     store._key.cache_clear()
@@ -158,7 +159,7 @@ def test_a_hostile_cache_folder_leaves_a_run_unchanged(tmp_path):
     marker = tmp_path / "marker"
     env = {**os.environ, "DYNCHECK_CACHE": str(tmp_path / "cache"),
            store.KEY: str(tmp_path / "key")}
-    env.pop(store.NO_CACHE, None)
+    env.pop(NO_CACHE, None)
 
     def run(out: str) -> subprocess.CompletedProcess[str]:
         return subprocess.run(
