@@ -33,7 +33,12 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
-from dyncheck.adapters.mujoco_api import GYROSCOPIC_IMPLICIT, full_inertia, mujoco_warnings
+from dyncheck.adapters.mujoco_api import (
+    GYROSCOPIC_IMPLICIT,
+    RK4_ON_GROUP,
+    full_inertia,
+    mujoco_warnings,
+)
 from dyncheck.errors import EngineError
 from dyncheck.vocabulary import Integrator
 
@@ -332,10 +337,11 @@ class MujocoModel:
 GYROSCOPIC_STEP = ("MuJoCo's implicitfast differentiates a free body's gyroscopic force "
                    "(since 3.11): its step is not Euler's on a free joint; the chain rule of "
                    "Euler's step is no referee for it")
-ROTATING_RK4 = (
-    "RK4's stages on a ball or free joint each turn the rotation by an exponential map: "
-    "their chain rule is not built, so the referee checks RK4's step on hinge and slide "
-    "joints only"
+
+NAIVE_RK4 = (
+    "MuJoCo before 4.0 sums RK4's stage velocities on a ball or free joint without dexp⁻¹ "
+    "(order 2 there); the referee's chain rule follows the Runge–Kutta–Munthe-Kaas stages of "
+    "MuJoCo ≥ 4.0"
 )
 
 
@@ -346,8 +352,9 @@ def _unfollowed(m: mujoco.MjModel, integrator: Integrator) -> str:
     free = int(mujoco.mjtJoint.mjJNT_FREE) in types
     if integrator is Integrator.IMPLICITFAST and free and GYROSCOPIC_IMPLICIT:
         return GYROSCOPIC_STEP
-    if integrator is Integrator.RK4 and (free or int(mujoco.mjtJoint.mjJNT_BALL) in types):
-        return ROTATING_RK4
+    if integrator is Integrator.RK4 and not RK4_ON_GROUP and (
+            free or int(mujoco.mjtJoint.mjJNT_BALL) in types):
+        return NAIVE_RK4
     return ""
 
 

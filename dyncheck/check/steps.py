@@ -3,13 +3,15 @@ semi-implicit Euler, implicitfast and RK4 step (``mjd_transitionFD``, centered d
 against the same step differentiated by the chain rule from the referee's continuous
 derivatives — :func:`euler_step`: exact for Euler, and for implicitfast without damping or
 actuators, whose implicit term is then M; :func:`rk4_step`: exact for RK4 through its four
-stages, each with the referee's derivatives at the stage's state."""
+stages — Runge–Kutta–Munthe-Kaas on rotations, as MuJoCo ≥ 4.0 takes them —, each with the
+referee's derivatives at the stage's state."""
 
 from __future__ import annotations
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from dyncheck.adapters.integrators import dexp_inv, quat_exp, quat_mul
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import JointType, ModelTree, Transition
 from dyncheck.check.derivatives import Referee, referee
@@ -65,36 +67,144 @@ RK4_STAGES = ((0.0, 1.0 / 6), (0.5, 1.0 / 3), (0.5, 1.0 / 3), (1.0, 1.0 / 6))
 weight) — the classical method, as MuJoCo's ``mj_RungeKutta`` with N = 4."""
 
 
-def rk4_stages(tree: ModelTree, states: States, ref: Referee,
-               h: float) -> list[tuple[States, Referee]]:
-    """The four stage states Xᵢ = x + cᵢ h Kᵢ₋₁ of one RK4 step (hinge and slide joints: q
-    adds), each with the referee at it (its v̇ and derivatives; ``ref``: at x itself)."""
-    out = [(states, ref)]
-    for c, _ in RK4_STAGES[1:]:
-        prev_states, prev = out[-1]
-        at = States(q=states.q + c * h * prev_states.v, v=states.v + c * h * prev.forward,
-                    a=states.a)
-        out.append((at, referee(tree, at)))
+def _rotations(canon: Canonical) -> list[tuple[int, int]]:
+    """(first velocity index, quaternion index) of every rotation: a ball joint's, a free
+    joint's angular part (canonical: w first, turned on the right, body-frame δ)."""
+    out = []
+    for kind, qs, vs in zip(canon.types, canon.q_start, canon.v_start, strict=True):
+        if kind is JointType.BALL:
+            out.append((vs, qs))
+        elif kind is JointType.FREE:
+            out.append((vs + 3, qs + 3))
     return out
 
 
-def rk4_step(stages: list[tuple[States, Referee]], h: float) -> np.ndarray:
-    """The Jacobian of one classical RK4 step of x = (q, v), ẋ = (v, v̇(q, v)), by the chain
-    rule through its stages: dXᵢ = I + cᵢ h dKᵢ₋₁, dKᵢ = J(Xᵢ) dXᵢ with J = [[0, I], [∂v̇/∂q,
-    ∂v̇/∂v]], dx₊ = I + h Σ bᵢ dKᵢ — exact for the step (hinge and slide joints, where q ⊕ δ
-    = q + δ at every stage)."""
+def _vectors(canon: Canonical) -> tuple[list[int], list[int]]:
+    """Velocity and position indices of the coordinates that add (hinge, slide, a free
+    joint's position)."""
+    vel: list[int] = []
+    pos: list[int] = []
+    for kind, qs, vs in zip(canon.types, canon.q_start, canon.v_start, strict=True):
+        count = 3 if kind is JointType.FREE else 0 if kind is JointType.BALL else 1
+        vel += range(vs, vs + count)
+        pos += range(qs, qs + count)
+    return vel, pos
+
+
+def advance(canon: Canonical, q: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """q ⊕ θ for every state (rows): coordinates add, a rotation turns by exp(θ) on the right
+    — the canonical chart, in which the referee's derivatives are taken."""
+    out = q.copy()
+    vel, pos = _vectors(canon)
+    out[:, pos] += theta[:, vel]
+    for va, qa in _rotations(canon):
+        turn = np.stack([quat_exp(t) for t in theta[:, va : va + 3]])
+        out[:, qa : qa + 4] = quat_mul(out[:, qa : qa + 4].T, turn.T).T
+    return out
+
+
+def _rates(canon: Canonical, theta: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """kᵢ = dexp⁻¹(θᵢ) vᵢ on every rotation (:func:`dexp_inv`), vᵢ elsewhere."""
+    out = v.copy()
+    for va, _ in _rotations(canon):
+        out[:, va : va + 3] = [dexp_inv(t, w) for t, w in
+                               zip(theta[:, va : va + 3], v[:, va : va + 3], strict=True)]
+    return out
+
+
+def _dexp_inv_k(angle: float) -> tuple[float, float]:
+    """k(t) = 1/t² − (1 + cos t)/(2 t sin t) of dexp⁻¹ and its derivative k′(t) (series
+    1/12 + t²/720 + t⁴/30240, t/360 + t³/7560 below 0.05 rad, where the closed forms cancel;
+    the next terms are below 1e-12 of k there)."""
+    if angle < 0.05:
+        return (1 / 12 + angle**2 / 720 + angle**4 / 30240, angle / 360 + angle**3 / 7560)
+    half = angle / 2
+    k = 1 / angle**2 - (1 + np.cos(angle)) / (2 * angle * np.sin(angle))
+    dk = -2 / angle**3 + (angle / np.sin(half)**2 + 2 / np.tan(half)) / (4 * angle**2)
+    return float(k), float(dk)
+
+
+def _skew(x: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
+
+
+def dexp_inv_matrices(theta: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """D = ∂(dexp⁻¹(θ) v)/∂v and E = ∂(dexp⁻¹(θ) v)/∂θ of one rotation, from
+    dexp⁻¹(θ) v = v + ½ θ × v + k(|θ|) θ × (θ × v): D = 1 + ½ [θ]× + k [θ]×², E = −½ [v]× +
+    k ((θ·v) 1 + θ vᵀ − 2 v θᵀ) + k′ (θ × (θ × v)) θᵀ/|θ|."""
+    angle = float(np.linalg.norm(theta))
+    k, dk = _dexp_inv_k(angle)
+    cross = _skew(theta)
+    d = np.eye(3) + 0.5 * cross + k * cross @ cross
+    e = -0.5 * _skew(v) + k * (float(theta @ v) * np.eye(3) + np.outer(theta, v)
+                               - 2 * np.outer(v, theta))
+    if angle > 0:
+        e += dk * np.outer(np.cross(theta, np.cross(theta, v)), theta / angle)
+    return d, e
+
+
+def rk4_stages(canon: Canonical, tree: ModelTree, states: States, ref: Referee,
+               h: float) -> list[tuple[States, Referee, np.ndarray]]:
+    """The four stages of one RK4 step as MuJoCo (≥ 4.0) takes them, Runge–Kutta–Munthe-Kaas
+    on rotations: θᵢ = cᵢ h kᵢ₋₁, Qᵢ = q ⊕ θᵢ, vᵢ = v + cᵢ h v̇ᵢ₋₁, kᵢ = dexp⁻¹(θᵢ) vᵢ (vᵢ
+    where coordinates add) — each stage's state with the referee at it and its θᵢ."""
+    theta = np.zeros_like(states.v)
+    out = [(states, ref, theta)]
+    for c, _ in RK4_STAGES[1:]:
+        prev_states, prev, prev_theta = out[-1]
+        theta = c * h * _rates(canon, prev_theta, prev_states.v)
+        at = States(q=advance(canon, states.q, theta),
+                    v=states.v + c * h * prev.forward, a=states.a)
+        out.append((at, referee(tree, at), theta))
+    return out
+
+
+def rk4_step(canon: Canonical, stages: list[tuple[States, Referee, np.ndarray]],
+             h: float) -> np.ndarray:
+    """The Jacobian of one RK4 step (:func:`rk4_stages`) of x = (q, v) in the canonical chart,
+    by the chain rule through its stages: dθᵢ = cᵢ h dkᵢ₋₁, dvᵢ = dv + cᵢ h dv̇ᵢ₋₁, dQᵢ =
+    R(θᵢ)ᵀ dq + J_r(θᵢ) dθᵢ on rotations (dq + dθᵢ elsewhere), dv̇ᵢ = ∂v̇/∂q dQᵢ + ∂v̇/∂v dvᵢ
+    (the referee's, at the stage), dkᵢ = D(θᵢ) dvᵢ + E(θᵢ, vᵢ) dθᵢ; then dΘ = h Σ bᵢ dkᵢ,
+    dq₊ = R(Θ)ᵀ dq + J_r(Θ) dΘ, dv₊ = dv + h Σ bᵢ dv̇ᵢ — exact for the step. Where every
+    coordinate adds (hinge and slide joints) R, J_r, D are 1 and E is 0: the classical
+    chain rule."""
     n, nv = stages[0][0].v.shape
-    eye = np.eye(2 * nv)
-    total = np.zeros((n, 2 * nv, 2 * nv))
-    slope = np.zeros((n, 2 * nv, 2 * nv))
-    for (c, b), (_, ref) in zip(RK4_STAGES, stages, strict=True):
-        jac = np.zeros((n, 2 * nv, 2 * nv))
-        jac[:, :nv, nv:] = np.eye(nv)
-        jac[:, nv:, :nv] = ref.derivatives.forward_q
-        jac[:, nv:, nv:] = ref.derivatives.forward_v
-        slope = jac @ (eye + c * h * slope)
-        total += b * slope
-    return eye + h * total
+    rotations = [va for va, _ in _rotations(canon)]
+    eye = np.eye(nv)
+    out = np.zeros((n, 2 * nv, 2 * nv))
+    dq0 = np.hstack([eye, np.zeros((nv, nv))])
+    dv0 = np.hstack([np.zeros((nv, nv)), eye])
+
+    def turned(theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
+        """d(q ⊕ θ) = R(θ)ᵀ dq + J_r(θ) dθ (rotations), dq + dθ (elsewhere)."""
+        moved = dq0 + dtheta
+        for va in rotations:
+            rows = slice(va, va + 3)
+            moved[rows] = Rotation.from_rotvec(-theta[rows]).as_matrix() @ dq0[rows] \
+                + _right_jacobian(theta[rows]) @ dtheta[rows]
+        return moved
+
+    for s in range(n):
+        dk = df = np.zeros((nv, 2 * nv))
+        total_k = np.zeros((nv, 2 * nv))
+        total_f = np.zeros((nv, 2 * nv))
+        for (c, b), (at, ref, theta) in zip(RK4_STAGES, stages, strict=True):
+            dtheta = c * h * dk
+            dv = dv0 + c * h * df
+            df = ref.derivatives.forward_q[s] @ turned(theta[s], dtheta) \
+                + ref.derivatives.forward_v[s] @ dv
+            dk = dv.copy()
+            for va in rotations:
+                rows = slice(va, va + 3)
+                d, e = dexp_inv_matrices(theta[s, rows], at.v[s, rows])
+                dk[rows] = d @ dv[rows] + e @ dtheta[rows]
+            total_k += b * dk
+            total_f += b * df
+        big_theta = h * sum(b * _rates(canon, theta[s : s + 1], at.v[s : s + 1])[0]
+                            for (_, b), (at, _, theta) in zip(RK4_STAGES, stages, strict=True))
+        out[s, :nv] = turned(big_theta, h * total_k)
+        out[s, nv:] = dv0 + h * total_f
+    return out
 
 
 def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref: Referee,
@@ -115,10 +225,10 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
             tolerance=float("nan"), basis="", verdict=Verdict.SKIPPED,
             note=why)]
     if rk4:
-        stages = rk4_stages(tree, states, ref, h)
-        expected = rk4_step(stages, h)
-        ref_q = np.max([r.error["forward_q"] for _, r in stages], axis=0)
-        ref_v = np.max([r.error["forward_v"] for _, r in stages], axis=0)
+        stages = rk4_stages(canon, tree, states, ref, h)
+        expected = rk4_step(canon, stages, h)
+        ref_q = np.max([r.error["forward_q"] for _, r, _ in stages], axis=0)
+        ref_v = np.max([r.error["forward_v"] for _, r, _ in stages], axis=0)
         rule = "RK4's chain rule through its 4 stages"
     else:
         expected = euler_step(canon, ref, states, h)
