@@ -149,6 +149,15 @@ class Placed:
         return frozenset(self.element.attrib)
 
 
+def children(holder: ET.Element, tag: str) -> list[ET.Element]:
+    """The ``tag`` children of a body (or the world), those in its ``<frame>``s (nested)
+    included: a frame's elements belong to its body."""
+    found = holder.findall(tag)
+    for frame in holder.findall("frame"):
+        found += children(frame, tag)
+    return found
+
+
 def placed(root: ET.Element, tag: str, keys: tuple[str, ...]) -> list[Placed]:
     """Every ``<tag>`` element of the bodies (geoms, joints), in document order."""
     defaults = class_defaults(root, tag, keys)
@@ -232,13 +241,18 @@ def _carries_inertia(attrs: dict[str, str], owner: Owner, mode: str,
     return groups[0] <= int(attrs.get("group", "0")) <= groups[1]
 
 
-def for_parser(path: Path, engine: str, readable: tuple[str, ...]) -> Copy:
+def for_parser(path: Path, engine: str, readable: tuple[str, ...], *,
+               massless_aborts: bool = False) -> Copy:
     """The copy of ``path`` that ``engine`` can read, whose mesh parser reads only files ending
-    in ``readable``; ``Copy.notes`` empty when nothing had to change (load the file itself).
-    Raises :class:`Unsupported` where an inertia comes from an unreadable mesh."""
+    in ``readable`` (and, ``massless_aborts``, which aborts on an ``<inertial mass="0">``);
+    ``Copy.notes`` empty when nothing had to change (load the file itself). Raises
+    :class:`Unsupported` where an inertia comes from an unreadable mesh, or a moving body
+    states a zero mass."""
     root = inline(path)
     folder = path.resolve().parent
     notes: list[str] = []
+    if massless_aborts:
+        notes += _without_massless(root, engine)
     files = _mesh_files(root, folder)
     unreadable = {name for name, file in files.items()
                   if file is None or file.suffix.lower() not in readable}
@@ -282,6 +296,47 @@ def for_parser(path: Path, engine: str, readable: tuple[str, ...]) -> Copy:
     if not notes and encoding(path) is None:  # a UTF-8 copy is said once, by model_files
         return Copy(text="", notes=())
     return Copy(text=_standalone(root, folder), notes=tuple(notes))
+
+
+MASSLESS = (
+    "{engine}'s MJCF parser aborts on an <inertial mass=\"0\"> (\"condition 'mass > 0' "
+    "failed\"; measured on robosuite's panda)"
+)
+
+
+def _without_massless(root: ET.Element, engine: str) -> list[str]:
+    """Drop every ``<inertial mass="0">`` whose body then still weighs nothing: welded to the
+    world (it moves no inertia), or without a geom that carries mass (MuJoCo's compiler then
+    finds zero from its geoms, and the parser reads a body without inertia); the dynamics are
+    unchanged. Refuse any other, naming the body and the fix."""
+    weighty = {id(g.body) for g in geoms(root)
+               if float(g.attrs.get("mass", "nan")) != 0.0 and (
+                   "mass" in g.attrs or float(g.attrs.get("density", "1000")) != 0.0)}
+    dropped = []
+
+    def walk(holder: ET.Element, welded: bool) -> None:
+        for body in children(holder, "body"):
+            still = welded and not (children(body, "joint") or children(body, "freejoint"))
+            inertial = body.find("inertial")
+            if inertial is not None and float(inertial.get("mass", "nan")) == 0.0:
+                name = body.get("name", "(unnamed)")
+                if not still and id(body) in weighty:
+                    raise Unsupported(f"{engine}: body {name!r} states <inertial mass=\"0\">: "
+                                      f"{MASSLESS.format(engine=engine)} (fix: give it a "
+                                      "positive mass, or no <inertial>)")
+                body.remove(inertial)
+                dropped.append(name)
+            walk(body, still)
+
+    for world in root.findall("worldbody"):
+        walk(world, True)
+    if not dropped:
+        return []
+    return [f"{engine}: given a copy without the <inertial mass=\"0\"> of "
+            f"{', '.join(repr(n) for n in dropped[:4])}{' …' if len(dropped) > 4 else ''}: "
+            f"{MASSLESS.format(engine=engine)}; each of these bodies is welded to the world or "
+            "has no geom with mass, so it weighs nothing either way and the dynamics are "
+            "unchanged"]
 
 
 TEXTURE_FILES = ("file", "fileright", "fileleft", "fileup", "filedown", "filefront",

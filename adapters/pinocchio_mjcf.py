@@ -13,7 +13,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from dyncheck.adapters.mjcf_copy import Placed, geoms, inline, joints
+from dyncheck.adapters.mjcf_copy import Placed, children, geoms, inline, joints
 from dyncheck.adapters.model_files import Format, ModelFile
 
 Hint = tuple[str, str, str]
@@ -160,24 +160,16 @@ def _body_hints(root: ET.Element) -> Iterable[Hint]:
                     yield name, field, "; ".join(why)
 
 
-def _direct(holder: ET.Element, tag: str) -> list[ET.Element]:
-    """The ``tag`` children of a body, those in its ``<frame>``s (nested) included."""
-    found = holder.findall(tag)
-    for frame in holder.findall("frame"):
-        found += _direct(frame, tag)
-    return found
-
-
 def _carriers(root: ET.Element) -> Iterable[tuple[list[ET.Element], tuple[str, ...]]]:
     """Each moving body with the bodies welded to it, and the names of its joints (a body
     with an unnamed joint: none, so its hints apply model-wide)."""
     out: list[tuple[list[ET.Element], tuple[str, ...]]] = []
 
     def own_joints(body: ET.Element) -> list[ET.Element]:
-        return [*_direct(body, "joint"), *_direct(body, "freejoint")]
+        return [*children(body, "joint"), *children(body, "freejoint")]
 
     def walk(body: ET.Element, group: list[ET.Element]) -> None:
-        for child in _direct(body, "body"):
+        for child in children(body, "body"):
             if own_joints(child):
                 start(child)
             else:
@@ -192,7 +184,7 @@ def _carriers(root: ET.Element) -> Iterable[tuple[list[ET.Element], tuple[str, .
             out.append((group, tuple(n for n in names if n) if all(names) else ()))
 
     for world in root.findall("worldbody"):
-        for body in _direct(world, "body"):
+        for body in children(world, "body"):
             start(body)
     return out
 

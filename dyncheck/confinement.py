@@ -32,13 +32,20 @@ def die_with_parent(parent: int) -> None:
         os._exit(0)
 
 
-def release_output() -> None:
-    """Point this process's stdout and stderr at /dev/null (the caller's pipe is let go)."""
+def release_output(errors: str | None = None) -> None:
+    """Point this process's stdout at /dev/null and its stderr there too, or at the file
+    ``errors`` (the parent reads a crash's last words from it): the caller's pipe is let
+    go."""
     sys.stdout.flush()
     sys.stderr.flush()
     null = os.open(os.devnull, os.O_WRONLY)
     os.dup2(null, 1)
-    os.dup2(null, 2)
+    if errors is None:
+        os.dup2(null, 2)
+    else:
+        err = os.open(errors, os.O_WRONLY | os.O_APPEND)
+        os.dup2(err, 2)
+        os.close(err)
     os.close(null)
 
 
@@ -51,9 +58,11 @@ def cap_memory(limit_bytes: int | None) -> None:
     resource.setrlimit(resource.RLIMIT_AS, (cap, hard))
 
 
-def confine(parent: int, *, memory_bytes: int | None = None, quiet: bool = False) -> None:
-    """All of the above for a child of ``parent``."""
+def confine(parent: int, *, memory_bytes: int | None = None, quiet: bool = False,
+            errors: str | None = None) -> None:
+    """All of the above for a child of ``parent`` (``errors``: where a quiet one's stderr
+    goes)."""
     die_with_parent(parent)
     if quiet:
-        release_output()
+        release_output(errors)
     cap_memory(memory_bytes)

@@ -15,12 +15,14 @@ trust their models).
 
 from __future__ import annotations
 
+import contextlib
 import faulthandler
 import importlib
 import importlib.metadata
 import multiprocessing as mp
 import os
 import signal
+import tempfile
 import time
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
@@ -140,19 +142,20 @@ def load(name: str, source: ModelFile, spec: Registration | None = None,
 
 
 def _serve(name: str, spec: Registration, source: ModelFile, conn: Connection, parent: int,
-           memory_mib: int | None, settings: Settings) -> None:
+           memory_mib: int | None, settings: Settings, errors: str) -> None:
     """The isolated engine's process: confined (it dies with dyncheck, lets go of the
-    caller's output, its memory capped), the command's settings in force, it loads, sends
-    the tree, then answers batches until None."""
-    with in_force(settings):
-        _answer(name, spec, source, conn, parent, memory_mib)
-
-
-def _answer(name: str, spec: Registration, source: ModelFile, conn: Connection, parent: int,
-            memory_mib: int | None) -> None:
+    caller's output — its stderr into ``errors``, a crash's last words —, its memory
+    capped), the command's settings in force, it loads, sends the tree, then answers
+    batches until None."""
     faulthandler.disable()  # a crash here is reported by the parent, in one line
     confine(parent, memory_bytes=None if memory_mib is None else memory_mib * 2**20,
-            quiet=True)
+            quiet=True, errors=errors)
+    with in_force(settings):
+        _answer(name, spec, source, conn, memory_mib)
+
+
+def _answer(name: str, spec: Registration, source: ModelFile, conn: Connection,
+            memory_mib: int | None) -> None:
     loaded = load(name, source, spec, memory_mib)
     if isinstance(loaded, NotLoaded):
         conn.send(loaded)
@@ -175,13 +178,37 @@ def _answer(name: str, spec: Registration, source: ModelFile, conn: Connection, 
             conn.send(EngineError(f"{type(exc).__name__}: {' '.join(str(exc).split())}"))
 
 
-def _death(code: int | None) -> str:
+def _death(code: int | None, errors: str | None = None) -> str:
+    """How the engine's process ended, with the last line it wrote to stderr (an engine's
+    own abort message: Drake's "condition 'mass > 0' failed")."""
     if code is not None and code < 0:
         try:
-            return f"killed by {signal.Signals(-code).name}"
+            how = f"killed by {signal.Signals(-code).name}"
         except ValueError:
-            return f"killed by signal {-code}"
-    return f"exit status {code}"
+            how = f"killed by signal {-code}"
+    else:
+        how = f"exit status {code}"
+    said = _last_words(errors) if errors else ""
+    return f"{how}: {said}" if said else how
+
+
+LAST_WORDS_BYTES = 4096
+LAST_WORDS_CHARS = 300
+
+
+def _last_words(path: str) -> str:
+    """The last non-empty line of the file (its last 4 KiB read), as one line of at most
+    300 characters; empty when there is none."""
+    try:
+        with open(path, "rb") as handle:
+            handle.seek(0, os.SEEK_END)
+            handle.seek(max(0, handle.tell() - LAST_WORDS_BYTES))
+            tail = handle.read().decode("utf-8", errors="replace")
+    except OSError:
+        return ""
+    lines = [" ".join(line.split()) for line in tail.splitlines() if line.strip()]
+    last = lines[-1] if lines else ""
+    return last if len(last) <= LAST_WORDS_CHARS else last[: LAST_WORDS_CHARS - 1] + "…"
 
 
 class Isolated:
@@ -195,9 +222,13 @@ class Isolated:
         self._source = source
         self._conn, child = ctx.Pipe()
         memory = None if name in PORTS else self.limits.memory_mib
+        with tempfile.NamedTemporaryFile(prefix=f"dyncheck-{name}-", suffix=".err",
+                                         delete=False) as errors:
+            self._errors = errors.name  # the child's stderr: a crash's last words
         # the spec travels with the call: a spawned child would not see a patched ENGINES
         self._proc = ctx.Process(target=_serve, args=(name, ENGINES[name], source, child,
-                                                      os.getpid(), memory, current()),
+                                                      os.getpid(), memory, current(),
+                                                      self._errors),
                                  daemon=True)
         self._proc.start()
         child.close()
@@ -207,7 +238,7 @@ class Isolated:
         while not self._conn.poll(0.02):
             if not self._proc.is_alive() and not self._conn.poll(0):
                 raise EngineError(f"{self.engine} crashed while {doing} "
-                                  f"({_death(self._proc.exitcode)})")
+                                  f"({_death(self._proc.exitcode, self._errors)})")
             if time.monotonic() > deadline:
                 self.close(hung=True)
                 raise EngineError(f"{self.engine} gave no answer within {timeout:.0f} s "
@@ -217,13 +248,14 @@ class Isolated:
         except EOFError:
             self._proc.join(5)
             raise EngineError(f"{self.engine} crashed while {doing} "
-                              f"({_death(self._proc.exitcode)})") from None
+                              f"({_death(self._proc.exitcode, self._errors)})") from None
 
     def loaded(self) -> Isolated | NotLoaded:
         """Wait for the load: this proxy with the engine's tree, or why it has none."""
         try:
             answer = self._receive("loading the model", self.limits.load_seconds(self._source))
         except EngineError as exc:
+            self.close()
             return NotLoaded(self.engine, False, str(exc))
         if isinstance(answer, NotLoaded):
             self.close()
@@ -249,7 +281,7 @@ class Isolated:
             self._conn.send((kind, q, v, a))
         except OSError:
             raise EngineError(f"{self.engine} crashed earlier "
-                              f"({_death(self._proc.exitcode)})") from None
+                              f"({_death(self._proc.exitcode, self._errors)})") from None
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
         """The engine's derivatives (:class:`Unsupported` where it offers none)."""
@@ -284,6 +316,8 @@ class Isolated:
             self._proc.kill()
             self._proc.join()
         self._conn.close()
+        with contextlib.suppress(OSError):
+            os.unlink(self._errors)
 
 
 def can_isolate() -> bool:

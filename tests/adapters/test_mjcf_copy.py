@@ -194,3 +194,52 @@ def test_every_engine_reads_a_file_in_another_encoding_as_its_utf8_twin(tmp_path
     for name in ("mass_matrix", "bias", "forward", "inverse"):
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
     assert nv == 2 and np.abs(a.mass_matrix).max() > 0
+
+
+MASSLESS = '<inertial pos="0 0 0" mass="0" diaginertia="0 0 0"/>'
+
+
+@pytest.mark.parametrize(("body", "dropped"), [
+    # welded to the world: moves no inertia (robosuite's panda 'base')
+    (f'<body name="base">{MASSLESS}<body name="b" pos="0 0 1"><joint type="hinge"/>'
+     '<geom size="0.1"/></body></body>', True),
+    # on a moving body, without a geom that weighs (sawyer's 'head_camera')
+    ('<body name="b" pos="0 0 1"><joint type="hinge"/><geom size="0.1"/>'
+     f'<body name="cam">{MASSLESS}<geom size="0.01" density="0"/></body></body>', True),
+    # on a moving body whose geom would weigh once the <inertial> is gone: refused
+    ('<body name="b" pos="0 0 1"><joint type="hinge"/><geom size="0.1"/>'
+     f'<body name="cam">{MASSLESS}<geom size="0.01"/></body></body>', False),
+])
+def test_a_massless_inertial_is_dropped_exactly_where_the_body_weighs_nothing_either_way(
+        tmp_path, body, dropped):
+    """Drake's MJCF parser aborts on <inertial mass="0"> (measured: "condition 'mass > 0'
+    failed", exit status 1). A body welded to the world moves no inertia, and one with no
+    geom of mass weighs nothing in MuJoCo without its <inertial> (its compiler computes zero
+    from its geoms, MuJoCo's documented inertiafromgeom="auto"): dropped there, said in the
+    notes; anywhere else refused, naming the body and the fix."""
+    path = _model(tmp_path, body, stl=False)
+    if not dropped:
+        with pytest.raises(Unsupported, match=r"body 'cam' states <inertial mass=\"0\">.*fix"):
+            for_parser(path, "drake", OBJ, massless_aborts=True)
+        return
+    copy = for_parser(path, "drake", OBJ, massless_aborts=True)
+    assert not [i for i in ET.fromstring(copy.text).iter("inertial")
+                if float(i.get("mass")) == 0]
+    assert any("without the <inertial mass=\"0\">" in n for n in copy.notes)
+    assert for_parser(path, "drake", OBJ).notes == ()  # a parser that reads it: untouched
+
+
+def test_drake_reads_a_model_with_a_massless_welded_base_alike(tmp_path):
+    """robosuite's arms begin with <body name="base"> holding <inertial mass="0">: Drake
+    crashed on them; given the copy, its dynamics agree with MuJoCo's and the referee's."""
+    pytest.importorskip("pydrake")
+    from dyncheck.check.model_check import check_model
+
+    path = tmp_path / "arm.xml"
+    path.write_text(f'<mujoco model="arm"><worldbody><body name="base">{MASSLESS}<body name="b" '
+                    'pos="0 0 1"><joint name="j" type="hinge" axis="0 1 0"/><geom size="0.1" '
+                    'pos="0 0 -0.3"/></body></body></worldbody></mujoco>')
+    result = check_model(path, states=5, impls=("reference", "mujoco", "drake"))
+    assert result.ok, result.failures()
+    loaded = result.rows[(result.rows.section == "load") & (result.rows.impl_a == "drake")]
+    assert list(loaded.verdict) == ["passed"]

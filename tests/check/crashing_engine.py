@@ -19,6 +19,19 @@ class CrashOnLoad(MujocoModel):
         _segfault()
 
 
+class AbortOnLoad(MujocoModel):
+    """A parser that states why on stderr, then ends its process (Drake's MJCF parser on an
+    ``<inertial mass="0">``: "Failure at …unit_inertia.h:104 …: condition 'mass > 0'
+    failed.", exit status 1)."""
+
+    def __init__(self, source):  # type: ignore[no-untyped-def]
+        import os
+
+        os.write(2, b"a first line the page need not show\n")
+        os.write(2, b"Failure at parser.cc:104 in Read(): condition 'mass > 0' failed.\n")
+        os._exit(1)
+
+
 class CrashOnDynamics(MujocoModel):
     def dynamics(self, q, v, a):  # type: ignore[no-untyped-def]
         _segfault()

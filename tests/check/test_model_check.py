@@ -181,10 +181,13 @@ def test_readme_pytest_recipe_names_the_plugin_s_options_and_fixture():
 
 CRASHES = {
     "CrashOnLoad": "crashed while loading the model (killed by SIGSEGV)",
+    "AbortOnLoad": "crashed while loading the model (exit status 1: Failure at parser.cc:104 "
+                   "in Read(): condition 'mass > 0' failed.)",
     "CrashOnDynamics": "crashed while computing the dynamics (killed by SIGSEGV)",
     "HangOnDynamics": "gave no answer within 1 s while computing the dynamics (stopped)",
 }
-"""tests/check/crashing_engine.py's engines, and the words of the one row each must fail."""
+"""tests/check/crashing_engine.py's engines, and the words of the one row each must fail
+(an engine's own last words on stderr quoted: the page says why)."""
 
 
 @pytest.fixture(scope="module")
