@@ -40,6 +40,7 @@ from pydrake.multibody.tree import (
 )
 
 from dyncheck.adapters.mjcf_copy import for_parser, inline
+from dyncheck.adapters.mjcf_unread import springdampers
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -173,10 +174,16 @@ SKIPPED_CLASS = (
     "{joint!r} takes its {fields} from default class {source!r} through class {gap!r}, "
     "which sets no <joint> attribute: Drake's MJCF parser passes a class's joint defaults on "
     "only through classes that have a <joint> element (measured: armature 0.01 and damping 3 "
-    "read as 0), "
+    "read as 0, axis 1 0 0 as 0 0 1, pos 0.1 0 0 as 0 0 0, range ±10 as none), "
     "so Drake reads the element's own default instead (fix: write the attribute on class "
     "{gap!r}'s <joint>, or on the joint)"
 )
+
+
+LOST_ACROSS_A_GAP = {"armature": "armature", "damping": "damping", "axis": "axis",
+                     "pos": "anchor", "range": "range"}
+"""The joint attributes Drake loses across a class without <joint>, and the description
+field each shows in."""
 
 
 def _skipped_classes(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
@@ -210,13 +217,14 @@ def _skipped_classes(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
                 if own is None or not later:
                     continue
                 below = [d.find("joint") for d in chain[k + 1:]]
-                fields = [f for f in ("armature", "damping") if f in own.attrib
+                fields = [f for f in LOST_ACROSS_A_GAP if f in own.attrib
                           and f not in joint.attrib
                           and not any(e is not None and f in e.attrib for e in below)]
                 for field in fields:
-                    out.append((joint.get("name", ""), field, SKIPPED_CLASS.format(
-                        joint=joint.get("name"), fields=field,
-                        source=default.get("class", "main"), gap=later[0].get("class"))))
+                    out.append((joint.get("name", ""), LOST_ACROSS_A_GAP[field],
+                                SKIPPED_CLASS.format(joint=joint.get("name"), fields=field,
+                                                     source=default.get("class", "main"),
+                                                     gap=later[0].get("class"))))
         for body in holder.findall("body"):
             visit(body, body.get("childclass", childclass))
         for frame in holder.findall("frame"):
@@ -372,7 +380,8 @@ class DrakeModel:
             if j.type is not JointType.FREE and j.name not in reflected
             and self._source.format is Format.MJCF
         ) + _skipped_classes(self._source) + _first_of_several(self._source) \
-            + _ignored_frames(notes)
+            + _ignored_frames(notes) + (tuple(springdampers(self._source.path, "Drake"))
+                                        if self._source.format is Format.MJCF else ())
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
                          nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,
                          hints=hints)

@@ -164,6 +164,12 @@ class MujocoModel:
         self.data = mujoco.MjData(m)
         if np.any(m.body_gravcomp != 0):
             notes += ("mujoco: gravity compensation (gravcomp) left out of the dynamics",)
+        if m.ntendon and np.any(m.tendon_armature != 0):
+            armed = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_TENDON, i) or f"tendon {i}"
+                     for i in np.flatnonzero(m.tendon_armature)]
+            notes += (TENDON_ARMATURE.format(tendons=", ".join(repr(t) for t in armed[:4])
+                                             + (" …" if len(armed) > 4 else "")),)
+            m.tendon_armature[:] = 0.0
         self.tree = self._tree(notes)
 
     def _tree(self, notes: tuple[str, ...]) -> ModelTree:
@@ -334,6 +340,10 @@ class MujocoModel:
         return tuple(out)
 
 
+TENDON_ARMATURE = (
+    "mujoco: tendon armature ({tendons}) left out of M, h and the dynamics compared: MuJoCo "
+    "adds a Jₜᵀ Jₜ of each tendon to M (measured), and no other engine's parser reads tendons"
+)
 GYROSCOPIC_STEP = ("MuJoCo's implicitfast differentiates a free body's gyroscopic force "
                    "(since 3.11): its step is not Euler's on a free joint; the chain rule of "
                    "Euler's step is no referee for it")

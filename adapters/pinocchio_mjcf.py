@@ -14,6 +14,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from dyncheck.adapters.mjcf_copy import Placed, children, geoms, inline, joints
+from dyncheck.adapters.mjcf_unread import springdampers
 from dyncheck.adapters.model_files import Format, ModelFile
 
 Hint = tuple[str, str, str]
@@ -34,6 +35,12 @@ SLIDE_RANGE = (
     "were an angle (measured: dm_control's cartpole slider (-1.8, 1.8) m read as (-0.0314, "
     "0.0314), × π/180), under <compiler angle=\"degree\">, MJCF's default (fix: none in the "
     "file that keeps it the same model; the dynamics here leave limits out)"
+)
+ROOT_PLACEMENT = (
+    "Pinocchio's MJCF parser puts a jointless top-level body ({body!r}, {where}) at the world "
+    "origin, unrotated (measured: quat=\"0 1 0 1\" and pos read as the identity) (fix: wrap "
+    "the model in a top-level body of your own without pos or orientation, or rotate "
+    "gravity by the same turn)"
 )
 GRAVITY_IGNORED = (
     "Pinocchio's MJCF parser does not read <option gravity=\"{gravity}\"> (its model keeps "
@@ -63,13 +70,6 @@ DEFAULT_POS = (
     "from a class read as 0 0 0; the same pos written on the joint read as written) (fix: "
     "write pos= on the joint)"
 )
-SPRINGDAMPER = (
-    "Pinocchio's MJCF parser does not read springdamper=\"{value}\", from which MuJoCo "
-    "derives the joint's stiffness and damping with the joint's inertia (measured: "
-    "springdamper=\"0.001 50\" on a 4.19 kg sphere: MuJoCo's damping 33.5, Pinocchio's 0) "
-    "(fix: state stiffness= and damping= on the joint)"
-)
-
 REF_RANGE = (
     "Pinocchio's MJCF parser subtracts the joint's ref={ref} from its range while its "
     "coordinate keeps ref (its qpos0 holds it): its limits are shifted by −ref (measured: "
@@ -96,7 +96,7 @@ def hints(source: ModelFile) -> tuple[Hint, ...]:
         return ()
     root = inline(source.path)
     return (*_model_hints(root, bare_bodies(source)), *_body_hints(root),
-            *_joint_hints(root))
+            *_joint_hints(root), *springdampers(source.path, "Pinocchio"))
 
 
 def _model_hints(root: ET.Element, bare: int) -> Iterable[Hint]:
@@ -112,6 +112,13 @@ def _model_hints(root: ET.Element, bare: int) -> Iterable[Hint]:
     if (angle[-1] if angle else "degree") == "degree" and any(
             j.get("type") == "slide" for j in root.iter("joint")):
         yield "model", "slide range", SLIDE_RANGE
+    tops = [b for world in root.findall("worldbody") for b in children(world, "body")]
+    placed = [k for k in ("pos", "quat", "euler", "axisangle", "xyaxes", "zaxis")
+              if tops and k in tops[0].attrib]
+    if placed and not (children(tops[0], "joint") or children(tops[0], "freejoint")):
+        where = ", ".join(f'{k}="{tops[0].get(k)}"' for k in placed)
+        yield "model", "placement", ROOT_PLACEMENT.format(body=tops[0].get("name", "(unnamed)"),
+                                                          where=where)
     stated = [o.get("gravity", "") for o in root.iter("option") if o.get("gravity")]
     if stated and not np.allclose([float(x) for x in stated[-1].split()], (0.0, 0.0, -9.81)):
         yield "model", "gravity", GRAVITY_IGNORED.format(gravity=stated[-1])
@@ -190,8 +197,8 @@ def _carriers(root: ET.Element) -> Iterable[tuple[list[ET.Element], tuple[str, .
 
 
 def _joint_hints(root: ET.Element) -> Iterable[Hint]:
-    """A joint's position from a default class; ``springdamper``; its range where it has a
-    ``ref`` or is not limited."""
+    """A joint's position from a default class; its range where it has a ``ref`` or is not
+    limited."""
     for joint in joints(root):
         name = joint.element.get("name")
         if not name:  # matched by place under another name: no hint rather than a wrong one
@@ -201,9 +208,6 @@ def _joint_hints(root: ET.Element) -> Iterable[Hint]:
             cls = joint.element.get("class")
             yield name, "anchor", DEFAULT_POS.format(
                 pos=pos, cls=f"class {cls!r}" if cls else "a default class")
-        if "springdamper" in joint.attrs and any(
-                float(x) for x in joint.attrs["springdamper"].split()):
-            yield name, "damping", SPRINGDAMPER.format(value=joint.attrs["springdamper"])
         if "range" in joint.attrs:
             if joint.attrs.get("limited") == "false":
                 yield name, "range", UNLIMITED_RANGE

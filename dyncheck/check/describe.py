@@ -15,9 +15,10 @@ parallel-axis term: 1e-8 kg m² of a point mass 1 m from its pivot to ~1e-16 abs
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from dyncheck.adapters.model_tree import JointType, ModelTree, TreeJoint
 from dyncheck.check.rows import CheckRow, Section
@@ -93,45 +94,120 @@ SHIFTED = (
     "body, say); under uniform gravity no dynamics depend on where the model sits, so the "
     "anchor and com rows are compared after that shift"
 )
+TURNED = (
+    "{b} places the whole model turned by {angle:.4g}° about {axis}{t} from where {a} does: "
+    "every anchor, axis, centre of mass and inertia carried by that one rigid motion, so the "
+    "fields are compared after undoing it; {effect}"
+)
+GRAVITY_TURNED = (
+    "gravity then pulls on the model from another direction, and every gravity force (h, "
+    "inverse and forward dynamics) differs"
+)
+GRAVITY_KEPT = (
+    "gravity is {why}, so no dynamics depend on the turn"
+)
 
 
-def shift(a: ModelTree, b: ModelTree, tol: float) -> np.ndarray | None:
-    """The one translation t that carries every common joint's anchor and centre of mass in
-    ``a`` onto ``b``'s (axes unchanged), where there is one and it is not zero (within
-    ``tol``): the model placed elsewhere in the world."""
+@dataclass(frozen=True, kw_only=True)
+class Placement:
+    """The one rigid motion x_b = R x_a + t that carries every common joint of ``a`` onto
+    ``b``'s (anchors and centres of mass as points, axes as directions)."""
+
+    rotation: np.ndarray
+    translation: np.ndarray
+
+    @property
+    def turned(self) -> bool:
+        return bool(np.abs(self.rotation - np.eye(3)).max() > 0)
+
+    def undo(self, joint: TreeJoint) -> TreeJoint:
+        """``joint`` of ``b`` carried back into ``a``'s placement."""
+        back = self.rotation.T
+        return replace(joint, anchor=back @ (joint.anchor - self.translation),
+                       com=back @ (joint.com - self.translation), axis=back @ joint.axis,
+                       frame=back @ joint.frame, inertia=back @ joint.inertia @ self.rotation)
+
+
+def placement(a: ModelTree, b: ModelTree, tol: float) -> Placement | None:
+    """The rigid motion (:class:`Placement`) that carries every common joint of ``a`` onto
+    ``b``'s, where there is one and it is not the identity (within ``tol``): the model placed
+    elsewhere in the world, or turned (Pinocchio's MJCF parser puts a jointless top-level
+    body at the world origin, unrotated — measured). The rotation from the joints' axes and
+    the directions between their points (Kabsch's SVD); a translation alone where those
+    directions do not fix one."""
     pairs = [(ja, b.joint(ja.name)) for ja in a.joints
              if ja.name in {j.name for j in b.joints} and b.joint(ja.name).type is ja.type]
-    coms = [(ja.com, jb.com) for ja, jb in pairs if ja.mass > 0 and jb.mass > 0]
-    if not coms:
+    points = [(ja.com, jb.com) for ja, jb in pairs if ja.mass > 0 and jb.mass > 0]
+    points += [(ja.anchor, jb.anchor) for ja, jb in pairs if ja.type is not JointType.SLIDE]
+    if not points:
         return None
-    t = coms[0][1] - coms[0][0]
-    if float(np.abs(t).max()) <= tol:
+    directions = [(ja.axis, jb.axis) for ja, jb in pairs
+                  if ja.type in (JointType.HINGE, JointType.SLIDE)]
+    directions += [(pa - points[0][0], pb - points[0][1]) for pa, pb in points[1:]]
+    rotation = np.eye(3)
+    if directions:
+        da = np.array([d for d, _ in directions])
+        db = np.array([d for _, d in directions])
+        if np.linalg.matrix_rank(da, tol=tol) >= 2:
+            u, _, vt = np.linalg.svd(db.T @ da)
+            rotation = u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt
+            if np.abs(rotation - np.eye(3)).max() <= tol:
+                rotation = np.eye(3)
+    t = points[0][1] - rotation @ points[0][0]
+    if not np.abs(rotation - np.eye(3)).max() and float(np.abs(t).max()) <= tol:
         return None
+    moved = Placement(rotation=rotation, translation=t)
     for ja, jb in pairs:
-        if np.abs(ja.axis - jb.axis).max() > tol:
+        back = moved.undo(jb)
+        if np.abs(ja.axis - back.axis).max() > tol:
             return None
-        moved = jb.anchor - t - ja.anchor
-        off = np.cross(moved, ja.axis) if ja.type is JointType.HINGE else moved
+        off = back.anchor - ja.anchor
+        off = np.cross(off, ja.axis) if ja.type is JointType.HINGE else off
         if ja.type is not JointType.SLIDE and float(np.abs(off).max()) > tol:
             return None
-    if any(float(np.abs(cb - t - ca).max()) > tol for ca, cb in coms):
-        return None
-    return t
+        if ja.mass > 0 and back.mass > 0 and float(np.abs(back.com - ja.com).max()) > tol:
+            return None
+    return moved
+
+
+def _placement_row(a: ModelTree, b: ModelTree, moved: Placement,
+                   tol: float) -> tuple[Verdict, str]:
+    """The verdict and note of the one row a placement gets: a translation, or a turn that
+    keeps gravity (none, or along the turn's axis), changes no dynamics — explained; a turn
+    that changes gravity's direction in the model is a difference of the dynamics."""
+    if not moved.turned:
+        return Verdict.EXPLAINED, SHIFTED.format(a=a.engine, b=b.engine,
+                                                 t=_fmt(moved.translation))
+    rotvec = Rotation.from_matrix(moved.rotation).as_rotvec()
+    angle = float(np.degrees(np.linalg.norm(rotvec)))
+    axis = _fmt(rotvec / np.linalg.norm(rotvec))
+    g = a.gravity
+    g_scale = float(np.linalg.norm(g))
+    kept = g_scale == 0 or float(np.abs(moved.rotation @ g - g).max()) <= tol * g_scale
+    effect = GRAVITY_KEPT.format(why="off" if g_scale == 0 else "along that axis") if kept \
+        else GRAVITY_TURNED
+    t = moved.translation
+    note = TURNED.format(a=a.engine, b=b.engine, angle=angle, axis=axis, effect=effect,
+                         t=f" and moved by {_fmt(t)} m" if np.abs(t).max() > tol * size(a)
+                         else "")
+    why = b.hint("model", "placement") or a.hint("model", "placement")
+    return (Verdict.EXPLAINED if kept else Verdict.FAILED), note + (f": {why}" if why else "")
 
 
 def diff(model: str, a: ModelTree, b: ModelTree,
          invalid: Mapping[str, str] | None = None) -> list[CheckRow]:
     """Every difference between two engines' trees (one row each), or one passed row. A model
-    placed elsewhere as a whole (:func:`shift`) is one explained row, its fields compared
-    after the shift. ``invalid``: the bodies whose inertia a validity row failed (body → that
-    row's note); a body field read differently there names it as its cause."""
+    placed elsewhere as a whole (:func:`placement`) is one row — explained where no dynamics
+    depend on it —, its fields compared after undoing it. ``invalid``: the bodies whose
+    inertia a validity row failed (body → that row's note); a body field read differently
+    there names it as its cause."""
     invalid = invalid or {}
     eps = max(a.eps, b.eps)  # a float32 engine's numbers are rounded to float32
     rtol = ROUNDOFF_FACTOR * eps * max(depth(a), depth(b))
     basis = f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth {max(depth(a), depth(b))}"
     length = size(a)
     rows: list[CheckRow] = []
-    moved = shift(a, b, rtol * length)
+    moved = placement(a, b, rtol * length)
 
     def row(subject: str, field: str, va: object, vb: object, err: float, tol: float,
             verdict: Verdict, note: str = "") -> None:
@@ -155,14 +231,19 @@ def diff(model: str, a: ModelTree, b: ModelTree,
                 f"{a.engine} has no joint {name!r}")
     compared = 0
     if moved is not None:
-        row("model", "placement", np.zeros(3), moved, float(np.abs(moved).max()) / length, rtol,
-            Verdict.EXPLAINED, SHIFTED.format(a=a.engine, b=b.engine, t=_fmt(moved)))
+        verdict, note = _placement_row(a, b, moved, rtol)
+        turn = Rotation.from_matrix(moved.rotation).as_rotvec()  # (t, the turn's rotation
+        shown = np.concatenate([moved.translation, turn]) if moved.turned \
+            else moved.translation  # vector) where turned, t alone where not
+        row("model", "placement", np.zeros_like(shown), shown,
+            max(float(np.abs(moved.translation).max()) / length, float(np.abs(turn).max())),
+            rtol, verdict, note)
     for ja in a.joints:
         if ja.name not in names_b:
             continue
         jb = b.joint(ja.name)
         if moved is not None:
-            jb = replace(jb, anchor=jb.anchor - moved, com=jb.com - moved)
+            jb = moved.undo(jb)
         if ja.type is not jb.type:
             row(ja.name, "type", ja.type, jb.type, np.inf, 0.0, Verdict.FAILED)
             continue

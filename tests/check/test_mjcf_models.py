@@ -270,6 +270,43 @@ def test_a_model_placed_elsewhere_as_a_whole_is_explained_not_failed(tmp_path):
     assert set(_rows(result, "dynamics")["verdict"]) == {"passed"}
 
 
+@pytest.mark.parametrize(("turn", "kept"), [("0 90 0", False), ("0 0 90", True)])
+def test_a_model_turned_as_a_whole_is_one_row_and_its_fields_agree_after_it(tmp_path, turn,
+                                                                            kept):
+    """A jointless root body turned (dm_control's and Menagerie's shadow hand: quat="0 1 0 1"):
+    Pinocchio's MJCF parser puts it at the world origin unrotated (measured), so every anchor,
+    axis, centre of mass and inertia is carried by one rigid motion — one placement row
+    naming the turn (90°, expected from the file's euler) and the cause, the fields compared
+    after undoing it (all agree). Turned about y, gravity pulls from another direction in
+    Pinocchio's model: the row fails and the gravity-dependent dynamics follow from it;
+    turned about z (gravity's axis), no dynamics depend on it: explained, all pass."""
+    body = (f'<body name="root" euler="{turn}"><inertial pos="0 0 0" mass="2" '
+            'diaginertia="0.1 0.1 0.1"/>' + LINK.format(
+                name="leg", pos="0.2 0.1 0", joint="hip", extra="", mass=1, child=LINK.format(
+                    name="foot", pos="0 0.1 -0.5", joint="ankle", extra="", mass=1,
+                    child="")) + "</body>")
+    result = check_model(_write(tmp_path, "turned", body), states=10,
+                         impls=("reference", "mujoco", "pinocchio"))
+    rows = _rows(result, "description")
+    rows = rows[rows["impl_b"] == "pinocchio"]
+    placed = rows[rows["field"] == "placement"]
+    assert len(placed) == 1
+    assert "turned by 90° about" in placed["note"].iloc[0]
+    assert "puts a jointless top-level body ('root', euler=" in placed["note"].iloc[0]
+    others = rows.drop(placed.index)
+    assert set(others["verdict"]) <= {"passed"}, others
+    assert placed["verdict"].iloc[0] == ("explained" if kept else "failed")
+    dynamics = _rows(result, "dynamics")
+    pinocchio = dynamics[dynamics["impl_b"] == "pinocchio"]
+    if kept:
+        assert set(pinocchio["verdict"]) == {"passed"}
+    else:
+        assert "failed" not in set(pinocchio["verdict"])
+        bias = pinocchio[pinocchio["subject"] == "bias_forces"]
+        assert set(bias["verdict"]) == {"explained"}
+        assert bias["note"].str.contains("placement").all()
+
+
 def test_all_but_the_last_of_several_joints_in_an_offset_body_are_drake_s_reading_named(
         tmp_path):
     """Three joints in a body 1 m above the world and turned 30° about z (dm_control's
@@ -517,3 +554,53 @@ def test_an_armature_drake_loses_across_a_class_without_a_joint_is_named(tmp_pat
     note = armature["note"].iloc[0]
     assert "from default class 'main' through class 'mid'" in note
     assert "write the attribute on class 'mid'" in note
+
+
+def test_an_axis_drake_loses_across_a_class_without_a_joint_is_named(tmp_path):
+    """The shadow hand's thumb (right_hand sets axis="1 0 0", thumb has no <joint>, thproximal
+    sets a range): Drake's MJCF parser reads the hinge about its own default z (measured).
+    The axis row fails naming the class in between; MuJoCo's axis is the class's x."""
+    pytest.importorskip("pydrake")
+    head = ('<default><default class="hand"><joint axis="1 0 0"/><default class="thumb">'
+            '<default class="proximal"><joint range="0 1"/></default></default></default>'
+            '</default>')
+    body = ('<body name="a" pos="0 0 1"><joint name="j" type="hinge" class="proximal"/>'
+            '<inertial pos="0 0 -0.2" mass="1" diaginertia="0.1 0.2 0.3"/></body>')
+    result = check_model(_write(tmp_path, "thumb", body, head=head), states=3,
+                         impls=("reference", "mujoco", "drake"))
+    rows = _rows(result, "description", "failed")
+    axis = rows[(rows["field"] == "axis") & (rows["impl_b"] == "drake")]
+    assert list(axis["subject"]) == ["j"]
+    assert [float(x) for x in axis["value_a"].iloc[0].strip("[]").split()] == [1.0, 0.0, 0.0]
+    assert "its axis from default class 'hand' through class 'thumb'" in axis["note"].iloc[0]
+
+
+def test_tendon_armature_is_left_out_and_said(tmp_path):
+    """MJX's test model tendon/armature.xml: a spatial tendon with armature 123 makes MuJoCo's
+    M larger by a Jₜᵀ Jₜ (measured here: its M with and without it), which no other parser
+    reads: it was 10 failed dynamics rows with no reason. Left out and said; the dynamics
+    then agree with the referee's."""
+    import mujoco
+    import numpy as np
+
+    from dyncheck.adapters.mujoco_api import full_inertia
+
+    body = ('<site name="s0" pos="1 0 1"/><body name="b"><joint name="z" type="slide" '
+            'axis="0 0 1"/><joint name="y" type="hinge" axis="0 1 0"/><geom type="box" '
+            'size="0.1 0.1 0.1" mass="1" pos="1 0 0"/><site name="s1"/></body>')
+    tail = '<tendon><spatial armature="123"><site site="s0"/><site site="s1"/></spatial></tendon>'
+    path = _write(tmp_path, "tendon", body, tail=tail)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    data.qpos[:] = (0.3, 0.4)
+    mujoco.mj_forward(model, data)
+    with_it = np.zeros((2, 2))
+    full_inertia(model, data, with_it)
+    model.tendon_armature[:] = 0
+    mujoco.mj_forward(model, data)
+    without = np.zeros((2, 2))
+    full_inertia(model, data, without)
+    assert np.abs(with_it - without).max() > 1.0  # the term the other engines lack
+    result = check_model(path, states=5, impls=("reference", "mujoco"))
+    assert result.ok, result.failures()
+    assert any("tendon armature" in n and "left out" in n for n in result.notes)
