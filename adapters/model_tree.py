@@ -15,6 +15,7 @@ knowing the engine.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
 
@@ -135,6 +136,13 @@ class ModelTree:
     """(joint, field, why): what the engine is known to do with that field of that joint and
     how to change it — the note of a description row that finds the field read differently;
     joint ``model``: of every joint."""
+    mesh_rounding: Mapping[str, float] = field(default_factory=dict)
+    """Joint → how far, relative, the mass, centre of mass and inertia its bodies take from
+    meshes may lie from the file's digits (MuJoCo: vertices held in float32); absent: none."""
+    exact_meshes: ModelTree | None = None
+    """The engine's reading with every mesh's volume and inertia computed exactly (MuJoCo:
+    ``inertia="exact"`` instead of its default ``"legacy"``, which overcounts a non-convex
+    mesh's volume); None where that changes no body."""
 
     def hint(self, joint: str, name: str) -> str | None:
         for wanted in (joint, "model"):

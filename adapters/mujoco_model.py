@@ -11,6 +11,7 @@ axes, angular in local axes); a ball joint v = angular velocity in local axes.
 from __future__ import annotations
 
 import warnings
+from dataclasses import replace
 
 import mujoco
 import numpy as np
@@ -67,13 +68,19 @@ is ≈ step/2 × |∂²τ| + 2 × (τ's round-off) / step — the check predicts
 """The free joint added to a URDF's root link with ``--floating`` (Pinocchio's name)."""
 
 
-def _compile(source: ModelFile) -> tuple[mujoco.MjModel, tuple[str, ...]]:
+def _compile(source: ModelFile, *, exact_meshes: bool = False
+             ) -> tuple[mujoco.MjModel, tuple[str, ...], frozenset[int]]:
     with mujoco_warnings() as said:  # to the page, never to MUJOCO_LOG.TXT in the user's cwd
-        model, notes = _compile_quietly(source)
-    return model, (*notes, *(f"mujoco warning: {m}" for m in said))
+        model, notes, from_geoms = _compile_quietly(source, exact_meshes=exact_meshes)
+    return model, (*notes, *(f"mujoco warning: {m}" for m in said)), from_geoms
 
 
-def _compile_quietly(source: ModelFile) -> tuple[mujoco.MjModel, tuple[str, ...]]:
+def _compile_quietly(source: ModelFile, *, exact_meshes: bool = False
+                     ) -> tuple[mujoco.MjModel, tuple[str, ...], frozenset[int]]:
+    """MuJoCo's compiled model of ``source`` (``exact_meshes``: every mesh of the default
+    ``inertia="legacy"`` computed ``"exact"`` instead), its notes, and the bodies (ids) whose
+    inertia the compiler takes from their geoms (``inertiafromgeom``: "true", or "auto" and
+    no ``<inertial>``)."""
     notes: list[str] = []
     try:
         if source.format is Format.MJCF:
@@ -85,6 +92,10 @@ def _compile_quietly(source: ModelFile) -> tuple[mujoco.MjModel, tuple[str, ...]
             root = spec.worldbody.first_body()
             root.add_freejoint(name=FLOATING_NAME)
             notes.append(f"mujoco: free joint {FLOATING_NAME!r} added to root link {root.name!r}")
+        if exact_meshes:
+            for mesh in spec.meshes:
+                if mesh.inertia == mujoco.mjtMeshInertia.mjMESH_INERTIA_LEGACY:
+                    mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_EXACT
         with warnings.catch_warnings(record=True) as caught:  # to the page, not stderr
             warnings.simplefilter("always")
             model = spec.compile()
@@ -94,7 +105,13 @@ def _compile_quietly(source: ModelFile) -> tuple[mujoco.MjModel, tuple[str, ...]
         raise EngineError(
             f"mujoco refused {source.path}: {' '.join(str(exc).split())}"
         ) from None
-    return model, tuple(notes)
+    mode = spec.compiler.inertiafromgeom
+    from_geoms = frozenset(
+        i for i, body in enumerate(spec.bodies) if i > 0 and (
+            mode == mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_TRUE
+            or (mode == mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_AUTO
+                and not body.explicitinertial)))
+    return model, tuple(notes), from_geoms
 
 
 def _joint_body_groups(m: mujoco.MjModel) -> dict[int, list[int]]:
@@ -107,6 +124,35 @@ def _joint_body_groups(m: mujoco.MjModel) -> dict[int, list[int]]:
         if owner[b] >= 0:
             groups.setdefault(owner[b], []).append(b)
     return groups
+
+
+FLOAT32_EPS = float(np.finfo(np.float32).eps)
+
+
+def _mesh_rounding(m: mujoco.MjModel, from_geoms: frozenset[int]) -> dict[int, float]:
+    """Body → the relative error its mesh-derived mass may carry from MuJoCo holding mesh
+    vertices in float32 (the file's digits rounded, |δx| ≤ ε₃₂/2 · |x| per coordinate): a
+    closed surface of area A moved by |δx| changes its volume V by at most A |δx|, so
+    δV/V ≤ (√3/2) ε₃₂ r A / V, r the mesh's largest vertex distance in the file's frame.
+    Only bodies that take their inertia from their geoms (``from_geoms``)."""
+    out: dict[int, float] = {}
+    for g in np.flatnonzero(m.geom_type == mujoco.mjtGeom.mjGEOM_MESH):
+        k = int(m.geom_dataid[g])
+        if k < 0 or int(m.geom_bodyid[g]) not in from_geoms:
+            continue
+        verts = m.mesh_vert[m.mesh_vertadr[k] : m.mesh_vertadr[k] + m.mesh_vertnum[k]]
+        faces = m.mesh_face[m.mesh_faceadr[k] : m.mesh_faceadr[k] + m.mesh_facenum[k]]
+        a, b, c = (verts[faces[:, i]].astype(float) for i in range(3))
+        normal = np.cross(b - a, c - a)
+        area = 0.5 * float(np.linalg.norm(normal, axis=1).sum())
+        volume = abs(float(np.einsum("ij,ij->", a, np.cross(b, c)))) / 6
+        if volume <= 0:
+            continue
+        reach = float(np.abs(verts).max()) * np.sqrt(3) + float(np.linalg.norm(m.mesh_pos[k]))
+        bound = np.sqrt(3) / 2 * FLOAT32_EPS * reach * area / volume
+        body = int(m.geom_bodyid[g])
+        out[body] = max(out.get(body, 0.0), bound)
+    return out
 
 
 def _layouts(m: mujoco.MjModel) -> list[Layout]:
@@ -147,8 +193,8 @@ class MujocoModel:
 
     engine = ENGINE
 
-    def __init__(self, source: ModelFile) -> None:
-        self.model, notes = _compile(source)
+    def __init__(self, source: ModelFile, *, exact_meshes: bool = False) -> None:
+        self.model, notes, self._from_geoms = _compile(source, exact_meshes=exact_meshes)
         m = self.model
         self._gravity = m.opt.gravity.copy()
         if m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_GRAVITY:
@@ -171,6 +217,20 @@ class MujocoModel:
                                              + (" …" if len(armed) > 4 else "")),)
             m.tendon_armature[:] = 0.0
         self.tree = self._tree(notes)
+        if not exact_meshes and m.nmesh:
+            self.tree = replace(self.tree, exact_meshes=self._exact_meshes(source))
+
+    def _exact_meshes(self, source: ModelFile) -> ModelTree | None:
+        """The tree with every mesh's inertia ``"exact"`` where that changes a body's mass or
+        inertia (a non-convex mesh under MuJoCo's default ``"legacy"``); None where it
+        changes none, or the meshes are not watertight (MuJoCo then refuses ``"exact"``)."""
+        try:
+            exact = MujocoModel(source, exact_meshes=True)
+        except EngineError:
+            return None
+        same = np.array_equal(exact.model.body_mass, self.model.body_mass) and \
+            np.array_equal(exact.model.body_inertia, self.model.body_inertia)
+        return None if same else exact.tree
 
     def _tree(self, notes: tuple[str, ...]) -> ModelTree:
         m, d = self.model, self.data
@@ -228,9 +288,13 @@ class MujocoModel:
                     layout=layouts[j],
                 )
             )
+        rounding = _mesh_rounding(m, self._from_geoms)
+        by_joint = {j.name: max(rounding.get(b, 0.0) for b in groups[int(m.jnt_bodyid[k])])
+                    for k, j in enumerate(joints)}
         return ModelTree(
             engine=ENGINE, joints=tuple(joints), gravity=self._gravity.copy(),
             nq=m.nq, nv=m.nv, notes=notes, hints=self._hints,
+            mesh_rounding={name: bound for name, bound in by_joint.items() if bound > 0},
         )
 
     def reference_q(self) -> np.ndarray:

@@ -144,6 +144,8 @@ def placement(a: ModelTree, b: ModelTree, tol: float) -> Placement | None:
     directions = [(ja.axis, jb.axis) for ja, jb in pairs
                   if ja.type in (JointType.HINGE, JointType.SLIDE)]
     directions += [(pa - points[0][0], pb - points[0][1]) for pa, pb in points[1:]]
+    if not all(np.isfinite(x).all() for pair in (*points, *directions) for x in pair):
+        return None  # a tree read with NaN (a broken file): nothing to place
     rotation = np.eye(3)
     if directions:
         da = np.array([d for d, _ in directions])
@@ -268,6 +270,15 @@ def diff(model: str, a: ModelTree, b: ModelTree,
             if err > rtol * scale and stored is not None and err <= rtol * scale + stored[0]:
                 row(ja.name, field, va, vb, err / scale, rtol, Verdict.EXPLAINED,
                     f"{stored[1]}: predicted up to {stored[0] / scale:.3g} of the scale")
+            elif err > rtol * scale and field in BODY_FIELDS and \
+                    err <= (rtol + (mesh := _mesh_bound(a, b, ja.name, field))) * scale:
+                row(ja.name, field, va, vb, err / scale, rtol, Verdict.EXPLAINED,
+                    MESH_ROUNDING.format(field=field, bound=rtol + mesh))
+            elif err > rtol * scale and (exact := _exact_meshes(a, b, ja, jb, field,
+                                                                 length, rtol)):
+                row(ja.name, field, va, vb, err / scale, rtol, Verdict.EXPLAINED,
+                    EXACT_MESHES.format(a=a.engine, b=b.engine, size=err / scale,
+                                        off=exact))
             elif err > rtol * scale:
                 known = b.hint(ja.name, field) or a.hint(ja.name, field)
                 if not known and field in BODY_FIELDS and ja.body in invalid:
@@ -290,6 +301,56 @@ def diff(model: str, a: ModelTree, b: ModelTree,
 
 
 BODY_FIELDS = frozenset({"mass", "com", "inertia"})
+
+EXACT_MESHES_LEAD = "{a}'s meshes take their volume by MuJoCo's default inertia=\"legacy\""
+EXACT_MESHES = (
+    EXACT_MESHES_LEAD + ", which "
+    "overcounts a non-convex mesh (MuJoCo's documentation); {b} computes it exactly: {b} "
+    "agrees with {a}'s own reading under inertia=\"exact\" ({off:.2g} of the scale, within "
+    "round-off and float32 vertices), {a}'s default differs by {size:.3g} (fix: "
+    "inertia=\"exact\" or "
+    "\"convex\" on the <mesh>, or the body's <inertial>)"
+)
+
+
+def changes_dynamics(row: CheckRow) -> bool:
+    """An explained description row whose difference the engines' dynamics carry (a mesh's
+    volume taken two ways): the dynamics rows follow from it; other explained rows (a model
+    placed elsewhere, float32 vertices) change no dynamics beyond their bounds."""
+    return row.verdict is Verdict.EXPLAINED and row.note.startswith(
+        EXACT_MESHES_LEAD.format(a=row.impl_a))
+
+
+def _exact_meshes(a: ModelTree, b: ModelTree, ja: TreeJoint, jb: TreeJoint, field: str,
+                  length: float, rtol: float) -> float | None:
+    """Where ``a``'s body field, read with MuJoCo's legacy mesh volume, differs from ``b``'s:
+    how far ``b``'s is from ``a``'s reading with exact mesh volumes (relative), if within
+    round-off — the difference is then the mesh algorithm's, measured; else None."""
+    if field not in BODY_FIELDS or a.exact_meshes is None:
+        return None
+    try:
+        exact = a.exact_meshes.joint(ja.name)
+    except KeyError:
+        return None
+    allowed = rtol + _mesh_bound(a, b, ja.name, field)
+    for name, _, _, err, scale in _compare(exact, jb, length):
+        if name == field:
+            return err / scale if err <= allowed * scale else None
+    return None
+
+
+MESH_ROUNDING = (
+    "MuJoCo holds mesh vertices in single precision (float32) and computes the body's {field} "
+    "from them; the other engine from the file's digits: predicted up to {bound:.2g} of the "
+    "scale (√3/2 ε₃₂ × the mesh's reach × its area / volume, ×2 for an inertia; + round-off)"
+)
+
+
+def _mesh_bound(a: ModelTree, b: ModelTree, joint: str, field: str) -> float:
+    """The relative bound of :attr:`ModelTree.mesh_rounding` for ``field`` of ``joint`` (the
+    larger of the two engines'): an inertia, a second moment, twice a mass's."""
+    bound = max(a.mesh_rounding.get(joint, 0.0), b.mesh_rounding.get(joint, 0.0))
+    return 2 * bound if field == "inertia" else bound
 """The fields of a joint's body: what an invalid inertia can make engines read differently."""
 
 FOLLOWS_FROM_INVALID = (

@@ -144,12 +144,16 @@ def compare(
     *,
     eps: float = EPS,
     kappa: float | None = None,
+    vertices: float = 0.0,
 ) -> list[CheckRow]:
     """One row per quantity. A failure is ``explained`` where ``explanations`` predicts it (the
     difference within prediction + tolerance), or where ``caused_by`` names a description
     difference found between the two (the dynamics follow from it). ``eps``: the coarser
     precision of the two (a float32 port's ε₃₂: the same bounds in its arithmetic); ``kappa``:
-    κ(M) of ``dyn_a`` where the caller has it (one per implementation, not per pair)."""
+    κ(M) of ``dyn_a`` where the caller has it (one per implementation, not per pair);
+    ``vertices``: the relative difference of the two models' inertias where one takes them
+    from float32 mesh vertices and the other from the file's digits (M, h, τ and the energies
+    are linear in the masses and inertias)."""
     d = depth(tree)
     kappa = condition(dyn_a.mass_matrix) if kappa is None else kappa
     least = floors(tree, dyn_a, states)
@@ -166,8 +170,10 @@ def compare(
         scale = max(float(np.abs(desired).max()), floor, 1e-300)
         errors = np.abs(actual - desired).max(axis=1)
         worst = int(np.argmax(errors))
-        rtol = ROUNDOFF_FACTOR * eps * d
+        rtol = ROUNDOFF_FACTOR * eps * d + vertices
         basis = f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth {d}"
+        if vertices:
+            basis += f"; + {vertices:.2g}: one engine's inertia from float32 mesh vertices"
         if floor >= float(np.abs(desired).max()) and floor_name:
             basis += f"; scale {floor_name} {floor:.3g} (the value's own is smaller)"
         if quantity == Quantity.FORWARD_DYNAMICS:

@@ -237,7 +237,8 @@ def _readings(model: str, source: ModelFile, loaded: dict[str, engine_processes.
             continue
         found = describe.diff(model, first.tree, m.tree, invalid)
         rows.extend(found)
-        fields = sorted({r.field for r in found if r.verdict is Verdict.FAILED})
+        fields = sorted({r.field for r in found
+                         if r.verdict is Verdict.FAILED or describe.changes_dynamics(r)})
         if fields:
             differing[engine] = ", ".join(fields)
     return differing
@@ -335,9 +336,14 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
     trees = {name: loaded[name].tree if name in loaded else referee_tree for name in results}
     order = list(results)
     kappas: dict[str, float] = {}  # κ(M) of each implementation, for every pair it leads
+    # an inertia from float32 mesh vertices (MuJoCo's, the referee's reading of it) against
+    # one from the file's digits: each quantity may differ by that much, relative
+    vertices = 2 * max(canonical_tree.mesh_rounding.values(), default=0.0)
+    rounded = {n for n in results if n not in loaded or trees[n].mesh_rounding}
     for i, a in enumerate(order):
         for b in order[i + 1 :]:
-            cause = ", ".join(differing[e] for e in (a, b) if e in differing)
+            cause = ", ".join(dict.fromkeys(f for e in (a, b) if e in differing
+                                            for f in differing[e].split(", ")))
             dofs = {n: _held(parts.get(n)) for n in (a, b)}
             if dofs[a] is None and dofs[b] is None:
                 explanations = predicted.differences(canon, canonical_tree, trees[a],
@@ -346,7 +352,9 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
                     kappas[a] = condition(results[a].mass_matrix)
                 rows.extend(compare(model, canonical_tree, a, results[a], b, results[b],
                                     explanations, cause, batch,
-                                    eps=max(trees[a].eps, trees[b].eps), kappa=kappas[a]))
+                                    eps=max(trees[a].eps, trees[b].eps), kappa=kappas[a],
+                                    vertices=vertices if (a in rounded) != (b in rounded)
+                                    else 0.0))
                 continue
             common = np.arange(canon.nv)
             for held in dofs.values():
@@ -356,7 +364,8 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
                 model, canonical_tree,
                 a, partial.restrict(results[a], partial.columns(dofs[a], common)),
                 b, partial.restrict(results[b], partial.columns(dofs[b], common)),
-                {}, cause, on, eps=max(trees[a].eps, trees[b].eps)))
+                {}, cause, on, eps=max(trees[a].eps, trees[b].eps),
+                vertices=vertices if (a in rounded) != (b in rounded) else 0.0))
     return rows
 
 
