@@ -142,7 +142,7 @@ class ModelTree:
     exact_meshes: ModelTree | None = None
     """The engine's reading with every mesh's volume and inertia computed exactly (MuJoCo:
     ``inertia="exact"`` instead of its default ``"legacy"``, which overcounts a non-convex
-    mesh's volume); None where that changes no body."""
+    mesh's volume, or ``"convex"``, the hull's); None where that changes no body."""
 
     def hint(self, joint: str, name: str) -> str | None:
         for wanted in (joint, "model"):

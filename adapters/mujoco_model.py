@@ -78,7 +78,8 @@ def _compile(source: ModelFile, *, exact_meshes: bool = False
 def _compile_quietly(source: ModelFile, *, exact_meshes: bool = False
                      ) -> tuple[mujoco.MjModel, tuple[str, ...], frozenset[int]]:
     """MuJoCo's compiled model of ``source`` (``exact_meshes``: every mesh of the default
-    ``inertia="legacy"`` computed ``"exact"`` instead), its notes, and the bodies (ids) whose
+    ``inertia="legacy"`` or of ``"convex"`` computed ``"exact"`` instead), its notes, and the
+    bodies (ids) whose
     inertia the compiler takes from their geoms (``inertiafromgeom``: "true", or "auto" and
     no ``<inertial>``)."""
     notes: list[str] = []
@@ -94,7 +95,8 @@ def _compile_quietly(source: ModelFile, *, exact_meshes: bool = False
             notes.append(f"mujoco: free joint {FLOATING_NAME!r} added to root link {root.name!r}")
         if exact_meshes:
             for mesh in spec.meshes:
-                if mesh.inertia == mujoco.mjtMeshInertia.mjMESH_INERTIA_LEGACY:
+                if mesh.inertia in (mujoco.mjtMeshInertia.mjMESH_INERTIA_LEGACY,
+                                    mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX):
                     mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_EXACT
         with warnings.catch_warnings(record=True) as caught:  # to the page, not stderr
             warnings.simplefilter("always")
@@ -222,8 +224,9 @@ class MujocoModel:
 
     def _exact_meshes(self, source: ModelFile) -> ModelTree | None:
         """The tree with every mesh's inertia ``"exact"`` where that changes a body's mass or
-        inertia (a non-convex mesh under MuJoCo's default ``"legacy"``); None where it
-        changes none, or the meshes are not watertight (MuJoCo then refuses ``"exact"``)."""
+        inertia (a non-convex mesh under MuJoCo's default ``"legacy"``, or ``"convex"``: its
+        hull); None where it changes none, or the meshes are not watertight (MuJoCo then
+        refuses ``"exact"``)."""
         try:
             exact = MujocoModel(source, exact_meshes=True)
         except EngineError:

@@ -302,14 +302,13 @@ def diff(model: str, a: ModelTree, b: ModelTree,
 
 BODY_FIELDS = frozenset({"mass", "com", "inertia"})
 
-EXACT_MESHES_LEAD = "{a}'s meshes take their volume by MuJoCo's default inertia=\"legacy\""
+EXACT_MESHES_LEAD = "{a} takes its meshes' volume by inertia=\"legacy\" or \"convex\""
 EXACT_MESHES = (
-    EXACT_MESHES_LEAD + ", which "
-    "overcounts a non-convex mesh (MuJoCo's documentation); {b} computes it exactly: {b} "
+    EXACT_MESHES_LEAD + " (MuJoCo's default \"legacy\" overcounts a non-convex mesh, "
+    "\"convex\" takes its hull: MuJoCo's documentation); {b} computes it exactly: {b} "
     "agrees with {a}'s own reading under inertia=\"exact\" ({off:.2g} of the scale, within "
-    "round-off and float32 vertices), {a}'s default differs by {size:.3g} (fix: "
-    "inertia=\"exact\" or "
-    "\"convex\" on the <mesh>, or the body's <inertial>)"
+    "round-off and float32 vertices), {a}'s as the file says differs by {size:.3g} (fix: "
+    "inertia=\"exact\" on the <mesh>, or the body's <inertial>)"
 )
 
 
