@@ -40,6 +40,7 @@ from dyncheck.adapters.mujoco_api import (
     full_inertia,
     mujoco_warnings,
 )
+from dyncheck.adapters.mujoco_meshes import TEXT_MESHES, mesh_files, mesh_rounding
 from dyncheck.errors import EngineError
 from dyncheck.vocabulary import Integrator
 
@@ -128,35 +129,6 @@ def _joint_body_groups(m: mujoco.MjModel) -> dict[int, list[int]]:
     return groups
 
 
-FLOAT32_EPS = float(np.finfo(np.float32).eps)
-
-
-def _mesh_rounding(m: mujoco.MjModel, from_geoms: frozenset[int]) -> dict[int, float]:
-    """Body → the relative error its mesh-derived mass may carry from MuJoCo holding mesh
-    vertices in float32 (the file's digits rounded, |δx| ≤ ε₃₂/2 · |x| per coordinate): a
-    closed surface of area A moved by |δx| changes its volume V by at most A |δx|, so
-    δV/V ≤ (√3/2) ε₃₂ r A / V, r the mesh's largest vertex distance in the file's frame.
-    Only bodies that take their inertia from their geoms (``from_geoms``)."""
-    out: dict[int, float] = {}
-    for g in np.flatnonzero(m.geom_type == mujoco.mjtGeom.mjGEOM_MESH):
-        k = int(m.geom_dataid[g])
-        if k < 0 or int(m.geom_bodyid[g]) not in from_geoms:
-            continue
-        verts = m.mesh_vert[m.mesh_vertadr[k] : m.mesh_vertadr[k] + m.mesh_vertnum[k]]
-        faces = m.mesh_face[m.mesh_faceadr[k] : m.mesh_faceadr[k] + m.mesh_facenum[k]]
-        a, b, c = (verts[faces[:, i]].astype(float) for i in range(3))
-        normal = np.cross(b - a, c - a)
-        area = 0.5 * float(np.linalg.norm(normal, axis=1).sum())
-        volume = abs(float(np.einsum("ij,ij->", a, np.cross(b, c)))) / 6
-        if volume <= 0:
-            continue
-        reach = float(np.abs(verts).max()) * np.sqrt(3) + float(np.linalg.norm(m.mesh_pos[k]))
-        bound = np.sqrt(3) / 2 * FLOAT32_EPS * reach * area / volume
-        body = int(m.geom_bodyid[g])
-        out[body] = max(out.get(body, 0.0), bound)
-    return out
-
-
 def _layouts(m: mujoco.MjModel) -> list[Layout]:
     out = []
     for j in range(m.njnt):
@@ -197,6 +169,8 @@ class MujocoModel:
 
     def __init__(self, source: ModelFile, *, exact_meshes: bool = False) -> None:
         self.model, notes, self._from_geoms = _compile(source, exact_meshes=exact_meshes)
+        self._text_meshes = frozenset(
+            k for k, path in enumerate(mesh_files(source)) if path.lower().endswith(TEXT_MESHES))
         m = self.model
         self._gravity = m.opt.gravity.copy()
         if m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_GRAVITY:
@@ -291,7 +265,7 @@ class MujocoModel:
                     layout=layouts[j],
                 )
             )
-        rounding = _mesh_rounding(m, self._from_geoms)
+        rounding = mesh_rounding(m, self._from_geoms, self._text_meshes)
         by_joint = {j.name: max(rounding.get(b, 0.0) for b in groups[int(m.jnt_bodyid[k])])
                     for k, j in enumerate(joints)}
         return ModelTree(

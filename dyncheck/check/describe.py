@@ -270,7 +270,8 @@ def diff(model: str, a: ModelTree, b: ModelTree,
             if err > rtol * scale and stored is not None and err <= rtol * scale + stored[0]:
                 row(ja.name, field, va, vb, err / scale, rtol, Verdict.EXPLAINED,
                     f"{stored[1]}: predicted up to {stored[0] / scale:.3g} of the scale")
-            elif err > rtol * scale and field in BODY_FIELDS and \
+            elif err > rtol * scale and field in BODY_FIELDS and not (
+                    b.hint(ja.name, field) or a.hint(ja.name, field)) and \
                     err <= (rtol + (mesh := _mesh_bound(a, b, ja.name, field))) * scale:
                 row(ja.name, field, va, vb, err / scale, rtol, Verdict.EXPLAINED,
                     MESH_ROUNDING.format(field=field, bound=rtol + mesh))
