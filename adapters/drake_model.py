@@ -154,13 +154,11 @@ FIRST_OF_SEVERAL = (
 )
 
 
-def _first_of_several(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
+def _first_of_several(root: ET.Element) -> tuple[tuple[str, str, str], ...]:
     """Why every joint but the last of a body with several reads differently in Drake (the
-    MJCF read as XML, includes inlined)."""
-    if source.format is not Format.MJCF:
-        return ()
+    MJCF ``root``, includes inlined)."""
     out: list[tuple[str, str, str]] = []
-    for body in inline(source.path).iter("body"):
+    for body in root.iter("body"):
         named = [j.get("name") for j in body.findall("joint")]
         for k, name in enumerate(named[:-1], start=1):
             if name:
@@ -186,14 +184,11 @@ LOST_ACROSS_A_GAP = {"armature": "armature", "damping": "damping", "axis": "axis
 field each shows in."""
 
 
-def _skipped_classes(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
+def _skipped_classes(root: ET.Element) -> tuple[tuple[str, str, str], ...]:
     """Joint attributes Drake loses on their way down the default classes: a joint whose
     class (``class``, else the nearest ``childclass``) inherits an attribute from an
-    ancestor class across a class without a ``<joint>`` element (read as XML, includes
-    inlined)."""
-    if source.format is not Format.MJCF:
-        return ()
-    root = inline(source.path)
+    ancestor class across a class without a ``<joint>`` element (the MJCF ``root``,
+    includes inlined)."""
     chains: dict[str, list[ET.Element]] = {}  # class -> its default elements, top first
 
     def walk(element: ET.Element, above: list[ET.Element]) -> None:
@@ -233,6 +228,15 @@ def _skipped_classes(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
     for world in root.findall("worldbody"):
         visit(world, "main")
     return tuple(out)
+
+
+def _file_hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
+    """What the MJCF itself shows Drake reads differently (read once, includes inlined)."""
+    if source.format is not Format.MJCF:
+        return ()
+    root = inline(source.path)
+    return (*_skipped_classes(root), *_first_of_several(root),
+            *springdampers(root, "Drake"))
 
 
 IGNORED_FRAME = (
@@ -379,9 +383,7 @@ class DrakeModel:
             for j in joints
             if j.type is not JointType.FREE and j.name not in reflected
             and self._source.format is Format.MJCF
-        ) + _skipped_classes(self._source) + _first_of_several(self._source) \
-            + _ignored_frames(notes) + (tuple(springdampers(self._source.path, "Drake"))
-                                        if self._source.format is Format.MJCF else ())
+        ) + _ignored_frames(notes) + _file_hints(self._source)
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
                          nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,
                          hints=hints)

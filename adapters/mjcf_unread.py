@@ -5,10 +5,10 @@ cause and the fix. Engine-specific readings live with their engine
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from collections.abc import Iterator
-from pathlib import Path
 
-from dyncheck.adapters.mjcf_copy import inline, joints
+from dyncheck.adapters.mjcf_copy import joints
 
 SPRINGDAMPER = (
     "{engine}'s MJCF parser does not read springdamper=\"{value}\", from which MuJoCo derives "
@@ -18,10 +18,10 @@ SPRINGDAMPER = (
 )
 
 
-def springdampers(path: Path, engine: str) -> Iterator[tuple[str, str, str]]:
-    """(joint, "damping", why) for every named joint whose ``springdamper`` (own or from a
-    default class) is not zero."""
-    for joint in joints(inline(path)):
+def springdampers(root: ET.Element, engine: str) -> Iterator[tuple[str, str, str]]:
+    """(joint, "damping", why) for every named joint of the MJCF ``root`` (includes inlined)
+    whose ``springdamper`` (own or from a default class) is not zero."""
+    for joint in joints(root):
         name = joint.element.get("name")
         value = joint.attrs.get("springdamper")
         if name and value and any(float(x) for x in value.split()):

@@ -6,9 +6,6 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from dyncheck.adapters.mjcf_copy import utf8_file
-from dyncheck.adapters.model_files import Format, ModelFile
-
 FLOAT32_EPS = float(np.finfo(np.float32).eps)
 
 
@@ -43,13 +40,3 @@ def mesh_rounding(m: mujoco.MjModel, from_geoms: frozenset[int],
         body = int(m.geom_bodyid[g])
         out[body] = max(out.get(body, 0.0), bound)
     return out
-
-
-def mesh_files(source: ModelFile) -> list[str]:
-    """Each mesh's file name, in MuJoCo's mesh order (empty for a mesh given by vertices)."""
-    if source.format is Format.MJCF:
-        with utf8_file(source.path) as file:
-            spec = mujoco.MjSpec.from_file(str(file))
-    else:
-        spec = mujoco.MjSpec.from_string(source.text)
-    return [mesh.file for mesh in spec.meshes]

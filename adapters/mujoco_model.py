@@ -11,7 +11,7 @@ axes, angular in local axes); a ball joint v = angular velocity in local axes.
 from __future__ import annotations
 
 import warnings
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import mujoco
 import numpy as np
@@ -40,7 +40,7 @@ from dyncheck.adapters.mujoco_api import (
     full_inertia,
     mujoco_warnings,
 )
-from dyncheck.adapters.mujoco_meshes import TEXT_MESHES, mesh_files, mesh_rounding
+from dyncheck.adapters.mujoco_meshes import TEXT_MESHES, mesh_rounding
 from dyncheck.errors import EngineError
 from dyncheck.vocabulary import Integrator
 
@@ -70,19 +70,17 @@ is ≈ step/2 × |∂²τ| + 2 × (τ's round-off) / step — the check predicts
 
 
 def _compile(source: ModelFile, *, exact_meshes: bool = False
-             ) -> tuple[mujoco.MjModel, tuple[str, ...], frozenset[int]]:
+             ) -> tuple[mujoco.MjModel, tuple[str, ...], Inertias]:
     with mujoco_warnings() as said:  # to the page, never to MUJOCO_LOG.TXT in the user's cwd
-        model, notes, from_geoms = _compile_quietly(source, exact_meshes=exact_meshes)
-    return model, (*notes, *(f"mujoco warning: {m}" for m in said)), from_geoms
+        model, notes, inertias = _compile_quietly(source, exact_meshes=exact_meshes)
+    return model, (*notes, *(f"mujoco warning: {m}" for m in said)), inertias
 
 
 def _compile_quietly(source: ModelFile, *, exact_meshes: bool = False
-                     ) -> tuple[mujoco.MjModel, tuple[str, ...], frozenset[int]]:
+                     ) -> tuple[mujoco.MjModel, tuple[str, ...], Inertias]:
     """MuJoCo's compiled model of ``source`` (``exact_meshes``: every mesh of the default
-    ``inertia="legacy"`` or of ``"convex"`` computed ``"exact"`` instead), its notes, and the
-    bodies (ids) whose
-    inertia the compiler takes from their geoms (``inertiafromgeom``: "true", or "auto" and
-    no ``<inertial>``)."""
+    ``inertia="legacy"`` or of ``"convex"`` computed ``"exact"`` instead), its notes, and
+    where its inertias come from (:class:`Inertias`, read from the same parse)."""
     notes: list[str] = []
     try:
         if source.format is Format.MJCF:
@@ -114,7 +112,30 @@ def _compile_quietly(source: ModelFile, *, exact_meshes: bool = False
             mode == mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_TRUE
             or (mode == mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_AUTO
                 and not body.explicitinertial)))
-    return model, tuple(notes), from_geoms
+    text = frozenset(k for k, mesh in enumerate(spec.meshes)
+                     if mesh.file.lower().endswith(TEXT_MESHES))
+    inexact = frozenset(k for k, mesh in enumerate(spec.meshes) if mesh.inertia in (
+        mujoco.mjtMeshInertia.mjMESH_INERTIA_LEGACY, mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX))
+    return model, tuple(notes), Inertias(from_geoms=from_geoms, text_meshes=text,
+                                         inexact_meshes=inexact)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Inertias:
+    """Where a compiled model's inertias come from: the bodies (ids) that take theirs from
+    their geoms (``inertiafromgeom``: "true", or "auto" and no ``<inertial>``), the meshes
+    (ids) written as text (:data:`TEXT_MESHES`), and those whose volume is not computed
+    exactly (``inertia="legacy"``, MuJoCo's default, or ``"convex"``)."""
+
+    from_geoms: frozenset[int]
+    text_meshes: frozenset[int]
+    inexact_meshes: frozenset[int]
+
+    def meshes_weigh(self, m: mujoco.MjModel, meshes: frozenset[int]) -> bool:
+        """Whether a mesh of ``meshes`` is a geom of a body that takes its inertia from
+        its geoms."""
+        return any(int(m.geom_dataid[g]) in meshes and int(m.geom_bodyid[g]) in self.from_geoms
+                   for g in np.flatnonzero(m.geom_type == mujoco.mjtGeom.mjGEOM_MESH))
 
 
 def _joint_body_groups(m: mujoco.MjModel) -> dict[int, list[int]]:
@@ -168,9 +189,7 @@ class MujocoModel:
     engine = ENGINE
 
     def __init__(self, source: ModelFile, *, exact_meshes: bool = False) -> None:
-        self.model, notes, self._from_geoms = _compile(source, exact_meshes=exact_meshes)
-        self._text_meshes = frozenset(
-            k for k, path in enumerate(mesh_files(source)) if path.lower().endswith(TEXT_MESHES))
+        self.model, notes, self._inertias = _compile(source, exact_meshes=exact_meshes)
         m = self.model
         self._gravity = m.opt.gravity.copy()
         if m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_GRAVITY:
@@ -193,7 +212,7 @@ class MujocoModel:
                                              + (" …" if len(armed) > 4 else "")),)
             m.tendon_armature[:] = 0.0
         self.tree = self._tree(notes)
-        if not exact_meshes and m.nmesh:
+        if not exact_meshes and self._inertias.meshes_weigh(m, self._inertias.inexact_meshes):
             self.tree = replace(self.tree, exact_meshes=self._exact_meshes(source))
 
     def _exact_meshes(self, source: ModelFile) -> ModelTree | None:
@@ -265,7 +284,7 @@ class MujocoModel:
                     layout=layouts[j],
                 )
             )
-        rounding = mesh_rounding(m, self._from_geoms, self._text_meshes)
+        rounding = mesh_rounding(m, self._inertias.from_geoms, self._inertias.text_meshes)
         by_joint = {j.name: max(rounding.get(b, 0.0) for b in groups[int(m.jnt_bodyid[k])])
                     for k, j in enumerate(joints)}
         return ModelTree(

@@ -83,9 +83,10 @@ UNLIMITED_RANGE = (
 )
 
 
-def bare_bodies(source: ModelFile) -> int:
-    """How many ``<body>`` elements carry no attribute (Pinocchio's parser skips them)."""
-    return sum(1 for body in inline(source.path).iter("body") if not body.attrib)
+def bare_bodies(root: ET.Element) -> int:
+    """How many ``<body>`` elements of the MJCF ``root`` carry no attribute (Pinocchio's
+    parser skips them)."""
+    return sum(1 for body in root.iter("body") if not body.attrib)
 
 
 def hints(source: ModelFile) -> tuple[Hint, ...]:
@@ -95,8 +96,8 @@ def hints(source: ModelFile) -> tuple[Hint, ...]:
     if source.format is not Format.MJCF:
         return ()
     root = inline(source.path)
-    return (*_model_hints(root, bare_bodies(source)), *_body_hints(root),
-            *_joint_hints(root), *springdampers(source.path, "Pinocchio"))
+    return (*_model_hints(root, bare_bodies(root)), *_body_hints(root),
+            *_joint_hints(root), *springdampers(root, "Pinocchio"))
 
 
 def _model_hints(root: ET.Element, bare: int) -> Iterable[Hint]:

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from dyncheck.adapters.mjcf_copy import utf8_file
+from dyncheck.adapters.mjcf_copy import inline, utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -68,7 +68,7 @@ def _load(source: ModelFile) -> pin.Model:
         # Pinocchio's C++ exceptions: "From file: … in function: … message:\n<the reason>"
         text = text.split("message:", 1)[1] if "message:" in text else text
         message = " ".join(text.split()) or type(exc).__name__
-        if source.format is Format.MJCF and (count := bare_bodies(source)):
+        if source.format is Format.MJCF and (count := bare_bodies(inline(source.path))):
             message += f" ({BARE_BODY.format(count=count)})"
         raise EngineError(f"pinocchio refused {source.path}: {message}") from None
 

@@ -1,4 +1,4 @@
-"""The disk cache's store: entries that are authenticated data, never code to run.
+"""The disk cache's store: entries that are authenticated before anything reads them.
 
 The cache folder (``$DYNCHECK_CACHE``, ``$XDG_CACHE_HOME/dyncheck`` or ``~/.cache/dyncheck``)
 is untrusted input: a CI cache restored from another branch, a folder shared between machines.
@@ -8,12 +8,15 @@ keyed by a secret that lives *outside* the cache folder (``$DYNCHECK_CACHE_KEY``
 created 0600, refused unless it is a regular file of this user's that nobody else can read)
 and over the entry's name as well as its bytes, so that neither a crafted file nor a genuine
 entry moved to another name is ever deserialized. What an authentic entry holds is then read
-by an unpickler that resolves only the classes of a fixed list of packages (never a builtin
-that runs code), and checked against the type the caller expects. A file that is missing is
-computed; one that is not authentic, not a regular file, too large or of the wrong type is
-computed afresh with a one-line note on stderr, never a traceback. Folders are created private
-(0700), files are written whole (a temporary file, then a rename), and nothing is written
-through a folder that resolves outside the cache folder.
+by an unpickler that resolves only names of a fixed list of packages and plain-data builtins
+(never a builtin that runs code), and checked against the type the caller expects. The
+authentication is what keeps code out: those packages hold functions too, and one kind of
+entry is compiled code (``reference/derivations.py``'s ``lambdified``), run only from an
+authentic entry. A file that is missing is computed; one that is not authentic, not a
+regular file, too large or of the wrong type is computed afresh with a one-line note on
+stderr, never a traceback. Folders are created private (0700), files are written whole (a
+temporary file, then a rename), and nothing is written through a folder that resolves
+outside the cache folder.
 
 Whether the cache is used at all is a command's setting (``--no-cache``,
 :class:`dyncheck.settings.Settings`), handed to every unit of work as an argument; the

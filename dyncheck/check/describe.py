@@ -302,6 +302,7 @@ def diff(model: str, a: ModelTree, b: ModelTree,
 
 
 BODY_FIELDS = frozenset({"mass", "com", "inertia"})
+"""The fields of a joint's body: what an invalid inertia can make engines read differently."""
 
 EXACT_MESHES_LEAD = "{a} takes its meshes' volume by inertia=\"legacy\" or \"convex\""
 EXACT_MESHES = (
@@ -351,7 +352,7 @@ def _mesh_bound(a: ModelTree, b: ModelTree, joint: str, field: str) -> float:
     larger of the two engines'): an inertia, a second moment, twice a mass's."""
     bound = max(a.mesh_rounding.get(joint, 0.0), b.mesh_rounding.get(joint, 0.0))
     return 2 * bound if field == "inertia" else bound
-"""The fields of a joint's body: what an invalid inertia can make engines read differently."""
+
 
 FOLLOWS_FROM_INVALID = (
     "follows from {body}'s invalid inertia (its validity row: {why}): {a} and {b} repair or "

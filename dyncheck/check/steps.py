@@ -26,7 +26,7 @@ from dyncheck.vocabulary import Integrator
 def _right_jacobian(phi: np.ndarray) -> np.ndarray:
     """SO(3)'s right Jacobian J_r(φ): exp(φ + δ) = exp(φ) exp(J_r(φ) δ) to first order."""
     theta = float(np.linalg.norm(phi))
-    cross = np.array([[0.0, -phi[2], phi[1]], [phi[2], 0.0, -phi[0]], [-phi[1], phi[0], 0.0]])
+    cross = _skew(phi)
     if theta < 1e-8:
         return np.eye(3) - 0.5 * cross
     return (np.eye(3) - (1 - np.cos(theta)) / theta**2 * cross
