@@ -31,6 +31,7 @@ from dyncheck.commands.run import run_command
 from dyncheck.commands.tutorials import tutorials_command
 from dyncheck.commands.versions import versions_command
 from dyncheck.errors import DyncheckError
+from dyncheck.workers import JOB_MEMORY, default_jobs
 
 
 class _Parser(argparse.ArgumentParser):
@@ -40,6 +41,10 @@ class _Parser(argparse.ArgumentParser):
         where = self.prog.removeprefix("dyncheck").strip()
         print(f"dyncheck: error: {where + ': ' if where else ''}{message}", file=sys.stderr)
         raise SystemExit(2)
+
+
+_JOBS = (f"{default_jobs()}: this machine's usable cores, at most one per "
+         f"{JOB_MEMORY // 2**30} GiB of memory")
 
 
 def _selection(p: argparse.ArgumentParser) -> None:
@@ -55,9 +60,9 @@ def _selection(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--jobs",
         type=int,
-        default=1,
+        default=default_jobs(),
         metavar="N",
-        help="cases in N parallel processes (same results)",
+        help=f"cases in N parallel processes (same results; default: {_JOBS})",
     )
     _dask(p)
     _no_cache(p)
@@ -165,8 +170,9 @@ def _parser() -> argparse.ArgumentParser:
     k.add_argument("--against", type=path_arg, default=None, metavar="PATH",
                    help="also compare what MuJoCo reads with this other file (a previous version)")
     k.add_argument("--out", type=path_arg, default=Path("reports/check"), help="output folder")
-    k.add_argument("--jobs", type=int, default=1, metavar="N",
-                   help="models checked in N parallel processes (same results)")
+    k.add_argument("--jobs", type=int, default=default_jobs(), metavar="N",
+                   help=f"models checked in N parallel processes (same results; default: "
+                   f"{_JOBS})")
     _dask(k)
     _ci(k)
     _quiet(k)
@@ -197,7 +203,8 @@ def _parser() -> argparse.ArgumentParser:
                    "all)")
     v.add_argument("--case", action="append", default=[], metavar="CASE",
                    help="cases to run (repeatable; default: all)")
-    v.add_argument("--jobs", type=int, default=2, metavar="N")
+    v.add_argument("--jobs", type=int, default=default_jobs(), metavar="N",
+                   help=f"each release's run in N parallel processes (default: {_JOBS})")
     v.add_argument("--bisect", nargs=3, default=None, metavar=("ENGINE", "GOOD", "BAD"),
                    help="name the first release between GOOD and BAD whose results moved")
     v.add_argument("--reuse", action="store_true",
@@ -216,7 +223,8 @@ def _parser() -> argparse.ArgumentParser:
         help="recompute every case and compare with the report folder",
     )
     c.add_argument("--out", type=path_arg, default=Path("reports"), help="report folder")
-    c.add_argument("--jobs", type=int, default=1, metavar="N")
+    c.add_argument("--jobs", type=int, default=default_jobs(), metavar="N",
+                   help=f"cases in N parallel processes (same results; default: {_JOBS})")
     _dask(c)
     _no_cache(c)
     c.add_argument(

@@ -28,6 +28,23 @@ CONNECT_SECONDS = 20
 """How long to wait for a scheduler before giving up (an error, before any work)."""
 
 
+JOB_MEMORY = 2 * 2**30
+"""Memory one worker may take with every engine and port loaded (a run's worker holding MJX
+and MuJoCo Warp: 1.8 GB resident, measured)."""
+
+
+def default_jobs() -> int:
+    """``--jobs``' default: the cores this process may use, at most one per
+    :data:`JOB_MEMORY` of the machine's memory (never fewer than one)."""
+    affinity = getattr(os, "sched_getaffinity", None)
+    cores = len(affinity(0)) if affinity is not None else (os.cpu_count() or 1)
+    try:
+        memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):  # no sysconf (Windows) or no such name
+        return max(1, cores)
+    return max(1, min(cores, memory // JOB_MEMORY))
+
+
 THREADED_RUNTIMES = ("jax", "warp")
 """Modules that start threads of their own when imported: a process holding one is not
 forked."""
@@ -176,7 +193,7 @@ def run_units(
     cluster (see :func:`executor`); ``progress`` hears of each unit done."""
     if progress is not None:
         progress.begin(len(units))
-    with executor(jobs if len(units) > 1 else 1, dask) as pool:
+    with executor(max(1, min(jobs, len(units))), dask) as pool:
         done = []
         if pool is None:
             for what, fn, args in units:
@@ -223,7 +240,7 @@ def each_unit(
     run); a worker that died is one, naming the unit."""
     from concurrent.futures.process import BrokenProcessPool
 
-    with executor(jobs if len(units) > 1 else 1, dask) as pool:
+    with executor(max(1, min(jobs, len(units))), dask) as pool:
         if pool is None:
             for what, fn, args in units:
                 try:

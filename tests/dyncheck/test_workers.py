@@ -52,6 +52,31 @@ def test_a_pool_starts_its_workers_by_the_start_method(monkeypatch):
     assert asked == ["spawn"]
 
 
+@pytest.mark.parametrize(("cores", "memory_gib", "expected"), [
+    (2, 24, 2),  # this machine: two cores, memory enough for both
+    (64, 16, 8),  # many cores, little memory: one worker per JOB_MEMORY (2 GiB)
+    (4, 1, 1),  # less memory than one worker takes: still one
+])
+def test_default_jobs_are_the_cores_as_memory_allows(monkeypatch, cores, memory_gib, expected):
+    """``--jobs``' default: the usable cores, at most one per :data:`workers.JOB_MEMORY` (the
+    expected counts worked out by hand from the two limits)."""
+    monkeypatch.setattr(workers.os, "sched_getaffinity", lambda pid: set(range(cores)),
+                        raising=False)
+    sizes = {"SC_PAGE_SIZE": 4096, "SC_PHYS_PAGES": memory_gib * 2**30 // 4096}
+    monkeypatch.setattr(workers.os, "sysconf", lambda name: sizes[name])
+    assert workers.default_jobs() == expected
+
+
+def test_more_jobs_than_units_start_no_idle_workers(monkeypatch):
+    """A pool is sized to the units (one unit runs here, with no pool at all)."""
+    sized = []
+    real = workers.executor
+    monkeypatch.setattr(workers, "executor", lambda jobs, dask: sized.append(jobs) or
+                        real(jobs, dask))
+    assert workers.run_units([("one", pow, (3, 2))], jobs=8) == [9]
+    assert sized == [1]
+
+
 def test_one_job_runs_here():
     with workers.executor(1) as pool:
         assert pool is None
