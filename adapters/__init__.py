@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 import importlib
+import importlib.metadata
 from dataclasses import dataclass
 from typing import Any
 
@@ -174,6 +175,13 @@ def _load(name: str) -> None:
     try:
         if entry.run is not None and entry.model is not None:
             from dyncheck.adapters.model_adapter import for_engine
+
+            # its loader imports the engine only when it loads a model (Newton's): an engine
+            # that is not installed must be missing here, not fail in the middle of a run
+            try:
+                importlib.metadata.distribution(entry.package)
+            except importlib.metadata.PackageNotFoundError:
+                raise ImportError(f"No module named {entry.package!r}") from None
 
             _ADAPTERS[name] = for_engine(name, package=entry.package, model=entry.model,
                                          run=entry.run, float32=entry.float32,

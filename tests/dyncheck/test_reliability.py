@@ -110,6 +110,34 @@ def test_memory_probe_does_not_wait_on_a_dead_child():
         peak_memory_kib("no_such_case", 5)
 
 
+@pytest.mark.parametrize("engine", ["newton", "pybullet"])
+def test_an_engine_whose_package_is_not_installed_is_skipped_not_a_crash(tmp_path, engine):
+    """The README's main command installs only the drake, mjx and warp extras: Newton's and
+    PyBullet's packages absent (no distribution, no module), the default run crashed with
+    PackageNotFoundError while naming the engines' versions (Newton's loader imports the
+    engine only when it loads a model, so nothing failed earlier). Now their rows are skipped
+    naming the extra, and the run exits 0."""
+    out = tmp_path / "rep"
+    package = REGISTRY[engine].package
+    code = (
+        "import importlib.metadata as md, sys\n"
+        "real = md.distribution\n"
+        f"def gone(name):\n    if name == {package!r}: raise md.PackageNotFoundError(name)\n"
+        "    return real(name)\n"
+        f"md.distribution = gone; sys.modules[{package!r}] = None\n"
+        "from dyncheck.cli import main\n"
+        f"raise SystemExit(main(['run', 'simple_pendulum', '--impl', 'reference', '--impl', "
+        f"{engine!r}, '--jobs', '1', '--quiet', '--out', {str(out)!r}]))"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr
+    d = pd.read_csv(out / "discrepancies.csv")
+    mine = d[(d.impl_a == engine) | (d.impl_b == engine)]
+    assert len(mine) and (mine.verdict == "skipped").all()
+    assert mine.note.str.contains(f"dyncheck[{REGISTRY[engine].extra}]", regex=False).all()
+
+
 @pytest.mark.slow
 def test_missing_engine_costs_only_its_rows(tmp_path):
     """Pinocchio not importable: its rows are skipped with the pip hint, the rest of the
