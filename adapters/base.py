@@ -17,11 +17,11 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from enum import StrEnum
 from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
+from dyncheck.adapters.model_tree import StateLayout
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import EngineError, Unsupported
 from dyncheck.vocabulary import Quantity
@@ -49,44 +49,6 @@ class LoadedBody:
     name: str
     mass: float
     inertia: np.ndarray
-
-
-class Chart(StrEnum):
-    """What a ball joint's positions are."""
-
-    QUATERNION = "quaternion"
-    RPY = "rpy"
-    """(roll, pitch, yaw), R = R_z(y) R_y(p) R_x(r) (Drake's ``BallRpyJoint``)."""
-    EULER = "euler"
-    """Example 9's angles (body Z, X, Z), their rates the velocities (a free joint likewise,
-    after its position)."""
-
-
-class Frame(StrEnum):
-    """The axes a velocity's components are taken on."""
-
-    LOCAL = "local"
-    WORLD = "world"
-    EULER_RATES = "euler rates"
-    """Not a frame: the angles' rates (a chart's velocities)."""
-
-
-@dataclass(frozen=True, kw_only=True)
-class StateLayout:
-    """How an engine stores a ball or free joint's state, measured on the installed versions
-    (tests/dyncheck/test_conventions.py rotates a body by a known quaternion and reads it
-    back). The canonical state is MuJoCo's: quaternion (w, x, y, z), a free joint's position
-    first, ω in body axes, a free joint's v in world axes, (v, ω)."""
-
-    quaternion_order: str = "wxyz"
-    ball_chart: Chart = Chart.QUATERNION
-    quaternion_first: bool = False
-    """A free joint stores (quaternion, position)."""
-    angular_velocity_frame: Frame = Frame.LOCAL
-    linear_velocity_frame: Frame = Frame.WORLD
-    """A free joint's linear velocity."""
-    angular_first: bool = False
-    """A free joint's velocity is (ω, v)."""
 
 
 def _computed(kind: str, inputs: object, compute: Callable[[], _T]) -> _T:

@@ -29,7 +29,7 @@ multiplier of the linear constraint C v = 0 (C constant, from the engine-neutral
 f = −tension; in simulation Cᵀ f enters the plant's applied-generalized-force input, recomputed
 from the state at every stage of Drake's integrators.
 
-State (measured, ``dyncheck.conventions``): a ball joint becomes a ``BallRpyJoint`` —
+State (measured, ``dyncheck.adapters.layout``): a ball joint becomes a ``BallRpyJoint`` —
 q = (roll, pitch, yaw), v = ω in *world* axes; a free joint a ``QuaternionFloatingJoint`` —
 q = (w, x, y, z, p), v = (ω, v) both in world axes. Drake integrates the quaternion's
 components (q̇ = ½ q ⊗ ω), so its norm drifts; the comparison layer renormalizes.
@@ -55,10 +55,11 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import LogVectorOutput
 
 from dyncheck.adapters import REGISTRY
-from dyncheck.adapters.base import Adapter, Chart, Frame, LoadedBody, StateLayout, Trajectory
+from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.drake_model import parser_warnings
 from dyncheck.adapters.linalg import solve
 from dyncheck.adapters.mjcf import to_mjcf
+from dyncheck.adapters.model_tree import Axes, Layout, Orientation, StateLayout
 from dyncheck.cases.multibody import Joint, Multibody
 from dyncheck.errors import EngineError
 from dyncheck.vocabulary import Integrator
@@ -134,8 +135,8 @@ def kkt(M: np.ndarray, rhs: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.n
 class DrakeAdapter(Adapter):
     name: ClassVar[str] = "drake"
     state_layout: ClassVar[StateLayout] = StateLayout(
-        ball_chart=Chart.RPY, quaternion_first=True, angular_velocity_frame=Frame.WORLD,
-        angular_first=True)
+        ball=Layout.ball(quat=Orientation.RPY, angular_axes=Axes.PARENT),
+        free=Layout.free(quat_first=True, angular_first=True, angular_axes=Axes.WORLD))
     """Its MJCF parser makes a ball joint a ``BallRpyJoint`` (ω in world axes) and a free
     joint a ``QuaternionFloatingJoint``, q = (w, x, y, z, p), v = (ω, v) in world axes."""
     package: ClassVar[str] = "drake"

@@ -39,7 +39,7 @@ from pydrake.multibody.tree import (
     QuaternionFloatingJoint,
 )
 
-from dyncheck.adapters.mjcf_copy import for_parser, inline
+from dyncheck.adapters.mjcf_copy import for_parser, inline, joints
 from dyncheck.adapters.mjcf_unread import springdampers
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
@@ -50,6 +50,7 @@ from dyncheck.adapters.model_tree import (
     JointType,
     Layout,
     ModelTree,
+    Orientation,
     TreeJoint,
     lump,
 )
@@ -199,34 +200,25 @@ def _skipped_classes(root: ET.Element) -> tuple[tuple[str, str, str], ...]:
 
     walk(root, [])
     out: list[tuple[str, str, str]] = []
-
-    def visit(holder: ET.Element, childclass: str) -> None:
-        for joint in holder.findall("joint"):
-            chain = chains.get(joint.get("class", childclass), [])
-            if not joint.get("name") or len(chain) < 2:
+    for placed in joints(root):
+        joint, chain = placed.element, chains.get(placed.cls, [])
+        if not joint.get("name") or len(chain) < 2:
+            continue
+        gaps = [d for d in chain[1:] if d.find("joint") is None]
+        for k, default in enumerate(chain[:-1]):
+            own = default.find("joint")
+            later = [d for d in chain[k + 1:] if d in gaps]
+            if own is None or not later:
                 continue
-            gaps = [d for d in chain[1:] if d.find("joint") is None]
-            for k, default in enumerate(chain[:-1]):
-                own = default.find("joint")
-                later = [d for d in chain[k + 1:] if d in gaps]
-                if own is None or not later:
-                    continue
-                below = [d.find("joint") for d in chain[k + 1:]]
-                fields = [f for f in LOST_ACROSS_A_GAP if f in own.attrib
-                          and f not in joint.attrib
-                          and not any(e is not None and f in e.attrib for e in below)]
-                for field in fields:
-                    out.append((joint.get("name", ""), LOST_ACROSS_A_GAP[field],
-                                SKIPPED_CLASS.format(joint=joint.get("name"), fields=field,
-                                                     source=default.get("class", "main"),
-                                                     gap=later[0].get("class"))))
-        for body in holder.findall("body"):
-            visit(body, body.get("childclass", childclass))
-        for frame in holder.findall("frame"):
-            visit(frame, frame.get("childclass", childclass))
-
-    for world in root.findall("worldbody"):
-        visit(world, "main")
+            below = [d.find("joint") for d in chain[k + 1:]]
+            fields = [f for f in LOST_ACROSS_A_GAP if f in own.attrib
+                      and f not in joint.attrib
+                      and not any(e is not None and f in e.attrib for e in below)]
+            for field in fields:
+                out.append((joint.get("name", ""), LOST_ACROSS_A_GAP[field],
+                            SKIPPED_CLASS.format(joint=joint.get("name"), fields=field,
+                                                 source=default.get("class", "main"),
+                                                 gap=later[0].get("class"))))
     return tuple(out)
 
 
@@ -369,7 +361,8 @@ class DrakeModel:
                     layout=Layout(
                         q_start=joint.position_start(), v_start=joint.velocity_start(),
                         nq=joint.num_positions(), nv=nv,
-                        quat="rpy" if kind is JointType.BALL else "wxyz", quat_first=True,
+                        quat=Orientation.RPY if kind is JointType.BALL else Orientation.WXYZ,
+                        quat_first=True,
                         angular_first=True, linear_axes=Axes.WORLD,
                         angular_axes=Axes.PARENT if kind is JointType.BALL else Axes.WORLD,
                         zero=float(q0[joint.position_start()]) if nv == 1 else 0.0,

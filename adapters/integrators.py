@@ -1,7 +1,7 @@
 """Integrators defined as MuJoCo defines them, for engines that have none (Pinocchio,
 dyncheck's own sympy-mechanics model), and error-controlled integration on the rotation group.
 
-States are laid out as MuJoCo lays them out (:class:`Layout`): a hinge or slide one
+States are laid out as MuJoCo lays them out (:class:`Addresses`): a hinge or slide one
 coordinate; a ball joint its unit quaternion (w, x, y, z) and its angular velocity ω in the
 body frame; a free joint (p, quaternion) and (v, ω) with the linear velocity v in the *world*
 frame. An engine whose state differs maps to this layout and back (its adapter does).
@@ -43,7 +43,7 @@ from dyncheck.errors import EngineError
 from dyncheck.vocabulary import Integrator
 
 Acceleration = Callable[..., np.ndarray]
-"""v̇(q, v[, held]) for one state in the :class:`Layout`, shapes (nq,), (nv,) → (nv,): called
+"""v̇(q, v[, held]) for one state in the :class:`Addresses`, shapes (nq,), (nv,) → (nv,): called
 with two arguments it evaluates every state-dependent external force now; with ``held``, what
 ``freeze`` returned at the start of the step, it uses that force instead."""
 
@@ -98,14 +98,14 @@ def dexp_inv(theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
 
 
 @dataclass(frozen=True, kw_only=True)
-class Layout:
+class Addresses:
     """A state laid out as MuJoCo's: per joint its type and the addresses of its positions
     (``qadr``) and velocities (``vadr``)."""
 
     joints: tuple[tuple[str, int, int], ...]
 
     @classmethod
-    def of(cls, joint_types: Sequence[str]) -> Layout:
+    def of(cls, joint_types: Sequence[str]) -> Addresses:
         joints, qa, va = [], 0, 0
         for jt in joint_types:
             joints.append((jt, qa, va))
@@ -153,11 +153,11 @@ class Layout:
         return out
 
 
-def _vector(nq: int) -> Layout:
-    return Layout.of(["slide"] * nq)
+def _vector(nq: int) -> Addresses:
+    return Addresses.of(["slide"] * nq)
 
 
-def _euler(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float, layout: Layout, naive):
+def _euler(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float, layout: Addresses, naive):
     v_new = v + h * acc(q, v)
     return layout.integrate_pos(q, h * v_new), v_new
 
@@ -166,7 +166,7 @@ RK4_A = ((0.5,), (0.0, 0.5), (0.0, 0.0, 1.0))
 RK4_B = (1 / 6, 1 / 3, 1 / 3, 1 / 6)
 
 
-def _rk4(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float, layout: Layout, naive):
+def _rk4(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float, layout: Addresses, naive):
     """MuJoCo's ``mj_RungeKutta`` (N = 4): stage positions q₀ ⊕ h Σ aᵢⱼ kⱼ, stage velocities
     vᵢ = v₀ + h Σ aᵢⱼ v̇ⱼ, and kᵢ = dexp⁻¹(θᵢ) vᵢ on rotations (``naive``: kᵢ = vᵢ). The
     tableau's one non-zero aᵢⱼ per row is written out (a sum over its zeros adds exact zeros:
@@ -191,7 +191,7 @@ def _rk4(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float, layout: Layo
     return layout.integrate_pos(q, dq), v + dv
 
 
-def _rk4_vector(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float, layout: Layout,
+def _rk4_vector(acc: Acceleration, q: np.ndarray, v: np.ndarray, h: float, layout: Addresses,
                 naive):
     """:func:`_rk4` on a vector state (no ball or free joint: q ⊕ dq = q + dq, dexp⁻¹ the
     identity) as one array y = (q, v) with y' = (v, v̇): element by element the same
@@ -234,7 +234,7 @@ def integrate(
     integrator: str,
     *,
     freeze: Callable[[np.ndarray, np.ndarray], object] | None = None,
-    layout: Layout | None = None,
+    layout: Addresses | None = None,
     naive_group: bool = False,
 ) -> tuple[np.ndarray, np.ndarray]:
     """States after 0..steps steps, shapes (steps + 1, nq) and (steps + 1, nv), in ``layout``
@@ -274,7 +274,7 @@ def solve_on_group(
     t_eval: np.ndarray,
     rtol: float,
     *,
-    layout: Layout,
+    layout: Addresses,
     label: str,
 ) -> tuple[np.ndarray, np.ndarray]:
     """scipy's DOP853 (rtol = atol = ``rtol``) of (q, v)' = (v, acc(q, v)). On the rotation

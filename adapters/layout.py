@@ -12,10 +12,37 @@ blocks, and on a free joint's blocks R or Rᵀ or 1), so that — the kinetic en
 τ·v being invariant — M_c = Tᵀ M_e T, τ_c = Tᵀ τ_e, and accelerations a_e = T a_c + Ṫ v_c, with
 Ṫ v_c = −ω × (Rᵀ v_w) on a free joint's linear velocity held in local axes (the only block
 whose T depends on q: d(Rᵀ)/dt = −ω̂ Rᵀ, ω in local axes).
+
+This is the one home of these maps: a model check maps one state at a time (:func:`state_map`,
+complex-stepped for its derivatives, with a free joint's placement and offset) from the
+layouts the engine's own model declares; a run's case maps batches (:func:`to_engine`,
+:func:`from_engine`, :func:`velocity_frames`, :func:`velocity_frame_rates`) from the layouts
+its adapter declares once (``Adapter.state_layout``, a
+:class:`~dyncheck.adapters.model_tree.StateLayout`). Those were found by experiment on the
+installed versions (tests/adapters/test_state_layouts.py rotates a body by a known quaternion
+and reads the result back):
+
+- MuJoCo: ball-joint qpos (w, x, y, z), qvel ω in body axes; a free joint's qpos (p, w, x, y,
+  z), qvel (v, ω), v of the body origin in *world* axes, ω in body axes (the canonical).
+- Pinocchio (``JointModelSpherical``, programmatic or from MJCF): q (x, y, z, w), v ω in the
+  joint's local frame; its free-flyer q (p, x, y, z, w), v (v, ω) *both* in body axes: v_b =
+  Rᵀ v_w, so T = diag(Rᵀ, 1) and Ṫ v = (−ω × v_b, 0) — the engine's v̇ is the derivative of
+  body-frame components (the "spatial" acceleration Rᵀ p̈ − ω × v_b), not the body's
+  acceleration.
+- Drake: its MJCF parser turns a ball joint into ``BallRpyJoint``, q = (roll, pitch, yaw),
+  v = ω in the parent's (here the world's) axes (T = R); a free joint into
+  ``QuaternionFloatingJoint``, q = (w, x, y, z, p), v = (ω, v) both in world axes. Drake
+  integrates the quaternion's components, so its norm drifts: :func:`from_engine`
+  renormalizes.
+- sympy-mechanics (dyncheck's own model): a rotating body in Example 9's angles (body Z, X,
+  Z), velocities their rates, so v = J⁻¹ ω̄ (exercise 23) and v̇ picks up −J⁻¹ J̇ q̇. Where
+  the book has fewer coordinates than the engine (a point mass's spin), least squares and
+  least-norm forces are taken in the canonical metric W = T⁻ᵀT⁻¹, not in the angle rates'.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,9 +56,10 @@ from dyncheck.adapters.model_tree import (
     JointType,
     Layout,
     ModelTree,
+    Orientation,
     TreeJoint,
 )
-from dyncheck.cases.coordinate_maps import quat_from_matrix, quat_to_matrix
+from dyncheck.cases.coordinate_maps import EulerAngleMap, quat_from_matrix, quat_to_matrix
 
 IDENTITY = np.eye(4)
 
@@ -230,3 +258,174 @@ def to_canonical(maps: list[StateMap], dyn: Dynamics) -> Dynamics:
         mass_matrix=np.array(mass), bias=np.array(bias), forward=np.array(forward),
         inverse=np.array(inverse), kinetic=dyn.kinetic, potential=dyn.potential,
     )
+
+
+# Batched maps for the run's cases: canonical states (n, nq) and (n, nv) in the canonical
+# joint order, to and from an engine whose joints are laid out one after another
+# (:meth:`~dyncheck.adapters.model_tree.StateLayout.joints`). The same conventions as
+# :func:`state_map`, for many states at once (a trajectory's), without the check's
+# placements and offsets (a case's free body is its own frame, placed at the origin).
+
+
+def _rotating(kinds: Sequence[JointType]) -> bool:
+    return any(JointType(k).rotating for k in kinds)
+
+
+def _order(quat: Orientation) -> list[int]:
+    return ["wxyz".index(c) for c in str(quat)]
+
+
+def _rpy_of(rot: np.ndarray) -> np.ndarray:
+    """(roll, pitch, yaw) with R = R_z(yaw) R_y(pitch) R_x(roll), batched (real: the run's
+    states; :func:`rpy_from_matrix` takes one state, complex-stepped or not)."""
+    return np.stack(
+        [
+            np.arctan2(rot[:, 2, 1], rot[:, 2, 2]),
+            np.arcsin(np.clip(-rot[:, 2, 0], -1.0, 1.0)),
+            np.arctan2(rot[:, 1, 0], rot[:, 0, 0]),
+        ],
+        -1,
+    )
+
+
+def _quat_of_rpy(rpy: np.ndarray) -> np.ndarray:
+    """Unit quaternion (w, x, y, z) of R_z(y) R_y(p) R_x(r), batched."""
+    r, p, y = (rpy[:, i] / 2 for i in range(3))
+    cr, sr, cp, sp_, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
+    return np.stack(
+        [
+            cr * cp * cy + sr * sp_ * sy,
+            sr * cp * cy - cr * sp_ * sy,
+            cr * sp_ * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp_ * cy,
+        ],
+        -1,
+    )
+
+
+def _unit(quat: np.ndarray) -> np.ndarray:
+    """Engines that integrate quaternion components (Drake) let the norm drift: renormalize."""
+    return quat / np.linalg.norm(quat, axis=-1, keepdims=True)
+
+
+def to_engine(layouts: Sequence[Layout], kinds: Sequence[JointType],
+              q_c: np.ndarray) -> np.ndarray:
+    """Canonical positions (quaternions (w, x, y, z); a free joint's position first) to the
+    engine's (each joint's orientation and order as its layout says), batched."""
+    if not _rotating(kinds):
+        return q_c
+    cols, i = [], 0
+    for lay, kind in zip(layouts, map(JointType, kinds), strict=True):
+        chunk = q_c[:, i : i + kind.nq]
+        if kind is JointType.BALL:
+            if lay.quat is Orientation.RPY:
+                cols.append(_rpy_of(quat_to_matrix(chunk)))
+            elif lay.quat is Orientation.EULER:
+                cols.append(EulerAngleMap().to_book(chunk))
+            else:
+                cols.append(chunk[:, _order(lay.quat)])
+        elif kind is JointType.FREE and lay.quat is Orientation.EULER:
+            cols.extend([chunk[:, :3], EulerAngleMap().to_book(chunk[:, 3:])])
+        elif kind is JointType.FREE:
+            quat = chunk[:, 3:][:, _order(lay.quat)]
+            cols.extend([quat, chunk[:, :3]] if lay.quat_first else [chunk[:, :3], quat])
+        else:
+            cols.append(chunk)
+        i += kind.nq
+    return np.concatenate(cols, -1)
+
+
+def from_engine(layouts: Sequence[Layout], kinds: Sequence[JointType],
+                q_e: np.ndarray) -> np.ndarray:
+    """The engine's positions back to canonical ones (:func:`to_engine` inverted), batched;
+    quaternions renormalized."""
+    if not _rotating(kinds):
+        return q_e
+    cols = []
+    for lay, kind in zip(layouts, map(JointType, kinds), strict=True):
+        chunk = q_e[:, lay.q_start : lay.q_start + lay.nq]
+        if kind is JointType.BALL and lay.quat is Orientation.RPY:
+            cols.append(_quat_of_rpy(chunk))
+        elif kind.rotating and lay.quat is Orientation.EULER:
+            if kind is JointType.FREE:
+                cols.append(chunk[:, :3])
+            cols.append(EulerAngleMap().to_engine(chunk[:, -3:]))
+        elif kind is JointType.BALL:
+            cols.append(_unit(chunk[:, np.argsort(_order(lay.quat))]))
+        elif kind is JointType.FREE:
+            quat, pos = (chunk[:, :4], chunk[:, 4:]) if lay.quat_first else \
+                (chunk[:, 3:], chunk[:, :3])
+            cols.extend([pos, _unit(quat[:, np.argsort(_order(lay.quat))])])
+        else:
+            cols.append(chunk)
+    return np.concatenate(cols, -1)
+
+
+def _canonical_velocities(lay: Layout, kind: JointType) -> bool:
+    if kind is JointType.BALL:
+        return lay.angular_axes is Axes.LOCAL
+    if kind is JointType.FREE:
+        return lay.linear_axes is Axes.WORLD and lay.angular_axes is Axes.LOCAL \
+            and not lay.angular_first
+    return True
+
+
+def velocity_frames(layouts: Sequence[Layout], kinds: Sequence[JointType],
+                    q_c: np.ndarray) -> np.ndarray | None:
+    """T(q) with v_engine = T v_canonical (canonical states, batched (n, nv, nv)), or None
+    where every joint's velocities are the canonical ones: a ball joint's ω in world or parent
+    axes (T = R), a free joint's linear velocity in body axes (Rᵀ) or its ω in world axes (R),
+    an Euler chart's angle rates (J⁻¹, exercise 23 inverted)."""
+    kinds = [JointType(k) for k in kinds]
+    if all(_canonical_velocities(lay, k) for lay, k in zip(layouts, kinds, strict=True)):
+        return None
+    nv = sum(k.nv for k in kinds)
+    t = np.broadcast_to(np.eye(nv), (q_c.shape[0], nv, nv)).copy()
+    i = k = 0
+    for lay, kind in zip(layouts, kinds, strict=True):
+        if kind.rotating and lay.angular_axes is Axes.RATES:
+            a, b = (i + 3, k + 3) if kind is JointType.FREE else (i, k)
+            angles = EulerAngleMap().to_book(q_c[:, a : a + 4])
+            t[:, b : b + 3, b : b + 3] = np.linalg.inv(EulerAngleMap().jacobian(angles))
+        elif kind is JointType.BALL and lay.angular_axes in (Axes.WORLD, Axes.PARENT):
+            t[:, k : k + 3, k : k + 3] = quat_to_matrix(q_c[:, i : i + 4])
+        elif kind is JointType.FREE:
+            rot = quat_to_matrix(q_c[:, i + 3 : i + 7])
+            lin = np.swapaxes(rot, -1, -2) if lay.linear_axes is Axes.LOCAL else \
+                np.broadcast_to(np.eye(3), rot.shape)
+            ang = rot if lay.angular_axes is Axes.WORLD else np.broadcast_to(np.eye(3), rot.shape)
+            t[:, k : k + 6, k : k + 6] = 0.0
+            if lay.angular_first:
+                t[:, k : k + 3, k + 3 : k + 6] = ang
+                t[:, k + 3 : k + 6, k : k + 3] = lin
+            else:
+                t[:, k : k + 3, k : k + 3] = lin
+                t[:, k + 3 : k + 6, k + 3 : k + 6] = ang
+        i += kind.nq
+        k += kind.nv
+    return t
+
+
+def velocity_frame_rates(layouts: Sequence[Layout], kinds: Sequence[JointType],
+                         q_c: np.ndarray, v_c: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Ṫ v for canonical states and velocities, given T = :func:`velocity_frames` there:
+    (−ω × Rᵀ v_w, 0) for a free joint whose linear velocity is in body axes; R ω̄ in world
+    axes has Ṙ ω̄ = R (ω̄ × ω̄) = 0; an Euler chart's −J⁻¹ J̇ q̇ (the chart's own (2.2.5)
+    term, d/dt (J⁻¹ ω̄) with q̇ = J⁻¹ ω̄)."""
+    out = np.zeros_like(v_c)
+    i = k = 0
+    for lay, kind in zip(layouts, map(JointType, kinds), strict=True):
+        if kind.rotating and lay.angular_axes is Axes.RATES:
+            a, b = (i + 3, k + 3) if kind is JointType.FREE else (i, k)
+            angles = EulerAngleMap().to_book(q_c[:, a : a + 4])
+            tb = t[:, b : b + 3, b : b + 3]
+            qdot = np.einsum("nij,nj->ni", tb, v_c[:, b : b + 3])
+            out[:, b : b + 3] = -np.einsum(
+                "nij,nj->ni", tb, EulerAngleMap().hessian_term(angles, qdot))
+        elif kind is JointType.FREE and lay.linear_axes is Axes.LOCAL:
+            rot = quat_to_matrix(q_c[:, i + 3 : i + 7])
+            vb = np.einsum("nji,nj->ni", rot, v_c[:, k : k + 3])
+            out[:, k : k + 3] = -np.cross(v_c[:, k + 3 : k + 6], vb)
+        i += kind.nq
+        k += kind.nv
+    return out

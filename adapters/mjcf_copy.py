@@ -134,14 +134,15 @@ def class_defaults(root: ET.Element, tag: str,
 class Placed:
     """A geom or joint as the compiler sees it: the element holding it (a body, a frame, the
     world), the body it belongs to (the world's own: ``<worldbody>``), whether that body's
-    inertia moves and is stated, and its attributes resolved through default classes (its
-    ``class``, else the nearest ``childclass``, else ``main``); ``stated``: those written on
-    the element itself."""
+    inertia moves and is stated, its default class ``cls`` (its ``class``, else the nearest
+    ``childclass``, else ``main``) and its attributes resolved through it; ``stated``: those
+    written on the element itself."""
 
     element: ET.Element
     holder: ET.Element
     body: ET.Element
     owner: Owner
+    cls: str
     attrs: dict[str, str]
 
     @property
@@ -169,7 +170,7 @@ def placed(root: ET.Element, tag: str, keys: tuple[str, ...]) -> list[Placed]:
             attrs = {**defaults.get(cls, defaults.get("main", {})),
                      **{k: v for k, v in element.attrib.items() if k in keys}}
             out.append(Placed(element=element, holder=holder, body=body, owner=owner,
-                              attrs=attrs))
+                              cls=cls, attrs=attrs))
         for frame in holder.findall("frame"):  # a frame's elements belong to its body
             walk(frame, body, frame.get("childclass", childclass), owner)
         for child in holder.findall("body"):

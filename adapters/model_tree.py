@@ -15,9 +15,10 @@ knowing the engine.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass, field
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
 from enum import StrEnum
+from typing import Any
 
 import numpy as np
 
@@ -32,6 +33,28 @@ class Axes(StrEnum):
     PARENT = "parent"
     """A ball joint's parent-side frame F, which coincides with the child's frame at the
     reference configuration (Drake's ``BallRpyJoint``: v = ω of the child in F, in F)."""
+    RATES = "rates"
+    """Not axes: the rates of a chart's angles (:attr:`Orientation.EULER`), v = J⁻¹ ω
+    (exercise 23)."""
+
+
+class Orientation(StrEnum):
+    """How a ball or free joint's orientation is held in q."""
+
+    WXYZ = "wxyz"
+    """A unit quaternion, scalar first (MuJoCo, Drake's free joint)."""
+    XYZW = "xyzw"
+    """A unit quaternion, scalar last (Pinocchio, Newton, PyBullet)."""
+    RPY = "rpy"
+    """A ball joint's (roll, pitch, yaw), R = R_z(yaw) R_y(pitch) R_x(roll) (Drake's
+    ``BallRpyJoint``): three coordinates."""
+    EULER = "euler"
+    """Example 9's angles (body Z, X, Z) (dyncheck's sympy-mechanics model): three
+    coordinates, their rates the velocities (:attr:`Axes.RATES`)."""
+
+    @property
+    def quaternion(self) -> bool:
+        return self in (Orientation.WXYZ, Orientation.XYZW)
 
 
 class GravityFrame(StrEnum):
@@ -61,19 +84,21 @@ NV = {t: t.nv for t in JointType}
 
 @dataclass(frozen=True, kw_only=True)
 class Layout:
-    """Where one joint's coordinates sit in an engine's q and v, and in which convention.
+    """Where one joint's coordinates sit in an engine's q and v, and in which convention — the
+    one description of a state's layout, for the run's cases (:class:`StateLayout`) and the
+    check's models alike.
 
-    ``quat`` is ``"wxyz"`` or ``"xyzw"``, or for a ball joint ``"rpy"`` (roll, pitch, yaw:
-    R = R_z(yaw) R_y(pitch) R_x(roll), three coordinates); a free joint's q is ``(p, quat)`` unless
-    ``quat_first``; its v is ``(linear, angular)`` unless ``angular_first``, each resolved in
-    ``linear_axes`` / ``angular_axes``. ``cos_sin``: a hinge stored as (cos θ, sin θ) (an
-    unbounded revolute joint)."""
+    ``quat``: a ball or free joint's orientation (:class:`Orientation`); a free joint's q is
+    ``(p, orientation)`` unless ``quat_first``; its v is ``(linear, angular)`` unless
+    ``angular_first``, each resolved in ``linear_axes`` / ``angular_axes`` (a ball joint's ω
+    in ``angular_axes``). ``cos_sin``: a hinge stored as (cos θ, sin θ) (an unbounded revolute
+    joint)."""
 
     q_start: int
     v_start: int
     nq: int
     nv: int
-    quat: str = "wxyz"
+    quat: Orientation = Orientation.WXYZ
     quat_first: bool = False
     angular_first: bool = False
     linear_axes: Axes = Axes.WORLD
@@ -87,6 +112,53 @@ class Layout:
     point: np.ndarray | None = None
     """Free: the point of the body (body frame) whose velocity v holds (Newton: the centre
     of mass); None: the origin of :attr:`offset`'s frame."""
+
+
+    @classmethod
+    def ball(cls, **convention: Any) -> Layout:
+        """A ball joint's layout at the start of q and v (:meth:`StateLayout.joint` places it)."""
+        quat = Orientation(convention.get("quat", Orientation.WXYZ))
+        return cls(q_start=0, v_start=0, nq=4 if quat.quaternion else 3, nv=3, **convention)
+
+    @classmethod
+    def free(cls, **convention: Any) -> Layout:
+        """A free joint's layout at the start of q and v (:meth:`StateLayout.joint` places it)."""
+        quat = Orientation(convention.get("quat", Orientation.WXYZ))
+        return cls(q_start=0, v_start=0, nq=7 if quat.quaternion else 6, nv=6, **convention)
+
+
+@dataclass(frozen=True, kw_only=True)
+class StateLayout:
+    """How an engine holds every ball and every free joint (:class:`Layout`), declared once per
+    engine for the run's cases (``Adapter.state_layout``), measured on the installed versions
+    (tests/adapters/test_state_layouts.py rotates a body by a known quaternion and reads it
+    back); a model check reads each joint's from the engine's own model instead. The default
+    is the canonical layout, MuJoCo's: quaternion (w, x, y, z), a free joint's position first,
+    ω in body axes, a free joint's linear velocity in world axes, (v, ω)."""
+
+    ball: Layout = field(default_factory=Layout.ball)
+    free: Layout = field(default_factory=Layout.free)
+
+    def joint(self, kind: JointType, *, q_start: int, v_start: int) -> Layout:
+        """The layout of a joint of ``kind`` whose coordinates start at ``q_start``, ``v_start``."""
+        if kind is JointType.BALL:
+            return replace(self.ball, q_start=q_start, v_start=v_start)
+        if kind is JointType.FREE:
+            return replace(self.free, q_start=q_start, v_start=v_start)
+        return Layout(q_start=q_start, v_start=v_start, nq=1, nv=1)
+
+    def joints(self, kinds: Sequence[JointType]) -> list[Layout]:
+        """The layouts of consecutive joints of ``kinds`` (their coordinates one after another)."""
+        out, q_start, v_start = [], 0, 0
+        for kind in kinds:
+            out.append(self.joint(kind, q_start=q_start, v_start=v_start))
+            q_start, v_start = q_start + out[-1].nq, v_start + out[-1].nv
+        return out
+
+    @property
+    def charted(self) -> bool:
+        """Whether a ball joint is held in angles (a chart), not a quaternion."""
+        return not self.ball.quat.quaternion
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -27,6 +27,7 @@ from dyncheck.adapters.model_tree import (
     JointType,
     Layout,
     ModelTree,
+    Orientation,
     Transition,
     TreeJoint,
     lump,
@@ -157,7 +158,7 @@ def _layouts(m: mujoco.MjModel) -> list[Layout]:
         out.append(
             Layout(
                 q_start=int(m.jnt_qposadr[j]), v_start=int(m.jnt_dofadr[j]),
-                nq=NQ[kind], nv=NV[kind], quat="wxyz", linear_axes=Axes.WORLD,
+                nq=NQ[kind], nv=NV[kind], quat=Orientation.WXYZ, linear_axes=Axes.WORLD,
                 angular_axes=Axes.LOCAL, zero=float(m.qpos0[m.jnt_qposadr[j]]),
             )
         )

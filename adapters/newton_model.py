@@ -31,6 +31,7 @@ from dyncheck.adapters.model_tree import (
     JointType,
     Layout,
     ModelTree,
+    Orientation,
     TreeJoint,
     lump,
 )
@@ -210,12 +211,12 @@ class NewtonModel:
             above = mover(int(parent[j]))
             limited = nv == 1 and abs(lower[vs]) < NO_LIMIT and abs(upper[vs]) < NO_LIMIT
             if kind is JointType.FREE:
-                layout = Layout(q_start=qs, v_start=vs, nq=7, nv=6, quat="xyzw",
+                layout = Layout(q_start=qs, v_start=vs, nq=7, nv=6, quat=Orientation.XYZW,
                                 linear_axes=Axes.WORLD, angular_axes=Axes.WORLD,
                                 placement=_pose(x_p[j]), offset=_pose(x_c[j]),
                                 point=np.asarray(com[child[j]], float))
             elif kind is JointType.BALL:
-                layout = Layout(q_start=qs, v_start=vs, nq=4, nv=3, quat="xyzw",
+                layout = Layout(q_start=qs, v_start=vs, nq=4, nv=3, quat=Orientation.XYZW,
                                 angular_axes=Axes.PARENT)
             else:
                 layout = Layout(q_start=qs, v_start=vs, nq=1, nv=1)

@@ -29,9 +29,10 @@ import numpy as np
 import pinocchio as pin
 
 from dyncheck.adapters import REGISTRY
-from dyncheck.adapters.base import Adapter, Frame, LoadedBody, StateLayout, Trajectory
-from dyncheck.adapters.integrators import Layout, cross, integrate, solve_on_group
+from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.integrators import Addresses, cross, integrate, solve_on_group
 from dyncheck.adapters.mjcf import to_mjcf
+from dyncheck.adapters.model_tree import Axes, Layout, Orientation, StateLayout
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.cases.multibody import Joint, Multibody
 from dyncheck.vocabulary import Integrator
@@ -97,7 +98,8 @@ def load_mjcf(xml: str) -> pin.Model:
 class PinocchioAdapter(Adapter):
     name: ClassVar[str] = "pinocchio"
     state_layout: ClassVar[StateLayout] = StateLayout(
-        quaternion_order="xyzw", linear_velocity_frame=Frame.LOCAL)
+        ball=Layout.ball(quat=Orientation.XYZW),
+        free=Layout.free(quat=Orientation.XYZW, linear_axes=Axes.LOCAL))
     """``JointModelSpherical``: q (x, y, z, w), ω in the joint's local frame; free-flyer q
     (p, x, y, z, w), v (v, ω) both in the body frame (programmatic or from MJCF)."""
     package: ClassVar[str] = "pin"
@@ -112,7 +114,7 @@ class PinocchioAdapter(Adapter):
         # the joint that carries each body's inertia, found through the body's frame
         self._joint_ids = [self._body_joint(b.name) for b in model.bodies]
         self._C = model.coupling_matrix() if model.couplings else None
-        self.layout = Layout.of([j.type for j in model.joints])
+        self.layout = Addresses.of([j.type for j in model.joints])
         # MuJoCo's positions → Pinocchio's: each quaternion (w, x, y, z) → (x, y, z, w), as
         # one permutation of q (and its inverse); the free joints, whose linear velocity
         # changes frame

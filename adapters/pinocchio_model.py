@@ -27,6 +27,7 @@ from dyncheck.adapters.model_tree import (
     JointType,
     Layout,
     ModelTree,
+    Orientation,
     TreeJoint,
 )
 from dyncheck.adapters.model_tree import (
@@ -178,7 +179,7 @@ class PinocchioModel:
                         damping=tuple(float(x) for x in m.damping[dofs]),
                         range=(float(lower), float(upper)) if limited else None,
                         layout=Layout(
-                            q_start=q_at, v_start=v_at, nq=nq, nv=nv, quat="xyzw",
+                            q_start=q_at, v_start=v_at, nq=nq, nv=nv, quat=Orientation.XYZW,
                             linear_axes=Axes.LOCAL, angular_axes=Axes.LOCAL,
                             cos_sin=short in _HINGE_UNBOUNDED,
                             zero=float(q0[q_at]) if nq == 1 else 0.0,

@@ -46,6 +46,7 @@ from dyncheck.adapters.model_tree import (
     JointType,
     Layout,
     ModelTree,
+    Orientation,
     TreeJoint,
     lump,
 )
@@ -299,7 +300,7 @@ class PybulletModel:
                     body=link.name, axis=np.zeros(3), anchor=link.origin, frame=link.rotation,
                     mass=mass, com=com, inertia=inertia, armature=(0.0,) * 6,
                     damping=(0.0,) * 6, range=None, gravity_frame=GravityFrame.RPY_REVERSED,
-                    layout=Layout(q_start=q_at, v_start=v_at, nq=7, nv=6, quat="xyzw",
+                    layout=Layout(q_start=q_at, v_start=v_at, nq=7, nv=6, quat=Orientation.XYZW,
                                   angular_first=True, linear_axes=Axes.WORLD,
                                   angular_axes=Axes.LOCAL, offset=link.offset),
                 ))

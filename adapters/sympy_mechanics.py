@@ -32,15 +32,13 @@ from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.base import (
     AFRESH,
     Adapter,
-    Chart,
-    Frame,
     LoadedBody,
-    StateLayout,
     Symbolic,
     Trajectory,
 )
 from dyncheck.adapters.integrators import integrate
 from dyncheck.adapters.linalg import solve
+from dyncheck.adapters.model_tree import Axes, Layout, Orientation, StateLayout
 from dyncheck.cases.multibody import ROTATING, Multibody
 from dyncheck.vocabulary import Integrator
 
@@ -197,7 +195,8 @@ def _derive(model: Multibody) -> Equations:
 class SympyMechanicsAdapter(Adapter):
     name: ClassVar[str] = "sympy-mechanics"
     state_layout: ClassVar[StateLayout] = StateLayout(
-        ball_chart=Chart.EULER, angular_velocity_frame=Frame.EULER_RATES)
+        ball=Layout.ball(quat=Orientation.EULER, angular_axes=Axes.RATES),
+        free=Layout.free(quat=Orientation.EULER, angular_axes=Axes.RATES))
     """dyncheck's own model: a rotating body in Example 9's angles, velocities their rates."""
     package: ClassVar[str] = "sympy"
     integrators: ClassVar[tuple[str, ...]] = REGISTRY["sympy-mechanics"].integrators

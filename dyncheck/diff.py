@@ -200,6 +200,32 @@ def keys(frame: pd.DataFrame, key: list[str]) -> pd.Series:
     return out
 
 
+@dataclass(frozen=True, kw_only=True)
+class Paired:
+    """Two tables' rows matched on their key (:func:`keys`), keys sorted: ``a`` and ``b`` the
+    rows of the keys both have once (same order), ``vanished`` / ``appeared`` the keys of one
+    side only, ``repeated`` the keys a side has more than once (left out of the rest)."""
+
+    a: pd.DataFrame
+    b: pd.DataFrame
+    vanished: list[str]
+    appeared: list[str]
+    repeated: list[str]
+
+
+def paired(a: pd.DataFrame, b: pd.DataFrame, key: list[str] | None = None) -> Paired:
+    """The one pairing of rows for everything that compares two tables (``diff``,
+    ``baseline``, ``report --check``): tables indexed by :func:`keys` already (``key`` None)
+    or keyed here on the columns ``key``."""
+    if key is not None:
+        a, b = a.set_axis(keys(a, key)), b.set_axis(keys(b, key))
+    repeated = sorted(set(a.index[a.index.duplicated()]) | set(b.index[b.index.duplicated()]))
+    ka, kb = set(a.index) - set(repeated), set(b.index) - set(repeated)
+    common = sorted(ka & kb)
+    return Paired(a=a.loc[common], b=b.loc[common], vanished=sorted(ka - kb),
+                  appeared=sorted(kb - ka), repeated=repeated)
+
+
 def read_versions(folder: Path) -> dict[str, str]:
     """The versions recorded in a folder's ``provenance.json`` (empty when it has none)."""
     path = folder / PROVENANCE
@@ -244,7 +270,12 @@ def diff(a: RunTables, b: RunTables, *, factor: float = FACTOR) -> pd.DataFrame:
         raise InvalidInput("RUN_B", str(b.path), f"the output of `{a.kind}`, like RUN_A")
     check_factor(factor)
     key = KEYS[a.kind]
-    joined = a.rows.add_suffix("_a").join(b.rows.add_suffix("_b"), how="outer")
+    p = paired(a.rows, b.rows)  # keys unique on each side (refused on loading otherwise)
+    joined = pd.concat([
+        p.a.add_suffix("_a").join(p.b.add_suffix("_b")),
+        a.rows.loc[p.vanished].add_suffix("_a"),
+        b.rows.loc[p.appeared].add_suffix("_b"),
+    ])
     for col in key:
         joined[col] = joined[f"{col}_a"].combine_first(joined[f"{col}_b"])
     tol = np.fmax(joined["tolerance_a"].to_numpy(), joined["tolerance_b"].to_numpy())

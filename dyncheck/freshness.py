@@ -243,16 +243,14 @@ def _joined(
             )
         )
         return moved, a.iloc[:0], b.iloc[:0]
-    a.index, b.index = diff.keys(a, key), diff.keys(b, key)
-    for k in sorted(set(a.index) - set(b.index)):
+    p = diff.paired(a, b, key)
+    for k in p.vanished:
         moved.append(Moved(file=name, key=k, field="row", old="present", new="vanished"))
-    for k in sorted(set(b.index) - set(a.index)):
+    for k in p.appeared:
         moved.append(Moved(file=name, key=k, field="row", old="absent", new="appeared"))
-    dup = set(a.index[a.index.duplicated()]) | set(b.index[b.index.duplicated()])
-    for k in sorted(dup):
+    for k in p.repeated:
         moved.append(Moved(file=name, key=k, field="row", old="", new="duplicated"))
-    common = sorted((set(a.index) & set(b.index)) - dup)
-    return moved, a.loc[common], b.loc[common]
+    return moved, p.a, p.b
 
 
 def _floors(*impls: pd.Series) -> np.ndarray:

@@ -28,20 +28,21 @@ from dyncheck.adapters import (
     get_adapter,
 )
 from dyncheck.adapters.base import Symbolic
-from dyncheck.cases import Case, StateSample
-from dyncheck.conventions import (
-    from_native,
-    to_native,
+from dyncheck.adapters.layout import (
+    from_engine,
+    to_engine,
     velocity_frame_rates,
     velocity_frames,
 )
+from dyncheck.adapters.model_tree import Layout, StateLayout
+from dyncheck.cases import Case, StateSample
 from dyncheck.errors import UnknownName
 from dyncheck.reference.constraints import Softness
 from dyncheck.reference.derivations import derived, lambdified
 from dyncheck.reference.systems import SYSTEMS
 from dyncheck.reference.trajectory import solve
 from dyncheck.roster import IMPLEMENTATIONS
-from dyncheck.vocabulary import INSTANTANEOUS, Quantity
+from dyncheck.vocabulary import INSTANTANEOUS, JointType, Quantity
 
 CACHED = Symbolic(derive=derived, lambdify=lambdified)
 """What an adapter that derives its equations symbolically (sympy-mechanics) is handed: the
@@ -241,28 +242,38 @@ class ReferenceImplementation(_Equations):
 
 @dataclass(frozen=True)
 class NativeMap:
-    """The case's map followed by the engine's storage conventions (``dyncheck.conventions``):
+    """The case's map followed by the engine's storage of each joint (its
+    :class:`~dyncheck.adapters.model_tree.Layout`, mapped by :mod:`dyncheck.adapters.layout`):
     quaternion order or chart, a free joint's layout, and the frames (or angle rates) of a
     rotating joint's velocities, v_native = T v_canonical."""
 
     base: Any
-    engine: str
-    spec: Any
+    layouts: tuple[Layout, ...]
+    kinds: tuple[JointType, ...]
+
+    @classmethod
+    def of(cls, case: Case, engine: str, base: Any = None,
+           state_layout: StateLayout | None = None) -> NativeMap:
+        """``case``'s map (or ``base``) into the layout ``engine``'s adapter declares (or
+        ``state_layout``)."""
+        kinds = tuple(JointType(j.type) for j in case.multibody().joints)
+        layouts = tuple((state_layout or get_adapter(engine).state_layout).joints(kinds))
+        return cls(case.engine_map() if base is None else base, layouts, kinds)
 
     @property
     def description(self) -> str:
         return self.base.description
 
     def to_engine(self, q: np.ndarray) -> np.ndarray:
-        return to_native(self.engine, self.spec, self.base.to_engine(q))
+        return to_engine(self.layouts, self.kinds, self.base.to_engine(q))
 
     def to_book(self, qn: np.ndarray) -> np.ndarray:
-        return self.base.to_book(from_native(self.engine, self.spec, qn))
+        return self.base.to_book(from_engine(self.layouts, self.kinds, qn))
 
     def _frames(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
         """The canonical engine state of ``q`` and T there (None where T = 1)."""
         qe = self.base.to_engine(q)
-        return qe, velocity_frames(self.engine, self.spec, qe)
+        return qe, velocity_frames(self.layouts, self.kinds, qe)
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         """T J: the case's Jacobian, then the engine's velocity frames."""
@@ -285,7 +296,7 @@ class NativeMap:
         if T is None:
             return H
         ve = np.einsum("nij,nj->ni", self.base.jacobian(q), v)
-        rates = velocity_frame_rates(self.engine, self.spec, qe, ve, T)
+        rates = velocity_frame_rates(self.layouts, self.kinds, qe, ve, T)
         return np.einsum("nij,nj->ni", T, H) + rates
 
 
@@ -296,7 +307,7 @@ class EngineImplementation(Implementation):
         super().__init__(case)
         self.name = adapter.name  # type: ignore[misc]
         self.adapter = adapter.create(case.multibody(), symbolic=CACHED)
-        self.map = NativeMap(case.engine_map(), adapter.name, case.multibody())
+        self.map = NativeMap.of(case, adapter.name)
         self.integrators = adapter.integrators
         self.eps = self.adapter.eps
         self._runs: dict[tuple[float, str], tuple[np.ndarray, np.ndarray]] = {}

@@ -13,7 +13,7 @@
 # the angular momentum (2.2.42) conserved:
 # I ω̇ = −ω × I ω in body axes, with the orientation q̇ = ½ q ⊗ (0, ω).
 #
-# The code: [`adapters/integrators.py`](../../adapters/integrators.py) (`integrate`, `Layout`, `dexp_inv`).
+# The code: [`adapters/integrators.py`](../../adapters/integrators.py) (`integrate`, `Addresses`, `dexp_inv`).
 
 # %%
 import matplotlib.pyplot as plt
@@ -21,7 +21,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
-from dyncheck.adapters.integrators import Layout, integrate
+from dyncheck.adapters.integrators import Addresses, integrate
 
 I = np.array([1.0, 2.0, 3.0])  # principal moments: an asymmetric top
 w0 = np.array([0.3, 2.0, 0.5])  # spin near the unstable middle axis: a tumbling body
@@ -57,7 +57,7 @@ def angle(qa, qb):
 
 
 q_ref = reference_orientation()
-layout = Layout.of(["ball"])
+layout = Addresses.of(["ball"])
 steps = np.array([0.04, 0.02, 0.01, 0.005])
 errors = {"Munthe-Kaas (dexp⁻¹)": [], "naive sum of stage ω": []}
 for h in steps:

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters import get_adapter
+from dyncheck.adapters.model_tree import Orientation
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.explain.entry import Entry, map_demo, pin_mjcf, worst
@@ -58,13 +59,9 @@ def coordinate_order() -> Entry:
 def quaternion_order() -> Entry:
     case = "spherical_pendulum"
     correct = worst(case, "pinocchio")
-    adapter = get_adapter("pinocchio")
-    old = adapter.state_layout
-    adapter.state_layout = dataclasses.replace(old, quaternion_order="wxyz")
-    try:
-        naive = worst(case, "pinocchio")
-    finally:
-        adapter.state_layout = old
+    declared = get_adapter("pinocchio").state_layout
+    mujocos = dataclasses.replace(declared.ball, quat=Orientation.WXYZ)
+    naive = worst(case, "pinocchio", state_layout=dataclasses.replace(declared, ball=mujocos))
     return Entry(
         "quaternion-storage-order",
         "A ball joint's orientation is a unit quaternion; engines store it in different orders.",

@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from dyncheck.adapters.model_tree import StateLayout
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.comparison import compare_instantaneous
@@ -36,14 +37,16 @@ class Entry:
     """Whose property the convention is (set from :data:`DEMOS`)."""
 
 
-def worst(case_name: str, engine: str, cmap=None) -> float:
+def worst(case_name: str, engine: str, cmap=None,
+          state_layout: StateLayout | None = None) -> float:
     """Largest relative error of ``engine`` against the reference over the instantaneous
-    quantities, with the case's map replaced by ``cmap`` (engine storage conventions kept)."""
+    quantities, with the case's map replaced by ``cmap`` or the engine's storage conventions
+    by ``state_layout`` (the other kept)."""
     case = get_case(case_name)
     impl = make_implementation(engine, case)
-    if cmap is not None:
+    if cmap is not None or state_layout is not None:
         assert isinstance(impl, EngineImplementation)
-        impl.map = NativeMap(cmap, engine, case.multibody())
+        impl.map = NativeMap.of(case, engine, cmap, state_layout)
     impls = {"reference": make_implementation("reference", case), engine: impl}
     rows = compare_instantaneous(case, impls, case.sample_states())
     errors = [r.max_rel_err for r in rows if r.verdict != Verdict.EXPLAINED or cmap is not None]

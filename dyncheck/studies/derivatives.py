@@ -57,7 +57,7 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
     spec = case.multibody()
     sample = case.sample_states(states)
     first = next(iter(MODELS))  # the canonical engine, whose layout the states are put in
-    cmap = NativeMap(case.engine_map(), first, spec)
+    cmap = NativeMap.of(case, first)
     q = cmap.to_engine(sample.q)
     on = States(q=q, v=co.velocity_to_engine(cmap, sample.q, sample.v),
                 a=co.acceleration_to_engine(cmap, sample.q, sample.v, sample.a))

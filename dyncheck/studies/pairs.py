@@ -9,11 +9,11 @@ from typing import Any
 
 import numpy as np
 
+from dyncheck.adapters import get_adapter
 from dyncheck.cases import NOMINAL_ORDER, Case
 from dyncheck.cases.multibody import ROTATING
 from dyncheck.comparison import soft_factor
-from dyncheck.conventions import is_chart
-from dyncheck.errors import EngineNotInstalled, Unsupported
+from dyncheck.errors import DyncheckError, EngineNotInstalled, Unsupported
 from dyncheck.implementations import Implementation, Variant, compared
 from dyncheck.results import Discrepancy, Verdict
 from dyncheck.studies.labels import CHARTS_DIFFER, GYROSCOPIC_IMPLICIT, NAIVE_GROUP_RK4
@@ -27,6 +27,14 @@ from dyncheck.tolerances import (
     roundoff_floor,
 )
 from dyncheck.vocabulary import Integrator, Quantity, is_rk4
+
+
+def _charted(name: str) -> bool:
+    """Whether an implementation holds a ball joint in angles (a chart), not a quaternion."""
+    try:
+        return get_adapter(name).state_layout.charted
+    except DyncheckError:  # the reference, the book, an engine that is not installed
+        return False
 
 
 def _no_numbers(
@@ -61,7 +69,7 @@ def _maps_differ(
     types = {j.type for j in case.multibody().joints}
     if not types & set(ROTATING):
         return None
-    if any(is_chart(e) for e in (a, b)) and a != b:
+    if any(_charted(e) for e in (a, b)) and a != b:
         return CHARTS_DIFFER
     if is_rk4(integrator) and len({_group_order(impls[e]) for e in (a, b)}) == 2:
         return NAIVE_GROUP_RK4

@@ -9,7 +9,7 @@ from typing import TypeVar
 import numpy as np
 
 from dyncheck import coordinates as co
-from dyncheck.adapters.integrators import Layout, integrate
+from dyncheck.adapters.integrators import Addresses, integrate
 from dyncheck.cases import Case
 from dyncheck.cases.coordinate_maps import CoordinateMap
 from dyncheck.implementations import Variant, general_method, reference_trajectory
@@ -122,13 +122,13 @@ class References:
         q0 = np.asarray(spec.q0, float)[None]
         qe0 = cmap.to_engine(q0)[0]
         ve0 = co.velocity_to_engine(cmap, q0, np.asarray(spec.v0, float)[None])[0]
-        layout = Layout.of([j.type for j in self.case.multibody().joints])
+        layout = Addresses.of([j.type for j in self.case.multibody().joints])
         qe, _ = integrate(acc, qe0, ve0, dt, steps, integrator, freeze=freeze, layout=layout)
         _require_chart(cmap, layout, qe)
         return cmap.to_book(qe), qe
 
 
-def _require_chart(cmap: CoordinateMap, layout: Layout, qe: np.ndarray) -> None:
+def _require_chart(cmap: CoordinateMap, layout: Addresses, qe: np.ndarray) -> None:
     """The book's coordinates must determine the engine state along the stepped run (the
     map's velocities and accelerations are those of ``to_engine(to_book(qe))``). A spherical
     pendulum's bob direction does not fix the spin about the rod, which the stepped rotation

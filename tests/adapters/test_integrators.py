@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from dyncheck.adapters.integrators import Layout, dexp_inv, integrate, quat_exp, quat_mul
+from dyncheck.adapters.integrators import Addresses, dexp_inv, integrate, quat_exp, quat_mul
 from dyncheck.cases import get_case
 from dyncheck.implementations import make_implementation
 
@@ -35,7 +35,7 @@ def _mujoco_step(joint: str, integrator: str, h: float, naive: bool = False):
         return d.qacc.copy()
 
     name = {"Euler": "euler", "RK4": "rk4"}[integrator]
-    qs, vs = integrate(acc, q0, v0, h, 1, name, layout=Layout.of([joint]), naive_group=naive)
+    qs, vs = integrate(acc, q0, v0, h, 1, name, layout=Addresses.of([joint]), naive_group=naive)
     d.qpos[:], d.qvel[:] = q0, v0
     mujoco.mj_forward(m, d)
     mujoco.mj_step(m, d)

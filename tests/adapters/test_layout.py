@@ -13,7 +13,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from dyncheck.adapters.layout import _free
-from dyncheck.adapters.model_tree import Axes, Layout
+from dyncheck.adapters.model_tree import Axes, Layout, Orientation
 
 H = 1e-5
 RNG = np.random.default_rng(7)
@@ -61,7 +61,8 @@ LAYOUTS = [
     Layout(q_start=0, v_start=0, nq=7, nv=6, quat=quat, angular_first=first,
            linear_axes=lin, angular_axes=ang, offset=offset, point=point)
     for quat, first, lin, ang, (offset, point) in itertools.product(
-        ("wxyz", "xyzw"), (False, True), (Axes.WORLD, Axes.LOCAL), (Axes.WORLD, Axes.LOCAL),
+        (Orientation.WXYZ, Orientation.XYZW), (False, True), (Axes.WORLD, Axes.LOCAL),
+        (Axes.WORLD, Axes.LOCAL),
         ((np.eye(4), None), (OFFSET, None), (np.eye(4), POINT), (OFFSET, POINT)))
 ]
 

@@ -1,5 +1,6 @@
-"""Engine state conventions, established by experiment on the installed versions: if an engine
-changes its quaternion order or velocity frame, these fail and say so."""
+"""Engine state conventions (each adapter's ``state_layout``, mapped by
+:mod:`dyncheck.adapters.layout`), established by experiment on the installed versions: if an
+engine changes its quaternion order or velocity frame, these fail and say so."""
 
 from __future__ import annotations
 
@@ -9,13 +10,13 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from dyncheck import conventions
-from dyncheck.adapters import get_adapter
-from dyncheck.adapters.base import Frame
+from dyncheck.adapters import get_adapter, layout
+from dyncheck.adapters.model_tree import Axes, Orientation
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import SphericalPendulumMap, quat_to_matrix
 from dyncheck.comparison import compare_instantaneous
 from dyncheck.implementations import make_implementation
+from dyncheck.vocabulary import JointType
 
 from ..conftest import ALL_ENGINES
 
@@ -24,13 +25,26 @@ ROT /= np.linalg.norm(ROT)  # a generic rotation, (w, x, y, z)
 OMEGA = np.array([0.3, -0.7, 1.1])  # body-frame angular velocity
 
 
+def _layouts(engine, spec):
+    kinds = [JointType(j.type) for j in spec.joints]
+    return get_adapter(engine).state_layout.joints(kinds), kinds
+
+
+def to_engine(engine, spec, q):
+    return layout.to_engine(*_layouts(engine, spec), q)
+
+
+def from_engine(engine, spec, q):
+    return layout.from_engine(*_layouts(engine, spec), q)
+
+
 def _mujoco():
     import mujoco
 
     case = get_case("spherical_pendulum")
     impl = make_implementation("mujoco", case)
     m, d = impl.adapter.model, impl.adapter.data
-    d.qpos[:] = conventions.to_native("mujoco", case.multibody(), ROT[None])[0]
+    d.qpos[:] = to_engine("mujoco", case.multibody(), ROT[None])[0]
     d.qvel[:] = OMEGA
     mujoco.mj_forward(m, d)
     vel = np.zeros(6)
@@ -44,7 +58,7 @@ def _pinocchio(name: str):
     case = get_case("spherical_pendulum")
     impl = make_implementation(name, case)
     m, d = impl.adapter.model, impl.adapter.data
-    q = conventions.to_native(name, case.multibody(), ROT[None])[0]
+    q = to_engine(name, case.multibody(), ROT[None])[0]
     pin.forwardKinematics(m, d, q, OMEGA)
     j = impl.adapter._joint_ids[0]
     world = pin.getVelocity(m, d, j, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).angular
@@ -58,20 +72,20 @@ def test_quaternion_order_and_velocity_frame(engine):
     R, omega_world = _mujoco() if engine == "mujoco" else _pinocchio(engine)
     assert_allclose(R, quat_to_matrix(ROT[None])[0], atol=1e-14)
     assert_allclose(omega_world, R @ OMEGA, atol=1e-14)
-    assert conventions.layout(engine).angular_velocity_frame is Frame.LOCAL
+    assert get_adapter(engine).state_layout.ball.angular_axes is Axes.LOCAL
 
 
 @pytest.mark.parametrize("engine", ALL_ENGINES)  # every engine declares a layout
 def test_native_order_round_trip(engine):
     spec = get_case("spherical_pendulum").multibody()
-    q = conventions.to_native(engine, spec, ROT[None])
-    assert_allclose(conventions.from_native(engine, spec, q), ROT[None])
+    q = to_engine(engine, spec, ROT[None])
+    assert_allclose(from_engine(engine, spec, q), ROT[None])
 
 
 def test_pinocchio_native_order_is_xyzw():
     spec = get_case("spherical_pendulum").multibody()
     assert_allclose(
-        conventions.to_native("pinocchio", spec, ROT[None])[0], [ROT[1], ROT[2], ROT[3], ROT[0]]
+        to_engine("pinocchio", spec, ROT[None])[0], [ROT[1], ROT[2], ROT[3], ROT[0]]
     )
 
 
@@ -79,8 +93,9 @@ def test_pinocchio_native_order_is_xyzw():
 def test_wrong_quaternion_order_is_caught(engine, wrong, monkeypatch):
     """The same engine with the other storage order assumed: its rows fail."""
     adapter = get_adapter(engine)
+    ball = dataclasses.replace(adapter.state_layout.ball, quat=Orientation(wrong))
     monkeypatch.setattr(adapter, "state_layout",
-                        dataclasses.replace(adapter.state_layout, quaternion_order=wrong))
+                        dataclasses.replace(adapter.state_layout, ball=ball))
     case = get_case("spherical_pendulum")
     impls = {
         "reference": make_implementation("reference", case),
@@ -104,7 +119,7 @@ def test_world_frame_velocity_would_be_caught():
         def jacobian(self, q):
             return base.rotation(q) @ base.jacobian(q)
 
-    impl.map = type(impl.map)(WorldFrame(), "mujoco", case.multibody())
+    impl.map = dataclasses.replace(impl.map, base=WorldFrame())
     impls = {"reference": make_implementation("reference", case), "mujoco": impl}
     rows = compare_instantaneous(case, impls, case.sample_states())
     assert {r.quantity for r in rows if r.verdict == "failed"} >= {"kinetic_energy"}
@@ -152,7 +167,7 @@ def test_mujoco_free_joint_linear_velocity_is_world_frame():
     assert_allclose(vel[3:], V_LIN, atol=1e-14)
     assert_allclose(vel[:3], R @ OMEGA, atol=1e-14)
     assert_allclose(d.qacc[:3], 0, atol=1e-12)
-    assert conventions.layout("mujoco").linear_velocity_frame is Frame.WORLD
+    assert get_adapter("mujoco").state_layout.free.linear_axes is Axes.WORLD
 
 
 @pytest.mark.parametrize("name", ["pinocchio", "pinocchio-mjcf"])
@@ -165,7 +180,7 @@ def test_pinocchio_free_flyer_velocity_is_body_frame(name):
     impl = make_implementation(name, case)
     m, d = impl.adapter.model, impl.adapter.data
     m.gravity.linear[:] = 0
-    q = conventions.to_native(name, case.multibody(), np.concatenate([[0.1, 0.2, 0.3], ROT])[None])[
+    q = to_engine(name, case.multibody(), np.concatenate([[0.1, 0.2, 0.3], ROT])[None])[
         0
     ]
     v = np.concatenate([V_LIN, OMEGA])
@@ -177,7 +192,7 @@ def test_pinocchio_free_flyer_velocity_is_body_frame(name):
     assert_allclose(world.angular, R @ OMEGA, atol=1e-14)
     a = pin.aba(m, d, q, v, np.zeros(6))
     assert_allclose(a[:3], -np.cross(OMEGA, V_LIN), atol=1e-12)
-    assert conventions.layout(name).linear_velocity_frame is Frame.LOCAL
+    assert get_adapter(name).state_layout.free.linear_axes is Axes.LOCAL
 
 
 def test_drake_ball_joint_is_rpy_with_world_angular_velocity():
@@ -186,7 +201,7 @@ def test_drake_ball_joint_is_rpy_with_world_angular_velocity():
     case = get_case("spherical_pendulum")
     adapter = make_implementation("drake", case).adapter
     plant, ctx = adapter.plant, adapter.context
-    q = conventions.to_native("drake", case.multibody(), ROT[None])[0]
+    q = to_engine("drake", case.multibody(), ROT[None])[0]
     assert q.shape == (3,)
     plant.SetPositions(ctx, q)
     plant.SetVelocities(ctx, OMEGA)
@@ -195,7 +210,7 @@ def test_drake_ball_joint_is_rpy_with_world_angular_velocity():
     assert_allclose(R, quat_to_matrix(ROT[None])[0], atol=1e-14)
     w = plant.EvalBodySpatialVelocityInWorld(ctx, body).rotational()
     assert_allclose(w, OMEGA, atol=1e-15)  # v is ω in world axes, not body axes
-    back = conventions.from_native("drake", case.multibody(), q[None])[0]
+    back = from_engine("drake", case.multibody(), q[None])[0]
     assert_allclose(quat_to_matrix(back[None])[0], quat_to_matrix(ROT[None])[0], atol=1e-14)
 
 
@@ -205,7 +220,7 @@ def test_drake_free_joint_is_quaternion_first_world_velocities():
     adapter = make_implementation("drake", case).adapter
     plant, ctx = adapter.plant, adapter.context
     canonical = np.concatenate([[0.1, 0.2, 0.3], ROT])
-    q = conventions.to_native("drake", case.multibody(), canonical[None])[0]
+    q = to_engine("drake", case.multibody(), canonical[None])[0]
     assert_allclose(q, np.concatenate([ROT, [0.1, 0.2, 0.3]]))
     plant.SetPositions(ctx, q)
     plant.SetVelocities(ctx, np.concatenate([OMEGA, V_LIN]))

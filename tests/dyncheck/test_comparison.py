@@ -302,7 +302,7 @@ def test_free_body_velocity_frame_ignored_is_caught():
             return self.base.hessian_term(q, v)
 
     impl = make_implementation("pinocchio", case)
-    naive = NoFrames(impl.map.base, "pinocchio", impl.map.spec)
+    naive = NoFrames(impl.map.base, impl.map.layouts, impl.map.kinds)
     failed = {
         r.quantity for r in _compare_with(case, "pinocchio", cmap=naive) if r.verdict == "failed"
     }
