@@ -40,10 +40,11 @@ class Progress:
                         file=self.stream, leave=False, dynamic_ncols=True, mininterval=0,
                         miniters=1)  # units are coarse (a case, a model): draw each
 
-    def done(self, unit: str) -> None:
-        """One unit finished (``unit``: what it was)."""
+    def done(self, unit: str, *, seconds: float | None = None) -> None:
+        """One unit finished (``unit``: what it was; ``seconds``: the time it took where it
+        ran — units on several workers overlap —, else the time since the last one)."""
         now = time.perf_counter()
-        took, self.last = now - self.last, now
+        took, self.last = (now - self.last) if seconds is None else seconds, now
         self.count += 1
         if self.quiet:
             return

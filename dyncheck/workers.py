@@ -12,8 +12,9 @@ import atexit
 import gc
 import os
 import sys
+import time
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import Executor, ProcessPoolExecutor
+from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from contextlib import contextmanager
 from typing import Any
 
@@ -182,6 +183,14 @@ def _under(settings: Settings, fn: Callable[..., Any], *args: Any) -> Any:
         return fn(*args)
 
 
+def _timed(settings: Settings, fn: Callable[..., Any], *args: Any) -> tuple[float, Any]:
+    """:func:`_under`, and the seconds the unit took where it ran (its own time, not the
+    wait for a worker)."""
+    start = time.perf_counter()
+    result = _under(settings, fn, *args)
+    return time.perf_counter() - start, result
+
+
 def run_units(
     units: Sequence[Unit],
     *,
@@ -190,7 +199,8 @@ def run_units(
     progress: Progress | None = None,
 ) -> list[Any]:
     """The units' results in submission order, run here, on ``jobs`` processes or on a dask
-    cluster (see :func:`executor`); ``progress`` hears of each unit done."""
+    cluster (see :func:`executor`); ``progress`` hears of each unit as it finishes, with the
+    time it took."""
     if progress is not None:
         progress.begin(len(units))
     with executor(max(1, min(jobs, len(units))), dask) as pool:
@@ -202,12 +212,15 @@ def run_units(
                     progress.done(what)
             return done
         settings = current()
-        futures = [pool.submit(_under, settings, fn, *args) for _what, fn, args in units]
-        for (what, _fn, _args), future in zip(units, futures, strict=True):
-            done.append(_result(future, what, dask))
+        futures = {pool.submit(_timed, settings, fn, *args): i
+                   for i, (_what, fn, args) in enumerate(units)}
+        results: dict[int, Any] = {}
+        for future in as_completed(futures):  # progress as units finish, not in order
+            i = futures[future]
+            seconds, results[i] = _result(future, units[i][0], dask)
             if progress is not None:
-                progress.done(what)
-        return done
+                progress.done(units[i][0], seconds=seconds)
+        return [results[i] for i in range(len(units))]
 
 
 def _result(future: Any, what: str, dask: str | None) -> Any:

@@ -6,7 +6,10 @@ which shares no scheduling code with the pool or the cluster.
 
 from __future__ import annotations
 
+import io
+import re
 import sys
+import time
 import types
 
 import pandas as pd
@@ -15,6 +18,7 @@ import pytest
 from dyncheck import workers
 from dyncheck.cases import get_case
 from dyncheck.errors import InvalidInput
+from dyncheck.progress import Progress
 from dyncheck.results import to_csv
 from dyncheck.run import run
 
@@ -75,6 +79,25 @@ def test_more_jobs_than_units_start_no_idle_workers(monkeypatch):
                         real(jobs, dask))
     assert workers.run_units([("one", pow, (3, 2))], jobs=8) == [9]
     assert sized == [1]
+
+
+def _slept(seconds: float) -> float:
+    time.sleep(seconds)
+    return seconds
+
+
+def test_a_pool_reports_each_unit_as_it_finishes_with_its_own_time():
+    """Two workers, the first unit slow: the fast one is reported first, each with the time
+    it took where it ran (not the wait between reports); results stay in submission
+    order (expected: the sleeps themselves)."""
+    stream = io.StringIO()
+    units = [("slow", _slept, (3.0,)), ("fast", _slept, (0.05,))]
+    assert workers.run_units(units, jobs=2, progress=Progress("run", stream=stream)) == \
+        [3.0, 0.05]
+    lines = stream.getvalue().splitlines()
+    assert [line.split("] ")[1].split(" done")[0] for line in lines] == ["fast", "slow"]
+    took = [float(re.search(r"done in ([0-9.]+) s", line).group(1)) for line in lines]
+    assert took[0] < 1.0 and 3.0 <= took[1] < 4.0
 
 
 def test_one_job_runs_here():
