@@ -1,5 +1,6 @@
 """``dyncheck bench --suite``: the commands a user runs, timed as that user runs them — each in
-a fresh process, wall-clock seconds on this machine — against the targets of issue #19.
+a fresh process, wall-clock seconds on this machine — against the targets of issues #19 and
+#45 (the README's main command, its install included, ≤ 120 s from empty caches).
 
 The engines' per-state costs are :mod:`dyncheck.bench`'s; this page is about the whole
 commands (imports, symbolic derivations, trajectory studies, figures, writing the report) and,
@@ -43,6 +44,18 @@ class Program(Enum):
     DYNCHECK = "dyncheck"
     PYTEST = "pytest"
     """In the source checkout (its ``tests/``): skipped where dyncheck is installed without."""
+    INSTALL = "pip"
+    """The README's install into a new virtual environment (``{tmp}/venv``) from the source
+    checkout with the extras ``argv`` (pip's own cache kept, as CI keeps its wheels):
+    skipped outside a checkout."""
+    SUM = "sum"
+    """Not a command: the sum of the steps ``argv`` names (their ``what``)."""
+
+
+MAIN_EXTRAS = ("drake", "mjx", "warp")
+"""The extras the README's main command installs (``tests/test_docs.py`` holds the README to
+them)."""
+VENV_PYTHON = "{tmp}/venv/bin/python"
 
 
 CHECKOUT = Path(__file__).resolve().parents[1]
@@ -59,6 +72,8 @@ class Step:
     warm: bool = False
     """Whether the step keeps the cache the step before it filled (derivations, measured
     demonstrations); otherwise it starts with an empty one, as on a new machine."""
+    python: str | None = None
+    """The interpreter (``{tmp}`` this suite's scratch folder); None: this one."""
 
 
 def _run(*selection: str, jobs: int, out: str) -> tuple[str, ...]:
@@ -92,6 +107,26 @@ STEPS: tuple[Step, ...] = (
         what="full run, core engines and Drake, --jobs 1",
         argv=_run(jobs=1, out="serial"),
         target_s=30.0,
+    ),
+    Step(
+        what="the README's main command: its install (extras " + ",".join(MAIN_EXTRAS)
+        + "; pip's wheel cache kept, as CI's)",
+        argv=MAIN_EXTRAS, program=Program.INSTALL, target_s=60.0,
+    ),
+    Step(
+        what="the README's main command: its run (every case and implementation installed, "
+        "--jobs by default), empty caches",
+        argv=("run", "--out", "{tmp}/main"), python=VENV_PYTHON, target_s=60.0,
+    ),
+    Step(
+        what="the README's main command in all (install and run), empty caches",
+        argv=("the README's main command: its install", "the README's main command: its run"),
+        program=Program.SUM, target_s=120.0,
+    ),
+    Step(
+        what="the README's main command's run again (warm caches)",
+        argv=("run", "--out", "{tmp}/main-again"), python=VENV_PYTHON, target_s=30.0,
+        warm=True,
     ),
     Step(
         what="report --check --from the run (reusing it)",
@@ -134,18 +169,28 @@ def measure(steps: tuple[Step, ...] = STEPS) -> pd.DataFrame:
         env.pop("PYTHONDONTWRITEBYTECODE", None)
         for i, step in enumerate(steps):
             row: dict[str, object] = {"command": step.what, "target_s": step.target_s}
-            if step.program is Program.PYTEST and not (CHECKOUT / "tests").is_dir():
-                rows.append(row | {"within_target": "skipped: no tests/ (not a source checkout)"})
+            needs = {Program.PYTEST: "tests/", Program.INSTALL: "constraints.txt"}
+            if step.program in needs and not (CHECKOUT / needs[step.program]).exists():
+                rows.append(row | {"within_target": f"skipped: no {needs[step.program]} (not "
+                                   "a source checkout)"})
+                continue
+            if step.program is Program.SUM:
+                parts = [r for r in rows if any(str(r["command"]).startswith(w)
+                                                for w in step.argv)]
+                if len(parts) != len(step.argv) or any("seconds" not in r for r in parts):
+                    rows.append(row | {"within_target": "skipped: a step it adds was"})
+                    continue
+                seconds = sum(float(str(r["seconds"])) for r in parts)
+                code = max(int(str(r["exit"])) for r in parts)
+                rows.append(row | {"seconds": round(seconds, 2), "exit": code,
+                                   "within_target": "yes" if seconds <= step.target_s
+                                   else "no"})
                 continue
             if not step.warm:
                 env["DYNCHECK_CACHE"] = f"{tmp}/cache-{i}"
                 env["DYNCHECK_JAX_CACHE"] = f"{tmp}/cache-{i}/jax"
-            argv = [a.replace("{tmp}", tmp) for a in step.argv]
             start = time.perf_counter()
-            done = subprocess.run(
-                [sys.executable, "-m", step.program.value, *argv], capture_output=True,
-                text=True, env=env, cwd=CHECKOUT if step.program is Program.PYTEST else None,
-            )
+            done = _execute(step, tmp, env)
             seconds = time.perf_counter() - start
             rows.append(row | {
                 "seconds": round(seconds, 2),
@@ -154,6 +199,26 @@ def measure(steps: tuple[Step, ...] = STEPS) -> pd.DataFrame:
             })
     columns = ["command", "seconds", "target_s", "within_target", "exit"]
     return pd.DataFrame(rows, columns=columns).astype({"exit": "Int64"})
+
+
+def _execute(step: Step, tmp: str, env: dict[str, str]) -> subprocess.CompletedProcess[str]:
+    """Run one step (a new virtual environment and pip for :attr:`Program.INSTALL`)."""
+    if step.program is Program.INSTALL:
+        made = subprocess.run([sys.executable, "-m", "venv", f"{tmp}/venv"],
+                              capture_output=True, text=True, env=env)
+        if made.returncode:
+            return made
+        spec = f"{CHECKOUT}[{','.join(step.argv)}]"
+        return subprocess.run(
+            [f"{tmp}/venv/bin/python", "-m", "pip", "install", "-q", "-c",
+             str(CHECKOUT / "constraints.txt"), "-e", spec],
+            capture_output=True, text=True, env=env)
+    python = sys.executable if step.python is None else step.python.replace("{tmp}", tmp)
+    argv = [a.replace("{tmp}", tmp) for a in step.argv]
+    return subprocess.run(
+        [python, "-m", step.program.value, *argv], capture_output=True, text=True, env=env,
+        cwd=CHECKOUT if step.program is Program.PYTEST else None,
+    )
 
 
 def write(table: pd.DataFrame, out: Path) -> None:
@@ -165,8 +230,9 @@ def write(table: pd.DataFrame, out: Path) -> None:
         "",
         "Generated by `dyncheck bench --suite`: each command in a fresh process, wall-clock "
         f"seconds on this machine ({platform.machine()}, {v['platform']}), against the "
-        "targets of issue #19. Each command starts with empty caches (derivations, measured "
-        "demonstrations, JAX's compiled programs), as on a new machine or in CI, except the "
+        "targets of issues #19 and #45. Each command starts with empty caches (derivations, "
+        "measured demonstrations, JAX's compiled programs), as on a new machine or in CI, "
+        "except the "
         "ones marked \"again\", which read what the command before them stored; the test "
         "commands run in the source checkout; Python keeps its bytecode cache as it does by "
         "default (PYTHONDONTWRITEBYTECODE unset). Versions: "

@@ -232,3 +232,15 @@ def test_no_note_names_its_engine_twice():
     notes = pd.read_csv(ROOT / "reports" / "discrepancies.csv", keep_default_na=False)["note"]
     twice = re.compile(r"^([\w-]+): \1: ")
     assert not [n for n in notes if twice.match(n)]
+
+
+def test_the_readmes_main_command_installs_the_extras_the_suite_times():
+    """`dyncheck bench --suite` times the README's main command by installing
+    ``MAIN_EXTRAS``: the README's first command must install exactly those."""
+    from dyncheck.bench_suite import MAIN_EXTRAS
+
+    first = next(line for line in (ROOT / "README.md").read_text().splitlines()
+                 if "pip install" in line)
+    extras = re.search(r'-e "\.\[([a-z,]+)\]"', first)
+    assert extras is not None and "dyncheck run" in first
+    assert tuple(extras.group(1).split(",")) == MAIN_EXTRAS

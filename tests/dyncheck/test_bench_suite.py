@@ -83,3 +83,36 @@ def test_a_test_step_outside_a_checkout_is_skipped_never_timed(tmp_path, monkeyp
     assert list(table["exit"].iloc[1:]) == [0]
     write(table, tmp_path)
     assert "skipped: no tests/" in (tmp_path / "benchmark-suite.md").read_text()
+
+
+def test_the_install_step_makes_a_new_environment_from_the_checkout(monkeypatch):
+    """The README's install as a user types it: a new virtual environment, then pip with the
+    pinned constraints and the extras, editable from the checkout (the argv checked against
+    the README's command, not run: it takes a minute)."""
+    import subprocess
+
+    from dyncheck import bench_suite
+
+    seen = []
+    monkeypatch.setattr(bench_suite.subprocess, "run", lambda argv, **kw: seen.append(argv)
+                        or subprocess.CompletedProcess(argv, 0))
+    table = measure((Step(what="install", argv=("drake", "mjx"), program=Program.INSTALL,
+                          target_s=60.0),))
+    assert list(table["exit"]) == [0]
+    venv, pip = seen
+    assert venv[1:3] == ["-m", "venv"] and venv[3].endswith("/venv")
+    assert pip[0] == venv[3] + "/bin/python" and pip[1:5] == ["-m", "pip", "install", "-q"]
+    assert pip[5:7] == ["-c", str(bench_suite.CHECKOUT / "constraints.txt")]
+    assert pip[7:] == ["-e", f"{bench_suite.CHECKOUT}[drake,mjx]"]
+
+
+def test_a_sum_row_adds_the_steps_it_names_or_says_one_is_missing():
+    steps = (Step(what="a one", argv=("list",), target_s=120.0),
+             Step(what="b two", argv=("list",), target_s=120.0),
+             Step(what="both", argv=("a", "b"), program=Program.SUM, target_s=240.0),
+             Step(what="with a missing one", argv=("a", "c"), program=Program.SUM,
+                  target_s=1.0))
+    table = measure(steps)
+    assert table["seconds"].iloc[2] == pytest.approx(table["seconds"].iloc[:2].sum(), abs=0.02)
+    assert table["within_target"].iloc[2] == "yes" and table["exit"].iloc[2] == 0
+    assert table["within_target"].iloc[3].startswith("skipped")
