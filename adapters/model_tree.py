@@ -311,6 +311,9 @@ class Transition:
     integrator: str
     unfollowed: str = ""
     """Why the referee's chain rule does not follow this integrator's step on this model
-    (implicitfast's gyroscopic term on a free joint, RK4's exponential maps on a rotation):
-    then no differences are taken (``matrix`` and ``coarse`` empty) and the row is skipped,
-    saying this; empty: it does."""
+    (RK4's naive stages on a rotation before MuJoCo 4.0): then no differences are taken
+    (``matrix`` and ``coarse`` empty) and the row is skipped, saying this; empty: it does."""
+    implicit_bias: tuple[str, ...] = ()
+    """The free joints whose velocities the step updates with (M + h ∂h/∂v)⁻¹ rather than
+    M⁻¹: MuJoCo's implicitfast on a standalone free body (``mjd_freeMhat``, ≥ 3.11: the
+    bias's — gyroscopic — derivative in the body's own 6×6 solve)."""

@@ -366,7 +366,8 @@ class MujocoModel:
         step, which ``mjd_transitionFD`` refuses ("RK4 integrator is not supported", MuJoCo
         4.0): :func:`_step_differences` (the smooth dynamics only, as everywhere in the
         check: no damping, no actuation, so implicitfast's implicit term (M − h ∂f/∂v with
-        f's passive and actuator forces) is M, and its step Euler's)."""
+        f's passive and actuator forces) is M, and its step Euler's — but on a standalone
+        free body, whose block holds the bias's derivative: ``Transition.implicit_bias``)."""
         m, d = self.model, self.data
         n, nv = len(q), m.nv
         size = 2 * nv + m.na
@@ -393,9 +394,11 @@ class MujocoModel:
                         mujoco.mj_forward(m, d)
                         mujoco.mjd_transitionFD(m, d, step, True, matrix, None, None, None)
                         found[i] = matrix[: 2 * nv, : 2 * nv]
-                out.append(Transition(matrix=fine, coarse=coarse,
-                                      time_step=float(m.opt.timestep), fd_step=FD_STEP,
-                                      integrator=name, unfollowed=why))
+                out.append(Transition(
+                    matrix=fine, coarse=coarse, time_step=float(m.opt.timestep),
+                    fd_step=FD_STEP, integrator=name, unfollowed=why,
+                    implicit_bias=_standalone_free(m) if name is Integrator.IMPLICITFAST
+                    else ()))
         finally:
             m.opt.integrator = integrator
         return tuple(out)
@@ -405,9 +408,6 @@ TENDON_ARMATURE = (
     "mujoco: tendon armature ({tendons}) left out of M, h and the dynamics compared: MuJoCo "
     "adds a Jₜᵀ Jₜ of each tendon to M (measured), and no other engine's parser reads tendons"
 )
-GYROSCOPIC_STEP = ("MuJoCo's implicitfast differentiates a free body's gyroscopic force "
-                   "(since 3.11): its step is not Euler's on a free joint; the chain rule of "
-                   "Euler's step is no referee for it")
 
 NAIVE_RK4 = (
     "MuJoCo before 4.0 sums RK4's stage velocities on a ball or free joint without dexp⁻¹ "
@@ -421,12 +421,26 @@ def _unfollowed(m: mujoco.MjModel, integrator: Integrator) -> str:
     (empty where it does)."""
     types = set(int(t) for t in m.jnt_type)
     free = int(mujoco.mjtJoint.mjJNT_FREE) in types
-    if integrator is Integrator.IMPLICITFAST and free and GYROSCOPIC_IMPLICIT:
-        return GYROSCOPIC_STEP
     if integrator is Integrator.RK4 and not RK4_ON_GROUP and (
             free or int(mujoco.mjtJoint.mjJNT_BALL) in types):
         return NAIVE_RK4
     return ""
+
+
+def _standalone_free(m: mujoco.MjModel) -> tuple[str, ...]:
+    """The free joints of MuJoCo's standalone free bodies (``mj_isFreeBody``: a body whose one
+    joint is free, alone in its tree, carrying no other body's mass), whose block
+    implicitfast solves with the bias's derivative (``mjd_freeMhat``, MuJoCo ≥ 3.11)."""
+    if not GYROSCOPIC_IMPLICIT:
+        return ()
+    out = []
+    for j in range(m.njnt):
+        body, adr = int(m.jnt_bodyid[j]), int(m.jnt_dofadr[j])
+        if (m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE and m.body_jntnum[body] == 1
+                and m.tree_dofnum[m.dof_treeid[adr]] == 6
+                and m.body_subtreemass[body] == m.body_mass[body]):
+            out.append(_joint_name(m, j))
+    return tuple(out)
 
 
 def _step_differences(m: mujoco.MjModel, d: mujoco.MjData, q: np.ndarray, v: np.ndarray,

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from dyncheck.adapters import ENGINE_PORTS, REGISTRY
 from dyncheck.results import to_csv, write_atomic
 from dyncheck.settings import NO_CACHE
 
@@ -52,9 +53,12 @@ class Program(Enum):
     """Not a command: the sum of the steps ``argv`` names (their ``what``)."""
 
 
-MAIN_EXTRAS = ("drake", "mjx", "warp")
-"""The extras the README's main command installs (``tests/test_docs.py`` holds the README to
-them)."""
+MAIN_EXTRAS = tuple(dict.fromkeys(
+    r.extra for name, r in REGISTRY.items()
+    if r.extra and (not r.on_request or name in ENGINE_PORTS)))
+"""The extras the README's main command installs: those of the engines a report holds (the
+registry's engines not checked on request only, and MuJoCo's ports); ``tests/test_docs.py``
+holds the README to them."""
 VENV_PYTHON = "{tmp}/venv/bin/python"
 
 

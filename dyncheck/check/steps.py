@@ -19,6 +19,7 @@ from dyncheck.check.describe import depth
 from dyncheck.check.dynamics import States
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
+from dyncheck.reference.tree import TreeDynamics
 from dyncheck.results import Verdict
 from dyncheck.vocabulary import Integrator
 
@@ -207,6 +208,101 @@ def rk4_step(canon: Canonical, stages: list[tuple[States, Referee, np.ndarray]],
     return out
 
 
+def _log(quat: np.ndarray) -> np.ndarray:
+    """The rotation vector of unit quaternions (w, x, y, z) (rows): exp's inverse."""
+    sign = np.where(quat[:, 0] < 0, -1.0, 1.0)[:, None]
+    w, xyz = quat[:, 0] * sign[:, 0], quat[:, 1:] * sign
+    norm = np.linalg.norm(xyz, axis=1)
+    angle = 2 * np.arctan2(norm, w)
+    scale = np.where(norm > 1e-12, angle / np.maximum(norm, 1e-300), 2 / np.maximum(w, 1e-300))
+    return xyz * scale[:, None]
+
+
+def _free_step(solver: TreeDynamics, canon: Canonical, q: np.ndarray, v: np.ndarray,
+               h: float, joint: int) -> tuple[np.ndarray, np.ndarray]:
+    """MuJoCo's implicitfast step of the standalone free body of canonical joint ``joint``,
+    at every state (rows): v₊ = v + h (M + h B)⁻¹ (−h_bias) on its block, B = ∂h_bias/∂v
+    there (exact by a central difference: h_bias is quadratic in v), q₊ = q ⊕ h v₊. The
+    body is alone in its tree: its block of M and h_bias depends on its own state only."""
+    vs, nv = canon.v_start[joint], canon.nv
+    block = slice(vs, vs + 6)
+    mass, bias, _, _ = solver.at_states(q, v)
+    spread = max(1.0, float(np.abs(v).max()))
+    nudged = np.repeat(v[None], 12, axis=0)
+    for k in range(6):
+        nudged[2 * k, :, vs + k] += spread
+        nudged[2 * k + 1, :, vs + k] -= spread
+    _, bias_w, _, _ = solver.at_states(np.tile(q, (12, 1)), nudged.reshape(-1, nv))
+    bias_w = bias_w.reshape(12, len(q), nv)[:, :, block]
+    slope = np.stack([(bias_w[2 * k] - bias_w[2 * k + 1]) / (2 * spread) for k in range(6)],
+                     axis=-1)
+    implicit = mass[:, block, block] + h * slope
+    v_next = v[:, block] + h * np.linalg.solve(implicit, -bias[:, block, None])[..., 0]
+    theta = np.zeros_like(v)
+    theta[:, block] = h * v_next
+    return advance(canon, q, theta), v_next
+
+
+def implicit_blocks(canon: Canonical, tree: ModelTree, states: States, h: float,
+                    joints: tuple[str, ...]) -> list[tuple[int, np.ndarray, np.ndarray]]:
+    """Per standalone free body (``joints``, MuJoCo's implicitfast with the bias's derivative
+    in its block): (its canonical joint, the 12×12 Jacobian of its step in the canonical
+    chart — δq₊ its position in world axes and its turn in body axes, δv₊ —, an estimate of
+    that Jacobian's error), by central differences of :func:`_free_step` at steps s, s/2,
+    s/4 extrapolated twice (Richardson: error O(s⁶)), the estimate the two first
+    extrapolations' difference plus the round-off of x₊ over the smallest step."""
+    from dyncheck.check.derivatives import STEP, perturb
+    from dyncheck.check.referee import ReferenceModel
+
+    solver = ReferenceModel(tree).solver
+    q, v = states.q, states.v
+    n = len(q)
+    steps = STEP / np.array([1.0, 2.0, 4.0])
+    out = []
+    for name in joints:
+        joint = canon.names.index(name)
+        vs, qs = canon.v_start[joint], canon.q_start[joint]
+        q_base, v_base = _free_step(solver, canon, q, v, h, joint)
+        q_p, v_p = [], []
+        for s in steps:
+            for sign in (1.0, -1.0):
+                for k in range(12):
+                    q_p.append(perturb(canon, q, vs + k, sign * s) if k < 6 else q)
+                    nudged = v.copy()
+                    if k >= 6:
+                        nudged[:, vs + k - 6] += sign * s
+                    v_p.append(nudged)
+        q_next, v_next = _free_step(solver, canon, np.concatenate(q_p), np.concatenate(v_p),
+                                    h, joint)
+        q_next, v_next = q_next.reshape(3, 2, 12, n, -1), v_next.reshape(3, 2, 12, n, 6)
+        base = np.broadcast_to(q_base, q_next.shape)
+        turn = quat_mul(_conj(base[..., qs + 3 : qs + 7]).reshape(-1, 4).T,
+                        q_next[..., qs + 3 : qs + 7].reshape(-1, 4).T).T
+        moved = np.concatenate([q_next[..., qs : qs + 3] - base[..., qs : qs + 3],
+                                _log(turn).reshape(*q_next.shape[:-1], 3),
+                                v_next - v_base], axis=-1)  # (step, sign, k, state, 12)
+        central = (moved[:, 0] - moved[:, 1]) / (2 * steps[:, None, None, None])
+        first = (4 * central[1] - central[0]) / 3
+        second = (4 * central[2] - central[1]) / 3
+        best = np.transpose((16 * second - first) / 15, (1, 2, 0))  # (state, row, column)
+        scale = np.maximum(np.abs(np.concatenate([q_base, v_base], axis=1)).max(axis=1), 1.0)
+        roundoff = ROUNDOFF_FACTOR * EPS * depth(tree) * scale / steps[-1]
+        estimate = np.abs(np.transpose(second - first, (1, 2, 0))) / 15 \
+            + roundoff[:, None, None]
+        out.append((joint, best, estimate))
+    return out
+
+
+def _block(canon: Canonical, joint: int) -> np.ndarray:
+    """A free joint's rows of x = (δq, v): its six chart coordinates, then its velocities."""
+    vs = canon.v_start[joint]
+    return np.r_[vs : vs + 6, canon.nv + vs : canon.nv + vs + 6]
+
+
+def _conj(quat: np.ndarray) -> np.ndarray:
+    return quat * np.array([1.0, -1.0, -1.0, -1.0])
+
+
 def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref: Referee,
               engine: str, found: Transition) -> list[CheckRow]:
     """The engine's step Jacobian against the referee's chain rule: one row. Tolerance:
@@ -234,6 +330,12 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
         expected = euler_step(canon, ref, states, h)
         ref_q, ref_v = ref.error["forward_q"], ref.error["forward_v"]
         rule = "the chain rule"
+    blocks = implicit_blocks(canon, tree, states, h, found.implicit_bias)
+    for joint, block, _ in blocks:  # a standalone free body: M + h ∂h/∂v in its solve
+        rows = _block(canon, joint)
+        expected[:, rows[:, None], rows[None, :]] = block
+    if blocks:
+        rule += " (a standalone free body's implicit block differentiated by Richardson)"
     off = np.abs(found.matrix - expected)
     scale = float(np.abs(expected).max())
     x_scale = max(float(np.abs(states.q).max()), float(np.abs(states.v).max()), 1.0)
@@ -253,6 +355,9 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
     ref_error[:, nv:, nv:] = h * ref_v
     ref_error[:, :nv] = np.concatenate([h * ref_error[:, nv:, :nv], h * ref_error[:, nv:, nv:]],
                                        axis=2) * 2  # through q₊ = q ⊕ h v₊ (J_r ≤ 1 + h|ω|)
+    for joint, _, estimate in blocks:
+        rows = _block(canon, joint)
+        ref_error[:, rows[:, None], rows[None, :]] = estimate
     allowed = ROUNDOFF_FACTOR * EPS * depth(tree) * scale + fd + ref_error
     worst = np.unravel_index(int(np.argmax(off / allowed)), off.shape)
     within = bool(np.all(off <= allowed))
@@ -266,6 +371,8 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
         error=float(off.max()) / scale, tolerance=float(allowed.max()) / scale,
         basis=(f"round-off: {ROUNDOFF_FACTOR} eps x tree depth {depth(tree)}; + {engine}'s "
                f"centered differences' error (steps {found.fd_step:g}, {2 * found.fd_step:g}); "
-               "+ the referee's estimated error x h"),
+               "+ the referee's estimated error x h"
+               + ("; a standalone free body's implicit block: its Richardson estimate"
+                  if blocks else "")),
         verdict=Verdict.PASSED if within else Verdict.FAILED, note=note,
         worst_state=int(worst[0]))]

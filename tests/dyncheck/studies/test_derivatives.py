@@ -18,13 +18,13 @@ CORE = ["reference", "mujoco", "pinocchio"]
 def test_every_case_has_derivative_rows_that_pass_or_say_why_not(case):
     """Every pair of the core engines and the referee on all five derivatives, passed; a
     skipped row only with Pinocchio's composite joint (an MJCF body with several joints), or
-    a step the referee's chain rule does not follow (implicitfast's gyroscopic term, RK4's
-    stages on a rotation), saying so."""
+    a step the referee's chain rule does not follow (RK4's naive stages on a rotation before
+    MuJoCo 4.0), saying so."""
     rows = derivative_rows(get_case(case), CORE, 8)
     verdicts = {r.verdict for r in rows}
     assert "failed" not in verdicts, [r.note for r in rows if r.verdict == "failed"]
     skipped = [r for r in rows if r.verdict == "skipped"]
-    steps = ("gyroscopic", "RK4's stages")
+    steps = ("RK4's stages",)
     assert all("composite joint" in r.note or any(s in r.note for s in steps) for r in skipped)
     derivative = [r for r in rows if r.quantity.startswith("d(")]
     pairs = {(r.impl_a, r.impl_b) for r in derivative}
