@@ -263,7 +263,8 @@ def _parser() -> argparse.ArgumentParser:
     _dask(b)
     b.add_argument("--suite", action="store_true",
                    help="instead: time the commands a user runs (list, explain, one case, the "
-                   "full run, report --check) in fresh processes -> benchmark-suite.md")
+                   "full run, the README's main command with its install, report --check, "
+                   "the test commands) in fresh processes -> benchmark-suite.md")
     for name, example in EXAMPLES.items():
         sub.choices[name].epilog = f"example: {example}"
     return p
