@@ -259,6 +259,18 @@ class Dynamics:
     kinetic: np.ndarray
     potential: np.ndarray
 
+    @classmethod
+    def at(cls, v: np.ndarray, *, mass_matrix: np.ndarray, bias: np.ndarray,
+           inverse: np.ndarray, potential: np.ndarray,
+           forward: np.ndarray | None = None) -> Dynamics:
+        """From M and h at velocities ``v``: T = ½ vᵀ M v and, unless the engine gave it,
+        the forward dynamics at τ = 0, v̇ = −M⁻¹ h."""
+        if forward is None:
+            forward = -np.linalg.solve(mass_matrix, bias[..., None])[..., 0]
+        kinetic = 0.5 * np.einsum("ni,nij,nj->n", v, mass_matrix, v)
+        return cls(mass_matrix=mass_matrix, bias=bias, forward=forward, inverse=inverse,
+                   kinetic=kinetic, potential=potential)
+
 
 class DerivativeChart(StrEnum):
     """With respect to which coordinates of q an engine's derivatives are taken."""

@@ -278,10 +278,8 @@ class NewtonModel:
             inverse[i] = force_out.numpy()
             centres = np.einsum("bij,bj->bi", bodies[:, :3, :3], self._coms) + bodies[:, :3, 3]
             potential[i] = -float(self._masses @ (centres @ gravity))
-        forward = -np.linalg.solve(mass, bias[..., None])[..., 0]
-        kinetic = 0.5 * np.einsum("ni,nij,nj->n", v, mass, v)
-        return Dynamics(mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
-                        kinetic=kinetic, potential=potential)
+        return Dynamics.at(v, mass_matrix=mass, bias=bias, inverse=inverse,
+                           potential=potential)
 
     def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float,
                  steps: int) -> tuple[np.ndarray, np.ndarray]:

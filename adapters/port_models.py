@@ -46,14 +46,12 @@ class PortModel(MujocoModel):
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
         raw = self.adapter.raw(q, v, np.zeros_like(v), a)
-        mass = raw["M"]
-        kinetic = 0.5 * np.einsum("ni,nij,nj->n", v, mass, v)
         masses = self.adapter.model_array("body_mass")[1:]
         gravity = self.adapter.model_array("opt.gravity") if np.any(self._gravity) else \
             self._gravity  # <flag gravity="disable">: none, as in MuJoCo's reading
         potential = -np.einsum("b,nb->n", masses, raw["xipos"][:, 1:] @ gravity)
-        return Dynamics(mass_matrix=mass, bias=raw["bias"], forward=raw["qacc"],
-                        inverse=raw["qfrc_inverse"], kinetic=kinetic, potential=potential)
+        return Dynamics.at(v, mass_matrix=raw["M"], bias=raw["bias"], forward=raw["qacc"],
+                           inverse=raw["qfrc_inverse"], potential=potential)
 
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:

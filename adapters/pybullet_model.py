@@ -362,10 +362,8 @@ class PybulletModel:
                     pb.resetJointState(body, j, x, 0.0, physicsClientId=c)
             potential[i] = -self.gravity @ sum((m * self._com(b, j) for b, j, m in self._masses
                                            if m > 0.0), np.zeros(3))
-        forward = -np.linalg.solve(mass, bias[..., None])[..., 0]
-        kinetic = 0.5 * np.einsum("ni,nij,nj->n", v, mass, v)
-        return Dynamics(mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
-                        kinetic=kinetic, potential=potential)
+        return Dynamics.at(v, mass_matrix=mass, bias=bias, inverse=inverse,
+                           potential=potential)
 
     def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float,
                  steps: int) -> tuple[np.ndarray, np.ndarray]:
