@@ -123,6 +123,16 @@ class Adapter(ABC):
     max_steps: int | None = None
     """The longest fixed-step run the engine makes here (None: no limit); a study whose runs
     are longer is refused before any of them starts."""
+    device: str = "cpu"
+    """Where the engine computes (a port: from ``--device``)."""
+    rk4_group_order: ClassVar[int] = 4
+    """RK4's order on a rotating joint as the engine defines its stages there (2 where it
+    sums stage velocities across tangent spaces: MJX, MuJoCo before 4.0)."""
+    error_controlled: ClassVar[bool] = False
+    """Whether the engine offers error-controlled integration of its own
+    (``simulate_controlled``: Drake's)."""
+    parser_warnings: Sequence[str] = ()
+    """What the engine's parser said it ignored in the case's model (Drake's)."""
 
     @property
     def eps(self) -> float:

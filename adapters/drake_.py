@@ -140,6 +140,7 @@ class DrakeAdapter(Adapter):
     """Its MJCF parser makes a ball joint a ``BallRpyJoint`` (ω in world axes) and a free
     joint a ``QuaternionFloatingJoint``, q = (w, x, y, z, p), v = (ω, v) in world axes."""
     package: ClassVar[str] = "drake"
+    error_controlled: ClassVar[bool] = True
     integrators: ClassVar[tuple[str, ...]] = REGISTRY["drake"].integrators
 
     def __init__(self, model: Multibody) -> None:

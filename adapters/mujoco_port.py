@@ -44,8 +44,6 @@ class PortAdapter(MuJoCoAdapter):
     port_of: ClassVar[str] = "mujoco"
     """The engine this one ports: the pair that matters most is (port_of, this)."""
     dtype: ClassVar[type[np.floating]] = np.float32
-    device: str = "cpu"
-    """The device the port computes on (set from ``--device`` or the environment)."""
     chunk: int = CHUNK
     """States per batched call (a GPU wants more: ``benchmarks/ports.py`` sets it)."""
 

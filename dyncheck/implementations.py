@@ -152,6 +152,8 @@ class Implementation(ABC):
     integrators: tuple[str, ...] = ()
     eps: float = float(np.finfo(float).eps)
     """Unit round-off of the arithmetic the implementation computes in."""
+    adapter: Adapter | None = None
+    """The engine behind the implementation (None: the book's side)."""
 
     def __init__(self, case: Case) -> None:
         self.case = case
@@ -306,7 +308,7 @@ class EngineImplementation(Implementation):
     def __init__(self, case: Case, adapter: type[Adapter]) -> None:
         super().__init__(case)
         self.name = adapter.name  # type: ignore[misc]
-        self.adapter = adapter.create(case.multibody(), symbolic=CACHED)
+        self.adapter: Adapter = adapter.create(case.multibody(), symbolic=CACHED)
         self.map = NativeMap.of(case, adapter.name)
         self.integrators = adapter.integrators
         self.eps = self.adapter.eps

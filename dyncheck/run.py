@@ -108,8 +108,9 @@ def _implementations(
     impls = _BUILT[key]
     if notes is not None:
         for name, impl in impls.items():
-            warnings = getattr(getattr(impl, "adapter", None), "parser_warnings", [])
-            notes.setdefault(name, set()).update(warnings)
+            adapter = impl.adapter if isinstance(impl, Implementation) else None
+            if adapter is not None:
+                notes.setdefault(name, set()).update(adapter.parser_warnings)
     return impls
 
 

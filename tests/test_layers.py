@@ -189,6 +189,16 @@ def test_no_module_reaches_into_another_modules_private_names():
     assert not reaches, "\n".join(reaches)
 
 
+def test_no_module_asks_an_implementation_for_its_engine_by_duck_typing():
+    """#43: an implementation's engine is ``Implementation.adapter`` (None on the book's
+    side) and an engine's facts are attributes of ``Adapter`` with defaults: a chain
+    ``getattr(getattr(impl, "adapter", None), ...)`` hides both from the type checker."""
+    chains = [f"{path.relative_to(ROOT)}:{n}" for path in _package_files()
+              for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+              if "getattr(getattr(" in line]
+    assert not chains, chains
+
+
 MAX_LINES = 500
 """#43: a module a reader holds in mind at once; a longer one is split where its parts have
 names of their own (the commands from the command line, the Cayley frame from the checks on

@@ -26,7 +26,7 @@ def engine_line(name: str) -> str:
     steps = list(adapter.integrators)
     if adapter.adaptive:
         steps.append("dop853 (scipy, error-controlled)")
-    if hasattr(adapter, "simulate_controlled"):
+    if adapter.error_controlled:
         steps.append("rk3-controlled (its own runge_kutta3, error-controlled)")
     return f"{ENGINE_PACKAGES[name]} {adapter.version()}; integrators: {', '.join(steps)}"
 

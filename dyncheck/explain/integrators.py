@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from dyncheck.cases import get_case
@@ -123,7 +125,7 @@ def group_rk4() -> Entry:
 
     case = get_case("rigid_body_ball")
     impl = make_implementation("pinocchio", case)
-    adapter = impl.adapter  # type: ignore[attr-defined]
+    adapter: Any = impl.adapter  # Pinocchio's: its state in MuJoCo's layout, its v̇ there
     q0, v0 = adapter.to_mujoco(*impl.engine_start())  # type: ignore[attr-defined]
     duration = case.trajectory.duration
     dts = case.trajectory.steps[Integrator.RK4][1:]

@@ -7,7 +7,13 @@ import numpy as np
 
 from dyncheck.cases import Case
 from dyncheck.cases.multibody import ROTATING
-from dyncheck.implementations import Implementation, Variant, book_variant, general_method
+from dyncheck.implementations import (
+    EngineImplementation,
+    Implementation,
+    Variant,
+    book_variant,
+    general_method,
+)
 from dyncheck.results import Discrepancy, Verdict
 from dyncheck.studies.order import finest_pair, observed_orders
 from dyncheck.studies.references import References, difference
@@ -23,8 +29,9 @@ def attainable_rtol(impl: Implementation) -> float:
     accelerations (relative ε κ(M)), and the step size collapses chasing noise. It binds only
     for the spherical pendulum's quaternion state, whose spin about the rod carries the
     inertia floor alone (κ(M) ≈ 1e8); every other case keeps 1e-13."""
-    qe0, _ = impl.engine_start()  # type: ignore[attr-defined]
-    mass = impl.adapter.mass_matrix(qe0[None])[0]  # type: ignore[attr-defined]
+    assert isinstance(impl, EngineImplementation), impl.name  # an engine's error control
+    qe0, _ = impl.engine_start()
+    mass = impl.adapter.mass_matrix(qe0[None])[0]
     return max(ADAPTIVE_RTOL, float(np.finfo(float).eps * np.linalg.cond(mass)))
 
 

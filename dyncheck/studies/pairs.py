@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from dyncheck.adapters import get_adapter
+from dyncheck.adapters import Adapter, get_adapter
 from dyncheck.cases import NOMINAL_ORDER, Case
 from dyncheck.cases.multibody import ROTATING
 from dyncheck.comparison import soft_factor
@@ -74,19 +74,22 @@ def _maps_differ(
     if is_rk4(integrator) and len({_group_order(impls[e]) for e in (a, b)}) == 2:
         return NAIVE_GROUP_RK4
     if integrator == Integrator.IMPLICITFAST and "free" in types:
-        facts = {
-            getattr(getattr(impls[e], "adapter", None), "gyroscopic_implicit", False)
-            for e in (a, b)
-        }
+        engines = [_adapter(impls[e]) for e in (a, b)]
+        facts = {x is not None and x.gyroscopic_implicit for x in engines}
         if len(facts) == 2:
             return GYROSCOPIC_IMPLICIT
     return None
 
 
+def _adapter(impl: Implementation | Exception) -> Adapter | None:
+    """The engine behind an implementation (None: the book's side, or one that failed)."""
+    return impl.adapter if isinstance(impl, Implementation) else None
+
+
 def _group_order(impl: Implementation | Exception) -> int:
     """RK4's order on the rotation group as the engine defines it (4 unless it says less)."""
-    return int(getattr(getattr(impl, "adapter", None), "rk4_group_order",
-                       NOMINAL_ORDER[Integrator.RK4]))
+    adapter = _adapter(impl)
+    return adapter.rk4_group_order if adapter is not None else NOMINAL_ORDER[Integrator.RK4]
 
 
 def _frame_pair(

@@ -94,12 +94,13 @@ def study(
                 continue
             nominal, convention = _expected(impl, integrator, rotating)
             ref, ref_err = refs(variant or book_variant(case))
-            limit = getattr(getattr(impl, "adapter", None), "max_steps", None)
+            engine = impl.adapter
+            limit = engine.max_steps if engine is not None else None
             longest = round(spec.duration / min(dts))
-            if limit is not None and longest > limit:  # refused before any run starts
+            if engine is not None and limit is not None and longest > limit:  # refused first
                 why = Unsupported(
                     f"{name}: the study's longest run has {longest} steps, more than the "
-                    f"{limit} this engine makes here ({impl.adapter.device})"  # type: ignore[attr-defined]
+                    f"{limit} this engine makes here ({engine.device})"
                 )
                 rows.append(unavailable(case, name, why, integrator, dts[0]))
                 continue
@@ -119,12 +120,12 @@ def study(
                                    ref, ref_err, judged)
             points += points_
             rows += rows_
-        if getattr(getattr(impl, "adapter", None), "adaptive", False):
+        if impl.adapter is not None and impl.adapter.adaptive:
             try:
                 rows.append(adaptive(case, impl, variant, refs))
             except Exception as exc:  # unsupported (quaternion state) or crashed: a row
                 rows.append(unavailable(case, name, exc, "dop853"))
-        if hasattr(getattr(impl, "adapter", None), "simulate_controlled"):
+        if impl.adapter is not None and impl.adapter.error_controlled:
             try:
                 rows += controlled(case, impl, variant, refs)
             except Exception as exc:  # crashed or diverged: a row, not a crash
@@ -139,7 +140,7 @@ def _expected(impl: Implementation, integrator: str, rotating: bool) -> tuple[in
     across tangent spaces on a rotating joint (the engine's declared order)."""
     nominal = NOMINAL_ORDER[integrator]
     convention = HELD_FORCE if integrator == Integrator.RK4_HELD_FORCE else ""
-    group_order = getattr(getattr(impl, "adapter", None), "rk4_group_order", nominal)
+    group_order = impl.adapter.rk4_group_order if impl.adapter is not None else nominal
     if is_rk4(integrator) and rotating and group_order < nominal:
         nominal, convention = group_order, NAIVE_GROUP_RK4
     return nominal, convention
