@@ -38,9 +38,10 @@ from functools import cached_property, partial
 
 import numpy as np
 
-from dyncheck.cases.multibody import NQ, NV, ROTATING
+from dyncheck.adapters.model_tree import StateLayout
+from dyncheck.cases.multibody import ROTATING
 from dyncheck.errors import EngineError
-from dyncheck.vocabulary import Integrator
+from dyncheck.vocabulary import Integrator, JointType
 
 Acceleration = Callable[..., np.ndarray]
 """v̇(q, v[, held]) for one state in the :class:`Addresses`, shapes (nq,), (nv,) → (nv,): called
@@ -76,6 +77,12 @@ def _norm(x: np.ndarray) -> float:
     return math.sqrt(x.dot(x))
 
 
+def quat_conj(quat: np.ndarray) -> np.ndarray:
+    """The conjugate (w, −x, −y, −z) — a unit quaternion's inverse — components on the first
+    axis, as :func:`quat_mul` takes them."""
+    return np.array([quat[0], -quat[1], -quat[2], -quat[3]])
+
+
 def quat_exp(theta: np.ndarray) -> np.ndarray:
     """The unit quaternion of the rotation vector θ: (cos |θ|/2, sin(|θ|/2) θ/|θ|)."""
     angle = _norm(theta)
@@ -106,10 +113,8 @@ class Addresses:
 
     @classmethod
     def of(cls, joint_types: Sequence[str]) -> Addresses:
-        joints, qa, va = [], 0, 0
-        for jt in joint_types:
-            joints.append((jt, qa, va))
-            qa, va = qa + NQ[jt], va + NV[jt]
+        places = StateLayout().joints([JointType(jt) for jt in joint_types])  # MuJoCo's
+        joints = [(jt, p.q_start, p.v_start) for jt, p in zip(joint_types, places, strict=True)]
         return cls(joints=tuple(joints))
 
     @cached_property

@@ -49,14 +49,13 @@ import numpy as np
 
 from dyncheck.adapters.integrators import quat_mul
 from dyncheck.adapters.model_tree import (
-    NQ,
-    NV,
     Axes,
     Dynamics,
     JointType,
     Layout,
     ModelTree,
     Orientation,
+    StateLayout,
     TreeJoint,
 )
 from dyncheck.cases.coordinate_maps import EulerAngleMap, quat_from_matrix, quat_to_matrix
@@ -78,14 +77,12 @@ class Canonical:
 
 
 def canonical(tree: ModelTree) -> Canonical:
-    q_start, v_start, nq, nv = [], [], 0, 0
-    for j in tree.joints:
-        q_start.append(nq)
-        v_start.append(nv)
-        nq, nv = nq + NQ[j.type], nv + NV[j.type]
+    types = tuple(j.type for j in tree.joints)
+    places = StateLayout().joints(types)  # the canonical layout: MuJoCo's
     return Canonical(
-        names=tuple(j.name for j in tree.joints), types=tuple(j.type for j in tree.joints),
-        q_start=tuple(q_start), v_start=tuple(v_start), nq=nq, nv=nv,
+        names=tuple(j.name for j in tree.joints), types=types,
+        q_start=tuple(p.q_start for p in places), v_start=tuple(p.v_start for p in places),
+        nq=sum(p.nq for p in places), nv=sum(p.nv for p in places),
         zeros=tuple(j.layout.zero for j in tree.joints),
     )
 
@@ -118,8 +115,10 @@ def _asin(z: complex) -> complex:
     return angle + 1j * np.imag(z) / np.sqrt(max(1.0 - zr * zr, 1e-300))
 
 
-def _quat_out(quat_wxyz: np.ndarray, order: str) -> np.ndarray:
-    return quat_wxyz if order == "wxyz" else np.concatenate([quat_wxyz[1:], quat_wxyz[:1]])
+def quat_order(quat: Orientation) -> list[int]:
+    """Where an engine's quaternion components come from in (w, x, y, z): q_engine =
+    q_wxyz[..., quat_order(quat)], and back through its ``np.argsort``."""
+    return ["wxyz".index(c) for c in str(quat)]
 
 
 @dataclass(frozen=True)
@@ -153,13 +152,13 @@ def _state_map(
             else:
                 q_e[qe] = value
             t[ve, vs] = 1.0
-        elif kind is JointType.BALL and lay.quat == "rpy":
+        elif kind is JointType.BALL and lay.quat == Orientation.RPY:
             rot = quat_to_matrix(q_c[None, qs : qs + 4])[0]
             q_e[qe : qe + 3] = rpy_from_matrix(rot)
             # ω in F = R ω in the child's axes; d/dt(R ω) = R ω̇ (Ṙ ω = R ω̂ ω = 0): Ṫ v = 0
             t[ve : ve + 3, vs : vs + 3] = rot if lay.angular_axes is Axes.PARENT else np.eye(3)
         elif kind is JointType.BALL:
-            q_e[qe : qe + 4] = _quat_out(q_c[qs : qs + 4], lay.quat)
+            q_e[qe : qe + 4] = q_c[qs : qs + 4][quat_order(lay.quat)]
             # ω in the parent-side frame = R ω in the child's axes; Ṫ v = 0 as above
             t[ve : ve + 3, vs : vs + 3] = (quat_to_matrix(q_c[None, qs : qs + 4])[0]
                                            if lay.angular_axes is Axes.PARENT else np.eye(3))
@@ -189,7 +188,7 @@ def _free(lay: Layout, place_quat: np.ndarray, q_c: np.ndarray,
         place_r.T @ (p_w - place_p)
     p_o = lay.offset[:3, 3] if lay.point is None else np.asarray(lay.point, float)
     turned = quat_mul(quat_w, quat_from_matrix(r_o[None])[0]) if offset else quat_w
-    quat_e = _quat_out(quat_mul(place_quat, turned), lay.quat)
+    quat_e = quat_mul(place_quat, turned)[quat_order(lay.quat)]
     q_e = np.concatenate([quat_e, p_e]) if lay.quat_first else np.concatenate([p_e, quat_e])
     kind_of = np.result_type(q_c, v_c, float)
     t = np.zeros((6, 6), kind_of)
@@ -271,10 +270,6 @@ def _rotating(kinds: Sequence[JointType]) -> bool:
     return any(JointType(k).rotating for k in kinds)
 
 
-def _order(quat: Orientation) -> list[int]:
-    return ["wxyz".index(c) for c in str(quat)]
-
-
 def _rpy_of(rot: np.ndarray) -> np.ndarray:
     """(roll, pitch, yaw) with R = R_z(yaw) R_y(pitch) R_x(roll), batched (real: the run's
     states; :func:`rpy_from_matrix` takes one state, complex-stepped or not)."""
@@ -323,11 +318,11 @@ def to_engine(layouts: Sequence[Layout], kinds: Sequence[JointType],
             elif lay.quat is Orientation.EULER:
                 cols.append(EulerAngleMap().to_book(chunk))
             else:
-                cols.append(chunk[:, _order(lay.quat)])
+                cols.append(chunk[:, quat_order(lay.quat)])
         elif kind is JointType.FREE and lay.quat is Orientation.EULER:
             cols.extend([chunk[:, :3], EulerAngleMap().to_book(chunk[:, 3:])])
         elif kind is JointType.FREE:
-            quat = chunk[:, 3:][:, _order(lay.quat)]
+            quat = chunk[:, 3:][:, quat_order(lay.quat)]
             cols.extend([quat, chunk[:, :3]] if lay.quat_first else [chunk[:, :3], quat])
         else:
             cols.append(chunk)
@@ -351,11 +346,11 @@ def from_engine(layouts: Sequence[Layout], kinds: Sequence[JointType],
                 cols.append(chunk[:, :3])
             cols.append(EulerAngleMap().to_engine(chunk[:, -3:]))
         elif kind is JointType.BALL:
-            cols.append(_unit(chunk[:, np.argsort(_order(lay.quat))]))
+            cols.append(_unit(chunk[:, np.argsort(quat_order(lay.quat))]))
         elif kind is JointType.FREE:
             quat, pos = (chunk[:, :4], chunk[:, 4:]) if lay.quat_first else \
                 (chunk[:, 3:], chunk[:, :3])
-            cols.extend([pos, _unit(quat[:, np.argsort(_order(lay.quat))])])
+            cols.extend([pos, _unit(quat[:, np.argsort(quat_order(lay.quat))])])
         else:
             cols.append(chunk)
     return np.concatenate(cols, -1)

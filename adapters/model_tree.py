@@ -113,7 +113,6 @@ class Layout:
     """Free: the point of the body (body frame) whose velocity v holds (Newton: the centre
     of mass); None: the origin of :attr:`offset`'s frame."""
 
-
     @classmethod
     def ball(cls, **convention: Any) -> Layout:
         """A ball joint's layout at the start of q and v (:meth:`StateLayout.joint` places it)."""

@@ -35,8 +35,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from dyncheck.adapters.integrators import quat_mul
-from dyncheck.adapters.layout import Canonical, StateMap
+from dyncheck.adapters.integrators import quat_conj, quat_mul
+from dyncheck.adapters.layout import Canonical, StateMap, quat_order
 from dyncheck.adapters.model_tree import (
     Axes,
     DerivativeChart,
@@ -44,6 +44,7 @@ from dyncheck.adapters.model_tree import (
     Dynamics,
     JointType,
     ModelTree,
+    Orientation,
 )
 from dyncheck.adapters.model_tree import derivatives as collect
 from dyncheck.cases.coordinate_maps import quat_to_matrix
@@ -189,13 +190,14 @@ def _chart(tree: ModelTree, chart: DerivativeChart, q_e: np.ndarray,
             out[vs] = dq_e[qs]
         elif lay.cos_sin:  # (cos θ, sin θ): dθ = cos d(sin) − sin d(cos)
             out[vs] = q_e[qs] * dq_e[qs + 1] - q_e[qs + 1] * dq_e[qs]
-        elif lay.quat == "rpy" or lay.point is not None:
+        elif lay.quat == Orientation.RPY or lay.point is not None:
             raise ValueError(f"{tree.engine}: no tangent chart for {joint.name!r}")
         else:
             at = qs + (0 if joint.type is JointType.BALL or lay.quat_first else 3)
-            quat, dquat = _wxyz(q_e[at : at + 4], lay.quat), _wxyz(dq_e[at : at + 4], lay.quat)
+            back = np.argsort(quat_order(lay.quat))  # the engine's order to (w, x, y, z)
+            quat, dquat = q_e[at : at + 4][back], dq_e[at : at + 4][back]
             local = lay.angular_axes is Axes.LOCAL
-            turn = quat_mul(_conj(quat), dquat) if local else quat_mul(dquat, _conj(quat))
+            turn = quat_mul(quat_conj(quat), dquat) if local else quat_mul(dquat, quat_conj(quat))
             omega = 2 * turn[1:]
             if joint.type is JointType.BALL:
                 out[vs : vs + 3] = omega
@@ -207,14 +209,6 @@ def _chart(tree: ModelTree, chart: DerivativeChart, q_e: np.ndarray,
             lin, ang = (vs + 3, vs) if lay.angular_first else (vs, vs + 3)
             out[lin : lin + 3], out[ang : ang + 3] = dp, omega
     return out
-
-
-def _wxyz(quat: np.ndarray, order: str) -> np.ndarray:
-    return quat if order == "wxyz" else np.concatenate([quat[3:], quat[:3]])
-
-
-def _conj(quat: np.ndarray) -> np.ndarray:
-    return np.array([quat[0], -quat[1], -quat[2], -quat[3]])
 
 
 def _turning(canon: Canonical) -> set[int]:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from dyncheck.adapters.integrators import dexp_inv, quat_exp, quat_mul
+from dyncheck.adapters.integrators import dexp_inv, quat_conj, quat_exp, quat_mul
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import JointType, ModelTree, Transition
 from dyncheck.check.derivatives import Referee, referee
@@ -208,16 +208,6 @@ def rk4_step(canon: Canonical, stages: list[tuple[States, Referee, np.ndarray]],
     return out
 
 
-def _log(quat: np.ndarray) -> np.ndarray:
-    """The rotation vector of unit quaternions (w, x, y, z) (rows): exp's inverse."""
-    sign = np.where(quat[:, 0] < 0, -1.0, 1.0)[:, None]
-    w, xyz = quat[:, 0] * sign[:, 0], quat[:, 1:] * sign
-    norm = np.linalg.norm(xyz, axis=1)
-    angle = 2 * np.arctan2(norm, w)
-    scale = np.where(norm > 1e-12, angle / np.maximum(norm, 1e-300), 2 / np.maximum(w, 1e-300))
-    return xyz * scale[:, None]
-
-
 def _free_step(solver: TreeDynamics, canon: Canonical, q: np.ndarray, v: np.ndarray,
                h: float, joint: int) -> tuple[np.ndarray, np.ndarray]:
     """MuJoCo's implicitfast step of the standalone free body of canonical joint ``joint``,
@@ -251,6 +241,8 @@ def implicit_blocks(canon: Canonical, tree: ModelTree, states: States, h: float,
     that Jacobian's error), by central differences of :func:`_free_step` at steps s, s/2,
     s/4 extrapolated twice (Richardson: error O(s⁶)), the estimate the two first
     extrapolations' difference plus the round-off of x₊ over the smallest step."""
+    if not joints:
+        return []
     from dyncheck.check.derivatives import STEP, perturb
     from dyncheck.check.referee import ReferenceModel
 
@@ -276,10 +268,11 @@ def implicit_blocks(canon: Canonical, tree: ModelTree, states: States, h: float,
                                     h, joint)
         q_next, v_next = q_next.reshape(3, 2, 12, n, -1), v_next.reshape(3, 2, 12, n, 6)
         base = np.broadcast_to(q_base, q_next.shape)
-        turn = quat_mul(_conj(base[..., qs + 3 : qs + 7]).reshape(-1, 4).T,
+        turn = quat_mul(quat_conj(base[..., qs + 3 : qs + 7].reshape(-1, 4).T),
                         q_next[..., qs + 3 : qs + 7].reshape(-1, 4).T).T
         moved = np.concatenate([q_next[..., qs : qs + 3] - base[..., qs : qs + 3],
-                                _log(turn).reshape(*q_next.shape[:-1], 3),
+                                Rotation.from_quat(turn, scalar_first=True).as_rotvec()
+                                .reshape(*q_next.shape[:-1], 3),
                                 v_next - v_base], axis=-1)  # (step, sign, k, state, 12)
         central = (moved[:, 0] - moved[:, 1]) / (2 * steps[:, None, None, None])
         first = (4 * central[1] - central[0]) / 3
@@ -299,8 +292,6 @@ def _block(canon: Canonical, joint: int) -> np.ndarray:
     return np.r_[vs : vs + 6, canon.nv + vs : canon.nv + vs + 6]
 
 
-def _conj(quat: np.ndarray) -> np.ndarray:
-    return quat * np.array([1.0, -1.0, -1.0, -1.0])
 
 
 def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref: Referee,
