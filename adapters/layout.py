@@ -42,7 +42,7 @@ and reads the result back):
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -211,30 +211,30 @@ def _free(lay: Layout, place_quat: np.ndarray, q_c: np.ndarray,
     return q_e, t, tdot_v
 
 
-def state_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray,
-              v_c: np.ndarray) -> StateMap:
-    """One state's map into ``tree``'s layout (real, or complex under a complex step)."""
+def mapper(canon: Canonical, tree: ModelTree) -> Callable[[np.ndarray, np.ndarray], StateMap]:
+    """One state's map into ``tree``'s layout as a function of (q_c, v_c) (real, or
+    complex under a complex step), the engine's joints and placements looked up once."""
     joints = [tree.joint(name) for name in canon.names]
     placements = [
         quat_from_matrix(j.layout.placement[:3, :3].T[None])[0]
         if kind is JointType.FREE else None
         for j, kind in zip(joints, canon.types, strict=True)
     ]
-    return _state_map(canon, joints, placements, tree, q_c, v_c)
+    return lambda q_c, v_c: _state_map(canon, joints, placements, tree, q_c, v_c)
+
+
+def state_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray,
+              v_c: np.ndarray) -> StateMap:
+    """One state's map into ``tree``'s layout (real, or complex under a complex step)."""
+    return mapper(canon, tree)(q_c, v_c)
 
 
 def engine_states(
     canon: Canonical, tree: ModelTree, q: np.ndarray, v: np.ndarray, a: np.ndarray
 ) -> tuple[list[StateMap], np.ndarray, np.ndarray, np.ndarray]:
     """The batch in the engine's layout: maps, q_e, v_e, a_e."""
-    joints = [tree.joint(name) for name in canon.names]
-    placements = [
-        quat_from_matrix(j.layout.placement[:3, :3].T[None])[0]
-        if kind is JointType.FREE else None
-        for j, kind in zip(joints, canon.types, strict=True)
-    ]
-    maps = [_state_map(canon, joints, placements, tree, qi, vi)
-            for qi, vi in zip(q, v, strict=True)]
+    one = mapper(canon, tree)
+    maps = [one(qi, vi) for qi, vi in zip(q, v, strict=True)]
     q_e = np.array([s.q for s in maps])
     v_e = np.array([s.t @ vi for s, vi in zip(maps, v, strict=True)])
     a_e = np.array([s.t @ ai + s.tdot_v for s, ai in zip(maps, a, strict=True)])

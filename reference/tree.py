@@ -58,7 +58,7 @@ NQ = {"hinge": 1, "slide": 1, "ball": 4, "free": 7}
 NV = {"hinge": 1, "slide": 1, "ball": 3, "free": 6}
 
 
-def _hat(x: np.ndarray) -> np.ndarray:
+def hat(x: np.ndarray) -> np.ndarray:
     """(..., 3) → (..., 3, 3) skew matrices, x̂ y = x × y."""
     z = np.zeros_like(x[..., 0])
     return np.stack(
@@ -78,15 +78,15 @@ def _exp_and_jr(xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     a = 1 - s / 6 + s**2 / 120 - s**3 / 5040  # sin θ / θ
     b = 0.5 - s / 24 + s**2 / 720 - s**3 / 40320  # (1 − cos θ) / θ²
     c = 1.0 / 6 - s / 120 + s**2 / 5040 - s**3 / 362880  # (θ − sin θ) / θ³
-    k = _hat(xi)
+    k = hat(xi)
     k2 = k @ k
     eye = np.eye(3)
     return eye + a * k + b * k2, eye - b * k + c * k2
 
 
-def _rotation(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+def rotation(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     """Rodrigues' rotation about a fixed unit axis by angles (...) (complex-analytic)."""
-    k = _hat(np.asarray(axis, float))
+    k = hat(np.asarray(axis, float))
     s, c = np.sin(angle)[..., None, None], np.cos(angle)[..., None, None]
     return np.eye(3) + s * k + (1 - c) * (k @ k)
 
@@ -223,7 +223,7 @@ class TreeDynamics:
                 coordinate = (q[:, qs] - body.zero)[:, None] + xj[..., 0]
                 columns = [(span, axis[..., None], pivot if body.kind == "hinge" else None)]
             if body.kind == "hinge":
-                rot = rp @ _rotation(body.axis, coordinate)
+                rot = rp @ rotation(body.axis, coordinate)
                 trans = pivot - np.einsum("srij,j->sri", rot, anchor)
             elif body.kind == "slide":
                 rot = np.asarray(rp)

@@ -3,26 +3,20 @@
 dynamics at the sampled v̇ — of every engine that offers them and of the referee, in the
 canonical chart, compared pair by pair.
 
-The chart (MuJoCo's, ``mj_integratePos``): q ⊕ δ moves a hinge or slide by δ, turns a ball
-or free body by exp(δ) in its body axes (quat ⊗ (cos ½|δ|, sin ½|δ| δ/|δ|)) and moves a free
-body's origin by δ in world axes. An engine's derivatives come in its own layout and chart
-(:class:`~dyncheck.adapters.model_tree.DerivativeChart`); they are mapped by the chain rule
-through the check's state map (:func:`~dyncheck.adapters.layout.state_map`: q_e(q), v_e = T v,
-v̇_e = T v̇ + Ṫv), whose own derivatives are taken by a complex step (exact to round-off:
-the map is analytic), :func:`to_canonical`.
+The chart, and an engine's own derivatives mapped into it: :mod:`dyncheck.check.derivative_charts`.
 
-The referee: the book's general method (:mod:`dyncheck.reference.tree`, M(q) and h(q, v)),
-differentiated in q (along q ⊕ δ) by central differences at h, h/2, h/4 extrapolated twice
-(Richardson: error O(h⁶)), its error estimated by the two first extrapolations' difference;
-in v exactly
-(h is quadratic in v: a central difference of any step is exact but for round-off); the
-forward derivatives through ∂v̇/∂x = −M⁻¹ ∂τ/∂x at v̇ = FD(q, v, 0), which follows from
-differentiating τ = ID(q, v, FD(q, v, τ)).
+The referee: the recursive Newton–Euler algorithm (:mod:`dyncheck.reference.recursive`,
+§2.2's momentum laws (2.2.48)–(2.2.49) body by body), tied to the book's general method
+(:mod:`dyncheck.reference.tree`) on this very tree (:mod:`dyncheck.check.referee`: where the
+two disagree, the referee's derivatives are not compared and the tie's failed row says why),
+differentiated by a complex step along q ⊕ iη eₖ and v + iη eₖ — exact to round-off, with no
+truncation error to estimate; the forward derivatives through ∂v̇/∂x = −M⁻¹ ∂τ/∂x at
+v̇ = FD(q, v, 0), which follows from differentiating τ = ID(q, v, FD(q, v, τ)).
 
 The step's Jacobian against the chain rule of these derivatives: :mod:`dyncheck.check.steps`.
 
 Tolerances: round-off, 64 ε × tree depth of each matrix's scale (× κ(M) for the forward
-ones), plus per entry the referee's estimated error where it is one side, plus an engine's
+ones), plus per entry the referee's own round-off where it is one side, plus an engine's
 predicted finite-difference error where it differences (MuJoCo's one-sided differences of
 step s: s/2 |∂²τ/∂x²| + 2 δτ/s, δτ the round-off of τ, ∂²τ/∂x² from the referee; through
 |M⁻¹| for the forward ones). A difference beyond its prediction is a finding.
@@ -32,59 +26,67 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
-from dyncheck.adapters.integrators import quat_conj, quat_mul
-from dyncheck.adapters.layout import Canonical, StateMap, quat_order
+from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import (
-    Axes,
     DerivativeChart,
     Derivatives,
-    Dynamics,
-    JointType,
     ModelTree,
-    Orientation,
 )
 from dyncheck.adapters.model_tree import derivatives as collect
-from dyncheck.cases.coordinate_maps import quat_to_matrix
+from dyncheck.check.derivative_charts import FIELDS, perturb, same_layout, to_canonical
 from dyncheck.check.describe import depth
 from dyncheck.check.dynamics import States, condition
-from dyncheck.check.referee import ReferenceModel
+from dyncheck.check.referee import TIE_STATES, ReferenceModel, Tie
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
 from dyncheck.results import Verdict
 
-FIELDS = ("forward_q", "forward_v", "forward_tau", "inverse_q", "inverse_v")
 SUBJECTS = {
     "forward_q": "d(forward)/dq", "forward_v": "d(forward)/dv", "forward_tau": "d(forward)/dtau",
     "inverse_q": "d(inverse)/dq", "inverse_v": "d(inverse)/dv",
 }
 STEP = 4e-3
-"""The referee's largest central-difference step in q (then /2, /4): its extrapolated error
-O(h⁶ τ⁽⁷⁾) stays below the round-off 2 δτ/(h/4) ≈ 1e-12 × depth of τ's scale."""
-COMPLEX_STEP = 1e-20
-"""The complex step of the state map's derivatives (any step ≪ √ε works: no cancellation)."""
+"""The largest central-difference step of the implicit step's Richardson extrapolation
+(:func:`dyncheck.check.steps.implicit_blocks`; then /2, /4)."""
+ETA = 1e-30
+"""The complex step through the recursive referee (no cancellation: the result is
+η-independent for any η ≪ √ε × scale)."""
+STEP_WORK = 2e6
+"""The step Jacobians' budget in nv² × depth per state: an engine's finite differences of its
+step take 2 nv steps, each O(nv × depth) (its mass matrix's factorization), so a state costs
+O(nv² depth): they are compared at the first ⌊STEP_WORK / (nv² depth)⌋ states (at least one;
+every state of a 35-dof humanoid, one of a 200-hinge chain — where MuJoCo's three integrators
+take ~3 s a state), and the row says how many."""
+CURVE = 1e-3
+"""The step along the chart between complex-stepped first derivatives, for the second and
+third derivatives a finite difference's truncation needs (bounds only: their own error,
+O(CURVE²) relative, changes no verdict)."""
 
 
-def perturb(canon: Canonical, q: np.ndarray, k: int, step: complex) -> np.ndarray:
-    """q ⊕ step·e_k for every state (rows of ``q``), in the canonical chart; ``step`` may be
-    imaginary (a complex step: cos and sin of i h/2 are analytic)."""
-    out = q.astype(np.result_type(q, step, float), copy=True)
-    joint = max(j for j in range(len(canon.types)) if canon.v_start[j] <= k)
-    kind, qs, offset = canon.types[joint], canon.q_start[joint], k - canon.v_start[joint]
-    if kind in (JointType.HINGE, JointType.SLIDE):
-        out[:, qs] += step
-        return out
-    if kind is JointType.FREE and offset < 3:
-        out[:, qs + offset] += step
-        return out
-    axis = offset - 3 if kind is JointType.FREE else offset
-    at = qs + 3 if kind is JointType.FREE else qs
-    turn = np.zeros((4, 1), out.dtype)
-    turn[0], turn[1 + axis] = np.cos(step / 2), np.sin(step / 2)
-    out[:, at : at + 4] = quat_mul(out[:, at : at + 4].T, turn).T
-    return out
+def step_states(tree: ModelTree, n: int) -> int:
+    """How many of ``n`` states the step Jacobians are compared at (:data:`STEP_WORK`)."""
+    return max(1, min(n, int(STEP_WORK // (max(tree.nv, 1) ** 2 * max(depth(tree), 1)))))
+
+
+def first(found: object, k: int) -> Any:
+    """A record of per-state arrays (:class:`Referee`, ``Derivatives``, ``States``) cut to
+    its first ``k`` states (an array field whose first axis is not the states' is kept)."""
+    n = len(found.forward) if isinstance(found, Referee) else None  # type: ignore[attr-defined]
+    out = {}
+    for name, value in vars(found).items():
+        if isinstance(value, np.ndarray) and value.ndim and (n is None or len(value) == n):
+            out[name] = value[:k]
+        elif isinstance(value, dict):
+            out[name] = {key: x[:k] for key, x in value.items()}
+        elif isinstance(value, Derivatives):
+            out[name] = first(value, k)
+        else:
+            out[name] = value
+    return type(found)(**out)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -99,198 +101,98 @@ class Referee:
     second_v: np.ndarray  # ∂²τᵢ/∂v_k²
     inverse_mass: np.ndarray
     roundoff: np.ndarray  # δτ per state: the round-off of τ
+    roundoff_v: np.ndarray  # δτ per unit of v: over the velocities' spread max(1, |v|)
     forward: np.ndarray  # v̇ at τ = 0
+    tie: Tie  # the recursive algorithm against the general method on this tree
 
 
-def referee(tree: ModelTree, states: States) -> Referee:
-    """The referee's derivatives at ``states`` (canonical layout and chart)."""
+def referee(tree: ModelTree, states: States, *, bounds: bool = True,
+            tied: Tie | None = None) -> Referee:
+    """The referee's derivatives at ``states`` (canonical layout and chart): the recursive
+    Newton–Euler referee (:mod:`dyncheck.reference.recursive`, tied to the book's general
+    method by :class:`~dyncheck.check.referee.ReferenceModel`) differentiated by a complex
+    step — τ(q ⊕ iη e_k, v, v̇) and τ(q, v + iη e_k, v̇), the imaginary part over η: no
+    cancellation, so no truncation error and no extrapolation; the error is the recursion's
+    round-off. The second and third derivatives along the chart, which bound an engine's
+    finite differences, are central differences of these exact first derivatives at
+    ±:data:`CURVE`; ∂²τ/∂v_k² = 2 h₀(q, e_k), h₀ the bias without gravity (h is quadratic in
+    v). Where ``bounds`` is false (an RK4 stage's referee) only what a step's chain rule
+    needs is computed: the forward derivatives (the inverse ones at v̇ = a, the bounds and
+    their error estimates are zero), and the tie is ``tied``, the step's own referee's."""
     from dyncheck.adapters.layout import canonical
 
     canon = canonical(tree)
-    solver = ReferenceModel(tree).solver
+    model = ReferenceModel(tree)
+    solver = model.recursive
     q, v, a = states.q, states.v, states.a
     n, nv = v.shape
+    if tied is None:
+        model.dynamics(q[:TIE_STATES], v[:TIE_STATES], a[:TIE_STATES])
+        tied = model.tie
+    assert tied is not None
     with np.errstate(all="ignore"):
         mass, bias, _, _ = solver.at_states(q, v)
         inverse_mass = np.linalg.inv(mass)
         forward = -np.einsum("sij,sj->si", inverse_mass, bias)
-        accelerations = {"inverse": a, "forward": forward}
-        eye = np.eye(nv)
-        steps = STEP / np.array([1.0, 2.0, 4.0])
-        # every perturbed state at once: (step, sign, k, state)
-        signs = np.array([1.0, -1.0])
-        q_p = np.stack([np.stack([np.stack([perturb(canon, q, k, sign * h) for k in range(nv)])
-                                  for sign in signs]) for h in steps]).reshape(-1, q.shape[1])
-        v_p = np.broadcast_to(v, (3, 2, nv, n, nv)).reshape(-1, nv)
-        m_p, h_p, _, _ = solver.at_states(q_p, v_p)
-        m_p, h_p = m_p.reshape(3, 2, nv, n, nv, nv), h_p.reshape(3, 2, nv, n, nv)
-        spread = max(1.0, float(np.abs(v).max()))
-        v_w = (v[None, None] + spread * signs[:, None, None, None]
-               * eye[None, :, None, :]).reshape(-1, nv)
-        _, h_w, _, _ = solver.at_states(np.broadcast_to(q, (2, nv, *q.shape)).reshape(
-            -1, q.shape[1]), v_w)
-        h_w = h_w.reshape(2, nv, n, nv)
+        offsets = (0.0, CURVE, -CURVE) if bounds else (0.0,)
+        # every complex-stepped state at once: (offset, k) states, two accelerations
+        q_c = np.stack([perturb(canon, q, k, t + 1j * ETA) for t in offsets for k in range(nv)])
+        columns = np.tile(np.arange(nv), len(offsets))
+        acc = np.stack([a, forward] if bounds else [forward])
+        rows_q = solver.inverse_along(q, v, acc, columns, q_along=q_c)  # (offset·k, acc, s, i)
+        d_q = np.moveaxis((rows_q.imag / ETA).reshape(len(offsets), nv, len(acc), n, nv), 2, 0)
+        if not bounds:  # the forward acceleration's only: the inverse ones left zero
+            d_q = np.concatenate([np.zeros_like(d_q), d_q])
+        v_c = v[None] + 1j * ETA * np.eye(nv)[:, None, :]  # (k, s, i)
+        d_v = solver.inverse_along(q, v, np.zeros_like(v), np.arange(nv), v_along=v_c)
+        d_v = np.transpose(d_v.imag / ETA, (1, 2, 0))
+        second_v = np.zeros((n, nv, nv))
+        if bounds:
+            unit = np.broadcast_to(np.eye(nv)[:, None, :], (nv, n, nv))
+            second_v = np.transpose(2 * solver.inverse_along(
+                q, np.zeros_like(v), np.zeros_like(v), np.arange(nv), v_along=unit,
+                gravity=False), (1, 2, 0))
     depth_ = depth(tree)
+    rtol = ROUNDOFF_FACTOR * EPS * depth_
     tau_scale = np.maximum(np.abs(bias).max(axis=1), np.abs(
         np.einsum("sij,sj->si", mass, a)).max(axis=1))
-    roundoff = ROUNDOFF_FACTOR * EPS * depth_ * np.maximum(tau_scale, 1e-300)
+    roundoff = rtol * np.maximum(tau_scale, 1e-300)
+    spread = max(1.0, float(np.abs(v).max()))
     out: dict[str, np.ndarray] = {}
     error: dict[str, np.ndarray] = {}
     second_q: dict[str, np.ndarray] = {}
     third_q: dict[str, np.ndarray] = {}
-    for key, acc in accelerations.items():
-        tau_p = np.einsum("abksij,sj->abksi", m_p, acc) + h_p  # (step, sign, k, s, i)
-        central = (tau_p[:, 0] - tau_p[:, 1]) / (2 * steps[:, None, None, None])
-        first = (4 * central[1] - central[0]) / 3
-        second = (4 * central[2] - central[1]) / 3
-        best = (16 * second - first) / 15  # (k, s, i)
-        jacobian = np.transpose(best, (1, 2, 0))  # (s, i, k)
-        estimate = np.abs(np.transpose(second - first, (1, 2, 0))) / 15 \
-            + 2 * roundoff[:, None, None] / steps[-1]
-        tau_0 = np.einsum("sij,sj->si", mass, acc) + bias
-        curvature = (tau_p[2, 0] + tau_p[2, 1] - 2 * tau_0[None]) / steps[2] ** 2
-        second_q[key] = np.transpose(curvature, (1, 2, 0))
-        # τ(q ± 2h), τ(q ± h) with h = steps[1] (steps[0] = 2h): the third derivative
-        third = (tau_p[0, 0] - 2 * tau_p[1, 0] + 2 * tau_p[1, 1] - tau_p[0, 1]) \
-            / (2 * steps[1] ** 3)
-        third_q[key] = np.transpose(third, (1, 2, 0))
-        if key == "inverse":
-            out["inverse_q"], error["inverse_q"] = jacobian, estimate
+
+    def own_roundoff(jacobian: np.ndarray) -> np.ndarray:
+        """The recursion's round-off in a complex-stepped Jacobian: c ε × depth of its
+        largest entry, per state."""
+        return np.broadcast_to(rtol * np.abs(jacobian).max(axis=(1, 2))[:, None, None],
+                               jacobian.shape).copy()
+
+    for index, key in enumerate(("inverse", "forward")):
+        at = np.transpose(d_q[index], (0, 2, 3, 1))  # (offset, s, i, k)
+        if bounds:
+            second_q[key] = (at[1] - at[2]) / (2 * CURVE)
+            third_q[key] = (at[1] - 2 * at[0] + at[2]) / CURVE**2
         else:
-            out["forward_q"] = -inverse_mass @ jacobian
-            error["forward_q"] = np.abs(inverse_mass) @ estimate
-    d_v = np.transpose((h_w[0] - h_w[1]) / (2 * spread), (1, 2, 0))
-    out["inverse_v"], error["inverse_v"] = d_v, np.broadcast_to(
-        (2 * roundoff / spread)[:, None, None], d_v.shape).copy()
+            second_q[key] = third_q[key] = np.zeros_like(at[0])
+        if key == "inverse":
+            out["inverse_q"] = at[0]
+            error["inverse_q"] = own_roundoff(at[0])
+        else:
+            out["forward_q"] = -inverse_mass @ at[0]
+            error["forward_q"] = np.abs(inverse_mass) @ own_roundoff(at[0])
+    out["inverse_v"], error["inverse_v"] = d_v, own_roundoff(d_v)
     out["forward_v"] = -inverse_mass @ d_v
     error["forward_v"] = np.abs(inverse_mass) @ error["inverse_v"]
     out["forward_tau"] = inverse_mass
     error["forward_tau"] = np.zeros_like(inverse_mass)
-    second_v = np.transpose((h_w[0] + h_w[1] - 2 * bias[None]) / spread**2, (1, 2, 0))
     return Referee(
-        derivatives=collect(out, method="the general method differentiated: central "
-                            "differences in q extrapolated (Richardson), exact in v"),
+        derivatives=collect(out, method="recursive Newton-Euler differentiated by a complex "
+                            "step (exact to round-off; tied to the general method)"),
         error=error, second_q=second_q, third_q=third_q, second_v=second_v,
-        inverse_mass=inverse_mass,
-        roundoff=roundoff, forward=forward)
-
-
-def _chart(tree: ModelTree, chart: DerivativeChart, q_e: np.ndarray,
-           dq_e: np.ndarray) -> np.ndarray:
-    """A displacement dq_e of the engine's q in the coordinates its derivatives are taken
-    in: q itself (COORDINATES), or its velocity coordinates (TANGENT: a rotation's as the
-    engine's angular velocity is resolved, a free body's origin as its linear velocity)."""
-    if chart is DerivativeChart.COORDINATES:
-        return dq_e
-    out = np.zeros(tree.nv)
-    for joint in tree.joints:
-        lay = joint.layout
-        qs, vs = lay.q_start, lay.v_start
-        if lay.nq == 1:
-            out[vs] = dq_e[qs]
-        elif lay.cos_sin:  # (cos θ, sin θ): dθ = cos d(sin) − sin d(cos)
-            out[vs] = q_e[qs] * dq_e[qs + 1] - q_e[qs + 1] * dq_e[qs]
-        elif lay.quat == Orientation.RPY or lay.point is not None:
-            raise ValueError(f"{tree.engine}: no tangent chart for {joint.name!r}")
-        else:
-            at = qs + (0 if joint.type is JointType.BALL or lay.quat_first else 3)
-            back = np.argsort(quat_order(lay.quat))  # the engine's order to (w, x, y, z)
-            quat, dquat = q_e[at : at + 4][back], dq_e[at : at + 4][back]
-            local = lay.angular_axes is Axes.LOCAL
-            turn = quat_mul(quat_conj(quat), dquat) if local else quat_mul(dquat, quat_conj(quat))
-            omega = 2 * turn[1:]
-            if joint.type is JointType.BALL:
-                out[vs : vs + 3] = omega
-                continue
-            p = qs + (4 if lay.quat_first else 0)
-            dp = dq_e[p : p + 3]
-            if lay.linear_axes is Axes.LOCAL:
-                dp = quat_to_matrix(quat[None])[0].T @ dp
-            lin, ang = (vs + 3, vs) if lay.angular_first else (vs, vs + 3)
-            out[lin : lin + 3], out[ang : ang + 3] = dp, omega
-    return out
-
-
-def _turning(canon: Canonical) -> set[int]:
-    """The velocity indices of ball and free joints: the state map depends on their q
-    nonlinearly (T, Ṫv); a hinge's or slide's q enters only its own coordinate."""
-    return {canon.v_start[j] + i for j, kind in enumerate(canon.types)
-            if kind in (JointType.BALL, JointType.FREE) for i in range(6 if kind is
-                                                                       JointType.FREE else 3)}
-
-
-def _moved(canon: Canonical, tree: ModelTree, base: StateMap, q: np.ndarray, v: np.ndarray,
-           k: int, h: float) -> StateMap:
-    """The complex-stepped map along a hinge or slide ``k`` without mapping every joint:
-    only that joint's engine coordinates move (T and Ṫv do not)."""
-    from dyncheck.adapters.layout import state_map
-
-    joint = max(j for j in range(len(canon.types)) if canon.v_start[j] <= k)
-    single = Canonical(names=(canon.names[joint],), types=(canon.types[joint],),
-                       q_start=(0,), v_start=(0,), nq=1, nv=1, zeros=(canon.zeros[joint],))
-    mine = tree.joint(canon.names[joint])
-    one = replace(tree, joints=(replace(mine, layout=replace(mine.layout, q_start=0,
-                                                             v_start=0)),),
-                  nq=mine.layout.nq, nv=1)
-    step = state_map(single, one, np.array([q[canon.q_start[joint]] + 1j * h]), v[k : k + 1])
-    q_e = base.q.astype(complex)
-    at = mine.layout.q_start
-    q_e[at : at + mine.layout.nq] = step.q
-    return StateMap(q=q_e, t=base.t.astype(complex), tdot_v=base.tdot_v.astype(complex))
-
-
-def _same_layout(canon: Canonical, tree: ModelTree, states: States) -> bool:
-    """Whether ``tree``'s layout is the canonical one at these states (q the same, T = I,
-    Ṫv = 0: MuJoCo's own): then its tangent chart is the canonical chart."""
-    from dyncheck.adapters.layout import state_map
-
-    if tree.nq != canon.nq or tree.nv != canon.nv:
-        return False
-    for q, v in zip(states.q, states.v, strict=True):
-        mapped = state_map(canon, tree, q, v)
-        if not (np.array_equal(mapped.q, q) and np.array_equal(mapped.t, np.eye(canon.nv))
-                and not np.any(mapped.tdot_v)):
-            return False
-    return True
-
-
-def to_canonical(canon: Canonical, tree: ModelTree, states: States, found: Derivatives,
-                 dynamics: Dynamics) -> Derivatives:
-    """An engine's derivatives (its layout and chart; ``dynamics`` its own values at the same
-    states: M, forward and inverse dynamics) in the canonical layout and chart, by the chain
-    rule through the state map — τ = Tᵀ τ_e(q_e(q), T v, T v̇ + Ṫv) and
-    v̇ = T⁻¹ (v̇_e(q_e(q), T v) − Ṫv) differentiated —, the map's own derivatives (dq_e, dT,
-    d(Ṫv)) by a complex step."""
-    from dyncheck.adapters.layout import state_map
-
-    n, nv = states.v.shape
-    out = {f: np.zeros((n, nv, nv)) for f in FIELDS}
-    h = COMPLEX_STEP
-    turning = _turning(canon)
-    for s in range(n):
-        q, v, a = states.q[s : s + 1], states.v[s], states.a[s]
-        base = state_map(canon, tree, q[0], v)
-        t, t_inv = base.t, np.linalg.inv(base.t)
-        mass, tau_e, f_e = (dynamics.mass_matrix[s], dynamics.inverse[s], dynamics.forward[s])
-        f_c = t_inv @ (f_e - base.tdot_v)
-        for k in range(nv):
-            moved = state_map(canon, tree, perturb(canon, q, k, 1j * h)[0], v) \
-                if k in turning else _moved(canon, tree, base, q[0], v, k, h)
-            chi = _chart(tree, found.chart, base.q, moved.q.imag / h)
-            d_t, d_tdot = moved.t.imag / h, moved.tdot_v.imag / h
-            out["inverse_q"][s, :, k] = d_t.T @ tau_e + t.T @ (
-                found.inverse_q[s] @ chi + found.inverse_v[s] @ (d_t @ v)
-                + mass @ (d_t @ a + d_tdot))
-            out["forward_q"][s, :, k] = -t_inv @ d_t @ f_c + t_inv @ (
-                found.forward_q[s] @ chi + found.forward_v[s] @ (d_t @ v) - d_tdot)
-            d_tdot_v = np.zeros(len(base.tdot_v))
-            if k in turning:  # Ṫv depends on a free joint's own velocities only
-                pushed = state_map(canon, tree, q[0], v + 1j * h * np.eye(nv)[k])
-                d_tdot_v = pushed.tdot_v.imag / h
-            out["inverse_v"][s, :, k] = t.T @ (found.inverse_v[s] @ t[:, k] + mass @ d_tdot_v)
-            out["forward_v"][s, :, k] = t_inv @ (found.forward_v[s] @ t[:, k] - d_tdot_v)
-        out["forward_tau"][s] = t_inv @ found.forward_tau[s] @ t_inv.T
-    return collect(out, method=found.method, step=found.step)
+        inverse_mass=inverse_mass, roundoff=roundoff, roundoff_v=roundoff / spread,
+        forward=forward, tie=tied)
 
 
 def _predicted(found: Derivatives, ref: Referee, field: str) -> np.ndarray:
@@ -320,7 +222,7 @@ def _floor(ref: Referee, field: str) -> np.ndarray:
     arithmetic (a ball joint's ∂τ/∂q without gravity torque) carries; through |M⁻¹| for
     the forward derivatives."""
     per_q = ref.roundoff[:, None, None]
-    per = {"q": per_q, "v": ref.error["inverse_v"] / 2, "tau": np.zeros_like(per_q)}
+    per = {"q": per_q, "v": ref.roundoff_v[:, None, None], "tau": np.zeros_like(per_q)}
     bound = np.broadcast_to(per[field.split("_", 1)[1]], ref.inverse_mass.shape)
     return np.abs(ref.inverse_mass) @ bound if field.startswith("forward") else bound
 
@@ -347,7 +249,7 @@ def compare(model: str, tree: ModelTree, name_a: str, da: Derivatives, name_b: s
         for name, found in ((name_a, da), (name_b, db)):
             if found is ref.derivatives:
                 allowed = allowed + ref.error[field]
-                basis += "; + the referee's estimated error"
+                basis += "; + the referee's own round-off (complex step: no truncation)"
             elif found.step:
                 allowed = allowed + _predicted(found, ref, field)
                 basis += f"; + {name}'s predicted finite-difference error (step {found.step:g})"
@@ -372,6 +274,25 @@ def _row(model: str, engine: str, verdict: Verdict, note: str) -> CheckRow:
                     error=0.0, tolerance=0.0, basis="", verdict=verdict, note=note)
 
 
+def _collect(engine: object, name: str, inputs: tuple[np.ndarray, np.ndarray, np.ndarray],
+             seconds: dict[str, float]) -> Derivatives | Exception:
+    """An engine's own derivatives (submitted earlier where it runs in a process of its own),
+    or the exception it raised; its seconds into ``seconds``."""
+    import time
+
+    t0 = time.perf_counter()
+    try:
+        if hasattr(engine, "submit"):
+            own, took = engine.collect()  # type: ignore[attr-defined]
+        else:
+            own = engine.derivatives(*inputs)  # type: ignore[attr-defined]
+            took = time.perf_counter() - t0
+    except Exception as exc:  # reported by the caller, as a row of its own
+        return exc
+    seconds[f"d {name}"] = took
+    return own  # type: ignore[no-any-return]
+
+
 def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, object],
          states: States, *, with_referee: bool,
          seconds: dict[str, float] | None = None) -> list[CheckRow]:
@@ -389,53 +310,75 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
     names = (["reference"] if with_referee else []) + list(engines)
     out: list[CheckRow] = []
     inputs = {}
+    # an engine in its own process whose layout is the canonical one (MuJoCo's) is asked for
+    # its derivatives and its step Jacobians in one request: it steps while the referee works
+    canonical_layout = {name: same_layout(canon, engine.tree, states)  # type: ignore[attr-defined]
+                        for name, engine in engines.items()}
+    at_steps = step_states(tree, len(states.q))
+    both: set[str] = set()
     for name, engine in engines.items():
         mine: ModelTree = engine.tree  # type: ignore[attr-defined]
         inputs[name] = layout.engine_states(canon, mine, states.q, states.v, states.a)[1:]
-        if hasattr(engine, "submit"):
+        if with_referee and canonical_layout[name] and hasattr(engine, "submit_both"):
+            engine.submit_both(*inputs[name], at_steps)
+            both.add(name)
+        elif hasattr(engine, "submit"):
             engine.submit(*inputs[name], kind="derivatives")
+    stepping: dict[str, object] = {}  # engine → its step Jacobians, or how they failed
     t0 = time.perf_counter()
     ref = referee(tree, states)
     seconds["d reference"] = time.perf_counter() - t0
-    found: dict[str, Derivatives] = {"reference": ref.derivatives} if with_referee else {}
+    trusted = with_referee and ref.tie.agrees
+    if with_referee and not trusted:  # never silently trusted: its rows give way to this one
+        out.append(replace(ref.tie.row(model), section=Section.DERIVATIVES))
+    found: dict[str, Derivatives] = {"reference": ref.derivatives} if trusted else {}
     for name, engine in engines.items():
-        q, v, a = inputs[name]
-        try:
-            t0 = time.perf_counter()
-            if hasattr(engine, "submit"):
-                own, took = engine.collect()  # type: ignore[attr-defined]
-            else:
-                own = engine.derivatives(q, v, a)  # type: ignore[attr-defined]
-                took = time.perf_counter() - t0
-            seconds[f"d {name}"] = took
-            t0 = time.perf_counter()
-            if own.chart is DerivativeChart.TANGENT and _same_layout(canon, engine.tree,  # type: ignore[attr-defined]
-                                                                       states):
-                found[name] = own  # its layout is the canonical one: nothing to map
-            else:
-                values = engine.dynamics(q, v, a)  # type: ignore[attr-defined]
-                found[name] = to_canonical(canon, engine.tree,  # type: ignore[attr-defined]
-                                           states, own, values)
-            seconds["d map"] = seconds.get("d map", 0.0) + time.perf_counter() - t0
-        except Unsupported as exc:
-            out.append(_row(model, name, Verdict.SKIPPED, str(exc)))
-        except AttributeError:
+        if name in both:
+            try:
+                own_part, step_part = engine.collect_both()  # type: ignore[attr-defined]
+            except Exception as exc:  # its process died: its rows say so
+                own_part = step_part = exc
+            own = own_part if isinstance(own_part, Exception) else own_part[0]
+            if isinstance(own_part, tuple):
+                seconds[f"d {name}"] = own_part[1]
+            stepping[name] = step_part if isinstance(step_part, Exception) else step_part[0]
+        else:
+            own = _collect(engine, name, inputs[name], seconds)
+        if isinstance(own, Unsupported):
+            out.append(_row(model, name, Verdict.SKIPPED, str(own)))
+        elif isinstance(own, AttributeError):
             out.append(_row(model, name, Verdict.SKIPPED, f"{name} offers no derivatives"))
-        except Exception as exc:  # an engine failing costs its own rows
-            out.append(_row(model, name, Verdict.FAILED, f"{type(exc).__name__}: {exc}"))
-    for name, engine in engines.items():  # the step's Jacobian, where an engine offers it
-        mine = engine.tree  # type: ignore[attr-defined]
-        if not with_referee or not _same_layout(canon, mine, states):
-            continue  # (in the canonical layout only: MuJoCo's, whose step it is)
-        try:
-            steps = engine.transition(*inputs[name])  # type: ignore[attr-defined]
-        except (Unsupported, AttributeError):
+        elif isinstance(own, Exception):  # an engine failing costs its own rows
+            out.append(_row(model, name, Verdict.FAILED, f"{type(own).__name__}: {own}"))
+        else:
+            assert isinstance(own, Derivatives)
+            t0 = time.perf_counter()
+            try:
+                if own.chart is DerivativeChart.TANGENT and canonical_layout[name]:
+                    found[name] = own  # its layout is the canonical one: nothing to map
+                else:
+                    values = engine.dynamics(*inputs[name])  # type: ignore[attr-defined]
+                    found[name] = to_canonical(canon, engine.tree,  # type: ignore[attr-defined]
+                                               states, own, values)
+            except Exception as exc:  # an engine failing costs its own rows
+                out.append(_row(model, name, Verdict.FAILED, f"{type(exc).__name__}: {exc}"))
+            seconds["d map"] = seconds.get("d map", 0.0) + time.perf_counter() - t0
+        if (with_referee and canonical_layout[name] and name not in both
+                and hasattr(engine, "transition")):
+            try:  # in this process: its steps are taken now
+                stepping[name] = engine.transition(  # type: ignore[attr-defined]
+                    *(x[:at_steps] for x in inputs[name]))
+            except Exception as exc:
+                stepping[name] = exc
+    for name, steps in stepping.items():
+        if not trusted or isinstance(steps, (Unsupported, AttributeError)):
+            continue  # no trusted referee, or no steps offered
+        if isinstance(steps, Exception):  # costs its own row
+            out.append(_row(model, name, Verdict.FAILED, f"{type(steps).__name__}: {steps}"))
             continue
-        except Exception as exc:  # costs its own row
-            out.append(_row(model, name, Verdict.FAILED, f"{type(exc).__name__}: {exc}"))
-            continue
-        for step in steps:  # Euler's, and implicitfast's (Euler's here: no damping)
-            out.extend(step_rows(model, canon, tree, states, ref, name, step))
+        for step in steps:  # type: ignore[attr-defined]
+            out.extend(step_rows(model, canon, tree, first(states, at_steps),
+                                 first(ref, at_steps), name, step, of=len(states.q)))
     order = [n for n in names if n in found]
     for i, a_name in enumerate(order):
         for b_name in order[i + 1 :]:

@@ -24,6 +24,7 @@ import os
 import signal
 import tempfile
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
 from typing import Protocol
@@ -163,19 +164,39 @@ def _answer(name: str, spec: Registration, source: ModelFile, conn: Connection,
     conn.send(loaded.tree)
     while (request := conn.recv()) is not None:
         kind, *batch = request
-        try:
+        if kind == BOTH:  # its derivatives at every state, its steps' at the first k
+            q, v, a, k = batch
             t0 = time.perf_counter()
-            method = getattr(loaded, kind, None)
-            if method is None:
-                raise Unsupported(f"{name} offers no {kind}")
-            answer = method(*batch)
-            conn.send((answer, time.perf_counter() - t0))
-        except MemoryError:
-            conn.send(EngineError(_out_of_memory(name, memory_mib)))
-        except Unsupported as exc:
-            conn.send(exc)
-        except Exception as exc:
-            conn.send(EngineError(f"{type(exc).__name__}: {' '.join(str(exc).split())}"))
+            answers = tuple(_one(name, loaded, part, args, memory_mib) for part, args in (
+                ("derivatives", (q, v, a)), ("transition", (q[:k], v[:k], a[:k]))))
+            conn.send((answers, time.perf_counter() - t0))
+        else:
+            conn.send(_one(name, loaded, kind, batch, memory_mib))
+
+
+BOTH = "derivatives+transition"
+"""One request for an engine's derivatives and then its step Jacobians (:meth:`Isolated.
+submit_both`): it takes its steps while the caller computes, with no second request to wait
+on."""
+
+
+def _one(name: str, loaded: object, kind: str, batch: Sequence[object],
+         memory_mib: int | None) -> tuple[object, float] | Exception:
+    """One request's answer and its seconds, or the error to hand back in the engine's
+    words."""
+    try:
+        t0 = time.perf_counter()
+        method = getattr(loaded, kind, None)
+        if method is None:
+            raise Unsupported(f"{name} offers no {kind}")
+        answer = method(*batch)
+        return answer, time.perf_counter() - t0
+    except MemoryError:
+        return EngineError(_out_of_memory(name, memory_mib))
+    except Unsupported as exc:
+        return exc
+    except Exception as exc:
+        return EngineError(f"{type(exc).__name__}: {' '.join(str(exc).split())}")
 
 
 def _death(code: int | None, errors: str | None = None) -> str:
@@ -282,6 +303,25 @@ class Isolated:
         except OSError:
             raise EngineError(f"{self.engine} crashed earlier "
                               f"({_death(self._proc.exitcode, self._errors)})") from None
+
+    def submit_both(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, k: int) -> None:
+        """Ask for the derivatives at the batch and the step Jacobians at its first ``k``
+        states in one request (:data:`BOTH`); :meth:`collect_both` waits for them."""
+        nv = v.shape[1] if v.ndim > 1 else 1
+        self._kind = BOTH
+        self._batch_seconds = self.limits.batch_seconds(len(q) * 4 * nv + k * 12 * nv, nv)
+        try:
+            self._conn.send((BOTH, q, v, a, k))
+        except OSError:
+            raise EngineError(f"{self.engine} crashed earlier "
+                              f"({_death(self._proc.exitcode, self._errors)})") from None
+
+    def collect_both(self) -> tuple[tuple[object, float] | Exception,
+                                    tuple[object, float] | Exception]:
+        """The answers to :meth:`submit_both`: each (its value, the engine's seconds) or the
+        exception it raised."""
+        answers, _ = self.collect()
+        return answers  # type: ignore[return-value]
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
         """The engine's derivatives (:class:`Unsupported` where it offers none)."""

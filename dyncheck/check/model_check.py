@@ -37,8 +37,10 @@ DERIVATIVES_NOTE = (
     "derivatives (the per-engine lines above include them): d(forward)/d(q, v, tau) at tau = 0 "
     "and d(inverse)/d(q, v) at the sampled accelerations, in MuJoCo's chart (a free body's "
     "origin moved in world axes, a rotation in body axes), each engine's own chart mapped by "
-    "the chain rule; the referee's are the general method's, differentiated with an error "
-    "estimate of their own (dyncheck/check/derivatives.py)"
+    "the chain rule; the referee's are those of its recursive Newton-Euler algorithm (tied to "
+    "the book's general method: the 'referee' row), differentiated by a complex step, exact "
+    "to round-off (dyncheck/check/derivatives.py); the step Jacobians at the states their "
+    "rows name"
 )
 SMOOTH_NOTE = (
     "smooth dynamics only: contacts, joint limits, equality constraints, actuators and passive "
@@ -301,7 +303,10 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
     if with_referee:
         t0 = time.perf_counter()
         try:
-            results[REFEREE] = ReferenceModel(canonical_tree).dynamics(batch.q, batch.v, batch.a)
+            referee = ReferenceModel(canonical_tree)
+            results[REFEREE] = referee.dynamics(batch.q, batch.v, batch.a)
+            assert referee.tie is not None
+            rows.append(referee.tie.row(model))
         except Exception as exc:  # the referee failing on a tree costs its own rows too
             rows.append(_row(model, Section.DYNAMICS, REFEREE, Verdict.FAILED,
                              f"{type(exc).__name__}: {exc}", field="dynamics"))

@@ -1,14 +1,36 @@
-"""The book's general method (:mod:`dyncheck.reference.tree`) as one more implementation,
-``reference``, on the neutral tree one engine read from the file (the report names which)."""
+"""The referee, ``reference``, on the neutral tree one engine read from the file (the report
+names which): the book's general method (:mod:`dyncheck.reference.tree`, Lagrange
+(2.2.23)–(2.2.24)) — the root of trust — and the recursive Newton–Euler algorithm
+(:mod:`dyncheck.reference.recursive`, (2.2.48)–(2.2.49) body by body), which serves the
+states and the derivatives once it is tied to the general method on this very tree.
+
+The tie: at the first :data:`TIE_STATES` sampled states both methods give M and h, compared
+to round-off: 64 ε × the tree's depth × (1 + X/ℓ) of M's scale, and of the larger of |h| and
+|M v̇| for h — X/ℓ how far from the world origin the model stands in its own lengths
+(:meth:`~dyncheck.reference.recursive.RecursiveDynamics.reach`): the general method sums
+momenta about the origin, whose lever arms lose ε X / ℓ; the recursive one works about each
+subtree's root point and does not. Where they agree the recursive algorithm serves every
+state; where they do not, the general method serves every state and the tie is a failed row
+naming the referee itself."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
+from dyncheck.check.rows import CheckRow, Section
+from dyncheck.precision import EPS, ROUNDOFF_FACTOR
+from dyncheck.reference.recursive import RecursiveDynamics
 from dyncheck.reference.tree import Body, TreeDynamics
+from dyncheck.results import Verdict
 
 ENGINE = "reference"
+TIE_STATES = 10
+"""States at which the recursive algorithm is tied to the general method on every tree."""
+GENERAL = "reference (general method)"
+RECURSIVE = "reference (recursive)"
 
 
 def bodies(tree: ModelTree) -> list[Body]:
@@ -23,21 +45,86 @@ def bodies(tree: ModelTree) -> list[Body]:
     ]
 
 
+@dataclass(frozen=True, kw_only=True)
+class Tie:
+    """The recursive algorithm's M and h against the general method's at ``states`` states:
+    the larger relative error of the two, and the round-off tolerance."""
+
+    states: int
+    mass_error: float
+    bias_error: float
+    tolerance: float
+    reach: float  # X / ℓ: how far from the origin the model stands, in its own lengths
+
+    @property
+    def agrees(self) -> bool:
+        return max(self.mass_error, self.bias_error) <= self.tolerance
+
+    def row(self, model: str) -> CheckRow:
+        """The tie as a row of the dynamics section (failed: the referee disagrees with
+        itself, and the general method gave every number on the page)."""
+        served = ("the recursive algorithm gave the referee's M, h and dynamics at every "
+                  "state and its derivatives" if self.agrees else
+                  "the referee's two methods disagree: the general method gave every "
+                  "number on this page; the referee's derivatives are not to be trusted")
+        return CheckRow(
+            model=model, section=Section.DYNAMICS, subject="referee",
+            field="recursive Newton-Euler against the general method (M, h)",
+            impl_a=GENERAL, impl_b=RECURSIVE, value_a="", value_b="",
+            error=max(self.mass_error, self.bias_error), tolerance=self.tolerance,
+            basis=(f"round-off: {ROUNDOFF_FACTOR} eps x tree depth x (1 + X/l = "
+                   f"{1 + self.reach:.3g}: the general method's momenta about the world "
+                   f"origin), at {self.states} states"),
+            verdict=Verdict.PASSED if self.agrees else Verdict.FAILED,
+            note=f"M {self.mass_error:.3g}, h {self.bias_error:.3g}; {served}")
+
+
+def tie(general: TreeDynamics, recursive: RecursiveDynamics, depth: int, q: np.ndarray,
+        v: np.ndarray, a: np.ndarray) -> Tie:
+    """Both methods at the states (q, v) — M against M's scale, h against the larger of
+    |h| and |M a| (h vanishes without gravity and velocity)."""
+    with np.errstate(all="ignore"):
+        mass_g, bias_g, _, _ = general.at_states(q, v)
+        mass_r, bias_r, _, _ = recursive.at_states(q, v)
+        m_scale = max(float(np.abs(mass_g).max(initial=0.0)), 1e-300)
+        h_scale = max(float(np.abs(bias_g).max(initial=0.0)),
+                      float(np.abs(np.einsum("sij,sj->si", mass_g, a)).max(initial=0.0)),
+                      1e-300)
+        mass_error = float(np.abs(mass_r - mass_g).max(initial=0.0)) / m_scale
+        bias_error = float(np.abs(bias_r - bias_g).max(initial=0.0)) / h_scale
+    far, length = recursive.reach(q)
+    return Tie(states=len(q), mass_error=float(np.nan_to_num(mass_error, nan=np.inf)),
+               bias_error=float(np.nan_to_num(bias_error, nan=np.inf)),
+               tolerance=ROUNDOFF_FACTOR * EPS * max(depth, 1) * (1 + far / length),
+               reach=far / length)
+
+
 class ReferenceModel:
-    """The referee, in the canonical layout of ``tree`` (whose order it keeps)."""
+    """The referee, in the canonical layout of ``tree`` (whose order it keeps): ``solver``
+    the general method, ``recursive`` the recursive algorithm; :attr:`tie` set by
+    :meth:`dynamics`."""
 
     engine = ENGINE
 
     def __init__(self, tree: ModelTree) -> None:
+        from dyncheck.check.describe import depth
+
         self.tree = tree
         self.solver = TreeDynamics(bodies(tree), tree.gravity)
+        self.recursive = RecursiveDynamics(bodies(tree), tree.gravity)
+        self.depth = depth(tree)
+        self.tie: Tie | None = None
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
-        """Every state at once (:meth:`TreeDynamics.at_states`); forward dynamics by one
-        batched solve, a singular M (a joint moving no mass, a NaN) giving NaN for its state:
-        a failed row (non-finite), never a crash."""
+        """Every state at once: the two methods tied at the first :data:`TIE_STATES`
+        states, then the one that may serve (the module's docstring); forward dynamics by
+        one batched solve, a singular M (a joint moving no mass, a NaN) giving NaN for its
+        state: a failed row (non-finite), never a crash."""
+        first = slice(0, TIE_STATES)
+        self.tie = tie(self.solver, self.recursive, self.depth, q[first], v[first], a[first])
+        serving = self.recursive if self.tie.agrees else self.solver
         with np.errstate(all="ignore"):  # an overflow shows as a non-finite result: a row
-            mass, bias, kinetic, potential = self.solver.at_states(q, v)
+            mass, bias, kinetic, potential = serving.at_states(q, v)
             forward = np.full_like(bias, np.nan)
             try:
                 forward = np.linalg.solve(mass, -bias[..., None])[..., 0]

@@ -19,7 +19,7 @@ from dyncheck.check.describe import depth
 from dyncheck.check.dynamics import States
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
-from dyncheck.reference.tree import TreeDynamics
+from dyncheck.reference.recursive import RecursiveDynamics
 from dyncheck.results import Verdict
 from dyncheck.vocabulary import Integrator
 
@@ -156,7 +156,7 @@ def rk4_stages(canon: Canonical, tree: ModelTree, states: States, ref: Referee,
         theta = c * h * _rates(canon, prev_theta, prev_states.v)
         at = States(q=advance(canon, states.q, theta),
                     v=states.v + c * h * prev.forward, a=states.a)
-        out.append((at, referee(tree, at), theta))
+        out.append((at, referee(tree, at, bounds=False, tied=ref.tie), theta))
     return out
 
 
@@ -208,7 +208,7 @@ def rk4_step(canon: Canonical, stages: list[tuple[States, Referee, np.ndarray]],
     return out
 
 
-def _free_step(solver: TreeDynamics, canon: Canonical, q: np.ndarray, v: np.ndarray,
+def _free_step(solver: RecursiveDynamics, canon: Canonical, q: np.ndarray, v: np.ndarray,
                h: float, joint: int) -> tuple[np.ndarray, np.ndarray]:
     """MuJoCo's implicitfast step of the standalone free body of canonical joint ``joint``,
     at every state (rows): v₊ = v + h (M + h B)⁻¹ (−h_bias) on its block, B = ∂h_bias/∂v
@@ -243,10 +243,11 @@ def implicit_blocks(canon: Canonical, tree: ModelTree, states: States, h: float,
     extrapolations' difference plus the round-off of x₊ over the smallest step."""
     if not joints:
         return []
-    from dyncheck.check.derivatives import STEP, perturb
+    from dyncheck.check.derivative_charts import perturb
+    from dyncheck.check.derivatives import STEP
     from dyncheck.check.referee import ReferenceModel
 
-    solver = ReferenceModel(tree).solver
+    solver = ReferenceModel(tree).recursive
     q, v = states.q, states.v
     n = len(q)
     steps = STEP / np.array([1.0, 2.0, 4.0])
@@ -295,12 +296,13 @@ def _block(canon: Canonical, joint: int) -> np.ndarray:
 
 
 def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref: Referee,
-              engine: str, found: Transition) -> list[CheckRow]:
+              engine: str, found: Transition, *, of: int = 0) -> list[CheckRow]:
     """The engine's step Jacobian against the referee's chain rule: one row. Tolerance:
     round-off, + the engine's finite-difference error estimated from its two steps (centered
     differences: error ≈ |A(2s) − A(s)| / 3) and their round-off 2 δx/(2 s) — δv₊ being
-    h v̇'s round-off, κ(M) times its own —, + the referee's estimated error of its
-    derivatives times h."""
+    h v̇'s round-off, κ(M) times its own —, + the referee's own round-off in its
+    derivatives times h. ``of``: the states sampled, where the step Jacobians are compared at
+    fewer (:func:`~dyncheck.check.derivatives.step_states`): the basis says so."""
     h = found.time_step
     rk4 = found.integrator == Integrator.RK4
     why = found.unfollowed
@@ -362,8 +364,11 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
         error=float(off.max()) / scale, tolerance=float(allowed.max()) / scale,
         basis=(f"round-off: {ROUNDOFF_FACTOR} eps x tree depth {depth(tree)}; + {engine}'s "
                f"centered differences' error (steps {found.fd_step:g}, {2 * found.fd_step:g}); "
-               "+ the referee's estimated error x h"
+               "+ the referee's own round-off x h"
                + ("; a standalone free body's implicit block: its Richardson estimate"
-                  if blocks else "")),
+                  if blocks else "")
+               + (f"; at the first {len(states.q)} of {of} states (the step Jacobians' "
+                  "budget: an engine's differences of its step cost O(nv^2 depth) a state)"
+                  if of > len(states.q) else "")),
         verdict=Verdict.PASSED if within else Verdict.FAILED, note=note,
         worst_state=int(worst[0]))]

@@ -22,13 +22,13 @@ def free_body_derivatives(states: int = 10) -> tuple[dict[str, float], dict[str,
     from Pinocchio's mapped ones."""
     from dyncheck.adapters import layout
     from dyncheck.adapters.pinocchio_model import PinocchioModel
-    from dyncheck.check import derivatives
+    from dyncheck.check import derivative_charts, derivatives
 
     mine, other, canon, batch = beside_mujoco(FALLING, PinocchioModel, states)
     theirs = mine.derivatives(batch.q, batch.v, batch.a)
     _, q, v, a = layout.engine_states(canon, other.tree, batch.q, batch.v, batch.a)
     raw = other.derivatives(q, v, a)
-    mapped = derivatives.to_canonical(canon, other.tree, batch, raw, other.dynamics(q, v, a))
+    mapped = derivative_charts.to_canonical(canon, other.tree, batch, raw, other.dynamics(q, v, a))
     referee = derivatives.referee(mine.tree, batch).derivatives
 
     def worst(x: derivatives.Derivatives, y: derivatives.Derivatives) -> dict[str, float]:

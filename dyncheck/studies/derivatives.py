@@ -2,8 +2,8 @@
 tree dynamics, every engine that differentiates its dynamics against the others and the
 referee, at the case's sampled states — the check's derivative rows
 (:mod:`dyncheck.check.derivatives`: one chart, each engine's chart mapped to it exactly, the
-referee the general method differentiated with an error estimate of its own, tolerances
-derived) on the case's MJCF, a book case being a model in a file.
+referee's recursive algorithm — tied to the general method — differentiated by a complex
+step, tolerances derived) on the case's MJCF, a book case being a model in a file.
 
 The model differentiated is the MJCF's tree: a case's couplings (tendon equalities) and
 external field are not part of its smooth dynamics (stated on every row). States are the

@@ -69,7 +69,7 @@ def test_the_pendulum_derivatives_are_the_books_closed_form(tmp_path):
     from dyncheck.adapters import layout
     from dyncheck.adapters.model_files import read
     from dyncheck.adapters.pinocchio_model import PinocchioModel
-    from dyncheck.check import derivatives
+    from dyncheck.check import derivative_charts, derivatives
     from dyncheck.check.dynamics import sample
 
     model = PinocchioModel(read(path))
@@ -79,7 +79,7 @@ def test_the_pendulum_derivatives_are_the_books_closed_form(tmp_path):
     ref = derivatives.referee(model.tree, states).derivatives
     _, q, v, a = layout.engine_states(canon, model.tree, states.q, states.v, states.a)
     assert q.shape[1] == 2  # Pinocchio holds a continuous joint as (cos θ, sin θ)
-    mine = derivatives.to_canonical(canon, model.tree, states, model.derivatives(q, v, a),
+    mine = derivative_charts.to_canonical(canon, model.tree, states, model.derivatives(q, v, a),
                                     model.dynamics(q, v, a))
     for found in (ref, mine):
         np.testing.assert_allclose(found.forward_q[:, 0, 0], -(g / length) * np.cos(theta),
@@ -151,7 +151,7 @@ def test_the_chain_rule_is_needed():
     """Without the map's derivative terms (Pinocchio's and Drake's matrices taken in the
     canonical chart as they come, only permuted), the free body's rows fail: the charts
     really differ."""
-    from dyncheck.check import derivatives
+    from dyncheck.check import derivative_charts, derivatives
 
     def plain(canon, tree, states, found, dynamics):
         from dyncheck.adapters.layout import engine_states
@@ -160,7 +160,7 @@ def test_the_chain_rule_is_needed():
         t = np.array([m.t for m in maps])
         size = t.shape[2]
         mapped = {f: np.einsum("sji,sjk,skl->sil", t, getattr(found, f)[:, :, :t.shape[1]], t)
-                  [:, :size, :size] for f in derivatives.FIELDS}
+                  [:, :size, :size] for f in derivative_charts.FIELDS}
         return derivatives.collect(mapped, method=found.method, step=found.step)
 
     with pytest.MonkeyPatch.context() as mp:
