@@ -15,20 +15,17 @@ if in one tangent space (MuJoCo C before 4.0; order 2 on ball and free joints), 
 ``implicit`` (implicitfast) differentiates only actuator and damping forces ("TODO: rne
 derivative") — no gyroscopic derivative on a free body (MuJoCo C ≥ 3.11 has one).
 
-JAX's persistent compilation cache is switched on (under the user's cache directory, or
-``DYNCHECK_JAX_CACHE``), so a second run does not compile again — only where that folder is
-this user's and writable by nobody else (its entries are machine code that XLA loads
-unchecked), and never under ``--no-cache``.
+JAX's persistent compilation cache is switched on in the folder the command line checked
+(:mod:`dyncheck.compiled_caches`: private to this user, every entry vouched for by an
+authenticated manifest before JAX sees it — its entries are machine code that XLA loads as
+found), so a second run does not compile again; never under ``--no-cache``.
 """
 
 from __future__ import annotations
 
-import os
 import re
-import stat
 from contextlib import AbstractContextManager
 from operator import attrgetter
-from pathlib import Path
 from typing import Any, ClassVar, cast
 
 import jax
@@ -43,34 +40,27 @@ from dyncheck.adapters.mujoco_port import STEPS, PortAdapter
 from dyncheck.cases.multibody import Multibody
 from dyncheck.settings import current
 
-_CACHE = Path(os.environ.get("DYNCHECK_JAX_CACHE", Path.home() / ".cache" / "dyncheck" / "jax"))
-
-
-def _private(folder: Path) -> bool:
-    """Whether ``folder`` (created 0700 where missing) is a real folder of this user's that
-    nobody else can write: XLA's cached executables are machine code, loaded unchecked."""
-    try:
-        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
-        info = folder.lstat()
-    except OSError:
-        return False
-    return stat.S_ISDIR(info.st_mode) and info.st_uid == os.getuid() and not info.st_mode & 0o022
-
 
 def _compile_cache() -> None:
     """JAX's settings for this work, made when an MJX model is first put on the device
     (before anything compiles), never by importing this module: its platform where the
-    command names a device (``--device``), and its persistent compilation cache in
-    :data:`_CACHE` where that folder is private and the cache is on. Both are JAX's,
-    process-wide."""
+    command names a device (``--device``), and its persistent compilation cache in the
+    folder the command line checked (:mod:`dyncheck.compiled_caches`: XLA's cached
+    executables are machine code, loaded as found) — none where there is no such folder.
+    Both are JAX's, process-wide."""
+    from dyncheck.adapters.compiled import folder
+
     settings = current()
     platform = settings.device.split(":")[0] if settings.device else None
     if platform and getattr(jax.config, "jax_platforms", None) != platform:
         jax.config.update("jax_platforms", platform)
-    if settings.cache and _private(_CACHE) \
-            and getattr(jax.config, "jax_compilation_cache_dir", None) != str(_CACHE):
-        jax.config.update("jax_compilation_cache_dir", str(_CACHE))
+    checked = folder(settings, "jax")
+    if checked is not None and getattr(jax.config, "jax_compilation_cache_dir", None) \
+            != str(checked):
+        jax.config.update("jax_compilation_cache_dir", str(checked))
         jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
+    elif checked is None and getattr(jax.config, "jax_compilation_cache_dir", None):
+        jax.config.update("jax_compilation_cache_dir", None)  # (an unchecked one: none)
 
 
 def _clear_trace_caches() -> None:

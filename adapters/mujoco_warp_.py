@@ -11,8 +11,9 @@ and ``implicitfast`` applies a free body's gyroscopic derivative (``implicit_fre
 The device is Warp's: ``cpu`` unless ``--device`` (or ``DYNCHECK_DEVICE``) names a CUDA device.
 On the CPU every kernel launch costs ~0.1 ms, so a step costs ~10 ms (Euler) to ~40 ms (RK4)
 even on a pendulum (measured); runs longer than ``CPU_STEPS`` are left to a GPU, where one
-step is a captured CUDA graph. Warp's kernel cache (``~/.cache/warp``) keeps compiled kernels
-across runs.
+step is a captured CUDA graph. Warp's kernel cache keeps compiled kernels across runs in the
+folder the command line checked (:mod:`dyncheck.compiled_caches`), never in Warp's own
+default under the home folder; without one (``--no-cache``), in a temporary folder.
 """
 
 from __future__ import annotations
@@ -48,7 +49,9 @@ def _init_quietly() -> None:
     process), and ``wp.init()`` with its native library's stderr held back: on a machine
     without a CUDA driver it prints a warning line on every start, which says nothing here
     (the CPU is Warp's device unless ``--device cuda``); shown if initialisation fails."""
-    wp.config.log_level = wp.LOG_ERROR
+    from dyncheck.adapters.compiled import start_warp
+
+    start_warp(wp)  # its log at errors only, its kernel cache checked (or temporary)
     sys.stderr.flush()
     saved = os.dup(2)
     with tempfile.TemporaryFile() as held:

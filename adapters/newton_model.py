@@ -78,7 +78,9 @@ CORRECTED = (
 def _load(source: ModelFile):  # -> (newton.Model, names of the bodies whose inertia it changed)
     import warp as wp
 
-    wp.config.log_level = wp.LOG_ERROR  # in the engine's own process: no banner, no kernel log
+    from dyncheck.adapters.compiled import start_warp
+
+    start_warp(wp)  # in the engine's own process: no banner, no kernel log; its kernel cache
     import newton
 
     builder = newton.ModelBuilder()

@@ -191,8 +191,7 @@ def measure(steps: tuple[Step, ...] = STEPS) -> pd.DataFrame:
                                    else "no"})
                 continue
             if not step.warm:
-                env["DYNCHECK_CACHE"] = f"{tmp}/cache-{i}"
-                env["DYNCHECK_JAX_CACHE"] = f"{tmp}/cache-{i}/jax"
+                env["DYNCHECK_CACHE"] = f"{tmp}/cache-{i}"  # the compiled caches inside
             start = time.perf_counter()
             done = _execute(step, tmp, env)
             seconds = time.perf_counter() - start

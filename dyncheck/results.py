@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import tempfile
@@ -129,6 +130,9 @@ def table(records: Iterable[Any], record_type: type, key: list[str]) -> pd.DataF
 def write_atomic(path: Path, content: str | bytes) -> None:
     """Write to a temporary file in the same folder, then rename over ``path``; where the
     write fails, the temporary file and any folder made for it are removed again."""
+    if path.is_symlink() or (path.exists() and not path.is_file()):  # (checked up front too)
+        raise OSError(errno.EPERM, "not a regular file (a symlink or a special file): not "
+                      "replaced", str(path))
     made = [p for p in (path.parent, *path.parent.parents) if not p.exists()]
     path.parent.mkdir(parents=True, exist_ok=True)
     mode = "wb" if isinstance(content, bytes) else "w"

@@ -31,10 +31,12 @@ DEVICE_NAME = re.compile(r"cpu|cuda(:\d+)?")
 class Settings:
     """``cache``: read and write the disk cache; ``device``: where MuJoCo's ports compute
     (``cpu``, ``cuda``, ``cuda:N``; None: each port's default — the CPU for Warp, JAX's
-    default device for MJX)."""
+    default device for MJX); ``compiled``: the folder of the compiled-code caches the
+    command line checked (:mod:`dyncheck.compiled_caches`; None: none used)."""
 
     cache: bool = True
     device: str | None = None
+    compiled: str | None = None
 
 
 _CURRENT: ContextVar[Settings | None] = ContextVar("dyncheck_settings", default=None)

@@ -40,6 +40,8 @@ from functools import cache
 from pathlib import Path
 from typing import Any, TypeVar
 
+from dyncheck.adapters.compiled import private_folder
+
 T = TypeVar("T")
 
 KEY = "DYNCHECK_CACHE_KEY"
@@ -86,21 +88,6 @@ def _inside(path: Path, folder: Path) -> bool:
         return path.resolve().is_relative_to(folder.resolve())
     except OSError:
         return True  # unresolvable (a symlink loop): treated as unsafe
-
-
-def private_folder(folder: Path) -> None:
-    """``mkdir -p`` with every created level 0700 (umask aside)."""
-    missing = []
-    at = folder
-    while not at.exists() and at != at.parent:
-        missing.append(at)
-        at = at.parent
-    for level in reversed(missing):
-        try:
-            level.mkdir(mode=0o700)
-        except FileExistsError:
-            pass
-        os.chmod(level, 0o700)
 
 
 def _read_key(path: Path) -> bytes:

@@ -129,7 +129,9 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     if args.seed < 0:
         raise InvalidInput("--seed", args.seed, "a non-negative integer")
     check_out(args.out)
-    ci_files(args)
+    read = [p for p, _ in targets] + (
+        [args.against] if args.against is not None else [])
+    ci_files(args, read)
     positive("--jobs", args.jobs)
     options = {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
                "floating": args.floating, "against": args.against,

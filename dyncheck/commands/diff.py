@@ -19,7 +19,10 @@ def diff_command(args: argparse.Namespace) -> int:
     factor = diff.FACTOR if args.tolerance is None else args.tolerance
     diff.check_factor(factor)
     if args.markdown is not None:
-        check_out_file("--markdown", args.markdown)
+        read = [p for side in (args.run_a, args.run_b) for p in (
+            (side,) if not side.is_dir() else tuple(side.glob("*.csv")) + tuple(
+                side.glob("*.json")))]
+        check_out_file("--markdown", args.markdown, read)
     sides = []
     for flag, path in (("RUN_A", args.run_a), ("RUN_B", args.run_b)):
         side = diff.load(path, flag)

@@ -8,6 +8,7 @@ import errno
 import os
 import sys
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -32,11 +33,12 @@ def path_arg(text: str) -> Path:
     return Path(text)
 
 
-def ci_files(args: argparse.Namespace) -> None:
-    """The ``--junit`` and ``--json`` files writable, checked before any work."""
+def ci_files(args: argparse.Namespace, inputs: Sequence[Path] = ()) -> None:
+    """The ``--junit`` and ``--json`` files writable and none of the command's ``inputs``,
+    checked before any work."""
     for flag, path in (("--junit", args.junit), ("--json", args.json)):
         if path is not None:
-            check_out_file(flag, path)
+            check_out_file(flag, path, inputs)
             out = getattr(args, "out", None)
             if out is not None and path.resolve() == Path(out).resolve():
                 raise InvalidInput(flag, str(path), "a file path other than the --out folder")
@@ -78,11 +80,32 @@ def check_out(out: Path, flag: str = "--out") -> None:
                 p.rmdir()
 
 
-def check_out_file(flag: str, path: Path) -> None:
-    """A file to write: not a folder, and its folder writable (:func:`check_out`)."""
+def check_out_file(flag: str, path: Path, inputs: Sequence[Path] = ()) -> None:
+    """A file to write, checked before any work: not a folder, not a symlink or a special
+    file (it is written beside and renamed over: a link or a device would be replaced, not
+    written through), not one of the command's ``inputs`` (the model it reads), and its folder
+    writable (:func:`check_out`)."""
+    if path.is_symlink():
+        raise InvalidInput(flag, str(path), "a regular file path, not a symlink (outputs are "
+                           "written beside and renamed over: the link would be replaced)")
     if path.is_dir():
         raise InvalidInput(flag, str(path), "a file path, not a folder")
+    if path.exists() and not path.is_file():
+        raise InvalidInput(flag, str(path), "a regular file path, not a special file (a "
+                           "device, a pipe or a socket)")
+    for given in inputs:
+        if _same_file(path, given):
+            raise InvalidInput(flag, str(path), f"a file other than the input {str(given)!r} "
+                               "(it would be overwritten)")
     check_out(path.parent, flag)
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether two paths name one file (hard links and links followed), or would."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return a.resolve() == b.resolve()
 
 
 MAX_STATES = 10**9
@@ -123,11 +146,15 @@ def positive(name: str, value: int | None, most: int | None = None) -> None:
 def settings_of(args: argparse.Namespace) -> Settings:
     """The command's :class:`~dyncheck.settings.Settings` (``--no-cache``, ``--device``,
     their environment defaults), checked before any work: ``cuda`` on a machine without an
-    NVIDIA driver is refused here."""
+    NVIDIA driver is refused here; the compiled-code caches checked here too, before any
+    engine runs (:func:`dyncheck.compiled_caches.prepare`)."""
+    from dyncheck import compiled_caches
+
     device = getattr(args, "device", None)
     if device == "cuda" and not has_cuda():
         raise InvalidInput("--device", device, "cpu on this machine (no NVIDIA driver found)")
-    return from_environment(no_cache=getattr(args, "no_cache", False), device=device)
+    return compiled_caches.prepare(from_environment(no_cache=getattr(args, "no_cache", False),
+                                                    device=device))
 
 
 def has_cuda() -> bool:

@@ -207,11 +207,12 @@ def newton_joint_order() -> Entry:
     import mujoco
 
     from dyncheck.adapters.c_output import c_output_dropped
+    from dyncheck.adapters.compiled import start_warp
 
     with c_output_dropped():
         import warp as wp
 
-        wp.config.log_level = wp.LOG_ERROR
+        start_warp(wp)
         import newton
 
     rng = np.random.default_rng(0)

@@ -1468,7 +1468,48 @@ EXTRA_FAULTS: tuple[Fault, ...] = (
           exit=2, answer=r"--states must be a positive integer at most 10000000, got -1$"),
 )
 
-FAULTS = (*FAULTS, *HOSTILE_MODELS, *MORE_FAULTS, *EXTRA_FAULTS)
+def _model_and_link(tmp: Path) -> None:
+    (tmp / "m.urdf").write_text(URDF)
+    (tmp / "link.json").symlink_to(tmp / "m.urdf")
+
+
+def _fifo(tmp: Path) -> None:
+    (tmp / "m.urdf").write_text(URDF)
+    os.mkfifo(tmp / "pipe.json")
+
+
+OUTPUT_PATHS = (  # #60: an output never replaces an input, a link or a special file
+    Fault(kind="--json the model being checked", area="check", prepare=_file("m.urdf", URDF),
+          argv=("check", "{tmp}/m.urdf", "--json", "{tmp}/m.urdf", "--out", OUT),
+          answer=r"--json must be a file other than the input '<tmp>/m\.urdf' \(it would be "
+                 r"overwritten\), got '<tmp>/m\.urdf'$"),
+    Fault(kind="--junit the model being checked, by another spelling", area="check",
+          prepare=_file("m.urdf", URDF),
+          argv=("check", "{tmp}/m.urdf", "--junit", "{tmp}/./m.urdf", "--out", OUT),
+          answer=r"--junit must be a file other than the input"),
+    Fault(kind="--json a symlink (to the model)", area="check", prepare=_model_and_link,
+          argv=("check", "{tmp}/m.urdf", "--json", "{tmp}/link.json", "--out", OUT),
+          answer=r"--json must be a regular file path, not a symlink"),
+    Fault(kind="--json a named pipe", area="check", prepare=_fifo,
+          argv=("check", "{tmp}/m.urdf", "--json", "{tmp}/pipe.json", "--out", OUT),
+          answer=r"--json must be a regular file path, not a special file"),
+    Fault(kind="--json /dev/stdout (a link to a device)", area="run",
+          argv=("run", "simple_pendulum", "--json", "/dev/stdout", "--out", OUT),
+          answer=r"--json must be a regular file path, not a symlink"),
+    Fault(kind="--junit /dev/null (a device)", area="run",
+          argv=("run", "simple_pendulum", "--junit", "/dev/null", "--out", OUT),
+          answer=r"--junit must be a regular file path, not a special file"),
+    Fault(kind="--markdown one of the runs compared", area="diff",
+          prepare=lambda tmp: _file("a.csv", (REPORTS / "baseline.csv").read_text())(tmp),
+          argv=("diff", "{tmp}/a.csv", "{tmp}/a.csv", "--markdown", "{tmp}/a.csv"),
+          answer=r"--markdown must be a file other than the input"),
+    Fault(kind="baseline --out a symlink", area="baseline",
+          prepare=lambda tmp: (tmp / "b.csv").symlink_to(tmp / "elsewhere.csv"),
+          argv=("baseline", "--out", "{tmp}/b.csv"),
+          answer=r"--out must be a regular file path, not a symlink"),
+)
+
+FAULTS = (*FAULTS, *HOSTILE_MODELS, *MORE_FAULTS, *EXTRA_FAULTS, *OUTPUT_PATHS)
 
 
 DEDICATED = (
@@ -1498,6 +1539,20 @@ DEDICATED = (
      "test_a_scheduler_that_dies_mid_run_is_one_line_naming_dask_not_a_failed_check"),
     ("1000 mutated MJCF and URDF files", "each a one-line error or a report, within a time "
      "limit", "tests/check/test_fuzz.py::test_mutated_models_never_traceback_or_hang"),
+    ("two entries of JAX's compilation cache swapped", "both deleted before JAX sees the "
+     "folder (its manifest does not vouch for them), compiled again, the right values — they "
+     "were loaded and run", "tests/dyncheck/test_compiled_caches.py::"
+     "test_swapped_jax_entries_are_compiled_again_not_run"),
+    ("a compiled-code entry changed, planted, or a link", "deleted before any engine starts "
+     "(a link never followed), one line on stderr", "tests/dyncheck/test_compiled_caches.py::"
+     "test_swapped_changed_and_planted_entries_are_deleted"),
+    ("a compiled-code manifest missing, forged or signed with another key", "nothing in the "
+     "folder trusted: every entry compiled again",
+     "tests/dyncheck/test_compiled_caches.py::test_without_an_authentic_manifest_nothing_is_"
+     "trusted"),
+    ("a compiled-code folder others can write", "not used: JAX keeps no persistent cache, "
+     "Warp compiles into a temporary folder (it wrote ~/.cache/warp even under --no-cache)",
+     "tests/dyncheck/test_compiled_caches.py::test_a_folder_others_can_write_is_not_used"),
 )
 
 OBSERVED: dict[int, tuple[int, str]] = {}

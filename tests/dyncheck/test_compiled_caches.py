@@ -1,0 +1,137 @@
+"""The compiled-code caches (dyncheck/compiled_caches.py): an entry the authenticated manifest
+does not vouch for is deleted before an engine sees the folder — swapped, changed, planted,
+a link — and JAX, given the checked folder, compiles such an entry again instead of running
+it. Expected values: the files the test wrote and what a jitted function computes."""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from dyncheck import compiled_caches
+from dyncheck.adapters import compiled
+from dyncheck.settings import Settings
+
+SECRET = b"k" * 32
+
+
+def _entries(folder: Path) -> dict[str, bytes]:
+    return {p.relative_to(folder).as_posix(): p.read_bytes() for p in folder.rglob("*")
+            if p.is_file() and not p.is_symlink() and p.name != compiled_caches.MANIFEST}
+
+
+def _filled(tmp_path: Path) -> Path:
+    folder = tmp_path / "jax"
+    (folder / "sub").mkdir(parents=True)
+    for name, body in (("a", b"code a"), ("b", b"code b"), ("sub/c", b"code c")):
+        (folder / name).write_bytes(body)
+    compiled_caches.sign(folder, SECRET)
+    return folder
+
+
+def test_vouched_entries_are_kept(tmp_path):
+    folder = _filled(tmp_path)
+    assert compiled_caches.verify(folder, SECRET) == []
+    assert _entries(folder) == {"a": b"code a", "b": b"code b", "sub/c": b"code c"}
+
+
+def test_swapped_changed_and_planted_entries_are_deleted(tmp_path):
+    folder = _filled(tmp_path)
+    a, b = (folder / "a").read_bytes(), (folder / "b").read_bytes()
+    (folder / "a").write_bytes(b)  # two entries swapped
+    (folder / "b").write_bytes(a)
+    (folder / "sub" / "c").write_bytes(b"code c, changed")
+    (folder / "planted").write_bytes(b"someone else's code")
+    outside = tmp_path / "outside"
+    outside.write_bytes(b"not ours")
+    (folder / "link").symlink_to(outside)
+    removed = compiled_caches.verify(folder, SECRET)
+    assert sorted(removed) == ["a", "b", "link", "planted", "sub/c"]
+    assert _entries(folder) == {}
+    assert outside.read_bytes() == b"not ours"  # a link is deleted, never followed
+
+
+@pytest.mark.parametrize("damage", ["missing", "forged", "other key"])
+def test_without_an_authentic_manifest_nothing_is_trusted(tmp_path, damage):
+    folder = _filled(tmp_path)
+    manifest = folder / compiled_caches.MANIFEST
+    if damage == "missing":
+        manifest.unlink()
+    elif damage == "forged":
+        manifest.write_bytes(manifest.read_bytes().replace(b'"a"', b'"x"'))
+    else:
+        compiled_caches.sign(folder, b"o" * 32)
+    assert sorted(compiled_caches.verify(folder, SECRET)) == ["a", "b", "sub/c"]
+
+
+def test_prepare_checks_the_folder_and_no_cache_uses_none(tmp_path, monkeypatch):
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("DYNCHECK_CACHE_KEY", str(tmp_path / "key"))
+    monkeypatch.setattr(compiled_caches, "_PREPARED", {})
+    planted = tmp_path / "cache" / "compiled" / "jax" / "planted"
+    planted.parent.mkdir(parents=True, mode=0o700)
+    planted.write_bytes(b"code")
+    settings = compiled_caches.prepare(Settings())
+    assert settings.compiled == str(tmp_path / "cache" / "compiled")
+    assert not planted.exists()
+    assert compiled.folder(settings, "jax") == planted.parent
+    assert compiled_caches.prepare(Settings(cache=False)).compiled is None
+    assert compiled.folder(Settings(cache=False, compiled=settings.compiled),
+                                  "jax") is None
+
+
+def test_a_folder_others_can_write_is_not_used(tmp_path, monkeypatch):
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("DYNCHECK_CACHE_KEY", str(tmp_path / "key"))
+    monkeypatch.setattr(compiled_caches, "_PREPARED", {})
+    shared = tmp_path / "cache" / "compiled" / "warp"
+    shared.mkdir(parents=True)
+    os.chmod(shared, 0o777)
+    assert compiled_caches.prepare(Settings()).compiled is None
+    assert compiled.warp_folder(Settings()) != shared  # a temporary one instead
+
+
+JAX_RUN = """
+import sys, jax, jax.numpy as jnp
+jax.config.update("jax_compilation_cache_dir", sys.argv[1])
+jax.config.update("jax_persistent_cache_min_compile_time_secs", 0)
+jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
+x = jnp.arange(4.0)
+print(jax.jit(lambda y: y * 2 + 1)(x).tolist(), jax.jit(lambda y: jnp.sin(y) - 3)(x).tolist())
+"""
+
+
+@pytest.mark.skipif(importlib.util.find_spec("jax") is None, reason="needs the 'mjx' extra")
+def test_swapped_jax_entries_are_compiled_again_not_run(tmp_path):
+    """Two functions compiled into JAX's persistent cache; their entries swapped; the check
+    deletes both, and the next process compiles them again (their files are back) and
+    computes the right values."""
+    folder = tmp_path / "jax"
+    folder.mkdir(mode=0o700)
+
+    def run() -> str:
+        done = subprocess.run([sys.executable, "-c", JAX_RUN, str(folder)],
+                              capture_output=True, text=True, timeout=300,
+                              env={**os.environ, "JAX_PLATFORMS": "cpu"})
+        assert done.returncode == 0, done.stderr[-2000:]
+        return done.stdout.strip()
+
+    expected = run()
+    compiled_caches.sign(folder, SECRET)
+    entries = [p for p in folder.rglob("*") if p.is_file() and p.name != ".manifest"
+               and p.stat().st_size > 100]
+    assert len(entries) >= 2, [p.name for p in folder.rglob("*")]
+    first, second = entries[:2]
+    a, b = first.read_bytes(), second.read_bytes()
+    first.write_bytes(b)
+    second.write_bytes(a)
+    removed = compiled_caches.verify(folder, SECRET)
+    assert {first.relative_to(folder).as_posix(), second.relative_to(folder).as_posix()} \
+        <= set(removed)
+    assert run() == expected
+    assert first.exists() and second.exists()  # compiled again
