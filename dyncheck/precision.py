@@ -17,3 +17,12 @@ ROUNDOFF_FACTOR = 64
 def eps_name(eps: float) -> str:
     """How a round-off basis names ε: "eps" (float64), "float32 eps", or its value."""
     return "eps" if eps == EPS else ("float32 eps" if eps == EPS32 else f"eps {eps:.3g}")
+
+
+def standing(far: float, length: float) -> float:
+    """The factor a model's distance from the world origin puts on a round-off bound:
+    max(1, X / ℓ), X the largest distance of a joint point or centre from the origin over the
+    states, ℓ the model's own length. Positions carry round-off ε X, and every lever arm an
+    engine or the general method takes as a difference of positions carries ε X / ℓ
+    relative; near the origin (X ≤ ℓ) the bound c ε already covers it."""
+    return max(1.0, far / max(length, 1e-300))

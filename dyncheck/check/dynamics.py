@@ -145,6 +145,7 @@ def compare(
     eps: float = EPS,
     kappa: float | None = None,
     vertices: float = 0.0,
+    standing: float = 1.0,
 ) -> list[CheckRow]:
     """One row per quantity. A failure is ``explained`` where ``explanations`` predicts it (the
     difference within prediction + tolerance), or where ``caused_by`` names a description
@@ -153,7 +154,8 @@ def compare(
     κ(M) of ``dyn_a`` where the caller has it (one per implementation, not per pair);
     ``vertices``: the relative difference of the two models' inertias where one takes them
     from float32 mesh vertices and the other from the file's digits (M, h, τ and the energies
-    are linear in the masses and inertias)."""
+    are linear in the masses and inertias); ``standing``: max(1, X/ℓ), how far from the world
+    origin the model stands in its own lengths (:func:`dyncheck.precision.standing`)."""
     d = depth(tree)
     kappa = condition(dyn_a.mass_matrix) if kappa is None else kappa
     least = floors(tree, dyn_a, states)
@@ -170,8 +172,10 @@ def compare(
         scale = max(float(np.abs(desired).max()), floor, 1e-300)
         errors = np.abs(actual - desired).max(axis=1)
         worst = int(np.argmax(errors))
-        rtol = ROUNDOFF_FACTOR * eps * d + vertices
+        rtol = ROUNDOFF_FACTOR * eps * d * standing + vertices
         basis = f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth {d}"
+        if standing > 1:
+            basis += f" x X/l {standing:.3g} (positions far from the origin)"
         if vertices:
             basis += f"; + {vertices:.2g}: one engine's inertia from float32 mesh vertices"
         if floor >= float(np.abs(desired).max()) and floor_name:

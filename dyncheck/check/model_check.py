@@ -28,7 +28,7 @@ from dyncheck.check import engines as engine_processes
 from dyncheck.check.derivatives import rows as derivative_rows
 from dyncheck.check.dynamics import States, compare, condition, sample
 from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
-from dyncheck.check.referee import ReferenceModel
+from dyncheck.check.referee import ReferenceModel, standing_of
 from dyncheck.check.rows import COLUMNS, CheckRow, Section
 from dyncheck.errors import InvalidInput, UnknownName
 from dyncheck.results import Verdict
@@ -345,6 +345,7 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
     # one from the file's digits: each quantity may differ by that much, relative
     vertices = 2 * max(canonical_tree.mesh_rounding.values(), default=0.0)
     rounded = {n for n in results if n not in loaded or trees[n].mesh_rounding}
+    factor = standing_of(canonical_tree, batch.q)  # how far from the origin it stands
     for i, a in enumerate(order):
         for b in order[i + 1 :]:
             cause = ", ".join(dict.fromkeys(f for e in (a, b) if e in differing
@@ -359,7 +360,7 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
                                     explanations, cause, batch,
                                     eps=max(trees[a].eps, trees[b].eps), kappa=kappas[a],
                                     vertices=vertices if (a in rounded) != (b in rounded)
-                                    else 0.0))
+                                    else 0.0, standing=factor))
                 continue
             common = np.arange(canon.nv)
             for held in dofs.values():
@@ -370,7 +371,8 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
                 a, partial.restrict(results[a], partial.columns(dofs[a], common)),
                 b, partial.restrict(results[b], partial.columns(dofs[b], common)),
                 {}, cause, on, eps=max(trees[a].eps, trees[b].eps),
-                vertices=vertices if (a in rounded) != (b in rounded) else 0.0))
+                vertices=vertices if (a in rounded) != (b in rounded) else 0.0,
+                standing=factor))
     return rows
 
 

@@ -5,7 +5,7 @@ names which): the book's general method (:mod:`dyncheck.reference.tree`, Lagrang
 states and the derivatives once it is tied to the general method on this very tree.
 
 The tie: at the first :data:`TIE_STATES` sampled states both methods give M and h, compared
-to round-off: 64 ε × the tree's depth × (1 + X/ℓ) of M's scale, and of the larger of |h| and
+to round-off: 64 ε × the tree's depth × max(1, X/ℓ) of M's scale, and of the larger of |h| and
 |M v̇| for h — X/ℓ how far from the world origin the model stands in its own lengths
 (:meth:`~dyncheck.reference.recursive.RecursiveDynamics.reach`): the general method sums
 momenta about the origin, whose lever arms lose ε X / ℓ; the recursive one works about each
@@ -21,7 +21,7 @@ import numpy as np
 
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check.rows import CheckRow, Section
-from dyncheck.precision import EPS, ROUNDOFF_FACTOR
+from dyncheck.precision import EPS, ROUNDOFF_FACTOR, standing
 from dyncheck.reference.recursive import RecursiveDynamics
 from dyncheck.reference.tree import Body, TreeDynamics
 from dyncheck.results import Verdict
@@ -54,7 +54,7 @@ class Tie:
     mass_error: float
     bias_error: float
     tolerance: float
-    reach: float  # X / ℓ: how far from the origin the model stands, in its own lengths
+    standing: float  # max(1, X / ℓ): how far from the origin the model stands
 
     @property
     def agrees(self) -> bool:
@@ -72,9 +72,10 @@ class Tie:
             field="recursive Newton-Euler against the general method (M, h)",
             impl_a=GENERAL, impl_b=RECURSIVE, value_a="", value_b="",
             error=max(self.mass_error, self.bias_error), tolerance=self.tolerance,
-            basis=(f"round-off: {ROUNDOFF_FACTOR} eps x tree depth x (1 + X/l = "
-                   f"{1 + self.reach:.3g}: the general method's momenta about the world "
-                   f"origin), at {self.states} states"),
+            basis=(f"round-off: {ROUNDOFF_FACTOR} eps x tree depth"
+                   + (f" x X/l {self.standing:.3g} (the general method's momenta about the "
+                      "world origin)" if self.standing > 1 else "")
+                   + f", at {self.states} states"),
             verdict=Verdict.PASSED if self.agrees else Verdict.FAILED,
             note=f"M {self.mass_error:.3g}, h {self.bias_error:.3g}; {served}")
 
@@ -92,11 +93,15 @@ def tie(general: TreeDynamics, recursive: RecursiveDynamics, depth: int, q: np.n
                       1e-300)
         mass_error = float(np.abs(mass_r - mass_g).max(initial=0.0)) / m_scale
         bias_error = float(np.abs(bias_r - bias_g).max(initial=0.0)) / h_scale
-    far, length = recursive.reach(q)
+    factor = standing(*recursive.reach(q))
     return Tie(states=len(q), mass_error=float(np.nan_to_num(mass_error, nan=np.inf)),
                bias_error=float(np.nan_to_num(bias_error, nan=np.inf)),
-               tolerance=ROUNDOFF_FACTOR * EPS * max(depth, 1) * (1 + far / length),
-               reach=far / length)
+               tolerance=ROUNDOFF_FACTOR * EPS * max(depth, 1) * factor, standing=factor)
+
+
+def standing_of(tree: ModelTree, q: np.ndarray) -> float:
+    """max(1, X/ℓ) of ``tree`` at the states ``q`` (:func:`dyncheck.precision.standing`)."""
+    return standing(*RecursiveDynamics(bodies(tree), tree.gravity).reach(q))
 
 
 class ReferenceModel:

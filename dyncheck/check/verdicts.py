@@ -87,7 +87,10 @@ def _reading(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Reading, 
 
 def _agreement(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Agreement, str]:
     """Judged against the referee (MuJoCo where the referee was not run): a difference
-    between two engines belongs to the one that differs from the judge."""
+    between two engines belongs to the one that differs from the judge. One rule, in this
+    order: a failed row → differ; else an explained row → differ only as explained (the
+    quantities named); else every compared row passed → agree; nothing compared → not
+    compared. "Agree" never stands beside a failed or explained row of that engine."""
     dynamics = rows[rows["section"].isin((Section.DYNAMICS, Section.DERIVATIVES))
                     & ((rows["impl_a"] == engine) | (rows["impl_b"] == engine))]
     for judge in (REFEREE, canonical):  # the referee judges; without it, the canonical engine
@@ -113,8 +116,9 @@ def _agreement(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Agreeme
                                   f"{worst['tolerance']:.3g}")
     partners = sorted({*compared["impl_a"], *compared["impl_b"]} - {engine})
     explained = compared[compared["verdict"] == Verdict.EXPLAINED]
-    if len(explained) == len(compared):
-        return Agreement.EXPLAINED, _first_notes(explained, 1)
+    if not explained.empty:  # one explained difference: never "agree" beside it
+        quantities = ", ".join(dict.fromkeys(explained["subject"]))
+        return Agreement.EXPLAINED, f"{quantities}: {_first_notes(explained, 1)}"
     skipped = dynamics[dynamics["verdict"] == Verdict.SKIPPED]
     tail = f"; not compared: {_first_notes(skipped, 1)}" if not skipped.empty else ""
     return Agreement.AGREE, f"with {' and '.join(partners)}{tail}"

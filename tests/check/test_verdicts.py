@@ -44,6 +44,33 @@ def test_a_difference_between_two_engines_belongs_to_the_one_the_referee_disowns
     assert "worst bias_forces against reference: error 0.003" in drake.agreement_why
 
 
+@pytest.mark.parametrize("mix", [
+    (a, b, c) for a in Verdict for b in Verdict for c in Verdict], ids=str)
+def test_the_dynamics_line_follows_from_its_rows_by_one_rule(mix):
+    """Every combination of three of an engine's dynamics and derivative rows against the
+    referee: failed anywhere → differ; else explained anywhere → differ only as explained;
+    else passed anywhere → agree; else not compared. The rule is written here from the
+    issue's statement, not read from the code."""
+    subjects = ("mass_matrix", "bias_forces", "d(forward)/dq")
+    sections = (Section.DYNAMICS, Section.DYNAMICS, Section.DERIVATIVES)
+    rows = _frame(*(_row(section, "reference", "drake", verdict, subject, error=1.0,
+                         tolerance=0.5, note=f"why {subject}")
+                    for section, verdict, subject in zip(sections, mix, subjects,
+                                                         strict=True)))
+    line = _by_engine(rows)["drake"]
+    if Verdict.FAILED in mix:
+        expected = Agreement.DIFFER
+    elif Verdict.EXPLAINED in mix:
+        expected = Agreement.EXPLAINED
+    elif Verdict.PASSED in mix:
+        expected = Agreement.AGREE
+    else:
+        expected = Agreement.NOT_COMPARED
+    assert line.agreement is expected, (mix, line.line())
+    if expected is not Agreement.AGREE:
+        assert Agreement.AGREE.value not in line.line()
+
+
 @pytest.mark.parametrize(("verdict", "reading"), [(Verdict.SKIPPED, Reading.SKIPPED),
                                                   (Verdict.FAILED, Reading.REFUSED)])
 def test_an_engine_that_did_not_load_says_why_and_nothing_else(verdict, reading):
