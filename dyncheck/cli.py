@@ -30,7 +30,7 @@ from dyncheck.commands.report import report_command
 from dyncheck.commands.run import run_command
 from dyncheck.commands.tutorials import tutorials_command
 from dyncheck.commands.versions import versions_command
-from dyncheck.errors import DyncheckError
+from dyncheck.errors import DyncheckError, Terminated
 from dyncheck.workers import JOB_MEMORY, default_jobs
 
 
@@ -302,6 +302,15 @@ COMMANDS = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    from dyncheck.workers import on_sigterm
+
+    with on_sigterm():
+        return _main(argv)
+
+
+def _main(argv: Sequence[str] | None) -> int:
+    from dyncheck.workers import end_now
+
     try:
         args = _parser().parse_args(argv)
     except SystemExit as exc:  # --help (0) or a one-line usage error (2), already printed
@@ -322,7 +331,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         where = exc.filename or "output"
         print(f"dyncheck: error: cannot write {where}: {exc.strerror or exc}", file=sys.stderr)
         return 2
+    except Terminated:
+        end_now()
+        print("dyncheck: terminated (nothing half-written)", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:
+        end_now()
         print("dyncheck: interrupted (nothing half-written)", file=sys.stderr)
         return 130
 

@@ -11,7 +11,11 @@ command line checks it before any engine starts (:func:`prepare`): an entry the 
 does not vouch for — changed, swapped with another, planted, a link, not a regular file — is
 deleted, so the engine compiles it again instead of running it. When the command ends the
 manifest is signed anew over the entries the folder holds then (written by the engines of
-this command, in a folder only this user can write). The folder reaches every unit of work
+this command, in a folder only this user can write). One command at a time uses the folder
+(a lock: exclusive to check it, shared while the command runs): a second command started
+meanwhile compiles into temporary folders, so that neither deletes the other's entries
+before they are signed (the kernels of a running command went missing under it: "Failed to
+load object file"). The folder reaches every unit of work
 as :attr:`dyncheck.settings.Settings.compiled`; without it (``--no-cache``, no key, an unsafe
 folder, or an engine used as a library) JAX keeps no persistent cache and Warp compiles into
 a temporary folder of its own, removed at exit.
@@ -144,14 +148,45 @@ def prepare(settings: Settings) -> Settings:
     if secret is None or not all(private(folder / name) for name in ENGINES) \
             or not folder.resolve().is_relative_to(root.resolve()):
         return settings
+    if not _hold(folder):
+        store.note("compiled code: the folder is in use by another dyncheck command; this "
+                   "one compiles into temporary folders")
+        return settings
     removed = [f"{name}/{entry}" for name in ENGINES for entry in verify(folder / name, secret)]
     if removed:
         store.note(f"compiled code not vouched for, deleted (compiled again): "
                    f"{', '.join(removed[:3])}" + (f" (+{len(removed) - 3})"
                                                   if len(removed) > 3 else ""))
+    import fcntl
+
+    fcntl.flock(_HELD[-1], fcntl.LOCK_SH)  # checked: held shared for the command's life
     _PREPARED[str(root)] = folder
     atexit.register(_sign_all, folder, secret)
     return replace(settings, compiled=str(folder))
+
+
+_HELD: list[int] = []
+"""The lock file's descriptor, open for the life of the process that checked the folder."""
+
+
+def _hold(folder: Path) -> bool:
+    """Take the folder for this command: an exclusive lock to check it, then a shared one
+    kept until the process ends — so that no other command deletes the entries this one's
+    engines write before they are signed, nor finds them unsigned. False where another
+    command holds it."""
+    import fcntl
+
+    try:
+        fd = os.open(folder / ".lock", os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o600)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(fd)
+        return False
+    _HELD.append(fd)
+    return True
 
 
 def _sign_all(folder: Path, secret: bytes) -> None:

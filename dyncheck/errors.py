@@ -74,3 +74,9 @@ class Unsupported(DyncheckError):
 
 class EngineError(DyncheckError, RuntimeError):
     """An engine call failed or returned a non-finite value."""
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the work is (:func:`dyncheck.workers.on_sigterm`), so that it
+    unwinds as Ctrl-C does: workers stopped, temporary files removed, nothing half-written;
+    the command exits 143."""

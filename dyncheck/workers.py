@@ -12,10 +12,12 @@ import atexit
 import gc
 import os
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from contextlib import contextmanager
+from multiprocessing import parent_process as mp_parent_process
 from typing import Any
 
 from dyncheck.errors import DyncheckError, EngineError, InvalidInput
@@ -74,9 +76,14 @@ def executor(jobs: int = 1, dask: str | None = None) -> Iterator[Executor | None
         import multiprocessing
 
         ctx = multiprocessing.get_context(start_method())
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_start,
-                                 initargs=(os.getpid(),)) as pool:
+        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_start,
+                                   initargs=(os.getpid(),))
+        try:
             yield pool
+        except BaseException:  # Ctrl-C, SIGTERM, an error: queued work is not computed
+            stop(pool)
+            raise
+        pool.shutdown(wait=True)
         return
     try:
         from distributed import Client, LocalCluster
@@ -137,13 +144,99 @@ def _dask_executor(jobs: int, dask: str, Client: Any,
         yield client.get_executor(pure=False)
 
 
+def stop(pool: ProcessPoolExecutor) -> None:
+    """End a local pool now: its queued units cancelled, its workers terminated (a unit
+    running in one is abandoned, its result never written) and reaped within a second —
+    ``shutdown(wait=True)``, the context manager's exit, computed every queued unit first
+    (27–230 s after Ctrl-C with ``--jobs 2``)."""
+    processes = list(getattr(pool, "_processes", {}).values())  # (the executor's own list)
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        if process.is_alive():
+            process.terminate()
+    for process in processes:
+        process.join(1.0)
+        if process.is_alive():
+            process.kill()
+            process.join(1.0)
+
+
+_AT_END: list[Callable[[], None]] = []
+"""What a process told to end does last (:func:`at_end`, :func:`end_now`)."""
+
+
+def at_end(fn: Callable[[], None]) -> None:
+    """Have :func:`end_now` call ``fn`` (an engine module's: kill its processes, remove
+    their files)."""
+    _AT_END.append(fn)
+
+
+def end_now() -> None:
+    """What this process must do before it ends on a signal: every :func:`at_end` call."""
+    for fn in _AT_END:
+        try:
+            fn()
+        except Exception:  # (ending anyway: the rest still runs)
+            pass
+
+
+_ENDING = threading.Event()
+"""Set when a signal asked this process to end: what is left is unwinding, at once."""
+
+
+def ending() -> bool:
+    """Whether a signal asked this process to end (an engine's process is then killed, not
+    asked to finish: :meth:`dyncheck.check.engines.Isolated.close`)."""
+    return _ENDING.is_set()
+
+
+@contextmanager
+def on_sigterm() -> Iterator[None]:
+    """While the block runs (the main thread only: Python's rule), SIGTERM raises
+    :class:`~dyncheck.errors.Terminated` and Ctrl-C KeyboardInterrupt, each marking this
+    process as ending (:func:`ending`); the previous handlers restored after."""
+    import signal
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    interrupt = signal.getsignal(signal.SIGINT)
+    if interrupt is signal.default_int_handler:
+        signal.signal(signal.SIGINT, _raise_interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        signal.signal(signal.SIGINT, interrupt)
+        _ENDING.clear()
+
+
+def _raise_terminated(signum: int, frame: object) -> None:
+    from dyncheck.errors import Terminated
+
+    _ENDING.set()
+    raise Terminated
+
+
+def _raise_interrupt(signum: int, frame: object) -> None:
+    _ENDING.set()
+    raise KeyboardInterrupt
+
+
 def _worker_start(parent: int) -> None:
     """A local worker dies with the process that started it (SIGTERM or SIGKILL of
-    ``dyncheck run --jobs 2`` left its workers computing) and skips the final collection."""
+    ``dyncheck run --jobs 2`` left its workers computing) and skips the final collection;
+    Ctrl-C is its parent's to answer (:func:`stop` ends it), and SIGTERM unwinds its unit
+    (an engine's process closed, its temporary files removed) before it exits."""
+    import signal
+
     from dyncheck.confinement import die_with_parent
 
     die_with_parent(parent)
     exit_without_collecting()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, _raise_terminated)
 
 
 def exit_without_collecting() -> None:
@@ -178,9 +271,18 @@ def settled(settings: Settings) -> Iterator[None]:
 
 def _under(settings: Settings, fn: Callable[..., Any], *args: Any) -> Any:
     """``fn(*args)`` with the submitting command's settings in force (in whatever process or
-    machine runs it: they travel as this argument)."""
-    with settled(settings):
-        return fn(*args)
+    machine runs it: they travel as this argument). A local worker told to end (SIGTERM from
+    :func:`stop`) unwinds the unit — its engines killed, their files removed — and exits."""
+    from dyncheck.errors import Terminated
+
+    try:
+        with settled(settings):
+            return fn(*args)
+    except Terminated:
+        if mp_parent_process() is not None and ending():
+            end_now()
+            os._exit(143)  # (a pool's worker: nothing of it is waited for)
+        raise
 
 
 def _timed(settings: Settings, fn: Callable[..., Any], *args: Any) -> tuple[float, Any]:

@@ -27,7 +27,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -37,7 +37,7 @@ from dyncheck.adapters.model_tree import Derivatives, Dynamics, ModelTree, Trans
 from dyncheck.confinement import confine
 from dyncheck.errors import DyncheckError, EngineError, Unsupported
 from dyncheck.settings import Settings, current, in_force
-from dyncheck.workers import start_method
+from dyncheck.workers import at_end, ending, start_method
 
 
 class ModelEngine(Protocol):
@@ -243,6 +243,9 @@ class Isolated:
         self._source = source
         self._conn, child = ctx.Pipe()
         memory = None if name in PORTS else self.limits.memory_mib
+        self._errors = ""
+        self._proc: Any = None
+        _LIVE.add(self)  # (until closed: a command told to end closes it, :func:`close_all`)
         with tempfile.NamedTemporaryFile(prefix=f"dyncheck-{name}-", suffix=".err",
                                          delete=False) as errors:
             self._errors = errors.name  # the child's stderr: a crash's last words
@@ -346,18 +349,38 @@ class Isolated:
     def close(self, *, hung: bool = False) -> None:
         """Ask the process to finish (``None``), or kill it at once when it is ``hung`` (it
         would not read the request: waiting for it cost every hang two more seconds)."""
-        if self._proc.is_alive() and not hung:
-            try:
-                self._conn.send(None)
-            except OSError:
-                pass
-            self._proc.join(2)
-        if self._proc.is_alive():
-            self._proc.kill()
-            self._proc.join()
-        self._conn.close()
-        with contextlib.suppress(OSError):
-            os.unlink(self._errors)
+        try:
+            if self._proc is not None and self._proc.pid is not None:  # (started)
+                if self._proc.is_alive() and not hung and not ending():
+                    try:
+                        self._conn.send(None)
+                    except OSError:
+                        pass
+                    self._proc.join(2)
+                if self._proc.is_alive():
+                    self._proc.kill()
+                    self._proc.join()
+            self._conn.close()
+        finally:  # (also when a signal ends this midway: close_all finishes it)
+            with contextlib.suppress(OSError):
+                if self._errors:
+                    os.unlink(self._errors)
+            _LIVE.discard(self)
+
+
+_LIVE: set[Isolated] = set()
+"""The engines' processes of this process not yet closed."""
+
+
+def close_all() -> None:
+    """Kill every engine process this process started and remove its files: what a command
+    told to end does last (:func:`dyncheck.workers.end_now`)."""
+    for proxy in list(_LIVE):
+        with contextlib.suppress(Exception):
+            proxy.close(hung=True)
+
+
+at_end(close_all)
 
 
 def can_isolate() -> bool:

@@ -85,6 +85,27 @@ def test_prepare_checks_the_folder_and_no_cache_uses_none(tmp_path, monkeypatch)
                                   "jax") is None
 
 
+def test_a_second_command_at_once_leaves_the_first_one_s_folder_alone(tmp_path, monkeypatch):
+    """Another dyncheck holds the folder (its lock, shared): this one neither checks it —
+    which would delete the other's entries not yet signed — nor uses it."""
+    import fcntl
+
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("DYNCHECK_CACHE_KEY", str(tmp_path / "key"))
+    monkeypatch.setattr(compiled_caches, "_PREPARED", {})
+    fresh = tmp_path / "cache" / "compiled" / "warp" / "kernel.o"
+    fresh.parent.mkdir(parents=True, mode=0o700)
+    (tmp_path / "cache" / "compiled" / "jax").mkdir(mode=0o700)
+    fresh.write_bytes(b"the other command's kernel, not signed yet")
+    fd = os.open(tmp_path / "cache" / "compiled" / ".lock", os.O_RDWR | os.O_CREAT, 0o600)
+    fcntl.flock(fd, fcntl.LOCK_SH)  # (as the other command holds it)
+    try:
+        assert compiled_caches.prepare(Settings()).compiled is None
+        assert fresh.exists()
+    finally:
+        os.close(fd)
+
+
 def test_a_folder_others_can_write_is_not_used(tmp_path, monkeypatch):
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path / "cache"))
     monkeypatch.setenv("DYNCHECK_CACHE_KEY", str(tmp_path / "key"))

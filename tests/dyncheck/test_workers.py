@@ -297,3 +297,82 @@ def test_a_scheduler_that_dies_mid_run_is_one_line_naming_dask_not_a_failed_chec
         workers.run_units([(f"u{i}", _slow_unit, (i,)) for i in range(3)], jobs=2,
                           dask=cluster.scheduler_address)
     assert "Traceback" not in capfd.readouterr().err
+
+
+SLOW_POOL = """
+import sys, time
+from dyncheck import workers
+from dyncheck.errors import Terminated
+units = [(f"u{i}", time.sleep, (60,)) for i in range(8)]
+with workers.on_sigterm():
+    try:
+        print("started", flush=True)
+        for _ in workers.each_unit(units, jobs=2):
+            pass
+    except Terminated:
+        sys.exit(143)
+    except KeyboardInterrupt:
+        sys.exit(130)
+"""
+
+
+@pytest.mark.parametrize(("signum", "code"), [(2, 130), (15, 143)], ids=["SIGINT", "SIGTERM"])
+def test_a_signal_ends_a_pool_at_once_not_after_its_queue(signum, code):
+    """Eight one-minute units on two workers: Ctrl-C or SIGTERM ends the process within 2 s
+    with 130 or 143 — the pool's queued units cancelled and its workers stopped (before, the
+    pool's exit waited for every queued unit)."""
+    import subprocess
+
+    child = subprocess.Popen([sys.executable, "-c", SLOW_POOL], stdout=subprocess.PIPE,
+                             text=True)
+    assert child.stdout is not None and child.stdout.readline().strip() == "started"
+    time.sleep(2.0)  # the workers are up and sleeping in their first units
+    sent = time.monotonic()
+    child.send_signal(signum)
+    try:
+        returned = child.wait(timeout=30)
+    finally:
+        child.kill()
+    assert returned == code
+    assert time.monotonic() - sent < 2.0
+
+
+def test_sigterm_during_a_check_of_a_folder_leaves_no_temporary_file(tmp_path):
+    """``check FOLDER --jobs 2`` on eight models, SIGTERM once the first page is written:
+    exit 143 within 2 s, the pages written kept, nothing of dyncheck's left in TMPDIR (the
+    engines' error files), no process left behind."""
+    import os
+    import shutil
+    import subprocess
+    from pathlib import Path
+
+    models = tmp_path / "models"
+    models.mkdir()
+    source = Path(__file__).resolve().parents[1] / "check" / "models" / "branches.urdf"
+    for i in range(8):
+        shutil.copy(source, models / f"m{i}.urdf")
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    out = tmp_path / "out"
+    child = subprocess.Popen(
+        [sys.executable, "-m", "dyncheck", "check", str(models), "--jobs", "2", "--states",
+         "2000", "--out", str(out)], env={**os.environ, "TMPDIR": str(scratch)},
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 120
+    while not list(out.glob("m*.md")) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert list(out.glob("m*.md")), "no page within 2 minutes"
+    sent = time.monotonic()
+    child.send_signal(15)
+    try:
+        returned = child.wait(timeout=30)
+    finally:
+        os.killpg(child.pid, 9) if child.poll() is None else None
+    took = time.monotonic() - sent
+    assert returned == 143, child.stderr.read() if child.stderr else ""
+    assert took < 2.0, took
+    time.sleep(0.5)  # (a worker's last cleanup)
+    assert [p.name for p in scratch.iterdir() if "dyncheck" in p.name] == [], \
+        child.stderr.read() if child.stderr else ""
+    left = subprocess.run(["pgrep", "-s", str(child.pid)], capture_output=True, text=True)
+    assert left.stdout.strip() == "", left.stdout
