@@ -302,9 +302,9 @@ COMMANDS = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    from dyncheck.workers import on_sigterm
+    from dyncheck.workers import on_sigterm, scratch
 
-    with on_sigterm():
+    with on_sigterm(), scratch():
         return _main(argv)
 
 

@@ -18,6 +18,7 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from contextlib import contextmanager
 from multiprocessing import parent_process as mp_parent_process
+from pathlib import Path
 from typing import Any
 
 from dyncheck.errors import DyncheckError, EngineError, InvalidInput
@@ -178,6 +179,31 @@ def end_now() -> None:
             fn()
         except Exception:  # (ending anyway: the rest still runs)
             pass
+
+
+@contextmanager
+def scratch() -> Iterator[Path]:
+    """A private temporary folder for this command's work (its ``TMPDIR`` and
+    ``tempfile``'s, inherited by every process it starts), removed with whatever is left in
+    it when the command ends — however it ends: a worker or an engine's process killed
+    mid-way (SIGTERM, Ctrl-C) cannot leave its files behind. The previous settings
+    restored."""
+    import shutil
+    import tempfile
+
+    folder = Path(tempfile.mkdtemp(prefix="dyncheck-"))
+    before, env = tempfile.tempdir, os.environ.get("TMPDIR")
+    tempfile.tempdir = str(folder)
+    os.environ["TMPDIR"] = str(folder)
+    try:
+        yield folder
+    finally:
+        tempfile.tempdir = before
+        if env is None:
+            os.environ.pop("TMPDIR", None)
+        else:
+            os.environ["TMPDIR"] = env
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 _ENDING = threading.Event()
