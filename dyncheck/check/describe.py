@@ -302,6 +302,19 @@ def diff(model: str, a: ModelTree, b: ModelTree,
 
 
 BODY_FIELDS = frozenset({"mass", "com", "inertia"})
+_EVERY = frozenset({"mass_matrix", "bias_forces", "forward_dynamics", "inverse_dynamics",
+                    "kinetic_energy", "potential_energy"})
+ENTERS: dict[str, frozenset[str]] = {
+    **dict.fromkeys(("joint", "placement", "type", "parent", "axis", "anchor", "mass", "com",
+                     "inertia"), _EVERY),
+    "armature": frozenset({"mass_matrix", "forward_dynamics", "inverse_dynamics",
+                           "kinetic_energy"}),  # M's diagonal: not h, not V
+    "gravity": frozenset({"bias_forces", "forward_dynamics", "inverse_dynamics",
+                          "potential_energy"}),  # h and V: not M, not T
+}
+"""The dynamics quantities a description field enters (M(q) v̇ + h(q, v) = τ, T, V): a
+difference in a field explains only these. Damping, ranges and springs enter none of them
+(the smooth dynamics compared leave passive forces and limits out)."""
 """The fields of a joint's body: what an invalid inertia can make engines read differently."""
 
 EXACT_MESHES_LEAD = "{a} takes its meshes' volume by inertia=\"legacy\" or \"convex\""

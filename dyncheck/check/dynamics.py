@@ -139,7 +139,7 @@ def compare(
     name_b: str,
     dyn_b: Dynamics,
     explanations: dict[str, Prediction],
-    caused_by: str,
+    caused_by: dict[str, str],
     states: States,
     *,
     eps: float = EPS,
@@ -148,8 +148,9 @@ def compare(
     standing: float = 1.0,
 ) -> list[CheckRow]:
     """One row per quantity. A failure is ``explained`` where ``explanations`` predicts it (the
-    difference within prediction + tolerance), or where ``caused_by`` names a description
-    difference found between the two (the dynamics follow from it). ``eps``: the coarser
+    difference within prediction + tolerance), or where ``caused_by`` names, for that
+    quantity, a description difference found between the two in a field the quantity uses
+    (the dynamics follow from it); else it fails, "cause unknown". ``eps``: the coarser
     precision of the two (a float32 port's ε₃₂: the same bounds in its arithmetic); ``kappa``:
     κ(M) of ``dyn_a`` where the caller has it (one per implementation, not per pair);
     ``vertices``: the relative difference of the two models' inertias where one takes them
@@ -191,9 +192,12 @@ def compare(
             if known is not None and _as_predicted(actual - desired, errors, known.size,
                                                    rtol * scale):
                 verdict, note = Verdict.EXPLAINED, known.note
-            elif caused_by:
+            elif caused_by.get(quantity):
                 verdict = Verdict.EXPLAINED
-                note = f"follows from the description difference in {caused_by} (rows above)"
+                note = (f"follows from the description difference in {caused_by[quantity]} "
+                        "(rows above)")
+            else:
+                note = "cause unknown"
         rows.append(
             CheckRow(
                 model=model, section=Section.DYNAMICS, subject=quantity, field="max rel error",

@@ -217,7 +217,7 @@ def _loaded(model: str, source_path: Path, source: ModelFile,
 
 
 def _readings(model: str, source: ModelFile, loaded: dict[str, engine_processes.ModelEngine],
-              rows: list[CheckRow]) -> dict[str, str]:
+              rows: list[CheckRow]) -> dict[str, list[str]]:
     """Steps 3 and 4: whether each body is physically possible (the file's URDF inertials
     and every engine's reading), and each engine's tree against the first's, field by field;
     returns the fields each engine read differently."""
@@ -233,7 +233,7 @@ def _readings(model: str, source: ModelFile, loaded: dict[str, engine_processes.
         if r.section is Section.VALIDITY and r.verdict is Verdict.FAILED:
             invalid.setdefault(r.subject, f"{r.impl_a}: {r.field}")
     first = next(iter(loaded.values()))
-    differing: dict[str, str] = {}
+    differing: dict[str, list[str]] = {}
     for engine, m in loaded.items():
         if m is first:
             continue
@@ -242,8 +242,18 @@ def _readings(model: str, source: ModelFile, loaded: dict[str, engine_processes.
         fields = sorted({r.field for r in found
                          if r.verdict is Verdict.FAILED or describe.changes_dynamics(r)})
         if fields:
-            differing[engine] = ", ".join(fields)
+            differing[engine] = fields
     return differing
+
+
+def _causes(fields: list[str]) -> dict[str, str]:
+    """Per dynamics quantity, the fields read differently that enter it
+    (:data:`describe.ENTERS`): a field it does not use never explains its difference."""
+    out: dict[str, list[str]] = {}
+    for name in fields:
+        for quantity in describe.ENTERS.get(name, ()):
+            out.setdefault(quantity, []).append(name)
+    return {q: ", ".join(f) for q, f in out.items()}
 
 
 def _parts(canon: layout.Canonical, canonical_tree: ModelTree,
@@ -332,7 +342,7 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
 def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch: States,
            loaded: dict[str, engine_processes.ModelEngine],
            parts: dict[str, partial.Part | None], results: dict[str, Dynamics],
-           differing: dict[str, str]) -> list[CheckRow]:
+           differing: dict[str, list[str]]) -> list[CheckRow]:
     """Step 6: every pair's dynamics compared — on the whole tree with the differences the
     engines' readings predict, or on the joints both hold."""
     rows: list[CheckRow] = []
@@ -348,8 +358,8 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
     factor = standing_of(canonical_tree, batch.q)  # how far from the origin it stands
     for i, a in enumerate(order):
         for b in order[i + 1 :]:
-            cause = ", ".join(dict.fromkeys(f for e in (a, b) if e in differing
-                                            for f in differing[e].split(", ")))
+            cause = _causes(list(dict.fromkeys(f for e in (a, b) if e in differing
+                                               for f in differing[e])))
             dofs = {n: _held(parts.get(n)) for n in (a, b)}
             if dofs[a] is None and dofs[b] is None:
                 explanations = predicted.differences(canon, canonical_tree, trees[a],

@@ -54,3 +54,25 @@ def test_a_mass_changed_by_1e_6_still_fails_far_from_the_origin(tmp_path, monkey
     dynamics = _dynamics(result)
     failed = set(dynamics[dynamics["verdict"] == "failed"]["subject"])
     assert {"mass_matrix", "bias_forces", "inverse_dynamics"} <= failed, dynamics
+
+
+FREE_WITH_ARMATURE = """<mujoco model="fa"><worldbody><body name="box" pos="0 0 1">
+  <joint name="root" type="free" armature="0.1" damping="0.5"/>
+  <inertial pos="0.05 0.02 0" mass="2" diaginertia="0.1 0.2 0.3"/></body></worldbody></mujoco>"""
+
+
+def test_a_field_the_dynamics_leave_out_never_explains_them(tmp_path):
+    """A free body with armature and damping: Pinocchio reads no damping (a description
+    row), Drake neither damping nor armature. Damping enters none of the quantities compared,
+    armature enters M (so forward and inverse dynamics and T) but not h: no bias row is
+    "explained" by either — it used to be, by whichever field differed — and a difference
+    without a checked cause says "cause unknown"."""
+    path = tmp_path / "fa.xml"
+    path.write_text(FREE_WITH_ARMATURE)
+    rows = check_model(path, states=20).rows
+    dynamics = rows[rows["section"] == "dynamics"]
+    assert not dynamics["note"].str.contains("damping").any(), dynamics
+    bias = dynamics[dynamics["subject"] == "bias_forces"]
+    assert not (bias["verdict"] == "explained").any(), bias[["impl_a", "impl_b", "note"]]
+    unexplained = dynamics[dynamics["verdict"] == "failed"]
+    assert (unexplained["note"] == "cause unknown").all(), unexplained
