@@ -111,7 +111,8 @@ def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str
     with parser_warnings() as warnings:
         try:
             if source.format is Format.MJCF and (copy := for_parser(
-                    source.path, ENGINE, MESH_FORMATS, massless_aborts=True)).text:
+                    source.path, ENGINE, MESH_FORMATS, massless_aborts=True,
+                    constraints_refused=True)).text:
                 Parser(plant).AddModelsFromString(copy.text, "xml")
                 notes.extend(copy.notes)
             elif source.format is Format.MJCF:

@@ -243,17 +243,20 @@ def _carries_inertia(attrs: dict[str, str], owner: Owner, mode: str,
 
 
 def for_parser(path: Path, engine: str, readable: tuple[str, ...], *,
-               massless_aborts: bool = False) -> Copy:
+               massless_aborts: bool = False, constraints_refused: bool = False) -> Copy:
     """The copy of ``path`` that ``engine`` can read, whose mesh parser reads only files ending
-    in ``readable`` (and, ``massless_aborts``, which aborts on an ``<inertial mass="0">``);
-    ``Copy.notes`` empty when nothing had to change (load the file itself). Raises
-    :class:`Unsupported` where an inertia comes from an unreadable mesh, or a moving body
-    states a zero mass."""
+    in ``readable`` (and, ``massless_aborts``, which aborts on an ``<inertial mass="0">``;
+    ``constraints_refused``, whose model then refuses its dynamics over ``<equality>``
+    constraints); ``Copy.notes`` empty when nothing had to change (load the file itself).
+    Raises :class:`Unsupported` where an inertia comes from an unreadable mesh, or a moving
+    body states a zero mass."""
     root = inline(path)
     folder = path.resolve().parent
     notes: list[str] = []
     if massless_aborts:
         notes += _without_massless(root, engine)
+    if constraints_refused:
+        notes += _without_equalities(root, engine)
     files = _mesh_files(root, folder)
     unreadable = {name for name, file in files.items()
                   if file is None or file.suffix.lower() not in readable}
@@ -297,6 +300,24 @@ def for_parser(path: Path, engine: str, readable: tuple[str, ...], *,
     if not notes and encoding(path) is None:  # a UTF-8 copy is said once, by model_files
         return Copy(text="", notes=())
     return Copy(text=_standalone(root, folder), notes=tuple(notes))
+
+
+def _without_equalities(root: ET.Element, engine: str) -> list[str]:
+    """Remove every ``<equality>`` block (the smooth dynamics compared leave constraints out,
+    in every engine); the note says how many constraints of which kinds."""
+    kinds: dict[str, int] = {}
+    for holder in [root, *root.iter()]:
+        for block in holder.findall("equality"):
+            for item in block:
+                kinds[item.tag] = kinds.get(item.tag, 0) + 1
+            holder.remove(block)
+    if not kinds:
+        return []
+    listed = ", ".join(f"{n} <{k}>" for k, n in sorted(kinds.items()))
+    return [f"{engine}: given a copy without its equality constraints ({listed}): its "
+            "continuous-time plant refuses its dynamics with any constraint ('Continuous "
+            "time does not support constraints'), and the smooth dynamics compared leave "
+            "constraints out in every engine"]
 
 
 MASSLESS = (

@@ -6,6 +6,7 @@ the engines' own values (MuJoCo, Pinocchio, Drake where installed)."""
 
 from __future__ import annotations
 
+import importlib.util
 from dataclasses import replace
 
 import pytest
@@ -76,3 +77,26 @@ def test_a_field_the_dynamics_leave_out_never_explains_them(tmp_path):
     assert not (bias["verdict"] == "explained").any(), bias[["impl_a", "impl_b", "note"]]
     unexplained = dynamics[dynamics["verdict"] == "failed"]
     assert (unexplained["note"] == "cause unknown").all(), unexplained
+
+
+EQUALITY = """<mujoco model="eq"><worldbody>
+  <body name="a" pos="0 0 1"><joint name="ja" type="hinge" axis="0 1 0"/>
+    <inertial pos="0 0 -0.5" mass="1" diaginertia="0.1 0.1 0.01"/>
+    <body name="b" pos="0 0 -1"><joint name="jb" type="hinge" axis="0 1 0"/>
+      <inertial pos="0 0 -0.5" mass="1" diaginertia="0.1 0.1 0.01"/></body></body>
+</worldbody><equality><connect body1="b" body2="world" anchor="0 0 -1"/></equality></mujoco>"""
+
+
+@pytest.mark.skipif(importlib.util.find_spec("pydrake") is None, reason="needs 'drake'")
+def test_drake_is_compared_on_a_model_with_equality_constraints(tmp_path):
+    """An MJCF <equality><connect>: Drake's continuous plant refused its dynamics ("dynamics
+    differ", an adapter's error shown as the engine's); it is now given the model without
+    its constraints — which every engine's smooth dynamics leave out — and says so. Expected:
+    Drake's dynamics agree with the referee's and MuJoCo's."""
+    path = tmp_path / "eq.xml"
+    path.write_text(EQUALITY)
+    result = check_model(path, states=20, impls=("reference", "mujoco", "drake"))
+    rows = result.rows
+    drake = rows[(rows["section"] == "dynamics") & (rows["impl_b"] == "drake")]
+    assert len(drake) == 12 and set(drake["verdict"]) == {"passed"}, drake
+    assert any("without its equality constraints (1 <connect>)" in n for n in result.notes)
