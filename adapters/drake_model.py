@@ -74,6 +74,13 @@ _TYPES = {
     "quaternion_floating": JointType.FREE,
     "ball_rpy": JointType.BALL,
 }
+UNREAD_ACTUATOR = (
+    "Drake's MJCF parser keeps armature only as the reflected inertia of an actuator it "
+    "reads, and {joint!r} is driven by {actuators} only, which Drake did not turn into a "
+    "joint actuator (its plant holds none on the joint; Drake 1.51 ignores <general> with a "
+    "warning): Drake's M leaves its armature out (fix: write the actuator as <motor> or "
+    "<position>)"
+)
 BALL_ARMATURE = (
     "Drake's MJCF parser keeps armature only as the reflected inertia of an actuator, and "
     "only a one-degree-of-freedom joint carries one: Drake's M leaves out the armature of "
@@ -154,6 +161,32 @@ FIRST_OF_SEVERAL = (
     "the body is offset or rotated (fix: one joint per body, with massless bodies of your own "
     "between them)"
 )
+
+
+def _actuators(source: ModelFile) -> dict[str, list[str]]:
+    """Per joint, the file's actuators on it, as ``<tag> 'name'`` (a joint transmission:
+    ``joint=``), read from the file with its includes."""
+    out: dict[str, list[str]] = {}
+    try:
+        root = inline(source.path)
+    except Exception:  # (the file loaded in Drake already: nothing more to say then)
+        return out
+    for block in root.iter("actuator"):
+        for act in block:
+            joint = act.get("joint")
+            if joint:
+                out.setdefault(joint, []).append(f"<{act.tag}> {act.get('name', '(unnamed)')!r}")
+    return out
+
+
+def _armature_hint(joint: TreeJoint, actuators: list[str]) -> str:
+    """Why Drake holds no armature on ``joint``, from what the file says drives it (checked
+    on the file, not assumed): no actuator, actuators Drake did not read, or a ball joint."""
+    if joint.type is JointType.BALL:
+        return BALL_ARMATURE.format(joint=joint.name)
+    if actuators:
+        return UNREAD_ACTUATOR.format(joint=joint.name, actuators=", ".join(actuators))
+    return UNACTUATED_ARMATURE.format(joint=joint.name)
 
 
 def _first_of_several(root: ET.Element) -> tuple[tuple[str, str, str], ...]:
@@ -371,9 +404,9 @@ class DrakeModel:
                 )
             )
         gravity = np.asarray(plant.gravity_field().gravity_vector(), float)
+        driven = _actuators(self._source) if self._source.format is Format.MJCF else {}
         hints = tuple(
-            (j.name, "armature", (BALL_ARMATURE if j.type is JointType.BALL
-                                  else UNACTUATED_ARMATURE).format(joint=j.name))
+            (j.name, "armature", _armature_hint(j, driven.get(j.name, [])))
             for j in joints
             if j.type is not JointType.FREE and j.name not in reflected
             and self._source.format is Format.MJCF
