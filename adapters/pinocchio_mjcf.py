@@ -8,6 +8,7 @@ none at all; a geom's own attributes overwrite its class's ``mass``).
 
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable
 
@@ -20,6 +21,10 @@ from dyncheck.adapters.model_files import Format, ModelFile
 Hint = tuple[str, str, str]
 """(joint, field, why): see :attr:`dyncheck.adapters.model_tree.ModelTree.hints`."""
 
+INCLUDES_SKIPPED = (
+    "; the file has <include> elements, which Pinocchio skips: the body it keeps is the first "
+    "one written in the file itself, not the first of the model with its includes"
+)
 FIRST_BODY_ONLY = (
     "Pinocchio's MJCF parser reads only the first body under <worldbody> ({first!r}); the "
     "other top-level bodies ({others}) and their joints are not in its model (fix: put the "
@@ -89,24 +94,30 @@ def bare_bodies(root: ET.Element) -> int:
     return sum(1 for body in root.iter("body") if not body.attrib)
 
 
-def hints(source: ModelFile) -> tuple[Hint, ...]:
+def hints(source: ModelFile, held: frozenset[str] = frozenset()) -> tuple[Hint, ...]:
     """Why Pinocchio's reading of an MJCF differs, where the file shows the cause: joints
-    missing; slide ranges, gravity; each body's mass, centre of mass and inertia on the
-    joints that carry it; joint positions and damping."""
+    missing (``held``: the bodies Pinocchio's model holds, measured — which top-level body it
+    kept is read from it, not assumed); slide ranges, gravity; each body's mass, centre of
+    mass and inertia on the joints that carry it; joint positions and damping."""
     if source.format is not Format.MJCF:
         return ()
     root = inline(source.path)
-    return (*_model_hints(root, bare_bodies(root)), *_body_hints(root),
+    includes = re.search(r"<include\b", source.text) is not None  # (the file's own text)
+    return (*_model_hints(root, bare_bodies(root), held, includes), *_body_hints(root),
             *_joint_hints(root), *springdampers(root, "Pinocchio"))
 
 
-def _model_hints(root: ET.Element, bare: int) -> Iterable[Hint]:
+def _model_hints(root: ET.Element, bare: int, held: frozenset[str],
+                 includes: bool) -> Iterable[Hint]:
     bodies = [b.get("name", "(unnamed)") for world in root.findall("worldbody")
               for b in world.findall("body")]
     missing = [BARE_BODY.format(count=bare)] if bare else []
-    if len(bodies) > 1:
-        others = ", ".join(repr(b) for b in bodies[1:6]) + (" …" if len(bodies) > 6 else "")
-        missing.append(FIRST_BODY_ONLY.format(first=bodies[0], others=others))
+    kept = [b for b in bodies if b in held] if held else bodies[:1]
+    dropped = [b for b in bodies if b not in kept]
+    if len(bodies) > 1 and len(kept) == 1 and dropped:
+        others = ", ".join(repr(b) for b in dropped[:5]) + (" …" if len(dropped) > 5 else "")
+        missing.append(FIRST_BODY_ONLY.format(first=kept[0], others=others)
+                       + (INCLUDES_SKIPPED if includes and kept[0] != bodies[0] else ""))
     if missing:
         yield "model", "joint", "; ".join(missing)
     angle = [c.get("angle") for c in root.iter("compiler") if c.get("angle")]

@@ -129,7 +129,8 @@ class PinocchioModel:
         self.model = _load(source)
         self.data = self.model.createData()
         notes: tuple[str, ...] = ()
-        self._hints = hints(source)
+        self._hints = hints(source, frozenset(
+            f.name for f in self.model.frames if f.type == pin.FrameType.BODY))
         if source.floating and source.format is Format.URDF:
             notes = ("pinocchio: JointModelFreeFlyer 'root_joint' at the URDF root",)
         self.tree = self._tree(notes)

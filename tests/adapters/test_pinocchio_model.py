@@ -50,3 +50,26 @@ def test_its_derivatives_are_refused_with_the_reason(several_joints_on_a_body):
     v = np.zeros((1, loaded.tree.nv))
     with pytest.raises(Unsupported, match="composite joint"):
         loaded.derivatives(q, v, v)
+
+
+def test_the_body_pinocchio_keeps_from_a_scene_with_includes_is_read_from_its_model(tmp_path):
+    """A scene whose included part comes first: Pinocchio skips the <include> and keeps the
+    first body of the file itself ('arm'); the row names 'arm' kept and 'table' dropped —
+    it said the reverse, taking the first body of the inlined model. Expected: the bodies
+    Pinocchio's own model holds."""
+    from dyncheck.check.model_check import check_model
+
+    (tmp_path / "part.xml").write_text(
+        '<mujoco><worldbody><body name="table" pos="1 0 0"><joint name="slide" type="slide" '
+        'axis="1 0 0"/><inertial pos="0 0 0" mass="3" diaginertia="0.1 0.1 0.1"/></body>'
+        "</worldbody></mujoco>")
+    (tmp_path / "scene.xml").write_text(
+        '<mujoco model="scene"><include file="part.xml"/><worldbody><body name="arm" '
+        'pos="0 0 1"><joint name="shoulder" type="hinge" axis="0 1 0"/><inertial '
+        'pos="0 0 -0.5" mass="1" diaginertia="0.1 0.1 0.01"/></body></worldbody></mujoco>')
+    rows = check_model(tmp_path / "scene.xml", states=10, impls=("mujoco", "pinocchio")).rows
+    missing = rows[(rows["field"] == "joint") & (rows["impl_b"] == "pinocchio")]
+    assert list(missing["subject"]) == ["slide"]
+    note = missing["note"].iloc[0]
+    assert "first body under <worldbody> ('arm')" in note and "('table')" in note
+    assert "<include> elements, which Pinocchio skips" in note
