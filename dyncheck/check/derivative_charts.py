@@ -118,17 +118,15 @@ def _hinge_maps(canon: Canonical, tree: ModelTree
     return out
 
 
-def _moved(canon: Canonical, tree: ModelTree, base: StateMap, q: np.ndarray, v: np.ndarray,
-           k: int, h: float, single: Callable[[np.ndarray, np.ndarray], StateMap]
-           ) -> StateMap:
-    """The complex-stepped map along hinge or slide ``k`` (``single``: its map alone, from
-    :func:`_hinge_maps`)."""
+def _along_hinge(canon: Canonical, tree: ModelTree, q: np.ndarray, v: np.ndarray, k: int,
+                 h: float, single: Callable[[np.ndarray, np.ndarray], StateMap]
+                 ) -> tuple[int, np.ndarray]:
+    """d q_e / d q_k along hinge or slide ``k`` (``single``: its map alone, from
+    :func:`_hinge_maps`): where in the engine's q, and the derivative of those coordinates
+    (T and Ṫv do not move along it)."""
     joint = max(j for j in range(len(canon.types)) if canon.v_start[j] <= k)
     step = single(np.array([q[canon.q_start[joint]] + 1j * h]), v[k : k + 1])
-    q_e = base.q.astype(complex)
-    at = tree.joint(canon.names[joint]).layout.q_start
-    q_e[at : at + step.q.size] = step.q
-    return StateMap(q=q_e, t=base.t.astype(complex), tdot_v=base.tdot_v.astype(complex))
+    return tree.joint(canon.names[joint]).layout.q_start, step.q.imag / h
 
 
 def same_layout(canon: Canonical, tree: ModelTree, states: States) -> bool:
@@ -175,13 +173,15 @@ def to_canonical(canon: Canonical, tree: ModelTree, states: States, found: Deriv
         d_tdot = np.zeros((len(base.tdot_v), nv))
         d_tdot_v = np.zeros((len(base.tdot_v), nv))
         for k in range(nv):
-            moved = state_map(perturb(canon, q, k, 1j * h)[0], v) \
-                if k in turning else _moved(canon, tree, base, q[0], v, k, h, singles[k])
+            if k not in turning:  # T and Ṫv move with a rotation only
+                at, moved_q = _along_hinge(canon, tree, q[0], v, k, h, singles[k])
+                d_q[at : at + len(moved_q), k] = moved_q
+                continue
+            moved = state_map(perturb(canon, q, k, 1j * h)[0], v)
             d_q[:, k] = moved.q.imag / h
-            if k in turning:  # T and Ṫv move with a rotation only; Ṫv with its velocities
-                d_t[k], d_tdot[:, k] = moved.t.imag / h, moved.tdot_v.imag / h
-                pushed = state_map(q[0], v + 1j * h * np.eye(nv)[k])
-                d_tdot_v[:, k] = pushed.tdot_v.imag / h
+            d_t[k], d_tdot[:, k] = moved.t.imag / h, moved.tdot_v.imag / h
+            pushed = state_map(q[0], v + 1j * h * np.eye(nv)[k])  # Ṫv with its velocities
+            d_tdot_v[:, k] = pushed.tdot_v.imag / h
         chi = _chart(tree, found.chart, base.q, d_q)  # (nv_e, k)
         dt_v = np.einsum("kij,j->ik", d_t, v)
         out["inverse_q"][s] = np.einsum("kji,j->ik", d_t, tau_e) + t.T @ (

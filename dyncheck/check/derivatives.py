@@ -40,7 +40,7 @@ from dyncheck.adapters.model_tree import derivatives as collect
 from dyncheck.check.derivative_charts import FIELDS, perturb, same_layout, to_canonical
 from dyncheck.check.describe import depth
 from dyncheck.check.dynamics import States, condition
-from dyncheck.check.referee import TIE_STATES, ReferenceModel, Tie
+from dyncheck.check.referee import TIE_STATES, ReferenceModel, Tie, tie
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name, standing
 from dyncheck.results import Verdict
@@ -129,12 +129,18 @@ def referee(tree: ModelTree, states: States, *, bounds: bool = True,
     solver = model.recursive
     q, v, a = states.q, states.v, states.a
     n, nv = v.shape
-    if tied is None:
-        model.dynamics(q[:TIE_STATES], v[:TIE_STATES], a[:TIE_STATES])
-        tied = model.tie
-    assert tied is not None
     with np.errstate(all="ignore"):
-        mass, bias, _, _ = solver.at_states(q, v)
+        # M and h from the general method (the root of trust): its M sums mᵢ Jᵢᵀ Jᵢ with no
+        # parallel-axis cancellation, which costs composite bodies the digits of a tiny
+        # inertia far from its pivot (the spherical pendulum's 1e-8 kg m² rod: M⁻¹ to 1e-8)
+        # (an RK4 stage's referee, ``bounds`` false, takes them from the recursion: a stage's
+        # M⁻¹ enters the step's Jacobian times h, far below its finite differences' error)
+        mass, bias, _, _ = (model.solver if bounds else solver).at_states(q, v)
+    if tied is None:  # the tie at the first states, with the general method's M, h there
+        first = slice(0, TIE_STATES)
+        tied = tie(model.solver, solver, depth(tree), q[first], v[first], a[first],
+                   found=(mass[first], bias[first]))
+    with np.errstate(all="ignore"):
         inverse_mass = np.linalg.inv(mass)
         forward = -np.einsum("sij,sj->si", inverse_mass, bias)
         offsets = (0.0, CURVE, -CURVE) if bounds else (0.0,)
@@ -352,7 +358,9 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
     if with_referee and not trusted:  # never silently trusted: its rows give way to this one
         out.append(replace(ref.tie.row(model), section=Section.DERIVATIVES))
     found: dict[str, Derivatives] = {"reference": ref.derivatives} if trusted else {}
-    for name, engine in engines.items():
+    # the engines still stepping (MuJoCo's derivatives and steps in one request) last: the
+    # others' derivatives are mapped meanwhile
+    for name, engine in sorted(engines.items(), key=lambda item: item[0] in both):
         if name in both:
             try:
                 own_part, step_part = engine.collect_both()  # type: ignore[attr-defined]

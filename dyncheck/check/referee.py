@@ -81,11 +81,13 @@ class Tie:
 
 
 def tie(general: TreeDynamics, recursive: RecursiveDynamics, depth: int, q: np.ndarray,
-        v: np.ndarray, a: np.ndarray) -> Tie:
+        v: np.ndarray, a: np.ndarray,
+        found: tuple[np.ndarray, np.ndarray] | None = None) -> Tie:
     """Both methods at the states (q, v) — M against M's scale, h against the larger of
-    |h| and |M a| (h vanishes without gravity and velocity)."""
+    |h| and |M a| (h vanishes without gravity and velocity); ``found``: the general
+    method's M and h there, where the caller has them."""
     with np.errstate(all="ignore"):
-        mass_g, bias_g, _, _ = general.at_states(q, v)
+        mass_g, bias_g = found if found is not None else general.at_states(q, v)[:2]
         mass_r, bias_r, _, _ = recursive.at_states(q, v)
         m_scale = max(float(np.abs(mass_g).max(initial=0.0)), 1e-300)
         h_scale = max(float(np.abs(bias_g).max(initial=0.0)),
