@@ -372,31 +372,34 @@ class RecursiveDynamics:
         return out
 
     def reach(self, q: np.ndarray) -> tuple[float, float]:
-        """(X, ℓ): the largest distance from the world origin of a body's joint point or
-        centre over the rows q (B, nq), and the model's own length — the largest distance of
-        a joint point or centre from its subtree's root point, or radius of gyration, at
-        the reference configuration (at least 1 mm). A position carries round-off ε X, so a
-        lever arm taken as a difference of positions carries ε X / ℓ relative: what a
-        method written about the world origin loses (the general method's momenta about
-        O; an engine's world-frame kinematics)."""
-        roots = []
-        for body in self.bodies:
-            roots.append(roots[body.parent] if body.parent >= 0
-                         else np.asarray(body.anchor, float))
+        """(X, ℓ) over the rows q (B, nq): X the largest distance from the world origin of a
+        subtree's root point (its root joint's anchor; a free body's origin) — how far the
+        model stands from the origin —, ℓ the model's own length: the largest distance of a
+        joint point or centre from its subtree's root point, or radius of gyration (at least
+        1 mm). A position carries round-off ε X, so a lever arm taken as a difference of
+        positions carries ε X / ℓ relative: what a method written about the world origin
+        loses (the general method's momenta about O; an engine's world-frame kinematics)."""
         lengths = [1e-3]
-        for body, root in zip(self.bodies, roots, strict=True):
-            lengths.append(float(np.linalg.norm(np.asarray(body.anchor) - root)))
+        for body in self.bodies:
             if body.mass > 0:
-                lengths.append(float(np.linalg.norm(np.asarray(body.com) - root)))
                 lengths.append(float(np.sqrt(np.abs(np.linalg.eigvalsh(
                     np.asarray(body.inertia, float))).max() / body.mass)))
+
+        def farthest(poses: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> float:
+            out = 0.0
+            for body, (rot, trans, _) in zip(self.bodies, poses, strict=True):
+                for point in (body.anchor, body.com):
+                    placed = (rot @ np.asarray(point, float) + trans).real
+                    out = max(out, float(np.sqrt((placed**2).sum(-1)).max(initial=0.0)))
+            return out
+
+        poses = self._kinematics(q, absolute=True)
         far = 0.0
-        for body, (rot, trans, _) in zip(self.bodies, self._kinematics(q, absolute=True),
-                                         strict=True):
-            for point in (body.anchor, body.com):
-                placed = np.abs(rot @ np.asarray(point, float) + trans)
-                far = max(far, float(np.sqrt((placed.real**2).sum(-1)).max(initial=0.0)))
-        return far, max(lengths)
+        for body, (rot, trans, _) in zip(self.bodies, poses, strict=True):
+            if body.parent < 0:  # a subtree's root point, where the model stands
+                placed = (rot @ np.asarray(body.anchor, float) + trans).real
+                far = max(far, float(np.sqrt((placed**2).sum(-1)).max(initial=0.0)))
+        return far, max(farthest(self._kinematics(q)), *lengths)
 
     def at_states(self, q: np.ndarray, v: np.ndarray
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
