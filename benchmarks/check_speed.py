@@ -55,7 +55,7 @@ def floating(n: int) -> str:
             axis = ["1 0 0", "0 1 0", "0 0 1"][i % 3]
             body += (f'<body name="l{count}" pos="{direction}"><joint name="j{count}" '
                      f'type="hinge" axis="{axis}"/><inertial pos="0.05 0.01 0" mass="0.2" '
-                     'diaginertia="2e-3 1e-3 5e-4"/>')
+                     'diaginertia="2e-3 1.5e-3 1e-3"/>')
             count += 1
         limbs.append(body + "</body>" * length)
     return (f'<mujoco model="floating{n}"><worldbody><body name="base"><freejoint '
