@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dyncheck.reference.tree import KINDS, NQ, NV, Body, hat, rotation
+from dyncheck.reference.tree import NQ, NV, Tree, hat, rotation
 
 
 def quat_matrix(q: np.ndarray) -> np.ndarray:
@@ -103,27 +103,9 @@ def _positions(have: np.ndarray, wanted: np.ndarray) -> np.ndarray:
     return np.where(found, at, len(have))
 
 
-class RecursiveDynamics:
+class RecursiveDynamics(Tree):
     """Inverse dynamics τ(q, v, v̇), M by composite bodies, h, T and V of a tree of
     :class:`Body` records, batched over rows of states (real or complex)."""
-
-    def __init__(self, bodies: list[Body], gravity: np.ndarray) -> None:
-        for b in bodies:
-            if b.kind not in KINDS:
-                raise ValueError(f"joint kind must be one of {KINDS}, got {b.kind!r}")
-        self.bodies = bodies
-        self.gravity = np.asarray(gravity, float)
-        self.q_start = [int(x) for x in np.cumsum([0] + [NQ[b.kind] for b in bodies])[:-1]]
-        self.v_start = [int(x) for x in np.cumsum([0] + [NV[b.kind] for b in bodies])[:-1]]
-        self.nv = int(sum(NV[b.kind] for b in bodies))
-        self.armature = np.concatenate([np.asarray(b.armature, float) for b in bodies]) \
-            if bodies else np.zeros(0)
-        chains: list[list[int]] = []
-        for j, b in enumerate(bodies):
-            chains.append([*(chains[b.parent] if b.parent >= 0 else []), j])
-        self.ancestor_columns = [
-            np.concatenate([np.arange(self.v_start[i], self.v_start[i] + NV[bodies[i].kind])
-                            for i in chain]) for chain in chains]
 
     def _joint(self, j: int, rp: np.ndarray, tp: np.ndarray, qj: np.ndarray, *,
                absolute: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

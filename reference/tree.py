@@ -104,8 +104,11 @@ def _quat_matrix(q: np.ndarray) -> np.ndarray:
     )
 
 
-class TreeDynamics:
-    """M, h, forward and inverse dynamics, T and V of a tree of :class:`Body` records."""
+class Tree:
+    """A tree of :class:`Body` records and its coordinates' layout: where each joint's q and
+    v start, the rotor inertia (armature) of every velocity, and each body's ancestor
+    columns (the velocities that move it) — what both the general method and the recursive
+    algorithm (:mod:`dyncheck.reference.recursive`) are evaluated on."""
 
     def __init__(self, bodies: list[Body], gravity: np.ndarray) -> None:
         for b in bodies:
@@ -116,7 +119,8 @@ class TreeDynamics:
         self.q_start = np.cumsum([0] + [NQ[b.kind] for b in bodies])[:-1]
         self.v_start = np.cumsum([0] + [NV[b.kind] for b in bodies])[:-1]
         self.nv = int(sum(NV[b.kind] for b in bodies))
-        self.armature = np.concatenate([np.asarray(b.armature, float) for b in bodies])
+        self.armature = np.concatenate([np.asarray(b.armature, float) for b in bodies]) \
+            if bodies else np.zeros(0)
         chains: list[list[int]] = []
         for j, b in enumerate(bodies):
             chains.append([*(chains[b.parent] if b.parent >= 0 else []), j])
@@ -125,6 +129,13 @@ class TreeDynamics:
                             for i in chain])
             for chain in chains
         ]
+
+
+class TreeDynamics(Tree):
+    """M, h, forward and inverse dynamics, T and V of a tree of :class:`Body` records."""
+
+    def __init__(self, bodies: list[Body], gravity: np.ndarray) -> None:
+        super().__init__(bodies, gravity)
         self._rows()
 
     def at(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
