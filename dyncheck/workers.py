@@ -168,8 +168,9 @@ _AT_END: list[Callable[[], None]] = []
 
 def at_end(fn: Callable[[], None]) -> None:
     """Have :func:`end_now` call ``fn`` (an engine module's: kill its processes, remove
-    their files)."""
-    _AT_END.append(fn)
+    their files), once however often it is asked."""
+    if fn not in _AT_END:
+        _AT_END.append(fn)
 
 
 def end_now() -> None:

@@ -24,6 +24,7 @@ from dyncheck.adapters.model_tree import JointType, ModelTree, TreeJoint
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
 from dyncheck.results import Verdict
+from dyncheck.vocabulary import Quantity
 
 
 def depth(tree: ModelTree) -> int:
@@ -302,15 +303,16 @@ def diff(model: str, a: ModelTree, b: ModelTree,
 
 
 BODY_FIELDS = frozenset({"mass", "com", "inertia"})
-_EVERY = frozenset({"mass_matrix", "bias_forces", "forward_dynamics", "inverse_dynamics",
-                    "kinetic_energy", "potential_energy"})
+_EVERY = frozenset({
+    Quantity.MASS_MATRIX, Quantity.BIAS_FORCES, Quantity.FORWARD_DYNAMICS,
+    Quantity.INVERSE_DYNAMICS, Quantity.KINETIC_ENERGY, Quantity.POTENTIAL_ENERGY})
 ENTERS: dict[str, frozenset[str]] = {
     **dict.fromkeys(("joint", "placement", "type", "parent", "axis", "anchor", "mass", "com",
                      "inertia"), _EVERY),
-    "armature": frozenset({"mass_matrix", "forward_dynamics", "inverse_dynamics",
-                           "kinetic_energy"}),  # M's diagonal: not h, not V
-    "gravity": frozenset({"bias_forces", "forward_dynamics", "inverse_dynamics",
-                          "potential_energy"}),  # h and V: not M, not T
+    "armature": frozenset({Quantity.MASS_MATRIX, Quantity.FORWARD_DYNAMICS,
+                           Quantity.INVERSE_DYNAMICS, Quantity.KINETIC_ENERGY}),  # M: not h
+    "gravity": frozenset({Quantity.BIAS_FORCES, Quantity.FORWARD_DYNAMICS,
+                          Quantity.INVERSE_DYNAMICS, Quantity.POTENTIAL_ENERGY}),  # not M, T
 }
 """The dynamics quantities a description field enters (M(q) v̇ + h(q, v) = τ, T, V): a
 difference in a field explains only these. Damping, ranges and springs enter none of them

@@ -246,6 +246,7 @@ class Isolated:
         self._errors = ""
         self._proc: Any = None
         _LIVE.add(self)  # (until closed: a command told to end closes it, :func:`close_all`)
+        at_end(close_all)
         with tempfile.NamedTemporaryFile(prefix=f"dyncheck-{name}-", suffix=".err",
                                          delete=False) as errors:
             self._errors = errors.name  # the child's stderr: a crash's last words
@@ -379,8 +380,6 @@ def close_all() -> None:
         with contextlib.suppress(Exception):
             proxy.close(hung=True)
 
-
-at_end(close_all)
 
 
 def can_isolate() -> bool:
