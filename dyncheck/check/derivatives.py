@@ -77,8 +77,8 @@ def step_states(tree: ModelTree, n: int) -> int:
 def first(found: object, k: int) -> Any:
     """A record of per-state arrays (:class:`Referee`, ``Derivatives``, ``States``) cut to
     its first ``k`` states (an array field whose first axis is not the states' is kept)."""
-    n = len(found.forward) if isinstance(found, Referee) else None  # type: ignore[attr-defined]
-    out = {}
+    n = len(found.forward) if isinstance(found, Referee) else None
+    out: dict[str, Any] = {}
     for name, value in vars(found).items():
         if isinstance(value, np.ndarray) and value.ndim and (n is None or len(value) == n):
             out[name] = value[:k]
@@ -316,7 +316,7 @@ def _collect(engine: object, name: str, inputs: tuple[np.ndarray, np.ndarray, np
     except Exception as exc:  # reported by the caller, as a row of its own
         return exc
     seconds[f"d {name}"] = took
-    return own  # type: ignore[no-any-return]
+    return own
 
 
 def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, object],
@@ -394,8 +394,7 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
         if (with_referee and canonical_layout[name] and name not in both
                 and hasattr(engine, "transition")):
             try:  # in this process: its steps are taken now
-                stepping[name] = engine.transition(  # type: ignore[attr-defined]
-                    *(x[:at_steps] for x in inputs[name]))
+                stepping[name] = engine.transition(*(x[:at_steps] for x in inputs[name]))
             except Exception as exc:
                 stepping[name] = exc
     for name, steps in stepping.items():
