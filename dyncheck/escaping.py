@@ -24,16 +24,33 @@ _CONTROL = re.compile(r"[\x00-\x08\x0e-\x1f\x7f]")
 FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
 
 
+_SHOWN_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
+
+
+def _decoded(text: str) -> str:
+    """Bytes of a file name that are not UTF-8 (surrogate escapes) as U+FFFD: a page, a CSV
+    cell, is UTF-8 text."""
+    return text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+
+
+def shown(text: str) -> str:
+    """A name from the file system as dyncheck shows and writes it anywhere (pages, CSV,
+    JUnit, JSON, file names, the terminal): bytes that are not UTF-8 (Python's surrogate
+    escapes) as U+FFFD, control characters as ``\\xNN`` (a terminal escape in a file name
+    never reaches a terminal; XML cannot hold them)."""
+    return _SHOWN_CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", _decoded(text))
+
+
 def markdown(text: object) -> str:
     """``text`` as literal Markdown: one line, no table cell break, no HTML, no link."""
-    one_line = _LINE_BREAKS.sub(" ", _CONTROL.sub("", str(text)))
+    one_line = _LINE_BREAKS.sub(" ", _CONTROL.sub("", _decoded(str(text))))
     return _MARKDOWN_RE.sub(lambda m: _MARKDOWN[m.group()], one_line)
 
 
 def markdown_code(text: object) -> str:
     """``text`` in a code span where it can be one (no backtick, no line break, no pipe),
     else as escaped plain text."""
-    s = str(text)
+    s = _decoded(str(text))
     if _LINE_BREAKS.search(s) or _CONTROL.search(s) or any(c in s for c in "`|"):
         return markdown(s)
     return f"`{s}`"
@@ -49,6 +66,7 @@ def _number(text: str) -> bool:
 def csv_cell(text: str) -> str:
     """A text cell that no spreadsheet reads as a formula: a leading ``'`` where it starts
     with one of :data:`FORMULA_STARTS` and is not a number."""
+    text = _decoded(text)
     if text.startswith(FORMULA_STARTS) and not _number(text):
         return "'" + text
     return text

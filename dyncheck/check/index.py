@@ -15,7 +15,7 @@ from dyncheck.check.model_check import CheckResult
 from dyncheck.check.page import counts
 from dyncheck.check.verdicts import Agreement, EngineVerdict, Reading, per_engine
 from dyncheck.errors import InvalidInput
-from dyncheck.escaping import markdown, markdown_link, markdown_table
+from dyncheck.escaping import markdown, markdown_link, markdown_table, shown
 from dyncheck.results import to_csv, write_atomic
 from dyncheck.vocabulary import Verdict
 
@@ -61,7 +61,7 @@ def page_names(paths: list[Path]) -> list[str]:
     """One page name per file: its stem; where stems collide, the fewest enclosing folders
     that tell the files apart (``suite__hopper``), else the suffix (``a-urdf``), else both;
     the same file given twice gets ``-2``."""
-    names = [p.stem for p in paths]
+    names = [shown(p.stem) for p in paths]
     groups: dict[str, list[int]] = {}
     for i, name in enumerate(names):
         groups.setdefault(name, []).append(i)
@@ -76,7 +76,8 @@ def page_names(paths: list[Path]) -> list[str]:
         for depth in range(0, max(len(p) for p in parents) + 1):
             folders = ["__".join(p[len(p) - depth:]) if depth else "" for p in parents]
             for with_suffix in (False, True):
-                tried = [(f"{f}__" if f else "") + stem + (f"-{x}" if with_suffix else "")
+                tried = [shown((f"{f}__" if f else "") + stem + (f"-{x}" if with_suffix
+                                                                  else ""))
                          for f, x in zip(folders, suffixes, strict=True)]
                 if len(set(tried)) == distinct:
                     break

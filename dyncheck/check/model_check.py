@@ -31,6 +31,7 @@ from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, N
 from dyncheck.check.referee import ReferenceModel, standing_of
 from dyncheck.check.rows import COLUMNS, CheckRow, Section
 from dyncheck.errors import InvalidInput, UnknownName
+from dyncheck.escaping import shown
 from dyncheck.results import Verdict
 
 DERIVATIVES_NOTE = (
@@ -127,7 +128,7 @@ def check_model(
     if not any(i in ENGINES for i in chosen):
         raise InvalidInput("--impl", ",".join(chosen), "at least one engine (the referee "
                            "checks an engine's tree)")
-    model = name or source_path.stem
+    model = name or shown(source_path.stem)
     source = read(source_path, floating=floating)
     if isolate and not engine_processes.can_isolate():
         isolate = False

@@ -100,6 +100,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     from dyncheck.check import index, inputs
     from dyncheck.check.model_check import check_model, implementations
     from dyncheck.check.page import summary_line, write
+    from dyncheck.escaping import shown
     from dyncheck.progress import Progress
     from dyncheck.workers import each_unit
 
@@ -109,7 +110,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     several = len(targets) > 1
     base = index.common_folder([p for p, _ in targets])
     files = {name: f"robot {robot}" if robot else f"book case {p.stem}" if p.parent == cases
-             else str(p.resolve().relative_to(base))
+             else shown(str(p.resolve().relative_to(base)))
              for (p, robot), name in zip(targets, names, strict=True)}
     entries: list[index.Entry] = []
     valid = []

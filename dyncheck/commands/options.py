@@ -170,4 +170,8 @@ def log(message: str) -> None:
 
 
 def one_line(text: str) -> str:
-    return " ".join(text.split())
+    """An error's one line, as the terminal may show it (:func:`dyncheck.escaping.shown`:
+    no control character from a file name reaches the terminal)."""
+    from dyncheck.escaping import shown
+
+    return shown(" ".join(text.split()))

@@ -5,8 +5,10 @@ refuses, which are included fragments) and from a Markdown parser reading the in
 
 from __future__ import annotations
 
+import os
 import pickle
 import re
+from pathlib import Path
 
 import pytest
 
@@ -105,3 +107,16 @@ def test_an_unknown_case_is_one_line_before_any_work(tmp_path, capsys):
     assert main(["check", "--case", "no_such_case", "--out", str(tmp_path / "o")]) == 2
     assert "unknown case 'no_such_case'" in capsys.readouterr().err
     assert not (tmp_path / "o").exists() or not any((tmp_path / "o").iterdir())
+
+
+def test_page_names_from_odd_file_names_are_shown_safely(tmp_path):
+    """A folder's file names become page names (and file names of pages, JUnit suites):
+    bytes that are not UTF-8 as U+FFFD, a terminal escape as visible text — they raised
+    UnicodeEncodeError writing the pages, or reached the terminal and the XML raw."""
+    from dyncheck.check.index import page_names
+
+    bad = Path(os.fsdecode(os.path.join(os.fsencode(tmp_path), b"bad\xff.urdf")))
+    names = page_names([bad, tmp_path / "ctl\x1b[31mred.urdf"])
+    assert names == ["bad\ufffd", "ctl\\x1b[31mred"]
+    for name in names:
+        name.encode("utf-8")  # writable as UTF-8

@@ -1478,6 +1478,25 @@ def _fifo(tmp: Path) -> None:
     os.mkfifo(tmp / "pipe.json")
 
 
+def _odd_names(tmp: Path) -> None:
+    with open(os.path.join(os.fsencode(tmp), b"bad\xff.urdf"), "w") as f:  # not UTF-8
+        f.write(URDF)
+    (tmp / "ctl\x1b[31mred.urdf").write_text(URDF)  # a terminal escape
+
+
+NAMES = (  # #60: names from the file system decoded with replacement, escaped everywhere
+    Fault(kind="a model file name that is not UTF-8 (its page, CSV, JUnit)", area="check",
+          prepare=_odd_names, exit=0,
+          argv=("check", os.fsdecode(b"{tmp}/bad\xff.urdf"), "--states", "5", "--junit",
+                "{tmp}/j.xml", "--out", OUT),
+          answer=r"^bad\ufffd: \d+ passed"),
+    Fault(kind="a model file name with a terminal escape (its page, JSON, the terminal)",
+          area="check", prepare=_odd_names, exit=0,
+          argv=("check", "{tmp}/ctl\x1b[31mred.urdf", "--states", "5", "--json",
+                "{tmp}/j.json", "--out", OUT),
+          answer=r"^ctl\\x1b\[31mred: \d+ passed"),
+)
+
 OUTPUT_PATHS = (  # #60: an output never replaces an input, a link or a special file
     Fault(kind="--json the model being checked", area="check", prepare=_file("m.urdf", URDF),
           argv=("check", "{tmp}/m.urdf", "--json", "{tmp}/m.urdf", "--out", OUT),
@@ -1509,7 +1528,7 @@ OUTPUT_PATHS = (  # #60: an output never replaces an input, a link or a special 
           answer=r"--out must be a regular file path, not a symlink"),
 )
 
-FAULTS = (*FAULTS, *HOSTILE_MODELS, *MORE_FAULTS, *EXTRA_FAULTS, *OUTPUT_PATHS)
+FAULTS = (*FAULTS, *HOSTILE_MODELS, *MORE_FAULTS, *EXTRA_FAULTS, *OUTPUT_PATHS, *NAMES)
 
 
 DEDICATED = (
