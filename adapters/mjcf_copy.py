@@ -80,11 +80,18 @@ def inline(path: Path) -> ET.Element:
     file's)."""
     main = path.resolve()
 
-    def expand(element: ET.Element, chain: tuple[Path, ...]) -> None:
+    def expand(start: ET.Element, origin: tuple[Path, ...]) -> None:
+        pending = [(start, origin)]  # (a walk without recursion: trees 1000 bodies deep)
+        while pending:
+            element, chain = pending.pop()
+            _expand_one(element, chain, pending)
+
+    def _expand_one(element: ET.Element, chain: tuple[Path, ...],
+                    pending: list[tuple[ET.Element, tuple[Path, ...]]]) -> None:
         children = list(element)
         for index, child in reversed(list(enumerate(children))):
             if child.tag != "include":
-                expand(child, chain)
+                pending.append((child, chain))
                 continue
             name = child.get("file", "")
             if not name.strip():
@@ -99,10 +106,10 @@ def inline(path: Path) -> ET.Element:
                 raise EngineError(f"{chain[-1]}: includes nested deeper than "
                                   f"{MAX_INCLUDE_DEPTH}")
             included = _read(target, chain[-1])
-            expand(included, (*chain, target))
             element.remove(child)
             for offset, part in enumerate(included):
                 element.insert(index + offset, part)
+                pending.append((part, (*chain, target)))
 
     root = _read(main, main)
     expand(root, (main,))

@@ -304,8 +304,16 @@ COMMANDS = {
 def main(argv: Sequence[str] | None = None) -> int:
     from dyncheck.workers import on_sigterm, scratch
 
+    deep_walks()
     with on_sigterm(), scratch():
         return _main(argv)
+
+
+def deep_walks() -> None:
+    """Python's recursion limit raised for the model walks, which recurse body by body, so
+    that a tree :data:`~dyncheck.check.inputs.MAX_NESTING` deep is walked (3.11's
+    Python-to-Python calls take no C stack); deeper ones are refused up front."""
+    sys.setrecursionlimit(max(sys.getrecursionlimit(), 10_000))
 
 
 def _main(argv: Sequence[str] | None) -> int:
@@ -316,11 +324,13 @@ def _main(argv: Sequence[str] | None) -> int:
     except SystemExit as exc:  # --help (0) or a one-line usage error (2), already printed
         return int(exc.code or 0)
     from dyncheck.commands.options import settings_of
+    from dyncheck.compiled_caches import held
     from dyncheck.workers import settled
 
     try:
-        settings = settings_of(args)  # handed to every unit of work (dyncheck.settings)
-        with settled(settings):
+        # handed to every unit of work (dyncheck.settings), with the compiled-code folder
+        # checked before any engine runs and signed when the command ends
+        with held(settings_of(args)) as settings, settled(settings):
             if args.command == "list":
                 return list_command(integrators=args.integrators)
             return COMMANDS[args.command](args)

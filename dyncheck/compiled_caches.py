@@ -7,7 +7,7 @@ unchecked.
 Both live in one folder, ``<cache>/compiled/{jax,warp}``, private to this user (0700, owned by
 them, nobody else may write it) and vouched for by a manifest: an HMAC-SHA256, keyed by the
 store's secret (kept outside the cache folder), over every entry's path and SHA-256. The
-command line checks it before any engine starts (:func:`prepare`): an entry the manifest
+command line checks it before any engine starts (:func:`held`): an entry the manifest
 does not vouch for — changed, swapped with another, planted, a link, not a regular file — is
 deleted, so the engine compiles it again instead of running it. When the command ends the
 manifest is signed anew over the entries the folder holds then (written by the engines of
@@ -23,7 +23,6 @@ a temporary folder of its own, removed at exit.
 
 from __future__ import annotations
 
-import atexit
 import hashlib
 import hmac
 import json
@@ -31,6 +30,8 @@ import os
 import shutil
 import stat
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 
@@ -43,8 +44,6 @@ ENGINES = ("jax", "warp")
 MANIFEST = ".manifest"
 MAGIC = b"dyncheck-compiled-1\n"
 
-_PREPARED: dict[str, Path] = {}
-"""The folder this process checked (and will sign at exit), by cache root."""
 def _entries(folder: Path) -> dict[str, Path]:
     """Every path below ``folder`` but the manifest, by its name relative to it (links and
     special files included: they are deleted, never followed)."""
@@ -134,59 +133,60 @@ def sign(folder: Path, secret: bytes) -> None:
         raise
 
 
-def prepare(settings: Settings) -> Settings:
+@contextmanager
+def held(settings: Settings) -> Iterator[Settings]:
     """The command's settings with its checked compiled-code folder (:attr:`Settings.
-    compiled`), each engine's folder verified now and signed when this process exits; the
-    settings unchanged where the cache is off, has no key, or the folder is not private."""
+    compiled`) while the block runs: the folder taken (:func:`_take`), each engine's folder
+    verified, then held shared until the block ends, when it is signed and let go. The
+    settings unchanged where the cache is off, has no key, the folder is not private, or
+    another command holds it (this one then compiles into temporary folders, silently: it
+    costs time, never a result)."""
     if not settings.cache:
-        return settings
+        yield settings
+        return
     root = store.cache_root()
-    if str(root) in _PREPARED:
-        return replace(settings, compiled=str(_PREPARED[str(root)]))
     secret = store.key()
     folder = root / "compiled"
     if secret is None or not all(private(folder / name) for name in ENGINES) \
             or not folder.resolve().is_relative_to(root.resolve()):
-        return settings
-    if not _hold(folder):
-        store.note("compiled code: the folder is in use by another dyncheck command; this "
-                   "one compiles into temporary folders")
-        return settings
-    removed = [f"{name}/{entry}" for name in ENGINES for entry in verify(folder / name, secret)]
-    if removed:
-        store.note(f"compiled code not vouched for, deleted (compiled again): "
-                   f"{', '.join(removed[:3])}" + (f" (+{len(removed) - 3})"
-                                                  if len(removed) > 3 else ""))
-    import fcntl
+        yield settings
+        return
+    fd = _take(folder)
+    if fd is None:
+        yield settings
+        return
+    try:
+        removed = [f"{name}/{entry}" for name in ENGINES
+                   for entry in verify(folder / name, secret)]
+        if removed:
+            store.note(f"compiled code not vouched for, deleted (compiled again): "
+                       f"{', '.join(removed[:3])}" + (f" (+{len(removed) - 3})"
+                                                      if len(removed) > 3 else ""))
+        import fcntl
 
-    fcntl.flock(_HELD[-1], fcntl.LOCK_SH)  # checked: held shared for the command's life
-    _PREPARED[str(root)] = folder
-    atexit.register(_sign_all, folder, secret)
-    return replace(settings, compiled=str(folder))
+        fcntl.flock(fd, fcntl.LOCK_SH)  # checked: held shared while the command runs
+        yield replace(settings, compiled=str(folder))
+        _sign_all(folder, secret)  # (not after a failure: unsigned entries compile again)
+    finally:
+        os.close(fd)
 
 
-_HELD: list[int] = []
-"""The lock file's descriptor, open for the life of the process that checked the folder."""
-
-
-def _hold(folder: Path) -> bool:
-    """Take the folder for this command: an exclusive lock to check it, then a shared one
-    kept until the process ends — so that no other command deletes the entries this one's
-    engines write before they are signed, nor finds them unsigned. False where another
-    command holds it."""
+def _take(folder: Path) -> int | None:
+    """Take the folder for this command: an exclusive lock to check it (kept shared while it
+    runs, so that no other command deletes the entries this one's engines write before they
+    are signed, nor finds them unsigned); None where another command holds it."""
     import fcntl
 
     try:
         fd = os.open(folder / ".lock", os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o600)
     except OSError:
-        return False
+        return None
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
         os.close(fd)
-        return False
-    _HELD.append(fd)
-    return True
+        return None
+    return fd
 
 
 def _sign_all(folder: Path, secret: bytes) -> None:

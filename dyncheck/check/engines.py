@@ -22,6 +22,7 @@ import importlib.metadata
 import multiprocessing as mp
 import os
 import signal
+import sys
 import tempfile
 import time
 from collections.abc import Sequence
@@ -149,6 +150,7 @@ def _serve(name: str, spec: Registration, source: ModelFile, conn: Connection, p
     capped), the command's settings in force, it loads, sends the tree, then answers
     batches until None."""
     faulthandler.disable()  # a crash here is reported by the parent, in one line
+    sys.setrecursionlimit(max(sys.getrecursionlimit(), 10_000))  # (deep trees' walks)
     confine(parent, memory_bytes=None if memory_mib is None else memory_mib * 2**20,
             quiet=True, errors=errors)
     with in_force(settings):

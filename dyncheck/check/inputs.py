@@ -55,10 +55,49 @@ def model_path(text: str) -> Path:
                                  f"its parser by the file's suffix (rename it; got "
                                  f"{path.suffix or 'no suffix'!r})")
         try:
-            inline(path)
+            inlined = inline(path)
         except EngineError as exc:
             raise ModelFileError(path, str(exc).removeprefix(f"{path.resolve()}: ")) from None
+        deepest = nesting(inlined)
+        if deepest > MAX_NESTING:
+            raise ModelFileError(path, f"bodies nested {deepest} deep (the check walks "
+                                 f"trees at most {MAX_NESTING} deep; split the model)")
+    if root.tag == "robot" and (deepest := _chain_depth(root)) > MAX_NESTING:
+        raise ModelFileError(path, f"links chained {deepest} deep (the check walks trees "
+                             f"at most {MAX_NESTING} deep; split the model)")
     return path
+
+
+MAX_NESTING = 2000
+"""The deepest tree the check walks (its walks recurse body by body: Python's recursion
+limit is raised for them, :func:`dyncheck.cli.main`); a deeper one is refused up front."""
+
+
+def nesting(root: ET.Element) -> int:
+    """The deepest nesting of XML elements under ``root``, walked without recursion."""
+    deepest, stack = 0, [(root, 1)]
+    while stack:
+        element, depth = stack.pop()
+        deepest = max(deepest, depth)
+        stack.extend((child, depth + 1) for child in element)
+    return deepest
+
+
+def _chain_depth(root: ET.Element) -> int:
+    """The longest parent-child chain of a URDF's joints, walked without recursion."""
+    parent_of = {}
+    for joint in root.findall("joint"):
+        p, c = joint.find("parent"), joint.find("child")
+        if p is not None and c is not None:
+            parent_of[c.get("link", "")] = p.get("link", "")
+    deepest = 0
+    for link in parent_of:
+        seen, at = set(), link
+        while at in parent_of and at not in seen:
+            seen.add(at)
+            at = parent_of[at]
+        deepest = max(deepest, len(seen))
+    return deepest
 
 
 XACRO = "{http://www.ros.org/wiki/xacro}"

@@ -146,15 +146,11 @@ def positive(name: str, value: int | None, most: int | None = None) -> None:
 def settings_of(args: argparse.Namespace) -> Settings:
     """The command's :class:`~dyncheck.settings.Settings` (``--no-cache``, ``--device``,
     their environment defaults), checked before any work: ``cuda`` on a machine without an
-    NVIDIA driver is refused here; the compiled-code caches checked here too, before any
-    engine runs (:func:`dyncheck.compiled_caches.prepare`)."""
-    from dyncheck import compiled_caches
-
+    NVIDIA driver is refused here."""
     device = getattr(args, "device", None)
     if device == "cuda" and not has_cuda():
         raise InvalidInput("--device", device, "cpu on this machine (no NVIDIA driver found)")
-    return compiled_caches.prepare(from_environment(no_cache=getattr(args, "no_cache", False),
-                                                    device=device))
+    return from_environment(no_cache=getattr(args, "no_cache", False), device=device)
 
 
 def has_cuda() -> bool:

@@ -69,20 +69,25 @@ def test_without_an_authentic_manifest_nothing_is_trusted(tmp_path, damage):
     assert sorted(compiled_caches.verify(folder, SECRET)) == ["a", "b", "sub/c"]
 
 
-def test_prepare_checks_the_folder_and_no_cache_uses_none(tmp_path, monkeypatch):
+def test_a_command_checks_the_folder_and_signs_it_when_it_ends(tmp_path, monkeypatch):
+    """A planted entry is gone before the command's engines see the folder; what the
+    command's engines write is vouched for by the next command; --no-cache uses none."""
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path / "cache"))
     monkeypatch.setenv("DYNCHECK_CACHE_KEY", str(tmp_path / "key"))
-    monkeypatch.setattr(compiled_caches, "_PREPARED", {})
     planted = tmp_path / "cache" / "compiled" / "jax" / "planted"
     planted.parent.mkdir(parents=True, mode=0o700)
     planted.write_bytes(b"code")
-    settings = compiled_caches.prepare(Settings())
-    assert settings.compiled == str(tmp_path / "cache" / "compiled")
-    assert not planted.exists()
-    assert compiled.folder(settings, "jax") == planted.parent
-    assert compiled_caches.prepare(Settings(cache=False)).compiled is None
-    assert compiled.folder(Settings(cache=False, compiled=settings.compiled),
-                                  "jax") is None
+    with compiled_caches.held(Settings()) as settings:
+        assert settings.compiled == str(tmp_path / "cache" / "compiled")
+        assert not planted.exists()
+        assert compiled.folder(settings, "jax") == planted.parent
+        (planted.parent / "written").write_bytes(b"this command's kernel")
+    with compiled_caches.held(Settings()) as again:
+        assert (planted.parent / "written").exists()  # signed: vouched for
+        assert again.compiled == settings.compiled
+    with compiled_caches.held(Settings(cache=False)) as off:
+        assert off.compiled is None
+    assert compiled.folder(Settings(cache=False, compiled=settings.compiled), "jax") is None
 
 
 def test_a_second_command_at_once_leaves_the_first_one_s_folder_alone(tmp_path, monkeypatch):
@@ -92,7 +97,6 @@ def test_a_second_command_at_once_leaves_the_first_one_s_folder_alone(tmp_path, 
 
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path / "cache"))
     monkeypatch.setenv("DYNCHECK_CACHE_KEY", str(tmp_path / "key"))
-    monkeypatch.setattr(compiled_caches, "_PREPARED", {})
     fresh = tmp_path / "cache" / "compiled" / "warp" / "kernel.o"
     fresh.parent.mkdir(parents=True, mode=0o700)
     (tmp_path / "cache" / "compiled" / "jax").mkdir(mode=0o700)
@@ -100,7 +104,8 @@ def test_a_second_command_at_once_leaves_the_first_one_s_folder_alone(tmp_path, 
     fd = os.open(tmp_path / "cache" / "compiled" / ".lock", os.O_RDWR | os.O_CREAT, 0o600)
     fcntl.flock(fd, fcntl.LOCK_SH)  # (as the other command holds it)
     try:
-        assert compiled_caches.prepare(Settings()).compiled is None
+        with compiled_caches.held(Settings()) as settings:
+            assert settings.compiled is None
         assert fresh.exists()
     finally:
         os.close(fd)
@@ -109,11 +114,11 @@ def test_a_second_command_at_once_leaves_the_first_one_s_folder_alone(tmp_path, 
 def test_a_folder_others_can_write_is_not_used(tmp_path, monkeypatch):
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path / "cache"))
     monkeypatch.setenv("DYNCHECK_CACHE_KEY", str(tmp_path / "key"))
-    monkeypatch.setattr(compiled_caches, "_PREPARED", {})
     shared = tmp_path / "cache" / "compiled" / "warp"
     shared.mkdir(parents=True)
     os.chmod(shared, 0o777)
-    assert compiled_caches.prepare(Settings()).compiled is None
+    with compiled_caches.held(Settings()) as settings:
+        assert settings.compiled is None
     assert compiled.warp_folder(Settings()) != shared  # a temporary one instead
 
 

@@ -1497,6 +1497,33 @@ NAMES = (  # #60: names from the file system decoded with replacement, escaped e
           answer=r"^ctl\\x1b\[31mred: \d+ passed"),
 )
 
+def _nested_mjcf(tmp: Path) -> None:
+    bodies = "".join(f'<body name="b{i}" pos="0 0 -0.1"><joint name="j{i}" axis="0 1 0"/>'
+                     '<inertial pos="0 0 -0.05" mass="0.1" diaginertia="1e-3 1e-3 1e-4"/>'
+                     for i in range(1000))
+    (tmp / "deep.xml").write_text(f"<mujoco><worldbody>{bodies}{'</body>' * 1000}"
+                                  "</worldbody></mujoco>")
+
+
+def _chained_urdf(tmp: Path) -> None:
+    link = '<link name="l{i}"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ' \
+           'ixy="0" ixz="0" iyz="0"/></inertial></link>'
+    joint = '<joint name="j{i}" type="revolute"><parent link="l{p}"/><child link="l{i}"/>' \
+            '<axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+    parts = [link.format(i=0)] + [link.format(i=i) + joint.format(i=i, p=i - 1)
+                                  for i in range(1, 2500)]
+    (tmp / "deep.urdf").write_text(f'<robot name="deep">{"".join(parts)}</robot>')
+
+
+DEEP = (  # #60: a tree deeper than the walks go is refused in one line, no RecursionError
+    Fault(kind="MJCF bodies nested 1000 deep", area="check", prepare=_nested_mjcf,
+          argv=("check", "{tmp}/deep.xml", "--states", "2", "--out", OUT),
+          answer=r"mujoco refused .*Element nesting is too deep"),
+    Fault(kind="URDF links chained 2500 deep", area="check", prepare=_chained_urdf,
+          argv=("check", "{tmp}/deep.urdf", "--states", "2", "--out", OUT),
+          answer=r"links chained 2499 deep \(the check walks trees at most 2000 deep"),
+)
+
 OUTPUT_PATHS = (  # #60: an output never replaces an input, a link or a special file
     Fault(kind="--json the model being checked", area="check", prepare=_file("m.urdf", URDF),
           argv=("check", "{tmp}/m.urdf", "--json", "{tmp}/m.urdf", "--out", OUT),
@@ -1528,7 +1555,7 @@ OUTPUT_PATHS = (  # #60: an output never replaces an input, a link or a special 
           answer=r"--out must be a regular file path, not a symlink"),
 )
 
-FAULTS = (*FAULTS, *HOSTILE_MODELS, *MORE_FAULTS, *EXTRA_FAULTS, *OUTPUT_PATHS, *NAMES)
+FAULTS = (*FAULTS, *HOSTILE_MODELS, *MORE_FAULTS, *EXTRA_FAULTS, *OUTPUT_PATHS, *NAMES, *DEEP)
 
 
 DEDICATED = (
