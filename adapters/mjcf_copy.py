@@ -81,7 +81,7 @@ def inline(path: Path) -> ET.Element:
     main = path.resolve()
 
     def expand(start: ET.Element, origin: tuple[Path, ...]) -> None:
-        pending = [(start, origin)]  # (a walk without recursion: trees 1000 bodies deep)
+        pending = [(start, origin)]  # (elements without recursion: trees 1000 bodies deep)
         while pending:
             element, chain = pending.pop()
             _expand_one(element, chain, pending)
@@ -106,10 +106,10 @@ def inline(path: Path) -> ET.Element:
                 raise EngineError(f"{chain[-1]}: includes nested deeper than "
                                   f"{MAX_INCLUDE_DEPTH}")
             included = _read(target, chain[-1])
+            expand(included, (*chain, target))  # (recursion only per include: at most 32)
             element.remove(child)
             for offset, part in enumerate(included):
                 element.insert(index + offset, part)
-                pending.append((part, (*chain, target)))
 
     root = _read(main, main)
     expand(root, (main,))
