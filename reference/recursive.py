@@ -363,9 +363,10 @@ class RecursiveDynamics(Tree):
         loses (the general method's momenta about O; an engine's world-frame kinematics)."""
         lengths = [1e-3]
         for body in self.bodies:
-            if body.mass > 0:
-                lengths.append(float(np.sqrt(np.abs(np.linalg.eigvalsh(
-                    np.asarray(body.inertia, float))).max() / body.mass)))
+            inertia = np.asarray(body.inertia, float)
+            if body.mass > 0 and np.isfinite(body.mass) and np.all(np.isfinite(inertia)):
+                lengths.append(float(np.sqrt(np.abs(np.linalg.eigvalsh(inertia)).max()
+                                             / body.mass)))  # (a broken inertia: none)
 
         def farthest(poses: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> float:
             out = 0.0
