@@ -181,13 +181,13 @@ class RecursiveDynamics(Tree):
     def _force(self, j: int, rot: np.ndarray, trans: np.ndarray, vel: np.ndarray,
                acc: np.ndarray) -> np.ndarray | None:
         """Body j's (M_O, F) = 𝕀 A + V ×* 𝕀 V (..., 6), None where it carries nothing."""
-        body = self.bodies[j]
-        if body.mass == 0.0 and not np.any(body.inertia):
+        placed = self._placed(j, rot, trans)
+        if placed is None:
             return None
-        com = rot @ body.com + trans
-        inertia = rot @ body.inertia @ np.swapaxes(rot, -1, -2)
-        momentum = _apply_inertia(body.mass, com, inertia, vel)
-        return _apply_inertia(body.mass, com, inertia, acc) + _force_cross(vel, momentum)
+        com, inertia = placed
+        mass = self.bodies[j].mass
+        momentum = _apply_inertia(mass, com, inertia, vel)
+        return _apply_inertia(mass, com, inertia, acc) + _force_cross(vel, momentum)
 
     def inverse_along(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, columns: np.ndarray,
                       *, q_along: np.ndarray | None = None, v_along: np.ndarray | None = None,
@@ -273,17 +273,19 @@ class RecursiveDynamics(Tree):
                     else parent_total + mine_total
         return np.moveaxis(tau + self.armature * a[..., None, :, :], -3, 0)
 
+    def _placed(self, j: int, rot: np.ndarray, trans: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray] | None:
+        """Body j's centre (..., 3) and inertia about it (..., 3, 3) at its pose, world axes
+        (None: it carries nothing)."""
+        body = self.bodies[j]
+        if body.mass == 0.0 and not np.any(body.inertia):
+            return None
+        return rot @ body.com + trans, rot @ body.inertia @ np.swapaxes(rot, -1, -2)
+
     def _inertias(self, poses: list[tuple[np.ndarray, np.ndarray, np.ndarray]]
                   ) -> list[tuple[np.ndarray, np.ndarray] | None]:
-        """Each body's centre (B, 3) and inertia about it (B, 3, 3) at its pose, world axes
-        (None: it carries nothing)."""
-        out: list[tuple[np.ndarray, np.ndarray] | None] = []
-        for body, (rot, trans, _) in zip(self.bodies, poses, strict=True):
-            if body.mass == 0.0 and not np.any(body.inertia):
-                out.append(None)
-                continue
-            out.append((rot @ body.com + trans, rot @ body.inertia @ np.swapaxes(rot, -1, -2)))
-        return out
+        """:meth:`_placed` of every body at its pose."""
+        return [self._placed(j, rot, trans) for j, (rot, trans, _) in enumerate(poses)]
 
     def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, *,
                 gravity: bool = True) -> np.ndarray:
