@@ -11,7 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 
-from dyncheck.check.predicted import BASE_GRAVITY, ROTOR_ENERGY
+from dyncheck.check.predicted import ARMATURE_AXES, BASE_GRAVITY, ROTOR_ENERGY
+from dyncheck.check.readings import READING
 from dyncheck.implementations import (
     ENGINE_DEFECT,
     GRAVITY_DEFAULT,
@@ -175,5 +176,24 @@ EXPLANATIONS: dict[str, Explanation] = {
         "and inverse dynamics are predicted per state as G(g′) − G(g), g′ = R R′ᵀ g, and its "
         "forward dynamics by −M⁻¹ that; the same defect a run declares as "
         f"`{ENGINE_DEFECT}`.",
+    ),
+    ARMATURE_AXES: Explanation(
+        origin=Origin.ENGINE,
+        text="Pinocchio (4.x) adds a joint's armature A to its own equations as A v̇ₑ in its "
+        "own velocity coordinates vₑ = T v; for a free flyer those hold the linear velocity "
+        "in body axes, whose derivative is not the body's acceleration (v̇ₑ = T v̇ + Ṫ v). "
+        "MuJoCo adds it on its own (world-axes) coordinates. `dyncheck check` predicts the "
+        "difference per state as ΔM = Tᵀ A T − A, Δh = Tᵀ A Ṫ v (T from the layouts each "
+        "engine declares); a row is `explained` only when observed − predicted is within "
+        "round-off.",
+    ),
+    READING: Explanation(
+        origin=Origin.ENGINE,
+        text="Two engines read the model file differently (their parsers: the description "
+        "rows name each field and the fix). `dyncheck check` measures the effect: the "
+        "referee evaluated on each engine's own reading, their difference the prediction, "
+        "and each differing field's share by substitution (one field group of one reading "
+        "put into the other). A row is `explained` only when the engines' difference is the "
+        "referee's within round-off; each engine is judged on its own reading separately.",
     ),
 }

@@ -103,7 +103,8 @@ def condition(mass: np.ndarray) -> float:
         return float(np.nan_to_num(ratio, nan=np.inf).max()) if eig.size else 1.0
 
 
-def _values(dyn: Dynamics, quantity: str) -> np.ndarray:
+def values(dyn: Dynamics, quantity: str) -> np.ndarray:
+    """One quantity per state as rows (n, k); the potential energy as V(q) − V(q₀)."""
     value = getattr(dyn, QUANTITIES[quantity])
     if quantity == Quantity.POTENTIAL_ENERGY:
         value = value - value[0]
@@ -131,6 +132,16 @@ def _as_predicted(difference: np.ndarray, errors: np.ndarray, predicted: np.ndar
     return bool(np.all(off <= tolerance + 1e-9 * np.abs(predicted).max(axis=1)))
 
 
+def _candidates(known: Prediction | None, read: Prediction | None) -> list[Prediction]:
+    """The predictions to try in turn: a computing convention, the readings' difference, and
+    both together where both are vectors (their effects add, to first order)."""
+    out = [p for p in (known, read) if p is not None]
+    if known is not None and read is not None and known.size.ndim == read.size.ndim == 2:
+        out.append(Prediction(size=known.size + read.size, note=f"{known.note}; and {read.note}",
+                              label=known.label))
+    return out
+
+
 def compare(
     model: str,
     tree: ModelTree,
@@ -139,30 +150,32 @@ def compare(
     name_b: str,
     dyn_b: Dynamics,
     explanations: dict[str, Prediction],
-    caused_by: dict[str, str],
+    readings: dict[str, Prediction],
     states: States,
     *,
     eps: float = EPS,
     kappa: float | None = None,
     vertices: float = 0.0,
     standing: float = 1.0,
+    judged_on: str = "",
 ) -> list[CheckRow]:
-    """One row per quantity. A failure is ``explained`` where ``explanations`` predicts it (the
-    difference within prediction + tolerance), or where ``caused_by`` names, for that
-    quantity, a description difference found between the two in a field the quantity uses
-    (the dynamics follow from it); else it fails, "cause unknown". ``eps``: the coarser
+    """One row per quantity. A failure is ``explained`` where ``explanations`` predicts it (a
+    computing convention an engine declares), or where ``readings`` does (the referee on one
+    engine's reading minus on the other's: the measured effect of their reading differently),
+    each within prediction + tolerance; else it fails, "cause unknown". ``eps``: the coarser
     precision of the two (a float32 port's ε₃₂: the same bounds in its arithmetic); ``kappa``:
     κ(M) of ``dyn_a`` where the caller has it (one per implementation, not per pair);
     ``vertices``: the relative difference of the two models' inertias where one takes them
     from float32 mesh vertices and the other from the file's digits (M, h, τ and the energies
     are linear in the masses and inertias); ``standing``: max(1, X/ℓ), how far from the world
-    origin the model stands in its own lengths (:func:`dyncheck.precision.standing`)."""
+    origin the model stands in its own lengths (:func:`dyncheck.precision.standing`);
+    ``judged_on``: whose reading ``dyn_a`` (the referee) was evaluated on, for the basis."""
     d = depth(tree)
     kappa = condition(dyn_a.mass_matrix) if kappa is None else kappa
     least = floors(tree, dyn_a, states)
     rows = []
     for quantity in QUANTITIES:
-        desired, actual = _values(dyn_a, quantity), _values(dyn_b, quantity)
+        desired, actual = values(dyn_a, quantity), values(dyn_b, quantity)
         if np.isnan(desired).all() or np.isnan(actual).all():
             rows.append(CheckRow(
                 model=model, section=Section.DYNAMICS, subject=quantity, field="max rel error",
@@ -188,16 +201,17 @@ def compare(
         verdict, note = Verdict.PASSED, ""
         if error > rtol:
             verdict = Verdict.FAILED
-            known = explanations.get(quantity)
-            if known is not None and _as_predicted(actual - desired, errors, known.size,
-                                                   rtol * scale):
-                verdict, note = Verdict.EXPLAINED, known.note
-            elif caused_by.get(quantity):
-                verdict = Verdict.EXPLAINED
-                note = (f"follows from the description difference in {caused_by[quantity]} "
-                        "(rows above)")
+            note = "cause unknown"
+            for known in _candidates(explanations.get(quantity), readings.get(quantity)):
+                if _as_predicted(actual - desired, errors, known.size, rtol * scale):
+                    verdict, note = Verdict.EXPLAINED, known.note
+                    break
             else:
-                note = "cause unknown"
+                if quantity in readings:
+                    note = ("cause unknown: beyond what the engines' readings account for "
+                            "(the referee on each reading)")
+        if judged_on:
+            basis += f"; the referee on {judged_on}'s reading"
         rows.append(
             CheckRow(
                 model=model, section=Section.DYNAMICS, subject=quantity, field="max rel error",

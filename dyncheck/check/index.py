@@ -25,9 +25,10 @@ MAX_MODELS = 10_000
 INDEX = "index"
 
 READING = {Reading.ALIKE: "read alike", Reading.DIFFERENTLY: "read differently",
-           Reading.REFUSED: "refused", Reading.SKIPPED: "not run"}
-AGREEMENT = {Agreement.AGREE: "agree", Agreement.EXPLAINED: "agree as explained",
-             Agreement.DIFFER: "differ", Agreement.NOT_COMPARED: "not compared"}
+           Reading.PART: "holds part", Reading.REFUSED: "refused", Reading.SKIPPED: "not run"}
+AGREEMENT = {Agreement.AGREE: "computes what it read",
+             Agreement.EXPLAINED: "computes differently as explained",
+             Agreement.DIFFER: "computes differently", Agreement.NOT_COMPARED: "not compared"}
 
 
 def _root(path: Path) -> ET.Element | None:
@@ -158,10 +159,11 @@ def index_page(entries: list[Entry], engines: tuple[str, ...]) -> str:
         "",
         f"{agree} with every engine in agreement, {len(entries) - agree - refusals} with "
         f"differences found, {refusals} refused. One line per model; per engine: how it read "
-        "the model, against MuJoCo's reading (read alike / read differently / refused / not "
-        "run), then whether its dynamics agree with the referee, the book's general method "
-        "(agree / agree as explained / differ / not compared). Each model's page gives the "
-        "reasons and the fixes in its first lines.",
+        "the model, against MuJoCo's reading (read alike / read differently / holds part / "
+        "refused / not run), then whether it computes what it read: its dynamics against the "
+        "referee, the book's general method, on that engine's own reading (computes what it "
+        "read / computes differently as explained / computes differently / not compared). "
+        "Each model's page gives the reasons and the fixes in its first lines.",
         "",
         markdown_table(shown, escaped=("model", "outcome")),
         "",

@@ -23,10 +23,10 @@ import pandas as pd
 from dyncheck.adapters import layout
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials
 from dyncheck.adapters.model_tree import Dynamics, ModelTree, TreeJoint
-from dyncheck.check import describe, inputs, partial, predicted
+from dyncheck.check import describe, inputs, partial, predicted, readings
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.derivatives import rows as derivative_rows
-from dyncheck.check.dynamics import States, compare, condition, sample
+from dyncheck.check.dynamics import QUANTITIES, Prediction, States, compare, condition, sample
 from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
 from dyncheck.check.referee import ReferenceModel, standing_of
 from dyncheck.check.rows import COLUMNS, CheckRow, Section
@@ -162,8 +162,9 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     if canonical_tree.nv == 0:
         raise inputs.ModelFileError(source_path, "has no degrees of freedom (nothing moves)")
     notes.append(
-        f"canonical layout and joint order: {first.engine}'s; the reference reads "
-        f"{first.engine}'s tree"
+        f"canonical layout and joint order: {first.engine}'s; the referee judges each engine's "
+        "dynamics on that engine's own reading (the basis of its rows says so where it is not "
+        f"{first.engine}'s), its derivatives on {first.engine}'s"
     )
     differing = _readings(model, source, loaded, rows)
     if against_path is not None:
@@ -171,10 +172,12 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     canon = layout.canonical(canonical_tree)
     parts, unmatched = _parts(canon, canonical_tree, loaded, notes)
     batch = sample(canon, canonical_tree, states, seed)
+    own: dict[str, Reading] = {}
     results = _dynamics(model, canon, canonical_tree, batch, loaded, parts, unmatched,
-                        with_referee=REFEREE in chosen, rows=rows, seconds=seconds)
+                        with_referee=REFEREE in chosen, rows=rows, seconds=seconds, own=own)
     seconds = {k: seconds[k] for k in ("load", REFEREE, *loaded) if k in seconds}
-    rows.extend(_pairs(model, canon, canonical_tree, batch, loaded, parts, results, differing))
+    rows.extend(_pairs(model, canon, canonical_tree, batch, loaded, parts, results, differing,
+                       own))
     if derivatives:
         t0 = time.perf_counter()
         whole = {e: loaded[e] for e in results if e in loaded and parts.get(e) is None}
@@ -247,14 +250,38 @@ def _readings(model: str, source: ModelFile, loaded: dict[str, engine_processes.
     return differing
 
 
-def _causes(fields: list[str]) -> dict[str, str]:
-    """Per dynamics quantity, the fields read differently that enter it
-    (:data:`describe.ENTERS`): a field it does not use never explains its difference."""
-    out: dict[str, list[str]] = {}
-    for name in fields:
-        for quantity in describe.ENTERS.get(name, ()):
-            out.setdefault(quantity, []).append(name)
-    return {q: ", ".join(f) for q, f in out.items()}
+@dataclass(frozen=True, kw_only=True)
+class Reading:
+    """An engine's reading in the canonical layout (:func:`readings.own_tree`) and the
+    referee's dynamics on it at the sampled states."""
+
+    tree: ModelTree
+    dynamics: Dynamics
+
+
+def _own_readings(canonical_tree: ModelTree, batch: States,
+                  loaded: dict[str, engine_processes.ModelEngine],
+                  parts: dict[str, partial.Part | None], referee: Dynamics,
+                  own: dict[str, Reading]) -> None:
+    """The referee on every engine's own reading (whole trees; the canonical engine's is the
+    referee's own): computed anew wherever a field it uses differs, bit for bit, from the
+    canonical reading."""
+    first = next(iter(loaded))
+    base = readings.own_tree(canonical_tree, canonical_tree)
+    assert base is not None
+    own[first] = Reading(tree=base, dynamics=referee)
+    for engine, m in loaded.items():
+        if engine == first or parts.get(engine, 0) is not None:
+            continue
+        tree = readings.own_tree(canonical_tree, m.tree)
+        if tree is None:
+            continue
+        if readings.same_dynamics_fields(tree, base):
+            own[engine] = Reading(tree=tree, dynamics=referee)
+            continue
+        with np.errstate(all="ignore"):
+            own[engine] = Reading(tree=tree, dynamics=ReferenceModel(tree).dynamics(
+                batch.q, batch.v, batch.a))
 
 
 def _parts(canon: layout.Canonical, canonical_tree: ModelTree,
@@ -284,10 +311,11 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
               loaded: dict[str, engine_processes.ModelEngine],
               parts: dict[str, partial.Part | None], unmatched: list[str], *,
               with_referee: bool, rows: list[CheckRow],
-              seconds: dict[str, float]) -> dict[str, Dynamics]:
+              seconds: dict[str, float], own: dict[str, Reading]) -> dict[str, Dynamics]:
     """Step 5: every engine's dynamics at the same states, in the canonical layout (engines
-    in processes of their own compute while the referee does); a failing engine, or one
-    returning a non-finite value, costs its own row."""
+    in processes of their own compute while the referee does, on the canonical reading and
+    on every engine's own: ``own``); a failing engine, or one returning a non-finite value,
+    costs its own row."""
     results: dict[str, Dynamics] = {}
     pending = {}
     for engine, m in loaded.items():
@@ -311,16 +339,19 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
             rows.append(_row(model, Section.DYNAMICS, engine, Verdict.FAILED,
                              f"{type(exc).__name__}: {exc}", field="dynamics"))
         seconds[engine] = seconds.get(engine, 0.0) + time.perf_counter() - t0
-    if with_referee:
-        t0 = time.perf_counter()
-        try:
-            referee = ReferenceModel(canonical_tree)
-            results[REFEREE] = referee.dynamics(batch.q, batch.v, batch.a)
-            assert referee.tie is not None
+    t0 = time.perf_counter()
+    try:  # the referee serves the readings' comparison even where its rows are not asked for
+        referee = ReferenceModel(canonical_tree)
+        on_canonical = referee.dynamics(batch.q, batch.v, batch.a)
+        assert referee.tie is not None
+        if with_referee:
+            results[REFEREE] = on_canonical
             rows.append(referee.tie.row(model))
-        except Exception as exc:  # the referee failing on a tree costs its own rows too
-            rows.append(_row(model, Section.DYNAMICS, REFEREE, Verdict.FAILED,
-                             f"{type(exc).__name__}: {exc}", field="dynamics"))
+        _own_readings(canonical_tree, batch, loaded, parts, on_canonical, own)
+    except Exception as exc:  # the referee failing on a tree costs its own rows too
+        rows.append(_row(model, Section.DYNAMICS, REFEREE, Verdict.FAILED,
+                         f"{type(exc).__name__}: {exc}", field="dynamics"))
+    if with_referee:
         seconds[REFEREE] = time.perf_counter() - t0
     for engine, (proxy, maps) in pending.items():
         try:
@@ -343,13 +374,15 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
 def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch: States,
            loaded: dict[str, engine_processes.ModelEngine],
            parts: dict[str, partial.Part | None], results: dict[str, Dynamics],
-           differing: dict[str, list[str]]) -> list[CheckRow]:
-    """Step 6: every pair's dynamics compared — on the whole tree with the differences the
-    engines' readings predict, or on the joints both hold."""
+           differing: dict[str, list[str]], own: dict[str, Reading]) -> list[CheckRow]:
+    """Step 6: every pair's dynamics compared. The referee judges each engine on that
+    engine's own reading (does it compute what it read); two engines are compared with the
+    differences their computing conventions predict and their readings' measured effect
+    (the referee on one reading against the other, :func:`readings.effect`), or on the
+    joints both hold."""
     rows: list[CheckRow] = []
-    referee_tree = replace(canonical_tree, joints=tuple(  # the referee counts every rotor
-        replace(j, rotor_in_kinetic=True) for j in canonical_tree.joints))
-    trees = {name: loaded[name].tree if name in loaded else referee_tree for name in results}
+    first = next(iter(loaded))
+    trees = {name: loaded[name].tree if name in loaded else own[first].tree for name in results}
     order = list(results)
     kappas: dict[str, float] = {}  # κ(M) of each implementation, for every pair it leads
     # an inertia from float32 mesh vertices (MuJoCo's, the referee's reading of it) against
@@ -359,19 +392,26 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
     factor = standing_of(canonical_tree, batch.q)  # how far from the origin it stands
     for i, a in enumerate(order):
         for b in order[i + 1 :]:
-            cause = _causes(list(dict.fromkeys(f for e in (a, b) if e in differing
-                                               for f in differing[e])))
             dofs = {n: _held(parts.get(n)) for n in (a, b)}
+            eps = max(trees[a].eps, trees[b].eps)
+            mesh = vertices if (a in rounded) != (b in rounded) else 0.0
             if dofs[a] is None and dofs[b] is None:
-                explanations = predicted.differences(canon, canonical_tree, trees[a],
-                                                     trees[b], batch, results[a])
-                if a not in kappas:
+                judged_on = ""
+                dyn_a, tree_a = results[a], trees[a]
+                if a == REFEREE and b in own:  # the referee on b's own reading
+                    dyn_a, tree_a = own[b].dynamics, own[b].tree
+                    judged_on = b
+                    mesh = 0.0  # the same inertias: b's own
+                explanations = predicted.differences(canon, canonical_tree, tree_a,
+                                                     trees[b], batch, dyn_a)
+                reading = {} if a == REFEREE else _reading_effect(
+                    canonical_tree, a, b, own, batch, differing)
+                if a != REFEREE and a not in kappas:
                     kappas[a] = condition(results[a].mass_matrix)
-                rows.extend(compare(model, canonical_tree, a, results[a], b, results[b],
-                                    explanations, cause, batch,
-                                    eps=max(trees[a].eps, trees[b].eps), kappa=kappas[a],
-                                    vertices=vertices if (a in rounded) != (b in rounded)
-                                    else 0.0, standing=factor))
+                rows.extend(compare(model, canonical_tree, a, dyn_a, b, results[b],
+                                    explanations, reading, batch, eps=eps,
+                                    kappa=kappas.get(a), vertices=mesh, standing=factor,
+                                    judged_on=judged_on))
                 continue
             common = np.arange(canon.nv)
             for held in dofs.values():
@@ -381,10 +421,21 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
                 model, canonical_tree,
                 a, partial.restrict(results[a], partial.columns(dofs[a], common)),
                 b, partial.restrict(results[b], partial.columns(dofs[b], common)),
-                {}, cause, on, eps=max(trees[a].eps, trees[b].eps),
-                vertices=vertices if (a in rounded) != (b in rounded) else 0.0,
-                standing=factor))
+                {}, {}, on, eps=eps, vertices=mesh, standing=factor))
     return rows
+
+
+def _reading_effect(canonical_tree: ModelTree, a: str, b: str, own: dict[str, Reading],
+                    batch: States, differing: dict[str, list[str]]) -> dict[str, Prediction]:
+    """Quantity → the measured effect of a and b reading the model differently (the
+    referee on b's reading minus on a's, with each differing field's share by substitution);
+    empty where one of them holds no whole reading or they read every field alike."""
+    groups = list(dict.fromkeys(f for e in (a, b) for f in differing.get(e, ())))
+    if not groups or a not in own or b not in own or own[a].dynamics is own[b].dynamics:
+        return {}
+    found = readings.effect(canonical_tree, a, own[a].tree, own[a].dynamics, b, own[b].tree,
+                            own[b].dynamics, batch, groups)
+    return {q: p for q in QUANTITIES if (p := found.prediction(q)) is not None}
 
 
 def _held(part: partial.Part | None) -> np.ndarray | None:

@@ -9,7 +9,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from dyncheck.adapters.layout import Canonical
+from dyncheck.adapters.layout import Canonical, engine_states
 from dyncheck.adapters.model_tree import (
     Dynamics,
     GravityFrame,
@@ -19,6 +19,7 @@ from dyncheck.adapters.model_tree import (
 )
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.check.dynamics import Prediction, States
+from dyncheck.check.readings import READING
 from dyncheck.check.referee import ReferenceModel
 from dyncheck.vocabulary import Quantity
 
@@ -26,7 +27,10 @@ ROTOR_ENERGY = "rotor energy left out of the kinetic energy"
 """An engine holds a joint's armature in M but leaves its rotor energy ½ a v² out of T."""
 BASE_GRAVITY = "floating base's gravity resolved through reversed roll-pitch-yaw"
 """PyBullet 3.2.7 resolves gravity in a floating base's frame through Rx(r) Ry(p) Rz(y)."""
-PREDICTIONS = (ROTOR_ENERGY, BASE_GRAVITY)
+ARMATURE_AXES = "armature added in the engine's own velocity coordinates"
+"""An engine adds a joint's armature A to its own equations, A v̇_e, with v_e = T v in axes
+that turn with the body (Pinocchio's free flyer: the linear velocity in body axes)."""
+PREDICTIONS = (ROTOR_ENERGY, BASE_GRAVITY, ARMATURE_AXES, READING)
 """Every label a check's prediction carries (each registered in ``EXPLANATIONS``)."""
 
 
@@ -39,7 +43,84 @@ def differences(canon: Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
         out[Quantity.KINETIC_ENERGY] = rotor
     for tree, sign in ((tree_b, 1.0), (tree_a, -1.0)):
         out |= base_gravity(canon, canonical_tree, tree, states, dyn_a, sign)
+    armature = armature_axes(canon, tree_a, tree_b, states, dyn_a)
+    for quantity, prediction in armature.items():
+        mine = out.get(quantity)
+        if mine is not None and mine.size.ndim == prediction.size.ndim:  # both act: they add
+            out[quantity] = replace(mine, size=mine.size + prediction.size,
+                                    note=f"{mine.note}; and {prediction.note}")
+        elif mine is None:
+            out[quantity] = prediction
     return out
+
+
+def _armature_terms(canon: Canonical, tree: ModelTree,
+                    states: States) -> tuple[np.ndarray, np.ndarray] | None:
+    """ΔM = Tᵀ A_e T − A and Δh = Tᵀ A_e Ṫ v per state, where ``tree``'s engine adds the
+    armature A_e in its own velocity coordinates v_e = T v (:mod:`dyncheck.adapters.layout`):
+    its τ_e holds A_e v̇_e = A_e (T v̇ + Ṫ v), which the canonical equations (A v̇, A the
+    armature on the canonical velocities) read as Tᵀ A_e T v̇ + Tᵀ A_e Ṫ v. None where that
+    is the canonical armature (T constant and A_e = A: a hinge, a slide, a world-axes free
+    joint)."""
+    if not any(any(j.armature) for j in tree.joints):
+        return None
+    a_e = np.zeros(tree.nv)
+    a_c = np.zeros(canon.nv)
+    for k, name in enumerate(canon.names):
+        joint = tree.joint(name)
+        arm = np.asarray(joint.armature, float)
+        a_e[joint.layout.v_start : joint.layout.v_start + len(arm)] = arm
+        if joint.type is JointType.FREE and joint.layout.angular_first and len(arm) == 6:
+            arm = np.concatenate([arm[3:], arm[:3]])
+        a_c[canon.v_start[k] : canon.v_start[k] + len(arm)] = arm
+    maps, _, _, _ = engine_states(canon, tree, states.q, states.v, states.a)
+    t = np.array([m.t for m in maps])
+    tdot_v = np.array([m.tdot_v for m in maps])
+    mass = np.einsum("nki,k,nkj->nij", t, a_e, t) - np.diag(a_c)
+    bias = np.einsum("nki,k,nk->ni", t, a_e, tdot_v)
+    if not (np.abs(mass).max() > 0 or np.abs(bias).max() > 0):
+        return None
+    return mass, bias
+
+
+def armature_axes(canon: Canonical, tree_a: ModelTree, tree_b: ModelTree, states: States,
+                  dyn_a: Dynamics) -> dict[str, Prediction]:
+    """The dynamics' predicted difference b − a where an engine adds the armature in its own
+    velocity coordinates (:func:`_armature_terms`): M by ΔM, h by Δh, inverse dynamics by
+    ΔM v̇ + Δh, forward dynamics −(M + ΔM)⁻¹ (h + Δh) against a's, the kinetic energy by
+    ½ vᵀ ΔM v where the engine counts its rotors."""
+    terms = {t.engine: (_armature_terms(canon, t, states), sign)
+             for t, sign in ((tree_a, -1.0), (tree_b, 1.0))}
+    found = [(x, sign, name) for name, (x, sign) in terms.items() if x is not None]
+    if not found:
+        return {}
+    d_mass = sum(sign * x[0] for x, sign, _ in found)
+    d_bias = sum(sign * x[1] for x, sign, _ in found)
+    n = len(states.q)
+    with np.errstate(all="ignore"):
+        forward = -np.linalg.solve(dyn_a.mass_matrix + d_mass,
+                                   (dyn_a.bias + d_bias)[..., None])[..., 0] - dyn_a.forward
+    kinetic = np.zeros(n)
+    for x, sign, name in found:
+        tree = tree_a if name == tree_a.engine else tree_b
+        if all(j.rotor_in_kinetic for j in tree.joints):
+            kinetic += sign * 0.5 * np.einsum("ni,nij,nj->n", states.v, x[0], states.v)
+    names = " and ".join(name for _, _, name in found)
+    size = float(np.abs(d_bias).max())
+    note = (f"{names} adds the armature in its own velocity coordinates (a free joint's linear "
+            "velocity in body axes), where MuJoCo adds it on the canonical ones: predicted per "
+            f"state as ΔM = Tᵀ A T − A, Δh = Tᵀ A Ṫ v (largest |Δh| {size:.3g})")
+    out = {Quantity.MASS_MATRIX: Prediction(size=d_mass.reshape(n, -1), note=note,
+                                            label=ARMATURE_AXES),
+           Quantity.BIAS_FORCES: Prediction(size=d_bias, note=note, label=ARMATURE_AXES),
+           Quantity.INVERSE_DYNAMICS: Prediction(
+               size=np.einsum("nij,nj->ni", d_mass, states.a) + d_bias, note=note,
+               label=ARMATURE_AXES),
+           Quantity.FORWARD_DYNAMICS: Prediction(size=forward, note=note, label=ARMATURE_AXES)}
+    if np.any(kinetic):
+        out[Quantity.KINETIC_ENERGY] = Prediction(size=kinetic[:, None], note=note,
+                                                  label=ARMATURE_AXES)
+    return {q: p for q, p in out.items() if np.any(p.size)}
 
 
 def rotor_energy(canon: Canonical, canonical_tree: ModelTree, tree_a: ModelTree,

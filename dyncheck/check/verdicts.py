@@ -1,6 +1,9 @@
-"""A model check's answer per engine, from its rows: did the engine load the file, read it as
-the canonical engine (the first loaded: MuJoCo where asked for) did, and compute the same
-dynamics — with the first reason and fix where not. What a page says in its first lines."""
+"""A model check's answer per engine, from its rows: did the engine load the file and read it
+as the canonical engine (the first loaded: MuJoCo where asked for) did — alike, differently,
+refused, or holding part of it —, and does it compute what it read: its dynamics against the
+referee evaluated on that engine's own reading (:mod:`dyncheck.check.readings`), so that
+reading and computing are two measured questions — with the first reason and fix where
+not. What a page says in its first lines."""
 
 from __future__ import annotations
 
@@ -20,17 +23,19 @@ class Reading(StrEnum):
 
     ALIKE = "read the model alike"
     DIFFERENTLY = "read it differently"
+    PART = "holds part of it"
     REFUSED = "refused it"
     SKIPPED = "not run"
 
 
 class Agreement(StrEnum):
-    """Whether the engine's dynamics agree with the referee and the canonical engine."""
+    """Whether the engine computes what it read: its dynamics against the referee on its own
+    reading (against the canonical engine where the referee was not run)."""
 
-    AGREE = "dynamics agree"
-    EXPLAINED = "dynamics differ only as explained"
-    DIFFER = "dynamics differ"
-    NOT_COMPARED = "dynamics not compared"
+    AGREE = "computes what it read"
+    EXPLAINED = "computes it differently only as explained"
+    DIFFER = "computes differently"
+    NOT_COMPARED = "computing not compared"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -49,7 +54,7 @@ class EngineVerdict:
     def line(self) -> str:
         """One sentence: the reading, then the dynamics, each with its first reason."""
         reading = self.reading.value + (f" ({self.reading_why})" if self.reading_why else "")
-        if self.reading in (Reading.REFUSED, Reading.SKIPPED):
+        if self.reading in (Reading.REFUSED, Reading.SKIPPED):  # nothing computed
             return reading
         agreement = self.agreement.value + (f" ({self.agreement_why})"
                                             if self.agreement_why else "")
@@ -75,6 +80,11 @@ def _reading(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Reading, 
         return Reading.ALIKE, "the canonical reading, which the others are compared with"
     description = rows[(rows["section"] == Section.DESCRIPTION) & (rows["impl_b"] == engine)]
     failed = description[description["verdict"] == Verdict.FAILED]
+    absent = failed[(failed["field"] == "joint") & (failed["value_b"] == "absent")]
+    if not failed.empty and len(absent) == len(failed):
+        names = ", ".join(dict.fromkeys(absent["subject"]))
+        return Reading.PART, (f"it has no joint {names}: compared on the joints it holds; "
+                              f"{_first_notes(absent, 1)}")
     if not failed.empty:
         subjects = list(dict.fromkeys(failed["subject"]))
         fields = ", ".join(dict.fromkeys(failed["field"]))
@@ -121,7 +131,9 @@ def _agreement(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Agreeme
         return Agreement.EXPLAINED, f"{quantities}: {_first_notes(explained, 1)}"
     skipped = dynamics[dynamics["verdict"] == Verdict.SKIPPED]
     tail = f"; not compared: {_first_notes(skipped, 1)}" if not skipped.empty else ""
-    return Agreement.AGREE, f"with {' and '.join(partners)}{tail}"
+    judge = ("the referee on its own reading" if REFEREE in partners
+             else f"with {' and '.join(partners)}")
+    return Agreement.AGREE, f"{judge}{tail}"
 
 
 def per_engine(rows: pd.DataFrame, impls: tuple[str, ...]) -> list[EngineVerdict]:

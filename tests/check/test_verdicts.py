@@ -115,7 +115,8 @@ def test_the_first_lines_name_pinocchio_s_first_body_and_the_fix(tmp_path):
                   + LINK.format(n="arm", p="1 0 1") + "</worldbody></mujoco>")
     result = check_model(path, states=5)
     pinocchio = _by_engine(result.rows, result.impls)["pinocchio"]
-    assert pinocchio.reading is Reading.DIFFERENTLY
+    assert pinocchio.reading is Reading.PART  # it holds the table, not the arm
+    assert "arm_j" in pinocchio.reading_why
     assert "only the first body under <worldbody> ('table')" in pinocchio.reading_why
     assert "fix: put the robot in one tree" in pinocchio.reading_why
 
