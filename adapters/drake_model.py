@@ -134,6 +134,7 @@ def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str
             ) from None
     notes.extend(_summary(warnings))
     if source.format is Format.URDF:
+        notes.extend(_floating_joints(plant, source.text))
         root = _urdf_root(plant)
         if root is None:
             notes.append("drake: the URDF's root link is 'world' (already welded)")
@@ -301,6 +302,28 @@ def _summary(warnings: list[str]) -> list[str]:
 
 MESSAGE_CHARS = 1000
 """The longest engine message a page quotes whole."""
+
+
+def _floating_joints(plant: MultibodyPlant, text: str) -> list[str]:
+    """A URDF ``floating`` joint from the world: Drake's parser leaves its child a free body
+    without a joint (its warning says so); it is given the ``QuaternionFloatingJoint`` of that
+    name that MuJoCo's and Pinocchio's parsers make of it (measured: both read a free joint).
+    A floating joint below another link is left as Drake reads it."""
+    import xml.etree.ElementTree as ET
+
+    notes = []
+    for joint in ET.fromstring(text).findall("joint"):
+        parent, child = joint.find("parent"), joint.find("child")
+        if joint.get("type") != "floating" or parent is None or child is None:
+            continue
+        if parent.get("link") != "world" or not plant.HasBodyNamed(child.get("link", "")):
+            continue
+        body = plant.GetBodyByName(child.get("link", ""))
+        plant.AddJoint(QuaternionFloatingJoint(joint.get("name", ""), plant.world_frame(),
+                                               body.body_frame()))
+        notes.append(f"drake: the URDF's floating joint {joint.get('name')!r} given as a "
+                     "QuaternionFloatingJoint (Drake's parser leaves its link a free body)")
+    return notes
 
 
 def _urdf_root(plant: MultibodyPlant):

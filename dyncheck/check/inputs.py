@@ -11,9 +11,10 @@ from dyncheck.adapters.mjcf_copy import inline
 from dyncheck.adapters.model_files import INERTIA_KEYS
 from dyncheck.errors import EngineError, InvalidInput, UnknownName
 
-URDF_JOINTS = ("revolute", "continuous", "prismatic", "fixed")
-"""The URDF joint types every engine here reads alike (``floating`` and ``planar`` are not:
-Pinocchio's parser maps them, MuJoCo's refuses or changes them)."""
+URDF_JOINTS = ("revolute", "continuous", "prismatic", "fixed", "floating")
+"""The URDF joint types every engine here reads alike (``floating``: a free joint in MuJoCo's
+and Pinocchio's parsers, given as one to Drake, whose parser leaves a free body; ``planar``
+is not: Pinocchio's parser maps it, MuJoCo's refuses or changes it)."""
 MAX_STATES = 100_000
 ROBOTS_EXTRA = "example-robot-data"
 

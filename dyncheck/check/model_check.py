@@ -26,7 +26,15 @@ from dyncheck.adapters.model_tree import Dynamics, ModelTree, TreeJoint
 from dyncheck.check import describe, inputs, partial, predicted, readings
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.derivatives import rows as derivative_rows
-from dyncheck.check.dynamics import QUANTITIES, Prediction, States, compare, condition, sample
+from dyncheck.check.dynamics import (
+    QUANTITIES,
+    Prediction,
+    States,
+    compare,
+    condition,
+    sample,
+    sampled_note,
+)
 from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
 from dyncheck.check.referee import ReferenceModel, standing_of
 from dyncheck.check.rows import COLUMNS, CheckRow, Section
@@ -172,6 +180,7 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     canon = layout.canonical(canonical_tree)
     parts, unmatched = _parts(canon, canonical_tree, loaded, notes)
     batch = sample(canon, canonical_tree, states, seed)
+    notes.append(sampled_note(canon, canonical_tree))
     own: dict[str, Reading] = {}
     results = _dynamics(model, canon, canonical_tree, batch, loaded, parts, unmatched,
                         with_referee=REFEREE in chosen, rows=rows, seconds=seconds, own=own)

@@ -295,3 +295,32 @@ def test_floating_is_not_applied_to_a_urdf_welded_to_world_and_a_missing_mesh_is
     assert any("'meshes/gone.stl'" in n for n in result.notes)
     assert set(_rows(result, section="load", verdict="passed")["impl_a"]) == {
         "mujoco", "pinocchio", *(("drake",) if DRAKE else ())}
+
+
+FLOATING_JOINT = """<robot name="fl">
+  <link name="world"/>
+  <link name="base"><inertial><origin xyz="0.01 0.02 0"/><mass value="2"/>
+    <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.04"/></inertial></link>
+  <link name="arm"><inertial><origin xyz="0.1 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.025"/></inertial></link>
+  <joint name="root" type="floating"><parent link="world"/><child link="base"/>
+    <origin xyz="0 0 1"/></joint>
+  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/>
+    <origin xyz="0 0.2 0"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>"""
+
+
+def test_a_urdf_floating_joint_is_checked_as_a_free_joint(tmp_path):
+    """#59: a URDF ``floating`` joint was refused ("not checked") although MuJoCo and
+    Pinocchio read it as a free joint (nq 8 with the hinge) and Drake leaves its link a free
+    body (its warning). Now checked: every engine holds 'root' as a free joint, reads alike,
+    and computes what it read (the referee on the same free body)."""
+    path = tmp_path / "fl.urdf"
+    path.write_text(FLOATING_JOINT)
+    result = check_model(path, states=20)
+    rows = result.rows
+    loads = rows[rows["section"] == "load"]
+    assert set(loads["note"]) == {"nq=8 nv=7"}, loads
+    assert result.ok, result.failures()
+    assert not (rows["verdict"] == "skipped").any()
