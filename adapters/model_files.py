@@ -131,6 +131,31 @@ class Inertial:
     inertia: tuple[tuple[float, float, float], ...]
 
 
+def urdf_welded(source: ModelFile) -> set[str]:
+    """The URDF links welded to the world: its root link (unless ``--floating`` frees it)
+    and every link joined to one of those by a ``fixed`` joint — bodies that never move,
+    whose inertia enters none of the dynamics a check compares (PyBullet's "mass 0 = fixed
+    base" idiom leaves such a link massless)."""
+    if source.format is not Format.URDF:
+        return set()
+    robot = ET.fromstring(source.text)
+    root = urdf_root_link(robot)
+    if root is None or source.floating:
+        return set()
+    welded = {root}
+    fixed = [(j.find("parent"), j.find("child")) for j in robot.findall("joint")
+             if j.get("type") == "fixed"]
+    grown = True
+    while grown:
+        grown = False
+        for parent, child in fixed:
+            if parent is not None and child is not None and parent.get("link") in welded \
+                    and child.get("link") not in welded:
+                welded.add(child.get("link", ""))
+                grown = True
+    return welded
+
+
 def urdf_inertials(source: ModelFile) -> list[Inertial]:
     """Every URDF link's stated inertial (none for MJCF: MuJoCo's compiler validates those)."""
     if source.format is not Format.URDF:

@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.adapters import layout
-from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials
+from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials, urdf_welded
 from dyncheck.adapters.model_tree import Dynamics, ModelTree, TreeJoint
 from dyncheck.check import describe, inputs, partial, predicted, readings
 from dyncheck.check import engines as engine_processes
@@ -138,6 +138,7 @@ def check_model(
                            "checks an engine's tree)")
     model = name or shown(source_path.stem)
     source = read(source_path, floating=floating)
+    _massive(source_path, source)
     if isolate and not engine_processes.can_isolate():
         isolate = False
         source = replace(source, notes=(*source.notes, IN_PROCESS_NOTE))
@@ -152,6 +153,19 @@ def check_model(
                           derivatives=derivatives)
     finally:
         engine_processes.stop(engines)
+
+
+def _massive(path: Path, source: ModelFile) -> None:
+    """A URDF none of whose moving links states a positive mass is refused before any engine
+    runs: every moving body would be massless, M zero or singular, the dynamics undefined."""
+    if source.format.value != "urdf":
+        return
+    welded = urdf_welded(source)
+    if not any(i.mass > 0 for i in urdf_inertials(source) if i.link not in welded):
+        raise inputs.ModelFileError(
+            path, "no moving link states an <inertial> with a positive mass: every moving "
+            "body is massless and its dynamics undefined (fix: give each moving link an "
+            "<inertial> with its mass and inertia)")
 
 
 def _check(model: str, source_path: Path, source: ModelFile, *,
@@ -174,7 +188,7 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
         "dynamics on that engine's own reading (the basis of its rows says so where it is not "
         f"{first.engine}'s), its derivatives on {first.engine}'s"
     )
-    differing = _readings(model, source, loaded, rows)
+    differing = _readings(model, source, loaded, rows, notes)
     if against_path is not None:
         rows.extend(_against(model, canonical_tree, read(against_path, floating=floating)))
     canon = layout.canonical(canonical_tree)
@@ -230,14 +244,18 @@ def _loaded(model: str, source_path: Path, source: ModelFile,
 
 
 def _readings(model: str, source: ModelFile, loaded: dict[str, engine_processes.ModelEngine],
-              rows: list[CheckRow]) -> dict[str, list[str]]:
+              rows: list[CheckRow], notes: list[str]) -> dict[str, list[str]]:
     """Steps 3 and 4: whether each body is physically possible (the file's URDF inertials
     and every engine's reading), and each engine's tree against the first's, field by field;
     returns the fields each engine read differently."""
-    stated = urdf_inertials(source)
+    welded = urdf_welded(source)
+    stated = [i for i in urdf_inertials(source) if i.link not in welded]
     if stated:
         rows.extend(describe.validity(model, "file", [
             (i.link, i.mass, np.array(i.inertia)) for i in stated]))
+    if welded & {i.link for i in urdf_inertials(source)}:
+        notes.append("links welded to the world (" + ", ".join(sorted(map(shown, welded)))
+                     + "): their inertials enter no compared quantity and are not checked")
     for engine, m in loaded.items():
         rows.extend(describe.validity(model, engine, describe.tree_bodies(m.tree),
                                       eps=m.tree.eps))

@@ -324,3 +324,48 @@ def test_a_urdf_floating_joint_is_checked_as_a_free_joint(tmp_path):
     assert set(loads["note"]) == {"nq=8 nv=7"}, loads
     assert result.ok, result.failures()
     assert not (rows["verdict"] == "skipped").any()
+
+
+BRANCHES = (Path(__file__).parent / "models" / "branches.urdf").read_text()
+ROOT_INERTIAL = ('<link name="base"><inertial><mass value="2"/>'
+                 '<inertia ixx="0.02" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.04"/>'
+                 '</inertial></link>')
+
+
+@pytest.mark.parametrize("world", [False, True], ids=["root", "world-fixed"])
+def test_a_massless_link_welded_to_the_world_is_no_finding(tmp_path, world):
+    """#59: PyBullet's "mass 0 = fixed base" idiom — the root link (or a link fixed to
+    'world') states mass 0. It never moves, so its inertia enters none of the compared
+    dynamics (2.2.23): no validity row fails for it, the page says it is not checked. The
+    control: freed with --floating, the same link moves and its mass 0 fails."""
+    assert ROOT_INERTIAL in BRANCHES
+    text = BRANCHES.replace('<mass value="2"/>', '<mass value="0"/>', 1)
+    if world:
+        text = text.replace('<robot name="branches">', '<robot name="branches"><link '
+                            'name="world"/><joint name="fix" type="fixed"><parent link="world"/>'
+                            '<child link="base"/></joint>')
+    path = tmp_path / "m.urdf"
+    path.write_text(text)
+    result = check_model(path, states=10)
+    assert result.ok, result.failures()
+    assert any(n.startswith("links welded to the world (base") for n in result.notes)
+    if not world:
+        freed = check_model(path, states=10, floating=True).rows
+        validity = freed[(freed["section"] == "validity") & (freed["subject"] == "base")]
+        assert "failed" in set(validity["verdict"]), validity
+
+
+def test_a_urdf_without_any_moving_inertial_is_refused_before_the_engines(tmp_path):
+    """#59: no <inertial> on any link: every engine read massless bodies (MuJoCo refused,
+    the others returned non-finite or raised) while validity "passed" with 0 bodies. Now a
+    one-line refusal naming the file and the fix, exit 2, before any engine starts."""
+    import re
+
+    path = tmp_path / "none.urdf"
+    path.write_text(re.sub(r"<inertial>.*?</inertial>", "", BRANCHES))
+    done = subprocess.run([sys.executable, "-m", "dyncheck", "check", str(path), "--out",
+                           str(tmp_path / "out")], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "none.urdf: no moving link states an <inertial>" in lines[0]
+    assert not (tmp_path / "out").exists()
