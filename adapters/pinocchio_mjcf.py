@@ -88,6 +88,33 @@ UNLIMITED_RANGE = (
 )
 
 
+LATER_DEFAULTS = (
+    "Pinocchio's MJCF parser reads only the first of the file's {blocks} top-level <default> "
+    "blocks (measured: a class of a later block is unknown to it), and {classes} used here "
+    "{are} defined in a later one: its class lookup fails (fix: put every class under one "
+    "top-level <default>)"
+)
+
+
+def later_defaults(root: ET.Element) -> str | None:
+    """Why Pinocchio fails on a file with several top-level ``<default>`` blocks whose later
+    blocks define a class the file uses (:data:`LATER_DEFAULTS`); None where that premise does
+    not hold on the file."""
+    blocks = root.findall("default")
+    if len(blocks) < 2:
+        return None
+    first = {d.get("class") for d in blocks[0].iter("default")}
+    later = {d.get("class") for b in blocks[1:] for d in b.iter("default")} - first - {None}
+    used = {e.get("class") for e in root.iter() if e.tag != "default"} | {
+        e.get("childclass") for e in root.iter()}
+    missing = sorted(c for c in later & used if c)
+    if not missing:
+        return None
+    return LATER_DEFAULTS.format(blocks=len(blocks),
+                                 classes=", ".join(repr(c) for c in missing),
+                                 are="is" if len(missing) == 1 else "are")
+
+
 def bare_bodies(root: ET.Element) -> int:
     """How many ``<body>`` elements of the MJCF ``root`` carry no attribute (Pinocchio's
     parser skips them)."""

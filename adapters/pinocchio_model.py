@@ -33,7 +33,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
-from dyncheck.adapters.pinocchio_mjcf import BARE_BODY, bare_bodies, hints
+from dyncheck.adapters.pinocchio_mjcf import BARE_BODY, bare_bodies, hints, later_defaults
 from dyncheck.errors import EngineError, Unsupported
 
 ENGINE = "pinocchio"
@@ -69,8 +69,12 @@ def _load(source: ModelFile) -> pin.Model:
         # Pinocchio's C++ exceptions: "From file: … in function: … message:\n<the reason>"
         text = text.split("message:", 1)[1] if "message:" in text else text
         message = " ".join(text.split()) or type(exc).__name__
-        if source.format is Format.MJCF and (count := bare_bodies(inline(source.path))):
-            message += f" ({BARE_BODY.format(count=count)})"
+        if source.format is Format.MJCF:
+            root = inline(source.path)
+            if (count := bare_bodies(root)):
+                message += f" ({BARE_BODY.format(count=count)})"
+            if (why := later_defaults(root)):
+                message += f" ({why})"
         raise EngineError(f"pinocchio refused {source.path}: {message}") from None
 
 

@@ -667,3 +667,33 @@ def test_a_non_convex_mesh_s_legacy_volume_is_explained_by_its_exact_reading(tmp
         assert float(drake[drake["field"] == "mass"]["value_b"].iloc[0]) == pytest.approx(
             exact, rel=1e-6)
         assert result.ok, result.failures()
+
+
+TWO_DEFAULTS = """<mujoco model="td">{defaults}<worldbody><body name="a" pos="0 0 1">
+  <joint name="j" class="b" type="hinge" axis="0 1 0"/>
+  <inertial pos="0 0 -0.3" mass="1.5" diaginertia="0.02 0.03 0.01"/></body></worldbody>
+  </mujoco>"""
+
+
+@pytest.mark.parametrize("one_block", [False, True], ids=["two-blocks", "one-block"])
+def test_two_top_level_defaults_are_pinocchios_refusal_named_with_its_fix(tmp_path,
+                                                                          one_block):
+    """#59: Pinocchio 4.1's MJCF parser reads only the first top-level <default> (measured:
+    a class of the second is unknown to it, its raw message "unordered_map::at"). The load
+    row names the cause, checked on the file (class 'b' used, defined in the second block),
+    and the fix; the fix applied (one block), Pinocchio loads the file and reads it alike."""
+    a = '<default class="a"><joint damping="0.1"/></default>'
+    b = '<default class="b"><joint damping="0.3"/></default>'
+    defaults = (f"<default>{a}{b}</default>" if one_block
+                else f"<default>{a}</default><default>{b}</default>")
+    path = tmp_path / "td.xml"
+    path.write_text(TWO_DEFAULTS.format(defaults=defaults))
+    rows = check_model(path, states=5, impls=("reference", "mujoco", "pinocchio")).rows
+    load = rows[(rows["section"] == "load") & (rows["impl_a"] == "pinocchio")].iloc[0]
+    if one_block:
+        assert load["verdict"] == "passed", load["note"]
+        return
+    assert load["verdict"] == "failed"
+    assert "reads only the first of the file's 2 top-level <default> blocks" in load["note"]
+    assert "'b' used here is defined in a later one" in load["note"]
+    assert "fix: put every class under one top-level <default>" in load["note"]
