@@ -23,9 +23,11 @@ from __future__ import annotations
 
 import logging
 import re
+import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -115,11 +117,11 @@ def parser_warnings() -> Iterator[list[str]]:
 def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str, tuple]]:
     plant = MultibodyPlant(0.0)
     notes: list[str] = []
-    with parser_warnings() as warnings:
+    with parser_warnings() as warnings, tempfile.TemporaryDirectory() as meshes:
         try:
             if source.format is Format.MJCF and (copy := for_parser(
                     source.path, ENGINE, MESH_FORMATS, massless_aborts=True,
-                    constraints_refused=True)).text:
+                    constraints_refused=True, convert_into=Path(meshes))).text:
                 Parser(plant).AddModelsFromString(copy.text, "xml")
                 notes.extend(copy.notes)
             elif source.format is Format.MJCF:
@@ -309,8 +311,6 @@ def _floating_joints(plant: MultibodyPlant, text: str) -> list[str]:
     without a joint (its warning says so); it is given the ``QuaternionFloatingJoint`` of that
     name that MuJoCo's and Pinocchio's parsers make of it (measured: both read a free joint).
     A floating joint below another link is left as Drake reads it."""
-    import xml.etree.ElementTree as ET
-
     notes = []
     for joint in ET.fromstring(text).findall("joint"):
         parent, child = joint.find("parent"), joint.find("child")

@@ -249,14 +249,58 @@ def _carries_inertia(attrs: dict[str, str], owner: Owner, mode: str,
     return groups[0] <= int(attrs.get("group", "0")) <= groups[1]
 
 
+CONVERTIBLE = (".stl",)
+"""Mesh formats converted to OBJ (by trimesh, where installed) for a parser that reads OBJ."""
+
+
+def _converted(root: ET.Element, files: dict[str, Path | None], unreadable: set[str],
+               needed: set[str | None], readable: tuple[str, ...], folder: Path | None,
+               engine: str) -> list[str]:
+    """Meshes that carry a body's inertia (``needed``), of a format the parser cannot read
+    but trimesh converts to OBJ (which it can):
+    written to ``folder`` (private to the command) and the copy's ``<mesh file>`` pointed at
+    them; removed from ``unreadable``. Reading a mesh executes nothing (trimesh parses the
+    triangles). Returns the notes."""
+    if folder is None or ".obj" not in readable:
+        return []
+    try:
+        import trimesh
+    except ImportError:
+        return []
+    done = []
+    for name in sorted(n for n in unreadable if n in needed):
+        file = files.get(name)
+        if file is None or file.suffix.lower() not in CONVERTIBLE or not file.is_file():
+            continue
+        try:
+            mesh = trimesh.load(file, force="mesh", process=False)
+            target = folder / f"{len(done)}.obj"
+            mesh.export(target, file_type="obj", include_normals=False, include_texture=False,
+                        digits=17)  # every float32 vertex written exactly
+        except Exception:  # a mesh trimesh cannot read stays unreadable: said as before
+            continue
+        for element in root.iter("mesh"):
+            if _mesh_name(element) == name and element.get("file"):
+                element.set("file", str(target))
+        unreadable.discard(name)
+        done.append(f"{name!r} ({file.name})")
+    if not done:
+        return []
+    return [f"{engine}: given {len(done)} meshes converted to OBJ by trimesh "
+            f"{trimesh.__version__}, the vertices and triangles unchanged (its MJCF parser "
+            f"reads {', '.join(readable)}): {', '.join(done)}"]
+
+
 def for_parser(path: Path, engine: str, readable: tuple[str, ...], *,
-               massless_aborts: bool = False, constraints_refused: bool = False) -> Copy:
+               massless_aborts: bool = False, constraints_refused: bool = False,
+               convert_into: Path | None = None) -> Copy:
     """The copy of ``path`` that ``engine`` can read, whose mesh parser reads only files ending
     in ``readable`` (and, ``massless_aborts``, which aborts on an ``<inertial mass="0">``;
     ``constraints_refused``, whose model then refuses its dynamics over ``<equality>``
     constraints); ``Copy.notes`` empty when nothing had to change (load the file itself).
     Raises :class:`Unsupported` where an inertia comes from an unreadable mesh, or a moving
-    body states a zero mass."""
+    body states a zero mass. ``convert_into``: a private folder for meshes converted to a
+    format the parser reads (:func:`_converted`)."""
     root = inline(path)
     folder = path.resolve().parent
     notes: list[str] = []
@@ -271,6 +315,11 @@ def for_parser(path: Path, engine: str, readable: tuple[str, ...], *,
         mode = _compiler(root, "inertiafromgeom", "auto")
         low, high = (int(float(x)) for x in
                      _compiler(root, "inertiagrouprange", "0 5").split()[:2])
+        needed = {found.attrs.get("mesh") for found in geoms(root)
+                  if found.attrs.get("mesh") in unreadable
+                  and _carries_inertia(found.attrs, found.owner, mode, (low, high))}
+        notes += _converted(root, files, unreadable, needed, readable, convert_into, engine)
+    if unreadable:
         removed = 0
         for found in geoms(root):  # the world's, and those of bodies welded to it, carry no
             uses = found.attrs.get("mesh")  # inertia that moves

@@ -8,6 +8,10 @@ reading (rotor inertia × gear² on the joint's actuator); a corrupted copy must
 
 from __future__ import annotations
 
+import importlib.util
+import sys
+
+import numpy as np
 import pytest
 
 from dyncheck.check.model_check import check_model
@@ -211,14 +215,16 @@ def test_stl_meshes_on_bodies_that_state_their_inertia_are_dropped_for_drake(tmp
     assert {("reference", "drake"), ("mujoco", "drake")} <= pairs
 
 
-def test_an_inertia_taken_from_an_stl_mesh_skips_drake_naming_the_mesh(tmp_path):
+def test_an_inertia_taken_from_an_stl_mesh_skips_drake_naming_the_mesh(tmp_path, monkeypatch):
     """The body states no inertia: MuJoCo computes it from the mesh, which Drake cannot read
-    — Drake is skipped naming the body, the mesh and the conversion; MuJoCo is still checked
-    against the referee."""
+    and, without trimesh to convert it, Drake is skipped naming the body, the mesh and the
+    conversion; MuJoCo is still checked against the referee."""
     (tmp_path / "assets").mkdir()
     _stl(tmp_path / "assets" / "cube.stl")
     body = MESHED.format(inertial="", geom='mass="2"')
-    result = check_model(_write(tmp_path, "mesh_inertia", body, head=MESH_HEAD), states=5)
+    monkeypatch.setitem(sys.modules, "trimesh", None)  # import trimesh fails (engines here)
+    result = check_model(_write(tmp_path, "mesh_inertia", body, head=MESH_HEAD), states=5,
+                         isolate=False)
     drake = _rows(result, verdict="skipped")
     drake = drake[(drake["impl_a"] == "drake") | (drake["impl_b"] == "drake")]
     assert not drake.empty
@@ -697,3 +703,49 @@ def test_two_top_level_defaults_are_pinocchios_refusal_named_with_its_fix(tmp_pa
     assert "reads only the first of the file's 2 top-level <default> blocks" in load["note"]
     assert "'b' used here is defined in a later one" in load["note"]
     assert "fix: put every class under one top-level <default>" in load["note"]
+
+
+def _binary_stl(path, low, high):
+    """A box from ``low`` to ``high`` as a binary STL (MuJoCo reads only binary STL)."""
+    import struct
+
+    v = np.array([[x, y, z] for x in (low[0], high[0]) for y in (low[1], high[1])
+                  for z in (low[2], high[2])])
+    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7),
+             (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+    data = bytearray(80) + struct.pack("<I", len(faces))
+    for face in faces:
+        a, b, c = v[list(face)]
+        n = np.cross(b - a, c - a)
+        data += struct.pack("<12fH", *(n / np.linalg.norm(n)), *a, *b, *c, 0)
+    path.write_bytes(bytes(data))
+
+
+STL_BODY = """<mujoco model="stl"><asset><mesh name="box" file="box.stl"/></asset>
+<worldbody><body name="a" pos="0 0 1"><joint name="j" type="hinge" axis="0 1 0"/>
+<geom type="mesh" mesh="box" density="1000"/></body></worldbody></mujoco>"""
+
+
+@pytest.mark.skipif(importlib.util.find_spec("trimesh") is None
+                    or importlib.util.find_spec("pydrake") is None,
+                    reason="needs trimesh and drake (extra drake)")
+def test_drake_is_given_an_stl_mesh_converted_and_compared(tmp_path):
+    """#59: a body whose inertia comes from an STL mesh, which Drake's MJCF parser cannot
+    read: Drake is given the mesh converted to OBJ by trimesh (every float32 vertex written
+    exactly) and reads mass, centre and inertia as MuJoCo does — expected: MuJoCo's own
+    reading of the same triangles (a 0.2 × 0.1 × 0.4 m box of density 1000). Without
+    trimesh: the test above."""
+    _binary_stl(tmp_path / "box.stl", (-0.07, -0.05, -0.19), (0.13, 0.05, 0.21))
+    path = tmp_path / "m.xml"
+    path.write_text(STL_BODY)
+    result = check_model(path, states=5, impls=("reference", "mujoco", "drake"))
+    rows = result.rows
+    load = rows[(rows["section"] == "load") & (rows["impl_a"] == "drake")].iloc[0]
+    assert load["verdict"] == "passed", load["note"]
+    assert any("converted to OBJ by trimesh" in n and "'box' (box.stl)" in n
+               for n in result.notes)
+    assert result.ok, result.failures()
+    read = rows[(rows["section"] == "description") & (rows["impl_b"] == "drake")]
+    assert set(read["verdict"]) == {"passed"}, read
+    masses = rows[(rows["section"] == "validity") & (rows["impl_a"] == "mujoco")]
+    assert not masses.empty
