@@ -265,9 +265,10 @@ def _converted(root: ET.Element, files: dict[str, Path | None], unreadable: set[
         return []
     try:
         import trimesh
+        from trimesh.exchange.obj import export_obj
     except ImportError:
         return []
-    done = []
+    done: list[str] = []
     for name in sorted(n for n in unreadable if n in needed):
         file = files.get(name)
         if file is None or file.suffix.lower() not in CONVERTIBLE or not file.is_file():
@@ -275,8 +276,8 @@ def _converted(root: ET.Element, files: dict[str, Path | None], unreadable: set[
         try:
             mesh = trimesh.load(file, force="mesh", process=False)
             target = folder / f"{len(done)}.obj"
-            mesh.export(target, file_type="obj", include_normals=False, include_texture=False,
-                        digits=17)  # every float32 vertex written exactly
+            target.write_text(export_obj(mesh, include_normals=False, include_texture=False,
+                                         digits=17))  # every float32 vertex written exactly
         except Exception:  # a mesh trimesh cannot read stays unreadable: said as before
             continue
         for element in root.iter("mesh"):

@@ -67,9 +67,20 @@ def _case(name: str, suite: str, rows: pd.DataFrame, columns: Columns) -> TestCa
     return case
 
 
-def junit(tables: dict[str, pd.DataFrame], columns: Columns) -> JUnitXml:
-    """One suite per table (a case, a model), one test case per group of rows."""
+def junit(tables: dict[str, pd.DataFrame], columns: Columns,
+          refused: dict[str, str] | None = None) -> JUnitXml:
+    """One suite per table (a case, a model), one test case per group of rows; a refused
+    model (bad input: no rows) one suite of one failed test case, its reason the message."""
     xml = JUnitXml("dyncheck")
+    for name, why in (refused or {}).items():
+        if name in tables:
+            continue
+        suite = TestSuite(name)
+        case = TestCase("refused", classname=f"dyncheck.{name}")
+        case.result = [Failure(_text(why), "refused")]
+        suite.add_testcase(case)
+        suite.update_statistics()
+        xml.add_testsuite(suite)
     for suite_name, rows in tables.items():
         suite = TestSuite(suite_name)
         for keys, group in rows.groupby(list(columns.group), sort=False, dropna=False):
@@ -86,8 +97,9 @@ def split(rows: pd.DataFrame, columns: Columns) -> dict[str, pd.DataFrame]:
     return {str(k): g for k, g in rows.groupby(columns.suite, sort=False)}
 
 
-def write_junit(path: Path, tables: dict[str, pd.DataFrame], columns: Columns) -> None:
-    text = junit(tables, columns).tostring()
+def write_junit(path: Path, tables: dict[str, pd.DataFrame], columns: Columns,
+                refused: dict[str, str] | None = None) -> None:
+    text = junit(tables, columns, refused).tostring()
     write_atomic(path, text.decode() if isinstance(text, bytes) else text)
 
 

@@ -349,6 +349,10 @@ def _main(argv: Sequence[str] | None) -> int:
         end_now()
         print("dyncheck: interrupted (nothing half-written)", file=sys.stderr)
         return 130
+    finally:
+        from dyncheck.commands.options import release_outs
+
+        release_outs()  # the output folders this command held (claim_out)
 
 
 def console() -> int:

@@ -14,6 +14,7 @@ Usable from a user's own test suite::
 from __future__ import annotations
 
 import time
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -22,9 +23,10 @@ import pandas as pd
 
 from dyncheck.adapters import layout
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials, urdf_welded
-from dyncheck.adapters.model_tree import Dynamics, ModelTree, TreeJoint
+from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import describe, inputs, partial, predicted, readings
 from dyncheck.check import engines as engine_processes
+from dyncheck.check.alignment import align_by_body
 from dyncheck.check.derivatives import rows as derivative_rows
 from dyncheck.check.dynamics import (
     QUANTITIES,
@@ -161,6 +163,9 @@ def _massive(path: Path, source: ModelFile) -> None:
     if source.format.value != "urdf":
         return
     welded = urdf_welded(source)
+    links = {link.get("name") for link in ET.fromstring(source.text).findall("link")}
+    if links <= welded:  # nothing moves: the check's own refusal says so
+        return
     if not any(i.mass > 0 for i in urdf_inertials(source) if i.link not in welded):
         raise inputs.ModelFileError(
             path, "no moving link states an <inertial> with a positive mass: every moving "
@@ -467,56 +472,6 @@ def _reading_effect(canonical_tree: ModelTree, a: str, b: str, own: dict[str, Re
 
 def _held(part: partial.Part | None) -> np.ndarray | None:
     return None if part is None else part.v
-
-
-def _parent(joint: TreeJoint, renames: dict[str, str]) -> str | None:
-    return renames.get(joint.parent, joint.parent) if joint.parent else None
-
-
-def align_by_body(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree, list[str]]:
-    """Joints an engine names otherwise matched to the canonical engine's by their body and
-    their order in it, where the types agree: Drake names an MJCF ``<freejoint>`` after its
-    body; Pinocchio's MJCF parser makes a body's several joints one composite joint whose
-    components it names ``<composite>[k]``. What is left — joints and bodies without names
-    in the file, which each engine names its own way — is matched by place in the tree: the
-    same number, the same types in the same order, the same parents."""
-    known = {j.name for j in canonical.joints}
-    names = {j.name for j in tree.joints}
-    renames: dict[str, str] = {}
-    for body in dict.fromkeys(j.body for j in tree.joints):
-        mine = [j for j in tree.joints if j.body == body]
-        theirs = [j for j in canonical.joints if j.body == body]
-        if (len(mine) == len(theirs) and any(j.name not in known for j in mine)
-                and all(a.type is b.type for a, b in zip(mine, theirs, strict=True))
-                and not any(b.name in names and b.name != a.name
-                            for a, b in zip(mine, theirs, strict=True))):
-            renames.update({a.name: b.name for a, b in zip(mine, theirs, strict=True)
-                            if a.name != b.name})
-    renamed = {renames.get(j.name, j.name) for j in tree.joints}
-    mine = [j for j in tree.joints if renames.get(j.name, j.name) not in known]
-    theirs = [j for j in canonical.joints if j.name not in renamed]
-    by_place = {a.name: b.name for a, b in zip(mine, theirs, strict=False)}
-    placed = bool(mine) and len(mine) == len(theirs) and all(  # the rest by place in the tree
-        a.type is b.type and _parent(a, renames | by_place) == b.parent
-        for a, b in zip(mine, theirs, strict=True))
-    if placed:
-        renames.update(by_place)
-    if not renames:
-        return tree, []
-    joints = tuple(
-        replace(j, name=renames.get(j.name, j.name),
-                parent=renames.get(j.parent, j.parent) if j.parent else None)
-        for j in tree.joints
-    )
-    notes = [f"{tree.engine}: joint {old!r} (body {tree.joint(old).body!r}) matched to {new!r} "
-             "by its body and its place in it" for old, new in renames.items()
-             if not (placed and old in by_place)]
-    if placed:
-        notes.append(f"{tree.engine}: {len(by_place)} joints without a common name (unnamed in "
-                     "the file) matched by their place in the tree: " + ", ".join(
-                         f"{old!r} = {new!r}" for old, new in by_place.items()))
-    return replace(tree, joints=joints, hints=tuple(
-        (renames.get(j, j), f, why) for j, f, why in tree.hints)), notes
 
 
 def _against(model: str, mine: ModelTree, other: ModelFile) -> list[CheckRow]:

@@ -94,8 +94,11 @@ def armature_axes(canon: Canonical, tree_a: ModelTree, tree_b: ModelTree, states
     found = [(x, sign, name) for name, (x, sign) in terms.items() if x is not None]
     if not found:
         return {}
-    d_mass = sum(sign * x[0] for x, sign, _ in found)
-    d_bias = sum(sign * x[1] for x, sign, _ in found)
+    d_mass = np.zeros_like(found[0][0][0])
+    d_bias = np.zeros_like(found[0][0][1])
+    for x, sign, _ in found:
+        d_mass += sign * x[0]
+        d_bias += sign * x[1]
     n = len(states.q)
     with np.errstate(all="ignore"):
         forward = -np.linalg.solve(dyn_a.mass_matrix + d_mass,

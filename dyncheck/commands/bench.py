@@ -7,6 +7,7 @@ import argparse
 from dyncheck.commands.options import (
     BENCH_MAX,
     check_out,
+    claim_out,
     positive,
 )
 
@@ -17,6 +18,7 @@ def bench_command(args: argparse.Namespace) -> int:
 
     check_out(args.out)
     if args.suite:
+        claim_out(args.out)
         from dyncheck import bench_suite
 
         print(bench_suite.main(args.out))
@@ -26,6 +28,7 @@ def bench_command(args: argparse.Namespace) -> int:
     positive("--repeats", args.repeats, BENCH_MAX["--repeats"])
     for n in args.memory:
         positive("--memory", n, BENCH_MAX["--memory"])
+    claim_out(args.out)
     positive("--jobs", args.jobs)
     print(bench.main(args.case, args.states, args.repeats, args.memory, args.out,
                      jobs=args.jobs, dask=args.dask))

@@ -17,6 +17,7 @@ if TYPE_CHECKING:
 from dyncheck.commands.options import (
     check_out,
     ci_files,
+    claim_out,
     positive,
     write_ci,
 )
@@ -134,6 +135,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
         [args.against] if args.against is not None else [])
     ci_files(args, read)
     positive("--jobs", args.jobs)
+    claim_out(args.out)  # every option checked: the folder held for this command
     options = {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
                "floating": args.floating, "against": args.against,
                "isolate": not args.in_process, "limits": _limits(args),

@@ -53,7 +53,7 @@ def write_ci(args: argparse.Namespace, tables: dict[str, pd.DataFrame], columns:
     from dyncheck import ci_outputs
 
     if args.junit is not None:
-        ci_outputs.write_junit(args.junit, tables, columns)
+        ci_outputs.write_junit(args.junit, tables, columns, refused)
     if args.json is not None:
         ci_outputs.write_json(args.json, tables, versions, refused)
 
@@ -78,6 +78,62 @@ def check_out(out: Path, flag: str = "--out") -> None:
         for p in missing:  # innermost first: leave no trace of the probe
             if p.is_dir() and not any(p.iterdir()):
                 p.rmdir()
+
+
+LOCK = ".dyncheck-lock"
+"""The file in an output folder that a dyncheck writing there holds locked (its process id
+inside), removed when the command ends."""
+
+_CLAIMS: list[tuple[int, Path, list[Path]]] = []
+"""The output folders this command holds: their lock's descriptor and path, and the folders
+made for it (removed again where the command leaves them empty)."""
+
+
+def claim_out(out: Path, flag: str = "--out") -> None:
+    """Hold ``out`` for this command (an exclusive ``flock`` on :data:`LOCK`), so that two
+    dyncheck commands never write one folder at once — a second is refused at once, naming
+    the process that holds it; the lock goes with the process, however it ends
+    (:func:`release_outs` also removes the file)."""
+    import fcntl
+
+    path = out / LOCK
+    if any(p == path for _, p, _ in _CLAIMS):
+        return
+    made = [p for p in (out, *out.parents) if not p.exists()]
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600)
+    except OSError as exc:
+        raise InvalidInput(flag, str(out), f"a folder whose lock file can be made ({LOCK}: "
+                           f"{exc.strerror})") from None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "unknown"
+        os.close(fd)
+        raise InvalidInput(flag, str(out), f"a folder no other dyncheck is writing (process "
+                           f"{holder[:16]!r} is: wait for it to end, or choose another "
+                           f"{flag})") from None
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    _CLAIMS.append((fd, path, made))
+    from dyncheck.workers import at_end
+
+    at_end(release_outs)
+
+
+def release_outs() -> None:
+    """Let go of every folder :func:`claim_out` took: its lock file removed, then closed."""
+    while _CLAIMS:
+        fd, path, made = _CLAIMS.pop()
+        try:
+            path.unlink(missing_ok=True)
+            for folder in made:  # innermost first: a refused command leaves no trace
+                if folder.is_dir() and not any(folder.iterdir()):
+                    folder.rmdir()
+        except OSError:
+            pass
+        os.close(fd)
 
 
 def check_out_file(flag: str, path: Path, inputs: Sequence[Path] = ()) -> None:

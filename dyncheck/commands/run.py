@@ -8,6 +8,7 @@ from dyncheck.commands.options import (
     MAX_STATES,
     check_out,
     ci_files,
+    claim_out,
     positive,
     warn_cost,
     write_ci,
@@ -29,6 +30,7 @@ def run_command(args: argparse.Namespace) -> int:
     positive("--jobs", args.jobs)
     reference = baseline.load(args.baseline) if args.baseline is not None else None
     cases, impls = resolve(args.cases, args.impl)
+    claim_out(args.out)  # every option checked: the folder held for this command
     if args.states is not None:
         warn_cost(args.states * len(cases), args.jobs)
     # the conventions catalogue does not depend on the cases: it runs with the full report

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from dyncheck.commands.options import check_out
+from dyncheck.commands.options import check_out, claim_out
 from dyncheck.errors import UnknownName
 from dyncheck.progress import Progress
 
@@ -20,6 +20,7 @@ def tutorials_command(args: argparse.Namespace) -> int:
         if name not in known:
             raise UnknownName("tutorial", name, known)
     check_out(args.out)
+    claim_out(args.out)
     failed = 0
     with Progress("tutorials", len(names), quiet=args.quiet) as progress:
         for name in names:

@@ -48,8 +48,8 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
     from dyncheck.adapters import layout
     from dyncheck.adapters.model_files import read
     from dyncheck.check import derivatives, engines
+    from dyncheck.check.alignment import align_by_body
     from dyncheck.check.dynamics import States
-    from dyncheck.check.model_check import align_by_body
 
     names = [n for n in MODELS if n in impl_names]
     if not names:

@@ -70,3 +70,23 @@ def test_run_writes_junit_per_case(tmp_path):
     rows = pd.read_csv(out / "discrepancies.csv")
     assert int(root.get("tests")) == len(rows.groupby(
         ["quantity", "impl_a", "impl_b", "integrator", "dt"], dropna=False))
+
+
+def test_a_refused_model_is_a_failed_test_case(tmp_path):
+    """#60: a folder with one good model and one the check refuses (not XML): the refused
+    one is a suite of one failed test case whose message is the refusal (it was absent,
+    failures="0", only the exit code said so); the exit code stays 2."""
+    folder = tmp_path / "models"
+    folder.mkdir()
+    (folder / "good.urdf").write_text((MODELS / "branches.urdf").read_text())
+    (folder / "broken.xml").write_text("<mujoco><worldbody>")
+    junit = tmp_path / "r.xml"
+    code = main(["check", str(folder), "--states", "3", "--out", str(tmp_path / "o"),
+                 "--junit", str(junit)])
+    assert code == 2
+    root = ET.parse(junit).getroot()
+    suites = {s.get("name"): s for s in root.iter("testsuite")}
+    assert set(suites) == {"good", "broken"}
+    failure = suites["broken"].find("testcase/failure")
+    assert failure is not None and "broken.xml" in failure.get("message", "")
+    assert int(root.get("failures")) >= 1

@@ -226,3 +226,34 @@ def test_a_reader_that_leaves_costs_no_page_and_no_error(tmp_path):
     assert proc.wait(timeout=300) == 0, err
     assert (out / "mixed.md").is_file() and (out / "branches.md").is_file()
     assert "error" not in err and "Traceback" not in err
+
+
+def test_an_out_folder_in_use_by_another_dyncheck_is_refused_naming_it(tmp_path):
+    """#60: two commands writing one --out interleaved their pages and CSVs. A second
+    dyncheck is refused at once (exit 2, one line naming the process that holds the folder,
+    nothing written); the folder is free again once the first ends, its lock file gone."""
+    from pathlib import Path
+
+    model = Path(__file__).resolve().parents[1] / "check" / "models" / "branches.urdf"
+    out = tmp_path / "out"
+    out.mkdir()
+    holder = subprocess.Popen(  # a stand-in for the first dyncheck: it holds the folder
+        [sys.executable, "-c", "import sys, time; from pathlib import Path; "
+         "from dyncheck.commands.options import claim_out; claim_out(Path(sys.argv[1])); "
+         "print('held', flush=True); time.sleep(60)", str(out)],
+        stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout is not None and holder.stdout.readline().strip() == "held"
+        done = subprocess.run([sys.executable, "-m", "dyncheck", "check", str(model), "--states",
+                               "2", "--out", str(out)], capture_output=True, text=True,
+                              timeout=120)
+        assert done.returncode == 2, done.stderr
+        lines = done.stderr.strip().splitlines()
+        assert len(lines) == 1 and f"process '{holder.pid}' is" in lines[0], lines
+        assert "--out" in lines[0]
+        assert sorted(p.name for p in out.iterdir()) == [".dyncheck-lock"]
+    finally:
+        holder.kill()
+        holder.wait()
+    assert main(["check", str(model), "--states", "2", "--out", str(out)]) == 0
+    assert not (out / ".dyncheck-lock").exists()

@@ -925,11 +925,11 @@ HOSTILE_MODELS: tuple[Fault, ...] = (
         answer=r"<tmp>/a\.urdf: no engine could load it: mujoco refused <tmp>/a\.urdf: XM",
     ),
     chk(
-        "URDF floating joint type",
+        "URDF floating joint below a link (was refused: MuJoCo and Pinocchio read it)",
         "a.urdf",
         URDF.replace('type="continuous"', 'type="floating"'),
-        exit=2,
-        answer=r"<tmp>/a\.urdf: joint 'leg_joint' has type 'floating', which is not chec",
+        exit=0,
+        answer=r"^a: \d+ passed, \d+ explained, 0 failed, 1 skipped",
     ),
     chk(
         "URDF with no links",
@@ -1555,7 +1555,128 @@ OUTPUT_PATHS = (  # #60: an output never replaces an input, a link or a special 
           answer=r"--out must be a regular file path, not a symlink"),
 )
 
-FAULTS = (*FAULTS, *HOSTILE_MODELS, *MORE_FAULTS, *EXTRA_FAULTS, *OUTPUT_PATHS, *NAMES, *DEEP)
+MJCF = ('<mujoco model="m">{head}<worldbody><body name="a" pos="0 0 1"><joint name="j" '
+        'type="hinge" axis="0 1 0"{ja}/><inertial pos="0 0 -0.3" mass="1.5" '
+        'diaginertia="0.02 0.03 0.01"/><body name="b" pos="0 0 -0.6"><joint name="k" '
+        'type="hinge" axis="1 0 0"/><inertial pos="0 0.1 -0.2" mass="0.7" '
+        'diaginertia="0.01 0.01 0.004"/></body></body></worldbody>{tail}</mujoco>')
+
+
+def _mjcf(head: str = "", ja: str = "", tail: str = "") -> str:
+    return MJCF.format(head=head, ja=ja, tail=tail)
+
+
+def _lock(kind: str) -> Callable[[Path], None]:
+    """An --out folder whose lock file is stale (left by a killed dyncheck), a symlink or a
+    folder."""
+    def make(tmp: Path) -> None:
+        (tmp / "m.urdf").write_text(URDF)
+        (tmp / "out").mkdir()
+        lock = tmp / "out" / ".dyncheck-lock"
+        if kind == "stale":
+            lock.write_text("999999\n")
+        elif kind == "link":
+            lock.symlink_to(tmp / "elsewhere")
+        else:
+            lock.mkdir()
+    return make
+
+
+FREE_ARMATURE = ('<mujoco model="m"><worldbody><body name="box" pos="0 0 1"><joint name="root" '
+                 'type="free" armature="0.1"/><inertial pos="0.05 0.02 0" mass="2" '
+                 'diaginertia="0.1 0.2 0.3"/></body></worldbody></mujoco>')
+AGREE = r"^a: \d+ passed, \d+ explained, 0 failed, 0 skipped"
+FINDS = r"^a: \d+ passed, \d+ explained, [1-9]\d* failed"
+ROUND3 = (  # #59 and #60: readings measured, refusals named, folders held
+    chk("URDF floating joint from the world (was refused)", "a.urdf", URDF.replace(
+        '<robot name="branches">', '<robot name="branches"><link name="world"/><joint '
+        'name="free" type="floating"><parent link="world"/><child link="base"/></joint>'),
+        exit=0, answer=AGREE),
+    chk("URDF with no <inertial> on any link (validity passed with 0 bodies)", "a.urdf",
+        re.sub(r"<inertial>.*?</inertial>", "", URDF),
+        answer=r"<tmp>/a\.urdf: no moving link states an <inertial> with a positive mass"),
+    chk("URDF every moving link of mass 0", "a.urdf",
+        re.sub(r'<mass value="[^"]*"/>', '<mass value="0"/>', URDF),
+        answer=r"<tmp>/a\.urdf: no moving link states an <inertial> with a positive mass"),
+    chk("URDF massless root link welded to the world (failed validity)", "a.urdf",
+        URDF.replace('<mass value="2"/>', '<mass value="0"/>', 1), exit=0, answer=AGREE),
+    chk("URDF massless root fixed to a 'world' link", "a.urdf",
+        URDF.replace('<mass value="2"/>', '<mass value="0"/>', 1).replace(
+            '<robot name="branches">', '<robot name="branches"><link name="world"/><joint '
+            'name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>'),
+        exit=0, answer=AGREE),
+    chk("URDF <limit> without lower and upper (Pinocchio reads (0, 0))", "a.urdf",
+        URDF.replace('<limit lower="-2" upper="2" effort="1" velocity="1"/>',
+                     '<limit effort="1" velocity="1"/>'), exit=1, answer=FINDS),
+    chk("URDF revolute joint without <limit> (Pinocchio refuses)", "a.urdf",
+        URDF.replace('<limit lower="-2" upper="2" effort="1" velocity="1"/>', ""), exit=1,
+        answer=FINDS),
+    chk("URDF limit lower above upper (Drake aborts)", "a.urdf",
+        URDF.replace('<limit lower="-2" upper="2"', '<limit lower="2" upper="-2"'), exit=1,
+        answer=FINDS),
+    chk("URDF axis not of unit length", "a.urdf",
+        URDF.replace('<axis xyz="0 1 0"/>', '<axis xyz="0 2 0"/>', 1), exit=0, answer=AGREE),
+    chk("URDF link with two <inertial> (MuJoCo refuses)", "a.urdf", URDF.replace(
+        '<link name="zz_arm">', '<link name="zz_arm"><inertial><mass value="3"/><inertia '
+        'ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>', 1), exit=1,
+        answer=FINDS),
+    chk("URDF mass of 1e-9 kg", "a.urdf",
+        URDF.replace('<mass value="1.5"/>', '<mass value="1e-9"/>'), exit=0, answer=AGREE),
+    chk("URDF mass of 1e9 kg", "a.urdf",
+        URDF.replace('<mass value="1.5"/>', '<mass value="1e9"/>'), exit=0, answer=AGREE),
+    chk("URDF origin rpy with four numbers", "a.urdf",
+        URDF.replace('rpy="0.1 0.2 0.3"', 'rpy="0.1 0.2 0.3 0.4"'),
+        answer=r"no engine could load it: mujoco refused .*attribute 'rpy' has too much data"),
+    chk("URDF continuous joint with a <limit>", "a.urdf", URDF.replace(
+        '<axis xyz="0 1 0"/></joint>', '<axis xyz="0 1 0"/><limit lower="-1" upper="1" '
+        'effort="1" velocity="1"/></joint>', 1), exit=1, answer=FINDS),
+    chk("MJCF two top-level <default> blocks (Pinocchio: unordered_map::at)", "a.xml",
+        _mjcf(head='<default><default class="x"><joint damping="0.1"/></default></default>'
+              '<default><default class="y"><joint damping="0.3"/></default></default>',
+              ja=' class="y"'), exit=1, answer=FINDS),
+    chk("MJCF free joint with armature (Pinocchio adds it in body axes)", "a.xml",
+        FREE_ARMATURE, exit=1, answer=FINDS),
+    chk("MJCF <option gravity> zero (Pinocchio ignores it)", "a.xml",
+        _mjcf(head='<option gravity="0 0 0"/>'), exit=1, answer=FINDS),
+    chk("MJCF ball joint with armature (Drake keeps none)", "a.xml", _mjcf().replace(
+        'type="hinge" axis="0 1 0"', 'type="ball" armature="0.05"', 1), exit=1,
+        answer=FINDS),
+    chk("MJCF slide joint without a range", "a.xml",
+        _mjcf().replace('type="hinge" axis="1 0 0"', 'type="slide" axis="1 0 0"'), exit=0,
+        answer=AGREE),
+    chk("MJCF range with limited=\"false\" (Pinocchio reads the range)", "a.xml",
+        _mjcf(ja=' range="-1 1" limited="false"'), exit=1, answer=FINDS),
+    chk("MJCF range of no width", "a.xml", _mjcf(ja=' range="0.5 0.5" limited="true"'),
+        answer=r"mujoco refused .*range\[0\] should be smaller than range\[1\]"),
+    chk("MJCF armature on a joint no actuator drives (Drake keeps none)", "a.xml",
+        _mjcf(ja=' armature="0.2"'), exit=1, answer=FINDS),
+    chk("MJCF armature with a <general> actuator (Drake reads none)", "a.xml",
+        _mjcf(ja=' armature="0.2"', tail='<actuator><general joint="j" gear="2"/></actuator>'),
+        exit=1, answer=FINDS),
+    chk("MJCF <connect> equality (removed for Drake, said)", "a.xml",
+        _mjcf(tail='<equality><connect body1="b" body2="world" anchor="0 0 -0.2"/>'
+              "</equality>"), exit=0, answer=AGREE),
+    chk("MJCF <joint> equality (removed for Drake, said)", "a.xml",
+        _mjcf(tail='<equality><joint joint1="j" joint2="k"/></equality>'), exit=0,
+        answer=AGREE),
+    chk("MJCF model 10^6 m from the origin", "a.xml",
+        _mjcf().replace('pos="0 0 1"', 'pos="1000000 0 1"'), exit=0, answer=AGREE),
+    chk("MJCF body inertia of 1e-12 kg m^2", "a.xml",
+        _mjcf().replace('diaginertia="0.01 0.01 0.004"', 'diaginertia="1e-12 1e-12 1e-12"'),
+        exit=0, answer=AGREE),
+    Fault(kind="--out holding a stale lock file (a killed dyncheck's)", area="check",
+          prepare=_lock("stale"), argv=("check", "{tmp}/m.urdf", "--states", "3", "--out", OUT),
+          exit=0, answer=r"^m: \d+ passed, \d+ explained, 0 failed, 0 skipped"),
+    Fault(kind="--out whose lock file is a symlink", area="check", prepare=_lock("link"),
+          argv=("check", "{tmp}/m.urdf", "--states", "3", "--out", OUT),
+          answer=r"--out must be a folder whose lock file can be made \(\.dyncheck-lock: "),
+    Fault(kind="--out whose lock file is a folder", area="check", prepare=_lock("folder"),
+          argv=("check", "{tmp}/m.urdf", "--states", "3", "--out", OUT),
+          answer=r"--out must be a folder whose lock file can be made \(\.dyncheck-lock: "),
+)
+
+FAULTS = (*FAULTS, *HOSTILE_MODELS, *MORE_FAULTS, *EXTRA_FAULTS, *OUTPUT_PATHS, *NAMES, *DEEP,
+          *ROUND3)
 
 
 DEDICATED = (
@@ -1596,6 +1717,13 @@ DEDICATED = (
      "folder trusted: every entry compiled again",
      "tests/dyncheck/test_compiled_caches.py::test_without_an_authentic_manifest_nothing_is_"
      "trusted"),
+    ("--out in use by another dyncheck", "refused at once, one line naming the process that "
+     "holds it, nothing written, exit 2 — two commands interleaved their pages and CSVs",
+     "tests/dyncheck/test_cli.py::"
+     "test_an_out_folder_in_use_by_another_dyncheck_is_refused_naming_it"),
+    ("a refused model in a folder checked with --junit", "a suite of one failed test case "
+     "naming the refusal — it was absent (failures=\"0\")",
+     "tests/dyncheck/test_ci_outputs.py::test_a_refused_model_is_a_failed_test_case"),
     ("a compiled-code folder others can write", "not used: JAX keeps no persistent cache, "
      "Warp compiles into a temporary folder (it wrote ~/.cache/warp even under --no-cache)",
      "tests/dyncheck/test_compiled_caches.py::test_a_folder_others_can_write_is_not_used"),
