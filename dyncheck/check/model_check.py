@@ -350,6 +350,7 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
     costs its own row."""
     results: dict[str, Dynamics] = {}
     pending = {}
+    failures: dict[str, str] = {}  # engine → why its dynamics failed
     for engine, m in loaded.items():
         if engine in unmatched:
             rows.append(_row(model, Section.DYNAMICS, engine, Verdict.SKIPPED,
@@ -368,8 +369,7 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
             else:
                 results[engine] = layout.to_canonical(maps, m.dynamics(q_e, v_e, a_e))
         except Exception as exc:  # an engine failing mid-way costs its own rows
-            rows.append(_row(model, Section.DYNAMICS, engine, Verdict.FAILED,
-                             f"{type(exc).__name__}: {exc}", field="dynamics"))
+            failures[engine] = f"{type(exc).__name__}: {exc}"
         seconds[engine] = seconds.get(engine, 0.0) + time.perf_counter() - t0
     t0 = time.perf_counter()
     try:  # the referee serves the readings' comparison even where its rows are not asked for
@@ -391,16 +391,45 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
             results[engine] = layout.to_canonical(maps, answer)
             seconds[engine] += took
         except Exception as exc:
-            rows.append(_row(model, Section.DYNAMICS, engine, Verdict.FAILED,
-                             f"{type(exc).__name__}: {exc}", field="dynamics"))
+            failures[engine] = f"{type(exc).__name__}: {exc}"
+    for engine, message in failures.items():
+        judge = own.get(engine, own.get(next(iter(loaded))))
+        undefined = _non_finite(judge.dynamics) if judge is not None else []
+        rows.append(_row(
+            model, Section.DYNAMICS, engine, Verdict.SKIPPED if undefined else Verdict.FAILED,
+            (f"not compared: the dynamics are not defined on the model as read (the referee's "
+             f"{', '.join(undefined)} on the same reading are not finite), and {engine} "
+             f"refused to compute them: {message}") if undefined else message,
+            field="dynamics"))
     results = {name: results[name] for name in (REFEREE, *loaded) if name in results}
+    undefined = _non_finite(own[next(iter(loaded))].dynamics) if own else []
+    if undefined:  # the model's own fault, measured by the referee: one failed row
+        singular = "forward" in undefined and "mass_matrix" not in undefined
+        rows.append(_row(
+            model, Section.DYNAMICS, REFEREE, Verdict.FAILED,
+            (f"the model's dynamics are not defined as read: the referee's {', '.join(undefined)}"
+             " are not finite" + (" (M is singular: a moving body without mass, or without "
+                                  "inertia about its joint's axis; fix: give every moving link "
+                                  "a mass and an inertia)" if singular else "")),
+            field="dynamics"))
     for name in list(results):
-        bad = [f for f, value in vars(results[name]).items() if not np.all(np.isfinite(value))]
-        if bad:
-            rows.append(_row(model, Section.DYNAMICS, name, Verdict.FAILED,
-                             f"{name} returned a non-finite {', '.join(bad)}", field="dynamics"))
+        bad = _non_finite(results[name])
+        if bad and name == REFEREE:
+            del results[name]
+        elif bad:
+            judge = own.get(name if name in own else next(iter(loaded)))
+            shared = judge is not None and set(bad) <= set(_non_finite(judge.dynamics))
+            rows.append(_row(
+                model, Section.DYNAMICS, name, Verdict.SKIPPED if shared else Verdict.FAILED,
+                (f"not compared: {', '.join(bad)} not defined on the model as read (the "
+                 "referee's on the same reading are not finite either)") if shared else
+                f"{name} returned a non-finite {', '.join(bad)}", field="dynamics"))
             del results[name]
     return results
+
+
+def _non_finite(dyn: Dynamics) -> list[str]:
+    return [f for f, value in vars(dyn).items() if not np.all(np.isfinite(value))]
 
 
 def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch: States,

@@ -17,6 +17,7 @@ import pytest
 
 from dyncheck.adapters import Registration
 from dyncheck.check.model_check import check_model
+from dyncheck.check.verdicts import Agreement, per_engine
 
 MODELS = Path(__file__).parent / "models"
 ROOT = Path(__file__).resolve().parents[2]
@@ -369,3 +370,26 @@ def test_a_urdf_without_any_moving_inertial_is_refused_before_the_engines(tmp_pa
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and "none.urdf: no moving link states an <inertial>" in lines[0]
     assert not (tmp_path / "out").exists()
+
+
+def test_dynamics_undefined_on_the_model_as_read_are_not_a_computing_finding(tmp_path):
+    """#59: a moving leaf link of mass 0 and inertia 0 (example-robot-data's romeo has such
+    finger links): M is singular, forward dynamics undefined — the referee's on the same
+    reading are not finite. Pinocchio's non-finite answer and Drake's refusal are then not
+    "computes differently" (a false finding): their lines say not compared, naming why; the
+    model's own fault is one failed row, the referee's, naming the singular M and the fix."""
+    text = BRANCHES.replace('<mass value="0.5"/>', '<mass value="0"/>').replace(
+        'ixx="0.002" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.001"',
+        'ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"')
+    assert text.count('<mass value="0"/>') == 1
+    path = tmp_path / "m.urdf"
+    path.write_text(text)
+    result = check_model(path, states=5, impls=("reference", "pinocchio", "drake"))
+    lines = {v.engine: v for v in per_engine(result.rows, result.impls)}
+    for engine in ("pinocchio", "drake"):
+        assert lines[engine].agreement is Agreement.NOT_COMPARED, lines[engine].line()
+        assert "not defined on the model as read" in lines[engine].agreement_why
+    rows = result.rows
+    failed = rows[rows["verdict"] == "failed"]
+    assert list(failed["impl_a"]) == ["reference"], failed
+    assert "M is singular" in failed["note"].iloc[0] and not result.ok
