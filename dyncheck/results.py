@@ -156,6 +156,42 @@ def write_atomic(path: Path, content: str | bytes) -> None:
         raise
 
 
+def write_together(files: dict[Path, str | bytes]) -> None:
+    """Write several files as one: each to a temporary file beside its target first, then —
+    only once every one is written — each renamed over its target (a rename writes no data:
+    no size limit or full disk can stop it half-way). A write that fails leaves every target
+    as it was and no temporary file behind: a report is replaced as a whole or not at all."""
+    staged: list[tuple[str, Path]] = []
+    made: list[Path] = []
+    try:
+        for path, content in files.items():
+            if path.is_symlink() or (path.exists() and not path.is_file()):
+                raise OSError(errno.EPERM, "not a regular file (a symlink or a special file): "
+                              "not replaced", str(path))
+            made += [p for p in (path.parent, *path.parent.parents)
+                     if not p.exists() and p not in made]
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+            staged.append((tmp, path))
+            try:
+                with os.fdopen(fd, "wb" if isinstance(content, bytes) else "w") as f:
+                    f.write(content)
+            except OSError as exc:
+                if exc.filename is None:
+                    raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
+                raise
+    except BaseException:
+        for tmp, _ in staged:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+        for folder in sorted(made, key=lambda p: len(p.parts), reverse=True):
+            if folder.is_dir() and not any(folder.iterdir()):
+                folder.rmdir()
+        raise
+    for tmp, path in staged:
+        os.replace(tmp, path)
+
+
 def to_csv(frame: pd.DataFrame) -> str:
     """Deterministic CSV text: fixed float format, LF line ends, no text cell a spreadsheet
     would read as a formula (:func:`~dyncheck.escaping.csv_safe`)."""

@@ -13,7 +13,7 @@ from dyncheck.check.model_check import CheckResult
 from dyncheck.check.rows import Section
 from dyncheck.check.verdicts import per_engine
 from dyncheck.escaping import markdown, markdown_code, markdown_table
-from dyncheck.results import PROVENANCE, Verdict, provenance_json, to_csv, write_atomic
+from dyncheck.results import PROVENANCE, Verdict, provenance_json, to_csv, write_together
 
 TITLES = {
     Section.LOAD: "Loading",
@@ -136,13 +136,13 @@ def without_paths(result: CheckResult) -> CheckResult:
 
 
 def write(result: CheckResult, out: Path, *, name: str | None = None) -> list[Path]:
-    """Both files, each written to a temporary name and renamed (``name``: the files' name,
-    by default the model's)."""
+    """The page, its CSV and the provenance, written as one (:func:`write_together`: never
+    one model's page beside another's CSV; ``name``: the files' name, by default the
+    model's)."""
     name = name or result.model.replace("/", "__")
     result = without_paths(result)
     csv_path, md_path = out / f"{name}.csv", out / f"{name}.md"
-    write_atomic(csv_path, to_csv(result.rows))
     versions = _versions(result)
-    write_atomic(md_path, page(result, versions))
-    write_atomic(out / PROVENANCE, provenance_json(versions))
+    write_together({csv_path: to_csv(result.rows), md_path: page(result, versions),
+                    out / PROVENANCE: provenance_json(versions)})
     return [csv_path, md_path, out / PROVENANCE]

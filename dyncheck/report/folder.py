@@ -14,7 +14,7 @@ from dyncheck.report.tables import (
     conservation_table,
     md,
 )
-from dyncheck.results import PROVENANCE, provenance_json, to_csv, write_atomic
+from dyncheck.results import PROVENANCE, provenance_json, to_csv, write_together
 from dyncheck.run import RunResult
 
 
@@ -79,11 +79,11 @@ def check(result: RunResult, out: Path) -> list[Moved]:
 
 
 def write(result: RunResult, out: Path, *, date: str | None = None) -> list[Path]:
-    """Write every file of the report under ``out``; each file atomically, after all of them
-    are computed (a run killed before this point changes nothing)."""
+    """Write every file of the report under ``out``, after all of them are computed (a run
+    killed before this point changes nothing), as one (:func:`write_together`: a write that
+    fails — a full disk, a file-size limit — leaves the previous report whole)."""
     files = render(result, out, date=date)
-    for path, content in files.items():
-        write_atomic(path, content)
+    write_together(files)
     return list(files)
 
 

@@ -60,3 +60,38 @@ def test_a_measured_row_is_relative_to_its_scale_and_an_unmeasured_one_has_no_nu
                                   verdict="skipped", note="needs the 'drake' extra")
     assert np.isnan(gone.max_abs_err) and np.isnan(gone.max_rel_err)
     assert gone.tolerance_basis == "" and gone.worst_state == -1
+
+
+def test_a_report_is_replaced_as_a_whole_or_not_at_all(tmp_path, monkeypatch):
+    """#60: a file-size limit hit while a report was overwritten left the new CSVs beside
+    the old README.md. ``write_together`` writes every file beside its target first: the
+    third write failing (EFBIG) leaves every old file as it was and no temporary file; a
+    write that succeeds replaces them all."""
+    import errno
+    import os
+
+    from dyncheck.results import write_together
+
+    old = {tmp_path / "a.csv": "old a", tmp_path / "README.md": "old readme"}
+    for path, text in old.items():
+        path.write_text(text)
+    new = {tmp_path / "a.csv": "new a", tmp_path / "figures" / "f.png": b"png",
+           tmp_path / "README.md": "new readme"}
+    real, calls = os.fdopen, []
+
+    def limited(fd, mode):
+        calls.append(fd)
+        if len(calls) == 3:
+            os.close(fd)
+            raise OSError(errno.EFBIG, "File too large")
+        return real(fd, mode)
+
+    monkeypatch.setattr("dyncheck.results.os.fdopen", limited)
+    with pytest.raises(OSError, match="File too large"):
+        write_together(new)
+    assert {p.name: p.read_text() for p in old} == {"a.csv": "old a", "README.md": "old readme"}
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["README.md", "a.csv"]
+    monkeypatch.setattr("dyncheck.results.os.fdopen", real)
+    write_together(new)
+    assert (tmp_path / "README.md").read_text() == "new readme"
+    assert (tmp_path / "figures" / "f.png").read_bytes() == b"png"
