@@ -30,7 +30,7 @@ from dyncheck.commands.report import report_command
 from dyncheck.commands.run import run_command
 from dyncheck.commands.tutorials import tutorials_command
 from dyncheck.commands.versions import versions_command
-from dyncheck.errors import DyncheckError, Terminated
+from dyncheck.errors import DyncheckError, InvalidInput, Terminated
 from dyncheck.workers import JOB_MEMORY, default_jobs
 
 
@@ -316,6 +316,21 @@ def deep_walks() -> None:
     sys.setrecursionlimit(max(sys.getrecursionlimit(), 10_000))
 
 
+def _address_space(args: argparse.Namespace) -> None:
+    """A limit on this process's address space (``ulimit -v``) below what the command needs
+    (:data:`dyncheck.confinement.FLOOR_MIB`, measured) is refused before any work: the engines
+    would otherwise abort in C++ (``std::bad_alloc``, exit 134) or fail their rows as if the
+    model were at fault."""
+    from dyncheck.confinement import address_space_mib, floor_mib
+
+    have = address_space_mib()
+    need = floor_mib(args.command, tuple(getattr(args, "impl", ()) or ()))
+    if have is not None and need is not None and have < need:
+        raise InvalidInput("ulimit -v", f"{have} MiB", f"at least {need} MiB for "
+                           f"`dyncheck {args.command}` (measured: its engines need that much "
+                           "address space to load); raise it, e.g. ulimit -v unlimited")
+
+
 def _main(argv: Sequence[str] | None) -> int:
     from dyncheck.workers import end_now
 
@@ -328,6 +343,7 @@ def _main(argv: Sequence[str] | None) -> int:
     from dyncheck.workers import settled
 
     try:
+        _address_space(args)
         # handed to every unit of work (dyncheck.settings), with the compiled-code folder
         # checked before any engine runs and signed when the command ends
         with held(settings_of(args)) as settings, settled(settings):

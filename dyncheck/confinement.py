@@ -66,3 +66,27 @@ def confine(parent: int, *, memory_bytes: int | None = None, quiet: bool = False
     if quiet:
         release_output(errors)
     cap_memory(memory_bytes)
+
+
+def address_space_mib() -> int | None:
+    """This process's address-space limit in MiB (``ulimit -v``; None: unlimited)."""
+    soft, _hard = resource.getrlimit(resource.RLIMIT_AS)
+    return None if soft == resource.RLIM_INFINITY else soft // 2**20
+
+
+FLOOR_MIB = {"check": 768, "engines": 4096}
+"""The address space a command needs, measured on this machine under ``ulimit -v``: ``check``
+of a URDF through MuJoCo, Pinocchio and Drake failed at 390 MiB and passed at 586 MiB;
+``run simple_pendulum`` (every engine, JAX's included) aborted in C++ (``std::bad_alloc``,
+exit 134) at 1953 MiB and finished at 3906 MiB. ``engines``: every command that loads JAX
+or Warp (``run``, ``bench``, ``tutorials``, a ``check`` with a MuJoCo port)."""
+
+
+def floor_mib(command: str, impls: tuple[str, ...] = ()) -> int | None:
+    """The address space ``command`` needs (None: no engine loaded: no floor)."""
+    if command == "check":
+        ports = {"mjx", "mjx-f64", "mujoco-warp"}
+        return FLOOR_MIB["engines"] if ports & set(impls) else FLOOR_MIB["check"]
+    if command in ("run", "bench", "tutorials"):
+        return FLOOR_MIB["engines"]
+    return None

@@ -110,7 +110,9 @@ def _out_of_memory(name: str, memory_mib: int | None) -> str:
     """Which limit an engine's process hit: dyncheck's cap, or a lower one it was started
     under (``ulimit -v``: the hard limit, which no process may raise), named with the option
     that raises it."""
-    effective = _address_space_mib()
+    from dyncheck.confinement import address_space_mib
+
+    effective = address_space_mib()
     if effective is not None and (memory_mib is None or effective < memory_mib):
         return (f"{name} ran out of memory (the address-space limit dyncheck was started "
                 f"under, {effective} MiB: raise it with ulimit -v"
@@ -121,12 +123,7 @@ def _out_of_memory(name: str, memory_mib: int | None) -> str:
     return f"{name} ran out of memory ({cap})"
 
 
-def _address_space_mib() -> int | None:
-    """This process's address-space limit in MiB (None: unlimited)."""
-    import resource
 
-    soft, _hard = resource.getrlimit(resource.RLIMIT_AS)
-    return None if soft == resource.RLIM_INFINITY else soft // 2**20
 
 
 def load(name: str, source: ModelFile, spec: Registration | None = None,

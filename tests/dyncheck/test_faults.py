@@ -1670,6 +1670,16 @@ ROUND3 = (  # #59 and #60: readings measured, refusals named, folders held
     Fault(kind="--out whose lock file is a symlink", area="check", prepare=_lock("link"),
           argv=("check", "{tmp}/m.urdf", "--states", "3", "--out", OUT),
           answer=r"--out must be a folder whose lock file can be made \(\.dyncheck-lock: "),
+    Fault(kind="check under ulimit -v 390 MiB (engines failed as if the model had)",
+          area="check", patch=lambda mp, tmp: mp.setattr(
+              "dyncheck.confinement.address_space_mib", lambda: 390),
+          argv=("check", BRANCHES, "--states", "2", "--out", OUT),
+          answer=r"^dyncheck: error: ulimit -v must be at least 768 MiB for `dyncheck check`"),
+    Fault(kind="run under ulimit -v 1953 MiB (std::bad_alloc, exit 134)", area="run",
+          patch=lambda mp, tmp: mp.setattr(
+              "dyncheck.confinement.address_space_mib", lambda: 1953),
+          argv=("run", "simple_pendulum", "--out", OUT),
+          answer=r"^dyncheck: error: ulimit -v must be at least 4096 MiB for `dyncheck run`"),
     Fault(kind="--out whose lock file is a folder", area="check", prepare=_lock("folder"),
           argv=("check", "{tmp}/m.urdf", "--states", "3", "--out", OUT),
           answer=r"--out must be a folder whose lock file can be made \(\.dyncheck-lock: "),
