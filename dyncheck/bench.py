@@ -45,6 +45,7 @@ from dyncheck.implementations import (
     implementations_for,
     make_implementation,
 )
+from dyncheck.progress import Progress
 from dyncheck.results import to_csv, write_atomic
 
 
@@ -175,8 +176,9 @@ NO_PORTS = "all but the ports"
 engine calls accounts for (a port's batched call is its rawest: it has no raw loop)."""
 
 
-def bench(case: Case, states: int, repeats: int) -> pd.DataFrame:
-    """Per-state times (µs) of every part and the whole sweep, one row each."""
+def bench(case: Case, states: int, repeats: int, progress: Progress | None = None) -> pd.DataFrame:
+    """Per-state times (µs) of every part and the whole sweep, one row each (``progress``:
+    told as each implementation is done)."""
     from dyncheck import coordinates as co
     from dyncheck.comparison import compare_instantaneous
 
@@ -233,6 +235,8 @@ def bench(case: Case, states: int, repeats: int) -> pd.DataFrame:
             name,
             _median_time(lambda impl=impl: impl.evaluate(sample), repeats),
         )
+        if progress is not None:
+            progress.done(name)
     add(
         "whole sweep",
         "all",
@@ -386,23 +390,25 @@ def write(times: pd.DataFrame, rat: pd.DataFrame, memory: pd.DataFrame, out: Pat
 
 
 def main(case_name: str, states: int, repeats: int, memory_sizes: list[int], out: Path, *,
-         jobs: int = 1, dask: str | None = None) -> str:
+         jobs: int = 1, dask: str | None = None, quiet: bool = False) -> str:
+    """The benchmark of one case (the module's docstring), its progress on stderr: a line per
+    implementation and per memory size, each with the time still expected."""
     case = get_case(case_name)
+    progress = Progress("bench", len(implementations_for(case)) + len(memory_sizes) + 1,
+                        quiet=quiet)
     # on the workers first: an unreachable scheduler is an error before the long work
     sliced = None if jobs <= 1 and dask is None else sliced_sweep(
         case, implementations_for(case), states, jobs=jobs, dask=dask, repeats=repeats)
-    times = bench(case, states, repeats)
+    times = bench(case, states, repeats, progress)
+    progress.done("whole sweeps")
     rat = ratios(times)
-    mem = pd.DataFrame(
-        [
-            {
-                "case": case_name,
-                "states": n,
-                "peak_rss_MiB": round(peak_memory_kib(case_name, n) / 1024, 1),
-            }
-            for n in memory_sizes
-        ]
-    )
+    peaks = []
+    for n in memory_sizes:
+        peaks.append({"case": case_name, "states": n,
+                      "peak_rss_MiB": round(peak_memory_kib(case_name, n) / 1024, 1)})
+        progress.done(f"peak memory at {n} states")
+    progress.close()
+    mem = pd.DataFrame(peaks)
     write(times, rat, mem, out, sliced)
     tables = [times, rat, mem] + ([] if sliced is None else [sliced])
     return "\n\n".join(t.to_string(index=False) for t in tables)

@@ -265,6 +265,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="instead: time the commands a user runs (list, explain, one case, the "
                    "full run, the README's main command with its install, report --check, "
                    "the test commands) in fresh processes -> benchmark-suite.md")
+    _quiet(b)
     for name, example in EXAMPLES.items():
         sub.choices[name].epilog = f"example: {example}"
     return p

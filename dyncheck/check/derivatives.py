@@ -319,6 +319,18 @@ def _collect(engine: object, name: str, inputs: tuple[np.ndarray, np.ndarray, np
     return own
 
 
+SECONDS_PER_STATE_DOF2 = 3e-5
+"""What the derivatives' rows cost on this machine per state and per nv² (every engine and
+the referee; reports/benchmark-check.md: a 35-dof humanoid at 100 states ≈ 3 s, a 200-hinge
+chain at 10 states ≈ 14 s): the estimate said before a long derivative check starts."""
+
+
+def expected_seconds(states: int, nv: int) -> float:
+    """About how long the derivatives' rows of ``states`` states of ``nv`` degrees of freedom
+    take (:data:`SECONDS_PER_STATE_DOF2`)."""
+    return SECONDS_PER_STATE_DOF2 * states * nv * nv
+
+
 def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, object],
          states: States, *, with_referee: bool,
          seconds: dict[str, float] | None = None) -> list[CheckRow]:

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import time
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -27,6 +28,7 @@ from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import describe, inputs, partial, predicted, readings
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.alignment import align_by_body
+from dyncheck.check.derivatives import expected_seconds
 from dyncheck.check.derivatives import rows as derivative_rows
 from dyncheck.check.dynamics import (
     QUANTITIES,
@@ -59,6 +61,9 @@ SMOOTH_NOTE = (
     "armature are compared as fields of the model"
 )
 
+
+SAY_AFTER_S = 10.0
+"""A derivative check expected to take longer than this is announced with its estimate."""
 
 IN_PROCESS_NOTE = (
     "The engines ran in the checking process, not each in its own: a daemonic worker (a dask "
@@ -124,13 +129,15 @@ def check_model(
     isolate: bool = True,
     limits: engine_processes.Limits | None = None,
     derivatives: bool = False,
+    say: Callable[[str], None] | None = None,
 ) -> CheckResult:
     """Check one model file (see the module's docstring); bad input raises
     :class:`~dyncheck.errors.InvalidInput` before any engine runs. With ``isolate`` (the
     default) each engine runs in its own process, within ``limits`` (memory, seconds scaled to
     the model), so that one crashing, hanging or growing on the file costs only its rows
     (:mod:`dyncheck.check.engines`). ``derivatives`` adds the derivatives' rows
-    (:mod:`dyncheck.check.derivatives`)."""
+    (:mod:`dyncheck.check.derivatives`), ``say`` hears the estimate of a derivative check
+    that will take a while (the command's progress)."""
     source_path = inputs.model_path(str(path))
     against_path = inputs.model_path(str(against)) if against is not None else None
     inputs.states(states)
@@ -152,7 +159,7 @@ def check_model(
             return _check(model, source_path, source, engines=engines, chosen=chosen,
                           states=states, seed=seed, floating=floating,
                           against_path=against_path, load_seconds=time.perf_counter() - t0,
-                          derivatives=derivatives)
+                          derivatives=derivatives, say=say)
     finally:
         engine_processes.stop(engines)
 
@@ -176,7 +183,8 @@ def _massive(path: Path, source: ModelFile) -> None:
 def _check(model: str, source_path: Path, source: ModelFile, *,
            engines: dict[str, engine_processes.ModelEngine | NotLoaded], chosen: tuple[str, ...],
            states: int, seed: int, floating: bool, against_path: Path | None,
-           load_seconds: float, derivatives: bool = False) -> CheckResult:
+           load_seconds: float, derivatives: bool = False,
+           say: Callable[[str], None] | None = None) -> CheckResult:
     """The check's steps in order: what loaded, what each engine read and whether it is
     physically possible, the dynamics at the same states, every pair compared, and the
     derivatives where asked for."""
@@ -208,6 +216,10 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
                        own))
     if derivatives:
         t0 = time.perf_counter()
+        expected = expected_seconds(states, canon.nv)
+        if say is not None and expected >= SAY_AFTER_S:
+            say(f"{model}: derivatives at {states} states, {canon.nv} degrees of freedom: "
+                f"about {expected:.0f} s on this machine")
         whole = {e: loaded[e] for e in results if e in loaded and parts.get(e) is None}
         rows.extend(derivative_rows(model, canon, canonical_tree, whole, batch,
                                     with_referee=REFEREE in chosen, seconds=seconds))

@@ -31,5 +31,5 @@ def bench_command(args: argparse.Namespace) -> int:
     claim_out(args.out)
     positive("--jobs", args.jobs)
     print(bench.main(args.case, args.states, args.repeats, args.memory, args.out,
-                     jobs=args.jobs, dask=args.dask))
+                     jobs=args.jobs, dask=args.dask, quiet=args.quiet))
     return 0

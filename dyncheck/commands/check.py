@@ -23,6 +23,12 @@ from dyncheck.commands.options import (
 )
 
 
+def say(message: str) -> None:
+    """A long step's estimate, on stderr (a function of this module: the workers' pickle
+    finds it)."""
+    print(f"dyncheck check: {message}", file=sys.stderr, flush=True)
+
+
 def _case_files(names: list[str], folder: Path) -> list[tuple[Path, str | None]]:
     """Each book case's MJCF (:func:`~dyncheck.adapters.mjcf.to_mjcf`, what ``run`` gives
     MuJoCo) written into ``folder``."""
@@ -139,7 +145,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     options = {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
                "floating": args.floating, "against": args.against,
                "isolate": not args.in_process, "limits": _limits(args),
-               "derivatives": args.derivatives}
+               "derivatives": args.derivatives, "say": None if args.quiet else say}
     units = [(name, partial(check_model, **options, name=robot or (name if several else None)),
               (str(path),)) for path, robot, name in valid]
     engines = tuple(i for i in implementations(tuple(args.impl) or None) if i != "reference")
