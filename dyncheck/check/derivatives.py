@@ -333,11 +333,16 @@ def expected_seconds(states: int, nv: int) -> float:
 
 def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, object],
          states: States, *, with_referee: bool,
-         seconds: dict[str, float] | None = None) -> list[CheckRow]:
+         seconds: dict[str, float] | None = None,
+         readings: Mapping[str, ModelTree] | None = None) -> list[CheckRow]:
     """Every pair's derivative rows: ``engines`` are the loaded engines (name → the engine,
     whole trees only) in the canonical order; the referee is a side when ``with_referee``.
     Engines in processes of their own differentiate while the referee does; ``seconds``
-    receives each one's own time ("d <name>") and the mapping's ("d map")."""
+    receives each one's own time ("d <name>") and the mapping's ("d map"). ``readings``:
+    the engines that read a field the dynamics use otherwise than ``tree`` (name → its own
+    reading in the canonical layout): each is judged against the referee on its own reading,
+    and a pair with one of them is compared after the readings' measured difference (the
+    referee on one reading minus the other's) — explained where that accounts for it."""
     import time
 
     from dyncheck.adapters import layout
@@ -365,6 +370,8 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
     stepping: dict[str, object] = {}  # engine → its step Jacobians, or how they failed
     t0 = time.perf_counter()
     ref = referee(tree, states)
+    own_refs = {name: mine for name, reading in (readings or {}).items() if name in engines
+                and (mine := referee(reading, states)).tie.agrees}
     seconds["d reference"] = time.perf_counter() - t0
     trusted = with_referee and ref.tie.agrees
     if with_referee and not trusted:  # never silently trusted: its rows give way to this one
@@ -423,6 +430,45 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
         for b_name in order[i + 1 :]:
             eps = max(getattr(engines.get(a_name), "tree", tree).eps,
                       getattr(engines.get(b_name), "tree", tree).eps)
-            out.extend(compare(model, tree, a_name, found[a_name], b_name, found[b_name], ref,
-                               eps=eps))
+            if a_name == "reference" and b_name in own_refs:  # on b's own reading
+                mine = own_refs[b_name]
+                out.extend(replace(r, basis=f"{r.basis}; the referee on {b_name}'s reading")
+                           for r in compare(model, tree, a_name, mine.derivatives, b_name,
+                                            found[b_name], mine, eps=eps))
+            elif a_name in own_refs or b_name in own_refs:
+                out.extend(_across_readings(model, tree, a_name, found[a_name], b_name,
+                                            found[b_name], own_refs.get(a_name, ref),
+                                            own_refs.get(b_name, ref), eps))
+            else:
+                out.extend(compare(model, tree, a_name, found[a_name], b_name, found[b_name],
+                                   ref, eps=eps))
+    return out
+
+
+ACROSS_READINGS = ("{a} and {b} read the model differently: compared after the referee on "
+                   "{b}'s reading minus on {a}'s (measured), which accounts for the difference")
+
+
+def _across_readings(model: str, tree: ModelTree, name_a: str, da: Derivatives, name_b: str,
+                     db: Derivatives, ref_a: Referee, ref_b: Referee,
+                     eps: float) -> list[CheckRow]:
+    """Two engines that read the model differently: b's derivatives less the readings'
+    difference (the referee's on b's reading minus on a's) against a's — explained where
+    that accounts for the difference, failed beyond it."""
+    shifted = replace(db, **{f: getattr(db, f) - (getattr(ref_b.derivatives, f)
+                                                  - getattr(ref_a.derivatives, f))
+                             for f in FIELDS})
+    note = ACROSS_READINGS.format(a=name_a, b=name_b)
+    out = []
+    for raw, r in zip(compare(model, tree, name_a, da, name_b, db, ref_a, eps=eps),
+                      compare(model, tree, name_a, da, name_b, shifted, ref_a, eps=eps),
+                      strict=True):
+        if raw.verdict is not Verdict.FAILED:  # alike without the readings' difference
+            out.append(raw)
+        elif r.verdict is Verdict.PASSED:
+            out.append(replace(r, verdict=Verdict.EXPLAINED, note=note))
+        elif r.verdict is Verdict.FAILED:
+            out.append(replace(r, note=f"beyond what the readings account for: {r.note}"))
+        else:
+            out.append(r)
     return out

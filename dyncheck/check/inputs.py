@@ -8,7 +8,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from dyncheck.adapters.mjcf_copy import inline
-from dyncheck.adapters.model_files import INERTIA_KEYS
+from dyncheck.adapters.model_files import INERTIA_KEYS, ModelFile, urdf_inertials, urdf_welded
 from dyncheck.errors import EngineError, InvalidInput, UnknownName
 
 URDF_JOINTS = ("revolute", "continuous", "prismatic", "fixed", "floating")
@@ -175,3 +175,19 @@ def robot(name: str) -> Path:
     if name not in available:
         raise UnknownName("robot", name, available)
     return available[name]
+
+
+def massive(path: Path, source: ModelFile) -> None:
+    """A URDF none of whose moving links states a positive mass is refused before any engine
+    runs: every moving body would be massless, M zero or singular, the dynamics undefined."""
+    if source.format.value != "urdf":
+        return
+    welded = urdf_welded(source)
+    links = {link.get("name") for link in ET.fromstring(source.text).findall("link")}
+    if links <= welded:  # nothing moves: the check's own refusal says so
+        return
+    if not any(i.mass > 0 for i in urdf_inertials(source) if i.link not in welded):
+        raise ModelFileError(
+            path, "no moving link states an <inertial> with a positive mass: every moving "
+            "body is massless and its dynamics undefined (fix: give each moving link an "
+            "<inertial> with its mass and inertia)")

@@ -14,7 +14,6 @@ Usable from a user's own test suite::
 from __future__ import annotations
 
 import time
-import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -45,6 +44,7 @@ from dyncheck.check.rows import COLUMNS, CheckRow, Section
 from dyncheck.errors import InvalidInput, UnknownName
 from dyncheck.escaping import shown
 from dyncheck.results import Verdict
+from dyncheck.vocabulary import Quantity
 
 DERIVATIVES_NOTE = (
     "derivatives (the per-engine lines above include them): d(forward)/d(q, v, tau) at tau = 0 "
@@ -147,7 +147,7 @@ def check_model(
                            "checks an engine's tree)")
     model = name or shown(source_path.stem)
     source = read(source_path, floating=floating)
-    _massive(source_path, source)
+    inputs.massive(source_path, source)
     if isolate and not engine_processes.can_isolate():
         isolate = False
         source = replace(source, notes=(*source.notes, IN_PROCESS_NOTE))
@@ -162,22 +162,6 @@ def check_model(
                           derivatives=derivatives, say=say)
     finally:
         engine_processes.stop(engines)
-
-
-def _massive(path: Path, source: ModelFile) -> None:
-    """A URDF none of whose moving links states a positive mass is refused before any engine
-    runs: every moving body would be massless, M zero or singular, the dynamics undefined."""
-    if source.format.value != "urdf":
-        return
-    welded = urdf_welded(source)
-    links = {link.get("name") for link in ET.fromstring(source.text).findall("link")}
-    if links <= welded:  # nothing moves: the check's own refusal says so
-        return
-    if not any(i.mass > 0 for i in urdf_inertials(source) if i.link not in welded):
-        raise inputs.ModelFileError(
-            path, "no moving link states an <inertial> with a positive mass: every moving "
-            "body is massless and its dynamics undefined (fix: give each moving link an "
-            "<inertial> with its mass and inertia)")
 
 
 def _check(model: str, source_path: Path, source: ModelFile, *,
@@ -208,7 +192,7 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     parts, unmatched = _parts(canon, canonical_tree, loaded, notes)
     batch = sample(canon, canonical_tree, states, seed)
     notes.append(sampled_note(canon, canonical_tree))
-    own: dict[str, Reading] = {}
+    own: dict[str, readings.Reading] = {}
     results = _dynamics(model, canon, canonical_tree, batch, loaded, parts, unmatched,
                         with_referee=REFEREE in chosen, rows=rows, seconds=seconds, own=own)
     seconds = {k: seconds[k] for k in ("load", REFEREE, *loaded) if k in seconds}
@@ -221,8 +205,11 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
             say(f"{model}: derivatives at {states} states, {canon.nv} degrees of freedom: "
                 f"about {expected:.0f} s on this machine")
         whole = {e: loaded[e] for e in results if e in loaded and parts.get(e) is None}
+        read_otherwise = {e: own[e].tree for e in whole if e in own and any(
+            f in describe.ENTERS for f in differing.get(e, ()))}
         rows.extend(derivative_rows(model, canon, canonical_tree, whole, batch,
-                                    with_referee=REFEREE in chosen, seconds=seconds))
+                                    with_referee=REFEREE in chosen, seconds=seconds,
+                                    readings=read_otherwise))
         notes.append(DERIVATIVES_NOTE)
         seconds["derivatives"] = time.perf_counter() - t0
     frame = pd.DataFrame([vars(r) for r in rows], columns=COLUMNS)
@@ -294,40 +281,6 @@ def _readings(model: str, source: ModelFile, loaded: dict[str, engine_processes.
     return differing
 
 
-@dataclass(frozen=True, kw_only=True)
-class Reading:
-    """An engine's reading in the canonical layout (:func:`readings.own_tree`) and the
-    referee's dynamics on it at the sampled states."""
-
-    tree: ModelTree
-    dynamics: Dynamics
-
-
-def _own_readings(canonical_tree: ModelTree, batch: States,
-                  loaded: dict[str, engine_processes.ModelEngine],
-                  parts: dict[str, partial.Part | None], referee: Dynamics,
-                  own: dict[str, Reading]) -> None:
-    """The referee on every engine's own reading (whole trees; the canonical engine's is the
-    referee's own): computed anew wherever a field it uses differs, bit for bit, from the
-    canonical reading."""
-    first = next(iter(loaded))
-    base = readings.own_tree(canonical_tree, canonical_tree)
-    assert base is not None
-    own[first] = Reading(tree=base, dynamics=referee)
-    for engine, m in loaded.items():
-        if engine == first or parts.get(engine, 0) is not None:
-            continue
-        tree = readings.own_tree(canonical_tree, m.tree)
-        if tree is None:
-            continue
-        if readings.same_dynamics_fields(tree, base):
-            own[engine] = Reading(tree=tree, dynamics=referee)
-            continue
-        with np.errstate(all="ignore"):
-            own[engine] = Reading(tree=tree, dynamics=ReferenceModel(tree).dynamics(
-                batch.q, batch.v, batch.a))
-
-
 def _parts(canon: layout.Canonical, canonical_tree: ModelTree,
            loaded: dict[str, engine_processes.ModelEngine],
            notes: list[str]) -> tuple[dict[str, partial.Part | None], list[str]]:
@@ -355,7 +308,7 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
               loaded: dict[str, engine_processes.ModelEngine],
               parts: dict[str, partial.Part | None], unmatched: list[str], *,
               with_referee: bool, rows: list[CheckRow],
-              seconds: dict[str, float], own: dict[str, Reading]) -> dict[str, Dynamics]:
+              seconds: dict[str, float], own: dict[str, readings.Reading]) -> dict[str, Dynamics]:
     """Step 5: every engine's dynamics at the same states, in the canonical layout (engines
     in processes of their own compute while the referee does, on the canonical reading and
     on every engine's own: ``own``); a failing engine, or one returning a non-finite value,
@@ -391,7 +344,7 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
         if with_referee:
             results[REFEREE] = on_canonical
             rows.append(referee.tie.row(model))
-        _own_readings(canonical_tree, batch, loaded, parts, on_canonical, own)
+        readings.own_readings(canonical_tree, batch, loaded, parts, on_canonical, own)
     except Exception as exc:  # the referee failing on a tree costs its own rows too
         rows.append(_row(model, Section.DYNAMICS, REFEREE, Verdict.FAILED,
                          f"{type(exc).__name__}: {exc}", field="dynamics"))
@@ -416,7 +369,8 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
     results = {name: results[name] for name in (REFEREE, *loaded) if name in results}
     undefined = _non_finite(own[next(iter(loaded))].dynamics) if own else []
     if undefined:  # the model's own fault, measured by the referee: one failed row
-        singular = "forward" in undefined and "mass_matrix" not in undefined
+        singular = (QUANTITIES[Quantity.FORWARD_DYNAMICS] in undefined
+                    and QUANTITIES[Quantity.MASS_MATRIX] not in undefined)
         rows.append(_row(
             model, Section.DYNAMICS, REFEREE, Verdict.FAILED,
             (f"the model's dynamics are not defined as read: the referee's {', '.join(undefined)}"
@@ -447,7 +401,7 @@ def _non_finite(dyn: Dynamics) -> list[str]:
 def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch: States,
            loaded: dict[str, engine_processes.ModelEngine],
            parts: dict[str, partial.Part | None], results: dict[str, Dynamics],
-           differing: dict[str, list[str]], own: dict[str, Reading]) -> list[CheckRow]:
+           differing: dict[str, list[str]], own: dict[str, readings.Reading]) -> list[CheckRow]:
     """Step 6: every pair's dynamics compared. The referee judges each engine on that
     engine's own reading (does it compute what it read); two engines are compared with the
     differences their computing conventions predict and their readings' measured effect
@@ -498,7 +452,7 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
     return rows
 
 
-def _reading_effect(canonical_tree: ModelTree, a: str, b: str, own: dict[str, Reading],
+def _reading_effect(canonical_tree: ModelTree, a: str, b: str, own: dict[str, readings.Reading],
                     batch: States, differing: dict[str, list[str]]) -> dict[str, Prediction]:
     """Quantity → the measured effect of a and b reading the model differently (the
     referee on b's reading minus on a's, with each differing field's share by substitution);

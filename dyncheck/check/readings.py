@@ -17,9 +17,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from dyncheck.adapters.model_tree import Dynamics, JointType, ModelTree, TreeJoint
+from dyncheck.check import engines as engine_processes
+from dyncheck.check import partial
 from dyncheck.check.describe import placement
 from dyncheck.check.dynamics import QUANTITIES, Prediction, States, values
-from dyncheck.check.referee import TIE_STATES, bodies
+from dyncheck.check.referee import TIE_STATES, ReferenceModel, bodies
 from dyncheck.reference.recursive import RecursiveDynamics
 
 READING = "engines read the model differently (measured by the referee on each reading)"
@@ -158,3 +160,36 @@ def effect(canonical_tree: ModelTree, name_a: str, tree_a: ModelTree, dyn_a: Dyn
                 shares.setdefault(quantity, {})[group] = min(share, 1.0)
     return ReadingEffect(a=name_a, b=name_b, difference=difference, shares=shares)
 
+
+@dataclass(frozen=True, kw_only=True)
+class Reading:
+    """An engine's reading in the canonical layout (:func:`readings.own_tree`) and the
+    referee's dynamics on it at the sampled states."""
+
+    tree: ModelTree
+    dynamics: Dynamics
+
+
+def own_readings(canonical_tree: ModelTree, batch: States,
+                  loaded: dict[str, engine_processes.ModelEngine],
+                  parts: dict[str, partial.Part | None], referee: Dynamics,
+                  own: dict[str, Reading]) -> None:
+    """The referee on every engine's own reading (whole trees; the canonical engine's is the
+    referee's own): computed anew wherever a field it uses differs, bit for bit, from the
+    canonical reading."""
+    first = next(iter(loaded))
+    base = own_tree(canonical_tree, canonical_tree)
+    assert base is not None
+    own[first] = Reading(tree=base, dynamics=referee)
+    for engine, m in loaded.items():
+        if engine == first or parts.get(engine, 0) is not None:
+            continue
+        tree = own_tree(canonical_tree, m.tree)
+        if tree is None:
+            continue
+        if same_dynamics_fields(tree, base):
+            own[engine] = Reading(tree=tree, dynamics=referee)
+            continue
+        with np.errstate(all="ignore"):
+            own[engine] = Reading(tree=tree, dynamics=ReferenceModel(tree).dynamics(
+                batch.q, batch.v, batch.a))

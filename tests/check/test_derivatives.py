@@ -14,6 +14,7 @@ import pytest
 
 from dyncheck.adapters import pinocchio_model
 from dyncheck.check.model_check import check_model
+from dyncheck.check.verdicts import Agreement, Reading, per_engine
 
 MODELS = Path(__file__).parent / "models"
 DRAKE = importlib.util.find_spec("pydrake") is not None
@@ -183,3 +184,36 @@ def test_a_model_stepped_by_rk4_still_gets_mujocos_derivatives(tmp_path):
     rows = _rows(result, section="derivatives", impl_b="mujoco")
     assert len(rows) == 8 and set(rows["verdict"]) == {"passed"}  # five and three steps
 
+
+
+ARMATURE = """<mujoco model="m"><worldbody><body name="a" pos="0 0 1">
+  <joint name="j" type="hinge" axis="0 1 0" armature="0.2"/>
+  <inertial pos="0 0 -0.3" mass="1.5" diaginertia="0.02 0.03 0.01"/>
+  <body name="b" pos="0 0 -0.6"><joint name="k" type="hinge" axis="1 0 0"/>
+  <inertial pos="0 0.1 -0.2" mass="0.7" diaginertia="0.01 0.01 0.004"/></body>
+  </body></worldbody></mujoco>"""
+
+
+@pytest.mark.skipif(importlib.util.find_spec("pydrake") is None, reason="needs drake")
+def test_an_engine_reading_the_model_otherwise_is_judged_on_its_own_reading(tmp_path):
+    """#59: Drake keeps no armature on a joint no actuator drives (its description row).
+    Its derivatives were judged against the referee on MuJoCo's reading: 'computes
+    differently' (d(forward)/dq off by 25 %), a false finding. Against the referee on its own
+    reading they pass; against MuJoCo's, the forward derivatives (which M⁻¹ carries the
+    armature into) are explained by the readings' measured difference and the inverse ones
+    (armature is constant in M: ∂τ/∂q, ∂τ/∂v hold none of it, (2.2.23)) pass as they are."""
+    path = tmp_path / "m.xml"
+    path.write_text(ARMATURE)
+    result = check_model(path, states=5, derivatives=True,
+                         impls=("reference", "mujoco", "drake"))
+    rows = result.rows[result.rows["section"] == "derivatives"]
+    own = rows[(rows["impl_a"] == "reference") & (rows["impl_b"] == "drake")]
+    assert len(own) == 5 and (own["verdict"] == "passed").all(), own
+    assert own["basis"].str.contains("the referee on drake's reading").all()
+    pair = rows[(rows["impl_a"] == "mujoco") & (rows["impl_b"] == "drake")].set_index("subject")
+    for subject in ("d(forward)/dq", "d(forward)/dv", "d(forward)/dtau"):
+        assert pair.loc[subject, "verdict"] == "explained", pair.loc[subject]
+    for subject in ("d(inverse)/dq", "d(inverse)/dv"):
+        assert pair.loc[subject, "verdict"] == "passed", pair.loc[subject]
+    line = {v.engine: v for v in per_engine(result.rows, result.impls)}["drake"]
+    assert line.reading is Reading.DIFFERENTLY and line.agreement is Agreement.AGREE
