@@ -186,7 +186,7 @@ def test_a_model_stepped_by_rk4_still_gets_mujocos_derivatives(tmp_path):
 
 
 
-ARMATURE = """<mujoco model="m"><worldbody><body name="a" pos="0 0 1">
+UNACTUATED = """<mujoco model="m"><worldbody><body name="a" pos="0 0 1">
   <joint name="j" type="hinge" axis="0 1 0" armature="0.2"/>
   <inertial pos="0 0 -0.3" mass="1.5" diaginertia="0.02 0.03 0.01"/>
   <body name="b" pos="0 0 -0.6"><joint name="k" type="hinge" axis="1 0 0"/>
@@ -203,7 +203,7 @@ def test_an_engine_reading_the_model_otherwise_is_judged_on_its_own_reading(tmp_
     armature into) are explained by the readings' measured difference and the inverse ones
     (armature is constant in M: ∂τ/∂q, ∂τ/∂v hold none of it, (2.2.23)) pass as they are."""
     path = tmp_path / "m.xml"
-    path.write_text(ARMATURE)
+    path.write_text(UNACTUATED)
     result = check_model(path, states=5, derivatives=True,
                          impls=("reference", "mujoco", "drake"))
     rows = result.rows[result.rows["section"] == "derivatives"]
