@@ -18,7 +18,6 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from dyncheck.adapters.model_tree import JointType, ModelTree, TreeJoint
 from dyncheck.check.rows import CheckRow, Section
@@ -181,6 +180,8 @@ def _placement_row(a: ModelTree, b: ModelTree, moved: Placement,
     if not moved.turned:
         return Verdict.EXPLAINED, SHIFTED.format(a=a.engine, b=b.engine,
                                                  t=_fmt(moved.translation))
+    from scipy.spatial.transform import Rotation  # (a placement found: rare; 0.3 s import)
+
     rotvec = Rotation.from_matrix(moved.rotation).as_rotvec()
     angle = float(np.degrees(np.linalg.norm(rotvec)))
     axis = _fmt(rotvec / np.linalg.norm(rotvec))
@@ -235,6 +236,8 @@ def diff(model: str, a: ModelTree, b: ModelTree,
     compared = 0
     if moved is not None:
         verdict, note = _placement_row(a, b, moved, rtol)
+        from scipy.spatial.transform import Rotation
+
         turn = Rotation.from_matrix(moved.rotation).as_rotvec()  # (t, the turn's rotation
         shown = np.concatenate([moved.translation, turn]) if moved.turned \
             else moved.translation  # vector) where turned, t alone where not
