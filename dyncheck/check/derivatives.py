@@ -370,8 +370,8 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
     stepping: dict[str, object] = {}  # engine → its step Jacobians, or how they failed
     t0 = time.perf_counter()
     ref = referee(tree, states)
-    own_refs = {name: mine for name, reading in (readings or {}).items() if name in engines
-                and (mine := referee(reading, states)).tie.agrees}
+    own_refs = {name: judged for name, reading in (readings or {}).items() if name in engines
+                and (judged := referee(reading, states)).tie.agrees}
     seconds["d reference"] = time.perf_counter() - t0
     trusted = with_referee and ref.tie.agrees
     if with_referee and not trusted:  # never silently trusted: its rows give way to this one
@@ -431,10 +431,10 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
             eps = max(getattr(engines.get(a_name), "tree", tree).eps,
                       getattr(engines.get(b_name), "tree", tree).eps)
             if a_name == "reference" and b_name in own_refs:  # on b's own reading
-                mine = own_refs[b_name]
+                on_b = own_refs[b_name]
                 out.extend(replace(r, basis=f"{r.basis}; the referee on {b_name}'s reading")
-                           for r in compare(model, tree, a_name, mine.derivatives, b_name,
-                                            found[b_name], mine, eps=eps))
+                           for r in compare(model, tree, a_name, on_b.derivatives, b_name,
+                                            found[b_name], on_b, eps=eps))
             elif a_name in own_refs or b_name in own_refs:
                 out.extend(_across_readings(model, tree, a_name, found[a_name], b_name,
                                             found[b_name], own_refs.get(a_name, ref),

@@ -104,12 +104,12 @@ PLACEMENT[:3, 3] = [0.3, 0.0, -0.2]
     f"{lay.angular_axes}-offset{int(not np.allclose(lay.offset, np.eye(4)))}-"
     f"point{int(lay.point is not None)}"))
 def test_the_batched_free_joint_map_is_the_one_state_map(lay):
-    """The check maps a batch of real states at once (``_free_batch``); expected: the
+    """The check maps a batch of real states at once (``free_batch``); expected: the
     one-state map above (itself held to finite differences), state by state, with a
     placement as well (a parser placing the model elsewhere)."""
     from dataclasses import replace
 
-    from dyncheck.adapters.layout import _free_batch
+    from dyncheck.adapters.layout_batch import free_batch
     from dyncheck.cases.coordinate_maps import quat_from_matrix
 
     lay = replace(lay, placement=PLACEMENT)
@@ -118,7 +118,7 @@ def test_the_batched_free_joint_map_is_the_one_state_map(lay):
     quats /= np.linalg.norm(quats, axis=1, keepdims=True)
     q_c = np.concatenate([RNG.normal(size=(20, 3)), quats], axis=1)
     v_c = RNG.normal(size=(20, 6))
-    q_e, t, tdot_v = _free_batch(lay, place, q_c, v_c)
+    q_e, t, tdot_v = free_batch(lay, place, q_c, v_c)
     for i in range(20):
         one = _free(lay, place, q_c[i], v_c[i])
         np.testing.assert_allclose(q_e[i], one[0], atol=1e-14)
@@ -129,10 +129,11 @@ def test_the_batched_free_joint_map_is_the_one_state_map(lay):
 def test_the_batched_ball_map_is_the_one_state_map():
     """A ball joint in roll-pitch-yaw with ω in the parent's axes (Drake's), batched against
     the one-state map, gimbal lock included (pitch ±π/2: roll taken 0)."""
-    from dyncheck.adapters.layout import _rpy_batch, rpy_from_matrix
+    from dyncheck.adapters.layout import rpy_from_matrix
+    from dyncheck.adapters.layout_batch import rpy_batch
 
     rot = Rotation.random(30, random_state=3).as_matrix()
     rot[0] = Rotation.from_euler("ZYX", [0.3, np.pi / 2, 0.0]).as_matrix()
-    batched = _rpy_batch(rot)
+    batched = rpy_batch(rot)
     for i in range(30):
         np.testing.assert_allclose(batched[i], rpy_from_matrix(rot[i]), atol=1e-12)

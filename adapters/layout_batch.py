@@ -1,0 +1,95 @@
+"""The check's state map (:mod:`dyncheck.adapters.layout`) for a batch of real states at once:
+the same formulas as the one-state map (:func:`~dyncheck.adapters.layout.state_map`, which a
+complex step goes through), each state a row (tests/adapters/test_layout.py holds the two
+equal over every layout variant)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dyncheck.adapters.integrators import quat_mul
+from dyncheck.adapters.layout import IDENTITY, Canonical, quat_order
+from dyncheck.adapters.model_tree import Axes, JointType, Layout, ModelTree, Orientation
+from dyncheck.cases.coordinate_maps import quat_from_matrix, quat_to_matrix
+
+
+def batch_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray,
+               v_c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_state_map` for every state at once (real states): q_e (n, nq_e), T (n, nv_e,
+    nv), Ṫ v (n, nv_e) — the same formulas, batched (tests/check/test_layout.py holds the two
+    equal)."""
+    n = len(q_c)
+    q_e = np.zeros((n, tree.nq))
+    t = np.zeros((n, tree.nv, canon.nv))
+    tdot_v = np.zeros((n, tree.nv))
+    for name, kind, qs, vs, zero in zip(canon.names, canon.types, canon.q_start, canon.v_start,
+                                        canon.zeros, strict=True):
+        joint = tree.joint(name)
+        lay = joint.layout
+        qe, ve = lay.q_start, lay.v_start
+        if kind in (JointType.HINGE, JointType.SLIDE):
+            value = q_c[:, qs] - zero + lay.zero
+            if lay.cos_sin:
+                q_e[:, qe], q_e[:, qe + 1] = np.cos(value), np.sin(value)
+            else:
+                q_e[:, qe] = value
+            t[:, ve, vs] = 1.0
+        elif kind is JointType.BALL:
+            rot = quat_to_matrix(q_c[:, qs : qs + 4])
+            if lay.quat == Orientation.RPY:
+                q_e[:, qe : qe + 3] = rpy_batch(rot)
+            else:
+                q_e[:, qe : qe + 4] = q_c[:, qs : qs + 4][:, quat_order(lay.quat)]
+            t[:, ve : ve + 3, vs : vs + 3] = rot if lay.angular_axes is Axes.PARENT \
+                else np.eye(3)
+        else:
+            place = quat_from_matrix(lay.placement[:3, :3].T[None])[0]
+            q_e[:, qe : qe + 7], t[:, ve : ve + 6, vs : vs + 6], tdot_v[:, ve : ve + 6] = \
+                free_batch(lay, place, q_c[:, qs : qs + 7], v_c[:, vs : vs + 6])
+    return q_e, t, tdot_v
+
+
+def rpy_batch(rot: np.ndarray) -> np.ndarray:
+    """:func:`rpy_from_matrix` for every state at once (real)."""
+    pitch = np.arcsin(np.clip(-rot[:, 2, 0], -1.0, 1.0))
+    locked = np.abs(rot[:, 2, 0]) > 1 - 1e-12
+    roll = np.where(locked, 0.0, np.arctan2(rot[:, 2, 1], rot[:, 2, 2]))
+    yaw = np.where(locked, np.arctan2(-rot[:, 0, 1], rot[:, 1, 1]),
+                   np.arctan2(rot[:, 1, 0], rot[:, 0, 0]))
+    return np.stack([roll, pitch, yaw], -1)
+
+
+def free_batch(lay: Layout, place_quat: np.ndarray, q_c: np.ndarray,
+                v_c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_free` for every state at once (real): the same formulas, each state's row."""
+    n = len(q_c)
+    p_w, quat_w = q_c[:, :3], q_c[:, 3:7]
+    rot = quat_to_matrix(quat_w)
+    r_o = lay.offset[:3, :3]
+    offset = not np.array_equal(lay.offset, IDENTITY)
+    place_r, place_p = lay.placement[:3, :3], lay.placement[:3, 3]
+    origin = p_w + rot @ lay.offset[:3, 3] if offset else p_w
+    p_e = (origin - place_p) @ place_r  # place_rᵀ x, row by row
+    p_o = lay.offset[:3, 3] if lay.point is None else np.asarray(lay.point, float)
+    turned = quat_mul(quat_w.T, quat_from_matrix(r_o[None])[0]).T if offset else quat_w
+    quat_e = quat_mul(place_quat, turned.T).T[:, quat_order(lay.quat)]
+    q_e = np.concatenate([quat_e, p_e] if lay.quat_first else [p_e, quat_e], axis=1)
+    t = np.zeros((n, 6, 6))
+    tdot_v = np.zeros((n, 6))
+    lin = slice(3, 6) if lay.angular_first else slice(0, 3)
+    ang = slice(0, 3) if lay.angular_first else slice(3, 6)
+    omega = v_c[:, 3:6]
+    cross_p = np.array([[0.0, -p_o[2], p_o[1]], [p_o[2], 0.0, -p_o[0]], [-p_o[1], p_o[0], 0.0]])
+    centripetal = np.cross(omega, np.cross(omega, p_o))
+    if lay.linear_axes is Axes.LOCAL:
+        r_e = rot @ r_o
+        t[:, lin, 0:3] = np.swapaxes(r_e, 1, 2)
+        t[:, lin, 3:6] = -r_o.T @ cross_p
+        linear = np.einsum("nij,nj->ni", t[:, lin, :], v_c)
+        tdot_v[:, lin] = centripetal @ r_o - np.cross(omega @ r_o, linear)
+    else:
+        t[:, lin, 0:3] = np.eye(3)
+        t[:, lin, 3:6] = -rot @ cross_p
+        tdot_v[:, lin] = np.einsum("nij,nj->ni", rot, centripetal)
+    t[:, ang, 3:6] = rot if lay.angular_axes is Axes.WORLD else r_o.T
+    return q_e, t, tdot_v
