@@ -85,8 +85,9 @@ or Warp (``run``, ``bench``, ``tutorials``, a ``check`` with a MuJoCo port)."""
 def floor_mib(command: str, impls: tuple[str, ...] = ()) -> int | None:
     """The address space ``command`` needs (None: no engine loaded: no floor)."""
     if command == "check":
-        ports = {"mjx", "mjx-f64", "mujoco-warp"}
-        return FLOOR_MIB["engines"] if ports & set(impls) else FLOOR_MIB["check"]
+        from dyncheck.adapters import ENGINE_PORTS
+
+        return FLOOR_MIB["engines"] if set(ENGINE_PORTS) & set(impls) else FLOOR_MIB["check"]
     if command in ("run", "bench", "tutorials"):
         return FLOOR_MIB["engines"]
     return None

@@ -80,60 +80,68 @@ def check_out(out: Path, flag: str = "--out") -> None:
                 p.rmdir()
 
 
-LOCK = ".dyncheck-lock"
-"""The file in an output folder that a dyncheck writing there holds locked (its process id
-inside), removed when the command ends."""
-
-_CLAIMS: list[tuple[int, Path, list[Path]]] = []
-"""The output folders this command holds: their lock's descriptor and path, and the folders
-made for it (removed again where the command leaves them empty)."""
+_CLAIMS: list[tuple[int, list[Path]]] = []
+"""The output folders this command holds: a descriptor of each folder (locked), and the
+folders made for it (removed again where the command leaves them empty)."""
 
 
 def claim_out(out: Path, flag: str = "--out") -> None:
-    """Hold ``out`` for this command (an exclusive ``flock`` on :data:`LOCK`), so that two
-    dyncheck commands never write one folder at once — a second is refused at once, naming
-    the process that holds it; the lock goes with the process, however it ends
-    (:func:`release_outs` also removes the file)."""
+    """Hold ``out`` for this command — an exclusive ``flock`` on the folder itself, so that
+    two dyncheck commands never write one folder at once and nothing is written to hold it
+    (a command killed with SIGKILL leaves no lock behind: the lock goes with the process). A
+    second command is refused at once, naming the process that holds the folder
+    (``/proc/locks``)."""
     import fcntl
 
-    path = out / LOCK
-    if any(p == path for _, p, _ in _CLAIMS):
-        return
     made = [p for p in (out, *out.parents) if not p.exists()]
     try:
         out.mkdir(parents=True, exist_ok=True)
-        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600)
+        fd = os.open(out, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
     except OSError as exc:
-        raise InvalidInput(flag, str(out), f"a folder whose lock file can be made ({LOCK}: "
-                           f"{exc.strerror})") from None
+        raise InvalidInput(flag, str(out), f"a folder that can be opened ({exc.strerror})") \
+            from None
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
-        holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "unknown"
+        holder = _lock_holder(fd)
         os.close(fd)
         raise InvalidInput(flag, str(out), f"a folder no other dyncheck is writing (process "
-                           f"{holder[:16]!r} is: wait for it to end, or choose another "
-                           f"{flag})") from None
-    os.ftruncate(fd, 0)
-    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
-    _CLAIMS.append((fd, path, made))
+                           f"{holder} is: wait for it to end, or choose another {flag})") \
+            from None
+    _CLAIMS.append((fd, made))
     from dyncheck.workers import at_end
 
     at_end(release_outs)
 
 
+def _lock_holder(fd: int) -> str:
+    """The process holding an flock on the file of ``fd`` (Linux ``/proc/locks``), or
+    "another process" where it cannot be read."""
+    st = os.fstat(fd)
+    inode = f"{os.major(st.st_dev):02x}:{os.minor(st.st_dev):02x}:{st.st_ino}"
+    try:
+        lines = Path("/proc/locks").read_text().splitlines()
+    except OSError:
+        return "another process"
+    for line in lines:
+        fields = line.split()
+        if "FLOCK" in fields and inode in fields:
+            pid = fields[fields.index(inode) - 1]
+            return pid if pid.isdigit() else "another process"
+    return "another process"
+
+
 def release_outs() -> None:
-    """Let go of every folder :func:`claim_out` took: its lock file removed, then closed."""
+    """Let go of every folder :func:`claim_out` took (a folder it made removed if empty)."""
     while _CLAIMS:
-        fd, path, made = _CLAIMS.pop()
-        try:
-            path.unlink(missing_ok=True)
-            for folder in made:  # innermost first: a refused command leaves no trace
+        fd, made = _CLAIMS.pop()
+        os.close(fd)
+        for folder in made:  # innermost first: a refused command leaves no trace
+            try:
                 if folder.is_dir() and not any(folder.iterdir()):
                     folder.rmdir()
-        except OSError:
-            pass
-        os.close(fd)
+            except OSError:
+                pass
 
 
 def check_out_file(flag: str, path: Path, inputs: Sequence[Path] = ()) -> None:

@@ -1566,22 +1566,6 @@ def _mjcf(head: str = "", ja: str = "", tail: str = "") -> str:
     return MJCF.format(head=head, ja=ja, tail=tail)
 
 
-def _lock(kind: str) -> Callable[[Path], None]:
-    """An --out folder whose lock file is stale (left by a killed dyncheck), a symlink or a
-    folder."""
-    def make(tmp: Path) -> None:
-        (tmp / "m.urdf").write_text(URDF)
-        (tmp / "out").mkdir()
-        lock = tmp / "out" / ".dyncheck-lock"
-        if kind == "stale":
-            lock.write_text("999999\n")
-        elif kind == "link":
-            lock.symlink_to(tmp / "elsewhere")
-        else:
-            lock.mkdir()
-    return make
-
-
 FREE_ARMATURE = ('<mujoco model="m"><worldbody><body name="box" pos="0 0 1"><joint name="root" '
                  'type="free" armature="0.1"/><inertial pos="0.05 0.02 0" mass="2" '
                  'diaginertia="0.1 0.2 0.3"/></body></worldbody></mujoco>')
@@ -1664,12 +1648,6 @@ ROUND3 = (  # #59 and #60: readings measured, refusals named, folders held
     chk("MJCF body inertia of 1e-12 kg m^2", "a.xml",
         _mjcf().replace('diaginertia="0.01 0.01 0.004"', 'diaginertia="1e-12 1e-12 1e-12"'),
         exit=0, answer=AGREE),
-    Fault(kind="--out holding a stale lock file (a killed dyncheck's)", area="check",
-          prepare=_lock("stale"), argv=("check", "{tmp}/m.urdf", "--states", "3", "--out", OUT),
-          exit=0, answer=r"^m: \d+ passed, \d+ explained, 0 failed, 0 skipped"),
-    Fault(kind="--out whose lock file is a symlink", area="check", prepare=_lock("link"),
-          argv=("check", "{tmp}/m.urdf", "--states", "3", "--out", OUT),
-          answer=r"--out must be a folder whose lock file can be made \(\.dyncheck-lock: "),
     Fault(kind="check under ulimit -v 390 MiB (engines failed as if the model had)",
           area="check", patch=lambda mp, tmp: mp.setattr(
               "dyncheck.confinement.address_space_mib", lambda: 390),
@@ -1680,9 +1658,6 @@ ROUND3 = (  # #59 and #60: readings measured, refusals named, folders held
               "dyncheck.confinement.address_space_mib", lambda: 1953),
           argv=("run", "simple_pendulum", "--out", OUT),
           answer=r"^dyncheck: error: ulimit -v must be at least 4096 MiB for `dyncheck run`"),
-    Fault(kind="--out whose lock file is a folder", area="check", prepare=_lock("folder"),
-          argv=("check", "{tmp}/m.urdf", "--states", "3", "--out", OUT),
-          answer=r"--out must be a folder whose lock file can be made \(\.dyncheck-lock: "),
 )
 
 FAULTS = (*FAULTS, *HOSTILE_MODELS, *MORE_FAULTS, *EXTRA_FAULTS, *OUTPUT_PATHS, *NAMES, *DEEP,
