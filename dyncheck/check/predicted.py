@@ -19,7 +19,7 @@ from dyncheck.adapters.model_tree import (
 )
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.check.dynamics import Prediction, States
-from dyncheck.check.readings import READING
+from dyncheck.check.readings import READING, canonical_armature
 from dyncheck.check.referee import ReferenceModel
 from dyncheck.vocabulary import Quantity
 
@@ -70,9 +70,7 @@ def _armature_terms(canon: Canonical, tree: ModelTree,
         joint = tree.joint(name)
         arm = np.asarray(joint.armature, float)
         a_e[joint.layout.v_start : joint.layout.v_start + len(arm)] = arm
-        if joint.type is JointType.FREE and joint.layout.angular_first and len(arm) == 6:
-            arm = np.concatenate([arm[3:], arm[:3]])
-        a_c[canon.v_start[k] : canon.v_start[k] + len(arm)] = arm
+        a_c[canon.v_start[k] : canon.v_start[k] + len(arm)] = canonical_armature(joint)
     maps, _, _, _ = engine_states(canon, tree, states.q, states.v, states.a)
     t = np.array([m.t for m in maps])
     tdot_v = np.array([m.tdot_v for m in maps])
