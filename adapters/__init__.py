@@ -47,6 +47,12 @@ class Registration:
     on_request: bool = False
     """Checked only when asked for (``--impl``): a port (compiling a model for it takes
     seconds to minutes on a CPU), or an engine a user names when moving a model to it."""
+    accelerator: bool = False
+    """Built for accelerators (a GPU): ``dyncheck run`` leaves it out unless asked for
+    (``--accelerators``, or ``--impl NAME``). On a CPU it dominates a run (MJX traces and
+    XLA-compiles each case and precision, ~25 s a case on two cores; Newton launches ~15 Warp
+    kernels a step, ~1.4 ms a step from Python: 21 s of one case's trajectory studies), so the
+    README's first command runs the engines a CPU runs in seconds, and these a second one."""
     label: str | None = None
     """Its engine's name in a report's provenance, where its adapter reports the version
     (one implementation per engine)."""
@@ -103,7 +109,7 @@ REGISTRY: dict[str, Registration] = {
     "mjx-f64": Registration(
         module=_A + "mjx_", cls="MJXF64Adapter", package="mujoco-mjx", extra="mjx", ports="mujoco",
         integrators=_PORTS,
-        model=_A + "port_models:MjxF64Model", on_request=True,
+        model=_A + "port_models:MjxF64Model", on_request=True, accelerator=True,
     ),
     "mjx": Registration(
         module=_A + "mjx_",
@@ -114,6 +120,7 @@ REGISTRY: dict[str, Registration] = {
         float32=True,
         integrators=_PORTS,
         model=_A + "port_models:MjxModel", on_request=True, label="mujoco-mjx",
+        accelerator=True,
     ),
     "mujoco-warp": Registration(
         module=_A + "mujoco_warp_",
@@ -124,11 +131,12 @@ REGISTRY: dict[str, Registration] = {
         float32=True,
         integrators=_PORTS,
         model=_A + "port_models:MujocoWarpModel", on_request=True, label="mujoco-warp",
+        accelerator=True,
     ),
 
     "newton": Registration(
         package="newton", extra="newton", model=_A + "newton_model:NewtonModel",
-        label="newton", on_request=True, float32=True, run=Format.MJCF,
+        label="newton", on_request=True, float32=True, run=Format.MJCF, accelerator=True,
         integrators=(Integrator.EULER,),
         releases=("1.7.0", "1.8.0"),
     ),
@@ -149,6 +157,9 @@ ENGINE_PACKAGES: dict[str, str] = {name: r.package for name, r in REGISTRY.items
 """Every engine implementation dyncheck knows, installed or not → its pip package."""
 ENGINE_EXTRAS: dict[str, str] = {n: r.extra for n, r in REGISTRY.items() if r.extra}
 """The optional extra of dyncheck that installs an engine (core engines have none)."""
+ACCELERATORS: tuple[str, ...] = tuple(n for n, r in REGISTRY.items() if r.accelerator)
+"""The engines built for accelerators, which ``dyncheck run`` runs only when asked for
+(:attr:`Registration.accelerator`)."""
 ENGINE_PORTS: dict[str, str] = {n: r.ports for n, r in REGISTRY.items() if r.ports}
 """Ports of another engine → that engine."""
 FLOAT32: frozenset[str] = frozenset(n for n, r in REGISTRY.items() if r.float32)
@@ -216,6 +227,7 @@ def get_adapter(name: str) -> type[Adapter]:
 
 
 __all__ = [
+    "ACCELERATORS",
     "ADAPTERS",
     "COUPLINGS_ONLY",
     "ENGINE_EXTRAS",

@@ -9,6 +9,7 @@ trajectory (judged by order, not by tolerance) — and any row that appeared or 
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from pathlib import Path
 
 import numpy as np
@@ -97,13 +98,21 @@ def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
 
 
 def compare(
-    current: pd.DataFrame, baseline: pd.DataFrame, *, cases: list[str] | None = None
+    current: pd.DataFrame,
+    baseline: pd.DataFrame,
+    *,
+    cases: list[str] | None = None,
+    impls: Collection[str] | None = None,
 ) -> pd.DataFrame:
     """Rows that moved (:func:`dyncheck.diff.diff` at :data:`FACTOR`): columns ``row`` (its
     key), ``change`` (the move and why), ``baseline`` and ``current`` (verdict and error).
-    ``cases`` restricts the baseline to the cases that were run."""
+    ``cases`` and ``impls`` restrict the baseline to the cases and implementations that were
+    run."""
     if cases is not None:
         baseline = baseline[baseline["case"].isin(cases)]
+    if impls is not None:
+        ran = [baseline[c].isna() | baseline[c].isin(impls) for c in ("impl_a", "impl_b")]
+        baseline = baseline[ran[0] & ran[1]]
     here = Path("current run")
     old = diff.tables(baseline[COLUMNS], diff.RunKind.RUN, path=here, flag="--baseline")
     new = diff.tables(current[COLUMNS], diff.RunKind.RUN, path=here)

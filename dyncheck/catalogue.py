@@ -126,7 +126,9 @@ def _skipped(name: str, why: str) -> Entry:
     return Entry(name, "", "", "", nan, nan, skipped=why)
 
 
-def not_selected(name: str, selected: Collection[str]) -> Entry | None:
+def not_selected(
+    name: str, selected: Collection[str], command: str = "dyncheck run"
+) -> Entry | None:
     """The entry ``name`` skipped when it needs an optional engine that a run leaves out
     (``dyncheck run --impl ...`` without it), else None: a run of the core engines loads
     neither JAX nor Drake for its catalogue, as on a machine without them."""
@@ -136,7 +138,9 @@ def not_selected(name: str, selected: Collection[str]) -> Entry | None:
                 if engine in RUN and engine not in selected]  # is not chosen by --impl
     if not left_out:
         return None
-    return _skipped(name, f"{', '.join(left_out)} not selected (--impl)")
+    from dyncheck.roster import IMPLEMENTATIONS, not_run
+
+    return _skipped(name, str(not_run(set(IMPLEMENTATIONS) - set(left_out), command)))
 
 
 def _run(name: str) -> Entry:
@@ -206,10 +210,29 @@ def measured_entry(name: str) -> tuple[Entry, dict[str, str], bool]:
     return entry, used, found
 
 
-def explain_cached(name: str | None = None) -> tuple[list[Entry], int]:
-    """:func:`explain` through :func:`measured_entry`, with how many entries were read back."""
-    results = [measured_entry(n) for n in _names(name)]
-    return [entry for entry, _, _ in results], sum(found for _, _, found in results)
+def _entry(name: str, selected: Collection[str] | None) -> tuple[Entry, bool]:
+    """One entry of ``dyncheck explain`` (a unit of work): measured or read back, or skipped
+    where it needs an engine left out of ``selected`` (None: every engine)."""
+    skipped = None if selected is None else not_selected(name, selected, "dyncheck explain")
+    if skipped is not None:
+        return skipped, False
+    entry, _, found = measured_entry(name)
+    return entry, found
+
+
+def explain_cached(
+    name: str | None = None, *, accelerators: bool = True, jobs: int = 1
+) -> tuple[list[Entry], int]:
+    """:func:`explain` through :func:`measured_entry`, with how many entries were read back;
+    the entries measured on ``jobs`` processes. Without ``accelerators`` the entries that need
+    an engine built for accelerators (Newton compiles its kernels for ~30 s on a CPU, MJX
+    traces for ~8 s) say so instead, unless ``name`` asks for one of them."""
+    from dyncheck.roster import ON_A_CPU
+    from dyncheck.workers import run_units
+
+    selected = None if accelerators or name is not None else ON_A_CPU
+    done = run_units([(n, _entry, (n, selected)) for n in _names(name)], jobs=jobs)
+    return [entry for entry, _ in done], sum(found for _, found in done)
 
 
 def render(entries: list[Entry]) -> str:

@@ -54,9 +54,11 @@ def _selection(p: argparse.ArgumentParser) -> None:
         action="append",
         default=[],
         metavar="NAME",
-        help="implementation to include (repeatable; default: all); the catalogue's entries "
-        "that need an optional engine left out (Drake, MJX) are skipped",
+        help="implementation to include (repeatable; default: every one but the engines "
+        "built for accelerators); the catalogue's entries that need an engine left out say "
+        "so",
     )
+    _accelerators(p)
     p.add_argument(
         "--jobs",
         type=int,
@@ -66,6 +68,15 @@ def _selection(p: argparse.ArgumentParser) -> None:
     )
     _dask(p)
     _no_cache(p)
+
+def _accelerators(p: argparse.ArgumentParser) -> None:
+    from dyncheck.adapters import ACCELERATORS
+
+    p.add_argument("--accelerators", action="store_true",
+                   help=f"also run the engines built for accelerators ({', '.join(ACCELERATORS)}"
+                   "): minutes on a CPU, where they compile every case; on a GPU add "
+                   "--device cuda")
+
 
 def _no_cache(p: argparse.ArgumentParser) -> None:
     p.add_argument(
@@ -227,6 +238,7 @@ def _parser() -> argparse.ArgumentParser:
                    help=f"cases in N parallel processes (same results; default: {_JOBS})")
     _dask(c)
     _no_cache(c)
+    _accelerators(c)
     c.add_argument(
         "--from",
         dest="run_dir",
@@ -237,6 +249,9 @@ def _parser() -> argparse.ArgumentParser:
     )
     e = sub.add_parser("explain", help="demonstrate a modelling convention (all if none)")
     e.add_argument("name", nargs="?", default=None, metavar="NAME")
+    e.add_argument("--jobs", type=int, default=default_jobs(), metavar="N",
+                   help=f"entries measured in N parallel processes (default: {_JOBS})")
+    _accelerators(e)
     _no_cache(e)
     er = sub.add_parser("errata", help="check every formula of §2.2 and write the errata page")
     er.add_argument("--out", type=path_arg, default=Path("reports/errata.md"),

@@ -245,7 +245,7 @@ def version_changes(a: dict[str, str], b: dict[str, str]) -> list[str]:
         return {k.replace(" ", "_"): v.replace(" ", "_") for k, v in d.items()}
 
     na, nb = norm(a), norm(b)
-    skip = {"date_(UTC)", "dyncheck_commit"}
+    skip = {"date_(UTC)", "dyncheck_commit", "implementations"}
     unused = NOT_USED.replace(" ", "_")
     names = [k for k in dict.fromkeys([*na, *nb])
              if k not in skip and unused not in (na.get(k), nb.get(k))]

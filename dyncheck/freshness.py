@@ -34,7 +34,7 @@ from __future__ import annotations
 import io
 import math
 import re
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -394,6 +394,48 @@ TABLES: dict[str, Callable[[str, str, str], list[Moved]]] = {
     "convergence.csv": convergence_moved,
     "conservation.csv": conservation_moved,
 }
+
+
+RAN = "implementations"
+"""The key of a run's ``provenance.json`` that lists the implementations it was asked for."""
+IMPL_COLUMNS = ("impl", "impl_a", "impl_b")
+
+
+def _implementations(table: pd.DataFrame) -> set[str]:
+    return {str(x) for c in IMPL_COLUMNS if c in table.columns for x in table[c].dropna()}
+
+
+def narrowed(
+    old: Mapping[str, str], new: Mapping[str, str], ran: Collection[str]
+) -> tuple[dict[str, str], dict[str, str], list[str]]:
+    """A run of fewer implementations than the report ``old`` holds (the README's first
+    command leaves out the engines built for accelerators), made comparable: ``old``'s tables
+    cut to the rows whose implementations all ran, the pages of both sides left out (each sums
+    up every implementation of its run), and the implementations of ``old`` not run. A run of
+    every implementation ``old`` holds is returned as it is, with no implementation left out."""
+    ran = set(ran)
+    tables = {name: _read(text) for name, text in old.items() if name in TABLES}
+    held = set().union(*(_implementations(t) for t in tables.values()))
+    left_out = sorted(held - ran)
+    if not left_out:
+        return dict(old), dict(new), []
+    cut = {}
+    for name, t in tables.items():
+        keep = np.ones(len(t), bool)
+        for column in IMPL_COLUMNS:
+            if column in t.columns:
+                keep &= (t[column].isna() | t[column].astype(str).isin(ran)).to_numpy()
+        cut[name] = t[keep].to_csv(index=False)
+    return cut, {name: text for name, text in new.items() if name in TABLES}, left_out
+
+
+def ran_in(folder: Path) -> list[str] | None:
+    """The implementations a report folder's run was asked for (its ``provenance.json``), or
+    None where it does not say (a report written before runs recorded it: every one)."""
+    from dyncheck.diff import read_versions
+
+    listed = read_versions(folder).get(RAN)
+    return None if listed is None else [n for n in listed.split(", ") if n]
 
 
 def compare(old: Mapping[str, str], new: Mapping[str, str]) -> list[Moved]:

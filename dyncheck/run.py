@@ -8,6 +8,7 @@ from functools import partial, reduce
 
 import pandas as pd
 
+from dyncheck.adapters import ACCELERATORS
 from dyncheck.cases import Case, get_case
 from dyncheck.catalogue import DEMOS, Entry, measured_entry, not_selected
 from dyncheck.closed_forms import closed_form_rows
@@ -29,6 +30,7 @@ from dyncheck.results import (
     Discrepancy,
     table,
 )
+from dyncheck.roster import ON_A_CPU
 from dyncheck.studies import TrajectoryFigures, study
 from dyncheck.studies.derivatives import derivative_rows
 from dyncheck.vocabulary import Verdict
@@ -51,6 +53,9 @@ class RunResult:
     engines: dict[str, str] = field(default_factory=dict)
     """The versions of the engines the units of work used (provenance name → version,
     :func:`dyncheck.provenance.engine_versions`)."""
+    ran: tuple[str, ...] = IMPLEMENTATIONS
+    """The implementations the run was asked for (the others have no rows: one line says
+    which, :func:`dyncheck.roster.not_run`)."""
 
     @property
     def failed(self) -> bool:
@@ -59,15 +64,20 @@ class RunResult:
         return lost or bool((self.discrepancies["verdict"] == Verdict.FAILED).any())
 
 
-def resolve(case_names: Sequence[str], impl_names: Sequence[str]) -> tuple[list[Case], list[str]]:
-    """Validate names before any work: UnknownName lists the valid ones."""
+def resolve(
+    case_names: Sequence[str], impl_names: Sequence[str], *, accelerators: bool = False
+) -> tuple[list[Case], list[str]]:
+    """Validate names before any work: UnknownName lists the valid ones. No ``impl_names``:
+    every implementation a CPU runs in seconds (:data:`~dyncheck.roster.ON_A_CPU`);
+    ``accelerators`` adds the engines built for accelerators."""
     from dyncheck.cases import CASES
 
     cases = [get_case(n) for n in dict.fromkeys(case_names or list(CASES))]  # once each
     for name in impl_names:
         if name not in IMPLEMENTATIONS:
             raise UnknownName("implementation", name, IMPLEMENTATIONS)
-    impls = [n for n in IMPLEMENTATIONS if n in (impl_names or IMPLEMENTATIONS)]
+    chosen = {*(impl_names or ON_A_CPU), *(ACCELERATORS if accelerators else ())}
+    impls = [n for n in IMPLEMENTATIONS if n in chosen]
     return cases, impls
 
 
@@ -225,4 +235,5 @@ def run(
         entries if conventions else None,
         pngs,
         engines,
+        tuple(impl_names),
     )

@@ -112,24 +112,41 @@ def test_every_explained_row_gives_its_reason():
 
 
 def test_the_readmes_counts_are_the_committed_reports():
-    """The counts the README quotes for the main command (and without MuJoCo's ports) are
-    those of the committed report's rows (#48: numbers in prose come from the data)."""
-    from dyncheck.adapters import ENGINE_PORTS
+    """The counts the README quotes for its two commands are those of the committed report's
+    rows (#48: numbers in prose come from the data): the second command's, every row; the
+    first command's, the rows of no engine built for accelerators."""
+    from dyncheck.adapters import ACCELERATORS
 
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     counts = r"(\d+) passed, (\d+) explained, (\d+) failed, (\d+) skipped"
-    whole = re.search(counts + r"; report in reports/README\.md", text)
-    without = re.search(r"Without the extras `mjx`\s+and `warp`: " + counts, text)
-    assert whole and without
+    first = re.search(r"\$ dyncheck run\n.*\n\s+" + counts, text)
+    second = re.search(r"\$ dyncheck run --accelerators\n\s+" + counts, text)
+    assert first and second
     rows = pd.read_csv(ROOT / "reports" / "discrepancies.csv")
-    ports = rows.impl_a.isin(list(ENGINE_PORTS)) | rows.impl_b.isin(list(ENGINE_PORTS))
+    ports = rows.impl_a.isin(ACCELERATORS) | rows.impl_b.isin(ACCELERATORS)
 
     def said(frame: pd.DataFrame) -> tuple[int, ...]:
         got = frame.verdict.value_counts()
         return tuple(int(got.get(v, 0)) for v in ("passed", "explained", "failed", "skipped"))
 
-    assert tuple(map(int, whole.groups())) == said(rows)
-    assert tuple(map(int, without.groups())) == said(rows[~ports])
+    assert tuple(map(int, second.groups())) == said(rows)
+    assert tuple(map(int, first.groups())) == said(rows[~ports])
+
+
+def test_the_readmes_timings_are_the_command_timings_page():
+    """The seconds the README gives its two commands are `dyncheck bench --suite`'s
+    (reports/benchmark-suite.csv), rounded to the second (#45 item 4, #61 item 6)."""
+    from dyncheck.bench_suite import MAIN, SECOND
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    timed = pd.read_csv(ROOT / "reports" / "benchmark-suite.csv").set_index("command")
+    first = re.search(r"(\d+) s on two cores, the install included", text)
+    second = re.search(r"(\d+) s on two CPU cores, where they compile", text)
+    assert first and second
+    main = timed.loc[f"{MAIN} in all (install and run), empty caches", "seconds"]
+    run = timed.loc[[c for c in timed.index if c.startswith(f"{SECOND}: its run")][0], "seconds"]
+    assert int(first.group(1)) == round(float(main))
+    assert int(second.group(1)) == round(float(run))
 
 
 def _number(pattern: str, text: str) -> list[float]:
@@ -236,11 +253,15 @@ def test_no_note_names_its_engine_twice():
 
 def test_the_readmes_main_command_installs_the_extras_the_suite_times():
     """`dyncheck bench --suite` times the README's main command by installing
-    ``MAIN_EXTRAS``: the README's first command must install exactly those."""
-    from dyncheck.bench_suite import MAIN_EXTRAS
+    ``MAIN_EXTRAS``, its second by adding ``ACCELERATOR_EXTRAS``: the README's first two
+    commands must install exactly those."""
+    from dyncheck.bench_suite import ACCELERATOR_EXTRAS, MAIN_EXTRAS
 
-    first = next(line for line in (ROOT / "README.md").read_text().splitlines()
-                 if "pip install" in line)
-    extras = re.search(r'-e "\.\[([a-z,]+)\]"', first)
-    assert extras is not None and "dyncheck run" in first
-    assert tuple(extras.group(1).split(",")) == MAIN_EXTRAS
+    first, second = [line for line in (ROOT / "README.md").read_text().splitlines()
+                     if "pip install" in line][:2]
+    for line, extras, command in ((first, MAIN_EXTRAS, "dyncheck run"),
+                                  (second, (*MAIN_EXTRAS, *ACCELERATOR_EXTRAS),
+                                   "dyncheck run --accelerators")):
+        found = re.search(r'-e "\.\[([a-z,]+)\]"', line)
+        assert found is not None and line.endswith(command)
+        assert tuple(found.group(1).split(",")) == extras

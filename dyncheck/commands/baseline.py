@@ -17,7 +17,7 @@ def baseline_command(args: argparse.Namespace) -> int:
 
     check_out_file("--out", args.out)
     positive("--jobs", args.jobs)
-    cases, impls = resolve(args.cases, args.impl)
+    cases, impls = resolve(args.cases, args.impl, accelerators=args.accelerators)
     previous = baseline.load(args.out, "--out") if args.out.exists() else None  # validated first
     result = run(cases, impls, jobs=args.jobs, dask=args.dask)
     if previous is not None:

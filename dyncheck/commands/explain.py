@@ -7,6 +7,7 @@ import argparse
 
 from dyncheck.commands.options import (
     check_out_file,
+    positive,
 )
 
 
@@ -18,7 +19,9 @@ def explain_command(args: argparse.Namespace) -> int:
 
         print(page.explain(args.name.removeprefix("erratum-")))
         return 0
-    entries, read_back = explain_cached(args.name)
+    positive("--jobs", args.jobs)
+    entries, read_back = explain_cached(args.name, accelerators=args.accelerators,
+                                        jobs=args.jobs)
     print(render(entries))
     if read_back:
         print(f"({read_back} of {len(entries)} measured by an earlier `dyncheck explain` with "

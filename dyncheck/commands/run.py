@@ -14,6 +14,7 @@ from dyncheck.commands.options import (
     write_ci,
 )
 from dyncheck.errors import InvalidInput
+from dyncheck.roster import not_run
 from dyncheck.vocabulary import Verdict
 
 
@@ -29,7 +30,7 @@ def run_command(args: argparse.Namespace) -> int:
         raise InvalidInput("--states", args.states, f"at most {MAX_STATES} (~50 µs per state)")
     positive("--jobs", args.jobs)
     reference = baseline.load(args.baseline) if args.baseline is not None else None
-    cases, impls = resolve(args.cases, args.impl)
+    cases, impls = resolve(args.cases, args.impl, accelerators=args.accelerators)
     claim_out(args.out)  # every option checked: the folder held for this command
     if args.states is not None:
         warn_cost(args.states * len(cases), args.jobs)
@@ -44,13 +45,17 @@ def run_command(args: argparse.Namespace) -> int:
 
     write_ci(args, split(result.discrepancies, RUN), RUN, report.versions(result.engines))
     counts = result.discrepancies["verdict"].value_counts()
+    left_out = not_run(impls)
+    if left_out is not None:
+        print(left_out)
     print(
         ", ".join(f"{counts.get(v, 0)} {v}" for v in Verdict)
         + f"; report in {args.out}/README.md"
     )
     regressed = False
     if reference is not None:
-        changes = baseline.compare(result.discrepancies, reference, cases=[c.name for c in cases])
+        changes = baseline.compare(result.discrepancies, reference,
+                                   cases=[c.name for c in cases], impls=impls)
         regressed = len(changes) > 0
         print(
             f"{len(changes)} rows regressed against {args.baseline}"

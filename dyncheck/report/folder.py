@@ -6,7 +6,7 @@ from __future__ import annotations
 from datetime import UTC, datetime
 from pathlib import Path
 
-from dyncheck.freshness import Moved, compare, read_report
+from dyncheck.freshness import RAN, Moved, compare, narrowed, read_report
 from dyncheck.provenance import versions
 from dyncheck.report.figures import figures
 from dyncheck.report.pages import case_page, conventions_page, errata, index_page
@@ -39,7 +39,8 @@ def render(
             files[out / "figures" / f"{case.name}_{kind}.png"] = png
     files[out / "README.md"] = index_page(result, date=date)
     files[out / "conventions.md"] = conventions_page(result.conventions)
-    files[out / PROVENANCE] = provenance_json({"date (UTC)": date, **versions(result.engines)})
+    files[out / PROVENANCE] = provenance_json(
+        {"date (UTC)": date, **versions(result.engines), RAN: ", ".join(result.ran)})
     lead, table = errata(result.discrepancies)
     files[out / "printed-equations.md"] = "\n".join(
         [
@@ -74,8 +75,11 @@ def rendered_text(result: RunResult, out: Path) -> dict[str, str]:
 
 def check(result: RunResult, out: Path) -> list[Moved]:
     """What moved between the committed report in ``out`` and what the code computes now,
-    compared on results, not bytes (:mod:`dyncheck.freshness`)."""
-    return compare(read_report(out), rendered_text(result, out))
+    compared on results, not bytes (:mod:`dyncheck.freshness`); a run of fewer
+    implementations than the report holds is compared on its own rows
+    (:func:`~dyncheck.freshness.narrowed`)."""
+    old, new, _ = narrowed(read_report(out), rendered_text(result, out), result.ran)
+    return compare(old, new)
 
 
 def write(result: RunResult, out: Path, *, date: str | None = None) -> list[Path]:

@@ -95,3 +95,22 @@ def test_jobs_give_identical_results():
         "simple_pendulum",
         "spherical_pendulum",
     ]
+
+
+def test_a_run_without_the_accelerator_engines_is_compared_on_its_own_rows():
+    """`run --baseline` after the README's first command (MuJoCo's ports left out): the
+    committed baseline's port rows are not "vanished"; the rows the run has are compared (the
+    current rows built here from the baseline itself with pandas, one of them then moved)."""
+    from dyncheck.adapters import ACCELERATORS
+
+    full = baseline.load(REPORTS / "baseline.csv")
+    ports = full["impl_a"].isin(ACCELERATORS) | full["impl_b"].isin(ACCELERATORS)
+    assert ports.any()
+    current = full[~ports].reset_index(drop=True)
+    ran = sorted({*current["impl_a"].dropna(), *current["impl_b"].dropna()})
+    assert baseline.compare(current, full, impls=ran).empty
+    assert not baseline.compare(current, full).empty  # unnarrowed: the port rows vanished
+    moved = current.copy()
+    at = int(moved.index[moved["verdict"] == "passed"][0])
+    moved.loc[at, "verdict"] = "failed"
+    assert len(baseline.compare(moved, full, impls=ran)) == 1

@@ -205,17 +205,20 @@ def test_mjx_integrator_definitions_are_measured():
 
 @pytest.mark.parametrize("name", sorted(catalogue.DEMOS))
 def test_an_entry_is_left_out_only_when_an_engine_it_needs_is(name):
-    """An entry that needs an optional engine of the run (Drake, MJX) is skipped by a run
-    that selects the others, never by one that selects it; entries of the core engines, and
-    of engines of the check only (PyBullet, Newton: no run selects them), are never skipped
-    for it."""
+    """An entry that needs an optional engine of the run (Drake, MJX, Newton, PyBullet) is
+    skipped by a run that selects the others, never by one that selects it; entries of the
+    core engines are never skipped for it."""
     from dyncheck.adapters import RUN
 
     needs = tuple(e for e in catalogue.REQUIRES.get(name, ()) if e in RUN)
     assert catalogue.not_selected(name, ["reference", "mujoco", "pinocchio", *needs]) is None
     left_out = catalogue.not_selected(name, ["reference", "mujoco", "pinocchio"])
-    if needs:
-        assert left_out is not None and left_out.skipped == f"{needs[0]} not selected (--impl)"
+    if needs:  # named, with the way to run it: the second command, or --impl
+        from dyncheck.adapters import ACCELERATORS
+
+        how = "run --accelerators`" if needs[0] in ACCELERATORS else "(left out by --impl)"
+        assert left_out is not None and left_out.skipped.startswith(f"not run: {needs[0]} ")
+        assert how in left_out.skipped
     else:
         assert left_out is None
 

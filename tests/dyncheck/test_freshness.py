@@ -5,6 +5,7 @@ report, independently of the code that wrote it)."""
 from __future__ import annotations
 
 import io
+import json
 import re
 import shutil
 from pathlib import Path
@@ -143,6 +144,56 @@ def test_check_from_a_run_folder_on_another_machine(tmp_path, capsys):
     assert main(["report", "--check", "--from", str(run_dir)]) == 1
     out = capsys.readouterr().out
     assert "moved: discrepancies.csv:" in out and "verdict 'passed' -> 'failed'" in out
+
+
+def _partial_run(run_dir: Path, left_out: tuple[str, ...], *, say: bool) -> None:
+    """The committed report as a run of every implementation but ``left_out`` writes it:
+    their rows cut from the tables (constructed here with pandas, not by freshness), the
+    pages left as they are, and (``say``) its provenance listing what it ran."""
+    shutil.copytree(REPORTS, run_dir)
+    for name in ("discrepancies.csv", "convergence.csv", "conservation.csv"):
+        t = _frame((REPORTS / name).read_text())
+        keep = np.ones(len(t), bool)
+        for column in ("impl", "impl_a", "impl_b"):
+            if column in t.columns:
+                keep &= ~t[column].isin(left_out).to_numpy()
+        assert not keep.all() or name == "conservation.csv"  # the ports have rows to cut
+        (run_dir / name).write_text(to_csv(t[keep]))
+    from dyncheck.roster import IMPLEMENTATIONS
+
+    provenance = run_dir / "provenance.json"
+    listed = {"implementations": ", ".join(n for n in IMPLEMENTATIONS if n not in left_out)}
+    provenance.write_text(json.dumps(listed if say else {}))
+
+
+PORTS = ("mjx-f64", "mjx", "mujoco-warp")
+
+
+def test_check_of_a_run_without_the_accelerator_engines_compares_the_rows_it_has(
+    tmp_path, capsys
+):
+    """The README's first command leaves MuJoCo's ports out: `report --check --from` its
+    folder passes, naming them; a result of an implementation it ran still fails when moved."""
+    run_dir = tmp_path / "run"
+    _partial_run(run_dir, PORTS, say=True)
+    assert main(["report", "--check", "--from", str(run_dir)]) == 0
+    out = capsys.readouterr().out
+    assert "not run here: mjx, mjx-f64, mujoco-warp" in out and "up to date" in out
+    csv = run_dir / "discrepancies.csv"
+    text = csv.read_text()
+    row = next(line for line in text.splitlines() if ",drake," in line and ",passed," in line)
+    csv.write_text(text.replace(row, row.replace(",passed,", ",failed,"), 1))
+    assert main(["report", "--check", "--from", str(run_dir)]) == 1
+    assert "verdict 'passed' -> 'failed'" in capsys.readouterr().out
+
+
+def test_rows_that_vanish_from_a_run_that_does_not_say_it_left_them_out_fail(tmp_path, capsys):
+    """Only the run's own record of what it ran narrows the comparison: the same rows missing
+    from a run that claims every implementation are rows that vanished."""
+    run_dir = tmp_path / "run"
+    _partial_run(run_dir, PORTS, say=False)
+    assert main(["report", "--check", "--from", str(run_dir)]) == 1
+    assert "'present' -> 'vanished'" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("flag", ["--from", "--out"])
