@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import pickle
 import re
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import pytest
@@ -187,13 +188,29 @@ settings.register_profile("nightly", max_examples=300, deadline=None)
 settings.load_profile("ci")
 
 
+SLOW_LIST = Path(__file__).with_name("slow_tests.txt")
+"""The tests measured at ≥ 0.4 s each in the quick loop on two cores
+(``benchmarks/slow_tests.py``): marked slow, so that ``pytest -m "not slow"`` stays under a
+minute and every assertion still runs in ``pytest -m slow`` (#61)."""
+
+
+def _listed_slow() -> frozenset[str]:
+    if os.environ.get("DYNCHECK_SLOW_LIST") == "off" or not SLOW_LIST.is_file():
+        return frozenset()
+    lines = SLOW_LIST.read_text(encoding="utf-8").splitlines()
+    return frozenset(line for line in lines if line and not line.startswith("#"))
+
+
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Every test that needs the full run, or runs one of MuJoCo's ports, is ``slow``
+    """Every test that needs the full run, runs an engine built for accelerators (MuJoCo's
+    ports, Newton: they compile per model) or is listed in :data:`SLOW_LIST` is ``slow``
     (``pytest -m "not slow"`` is the README's test command; ``-m slow`` its second one)."""
+    from dyncheck.adapters import ACCELERATORS
+
+    listed = _listed_slow()
+    ported = re.compile(r"(^|-)(" + "|".join(map(re.escape, ACCELERATORS)) + r")($|-)")
     for item in items:
-        if "full_run" in getattr(item, "fixturenames", ()):
-            item.add_marker(pytest.mark.slow)
-        # MuJoCo's ports compile per model (JAX, Warp): seconds per parametrized case
         ident = getattr(getattr(item, "callspec", None), "id", "")
-        if re.search(r"(^|-)(mjx-f64|mjx|mujoco-warp)($|-)", ident):
+        if ("full_run" in getattr(item, "fixturenames", ()) or item.nodeid in listed
+                or ported.search(ident)):
             item.add_marker(pytest.mark.slow)

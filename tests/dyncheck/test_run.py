@@ -76,3 +76,36 @@ def test_a_catalogue_entry_whose_engine_is_left_out_is_skipped_without_running(m
     drake, hinge = result.conventions
     assert drake.skipped == "drake not selected (--impl)" and not drake.failed
     assert hinge == catalogue.explain("hinge-axis-sign")[0] and not hinge.skipped
+
+
+@pytest.mark.parametrize("accelerators", [False, True])
+def test_the_default_run_is_every_implementation_but_those_built_for_accelerators(accelerators):
+    """No --impl: every implementation of the roster, the engines the registry marks as built
+    for accelerators only with --accelerators; the one line naming what was not run says the
+    command that runs them (nothing left out: no line)."""
+    from dyncheck.adapters import ACCELERATORS, REGISTRY
+    from dyncheck.roster import IMPLEMENTATIONS, not_run
+    from dyncheck.run import resolve
+
+    assert ACCELERATORS and all(REGISTRY[n].accelerator for n in ACCELERATORS)
+    _, impls = resolve(["simple_pendulum"], [], accelerators=accelerators)
+    expected = [n for n in IMPLEMENTATIONS if accelerators or n not in ACCELERATORS]
+    assert impls == expected
+    line = not_run(impls)
+    if accelerators:
+        assert line is None
+    else:
+        assert line is not None and line.startswith(f"not run: {', '.join(ACCELERATORS)} (")
+        assert "`dyncheck run --accelerators`" in line
+
+
+def test_impl_names_an_accelerator_engine_without_the_flag():
+    """--impl mjx runs MJX (and only what was named) without --accelerators; the others are
+    named as left out by --impl."""
+    from dyncheck.roster import not_run
+    from dyncheck.run import resolve
+
+    _, impls = resolve([], ["reference", "mjx"])
+    assert impls == ["reference", "mjx"]
+    line = not_run(impls)
+    assert line is not None and "mjx (" not in line and "(left out by --impl)" in line
