@@ -16,7 +16,7 @@ from functools import partial
 import numpy as np
 
 from dyncheck.errors import EngineNotInstalled, UnknownName
-from dyncheck.explain.charts import derivative_chart
+from dyncheck.explain.charts import composite_derivatives, derivative_chart
 from dyncheck.explain.constraints import (
     drake_equality,
     multiplier_sign,
@@ -86,6 +86,7 @@ DEMOS: dict[str, tuple[Callable[[], Entry], Origin]] = {
     "pybullet-default-motors": (pybullet_default_motors, Origin.ENGINE),
     "newton-several-joints-on-a-body": (newton_joint_order, Origin.ENGINE),
     "derivative-chart": (derivative_chart, Origin.MATHEMATICS),
+    "pinocchio-composite-derivatives": (composite_derivatives, Origin.ENGINE),
 }
 """Conventions demonstrated by a run of their own, with whose property each is; the others
 (point-mass inertia floor, MJCF gravity, held forces, soft constraints: :mod:`.explanations`)

@@ -251,6 +251,10 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("name", nargs="?", default=None, metavar="NAME")
     e.add_argument("--jobs", type=int, default=default_jobs(), metavar="N",
                    help=f"entries measured in N parallel processes (default: {_JOBS})")
+    e.add_argument("--reproducer", type=path_arg, default=None, metavar="FILE",
+                   help="write NAME's standalone script for the engine's issue tracker "
+                   "instead (its engine, numpy and an inline model; exits 1 while the defect "
+                   "stands)")
     _accelerators(e)
     _no_cache(e)
     er = sub.add_parser("errata", help="check every formula of §2.2 and write the errata page")

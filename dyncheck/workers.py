@@ -11,6 +11,7 @@ from __future__ import annotations
 import atexit
 import gc
 import os
+import signal
 import sys
 import threading
 import time
@@ -222,8 +223,6 @@ def on_sigterm() -> Iterator[None]:
     """While the block runs (the main thread only: Python's rule), SIGTERM raises
     :class:`~dyncheck.errors.Terminated` and Ctrl-C KeyboardInterrupt, each marking this
     process as ending (:func:`ending`); the previous handlers restored after."""
-    import signal
-
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -256,14 +255,35 @@ def _worker_start(parent: int) -> None:
     ``dyncheck run --jobs 2`` left its workers computing) and skips the final collection;
     Ctrl-C is its parent's to answer (:func:`stop` ends it), and SIGTERM unwinds its unit
     (an engine's process closed, its temporary files removed) before it exits."""
-    import signal
-
     from dyncheck.confinement import die_with_parent
 
     die_with_parent(parent)
     exit_without_collecting()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, _raise_terminated)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD)  # (forked while they were held)
+
+
+HELD = frozenset({signal.SIGINT, signal.SIGTERM})
+"""SIGINT and SIGTERM: held while a pool's units are submitted (:func:`_signals_held`)."""
+
+
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """Ctrl-C and SIGTERM held back while units are submitted to a pool, delivered as soon as
+    the submission is done. Submitting starts the pool's workers; a signal that landed between
+    a worker's start and the pool recording it left a worker :func:`stop` could not see, and
+    the interpreter's exit then waited for it (a 60-second unit: the exit took a minute, not
+    a moment). Workers forked meanwhile start with them held and release them
+    (:func:`_worker_start`)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    signal.pthread_sigmask(signal.SIG_BLOCK, HELD)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD)
 
 
 def exit_without_collecting() -> None:
@@ -341,8 +361,9 @@ def run_units(
                     progress.done(what)
             return done
         settings = current()
-        futures = {pool.submit(_timed, settings, fn, *args): i
-                   for i, (_what, fn, args) in enumerate(units)}
+        with _signals_held():
+            futures = {pool.submit(_timed, settings, fn, *args): i
+                       for i, (_what, fn, args) in enumerate(units)}
         results: dict[int, Any] = {}
         for future in as_completed(futures):  # progress as units finish, not in order
             i = futures[future]
@@ -391,7 +412,8 @@ def each_unit(
                     yield what, exc
             return
         settings = current()
-        futures = [pool.submit(_under, settings, fn, *args) for _what, fn, args in units]
+        with _signals_held():
+            futures = [pool.submit(_under, settings, fn, *args) for _what, fn, args in units]
         for (what, _fn, _args), future in zip(units, futures, strict=True):
             try:
                 yield what, future.result()

@@ -4,11 +4,14 @@ book's formulas."""
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from dyncheck.commands.options import (
     check_out_file,
     positive,
 )
+from dyncheck.errors import InvalidInput
+from dyncheck.escaping import shown
 
 
 def explain_command(args: argparse.Namespace) -> int:
@@ -20,6 +23,8 @@ def explain_command(args: argparse.Namespace) -> int:
         print(page.explain(args.name.removeprefix("erratum-")))
         return 0
     positive("--jobs", args.jobs)
+    if args.reproducer is not None:
+        return _reproducer(args.name, args.reproducer)
     entries, read_back = explain_cached(args.name, accelerators=args.accelerators,
                                         jobs=args.jobs)
     print(render(entries))
@@ -28,6 +33,23 @@ def explain_command(args: argparse.Namespace) -> int:
               "the same dyncheck, engines and machine, read from the cache; --no-cache "
               "measures afresh)")
     return 1 if any(e.failed for e in entries) else 0
+
+
+def _reproducer(name: str | None, out: Path) -> int:
+    """``explain NAME --reproducer FILE``: the entry's standalone script, written whole."""
+    from dyncheck.explain.reproducers import REPRODUCERS
+    from dyncheck.results import write_atomic
+
+    if name is None or name not in REPRODUCERS:
+        raise InvalidInput("--reproducer", str(name), "given with a convention that is an "
+                           f"engine's defect: one of {', '.join(REPRODUCERS)}")
+    check_out_file("--reproducer", out)
+    found = REPRODUCERS[name]
+    write_atomic(out, found.script)
+    print(f"wrote {shown(str(out))}: `python {shown(str(out))}` needs only {found.engine} and "
+          "numpy; it prints the expected and the observed value and exits 1 while the defect "
+          "stands")
+    return 0
 
 
 def errata_command(args: argparse.Namespace) -> int:

@@ -1,0 +1,166 @@
+"""Standalone reproducers of the engine defects the catalogue measures: what a user pastes into
+the engine's issue tracker (``dyncheck explain NAME --reproducer FILE``).
+
+Each script uses only its engine, numpy and the standard library, holds its model inline,
+prints the expected and the observed value and exits 1 while the defect stands (0 once an
+engine release fixes it). ``tests/dyncheck/explain/test_reproducers.py`` runs every one in
+an isolated interpreter (``python -I``) and checks its imports, so a release that fixes a
+defect is noticed when the engine is upgraded. The expected values come from the physics
+(a closed form, or the engine's own finite differences), never from another engine.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True, kw_only=True)
+class Reproducer:
+    """One engine defect as a standalone script."""
+
+    engine: str
+    """The implementation whose defect it is (its registry name)."""
+    imports: frozenset[str]
+    """The top-level modules the script imports besides the standard library."""
+    script: str
+
+
+_PINOCCHIO_GRAVITY = '''\
+"""Pinocchio's MJCF parser does not read <option gravity>: a model written for the Moon
+(g = 1.62 m/s^2) is built with Earth's default gravity. Exits 1 while it does not."""
+import os
+import sys
+import tempfile
+
+import numpy as np
+import pinocchio as pin
+
+MJCF = """<mujoco><option gravity="0 0 -1.62"/><worldbody>
+<body name="b"><joint name="j" type="hinge" axis="0 1 0"/>
+<inertial pos="0 0 -1" mass="1" diaginertia="1e-3 1e-3 1e-3"/></body>
+</worldbody></mujoco>"""
+
+with tempfile.TemporaryDirectory() as folder:
+    path = os.path.join(folder, "moon.xml")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(MJCF)
+    model = pin.buildModelFromMJCF(path)
+expected = np.array([0.0, 0.0, -1.62])  # the file's <option gravity>
+observed = np.asarray(model.gravity.linear, dtype=float)
+print(f"pinocchio {pin.__version__}")
+print(f"expected gravity {expected.tolist()} (the file's <option gravity>)")
+print(f"observed gravity {observed.tolist()}")
+sys.exit(0 if np.allclose(observed, expected, atol=1e-12) else 1)
+'''
+
+_PINOCCHIO_COMPOSITE = '''\
+"""Pinocchio's analytic derivatives (computeRNEADerivatives, computeABADerivatives) of a
+composite joint (an MJCF body with two hinges) disagree with central finite differences of
+its own rnea and aba. Exits 1 while they do."""
+import os
+import sys
+import tempfile
+
+import numpy as np
+import pinocchio as pin
+
+MJCF = """<mujoco><worldbody><body name="b">
+<joint name="j1" type="hinge" axis="1 0 0"/><joint name="j2" type="hinge" axis="0 1 0"/>
+<geom type="sphere" size="0.1" pos="0 0 -1" mass="1"/>
+<body name="c" pos="0 0 -1"><joint name="j3" type="hinge" axis="1 0 0"/>
+<geom type="sphere" size="0.1" pos="0 0 -1" mass="1"/></body>
+</body></worldbody></mujoco>"""
+
+with tempfile.TemporaryDirectory() as folder:
+    path = os.path.join(folder, "composite.xml")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(MJCF)
+    model = pin.buildModelFromMJCF(path)
+data = model.createData()
+rng = np.random.default_rng(0)
+q, v, a = (rng.uniform(-1.0, 1.0, model.nv) for _ in range(3))
+h = 1e-6
+
+
+def differences(f, x):
+    """Central differences of f along each coordinate of x (hinges: q and v alike)."""
+    columns = []
+    for i in range(len(x)):
+        e = np.zeros_like(x)
+        e[i] = h
+        columns.append((f(x + e) - f(x - e)) / (2 * h))
+    return np.column_stack(columns)
+
+
+pin.computeRNEADerivatives(model, data, q, v, a)
+analytic = np.array(data.dtau_dq)
+expected = differences(lambda x: pin.rnea(model, data, x, v, a).copy(), q)
+gap = float(np.abs(analytic - expected).max())
+bound = 1e-6 * max(1.0, float(np.abs(expected).max()))  # O(h^2) truncation and round-off
+joints = [model.joints[i].shortname() for i in range(1, model.njoints)]
+print(f"pinocchio {pin.__version__}; joints {joints}")
+print("expected dtau/dq (central differences of rnea):")
+print(np.array2string(expected, precision=4, suppress_small=True))
+print("observed dtau/dq (computeRNEADerivatives):")
+print(np.array2string(analytic, precision=4, suppress_small=True))
+print(f"largest difference {gap:.3g} (finite differences agree to {bound:.1g})")
+sys.exit(0 if gap <= bound else 1)
+'''
+
+_NEWTON_D6 = '''\
+"""Newton's MJCF importer fuses a body's joints into one D6 joint whose slides are applied
+before its hinges whatever the written order: a hinge written before a slide no longer turns
+it. MJCF applies them as written: a hinge about z by theta, then a slide along z and a slide
+along the turned x by r put the body at (r cos theta, r sin theta, z). Exits 1 while it does
+not."""
+import os
+import sys
+import tempfile
+
+import numpy as np
+import warp as wp
+
+wp.config.log_level = wp.LOG_ERROR  # (before newton starts Warp: no banner, no log)
+import newton  # noqa: E402
+
+MJCF = """<mujoco><worldbody><body name="particle">
+<joint name="theta" type="hinge" axis="0 0 1"/>
+<joint name="z" type="slide" axis="0 0 1"/>
+<joint name="r" type="slide" axis="1 0 0"/>
+<inertial pos="0 0 0" mass="1.5" diaginertia="1e-3 1e-3 1e-3"/>
+</body></worldbody></mujoco>"""
+
+with tempfile.TemporaryDirectory() as folder:
+    path = os.path.join(folder, "cylindrical.xml")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(MJCF)
+    builder = newton.ModelBuilder()
+    builder.add_mjcf(path)
+    model = builder.finalize(device="cpu")
+state = model.state()
+theta, z, r = 0.7, 0.2, 0.5
+expected = np.array([r * np.cos(theta), r * np.sin(theta), z])
+# Newton holds the three coordinates of its D6 joint with the slides first: (z, r, theta)
+coords = np.array([z, r, theta] if model.joint_count == 1 else [theta, z, r], np.float32)
+state.joint_q.assign(coords)
+newton.eval_fk(model, state.joint_q, state.joint_qd, state)
+observed = np.array(state.body_q.numpy()[-1][:3], dtype=float)
+gap = float(np.abs(observed - expected).max())
+print(f"newton {newton.__version__}; the body's three joints read as {model.joint_count}")
+print(f"expected position {expected.round(6).tolist()} (the joints applied as written)")
+print(f"observed position {observed.round(6).tolist()}")
+sys.exit(0 if gap <= 1e-5 else 1)  # float32 positions of size 1
+'''
+
+REPRODUCERS: dict[str, Reproducer] = {
+    "pinocchio-mjcf-options": Reproducer(
+        engine="pinocchio", imports=frozenset({"numpy", "pinocchio"}),
+        script=_PINOCCHIO_GRAVITY),
+    "pinocchio-composite-derivatives": Reproducer(
+        engine="pinocchio", imports=frozenset({"numpy", "pinocchio"}),
+        script=_PINOCCHIO_COMPOSITE),
+    "newton-several-joints-on-a-body": Reproducer(
+        engine="newton", imports=frozenset({"numpy", "newton", "warp"}), script=_NEWTON_D6),
+}
+"""Catalogue entry → its reproducer: the entries whose difference is an engine's defect (a
+documented input it drops, a derivative it gets wrong), not a convention it documents."""
