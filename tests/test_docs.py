@@ -144,7 +144,8 @@ def test_the_readmes_timings_are_the_command_timings_page():
     second = re.search(r"(\d+) s on two CPU cores, where they compile", text)
     assert first and second
     main = timed.loc[f"{MAIN} in all (install and run), empty caches", "seconds"]
-    run = timed.loc[[c for c in timed.index if c.startswith(f"{SECOND}: its run")][0], "seconds"]
+    second_run = next(c for c in timed.index if c.startswith(f"{SECOND}: its run"))
+    run = timed.loc[second_run, "seconds"]
     assert int(first.group(1)) == round(float(main))
     assert int(second.group(1)) == round(float(run))
 
