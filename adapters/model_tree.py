@@ -299,6 +299,11 @@ class Derivatives:
     method: str
     step: float = 0.0
     chart: DerivativeChart = DerivativeChart.TANGENT
+    defect: str = ""
+    """A defect the engine's own derivatives are known to have on this model (measured), or
+    empty; then :attr:`own_differences` holds the engine's finite differences of its own
+    dynamics, which the check compares after its analytic ones."""
+    own_differences: Derivatives | None = None
 
 
 def derivatives(found: dict[str, np.ndarray], *, method: str, step: float = 0.0,

@@ -15,6 +15,8 @@ joint v = (linear, angular), both in local axes; an unbounded revolute joint q =
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pinocchio as pin
 
@@ -229,18 +231,15 @@ class PinocchioModel:
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
         """``computeABADerivatives`` at τ = 0 (∂v̇/∂q, ∂v̇/∂v, M⁻¹, upper triangle mirrored)
         and ``computeRNEADerivatives`` at v̇ = a (∂τ/∂q, ∂τ/∂v): analytic, in Pinocchio's
-        tangent space (a hinge's or slide's: its coordinate). Refused on a model with a
-        composite joint (an MJCF body with several joints): Pinocchio 4.1 returns ∂τ/∂q = 0
-        in its columns (measured against its own finite differences,
-        tests/adapters/test_pinocchio_model.py)."""
+        tangent space (a hinge's or slide's: its coordinate). On a model with a composite
+        joint (an MJCF body with several joints) Pinocchio 4.1's analytic derivatives differ
+        from its own finite differences in the columns of the joint's coordinates past its
+        first (measured, ``dyncheck explain pinocchio-composite-derivatives``): the defect is
+        declared and its own finite differences of ``rnea`` and ``aba`` are handed with them
+        (:func:`own_differences`)."""
         m, d = self.model, self.data
         composite = [m.names[i] for i in range(1, m.njoints)
                      if m.joints[i].shortname() == "JointModelComposite"]
-        if composite:
-            raise Unsupported(
-                f"pinocchio {pin.__version__}'s derivatives of a composite joint "
-                f"({composite[0]!r}: a body with several joints) are zero in q (measured "
-                "against its own finite differences): not compared")
         n, nv = len(q), m.nv
         out = {k: np.empty((n, nv, nv)) for k in
                ("forward_q", "forward_v", "forward_tau", "inverse_q", "inverse_v")}
@@ -252,5 +251,47 @@ class PinocchioModel:
             out["forward_tau"][i] = np.triu(upper) + np.triu(upper, 1).T
             pin.computeRNEADerivatives(m, d, q[i], v[i], a[i])
             out["inverse_q"][i], out["inverse_v"][i] = d.dtau_dq, d.dtau_dv
-        return _derivatives(out, method="analytic (computeABADerivatives, "
-                            "computeRNEADerivatives)")
+        found = _derivatives(out, method="analytic (computeABADerivatives, "
+                             "computeRNEADerivatives)")
+        if not composite:
+            return found
+        return replace(found, own_differences=own_differences(m, d, q, v, a, out["forward_tau"]),
+                       defect=f"pinocchio {pin.__version__}'s analytic derivatives of a "
+                       f"composite joint ({composite[0]!r}: a body with several joints) differ "
+                       "from its own finite differences, an engine defect (`dyncheck explain "
+                       "pinocchio-composite-derivatives`)")
+
+
+OWN_STEP = 1e-6
+"""The step of Pinocchio's own finite differences (one-sided, as MuJoCo's ``mjd_inverseFD``:
+the check predicts their error from it)."""
+
+
+def own_differences(m: pin.Model, d: pin.Data, q: np.ndarray, v: np.ndarray, a: np.ndarray,
+                    inverse_mass: np.ndarray) -> Derivatives:
+    """One-sided finite differences of Pinocchio's own ``rnea`` along each tangent direction
+    (q moved by ``pin.integrate``), step :data:`OWN_STEP`: ∂τ/∂q and ∂τ/∂v at v̇ = a, and the
+    forward ones as MuJoCo's ``mjd_inverseFD`` forms them, −M⁻¹ ∂τ/∂x at v̇ = aba(q, v, 0)
+    (the check predicts their error from the step on that form); M⁻¹ its analytic one."""
+    n, nv = len(q), m.nv
+    out = {k: np.empty((n, nv, nv)) for k in ("forward_q", "forward_v", "inverse_q",
+                                              "inverse_v")}
+    h = OWN_STEP
+
+    def rnea_differences(s: int, acc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        base = pin.rnea(m, d, q[s], v[s], acc).copy()
+        in_q, in_v = np.empty((nv, nv)), np.empty((nv, nv))
+        for k, e in enumerate(np.eye(nv) * h):
+            in_q[:, k] = (pin.rnea(m, d, pin.integrate(m, q[s], e), v[s], acc) - base) / h
+            in_v[:, k] = (pin.rnea(m, d, q[s], v[s] + e, acc) - base) / h
+        return in_q, in_v
+
+    for s in range(n):
+        out["inverse_q"][s], out["inverse_v"][s] = rnea_differences(s, a[s])
+        free = pin.aba(m, d, q[s], v[s], np.zeros(nv)).copy()
+        at_q, at_v = rnea_differences(s, free)
+        out["forward_q"][s] = -inverse_mass[s] @ at_q
+        out["forward_v"][s] = -inverse_mass[s] @ at_v
+    out["forward_tau"] = inverse_mass
+    return _derivatives(out, method=f"finite differences of its own rnea (one-sided, step "
+                        f"{h:g}; the forward ones through M⁻¹)", step=h)

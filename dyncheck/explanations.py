@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 
+from dyncheck.check.derivative_pairs import DEFECT, READINGS
 from dyncheck.check.predicted import ARMATURE_AXES, BASE_GRAVITY, ROTOR_ENERGY
 from dyncheck.check.readings import READING
 from dyncheck.implementations import (
@@ -60,6 +61,21 @@ EXPLANATIONS: dict[str, Explanation] = {
         "ω = θ̇ for a pendulum bob with θ absolute, the rotation of the coordinate triad for a "
         "particle carried by coordinate joints). A row is `explained` only when observed − "
         "predicted is within round-off.",
+    ),
+    DEFECT: Explanation(
+        origin=Origin.ENGINE,
+        text="An engine's analytic derivatives declared defective on the model by its adapter "
+        "(Pinocchio 4.1's of a composite joint, an MJCF body with several joints: measured "
+        "against central differences of its own rnea, `dyncheck explain "
+        "pinocchio-composite-derivatives`): the row's error is the defect's size, and the "
+        "engine's own one-sided finite differences of its dynamics agree with the other side "
+        "within their predicted truncation and round-off.",
+    ),
+    READINGS: Explanation(
+        origin=Origin.ENGINE,
+        text="Two engines read a field the dynamics use differently (Drake's armature on a "
+        "joint without an actuator): their derivatives are compared after the referee's on "
+        "one reading minus on the other's, measured, which accounts for the difference.",
     ),
     ENGINE_DEFECT: Explanation(
         origin=Origin.ENGINE,

@@ -37,20 +37,15 @@ from dyncheck.adapters.model_tree import (
     ModelTree,
 )
 from dyncheck.adapters.model_tree import derivatives as collect
-from dyncheck.check.derivative_charts import FIELDS, perturb, same_layout, to_canonical
+from dyncheck.check.derivative_charts import perturb, same_layout, to_canonical
+from dyncheck.check.derivative_pairs import across_readings, after_defects, compare
 from dyncheck.check.describe import depth
-from dyncheck.check.dynamics import States, condition
+from dyncheck.check.dynamics import States
 from dyncheck.check.referee import TIE_STATES, ReferenceModel, Tie, tie
 from dyncheck.check.rows import CheckRow, Section
-from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name, standing
+from dyncheck.precision import EPS, ROUNDOFF_FACTOR, standing
 from dyncheck.results import Verdict
 
-ZERO = "0 within round-off"
-"""What a derivative zero within its bound on both sides is shown as."""
-SUBJECTS = {
-    "forward_q": "d(forward)/dq", "forward_v": "d(forward)/dv", "forward_tau": "d(forward)/dtau",
-    "inverse_q": "d(inverse)/dq", "inverse_v": "d(inverse)/dv",
-}
 STEP = 4e-3
 """The largest central-difference step of the implicit step's Richardson extrapolation
 (:func:`dyncheck.check.steps.implicit_blocks`; then /2, /4)."""
@@ -204,96 +199,6 @@ def referee(tree: ModelTree, states: States, *, bounds: bool = True,
         forward=forward, tie=tied, standing=standing(*solver.reach(q)))
 
 
-def _predicted(found: Derivatives, ref: Referee, field: str) -> np.ndarray:
-    """An engine's predicted finite-difference error per entry (zero for analytic ones):
-    one-sided differences of step s, s/2 |∂²τ/∂x²| + s²/6 |∂³τ/∂x³| + 2 δτ/s (the Taylor
-    remainder's next term matters where the curvature vanishes; in v, τ is quadratic: no
-    third term) through |M⁻¹| for the forward derivatives, which it forms from its inverse
-    ones."""
-    if not found.step:
-        return np.zeros_like(getattr(found, field))
-    s = found.step
-    roundoff = 2 * ref.roundoff[:, None, None] / s
-    if field == "forward_tau":
-        return np.zeros_like(found.forward_tau)
-    key = "inverse" if field.startswith("inverse") else "forward"
-    if field.endswith("_v"):
-        inverse = s / 2 * np.abs(ref.second_v) + roundoff
-    else:
-        inverse = s / 2 * np.abs(ref.second_q[key]) + s**2 / 6 * np.abs(ref.third_q[key]) \
-            + roundoff
-    return inverse if field.startswith("inverse") else np.abs(ref.inverse_mass) @ inverse
-
-
-def _floor(ref: Referee, field: str) -> np.ndarray:
-    """The round-off of an entry computed from terms of τ's size (per state), per unit of
-    q (δτ) or of v (δτ / the velocities' spread): what an entry that is zero in exact
-    arithmetic (a ball joint's ∂τ/∂q without gravity torque) carries; through |M⁻¹| for
-    the forward derivatives."""
-    per_q = ref.roundoff[:, None, None]
-    per = {"q": per_q, "v": ref.roundoff_v[:, None, None], "tau": np.zeros_like(per_q)}
-    bound = np.broadcast_to(per[field.split("_", 1)[1]], ref.inverse_mass.shape)
-    return np.abs(ref.inverse_mass) @ bound if field.startswith("forward") else bound
-
-
-def compare(model: str, tree: ModelTree, name_a: str, da: Derivatives, name_b: str,
-            db: Derivatives, ref: Referee, *, eps: float = EPS) -> list[CheckRow]:
-    """One row per derivative for the pair (a, b); ``ref`` gives the referee's estimated
-    error where it is a side, and the curvatures an engine's finite differences need."""
-    d = depth(tree)
-    kappa = condition(ref.derivatives.forward_tau)
-    rows = []
-    for field in FIELDS:
-        desired, actual = getattr(da, field), getattr(db, field)
-        scale = max(float(np.abs(desired).max()), float(np.abs(actual).max()), 1e-300)
-        rtol = ROUNDOFF_FACTOR * eps * d * ref.standing \
-            * (kappa if field.startswith("forward") else 1.0)
-        allowed = np.full(desired.shape, rtol * scale) + _floor(ref, field) * eps / EPS
-        # an entry zero in exact arithmetic everywhere (a slide's ∂τ/∂q): errors relative to
-        # its round-off floor, not to a scale of zero
-        scale = max(scale, float(allowed.max()))
-        basis = f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth {d}"
-        if ref.standing > 1:
-            basis += f" x X/l {ref.standing:.3g} (positions far from the origin)"
-        if field.startswith("forward"):
-            basis += f" x cond(M) {kappa:.3g}"
-        basis += " (of the largest entry, and of tau's terms per unit of q or v)"
-        for name, found in ((name_a, da), (name_b, db)):
-            if found is ref.derivatives:
-                allowed = allowed + ref.error[field]
-                basis += "; + the referee's own round-off (complex step: no truncation)"
-            elif found.step:
-                allowed = allowed + _predicted(found, ref, field)
-                basis += f"; + {name}'s predicted finite-difference error (step {found.step:g})"
-        off = np.abs(actual - desired)
-        worst = np.unravel_index(int(np.argmax(off / allowed)), off.shape)
-        within = bool(np.all(off <= allowed))
-        note = "" if within else (
-            f"{name_b} differs from {name_a} at state {worst[0]}, entry ({worst[1]}, "
-            f"{worst[2]}): {off[worst]:.3g} beyond its predicted {allowed[worst]:.3g}")
-        if within and np.all(np.abs(desired) <= allowed) and np.all(np.abs(actual) <= allowed):
-            # zero within its bound on both sides (∂v̇/∂q of a free body): what is left is
-            # round-off and truncation, whose digits differ from machine to machine — shown
-            # as zero, compared by absolute error
-            bound = float(f"{float(allowed.max()):.2g}")
-            rows.append(CheckRow(
-                model=model, section=Section.DERIVATIVES, subject=SUBJECTS[field],
-                field="max abs error", impl_a=name_a, impl_b=name_b, value_a=ZERO,
-                value_b=ZERO, error=0.0, tolerance=bound,
-                basis=basis + f"; both sides zero within it (every entry <= its bound, at "
-                f"most {bound:.2g}): compared by absolute error",
-                verdict=Verdict.PASSED, note=f"0 within round-off (absolute error <= "
-                f"{bound:.2g})", worst_state=-1))
-            continue
-        rows.append(CheckRow(
-            model=model, section=Section.DERIVATIVES, subject=SUBJECTS[field],
-            field="max rel error", impl_a=name_a, impl_b=name_b, value_a="", value_b="",
-            error=float(off.max()) / scale, tolerance=float(allowed.max()) / scale,
-            basis=basis, verdict=Verdict.PASSED if within else Verdict.FAILED, note=note,
-            worst_state=int(worst[0])))
-    return rows
-
-
 def _row(model: str, engine: str, verdict: Verdict, note: str) -> CheckRow:
     return CheckRow(model=model, section=Section.DERIVATIVES, subject="derivatives",
                     field="offered", impl_a=engine, impl_b="", value_a="", value_b="",
@@ -405,8 +310,12 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
                     found[name] = own  # its layout is the canonical one: nothing to map
                 else:
                     values = engine.dynamics(*inputs[name])  # type: ignore[attr-defined]
-                    found[name] = to_canonical(canon, engine.tree,  # type: ignore[attr-defined]
-                                               states, own, values)
+                    mine = engine.tree  # type: ignore[attr-defined]
+                    mapped = to_canonical(canon, mine, states, own, values)
+                    if own.own_differences is not None:
+                        mapped = replace(mapped, defect=own.defect, own_differences=to_canonical(
+                            canon, mine, states, own.own_differences, values))
+                    found[name] = mapped
             except Exception as exc:  # an engine failing costs its own rows
                 out.append(_row(model, name, Verdict.FAILED, f"{type(exc).__name__}: {exc}"))
             seconds["d map"] = seconds.get("d map", 0.0) + time.perf_counter() - t0
@@ -436,39 +345,12 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
                            for r in compare(model, tree, a_name, on_b.derivatives, b_name,
                                             found[b_name], on_b, eps=eps))
             elif a_name in own_refs or b_name in own_refs:
-                out.extend(_across_readings(model, tree, a_name, found[a_name], b_name,
+                out.extend(across_readings(model, tree, a_name, found[a_name], b_name,
                                             found[b_name], own_refs.get(a_name, ref),
                                             own_refs.get(b_name, ref), eps))
             else:
-                out.extend(compare(model, tree, a_name, found[a_name], b_name, found[b_name],
-                                   ref, eps=eps))
+                out.extend(after_defects(model, tree, a_name, found[a_name], b_name,
+                                         found[b_name], ref, eps=eps))
     return out
 
 
-ACROSS_READINGS = ("{a} and {b} read the model differently: compared after the referee on "
-                   "{b}'s reading minus on {a}'s (measured), which accounts for the difference")
-
-
-def _across_readings(model: str, tree: ModelTree, name_a: str, da: Derivatives, name_b: str,
-                     db: Derivatives, ref_a: Referee, ref_b: Referee,
-                     eps: float) -> list[CheckRow]:
-    """Two engines that read the model differently: b's derivatives less the readings'
-    difference (the referee's on b's reading minus on a's) against a's — explained where
-    that accounts for the difference, failed beyond it."""
-    shifted = replace(db, **{f: getattr(db, f) - (getattr(ref_b.derivatives, f)
-                                                  - getattr(ref_a.derivatives, f))
-                             for f in FIELDS})
-    note = ACROSS_READINGS.format(a=name_a, b=name_b)
-    out = []
-    for raw, r in zip(compare(model, tree, name_a, da, name_b, db, ref_a, eps=eps),
-                      compare(model, tree, name_a, da, name_b, shifted, ref_a, eps=eps),
-                      strict=True):
-        if raw.verdict is not Verdict.FAILED:  # alike without the readings' difference
-            out.append(raw)
-        elif r.verdict is Verdict.PASSED:
-            out.append(replace(r, verdict=Verdict.EXPLAINED, note=note))
-        elif r.verdict is Verdict.FAILED:
-            out.append(replace(r, note=f"beyond what the readings account for: {r.note}"))
-        else:
-            out.append(r)
-    return out

@@ -49,6 +49,7 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
     from dyncheck.adapters.model_files import read
     from dyncheck.check import derivatives, engines
     from dyncheck.check.alignment import align_by_body
+    from dyncheck.check.derivative_pairs import label
     from dyncheck.check.dynamics import States
 
     names = [n for n in MODELS if n in impl_names]
@@ -105,17 +106,17 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
                              with_referee=REFEREE in impl_names)
     return failed + [_row(case, r.subject, r.impl_a, r.impl_b, str(r.verdict), r.note,
                           error=r.error, tolerance=r.tolerance, basis=r.basis,
-                          worst=r.worst_state) for r in found]
+                          worst=r.worst_state, convention=label(r)) for r in found]
 
 
 def _row(case: Case, quantity: str, a: str, b: str, verdict: str, note: str, *,
          error: float = float("nan"), tolerance: float = float("nan"), basis: str = "",
-         worst: int = -1) -> Discrepancy:
+         worst: int = -1, convention: str = "") -> Discrepancy:
     spec = case.multibody()
     said = "; ".join(x for x in (note, TREE_ONLY if spec.couplings or spec.central_mu else "")
                      if x)
     return Discrepancy(case=case.name, quantity=quantity, impl_a=a, impl_b=b, integrator="",
                        dt=float("nan"), max_abs_err=float("nan"), max_rel_err=error,
                        tolerance=tolerance, tolerance_basis=basis, verdict=verdict,
-                       convention="", note=said, worst_state=worst)
+                       convention=convention, note=said, worst_state=worst)
 

@@ -1,6 +1,7 @@
 """Pinocchio on users' files: the composite joint its MJCF parser makes of a body's several
-joints, whose derivatives it does not compute. Expected values: Pinocchio's own central
-differences of ``rnea`` (an independent computation of the same derivative)."""
+joints, whose analytic derivatives are wrong (a defect declared, its own finite differences
+handed with them). Expected values: Pinocchio's own central differences of ``rnea`` (an
+independent computation of the same derivative)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,6 @@ from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.model_files import read
 from dyncheck.adapters.pinocchio_model import PinocchioModel
 from dyncheck.cases import get_case
-from dyncheck.errors import Unsupported
 
 
 @pytest.fixture
@@ -25,9 +25,9 @@ def several_joints_on_a_body(tmp_path: Path) -> Path:
 
 
 def test_a_composite_joints_derivative_in_q_is_not_computed(several_joints_on_a_body):
-    """The fact the refusal rests on: Pinocchio's analytic ∂τ/∂q of a composite joint is zero
-    where its own finite differences are not. When a release computes it, this fails: lift
-    the refusal in ``PinocchioModel.derivatives``."""
+    """The fact the declared defect rests on: Pinocchio's analytic ∂τ/∂q of a composite joint
+    differs from its own finite differences. When a release computes it, this fails: remove
+    the declaration in ``PinocchioModel.derivatives``."""
     model = pin.buildModelFromMJCF(str(several_joints_on_a_body))
     assert any(j.shortname() == "JointModelComposite" for j in model.joints)
     data = model.createData()
@@ -44,12 +44,26 @@ def test_a_composite_joints_derivative_in_q_is_not_computed(several_joints_on_a_
     assert np.abs(analytic - fd).max() > 0.5 * np.abs(fd).max()
 
 
-def test_its_derivatives_are_refused_with_the_reason(several_joints_on_a_body):
+def test_its_derivatives_declare_the_defect_and_carry_its_own_differences(
+        several_joints_on_a_body):
+    """The derivatives of a model with a composite joint say so, and hand Pinocchio's own
+    one-sided differences: within their truncation (step × |∂²τ/∂q²| ~ 1e-6 relative) of
+    central differences of ``rnea`` computed here; the analytic ones are not."""
     loaded = PinocchioModel(read(several_joints_on_a_body))
-    q = np.zeros((1, loaded.tree.nq))
-    v = np.zeros((1, loaded.tree.nv))
-    with pytest.raises(Unsupported, match="composite joint"):
-        loaded.derivatives(q, v, v)
+    rng = np.random.default_rng(2)
+    q = rng.normal(size=(2, loaded.tree.nq))
+    v, a = rng.normal(size=(2, loaded.tree.nv)), rng.normal(size=(2, loaded.tree.nv))
+    found = loaded.derivatives(q, v, a)
+    assert "composite joint" in found.defect and found.own_differences is not None
+    model, data, h = loaded.model, loaded.model.createData(), 1e-6
+    for s in range(2):
+        central = np.column_stack([
+            (pin.rnea(model, data, pin.integrate(model, q[s], h * e), v[s], a[s])
+             - pin.rnea(model, data, pin.integrate(model, q[s], -h * e), v[s], a[s])) / (2 * h)
+            for e in np.eye(model.nv)])
+        scale = np.abs(central).max()
+        assert np.abs(found.own_differences.inverse_q[s] - central).max() < 1e-4 * scale
+        assert np.abs(found.inverse_q[s] - central).max() > 0.1 * scale
 
 
 def test_the_body_pinocchio_keeps_from_a_scene_with_includes_is_read_from_its_model(tmp_path):

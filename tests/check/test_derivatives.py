@@ -217,3 +217,65 @@ def test_an_engine_reading_the_model_otherwise_is_judged_on_its_own_reading(tmp_
         assert pair.loc[subject, "verdict"] == "passed", pair.loc[subject]
     line = {v.engine: v for v in per_engine(result.rows, result.impls)}["drake"]
     assert line.reading is Reading.DIFFERENTLY and line.agreement is Agreement.AGREE
+
+
+COMPOSITE = """<mujoco model="walker"><worldbody>
+  <body name="torso"><joint name="x" type="slide" axis="1 0 0"/>
+    <joint name="pitch" type="hinge" axis="0 1 0"/>
+    <inertial pos="0.1 0 -0.2" mass="2" diaginertia="0.05 0.06 0.04"/>
+    <body name="leg" pos="0 0 -0.4"><joint name="knee" type="hinge" axis="0 1 0"/>
+      <inertial pos="0 0 -0.2" mass="1" diaginertia="0.01 0.01 0.002"/></body>
+  </body></worldbody></mujoco>
+"""
+
+
+def test_pinocchios_composite_joint_derivatives_are_its_measured_defect(tmp_path):
+    """A body with a slide and a hinge (one composite joint in Pinocchio): its analytic
+    derivatives are far off the referee's and MuJoCo's (the defect's size on the row), its
+    own finite differences agree — explained by the declared defect, never failed or
+    skipped; every other pair passes (expected: the referee, and MuJoCo's finite
+    differences, which see no composite joint)."""
+    from dyncheck.check.derivative_pairs import DEFECT, label
+
+    path = tmp_path / "walker.xml"
+    path.write_text(COMPOSITE)
+    result = check_model(path, impls=("reference", "mujoco", "pinocchio"), states=12,
+                         derivatives=True, isolate=False)
+    rows = _rows(result, section="derivatives")
+    pinocchio = rows[(rows["impl_a"] == "pinocchio") | (rows["impl_b"] == "pinocchio")]
+    explained = pinocchio[pinocchio["verdict"] == "explained"]
+    assert set(explained["subject"]) >= {"d(inverse)/dq", "d(forward)/dq"}
+    assert (explained["error"] > 1e-2).all()  # the defect's size, not round-off
+    assert all("its own finite differences agree" in n and "composite joint" in n
+               for n in explained["note"])
+    assert set(rows["verdict"]) <= {"passed", "explained"}
+    assert set(rows[(rows["impl_a"] != "pinocchio") & (rows["impl_b"] != "pinocchio")]
+               ["verdict"]) == {"passed"}
+    from dyncheck.check.rows import CheckRow
+
+    first = explained.iloc[0].to_dict()
+    assert label(CheckRow(**{k: first[k] for k in CheckRow.__dataclass_fields__})) == DEFECT
+
+
+def test_own_differences_that_disagree_too_leave_the_row_failed(monkeypatch, tmp_path):
+    """The declared defect explains a row only where the engine's own finite differences
+    agree: the same model with its own ∂τ/∂q scaled by 1 + 1e-3 fails, saying both."""
+    from dataclasses import replace
+
+    original = pinocchio_model.PinocchioModel.derivatives
+
+    def off(self, q, v, a):
+        found = original(self, q, v, a)
+        own = found.own_differences
+        assert own is not None
+        bent = own.inverse_q * (1 + 1e-3)
+        return replace(found, own_differences=replace(own, inverse_q=bent))
+
+    monkeypatch.setattr(pinocchio_model.PinocchioModel, "derivatives", off)
+    path = tmp_path / "walker.xml"
+    path.write_text(COMPOSITE)
+    result = check_model(path, impls=("reference", "mujoco", "pinocchio"), states=12,
+                         derivatives=True, isolate=False)
+    failed = _rows(result, section="derivatives", verdict="failed")
+    assert set(failed["subject"]) == {"d(inverse)/dq"}
+    assert all("its own finite differences differ too" in n for n in failed["note"])
