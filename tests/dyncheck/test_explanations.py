@@ -44,8 +44,8 @@ def test_full_default_run_has_no_failed_row_and_skips_only_with_a_stated_reason(
     rotation's trajectory not mapped back, no derivatives); Pinocchio's composite-joint
     derivatives are explained by its declared defect, never skipped. RK4's step on a
     rotation is refereed (its Munthe-Kaas stages): passed on the four cases with a ball or
-    free joint; so is implicitfast's on the standalone free body (its block solved with M + h ∂h/∂v, the referee's implicit step differentiated by
-    Richardson extrapolation)."""
+    free joint; so is implicitfast's on the standalone free body (its block solved with
+    M + h ∂h/∂v, the referee's implicit step differentiated by Richardson extrapolation)."""
     d = full_run.discrepancies
     assert not (d.verdict == "failed").any(), d[d.verdict == "failed"]
     skipped = d[d.verdict == "skipped"]
