@@ -474,6 +474,15 @@ FAULTS: tuple[Fault, ...] = (
     # --- explain, tutorials
     Fault(kind="unknown convention", area="explain", argv=("explain", "nope"),
           answer=r"unknown convention 'nope'; valid: "),
+    Fault(kind="--reproducer of a convention that is no engine defect", area="explain",
+          argv=("explain", "quaternion-storage-order", "--reproducer", OUT + "/r.py"),
+          answer=r"--reproducer must be given with a convention that is an engine's defect: "
+          r"one of pinocchio-mjcf-options"),
+    Fault(kind="--reproducer into a folder", area="explain",
+          argv=("explain", "pinocchio-mjcf-options", "--reproducer", "{tmp}"),
+          answer=r"--reproducer must be a file path, not a folder"),
+    Fault(kind="--jobs 0 (explain)", area="explain", argv=("explain", "--jobs", "0"),
+          answer=r"--jobs must be"),
     Fault(kind="unknown tutorial", area="tutorials", argv=("tutorials", "nope", "--out", OUT),
           answer=r"unknown tutorial 'nope'; valid: 01_quaternion_order"),
     Fault(kind="--out below a file", area="tutorials", prepare=_file("file", "keep"),
