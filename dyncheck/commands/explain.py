@@ -11,7 +11,6 @@ from dyncheck.commands.options import (
     positive,
 )
 from dyncheck.errors import InvalidInput
-from dyncheck.escaping import shown
 
 
 def explain_command(args: argparse.Namespace) -> int:
@@ -37,6 +36,7 @@ def explain_command(args: argparse.Namespace) -> int:
 
 def _reproducer(name: str | None, out: Path) -> int:
     """``explain NAME --reproducer FILE``: the entry's standalone script, written whole."""
+    from dyncheck.escaping import shown  # (pandas: not on `dyncheck list`'s path)
     from dyncheck.explain.reproducers import REPRODUCERS
     from dyncheck.results import write_atomic
 
