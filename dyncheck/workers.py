@@ -261,29 +261,6 @@ def _worker_start(parent: int) -> None:
     exit_without_collecting()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, _raise_terminated)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD)  # (forked while they were held)
-
-
-HELD = frozenset({signal.SIGINT, signal.SIGTERM})
-"""SIGINT and SIGTERM: held while a pool's units are submitted (:func:`_signals_held`)."""
-
-
-@contextmanager
-def _signals_held() -> Iterator[None]:
-    """Ctrl-C and SIGTERM held back while units are submitted to a pool, delivered as soon as
-    the submission is done. Submitting starts the pool's workers; a signal that landed between
-    a worker's start and the pool recording it left a worker :func:`stop` could not see, and
-    the interpreter's exit then waited for it (a 60-second unit: the exit took a minute, not
-    a moment). Workers forked meanwhile start with them held and release them
-    (:func:`_worker_start`)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    signal.pthread_sigmask(signal.SIG_BLOCK, HELD)
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD)
 
 
 def exit_without_collecting() -> None:
@@ -361,9 +338,8 @@ def run_units(
                     progress.done(what)
             return done
         settings = current()
-        with _signals_held():
-            futures = {pool.submit(_timed, settings, fn, *args): i
-                       for i, (_what, fn, args) in enumerate(units)}
+        futures = {pool.submit(_timed, settings, fn, *args): i
+                   for i, (_what, fn, args) in enumerate(units)}
         results: dict[int, Any] = {}
         for future in as_completed(futures):  # progress as units finish, not in order
             i = futures[future]
@@ -412,8 +388,7 @@ def each_unit(
                     yield what, exc
             return
         settings = current()
-        with _signals_held():
-            futures = [pool.submit(_under, settings, fn, *args) for _what, fn, args in units]
+        futures = [pool.submit(_under, settings, fn, *args) for _what, fn, args in units]
         for (what, _fn, _args), future in zip(units, futures, strict=True):
             try:
                 yield what, future.result()

@@ -122,7 +122,8 @@ def test_every_instantaneous_pair_is_passed_or_explained(full_run):
 
 def test_programmatic_pinocchio_needs_no_explanation(full_run):
     """pinocchio holds exact point masses and the case's gravity: it must pass against book
-    and reference outright (except the deliberate held-force RK4, a finding)."""
+    and reference outright (except the deliberate held-force RK4, a finding, and the
+    derivatives of a composite joint, its declared defect)."""
     d = full_run.discrepancies
     rows = d[
         (d.impl_b == "pinocchio")
@@ -130,7 +131,10 @@ def test_programmatic_pinocchio_needs_no_explanation(full_run):
         & (d.integrator != "rk4-held-force")
         & ~d.case.isin(BALL_CASES)  # a point mass on a ball joint needs the inertia floor
     ]
-    assert (rows.verdict == "passed").all()
+    from dyncheck.check.derivative_pairs import DEFECT
+
+    # its derivatives of a composite joint: its own declared defect, measured on the row
+    assert ((rows.verdict == "passed") | (rows.convention == DEFECT)).all()
 
 
 def _compare_with(case, impl_name, *, cmap=None, model_case=None):

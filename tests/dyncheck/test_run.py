@@ -74,7 +74,7 @@ def test_a_catalogue_entry_whose_engine_is_left_out_is_skipped_without_running(m
     result = run_module.run([get_case("simple_pendulum")], ["reference", "mujoco"],
                             conventions=True)
     drake, hinge = result.conventions
-    assert drake.skipped == "drake not selected (--impl)" and not drake.failed
+    assert drake.skipped == "not run: drake (left out by --impl)" and not drake.failed
     assert hinge == catalogue.explain("hinge-axis-sign")[0] and not hinge.skipped
 
 
