@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 from dyncheck.adapters.integrators import quat_mul
-from dyncheck.adapters.layout import IDENTITY, Canonical, quat_order
-from dyncheck.adapters.model_tree import Axes, JointType, Layout, ModelTree, Orientation
+from dyncheck.adapters.layout import IDENTITY, Canonical, StateMap, mapper, quat_order
+from dyncheck.adapters.model_tree import Axes, Dynamics, JointType, Layout, ModelTree, Orientation
 from dyncheck.cases.coordinate_maps import quat_from_matrix, quat_to_matrix
 
 
@@ -93,3 +93,42 @@ def free_batch(lay: Layout, place_quat: np.ndarray, q_c: np.ndarray,
         tdot_v[:, lin] = np.einsum("nij,nj->ni", rot, centripetal)
     t[:, ang, 3:6] = rot if lay.angular_axes is Axes.WORLD else r_o.T
     return q_e, t, tdot_v
+
+
+def engine_states(
+    canon: Canonical, tree: ModelTree, q: np.ndarray, v: np.ndarray, a: np.ndarray
+) -> tuple[list[StateMap], np.ndarray, np.ndarray, np.ndarray]:
+    """The batch in the engine's layout: maps, q_e, v_e, a_e (real states: every state at
+    once, :func:`batch_map`; complex-stepped: one at a
+    time, :func:`~dyncheck.adapters.layout.mapper`)."""
+    if np.iscomplexobj(q) or np.iscomplexobj(v) or not len(q):
+        one = mapper(canon, tree)
+        maps = [one(qi, vi) for qi, vi in zip(q, v, strict=True)]
+        q_e = np.array([s.q for s in maps])
+        v_e = np.array([s.t @ vi for s, vi in zip(maps, v, strict=True)])
+        a_e = np.array([s.t @ ai + s.tdot_v for s, ai in zip(maps, a, strict=True)])
+        return maps, q_e, v_e, a_e
+    q_e, t, tdot_v = batch_map(canon, tree, np.asarray(q, float), np.asarray(v, float))
+    maps = [StateMap(q=qi, t=ti, tdot_v=di) for qi, ti, di in zip(q_e, t, tdot_v, strict=True)]
+    v_e = (t @ np.asarray(v, float)[..., None])[..., 0]
+    a_e = (t @ np.asarray(a, float)[..., None])[..., 0] + tdot_v
+    return maps, q_e, v_e, a_e
+
+
+def to_canonical(maps: list[StateMap], dyn: Dynamics) -> Dynamics:
+    """An engine's dynamics in the canonical layout (see the module's docstring)."""
+    if not maps:
+        return dyn
+    t = np.array([s.t for s in maps])
+    tdot_v = np.array([s.tdot_v for s in maps])
+    m_e = np.asarray(dyn.mass_matrix)
+    # v_e = T v: accelerations map back by T⁻¹ (T is not orthogonal where a free joint's
+    # velocity is that of an offset point); forces, duals, by Tᵀ
+    t_t = np.swapaxes(t, 1, 2)
+    return Dynamics(
+        mass_matrix=t_t @ m_e @ t,
+        bias=(t_t @ (dyn.bias + (m_e @ tdot_v[..., None])[..., 0])[..., None])[..., 0],
+        forward=np.linalg.solve(t, (dyn.forward - tdot_v)[..., None])[..., 0],
+        inverse=(t_t @ np.asarray(dyn.inverse)[..., None])[..., 0],
+        kinetic=dyn.kinetic, potential=dyn.potential,
+    )

@@ -30,7 +30,8 @@ import numpy as np
 
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.c_output import c_output_dropped
-from dyncheck.adapters.layout import Canonical, engine_states, to_canonical
+from dyncheck.adapters.layout import Canonical
+from dyncheck.adapters.layout_batch import engine_states, to_canonical
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.model_files import Format, read
 from dyncheck.adapters.model_tree import (

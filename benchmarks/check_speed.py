@@ -71,7 +71,7 @@ def scale(folder: Path, repeats: int) -> tuple[pd.DataFrame, dict[str, float]]:
     from dyncheck.adapters.layout import canonical
     from dyncheck.adapters.model_files import read
     from dyncheck.adapters.mujoco_model import MujocoModel
-    from dyncheck.check.derivatives import referee
+    from dyncheck.check.derivative_referee import referee
     from dyncheck.check.dynamics import sample
     from dyncheck.check.referee import ReferenceModel
 

@@ -19,6 +19,7 @@ engine: the functions and result types are imported on first use.
 from __future__ import annotations
 
 import importlib
+import importlib.metadata
 from typing import TYPE_CHECKING, Any
 
 from dyncheck.errors import (
@@ -37,8 +38,6 @@ if TYPE_CHECKING:
     from dyncheck.results import Discrepancy
     from dyncheck.run import RunResult
     from dyncheck.run import run as run_cases
-
-__version__ = "0.1.0"
 
 LAZY = {
     "check_model": ("dyncheck.check.model_check", "check_model"),
@@ -73,6 +72,8 @@ __all__ = [
 
 def __getattr__(name: str) -> Any:
     """A public name of :data:`LAZY`, imported from its module on first use."""
+    if name == "__version__":  # one home: pyproject.toml, read from the installed metadata
+        return importlib.metadata.version("dyncheck")
     if name in LAZY:
         module, attr = LAZY[name]
         return getattr(importlib.import_module(module), attr)

@@ -126,7 +126,7 @@ def _raw_loader(adapter, qe, ve, te, ae) -> Callable[[], None]:
     """An engine served by its file loader (:mod:`dyncheck.adapters.model_adapter`): the
     loader's own per-state engine calls on states already in its layout (the map to it is
     dyncheck's, timed in the adapter's row)."""
-    from dyncheck.adapters.layout import engine_states
+    from dyncheck.adapters.layout_batch import engine_states
 
     _, q, v, a = engine_states(adapter.canon, adapter.tree, qe, ve, ae)
     return partial(adapter.engine.dynamics, q, v, a)

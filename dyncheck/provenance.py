@@ -41,7 +41,6 @@ def versions(engines: Mapping[str, str] | None = None) -> dict[str, str]:
 
     import numpy
 
-    from dyncheck import __version__
     from dyncheck.adapters import LABELS, RUN
 
     out = {
@@ -54,7 +53,7 @@ def versions(engines: Mapping[str, str] | None = None) -> dict[str, str]:
     used = engine_versions(RUN) if engines is None else engines
     out |= {label: used.get(label, NOT_USED) for name, label in LABELS.items()
             if name in RUN or label in used}
-    out["dyncheck"] = __version__
+    out["dyncheck"] = version("dyncheck")
     try:
         commit = subprocess.run(
             ["git", "rev-parse", "--short", "HEAD"],

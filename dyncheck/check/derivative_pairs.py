@@ -20,7 +20,7 @@ from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
 from dyncheck.results import Verdict
 
 if TYPE_CHECKING:
-    from dyncheck.check.derivatives import Referee
+    from dyncheck.check.derivative_referee import Referee
 
 ZERO = "0 within round-off"
 """What a derivative zero within its bound on both sides is shown as."""

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from dyncheck.adapters import layout
+from dyncheck.adapters import layout, layout_batch
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials, urdf_welded
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import describe, inputs, partial, predicted, readings
@@ -325,14 +325,14 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
         t0 = time.perf_counter()
         part = parts[engine]
         on = batch if part is None else partial.states(batch, part)
-        maps, q_e, v_e, a_e = layout.engine_states(
+        maps, q_e, v_e, a_e = layout_batch.engine_states(
             canon if part is None else layout.canonical(part.tree), m.tree, on.q, on.v, on.a)
         try:
             if isinstance(m, engine_processes.Isolated):
                 m.submit(q_e, v_e, a_e)
                 pending[engine] = (m, maps)
             else:
-                results[engine] = layout.to_canonical(maps, m.dynamics(q_e, v_e, a_e))
+                results[engine] = layout_batch.to_canonical(maps, m.dynamics(q_e, v_e, a_e))
         except Exception as exc:  # an engine failing mid-way costs its own rows
             failures[engine] = f"{type(exc).__name__}: {exc}"
         seconds[engine] = seconds.get(engine, 0.0) + time.perf_counter() - t0
@@ -353,7 +353,7 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
     for engine, (proxy, maps) in pending.items():
         try:
             answer, took = proxy.collect()
-            results[engine] = layout.to_canonical(maps, answer)
+            results[engine] = layout_batch.to_canonical(maps, answer)
             seconds[engine] += took
         except Exception as exc:
             failures[engine] = f"{type(exc).__name__}: {exc}"

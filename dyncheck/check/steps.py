@@ -14,7 +14,7 @@ from scipy.spatial.transform import Rotation
 from dyncheck.adapters.integrators import dexp_inv, quat_conj, quat_exp, quat_mul
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import JointType, ModelTree, Transition
-from dyncheck.check.derivatives import Referee, referee
+from dyncheck.check.derivative_referee import Referee, referee
 from dyncheck.check.describe import depth
 from dyncheck.check.dynamics import States
 from dyncheck.check.rows import CheckRow, Section
@@ -244,7 +244,7 @@ def implicit_blocks(canon: Canonical, tree: ModelTree, states: States, h: float,
     if not joints:
         return []
     from dyncheck.check.derivative_charts import perturb
-    from dyncheck.check.derivatives import STEP
+    from dyncheck.check.derivative_referee import STEP
     from dyncheck.check.referee import ReferenceModel
 
     solver = ReferenceModel(tree).recursive
@@ -302,7 +302,7 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
     differences: error ≈ |A(2s) − A(s)| / 3) and their round-off 2 δx/(2 s) — δv₊ being
     h v̇'s round-off, κ(M) times its own —, + the referee's own round-off in its
     derivatives times h. ``of``: the states sampled, where the step Jacobians are compared at
-    fewer (:func:`~dyncheck.check.derivatives.step_states`): the basis says so."""
+    fewer (:func:`~dyncheck.check.derivative_referee.step_states`): the basis says so."""
     h = found.time_step
     rk4 = found.integrator == Integrator.RK4
     why = found.unfollowed

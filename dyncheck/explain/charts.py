@@ -20,18 +20,19 @@ def free_body_derivatives(states: int = 10) -> tuple[dict[str, float], dict[str,
     axes) and Pinocchio's (analytic, in its tangent: origin moved in body axes), first as
     they come, then with Pinocchio's mapped to MuJoCo's chart; and the referee's difference
     from Pinocchio's mapped ones."""
-    from dyncheck.adapters import layout
+    from dyncheck.adapters import layout_batch
+    from dyncheck.adapters.model_tree import Derivatives
     from dyncheck.adapters.pinocchio_model import PinocchioModel
-    from dyncheck.check import derivative_charts, derivatives
+    from dyncheck.check import derivative_charts, derivative_referee
 
     mine, other, canon, batch = beside_mujoco(FALLING, PinocchioModel, states)
     theirs = mine.derivatives(batch.q, batch.v, batch.a)
-    _, q, v, a = layout.engine_states(canon, other.tree, batch.q, batch.v, batch.a)
+    _, q, v, a = layout_batch.engine_states(canon, other.tree, batch.q, batch.v, batch.a)
     raw = other.derivatives(q, v, a)
     mapped = derivative_charts.to_canonical(canon, other.tree, batch, raw, other.dynamics(q, v, a))
-    referee = derivatives.referee(mine.tree, batch).derivatives
+    referee = derivative_referee.referee(mine.tree, batch).derivatives
 
-    def worst(x: derivatives.Derivatives, y: derivatives.Derivatives) -> dict[str, float]:
+    def worst(x: Derivatives, y: Derivatives) -> dict[str, float]:
         return {f: float(np.abs(getattr(x, f) - getattr(y, f)).max()
                          / np.abs(getattr(x, f)).max()) for f in ("forward_q", "inverse_q")}
 

@@ -67,18 +67,18 @@ def test_the_pendulum_derivatives_are_the_books_closed_form(tmp_path):
     m, length, g = 1.3, 0.7, 9.81
     path = tmp_path / "pendulum.urdf"
     path.write_text(PENDULUM.format(m=m, l=length))
-    from dyncheck.adapters import layout
+    from dyncheck.adapters import layout, layout_batch
     from dyncheck.adapters.model_files import read
     from dyncheck.adapters.pinocchio_model import PinocchioModel
-    from dyncheck.check import derivative_charts, derivatives
+    from dyncheck.check import derivative_charts, derivative_referee
     from dyncheck.check.dynamics import sample
 
     model = PinocchioModel(read(path))
     canon = layout.canonical(model.tree)
     states = sample(canon, model.tree, 10, 0)
     theta = states.q[:, 0]
-    ref = derivatives.referee(model.tree, states).derivatives
-    _, q, v, a = layout.engine_states(canon, model.tree, states.q, states.v, states.a)
+    ref = derivative_referee.referee(model.tree, states).derivatives
+    _, q, v, a = layout_batch.engine_states(canon, model.tree, states.q, states.v, states.a)
     assert q.shape[1] == 2  # Pinocchio holds a continuous joint as (cos θ, sin θ)
     mine = derivative_charts.to_canonical(canon, model.tree, states, model.derivatives(q, v, a),
                                     model.dynamics(q, v, a))
@@ -152,17 +152,18 @@ def test_the_chain_rule_is_needed():
     """Without the map's derivative terms (Pinocchio's and Drake's matrices taken in the
     canonical chart as they come, only permuted), the free body's rows fail: the charts
     really differ."""
+    from dyncheck.adapters.model_tree import derivatives as collect
     from dyncheck.check import derivative_charts, derivatives
 
     def plain(canon, tree, states, found, dynamics):
-        from dyncheck.adapters.layout import engine_states
+        from dyncheck.adapters.layout_batch import engine_states
 
         maps = engine_states(canon, tree, states.q, states.v, states.a)[0]
         t = np.array([m.t for m in maps])
         size = t.shape[2]
         mapped = {f: np.einsum("sji,sjk,skl->sil", t, getattr(found, f)[:, :, :t.shape[1]], t)
                   [:, :size, :size] for f in derivative_charts.FIELDS}
-        return derivatives.collect(mapped, method=found.method, step=found.step)
+        return collect(mapped, method=found.method, step=found.step)
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(derivatives, "to_canonical", plain)

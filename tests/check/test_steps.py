@@ -152,7 +152,7 @@ def test_the_rk4_chain_rule_on_rotations_is_the_derivative_of_the_step_itself():
     from dyncheck.adapters.layout import canonical
     from dyncheck.adapters.model_files import read
     from dyncheck.check.derivative_charts import perturb
-    from dyncheck.check.derivatives import referee
+    from dyncheck.check.derivative_referee import referee
     from dyncheck.check.dynamics import States, sample
     from dyncheck.check.engines import load
     from dyncheck.check.referee import ReferenceModel
