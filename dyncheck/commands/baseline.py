@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
+from dyncheck.commands import flags
+from dyncheck.commands.flags import Command
 from dyncheck.commands.options import (
     check_out_file,
+    path_arg,
     positive,
 )
 
@@ -26,3 +30,14 @@ def baseline_command(args: argparse.Namespace) -> int:
     baseline.write(result.discrepancies, args.out, versions=report.versions(result.engines))
     print(f"baseline written to {args.out} ({len(result.discrepancies)} rows)")
     return 0
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    flags.selection(p)
+    p.add_argument("--out", type=path_arg, default=Path("reports/baseline.csv"), metavar="FILE")
+
+
+COMMAND = Command(
+    name="baseline", help="run and write the regression baseline",
+    example="dyncheck baseline --out reports/baseline.csv",
+    arguments=_arguments, handler=baseline_command)

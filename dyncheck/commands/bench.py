@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
+from dyncheck.commands import flags
+from dyncheck.commands.flags import Command
 from dyncheck.commands.options import (
     BENCH_MAX,
     check_out,
     claim_out,
+    path_arg,
     positive,
 )
 
@@ -33,3 +37,33 @@ def bench_command(args: argparse.Namespace) -> int:
     print(bench.main(args.case, args.states, args.repeats, args.memory, args.out,
                      jobs=args.jobs, dask=args.dask, quiet=args.quiet))
     return 0
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("case", nargs="?", default="compound_pendulum", metavar="CASE")
+    p.add_argument("--states", type=int, default=100_000, metavar="N")
+    p.add_argument("--repeats", type=int, default=3, metavar="R")
+    p.add_argument(
+        "--memory",
+        type=int,
+        nargs="*",
+        default=[100_000, 1_000_000],
+        metavar="N",
+        help="sweep sizes whose peak memory is measured in fresh processes",
+    )
+    p.add_argument("--out", type=path_arg, default=Path("reports"), help="report folder")
+    p.add_argument("--jobs", type=int, default=1, metavar="N",
+                   help="also time the sweep in slices on N processes against this one "
+                   "(the same rows, checked)")
+    flags.dask(p)
+    p.add_argument("--suite", action="store_true",
+                   help="instead: time the commands a user runs (list, explain, one case, the "
+                   "full run, the README's main command with its install, report --check, "
+                   "the test commands) in fresh processes -> benchmark-suite.md")
+    flags.quiet(p)
+
+
+COMMAND = Command(
+    name="bench", help="time the engines, adapters, reference and a sweep",
+    example="dyncheck bench compound_pendulum --states 100000",
+    arguments=_arguments, handler=bench_command)

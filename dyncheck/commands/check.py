@@ -8,6 +8,9 @@ import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from dyncheck.commands import flags
+from dyncheck.commands.flags import Command
+from dyncheck.commands.options import path_arg
 from dyncheck.errors import DyncheckError, InvalidInput
 
 if TYPE_CHECKING:
@@ -184,3 +187,51 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
         write_ci(args, tables, CHECK, engine_versions_of(implementations(
             tuple(args.impl) or None)), refused)
     return 2 if refusals else 1 if failed else 0
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("paths", nargs="*", type=path_arg, metavar="PATH",
+                   help="MJCF (.xml) or URDF files, or folders (every model file under "
+                   "them; files another one includes left out); several: an index page too")
+    p.add_argument("--robot", action="append", default=[], metavar="NAME",
+                   help="a robot of example-robot-data (extra 'robots'; see `dyncheck list`; "
+                   "'all': every one)")
+    p.add_argument("--case", action="append", default=[], metavar="CASE",
+                   help="a book case's MJCF, the file `run` gives MuJoCo (repeatable; 'all': "
+                   "every case)")
+    p.add_argument("--impl", action="append", default=[], metavar="NAME",
+                   help="reference, mujoco, pinocchio, drake, MuJoCo's ports mjx, mjx-f64, "
+                   "mujoco-warp, and newton, pybullet (repeatable; default: the first four; the "
+                   "others only when named)")
+    p.add_argument("--states", type=int, default=100, metavar="N", help="sampled states")
+    p.add_argument("--seed", type=int, default=0, metavar="S")
+    p.add_argument("--floating", action="store_true",
+                   help="a URDF's root link is a free body (a free joint in every engine)")
+    p.add_argument("--derivatives", action="store_true",
+                   help="also compare the derivatives of the dynamics (d(forward)/d(q, v, tau), "
+                   "d(inverse)/d(q, v)) of every engine that offers them with the referee's")
+    p.add_argument("--against", type=path_arg, default=None, metavar="PATH",
+                   help="also compare what MuJoCo reads with this other file (a previous version)")
+    p.add_argument("--out", type=path_arg, default=Path("reports/check"), help="output folder")
+    flags.jobs(p, "models checked")
+    flags.dask(p)
+    flags.ci(p)
+    flags.quiet(p)
+    flags.no_cache(p)
+    p.add_argument("--engine-memory", type=int, default=None, metavar="MIB",
+                   help="address space each engine process may use (default 8192 MiB; 0: no "
+                   "cap; MuJoCo's ports are never capped)")
+    p.add_argument("--engine-seconds", type=float, default=None, metavar="S",
+                   help="base time limit of an engine's load and of each batch of states "
+                   "(default 120 s), scaled up with the file's size and states x dofs^2")
+    p.add_argument("--in-process", action="store_true",
+                   help="load the engines in this process (faster start; an engine that "
+                   "crashes on the file then ends the check)")
+
+
+COMMAND = Command(
+    name="check",
+    help="do the engines read YOUR model alike and compute the same dynamics (and "
+    "derivatives)?",
+    example="dyncheck check my_robot.urdf --floating --states 1000",
+    arguments=_arguments, handler=check_command)

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import argparse
 
+from dyncheck.commands.flags import Command
 from dyncheck.commands.options import (
     check_out_file,
+    path_arg,
 )
 
 
@@ -36,3 +38,21 @@ def diff_command(args: argparse.Namespace) -> int:
     if args.markdown is not None:
         write_atomic(args.markdown, diff.markdown(a, b, table, factor=factor, every=args.all))
     return 0 if counts[diff.Move.UNCHANGED] == len(table) else 1
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("run_a", type=path_arg, metavar="RUN_A",
+                   help="output folder of `run` or `check` (or a baseline CSV): the old side")
+    p.add_argument("run_b", type=path_arg, metavar="RUN_B", help="the new side, same kind")
+    p.add_argument("--tolerance", type=float, default=None, metavar="FACTOR",
+                   help="an error above its tolerance moved when it changed by more than this "
+                        "factor (default 10)")
+    p.add_argument("--markdown", type=path_arg, default=None, metavar="FILE",
+                   help="also write the diff as a Markdown page")
+    p.add_argument("--all", action="store_true", help="list unchanged rows too")
+
+
+COMMAND = Command(
+    name="diff", help="what moved between two runs (engine upgrade, code change)",
+    example="dyncheck diff reports /tmp/report_after_upgrade --markdown /tmp/diff.md",
+    arguments=_arguments, handler=diff_command)

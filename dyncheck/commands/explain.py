@@ -1,16 +1,19 @@
-"""``dyncheck explain`` and ``dyncheck errata``: the conventions catalogue and the
-book's formulas."""
+"""``dyncheck explain``: the conventions catalogue, and an engine defect's reproducer."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
 
+from dyncheck.commands import flags
+from dyncheck.commands.flags import Command
 from dyncheck.commands.options import (
     check_out_file,
+    path_arg,
     positive,
 )
 from dyncheck.errors import InvalidInput
+from dyncheck.workers import default_jobs
 
 
 def explain_command(args: argparse.Namespace) -> int:
@@ -52,11 +55,19 @@ def _reproducer(name: str | None, out: Path) -> int:
     return 0
 
 
-def errata_command(args: argparse.Namespace) -> int:
-    from dyncheck.errata import page
-    from dyncheck.results import write_atomic
+def _arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("name", nargs="?", default=None, metavar="NAME")
+    p.add_argument("--jobs", type=int, default=default_jobs(), metavar="N",
+                   help=f"entries measured in N parallel processes (default: {flags.JOBS})")
+    p.add_argument("--reproducer", type=path_arg, default=None, metavar="FILE",
+                   help="write NAME's standalone script for the engine's issue tracker "
+                   "instead (its engine, numpy and an inline model; exits 1 while the defect "
+                   "stands)")
+    flags.accelerators(p)
+    flags.no_cache(p)
 
-    check_out_file("--out", args.out)
-    write_atomic(args.out, page.page())
-    print(f"errata page written to {args.out}")
-    return 0
+
+COMMAND = Command(
+    name="explain", help="demonstrate a modelling convention (all if none)",
+    example="dyncheck explain quaternion-storage-order",
+    arguments=_arguments, handler=explain_command)

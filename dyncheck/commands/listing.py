@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import argparse
+
+from dyncheck.commands.flags import Command
 from dyncheck.errors import EngineNotInstalled
 
 
@@ -66,3 +69,18 @@ def list_command(*, integrators: bool = False) -> int:
     else:
         print("robots: the 'robots' extra is not installed (pip install 'dyncheck[robots]')")
     return 0
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--integrators",
+        action="store_true",
+        help="import each engine: its integrators and, for the ports, the device (slower: "
+        "JAX and Warp take seconds to import)",
+    )
+
+
+COMMAND = Command(
+    name="list", help="cases and implementations, with installed engine versions",
+    example="dyncheck list --integrators", arguments=_arguments,
+    handler=lambda args: list_command(integrators=args.integrators))

@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
+from dyncheck.commands import flags
+from dyncheck.commands.flags import Command
 from dyncheck.commands.options import (
+    path_arg,
     positive,
 )
 from dyncheck.errors import InvalidInput
@@ -48,3 +52,31 @@ def report_command(args: argparse.Namespace) -> int:
         else f"{len(moved)} results moved: run `dyncheck run --out {args.out}` and commit"
     )
     return 1 if moved else 0
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--check",
+        action="store_true",
+        required=True,
+        help="recompute every case and compare with the report folder",
+    )
+    p.add_argument("--out", type=path_arg, default=Path("reports"), help="report folder")
+    flags.jobs(p, "cases")
+    flags.dask(p)
+    flags.no_cache(p)
+    flags.accelerators(p)
+    p.add_argument(
+        "--from",
+        dest="run_dir",
+        type=path_arg,
+        default=None,
+        metavar="DIR",
+        help="compare with the output folder of a finished `dyncheck run` instead of running",
+    )
+
+
+COMMAND = Command(
+    name="report", help="check that the committed report matches the code",
+    example="dyncheck report --check --from /tmp/report",
+    arguments=_arguments, handler=report_command)

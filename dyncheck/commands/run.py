@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
+from dyncheck.commands import flags
+from dyncheck.commands.flags import Command
 from dyncheck.commands.options import (
     MAX_STATES,
     check_out,
     ci_files,
     claim_out,
+    path_arg,
     positive,
     warn_cost,
     write_ci,
@@ -71,3 +75,33 @@ def run_command(args: argparse.Namespace) -> int:
         if regressed:
             print(changes.to_string(index=False))
     return 1 if result.failed or regressed else 0
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    flags.selection(p)
+    p.add_argument("--out", type=path_arg, default=Path("reports"), help="report folder")
+    p.add_argument("--device", choices=("cpu", "cuda"), default=None,
+                   help="where MuJoCo's ports (MJX, MuJoCo Warp) compute (default: the CPU "
+                   "for Warp, JAX's default device for MJX); named in the provenance")
+    p.add_argument(
+        "--states",
+        type=int,
+        default=None,
+        metavar="N",
+        help="sampled states per case (default: each case's own, 16)",
+    )
+    p.add_argument(
+        "--baseline",
+        type=path_arg,
+        default=None,
+        metavar="FILE",
+        help="report every row that regressed against this baseline (exit 1)",
+    )
+    flags.ci(p)
+    flags.quiet(p)
+
+
+COMMAND = Command(
+    name="run", help="compare implementations on cases and write the report",
+    example="dyncheck run simple_pendulum --impl reference --impl mujoco --out /tmp/report",
+    arguments=_arguments, handler=run_command)

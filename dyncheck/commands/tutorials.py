@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
-from dyncheck.commands.options import check_out, claim_out
+from dyncheck.commands import flags
+from dyncheck.commands.flags import Command
+from dyncheck.commands.options import check_out, claim_out, path_arg
 from dyncheck.errors import UnknownName
 from dyncheck.progress import Progress
 
@@ -37,3 +40,16 @@ def tutorials_command(args: argparse.Namespace) -> int:
     if not args.names:
         tutorials.index(args.out)
     return 1 if failed else 0
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("names", nargs="*", metavar="NAME", help="tutorials (default: all)")
+    p.add_argument("--out", type=path_arg, default=Path("reports/tutorials"),
+                   help="output folder")
+    flags.quiet(p)
+
+
+COMMAND = Command(
+    name="tutorials", help="execute the tutorials and render them to Markdown",
+    example="dyncheck tutorials 01_quaternion_order --out /tmp/tutorials",
+    arguments=_arguments, handler=tutorials_command)

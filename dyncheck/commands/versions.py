@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
-from dyncheck.commands.options import check_out_file, log, positive
+from dyncheck.commands import flags
+from dyncheck.commands.flags import Command
+from dyncheck.commands.options import check_out_file, log, path_arg, positive
 from dyncheck.progress import Progress
+from dyncheck.workers import default_jobs
 
 
 def versions_command(args: argparse.Namespace) -> int:
@@ -35,3 +39,26 @@ def versions_command(args: argparse.Namespace) -> int:
     write_atomic(args.out, matrix.page(steps, notes=matrix.EXPLANATIONS))
     print(f"version matrix written to {args.out}")
     return 0
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--engine", action="append", default=[], metavar="NAME",
+                   help="mujoco, pinocchio, drake, newton, pybullet (repeatable; default: "
+                   "all)")
+    p.add_argument("--case", action="append", default=[], metavar="CASE",
+                   help="cases to run (repeatable; default: all)")
+    p.add_argument("--jobs", type=int, default=default_jobs(), metavar="N",
+                   help=f"each release's run in N parallel processes (default: {flags.JOBS})")
+    p.add_argument("--bisect", nargs=3, default=None, metavar=("ENGINE", "GOOD", "BAD"),
+                   help="name the first release between GOOD and BAD whose results moved")
+    p.add_argument("--reuse", action="store_true",
+                   help="reuse each release's newest cached run, whatever code made it")
+    p.add_argument("--out", type=path_arg, default=Path("reports/versions.md"), metavar="FILE")
+    flags.quiet(p)
+
+
+COMMAND = Command(
+    name="versions", help="the version matrix: each engine release in its own environment",
+    example="dyncheck versions --engine mujoco   |   dyncheck versions --bisect mujoco 3.3.7 "
+    "4.0.0",
+    arguments=_arguments, handler=versions_command)

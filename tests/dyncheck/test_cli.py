@@ -192,13 +192,14 @@ def test_bench_writes_its_tables(tmp_path, monkeypatch, selection, parts):
 
 
 def test_help_lists_every_command_in_full_with_an_example(capsys):
-    from dyncheck.cli import COMMANDS, EXAMPLES
+    from dyncheck.cli import COMMANDS
 
     assert main(["--help"]) == 0
     top = capsys.readouterr().out
-    for command in [*COMMANDS, "list"]:
+    assert {"list", "run", "check", "diff", "versions", "tutorials", "report", "explain",
+            "errata", "baseline", "bench"} <= set(COMMANDS)
+    for command in COMMANDS:
         assert command in top
-        assert command in EXAMPLES
         assert main([command, "--help"]) == 0
         assert "example: dyncheck " + command in " ".join(capsys.readouterr().out.split())
 
