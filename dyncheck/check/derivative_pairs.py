@@ -60,8 +60,8 @@ def _floor(ref: Referee, field: str) -> np.ndarray:
     return np.abs(ref.inverse_mass) @ bound if field.startswith("forward") else bound
 
 
-def compare(model: str, tree: ModelTree, name_a: str, da: Derivatives, name_b: str,
-            db: Derivatives, ref: Referee, *, eps: float = EPS) -> list[CheckRow]:
+def compare(model: str, tree: ModelTree, *, name_a: str, da: Derivatives, name_b: str,
+            db: Derivatives, ref: Referee, eps: float = EPS) -> list[CheckRow]:
     """One row per derivative for the pair (a, b); ``ref`` gives the referee's estimated
     error where it is a side, and the curvatures an engine's finite differences need."""
     d = depth(tree)
@@ -139,19 +139,20 @@ def label(row: CheckRow) -> str:
     return next((name for said, name in causes.items() if said in row.note), "")
 
 
-def after_defects(model: str, tree: ModelTree, name_a: str, da: Derivatives, name_b: str,
-                  db: Derivatives, ref: Referee, *, eps: float = EPS) -> list[CheckRow]:
+def after_defects(model: str, tree: ModelTree, *, name_a: str, da: Derivatives, name_b: str,
+                  db: Derivatives, ref: Referee, eps: float = EPS) -> list[CheckRow]:
     """:func:`compare`, and where a side declares a defect of its analytic derivatives
     (:attr:`Derivatives.defect`) and a row fails, the same row with that side's own finite
     differences: explained where they agree within their predicted error (the size of the
     defect is the failed row's error, on the note), failed where they do not either."""
-    raw = compare(model, tree, name_a, da, name_b, db, ref, eps=eps)
+    raw = compare(model, tree, name_a=name_a, da=da, name_b=name_b, db=db, ref=ref, eps=eps)
     flawed = [(n, d) for n, d in ((name_a, da), (name_b, db)) if d.own_differences is not None]
     if not flawed or all(r.verdict is not Verdict.FAILED for r in raw):
         return raw
     own_a = da.own_differences or da
     own_b = db.own_differences or db
-    redone = compare(model, tree, name_a, own_a, name_b, own_b, ref, eps=eps)
+    redone = compare(model, tree, name_a=name_a, da=own_a, name_b=name_b, db=own_b, ref=ref,
+                     eps=eps)
     engine, declared = flawed[0]
     out = []
     for first_try, second in zip(raw, redone, strict=True):
@@ -171,9 +172,9 @@ ACROSS_READINGS = ("{a} and {b} read the model differently: compared after the r
                    "{b}'s reading minus on {a}'s (measured), which accounts for the difference")
 
 
-def across_readings(model: str, tree: ModelTree, name_a: str, da: Derivatives, name_b: str,
-                     db: Derivatives, ref_a: Referee, ref_b: Referee,
-                     eps: float) -> list[CheckRow]:
+def across_readings(model: str, tree: ModelTree, *, name_a: str, da: Derivatives,
+                    name_b: str, db: Derivatives, ref_a: Referee, ref_b: Referee,
+                    eps: float) -> list[CheckRow]:
     """Two engines that read the model differently: b's derivatives less the readings'
     difference (the referee's on b's reading minus on a's) against a's — explained where
     that accounts for the difference, failed beyond it."""
@@ -182,9 +183,9 @@ def across_readings(model: str, tree: ModelTree, name_a: str, da: Derivatives, n
                              for f in FIELDS})
     note = ACROSS_READINGS.format(a=name_a, b=name_b)
     out = []
-    for raw, r in zip(compare(model, tree, name_a, da, name_b, db, ref_a, eps=eps),
-                      compare(model, tree, name_a, da, name_b, shifted, ref_a, eps=eps),
-                      strict=True):
+    pair = {"name_a": name_a, "da": da, "name_b": name_b, "ref": ref_a, "eps": eps}
+    for raw, r in zip(compare(model, tree, db=db, **pair),
+                      compare(model, tree, db=shifted, **pair), strict=True):
         if raw.verdict is not Verdict.FAILED:  # alike without the readings' difference
             out.append(raw)
         elif r.verdict is Verdict.PASSED:

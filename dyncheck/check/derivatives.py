@@ -37,7 +37,7 @@ from dyncheck.adapters.model_tree import (
 )
 from dyncheck.check.derivative_charts import same_layout, to_canonical
 from dyncheck.check.derivative_pairs import across_readings, after_defects, compare
-from dyncheck.check.derivative_referee import first, referee, step_states
+from dyncheck.check.derivative_referee import Referee, first, referee, step_states
 from dyncheck.check.dynamics import States
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.check.steps import step_rows
@@ -179,22 +179,34 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
             out.extend(step_rows(model, canon, tree, first(states, at_steps),
                                  first(ref, at_steps), name, step, of=len(states.q)))
     order = [n for n in names if n in found]
+    out.extend(_pair_rows(model, tree, order=order, found=found, engines=engines, ref=ref,
+                          own_refs=own_refs))
+    return out
+
+
+def _pair_rows(model: str, tree: ModelTree, *, order: list[str], found: dict[str, Derivatives],
+               engines: Mapping[str, object], ref: Referee,
+               own_refs: dict[str, Referee]) -> list[CheckRow]:
+    """The rows of every pair of ``order`` (the sides whose derivatives were ``found``): a
+    pair with an engine that reads the model otherwise (``own_refs``: the referee on its own
+    reading) is compared on that reading; a declared defect is compared after it."""
+    rows: list[CheckRow] = []
     for i, a_name in enumerate(order):
         for b_name in order[i + 1 :]:
             eps = max(getattr(engines.get(a_name), "tree", tree).eps,
                       getattr(engines.get(b_name), "tree", tree).eps)
             if a_name == "reference" and b_name in own_refs:  # on b's own reading
                 on_b = own_refs[b_name]
-                out.extend(replace(r, basis=f"{r.basis}; the referee on {b_name}'s reading")
-                           for r in compare(model, tree, a_name, on_b.derivatives, b_name,
-                                            found[b_name], on_b, eps=eps))
+                rows.extend(replace(r, basis=f"{r.basis}; the referee on {b_name}'s reading")
+                           for r in compare(model, tree, name_a=a_name, da=on_b.derivatives,
+                                            name_b=b_name, db=found[b_name], ref=on_b,
+                                            eps=eps))
             elif a_name in own_refs or b_name in own_refs:
-                out.extend(across_readings(model, tree, a_name, found[a_name], b_name,
-                                            found[b_name], own_refs.get(a_name, ref),
-                                            own_refs.get(b_name, ref), eps))
+                rows.extend(across_readings(
+                    model, tree, name_a=a_name, da=found[a_name], name_b=b_name,
+                    db=found[b_name], ref_a=own_refs.get(a_name, ref),
+                    ref_b=own_refs.get(b_name, ref), eps=eps))
             else:
-                out.extend(after_defects(model, tree, a_name, found[a_name], b_name,
-                                         found[b_name], ref, eps=eps))
-    return out
-
-
+                rows.extend(after_defects(model, tree, name_a=a_name, da=found[a_name],
+                                         name_b=b_name, db=found[b_name], ref=ref, eps=eps))
+    return rows

@@ -198,6 +198,7 @@ def _candidates(known: Prediction | None, read: Prediction | None) -> list[Predi
 def compare(
     model: str,
     tree: ModelTree,
+    *,
     name_a: str,
     dyn_a: Dynamics,
     name_b: str,
@@ -205,7 +206,6 @@ def compare(
     explanations: dict[str, Prediction],
     readings: dict[str, Prediction],
     states: States,
-    *,
     eps: float = EPS,
     kappa: float | None = None,
     vertices: float = 0.0,

@@ -435,8 +435,9 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
                     canonical_tree, a, b, own, batch, differing)
                 if a != REFEREE and a not in kappas:
                     kappas[a] = condition(results[a].mass_matrix)
-                rows.extend(compare(model, canonical_tree, a, dyn_a, b, results[b],
-                                    explanations, reading, batch, eps=eps,
+                rows.extend(compare(model, canonical_tree, name_a=a, dyn_a=dyn_a, name_b=b,
+                                    dyn_b=results[b], explanations=explanations,
+                                    readings=reading, states=batch, eps=eps,
                                     kappa=kappas.get(a), vertices=mesh, standing=factor,
                                     judged_on=judged_on))
                 continue
@@ -446,9 +447,10 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
             on = States(q=batch.q, v=batch.v[:, common], a=batch.a[:, common])
             rows.extend(compare(
                 model, canonical_tree,
-                a, partial.restrict(results[a], partial.columns(dofs[a], common)),
-                b, partial.restrict(results[b], partial.columns(dofs[b], common)),
-                {}, {}, on, eps=eps, vertices=mesh, standing=factor))
+                name_a=a, dyn_a=partial.restrict(results[a], partial.columns(dofs[a], common)),
+                name_b=b, dyn_b=partial.restrict(results[b], partial.columns(dofs[b], common)),
+                explanations={}, readings={}, states=on, eps=eps, vertices=mesh,
+                standing=factor))
     return rows
 
 
