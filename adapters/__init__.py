@@ -21,6 +21,23 @@ from dyncheck.vocabulary import Integrator
 
 
 @dataclass(frozen=True, kw_only=True)
+class Needs:
+    """What a series of an engine's releases needs beyond ``constraints.txt`` to import at
+    all (``dyncheck versions``): pins left out (``unpin``, the whole environment then
+    resolves around the release) and requirements added (``require``), with the packaging
+    fact that forces them."""
+
+    series: str
+    """A release prefix: ``"3."`` is every 3.x release."""
+    unpin: tuple[str, ...] = ()
+    require: tuple[str, ...] = ()
+    reason: str
+
+    def applies(self, release: str) -> bool:
+        return release.startswith(self.series)
+
+
+@dataclass(frozen=True, kw_only=True)
 class Registration:
     """One engine implementation: where its adapter is, and the facts about its installation
     that are needed before (or without) importing it."""
@@ -62,8 +79,16 @@ class Registration:
     """Differs from another implementation only in how couplings are held: run on cases with
     couplings only (elsewhere it would repeat that one under a second name)."""
     releases: tuple[str, ...] = ()
-    """The releases the committed version matrix runs (``dyncheck versions``), for an engine
-    the matrix knows through its registration alone (one package, its implementation)."""
+    """The releases the committed version matrix runs (``dyncheck versions``; the other
+    registrations of its package are run with it)."""
+    released_with: tuple[str, ...] = ()
+    """Packages released with it, left out of the constraints in the version matrix so that
+    they follow the release under test."""
+    needs: tuple[Needs, ...] = ()
+    """What some of its releases need to be installed (:class:`Needs`)."""
+    native: Format | None = None
+    """The file format the engine defines (MuJoCo's MJCF): its refusal of a file in that
+    format is the file's fault, and ends the check with the engine's message."""
     run: Format | None = None
     """An engine without a run adapter of its own (``module``): the format a book case is
     written in for its file loader (``model``), which then serves ``dyncheck run`` too
@@ -84,6 +109,18 @@ REGISTRY: dict[str, Registration] = {
     "pinocchio": Registration(
         module=_A + "pinocchio_", cls="PinocchioAdapter", package="pin", integrators=_MUJOCO_C,
         model=_A + "pinocchio_model:PinocchioModel", label="pinocchio",
+        releases=("3.4.0", "3.7.0", "3.9.0", "4.0.0", "4.1.0"),
+        released_with=("libpinocchio", "cmeel", "coal", "libcoal", "eigenpy",
+                       "jrl-cmakemodules"),
+        needs=(
+            Needs(series="3.", unpin=("numpy",),
+                  reason="Pinocchio 3.x needs cmeel-boost < 1.90, whose wheels are built "
+                  "against numpy < 2.4: numpy resolves to the newest 2.3"),
+            Needs(series="3.", require=("cmeel-urdfdom<5", "cmeel-tinyxml2<11"),
+                  reason="Pinocchio 3.x wheels link liburdfdom 4 and libtinyxml2 10 but "
+                  "do not bound cmeel-urdfdom or cmeel-tinyxml2 (the newest fail to "
+                  "import: `liburdfdom_sensor.so.4.0: cannot open shared object file`)"),
+        ),
     ),
     "pinocchio-mjcf": Registration(
         module=_A + "pinocchio_", cls="PinocchioMJCFAdapter", package="pin",
@@ -97,10 +134,15 @@ REGISTRY: dict[str, Registration] = {
         integrators=(Integrator.EULER, Integrator.RK2, Integrator.RK3),
         model=_A + "drake_model:DrakeModel",
         label="drake",
+        releases=("1.40.0", "1.45.0", "1.51.1"),
+        released_with=("mosek",),
     ),
     "mujoco": Registration(
         module=_A + "mujoco_", cls="MuJoCoAdapter", package="mujoco", integrators=_MUJOCO_C,
         model=_A + "mujoco_model:MujocoModel", label="mujoco", canonical=True,
+        native=Format.MJCF,
+        releases=("3.2.7", "3.3.7", "3.6.0", "3.10.0", "3.14.0", "3.17.0", "4.0.0"),
+        released_with=("glfw", "pyopengl"),
     ),
     "mujoco-stiff": Registration(
         module=_A + "mujoco_", cls="MuJoCoStiffAdapter", package="mujoco", integrators=_MUJOCO_C,

@@ -275,3 +275,12 @@ class Adapter(ABC):
         if what == "simulate" and np.abs(value).max() > DIVERGED:
             raise EngineError(f"{self.name}: simulate diverged (|q| > {DIVERGED:g})")
         return value
+
+    def raw_calls(self, qe: np.ndarray, ve: np.ndarray, te: np.ndarray,
+                  ae: np.ndarray) -> Callable[[], None] | None:
+        """The engine's plainest loop over these states (its layout): every quantity of
+        :meth:`evaluate_all` by the engine's own calls, state by state — what ``dyncheck
+        bench`` times the adapter against. None: no engine call of its own to time
+        (dyncheck's symbolic peer, a port timed by its compiled batch)."""
+        return None
+

@@ -41,6 +41,7 @@ system, and Drake's own integrators.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -57,7 +58,7 @@ from pydrake.systems.primitives import LogVectorOutput
 from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.drake_model import parser_warnings
-from dyncheck.adapters.linalg import solve
+from dyncheck.adapters.linalg import kkt
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.model_tree import Axes, Layout, Orientation, StateLayout
 from dyncheck.cases.multibody import Joint, Multibody
@@ -119,17 +120,6 @@ class _Cords(LeafSystem):
         self._a.plant.SetPositionsAndVelocities(self._ctx, self._state.Eval(context))
         f = self._a._closed(self._ctx, self._zero)[1]
         output.SetFromVector(self._a._C.T @ f)
-
-
-def kkt(M: np.ndarray, rhs: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """v̇ and f of M v̇ − Cᵀ f = rhs, C v̇ = 0 (a constant constraint: no drift term)."""
-    n, m = M.shape[0], C.shape[0]
-    K = np.zeros((n + m, n + m))
-    K[:n, :n], K[:n, n:], K[n:, :n] = M, -C.T, C
-    b = np.zeros(n + m)
-    b[:n] = rhs
-    x = solve(K, b)
-    return x[:n], x[n:]
 
 
 class DrakeAdapter(Adapter):
@@ -479,3 +469,30 @@ class DrakeAdapter(Adapter):
             integ.get_num_steps_taken(), integ.get_num_step_shrinkages_from_error_control()
         )
         return Trajectory(t, self._check("simulate", qs), vs), steps
+
+    def raw_calls(self, qe: np.ndarray, ve: np.ndarray, te: np.ndarray,
+                  ae: np.ndarray) -> Callable[[], None] | None:
+        from pydrake.multibody.tree import MultibodyForces
+
+        plant, ctx = self.plant, self.context
+        tau_port = plant.get_applied_generalized_force_input_port()
+        acc_port = plant.get_generalized_acceleration_output_port()
+        forces = MultibodyForces(plant)
+
+        def loop() -> None:
+            for k in range(len(qe)):
+                plant.SetPositions(ctx, qe[k])
+                plant.SetVelocities(ctx, ve[k])
+                plant.CalcMassMatrix(ctx)
+                plant.CalcBiasTerm(ctx)
+                plant.CalcGravityGeneralizedForces(ctx)
+                tau_port.FixValue(ctx, te[k])
+                acc_port.Eval(ctx)
+                forces.SetZero()
+                plant.CalcForceElementsContribution(ctx, forces)
+                plant.CalcInverseDynamics(ctx, ae[k], forces)
+                plant.CalcKineticEnergy(ctx)
+                plant.CalcPotentialEnergy(ctx)
+
+        return loop
+

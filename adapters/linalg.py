@@ -1,4 +1,5 @@
-"""One small dense solve per integrator stage, at LAPACK's own cost."""
+"""One small dense solve per integrator stage, at LAPACK's own cost; the KKT system of a
+constant linear constraint."""
 
 from __future__ import annotations
 
@@ -15,3 +16,14 @@ def solve(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     if info != 0:
         raise np.linalg.LinAlgError(f"dgesv: singular matrix or bad argument (info {info})")
     return x
+
+
+def kkt(M: np.ndarray, rhs: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """v̇ and f of M v̇ − Cᵀ f = rhs, C v̇ = 0 (a constant constraint: no drift term)."""
+    n, m = M.shape[0], C.shape[0]
+    K = np.zeros((n + m, n + m))
+    K[:n, :n], K[:n, n:], K[n:, :n] = M, -C.T, C
+    b = np.zeros(n + m)
+    b[:n] = rhs
+    x = solve(K, b)
+    return x[:n], x[n:]

@@ -7,6 +7,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
+from dyncheck.adapters.model_files import ROOT_TAG, Format
 from dyncheck.cases.multibody import Multibody
 
 
@@ -29,7 +30,7 @@ def to_mjcf(
     Pinocchio's MJCF parser loads only the first top-level body. A coupling becomes a fixed
     tendon with an ``<equality>`` holding its length (``solimp`` given, or MuJoCo's default).
     """
-    root = ET.Element("mujoco", model=model.name)
+    root = ET.Element(ROOT_TAG[Format.MJCF], model=model.name)
     ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false", autolimits="true")
     option = ET.SubElement(
         root,

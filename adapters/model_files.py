@@ -17,6 +17,10 @@ class Format(StrEnum):
     URDF = "urdf"
 
 
+ROOT_TAG = {Format.MJCF: "mujoco", Format.URDF: "robot"}
+"""Each format's root element: how a file says which it is."""
+
+
 GEOMETRY_NOTE = (
     "URDF geometry (<visual>, <collision>) removed before loading: the check is inertial"
 )

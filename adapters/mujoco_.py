@@ -20,7 +20,7 @@ MuJoCo's ceiling (solimp d = 0.9999 everywhere).
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import ClassVar
 
 import mujoco
@@ -275,6 +275,22 @@ class MuJoCoAdapter(Adapter):
         if m is self.model:
             self._field_generalized(d, d.qfrc_passive)
 
+    def raw_calls(self, qe: np.ndarray, ve: np.ndarray, te: np.ndarray,
+                  ae: np.ndarray) -> Callable[[], None] | None:
+        m, d = self.model, self.data
+        mass = np.empty((m.nv, m.nv))
+
+        def loop() -> None:
+            for k in range(len(qe)):
+                d.qpos[:], d.qvel[:], d.qfrc_applied[:] = qe[k], ve[k], te[k]
+                mujoco.mj_forward(m, d)
+                full_inertia(m, d, mass)
+                d.qacc[:] = ae[k]
+                mujoco.mj_inverse(m, d)
+
+        return loop
+
+
 
 class MuJoCoStiffAdapter(MuJoCoAdapter):
     """MuJoCo with the equalities' impedance at its ceiling mjMAXIMP = 0.9999 (solimp
@@ -283,3 +299,8 @@ class MuJoCoStiffAdapter(MuJoCoAdapter):
     name: ClassVar[str] = "mujoco-stiff"
     requires_couplings: ClassVar[bool] = True
     solimp: ClassVar[tuple[float, ...] | None] = (0.9999, 0.9999, 0.001, 0.5, 2.0)
+
+    def raw_calls(self, qe: np.ndarray, ve: np.ndarray, te: np.ndarray,
+                  ae: np.ndarray) -> Callable[[], None] | None:
+        return None  # MuJoCo's own calls, timed under its name
+

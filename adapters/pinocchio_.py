@@ -360,6 +360,24 @@ class PinocchioAdapter(Adapter):
         qs, vs = self._states_from_mujoco(qs, vs)
         return Trajectory(t_eval, self._check("solve", qs), vs)
 
+    def raw_calls(self, qe: np.ndarray, ve: np.ndarray, te: np.ndarray,
+                  ae: np.ndarray) -> Callable[[], None] | None:
+        m, d = self.model, self.data
+        zero = np.zeros(m.nv)
+
+        def loop() -> None:
+            for k in range(len(qe)):
+                q, v = qe[k], ve[k]
+                pin.crba(m, d, q)
+                pin.rnea(m, d, q, v, zero)
+                pin.aba(m, d, q, v, te[k])
+                pin.rnea(m, d, q, v, ae[k])
+                pin.computeKineticEnergy(m, d, q, v)
+                pin.computePotentialEnergy(m, d, q)
+
+        return loop
+
+
 
 class PinocchioMJCFAdapter(PinocchioAdapter):
     """The very same MJCF file MuJoCo loads, read by Pinocchio's MJCF parser."""

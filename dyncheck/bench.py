@@ -33,10 +33,9 @@ from collections.abc import Callable, Sequence
 from functools import partial, reduce
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
-from dyncheck.adapters import ENGINE_PORTS, REGISTRY
+from dyncheck.adapters import ENGINE_PORTS
 from dyncheck.cases import Case, get_case
 from dyncheck.errors import EngineError
 from dyncheck.implementations import (
@@ -56,90 +55,6 @@ def _median_time(fn: Callable[[], object], repeats: int) -> float:
         fn()
         times.append(time.perf_counter() - t0)
     return statistics.median(times)
-
-
-def _raw_mujoco(adapter, qe, ve, te, ae) -> Callable[[], None]:
-    import mujoco
-
-    from dyncheck.adapters.mujoco_api import full_inertia
-
-    m, d = adapter.model, adapter.data
-    M = np.empty((m.nv, m.nv))
-
-    def loop() -> None:
-        for k in range(len(qe)):
-            d.qpos[:], d.qvel[:], d.qfrc_applied[:] = qe[k], ve[k], te[k]
-            mujoco.mj_forward(m, d)
-            full_inertia(m, d, M)
-            d.qacc[:] = ae[k]
-            mujoco.mj_inverse(m, d)
-
-    return loop
-
-
-def _raw_pinocchio(adapter, qe, ve, te, ae) -> Callable[[], None]:
-    import pinocchio as pin
-
-    m, d = adapter.model, adapter.data
-    zero = np.zeros(m.nv)
-
-    def loop() -> None:
-        for k in range(len(qe)):
-            q, v = qe[k], ve[k]
-            pin.crba(m, d, q)
-            pin.rnea(m, d, q, v, zero)
-            pin.aba(m, d, q, v, te[k])
-            pin.rnea(m, d, q, v, ae[k])
-            pin.computeKineticEnergy(m, d, q, v)
-            pin.computePotentialEnergy(m, d, q)
-
-    return loop
-
-
-def _raw_drake(adapter, qe, ve, te, ae) -> Callable[[], None]:
-    from pydrake.multibody.tree import MultibodyForces
-
-    plant, ctx = adapter.plant, adapter.context
-    tau_port = plant.get_applied_generalized_force_input_port()
-    acc_port = plant.get_generalized_acceleration_output_port()
-    forces = MultibodyForces(plant)
-
-    def loop() -> None:
-        for k in range(len(qe)):
-            plant.SetPositions(ctx, qe[k])
-            plant.SetVelocities(ctx, ve[k])
-            plant.CalcMassMatrix(ctx)
-            plant.CalcBiasTerm(ctx)
-            plant.CalcGravityGeneralizedForces(ctx)
-            tau_port.FixValue(ctx, te[k])
-            acc_port.Eval(ctx)
-            forces.SetZero()
-            plant.CalcForceElementsContribution(ctx, forces)
-            plant.CalcInverseDynamics(ctx, ae[k], forces)
-            plant.CalcKineticEnergy(ctx)
-            plant.CalcPotentialEnergy(ctx)
-
-    return loop
-
-
-def _raw_loader(adapter, qe, ve, te, ae) -> Callable[[], None]:
-    """An engine served by its file loader (:mod:`dyncheck.adapters.model_adapter`): the
-    loader's own per-state engine calls on states already in its layout (the map to it is
-    dyncheck's, timed in the adapter's row)."""
-    from dyncheck.adapters.layout_batch import engine_states
-
-    _, q, v, a = engine_states(adapter.canon, adapter.tree, qe, ve, ae)
-    return partial(adapter.engine.dynamics, q, v, a)
-
-
-RAW = {
-    "mujoco": _raw_mujoco,
-    "pinocchio": _raw_pinocchio,
-    "pinocchio-mjcf": _raw_pinocchio,
-    "drake": _raw_drake,
-} | {name: _raw_loader for name, r in REGISTRY.items() if r.run}
-"""The engines' plainest loops (sympy-mechanics is dyncheck's own symbolic peer: no raw
-engine call to compare with)."""
 
 
 def _sweep_rss(case_name: str, states: int, queue: mp.Queue) -> None:
@@ -198,16 +113,15 @@ def bench(case: Case, states: int, repeats: int, progress: Progress | None = Non
         )
 
     for name, impl in impls.items():
-        if isinstance(impl, EngineImplementation) and name in RAW:
+        raw = None
+        if isinstance(impl, EngineImplementation) and name not in ENGINE_PORTS:
             cmap, q = impl.map, sample.q
             qe, ve = cmap.to_engine(q), co.velocity_to_engine(cmap, q, sample.v)
             te = co.force_to_engine(cmap, q, sample.tau)
             ae = co.acceleration_to_engine(cmap, q, sample.v, sample.a)
-            add(
-                "raw engine calls",
-                name,
-                _median_time(RAW[name](impl.adapter, qe, ve, te, ae), repeats),
-            )
+            raw = impl.adapter.raw_calls(qe, ve, te, ae)
+        if raw is not None:
+            add("raw engine calls", name, _median_time(raw, repeats))
             add(
                 "adapter batched",
                 name,
@@ -260,7 +174,7 @@ def ratios(t: pd.DataFrame) -> pd.DataFrame:
         sel = t[(t.part == part) & (t.implementation == impl)]
         return float(sel.us_per_state.iloc[0]) if len(sel) else float("nan")
 
-    engines = [n for n in RAW if n in set(t[t.part == "raw engine calls"].implementation)]
+    engines = list(dict.fromkeys(t[t.part == "raw engine calls"].implementation))
     raw_sum = sum(us("raw engine calls", e) for e in engines)
     fastest_raw = min(us("raw engine calls", e) for e in engines)
     parts = sum(

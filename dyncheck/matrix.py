@@ -18,7 +18,9 @@ Not part of CI (it installs engines); CI tests the pieces that do not install an
 from __future__ import annotations
 
 import hashlib
+import importlib.metadata
 import itertools
+import re
 import subprocess
 import sys
 from collections.abc import Callable, Sequence
@@ -28,7 +30,7 @@ from pathlib import Path
 import pandas as pd
 
 from dyncheck import diff
-from dyncheck.adapters import REGISTRY
+from dyncheck.adapters import REGISTRY, Needs
 from dyncheck.errors import DyncheckError, InvalidInput, UnknownName
 from dyncheck.progress import Progress
 from dyncheck.settings import current
@@ -36,24 +38,10 @@ from dyncheck.store import cache_root
 from dyncheck.vocabulary import Verdict
 
 ROOT = Path(__file__).resolve().parents[1]
-CORE = ("numpy", "scipy", "sympy", "pandas", "tabulate", "matplotlib", "mujoco", "pin")
-"""What every environment installs (dyncheck's own dependencies, without their ranges)."""
-
-
-@dataclass(frozen=True, kw_only=True)
-class Needs:
-    """What a series of an engine's releases needs beyond ``constraints.txt`` to import at
-    all: pins left out (``unpin``, the whole environment then resolves around the release)
-    and requirements added (``require``), with the packaging fact that forces them."""
-
-    series: str
-    """A release prefix: ``"3."`` is every 3.x release."""
-    unpin: tuple[str, ...] = ()
-    require: tuple[str, ...] = ()
-    reason: str
-
-    def applies(self, release: str) -> bool:
-        return release.startswith(self.series)
+CORE = tuple(re.match(r"[A-Za-z0-9_.-]+", r)[0]  # type: ignore[index]
+             for r in importlib.metadata.requires("dyncheck") or () if ";" not in r)
+"""What every environment installs: dyncheck's own dependencies (pyproject.toml's, read from
+the installed metadata), without their ranges."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -75,79 +63,15 @@ class Engine:
 
 
 ENGINES = {
-    e.name: e
-    for e in (
-        Engine(
-            name="mujoco",
-            package="mujoco",
-            family=("mujoco", "glfw", "pyopengl"),
-            impls=("mujoco", "mujoco-stiff"),
-            releases=("3.2.7", "3.3.7", "3.6.0", "3.10.0", "3.14.0", "3.17.0", "4.0.0"),
-        ),
-        Engine(
-            name="pinocchio",
-            package="pin",
-            family=("pin", "libpinocchio", "cmeel", "coal", "libcoal", "eigenpy",
-                    "jrl-cmakemodules"),
-            impls=("pinocchio", "pinocchio-mjcf"),
-            releases=("3.4.0", "3.7.0", "3.9.0", "4.0.0", "4.1.0"),
-            needs=(
-                Needs(series="3.", unpin=("numpy",),
-                      reason="Pinocchio 3.x needs cmeel-boost < 1.90, whose wheels are built "
-                      "against numpy < 2.4: numpy resolves to the newest 2.3"),
-                Needs(series="3.", require=("cmeel-urdfdom<5", "cmeel-tinyxml2<11"),
-                      reason="Pinocchio 3.x wheels link liburdfdom 4 and libtinyxml2 10 but "
-                      "do not bound cmeel-urdfdom or cmeel-tinyxml2 (the newest fail to "
-                      "import: `liburdfdom_sensor.so.4.0: cannot open shared object file`)"),
-            ),
-        ),
-        Engine(
-            name="drake",
-            package="drake",
-            family=("drake", "mosek"),
-            impls=("drake",),
-            releases=("1.40.0", "1.45.0", "1.51.1"),
-            extra=("drake",),
-        ),
-    )
-} | {
-    name: Engine(name=name, package=r.package, family=(r.package,), impls=(name,),
-                 releases=r.releases, extra=(r.extra,) if r.extra else ())
+    name: Engine(
+        name=name, package=r.package, family=(r.package, *r.released_with),
+        impls=(name, *(n for n, x in REGISTRY.items() if x.package == r.package and n != name)),
+        releases=r.releases, extra=(r.extra,) if r.extra else (), needs=r.needs)
     for name, r in REGISTRY.items() if r.releases
 }
-"""The engines of the matrix: those written out above (several implementations, packages
-released together, environments that need more), and every registration that names its
-releases (:attr:`~dyncheck.adapters.Registration.releases`)."""
-
-
-EXPLANATIONS: dict[tuple[str, str, str], str] = {
-    ("mujoco", "3.2.7", "3.3.7"): "MuJoCo 3.3.7 cannot evaluate the compound pulley: every call "
-    "on its model (two tendon equalities sharing a body) raises `addEdge: edge array too small` "
-    "(the constraint-island graph's edge array is sized too small), so every row of that case "
-    "fails with the engine's message — an engine defect, reported as failed rows, not hidden. "
-    "MuJoCo 3.2.7 and 3.6.0 evaluate it.",
-    ("mujoco", "3.3.7", "3.6.0"): "The compound-pulley defect of 3.3.7 is gone: its rows are "
-    "back to the values of 3.2.7.",
-    ("mujoco", "3.10.0", "3.14.0"): "Rigid bodies with a full (non-diagonal) inertia tensor "
-    "(`rigid_body_ball`, `rigid_body_free`): M, h, forward and inverse dynamics, T and the "
-    "trajectories differ from the book by ~2e-9 relative up to 3.13.0 and agree to round-off "
-    "(1e-14) from 3.14.0 on. MuJoCo's compiler turns `fullinertia` into principal moments and "
-    "a frame (an eigen-decomposition); the tensor rebuilt from the compiled `body_inertia` and "
-    "`body_iquat`, R diag(I) Rᵀ, differs from the MJCF's by 4.8e-9 relative in 3.10.0 and "
-    "3.13.0 and by 2.6e-15 in 3.14.0 (measured on a free body with products of inertia): the "
-    "accuracy of that step in the older releases, not of dyncheck's model (the same MJCF; "
-    "Pinocchio and the book agree to round-off). `dyncheck versions --bisect mujoco 3.10.0 "
-    "3.14.0 --case rigid_body_ball` names 3.14.0 the first release that moved (3.12.0 and "
-    "3.13.0 give the rows of 3.10.0).",
-    ("mujoco", "3.17.0", "4.0.0"): "RK4 on ball and free joints: the difference between the "
-    "two releases' errors shrinks as dt² — `diff` classifies it `definition changed`. MuJoCo "
-    "4.0.0 combines RK4's stages on the rotation group (Runge-Kutta-Munthe-Kaas, dexp⁻¹): "
-    "order 4; before, the stages' angular velocities were summed as vectors: order 2 "
-    "(declared by the adapter, `adapters/mujoco_api.py` `RK4_ON_GROUP`; tutorial 07). The "
-    "runs of the earlier releases predate that declaration: their rk4 rows on these cases "
-    "show `failed` (observed order 2.000); with it they are `explained`.",
-}
-"""What the engine's changelog says about a step where rows moved: (engine, old, new) → text."""
+"""The engines of the matrix: every registration that names its releases
+(:attr:`~dyncheck.adapters.Registration.releases`), with the other registrations of its
+package (:attr:`~dyncheck.adapters.Registration.package`) run beside it."""
 
 
 def engine(name: str) -> Engine:

@@ -7,6 +7,7 @@ finite differences agree) and two readings of the model (the referee on each).""
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import partial
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -183,9 +184,9 @@ def across_readings(model: str, tree: ModelTree, *, name_a: str, da: Derivatives
                              for f in FIELDS})
     note = ACROSS_READINGS.format(a=name_a, b=name_b)
     out = []
-    pair = {"name_a": name_a, "da": da, "name_b": name_b, "ref": ref_a, "eps": eps}
-    for raw, r in zip(compare(model, tree, db=db, **pair),
-                      compare(model, tree, db=shifted, **pair), strict=True):
+    against_a = partial(compare, model, tree, name_a=name_a, da=da, name_b=name_b, ref=ref_a,
+                        eps=eps)
+    for raw, r in zip(against_a(db=db), against_a(db=shifted), strict=True):
         if raw.verdict is not Verdict.FAILED:  # alike without the readings' difference
             out.append(raw)
         elif r.verdict is Verdict.PASSED:

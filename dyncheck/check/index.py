@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from dyncheck.adapters.model_files import ROOT_TAG, Format
 from dyncheck.check.model_check import CheckResult
 from dyncheck.check.page import counts
 from dyncheck.check.verdicts import Agreement, EngineVerdict, Reading, per_engine
@@ -48,13 +49,14 @@ def in_folder(folder: Path) -> list[Path]:
     for path in sorted(folder.rglob("*")):
         if path.suffix.lower() in MODEL_SUFFIXES and path.is_file() and not path.is_symlink():
             root = _root(path)
-            if root is None or root.tag in ("mujoco", "robot"):
+            if root is None or root.tag in ROOT_TAG.values():
                 candidates.append((path, root))
             if len(candidates) > MAX_MODELS:
                 raise InvalidInput("PATH", str(folder), f"a folder of at most {MAX_MODELS} "
                                    "model files")
     included = {(path.parent / i.get("file", "")).resolve() for path, root in candidates
-                if root is not None and root.tag == "mujoco" for i in root.iter("include")}
+                if root is not None and root.tag == ROOT_TAG[Format.MJCF]
+                for i in root.iter("include")}
     return [p for p, _ in candidates if p.resolve() not in included]
 
 

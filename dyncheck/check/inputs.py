@@ -8,7 +8,14 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from dyncheck.adapters.mjcf_copy import inline
-from dyncheck.adapters.model_files import INERTIA_KEYS, ModelFile, urdf_inertials, urdf_welded
+from dyncheck.adapters.model_files import (
+    INERTIA_KEYS,
+    ROOT_TAG,
+    Format,
+    ModelFile,
+    urdf_inertials,
+    urdf_welded,
+)
 from dyncheck.errors import EngineError, InvalidInput, UnknownName
 
 URDF_JOINTS = ("revolute", "continuous", "prismatic", "fixed", "floating")
@@ -46,9 +53,9 @@ def model_path(text: str) -> Path:
     except LookupError as exc:  # <?xml encoding="..."?> that Python does not know
         raise ModelFileError(path, f"not XML: it declares an encoding no parser knows "
                              f"({exc})") from None
-    if root.tag == "robot":
+    if root.tag == ROOT_TAG[Format.URDF]:
         _check_urdf(path, root)
-    elif root.tag != "mujoco":
+    elif root.tag != ROOT_TAG[Format.MJCF]:
         raise ModelFileError(path, f"root element <{root.tag}> is neither <mujoco> nor <robot>")
     else:  # an include cycle or a FIFO would hang a parser: refused before any engine runs
         if path.suffix != ".xml":  # MuJoCo picks its decoder by the suffix, case and all

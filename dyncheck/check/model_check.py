@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from dyncheck.adapters import layout, layout_batch
+from dyncheck.adapters import REGISTRY, layout, layout_batch
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials, urdf_welded
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import describe, inputs, partial, predicted, readings
@@ -229,7 +229,8 @@ def _loaded(model: str, source_path: Path, source: ModelFile,
         if isinstance(result, NotLoaded):
             verdict = Verdict.SKIPPED if result.skip else Verdict.FAILED
             rows.append(_row(model, Section.LOAD, engine, verdict, result.message))
-            if engine == "mujoco" and result.refused and source.format.value == "mjcf":
+            native = REGISTRY[engine].native if engine in REGISTRY else None
+            if result.refused and native is not None and native.value == source.format.value:
                 raise inputs.ModelFileError(source_path, result.message)
             continue
         if loaded:

@@ -16,6 +16,7 @@ def versions_command(args: argparse.Namespace) -> int:
     """Exit 0 (the matrix reports moves; it does not judge them)."""
     from dyncheck import matrix
     from dyncheck.cases import get_case
+    from dyncheck.explain.releases import EXPLANATIONS
     from dyncheck.results import write_atomic
 
     positive("--jobs", args.jobs)
@@ -36,7 +37,7 @@ def versions_command(args: argparse.Namespace) -> int:
     with Progress("versions", releases, quiet=args.quiet) as progress:
         steps = matrix.matrix(names, cases=args.case, jobs=args.jobs, log=log,
                               reuse=args.reuse, progress=progress)
-    write_atomic(args.out, matrix.page(steps, notes=matrix.EXPLANATIONS))
+    write_atomic(args.out, matrix.page(steps, notes=EXPLANATIONS))
     print(f"version matrix written to {args.out}")
     return 0
 

@@ -159,14 +159,16 @@ def test_a_run_of_some_cases_is_cached_apart_from_the_run_of_all(tmp_path, monke
 
 @pytest.mark.parametrize("name", [n for n, r in REGISTRY.items() if r.releases])
 def test_an_engine_registered_with_releases_is_in_the_matrix(name):
-    """An engine known through its registration alone (#47): the matrix runs its releases on
-    its implementation, and its environment unpins its package only."""
+    """An engine known through its registration alone (#47, #62): the matrix runs its
+    releases on its implementation and every other one of its package, and its environment
+    unpins its package and the packages released with it only."""
     eng = ENGINES[name]
     reg = REGISTRY[name]
     assert eng.releases == reg.releases and len(reg.releases) >= 2
-    assert eng.impls == (name,)
-    pins = f"{reg.package}==0.0\nnumpy==2.0\n"
-    assert constraints(eng, pins) == "numpy==2.0\n"
+    assert eng.impls[0] == name
+    assert set(eng.impls) == {n for n, r in REGISTRY.items() if r.package == reg.package}
+    family = "".join(f"{p}==0.0\n" for p in (reg.package, *reg.released_with))
+    assert constraints(eng, family + "numpy==2.0\n") == "numpy==2.0\n"
 
 
 def test_a_release_whose_engine_does_not_import_is_named_not_compared(tmp_path):
