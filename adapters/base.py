@@ -14,14 +14,16 @@ Adapters never see the book's coordinates: the comparison layer maps them.
 
 from __future__ import annotations
 
+import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from enum import StrEnum
 from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
-from dyncheck.adapters.model_tree import StateLayout
+from dyncheck.adapters.model_tree import Derivatives, Dynamics, ModelTree, StateLayout, Transition
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import EngineError, Unsupported
 from dyncheck.vocabulary import Quantity
@@ -284,3 +286,90 @@ class Adapter(ABC):
         (dyncheck's symbolic peer, a port timed by its compiled batch)."""
         return None
 
+
+
+class Offer(StrEnum):
+    """What an engine computes beyond its dynamics (:attr:`ModelEngine.offers`)."""
+
+    DERIVATIVES = "derivatives"
+    """``derivatives(q, v, a)``: ∂v̇/∂(q, v, τ) and ∂τ/∂(q, v), its own (analytic, automatic
+    or finite differences)."""
+    TRANSITION = "transition"
+    """``transition(q, v, a)``: the Jacobians of one step of each of its integrators."""
+    STEPPING = "simulate"
+    """``simulate(q0, v0, dt, steps)``: trajectories by its own stepping."""
+
+
+Answer = tuple[Any, float] | Exception
+"""A request's answer: (its value, the engine's seconds), or the exception it raised."""
+
+
+class ModelEngine(ABC):
+    """An engine's reading of a model file (an MJCF or a URDF): the engine interface of
+    ``dyncheck check``, and of ``dyncheck run`` where a registration names ``run`` (the book
+    case written as a file, :mod:`dyncheck.adapters.model_adapter`).
+
+    It holds the engine-neutral ``tree`` (:class:`~dyncheck.adapters.model_tree.ModelTree`:
+    what the engine read, in its own layout) and computes, over a batch of states in that
+    layout, the canonical form M(q) v̇ + h(q, v) = τ — the book's equations of motion
+    (2.2.23)–(2.2.26) in joint coordinates: M, h, τ at v̇ and v̇ at τ = 0, and T, V
+    (:meth:`dynamics`). What it offers beyond that is a class fact, :attr:`offers`, never
+    found by asking the object; a method it does not offer raises
+    :class:`~dyncheck.errors.Unsupported` in the engine's words.
+
+    A batch is asked for by :meth:`submit` and answered by :meth:`collect` (or both kinds
+    at once, :meth:`submit_both`): an engine in this process answers at once, one in its own
+    process (``dyncheck.check.engines.Isolated``) while the caller computes."""
+
+    engine: str
+    """Its implementation's name (the registry's): a class fact."""
+    offers: frozenset[Offer] = frozenset()
+    """A class fact (a proxy of an engine in another process copies its engine's)."""
+    tree: ModelTree
+    _answer: Answer
+    _both: tuple[Answer, Answer]
+
+    @abstractmethod
+    def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics: ...
+
+    def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
+        raise Unsupported(f"{self.engine} offers no derivatives")
+
+    def transition(self, q: np.ndarray, v: np.ndarray,
+                   a: np.ndarray) -> tuple[Transition, ...]:
+        raise Unsupported(f"{self.engine} offers no step Jacobians")
+
+    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float,
+                 steps: int) -> tuple[np.ndarray, np.ndarray]:
+        raise Unsupported(f"{self.engine} offers no stepping of its own")
+
+    def request(self, kind: str, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Answer:
+        """One request of ``kind`` (``dynamics``, ``derivatives`` or ``transition``)
+        answered here, timed; its exception handed back, not raised."""
+        method = {"dynamics": self.dynamics, "derivatives": self.derivatives,
+                  "transition": self.transition}[kind]
+        t0 = time.perf_counter()
+        try:
+            return method(q, v, a), time.perf_counter() - t0
+        except Exception as exc:  # the caller's rows say how the engine failed
+            return exc
+
+    def submit(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, *,
+               kind: str = "dynamics") -> None:
+        """Ask for the batch's ``dynamics`` or ``derivatives``: :meth:`collect` answers."""
+        self._answer = self.request(kind, q, v, a)
+
+    def collect(self) -> tuple[Any, float]:
+        """The submitted batch's answer and the engine's seconds; its exception raised."""
+        if isinstance(self._answer, Exception):
+            raise self._answer
+        return self._answer
+
+    def submit_both(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, k: int) -> None:
+        """Ask for the derivatives at the batch and the step Jacobians at its first ``k``
+        states in one request: :meth:`collect_both` answers."""
+        self._both = (self.request("derivatives", q, v, a),
+                      self.request("transition", q[:k], v[:k], a[:k]))
+
+    def collect_both(self) -> tuple[Answer, Answer]:
+        return self._both

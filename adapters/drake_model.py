@@ -41,6 +41,7 @@ from pydrake.multibody.tree import (
     QuaternionFloatingJoint,
 )
 
+from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.drake_hints import actuators, armature_hint, file_hints, ignored_frames
 from dyncheck.adapters.mjcf_copy import for_parser
 from dyncheck.adapters.model_files import Format, ModelFile
@@ -199,10 +200,11 @@ def _urdf_root(plant: MultibodyPlant):
     return candidates[0] if candidates else None
 
 
-class DrakeModel:
+class DrakeModel(ModelEngine):
     """A Drake plant and its neutral tree."""
 
     engine = ENGINE
+    offers = frozenset({Offer.DERIVATIVES})
 
     def __init__(self, source: ModelFile) -> None:
         self.plant, notes, self._damping = _plant(source)

@@ -16,6 +16,7 @@ from dataclasses import dataclass, replace
 import mujoco
 import numpy as np
 
+from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.mjcf_copy import inline, utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
@@ -184,10 +185,11 @@ def _total_mass_hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
     return tuple(("model", f, why) for f in ("mass", "inertia", "com"))
 
 
-class MujocoModel:
+class MujocoModel(ModelEngine):
     """A compiled model and its neutral tree."""
 
     engine = ENGINE
+    offers = frozenset({Offer.DERIVATIVES, Offer.TRANSITION})
 
     def __init__(self, source: ModelFile, *, exact_meshes: bool = False) -> None:
         self.model, notes, self._inertias = _compile(source, exact_meshes=exact_meshes)

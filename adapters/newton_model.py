@@ -23,6 +23,7 @@ import warnings
 
 import numpy as np
 
+from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.mjcf_copy import utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
@@ -105,10 +106,11 @@ def _load(source: ModelFile):  # -> (newton.Model, names of the bodies whose ine
     return model, [_last(model.body_label[b]) for b in np.flatnonzero(changed)]
 
 
-class NewtonModel:
+class NewtonModel(ModelEngine):
     """A finalized Newton model on the CPU and its neutral tree."""
 
     engine = ENGINE
+    offers = frozenset({Offer.STEPPING})
 
     def __init__(self, source: ModelFile) -> None:
         import newton

@@ -20,6 +20,7 @@ from dataclasses import replace
 import numpy as np
 import pinocchio as pin
 
+from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.mjcf_copy import inline, utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
@@ -126,10 +127,11 @@ def _components(m: pin.Model, d: pin.Data, i: int) -> list[tuple]:
     return out
 
 
-class PinocchioModel:
+class PinocchioModel(ModelEngine):
     """A Pinocchio model and its neutral tree."""
 
     engine = ENGINE
+    offers = frozenset({Offer.DERIVATIVES})
 
     def __init__(self, source: ModelFile) -> None:
         self.model = _load(source)

@@ -18,6 +18,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from dyncheck.adapters.base import Offer
 from dyncheck.adapters.model_files import ModelFile
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, derivatives
 from dyncheck.adapters.mujoco_model import MujocoModel
@@ -28,6 +29,7 @@ class PortModel(MujocoModel):
     """MuJoCo's reading of the file, computed on a port."""
 
     engine = ""
+    offers = frozenset()  # a port's own derivatives where it has them (MJX's); no steps
     port: ClassVar[str] = ""
     """``module:class`` of the port's adapter (imported here only: JAX and Warp cost seconds)."""
 
@@ -59,12 +61,12 @@ class PortModel(MujocoModel):
         MJX's by JAX's automatic differentiation (``jacfwd``, exact to the port's round-off,
         in MuJoCo's chart); a port without them (MuJoCo Warp's kernels are not
         differentiated) is a skipped row that says so."""
-        own = getattr(self.adapter, "derivatives", None)
-        if own is None:
+        if Offer.DERIVATIVES not in self.offers:
             raise Unsupported(f"{self.engine} offers no derivatives of its dynamics (its "
                               "kernels are not differentiated; MuJoCo C's are on MuJoCo's "
                               "rows)")
-        return derivatives(own(q, v, a), method=f"automatic differentiation (JAX jacfwd, "
+        own = self.adapter.derivatives(q, v, a)
+        return derivatives(own, method=f"automatic differentiation (JAX jacfwd, "
                            f"{np.dtype(self.adapter.dtype).name})")
 
     def transition(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> tuple:
@@ -73,11 +75,13 @@ class PortModel(MujocoModel):
 
 class MjxModel(PortModel):
     engine = "mjx"
+    offers = frozenset({Offer.DERIVATIVES})
     port = "dyncheck.adapters.mjx_:MJXAdapter"
 
 
 class MjxF64Model(PortModel):
     engine = "mjx-f64"
+    offers = frozenset({Offer.DERIVATIVES})
     port = "dyncheck.adapters.mjx_:MJXF64Adapter"
 
 

@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 
+from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.mjcf_copy import utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile, urdf_inertials
 from dyncheck.adapters.model_tree import (
@@ -187,10 +188,11 @@ def _defaulted(source: ModelFile, links: list[_Link]) -> tuple[tuple[str, str, s
                  for field in ("mass", "com", "inertia"))
 
 
-class PybulletModel:
+class PybulletModel(ModelEngine):
     """A PyBullet client holding the file's multibodies, and their neutral tree."""
 
     engine = ENGINE
+    offers = frozenset({Offer.STEPPING})
 
     def __init__(self, source: ModelFile, *, gravity: np.ndarray | None = None) -> None:
         """``gravity``: what the user sets with ``setGravity`` (a URDF states none; PyBullet's

@@ -166,7 +166,7 @@ class Evaluator:
     @property
     def eps(self) -> float:
         """Unit round-off of the implementation's arithmetic (float64's when it failed)."""
-        return EPS if isinstance(self.impl, Exception) else getattr(self.impl, "eps", EPS)
+        return EPS if isinstance(self.impl, Exception) else self.impl.eps
 
     effects: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
     """What its declared defects add to ``values`` (the chunk's states)."""

@@ -193,6 +193,10 @@ class Implementation(ABC):
     def simulate(self, dt: float, integrator: str) -> tuple[np.ndarray, np.ndarray]:
         raise NotImplementedError(f"{self.name} has no fixed-step integrator")
 
+    def velocities(self, dt: float, integrator: str) -> np.ndarray | None:
+        """Book-coordinate velocities of a run :meth:`simulate` made (None: none kept)."""
+        return None
+
 
 class _Equations(Implementation):
     """An implementation backed by numeric book dynamics (printed or general)."""

@@ -94,7 +94,7 @@ slices of a case loads its engines once."""
 def _release() -> None:
     """Drop the implementations built in this process, and what their engines compiled."""
     engines = {type(adapter) for built in _BUILT.values() for impl in built.values()
-               if (adapter := getattr(impl, "adapter", None)) is not None}
+               if not isinstance(impl, Exception) and (adapter := impl.adapter) is not None}
     _BUILT.clear()
     for engine in engines:
         engine.release_compiled()

@@ -199,6 +199,42 @@ def test_no_module_asks_an_implementation_for_its_engine_by_duck_typing():
     assert not chains, chains
 
 
+NOT_ENGINES = {
+    ("dyncheck/cli.py", "impl"): "an argparse namespace: commands differ in their flags",
+    ("dyncheck/commands/options.py", "device"): "an argparse namespace",
+    ("dyncheck/commands/options.py", "out"): "an argparse namespace",
+    ("dyncheck/commands/options.py", "no_cache"): "an argparse namespace",
+    ("dyncheck/coordinates.py", "weight"): "a case's coordinate map",
+    ("dyncheck/implementations.py", "softness"): "the reference's general method of a case",
+    ("dyncheck/studies/references.py", "softness"): "the reference's general method",
+    ("dyncheck/studies/drift.py", "field_potential"): "the reference's general method",
+    ("dyncheck/studies/drift.py", "inertia"): "a case (rigid cases hold one)",
+    ("dyncheck/studies/controlled.py", "polynomial_degree"): "the reference's general method",
+    ("dyncheck/studies/study.py", "polynomial_degree"): "the reference's general method",
+    ("dyncheck/store.py", "__name__"): "a type named in a message",
+    ("dyncheck/workers.py", "sched_getaffinity"): "the platform's os module",
+    ("dyncheck/workers.py", "_processes"): "concurrent.futures' pool",
+}
+"""The comparison layer's ``hasattr``/``getattr`` by a written name, each on what is not an
+engine (with why)."""
+
+
+def test_no_engine_is_asked_what_it_can_do_by_its_attributes():
+    """#62: an engine's capabilities are class facts (``ModelEngine.offers``, the adapter's
+    attributes with defaults), read as such: the comparison layer asks no object whether it
+    has an attribute of a written name, but for :data:`NOT_ENGINES` (an engine's own modules
+    under adapters/ may probe their engine's API across releases)."""
+    found = set()
+    for path in sorted((ROOT / "dyncheck").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                    and node.func.id in ("hasattr", "getattr") and len(node.args) >= 2
+                    and isinstance(node.args[1], ast.Constant)):
+                found.add((path.relative_to(ROOT).as_posix(), node.args[1].value))
+    assert found <= set(NOT_ENGINES), sorted(found - set(NOT_ENGINES))
+    assert set(NOT_ENGINES) <= found, f"gone, take off NOT_ENGINES: {set(NOT_ENGINES) - found}"
+
+
 MAX_LINES = 500
 """#43: a module a reader holds in mind at once; a longer one is split where its parts have
 names of their own (the commands from the command line, the Cayley frame from the checks on

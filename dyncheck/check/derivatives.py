@@ -27,8 +27,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import replace
 
-import numpy as np
-
+from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import (
     DerivativeChart,
@@ -50,19 +49,12 @@ def _row(model: str, engine: str, verdict: Verdict, note: str) -> CheckRow:
                     error=0.0, tolerance=0.0, basis="", verdict=verdict, note=note)
 
 
-def _collect(engine: object, name: str, inputs: tuple[np.ndarray, np.ndarray, np.ndarray],
+def _collect(engine: ModelEngine, name: str,
              seconds: dict[str, float]) -> Derivatives | Exception:
-    """An engine's own derivatives (submitted earlier where it runs in a process of its own),
-    or the exception it raised; its seconds into ``seconds``."""
-    import time
-
-    t0 = time.perf_counter()
+    """An engine's own derivatives, submitted earlier (an engine in a process of its own
+    computed them meanwhile), or the exception it raised; its seconds into ``seconds``."""
     try:
-        if hasattr(engine, "submit"):
-            own, took = engine.collect()  # type: ignore[attr-defined]
-        else:
-            own = engine.derivatives(*inputs)  # type: ignore[attr-defined]
-            took = time.perf_counter() - t0
+        own, took = engine.collect()
     except Exception as exc:  # reported by the caller, as a row of its own
         return exc
     seconds[f"d {name}"] = took
@@ -81,7 +73,7 @@ def expected_seconds(states: int, nv: int) -> float:
     return SECONDS_PER_STATE_DOF2 * states * nv * nv
 
 
-def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, object],
+def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ModelEngine],
          states: States, *, with_referee: bool,
          seconds: dict[str, float] | None = None,
          readings: Mapping[str, ModelTree] | None = None) -> list[CheckRow]:
@@ -104,17 +96,17 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
     inputs = {}
     # an engine in its own process whose layout is the canonical one (MuJoCo's) is asked for
     # its derivatives and its step Jacobians in one request: it steps while the referee works
-    canonical_layout = {name: same_layout(canon, engine.tree, states)  # type: ignore[attr-defined]
+    canonical_layout = {name: same_layout(canon, engine.tree, states)
                         for name, engine in engines.items()}
     at_steps = step_states(tree, len(states.q))
     both: set[str] = set()
     for name, engine in engines.items():
-        mine: ModelTree = engine.tree  # type: ignore[attr-defined]
-        inputs[name] = layout_batch.engine_states(canon, mine, states.q, states.v, states.a)[1:]
-        if with_referee and canonical_layout[name] and hasattr(engine, "submit_both"):
+        inputs[name] = layout_batch.engine_states(canon, engine.tree, states.q, states.v,
+                                                  states.a)[1:]
+        if with_referee and canonical_layout[name] and Offer.TRANSITION in engine.offers:
             engine.submit_both(*inputs[name], at_steps)
             both.add(name)
-        elif hasattr(engine, "submit"):
+        else:
             engine.submit(*inputs[name], kind="derivatives")
     stepping: dict[str, object] = {}  # engine → its step Jacobians, or how they failed
     t0 = time.perf_counter()
@@ -131,7 +123,7 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
     for name, engine in sorted(engines.items(), key=lambda item: item[0] in both):
         if name in both:
             try:
-                own_part, step_part = engine.collect_both()  # type: ignore[attr-defined]
+                own_part, step_part = engine.collect_both()
             except Exception as exc:  # its process died: its rows say so
                 own_part = step_part = exc
             own = own_part if isinstance(own_part, Exception) else own_part[0]
@@ -139,11 +131,9 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
                 seconds[f"d {name}"] = own_part[1]
             stepping[name] = step_part if isinstance(step_part, Exception) else step_part[0]
         else:
-            own = _collect(engine, name, inputs[name], seconds)
+            own = _collect(engine, name, seconds)
         if isinstance(own, Unsupported):
             out.append(_row(model, name, Verdict.SKIPPED, str(own)))
-        elif isinstance(own, AttributeError):
-            out.append(_row(model, name, Verdict.SKIPPED, f"{name} offers no derivatives"))
         elif isinstance(own, Exception):  # an engine failing costs its own rows
             out.append(_row(model, name, Verdict.FAILED, f"{type(own).__name__}: {own}"))
         else:
@@ -153,8 +143,8 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
                 if own.chart is DerivativeChart.TANGENT and canonical_layout[name]:
                     found[name] = own  # its layout is the canonical one: nothing to map
                 else:
-                    values = engine.dynamics(*inputs[name])  # type: ignore[attr-defined]
-                    mine = engine.tree  # type: ignore[attr-defined]
+                    values = engine.dynamics(*inputs[name])
+                    mine = engine.tree
                     mapped = to_canonical(canon, mine, states, own, values)
                     if own.own_differences is not None:
                         mapped = replace(mapped, defect=own.defect, own_differences=to_canonical(
@@ -163,14 +153,8 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
             except Exception as exc:  # an engine failing costs its own rows
                 out.append(_row(model, name, Verdict.FAILED, f"{type(exc).__name__}: {exc}"))
             seconds["d map"] = seconds.get("d map", 0.0) + time.perf_counter() - t0
-        if (with_referee and canonical_layout[name] and name not in both
-                and hasattr(engine, "transition")):
-            try:  # in this process: its steps are taken now
-                stepping[name] = engine.transition(*(x[:at_steps] for x in inputs[name]))
-            except Exception as exc:
-                stepping[name] = exc
     for name, steps in stepping.items():
-        if not trusted or isinstance(steps, (Unsupported, AttributeError)):
+        if not trusted or isinstance(steps, Unsupported):
             continue  # no trusted referee, or no steps offered
         if isinstance(steps, Exception):  # costs its own row
             out.append(_row(model, name, Verdict.FAILED, f"{type(steps).__name__}: {steps}"))
@@ -185,7 +169,7 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, ob
 
 
 def _pair_rows(model: str, tree: ModelTree, *, order: list[str], found: dict[str, Derivatives],
-               engines: Mapping[str, object], ref: Referee,
+               engines: Mapping[str, ModelEngine], ref: Referee,
                own_refs: dict[str, Referee]) -> list[CheckRow]:
     """The rows of every pair of ``order`` (the sides whose derivatives were ``found``): a
     pair with an engine that reads the model otherwise (``own_refs``: the referee on its own
@@ -193,8 +177,7 @@ def _pair_rows(model: str, tree: ModelTree, *, order: list[str], found: dict[str
     rows: list[CheckRow] = []
     for i, a_name in enumerate(order):
         for b_name in order[i + 1 :]:
-            eps = max(getattr(engines.get(a_name), "tree", tree).eps,
-                      getattr(engines.get(b_name), "tree", tree).eps)
+            eps = max((engines[n].tree if n in engines else tree).eps for n in (a_name, b_name))
             if a_name == "reference" and b_name in own_refs:  # on b's own reading
                 on_b = own_refs[b_name]
                 rows.extend(replace(r, basis=f"{r.basis}; the referee on {b_name}'s reading")

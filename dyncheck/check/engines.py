@@ -28,25 +28,18 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 
 from dyncheck.adapters import MODELS, Registration
+from dyncheck.adapters.base import Answer, ModelEngine
 from dyncheck.adapters.model_files import ModelFile
-from dyncheck.adapters.model_tree import Derivatives, Dynamics, ModelTree, Transition
+from dyncheck.adapters.model_tree import Derivatives, Dynamics, Transition
 from dyncheck.confinement import confine
 from dyncheck.errors import DyncheckError, EngineError, Unsupported
 from dyncheck.settings import Settings, current, in_force
 from dyncheck.workers import at_end, ending, start_method
-
-
-class ModelEngine(Protocol):
-    engine: str
-    tree: ModelTree
-
-    def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics: ...
-
 
 ENGINES: dict[str, Registration] = dict(MODELS)
 """The engines that load a user's file: their registrations (:data:`~dyncheck.adapters.MODELS`)."""
@@ -177,7 +170,7 @@ def _answer(name: str, spec: Registration, source: ModelFile, conn: Connection,
     if isinstance(loaded, NotLoaded):
         conn.send(loaded)
         return
-    conn.send(loaded.tree)
+    conn.send((loaded.tree, loaded.offers))
     while (request := conn.recv()) is not None:
         kind, *batch = request
         if kind == BOTH:  # its derivatives at every state, its steps' at the first k
@@ -196,23 +189,16 @@ submit_both`): it takes its steps while the caller computes, with no second requ
 on."""
 
 
-def _one(name: str, loaded: object, kind: str, batch: Sequence[object],
-         memory_mib: int | None) -> tuple[object, float] | Exception:
+def _one(name: str, loaded: ModelEngine, kind: str, batch: Sequence[np.ndarray],
+         memory_mib: int | None) -> Answer:
     """One request's answer and its seconds, or the error to hand back in the engine's
     words."""
-    try:
-        t0 = time.perf_counter()
-        method = getattr(loaded, kind, None)
-        if method is None:
-            raise Unsupported(f"{name} offers no {kind}")
-        answer = method(*batch)
-        return answer, time.perf_counter() - t0
-    except MemoryError:
+    answer = loaded.request(kind, *batch)
+    if isinstance(answer, MemoryError):
         return EngineError(_out_of_memory(name, memory_mib))
-    except Unsupported as exc:
-        return exc
-    except Exception as exc:
-        return EngineError(f"{type(exc).__name__}: {' '.join(str(exc).split())}")
+    if isinstance(answer, Exception) and not isinstance(answer, Unsupported):
+        return EngineError(f"{type(answer).__name__}: {' '.join(str(answer).split())}")
+    return answer
 
 
 def _death(code: int | None, errors: str | None = None) -> str:
@@ -248,9 +234,10 @@ def _last_words(path: str) -> str:
     return last if len(last) <= LAST_WORDS_CHARS else last[: LAST_WORDS_CHARS - 1] + "…"
 
 
-class Isolated:
-    """An engine in its own process (see the module's docstring): its ``tree`` and
-    ``dynamics`` as :class:`ModelEngine`, a crash or a hang an :class:`EngineError`."""
+class Isolated(ModelEngine):
+    """An engine in its own process (see the module's docstring): its ``tree``, what it
+    ``offers`` and its requests as :class:`ModelEngine`, a crash or a hang an
+    :class:`EngineError`."""
 
     def __init__(self, name: str, source: ModelFile, limits: Limits | None = None) -> None:
         ctx = mp.get_context(start_method())
@@ -301,7 +288,7 @@ class Isolated:
         if isinstance(answer, NotLoaded):
             self.close()
             return answer
-        self.tree: ModelTree = answer  # type: ignore[assignment]
+        self.tree, self.offers = answer  # type: ignore[misc]
         return self
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
@@ -336,26 +323,25 @@ class Isolated:
             raise EngineError(f"{self.engine} crashed earlier "
                               f"({_death(self._proc.exitcode, self._errors)})") from None
 
-    def collect_both(self) -> tuple[tuple[object, float] | Exception,
-                                    tuple[object, float] | Exception]:
+    def collect_both(self) -> tuple[Answer, Answer]:
         """The answers to :meth:`submit_both`: each (its value, the engine's seconds) or the
         exception it raised."""
         answers, _ = self.collect()
-        return answers  # type: ignore[return-value]
+        return answers
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
         """The engine's derivatives (:class:`Unsupported` where it offers none)."""
         self.submit(q, v, a, kind="derivatives")
-        return self.collect()[0]  # type: ignore[return-value]
+        return self.collect()[0]
 
     def transition(self, q: np.ndarray, v: np.ndarray,
                    a: np.ndarray) -> tuple[Transition, ...]:
         """The engine's Jacobians of one step of its integrators (:class:`Unsupported`
         where it offers none)."""
         self.submit(q, v, a, kind="transition")
-        return self.collect()[0]  # type: ignore[return-value]
+        return self.collect()[0]
 
-    def collect(self) -> tuple[Dynamics, float]:
+    def collect(self) -> tuple[Any, float]:
         """The submitted batch's answer (dynamics or derivatives) and the seconds the engine
         spent on it."""
         answer = self._receive(f"computing the {self._kind}", self._batch_seconds)

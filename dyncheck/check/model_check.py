@@ -22,6 +22,7 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.adapters import REGISTRY, layout, layout_batch
+from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials, urdf_welded
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import describe, inputs, partial, predicted, readings
@@ -165,7 +166,7 @@ def check_model(
 
 
 def _check(model: str, source_path: Path, source: ModelFile, *,
-           engines: dict[str, engine_processes.ModelEngine | NotLoaded], chosen: tuple[str, ...],
+           engines: dict[str, ModelEngine | NotLoaded], chosen: tuple[str, ...],
            states: int, seed: int, floating: bool, against_path: Path | None,
            load_seconds: float, derivatives: bool = False,
            say: Callable[[str], None] | None = None) -> CheckResult:
@@ -220,11 +221,11 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
 
 
 def _loaded(model: str, source_path: Path, source: ModelFile,
-            engines: dict[str, engine_processes.ModelEngine | NotLoaded], rows: list[CheckRow],
-            notes: list[str]) -> dict[str, engine_processes.ModelEngine]:
+            engines: dict[str, ModelEngine | NotLoaded], rows: list[CheckRow],
+            notes: list[str]) -> dict[str, ModelEngine]:
     """Step 1: the engines that loaded the file, each tree aligned with the first's (a load
     row each; MuJoCo refusing an MJCF, or no engine loading it, is the file's fault)."""
-    loaded: dict[str, engine_processes.ModelEngine] = {}
+    loaded: dict[str, ModelEngine] = {}
     for engine, result in engines.items():
         if isinstance(result, NotLoaded):
             verdict = Verdict.SKIPPED if result.skip else Verdict.FAILED
@@ -248,7 +249,7 @@ def _loaded(model: str, source_path: Path, source: ModelFile,
     return loaded
 
 
-def _readings(model: str, source: ModelFile, loaded: dict[str, engine_processes.ModelEngine],
+def _readings(model: str, source: ModelFile, loaded: dict[str, ModelEngine],
               rows: list[CheckRow], notes: list[str]) -> dict[str, list[str]]:
     """Steps 3 and 4: whether each body is physically possible (the file's URDF inertials
     and every engine's reading), and each engine's tree against the first's, field by field;
@@ -283,7 +284,7 @@ def _readings(model: str, source: ModelFile, loaded: dict[str, engine_processes.
 
 
 def _parts(canon: layout.Canonical, canonical_tree: ModelTree,
-           loaded: dict[str, engine_processes.ModelEngine],
+           loaded: dict[str, ModelEngine],
            notes: list[str]) -> tuple[dict[str, partial.Part | None], list[str]]:
     """Which joints each engine holds: all (None), a common part of whole subtrees (its
     dynamics compared there), or joints that match nothing (the engine's dynamics skipped)."""
@@ -306,7 +307,7 @@ def _parts(canon: layout.Canonical, canonical_tree: ModelTree,
 
 
 def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch: States,
-              loaded: dict[str, engine_processes.ModelEngine],
+              loaded: dict[str, ModelEngine],
               parts: dict[str, partial.Part | None], unmatched: list[str], *,
               with_referee: bool, rows: list[CheckRow],
               seconds: dict[str, float], own: dict[str, readings.Reading]) -> dict[str, Dynamics]:
@@ -328,15 +329,12 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
         on = batch if part is None else partial.states(batch, part)
         maps, q_e, v_e, a_e = layout_batch.engine_states(
             canon if part is None else layout.canonical(part.tree), m.tree, on.q, on.v, on.a)
-        try:
-            if isinstance(m, engine_processes.Isolated):
-                m.submit(q_e, v_e, a_e)
-                pending[engine] = (m, maps)
-            else:
-                results[engine] = layout_batch.to_canonical(maps, m.dynamics(q_e, v_e, a_e))
+        seconds[engine] = seconds.get(engine, 0.0) + time.perf_counter() - t0  # the map's
+        try:  # (an engine in its own process computes while the referee does; its answer
+            m.submit(q_e, v_e, a_e)  # comes with its own seconds)
+            pending[engine] = (m, maps)
         except Exception as exc:  # an engine failing mid-way costs its own rows
             failures[engine] = f"{type(exc).__name__}: {exc}"
-        seconds[engine] = seconds.get(engine, 0.0) + time.perf_counter() - t0
     t0 = time.perf_counter()
     try:  # the referee serves the readings' comparison even where its rows are not asked for
         referee = ReferenceModel(canonical_tree)
@@ -400,7 +398,7 @@ def _non_finite(dyn: Dynamics) -> list[str]:
 
 
 def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch: States,
-           loaded: dict[str, engine_processes.ModelEngine],
+           loaded: dict[str, ModelEngine],
            parts: dict[str, partial.Part | None], results: dict[str, Dynamics],
            differing: dict[str, list[str]], own: dict[str, readings.Reading]) -> list[CheckRow]:
     """Step 6: every pair's dynamics compared. The referee judges each engine on that

@@ -16,8 +16,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.model_tree import Dynamics, JointType, ModelTree, TreeJoint
-from dyncheck.check import engines as engine_processes
 from dyncheck.check import partial
 from dyncheck.check.describe import placement
 from dyncheck.check.dynamics import QUANTITIES, Prediction, States, values
@@ -171,7 +171,7 @@ class Reading:
 
 
 def own_readings(canonical_tree: ModelTree, batch: States,
-                  loaded: dict[str, engine_processes.ModelEngine],
+                  loaded: dict[str, ModelEngine],
                   parts: dict[str, partial.Part | None], referee: Dynamics,
                   own: dict[str, Reading]) -> None:
     """The referee on every engine's own reading (whole trees; the canonical engine's is the

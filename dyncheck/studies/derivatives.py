@@ -18,6 +18,7 @@ from pathlib import Path
 
 from dyncheck import coordinates as co
 from dyncheck.adapters import MODELS, RUN, get_adapter
+from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases import Case
 from dyncheck.errors import EngineNotInstalled
@@ -31,15 +32,18 @@ TREE_ONLY = ("the smooth dynamics of the case's MJCF tree (its couplings and ext
 
 
 def _differentiates(entry: str) -> bool:
-    """Whether the loader ``module:class`` offers its engine's derivatives (a port's refuses
-    them itself: a skipped row naming it)."""
+    """Whether the loader ``module:class`` answers for its engine's derivatives: it offers
+    them (:attr:`~dyncheck.adapters.base.ModelEngine.offers`), or refuses them in words of
+    its own (a port whose kernels are not differentiated: a skipped row naming why)."""
     import importlib
 
     module, cls = entry.split(":")
     try:
-        return hasattr(getattr(importlib.import_module(module), cls), "derivatives")
+        loader = getattr(importlib.import_module(module), cls)
     except ImportError:
         return True  # its load reports the missing engine
+    return Offer.DERIVATIVES in loader.offers or loader.derivatives is not \
+        ModelEngine.derivatives
 
 
 def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[Discrepancy]:
@@ -62,7 +66,7 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
     q = cmap.to_engine(sample.q)
     on = States(q=q, v=co.velocity_to_engine(cmap, sample.q, sample.v),
                 a=co.acceleration_to_engine(cmap, sample.q, sample.v, sample.a))
-    loaded: dict[str, engines.ModelEngine] = {}
+    loaded: dict[str, ModelEngine] = {}
     failed: list[Discrepancy] = []
     with tempfile.TemporaryDirectory(prefix="dyncheck-case-") as folder:
         path = Path(folder) / f"{case.name}.xml"
