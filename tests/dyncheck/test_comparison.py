@@ -172,14 +172,16 @@ def test_one_percent_mass_change_is_caught(engine):
 def test_an_implementation_that_raises_becomes_a_failed_row():
     case = get_case("simple_pendulum")
 
-    class Broken:
+    from dyncheck.implementations import ReferenceImplementation
+
+    class Broken(ReferenceImplementation):
         def variant(self):
             return None
 
         def evaluate(self, sample):
             raise FloatingPointError("boom")
 
-    impls = {"reference": make_implementation("reference", case), "mujoco": Broken()}
+    impls = {"reference": make_implementation("reference", case), "mujoco": Broken(case)}
     rows = compare_instantaneous(case, impls, case.sample_states())
     assert all(r.verdict == "failed" and "boom" in r.note for r in rows)
     assert len(rows) == len(quantities(case))
