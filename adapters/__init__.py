@@ -193,6 +193,38 @@ the report lists them (after the reference and the book). A module is imported w
 adapter is first asked for — an engine's import (JAX and Warp take seconds) is paid only by
 the runs that use it."""
 
+ENTRY_POINTS = "dyncheck.engines"
+"""The entry-point group through which an installed package adds an engine: each entry's name
+is the implementation's, its value ``module:NAME`` a :class:`Registration` in a module
+importable without the engine (its loader, a :class:`~dyncheck.adapters.base.ModelEngine`,
+named by ``model``). It joins :data:`REGISTRY` after the built-in engines — in ``list``,
+``run``, ``check``, ``versions`` and ``bench`` — with no file of dyncheck touched."""
+
+
+def _installed_engines() -> tuple[dict[str, Registration], dict[str, str]]:
+    """The registrations installed packages add (:data:`ENTRY_POINTS`), and why any could
+    not be added (its name → the reason, said by ``dyncheck list``)."""
+    found: dict[str, Registration] = {}
+    broken: dict[str, str] = {}
+    for point in importlib.metadata.entry_points(group=ENTRY_POINTS):
+        if point.name in REGISTRY or point.name in found:
+            broken[point.name] = f"{point.value}: the name is taken by another engine"
+            continue
+        try:
+            registration = point.load()
+        except Exception as exc:  # a broken package costs only its own engine
+            broken[point.name] = f"{point.value} failed to load: {type(exc).__name__}: {exc}"
+            continue
+        if not isinstance(registration, Registration):
+            broken[point.name] = f"{point.value} is not a Registration"
+            continue
+        found[point.name] = registration
+    return found, broken
+
+
+_ADDED, NOT_ADDED = _installed_engines()
+REGISTRY.update(_ADDED)
+
 RUN: tuple[str, ...] = tuple(n for n, r in REGISTRY.items() if r.module or r.run)
 """The implementations with an adapter of a book case (``dyncheck run``)."""
 ENGINE_PACKAGES: dict[str, str] = {name: r.package for name, r in REGISTRY.items()}
@@ -279,6 +311,7 @@ __all__ = [
     "LABELS",
     "MISSING",
     "MODELS",
+    "NOT_ADDED",
     "REGISTRY",
     "RUN",
     "Adapter",

@@ -228,6 +228,13 @@ class ModelAdapter(Adapter):
         return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", q_e[:, at]),
                           v_e[:, dof])
 
+    def raw_calls(self, qe: np.ndarray, ve: np.ndarray, te: np.ndarray,
+                  ae: np.ndarray) -> Callable[[], None] | None:
+        """The loader's own per-state engine calls on states already in its layout (the map
+        to it is dyncheck's, timed in the adapter's row)."""
+        _, q, v, a = engine_states(self.canon, self.tree, qe, ve, ae)
+        return partial(self.engine.dynamics, q, v, a)
+
 
 def for_engine(name: str, *, package: str, model: str, run: Format, float32: bool,
                integrators: tuple[str, ...]) -> type[Adapter]:
@@ -240,11 +247,3 @@ def for_engine(name: str, *, package: str, model: str, run: Format, float32: boo
              "dtype": np.float32 if float32 else np.float64, "integrators": integrators,
              "__module__": __name__}
     return type(f"{cls}Adapter", (ModelAdapter,), attrs)
-
-    def raw_calls(self, qe: np.ndarray, ve: np.ndarray, te: np.ndarray,
-                  ae: np.ndarray) -> Callable[[], None] | None:
-        """The loader's own per-state engine calls on states already in its layout (the map
-        to it is dyncheck's, timed in the adapter's row)."""
-        _, q, v, a = engine_states(self.canon, self.tree, qe, ve, ae)
-        return partial(self.engine.dynamics, q, v, a)
-

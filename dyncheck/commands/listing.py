@@ -37,7 +37,7 @@ def engine_line(name: str) -> str:
 def list_command(*, integrators: bool = False) -> int:
     """Cases, implementations and robots. Engines are named with their installed version from
     the package metadata — fast, nothing imported — or, with ``integrators``, imported."""
-    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES
+    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES, NOT_ADDED
     from dyncheck.cases import CASES
     from dyncheck.roster import IMPLEMENTATIONS
 
@@ -59,6 +59,8 @@ def list_command(*, integrators: bool = False) -> int:
         else:
             what = f"not installed: pip install {ENGINE_PACKAGES[name]}"
         print(f"  {name:24s} {what}")
+    for name, why in NOT_ADDED.items():  # an installed package's engine that did not register
+        print(f"  {name:24s} not added: {why}")
     from dyncheck.check.inputs import robots
 
     found = robots()
