@@ -227,6 +227,11 @@ class Adapter(ABC):
             )
         return out
 
+    def unavailable_quantities(self) -> dict[str, str]:
+        """Quantity → why the engine does not compute it on this model (its limit, in its
+        words; its values NaN in :meth:`evaluate_all`): none by default."""
+        return {}
+
     def defects(self) -> tuple[str, ...]:
         """What the engine is known (measured) to do wrong on this model, each in a sentence
         a failed row cites as its evidence; none by default."""
@@ -269,7 +274,9 @@ class Adapter(ABC):
         }
         if constraint is not None:
             out[Quantity.CONSTRAINT_FORCE] = constraint
-        return {key: self._check(key, val) for key, val in out.items()}
+        unavailable = self.unavailable_quantities()  # its limits: NaN, said on their rows
+        return {key: val if key in unavailable else self._check(key, val)
+                for key, val in out.items()}
 
     def _check(self, what: str, value: np.ndarray) -> np.ndarray:
         if not np.all(np.isfinite(value)):
@@ -331,6 +338,12 @@ class ModelEngine(ABC):
 
     @abstractmethod
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics: ...
+
+    def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """v̇ at τ (its layout): M⁻¹ (τ − h) from :meth:`dynamics`; an engine that computes
+        its forward dynamics otherwise (where its h fails) says so by overriding it."""
+        d = self.dynamics(q, v, np.zeros_like(v))
+        return np.linalg.solve(d.mass_matrix, (tau - d.bias)[..., None])[..., 0]
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
         raise Unsupported(f"{self.engine} offers no derivatives")

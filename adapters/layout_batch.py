@@ -130,5 +130,5 @@ def to_canonical(maps: list[StateMap], dyn: Dynamics) -> Dynamics:
         bias=(t_t @ (dyn.bias + (m_e @ tdot_v[..., None])[..., 0])[..., None])[..., 0],
         forward=np.linalg.solve(t, (dyn.forward - tdot_v)[..., None])[..., 0],
         inverse=(t_t @ np.asarray(dyn.inverse)[..., None])[..., 0],
-        kinetic=dyn.kinetic, potential=dyn.potential,
+        kinetic=dyn.kinetic, potential=dyn.potential, unavailable=dyn.unavailable,
     )

@@ -39,6 +39,7 @@ from dyncheck.adapters.model_files import Format, read
 from dyncheck.adapters.model_tree import (
     NQ,
     NV,
+    QUANTITY_OF,
     Dynamics,
     GravityFrame,
     JointType,
@@ -80,6 +81,7 @@ class ModelAdapter(Adapter):
         self.tree: ModelTree = self.engine.tree
         self.inertia_rounded = self.tree.inertia_accuracy > 0.0
         self.canon, self._carriers = self._canonical(model)
+        self._unavailable: dict[str, str] = {}
 
     def _canonical(self, model: Multibody) -> tuple[Canonical, list[TreeJoint]]:
         """The case's joints in MuJoCo's order, each matched to the engine's joint by name (a
@@ -135,8 +137,15 @@ class ModelAdapter(Adapter):
 
     def defects(self) -> tuple[str, ...]:
         """A free joint whose engine resolves gravity in its frame through another rotation
-        than the state's (:class:`~.model_tree.GravityFrame`, declared on the tree)."""
-        return tuple(
+        than the state's (:class:`~.model_tree.GravityFrame`, declared on the tree); a joint
+        whose engine computes with another inertia than it holds
+        (:attr:`~.model_tree.TreeJoint.computed_inertia`, declared on the tree)."""
+        computed = tuple(
+            f"its dynamics take the inertia of {j.name!r} otherwise than it holds it (its "
+            "link's principal moments in the link's axes, the inertial frame's rotation "
+            "dropped; measured; predicted per state by the general method on the inertia it "
+            "computes with)" for j in self.tree.joints if j.computed_inertia is not None)
+        return computed + tuple(
             f"its dynamics resolve gravity in the frame of {j.name!r} through Rx(r) Ry(p) "
             "Rz(y) of the orientation's roll, pitch, yaw, the state's Rz(y) Ry(p) Rx(r) in "
             f"reverse order (GravityFrame.{j.gravity_frame.name}, measured; predicted per "
@@ -184,10 +193,23 @@ class ModelAdapter(Adapter):
     def evaluate_all(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
     ) -> dict[str, np.ndarray]:
-        d = self._dynamics(q, v, a)
-        forward = np.linalg.solve(d.mass_matrix, (tau - d.bias)[..., None])[..., 0]
+        maps, qe, ve, ae = engine_states(self.canon, self.tree, q, v, a)
+        d = to_canonical(maps, self.engine.dynamics(qe, ve, ae))
+        unavailable = dict(d.unavailable)
+        self._unavailable = {QUANTITY_OF[field]: why for field, why in unavailable.items()}
+        if "bias" in unavailable:  # its own forward dynamics at τ, mapped: v̇_e = T v̇ + Ṫ v
+            t = np.array([m.t for m in maps])
+            tdot_v = np.array([m.tdot_v for m in maps])
+            tau_e = np.linalg.solve(np.swapaxes(t, 1, 2), tau[..., None])[..., 0]
+            forward = np.linalg.solve(t, (self.engine.forward(qe, ve, tau_e)
+                                          - tdot_v)[..., None])[..., 0]
+        else:
+            forward = np.linalg.solve(d.mass_matrix, (tau - d.bias)[..., None])[..., 0]
         return self._outputs(d.mass_matrix, d.bias, forward, d.inverse, d.kinetic,
                              d.potential)
+
+    def unavailable_quantities(self) -> dict[str, str]:
+        return self._unavailable
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         zero = np.zeros((len(q), self.canon.nv))

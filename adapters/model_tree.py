@@ -16,13 +16,13 @@ knowing the engine.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from enum import StrEnum
 from typing import Any
 
 import numpy as np
 
-from dyncheck.vocabulary import JointType
+from dyncheck.vocabulary import JointType, Quantity
 
 
 class Axes(StrEnum):
@@ -184,6 +184,11 @@ class TreeJoint:
     gravity_frame: GravityFrame = GravityFrame.STATE
     """A free joint: how the engine's h and inverse dynamics resolve gravity in its body's
     frame (the frame whose pose q holds, :attr:`Layout.offset`)."""
+    computed_inertia: np.ndarray | None = None
+    """The inertia (about the centre of mass, world axes) the engine's dynamics compute with
+    where a measured defect makes it differ from the ``inertia`` it holds (PyBullet's
+    spherical joint: its link's principal moments taken in the link's axes); None: the held
+    one."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -257,18 +262,29 @@ class Dynamics:
     inverse: np.ndarray
     kinetic: np.ndarray
     potential: np.ndarray
+    unavailable: tuple[tuple[str, str], ...] = ()
+    """(field, why) for a field the engine does not compute on this model (its values NaN):
+    its limit, a skipped row of that quantity in the engine's words."""
 
     @classmethod
     def at(cls, v: np.ndarray, *, mass_matrix: np.ndarray, bias: np.ndarray,
-           inverse: np.ndarray, potential: np.ndarray,
-           forward: np.ndarray | None = None) -> Dynamics:
+           inverse: np.ndarray, potential: np.ndarray, forward: np.ndarray | None = None,
+           unavailable: tuple[tuple[str, str], ...] = ()) -> Dynamics:
         """From M and h at velocities ``v``: T = ½ vᵀ M v and, unless the engine gave it,
         the forward dynamics at τ = 0, v̇ = −M⁻¹ h."""
         if forward is None:
             forward = -np.linalg.solve(mass_matrix, bias[..., None])[..., 0]
         kinetic = 0.5 * np.einsum("ni,nij,nj->n", v, mass_matrix, v)
         return cls(mass_matrix=mass_matrix, bias=bias, forward=forward, inverse=inverse,
-                   kinetic=kinetic, potential=potential)
+                   kinetic=kinetic, potential=potential, unavailable=unavailable)
+
+
+QUANTITY_OF: dict[str, Quantity] = dict(zip(
+    (f.name for f in fields(Dynamics)),
+    (Quantity.MASS_MATRIX, Quantity.BIAS_FORCES, Quantity.FORWARD_DYNAMICS,
+     Quantity.INVERSE_DYNAMICS, Quantity.KINETIC_ENERGY, Quantity.POTENTIAL_ENERGY),
+    strict=False))  # (its last field, ``unavailable``, is no quantity)
+"""A field of :class:`Dynamics` → the quantity it holds."""
 
 
 class DerivativeChart(StrEnum):

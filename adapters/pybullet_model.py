@@ -29,17 +29,11 @@ declared on the tree so that the check predicts the difference it makes.
 
 from __future__ import annotations
 
-import tempfile
-import xml.etree.ElementTree as ET
-from dataclasses import dataclass
-from pathlib import Path
-
 import numpy as np
 import pybullet as pb
 
 from dyncheck.adapters.base import ModelEngine, Offer
-from dyncheck.adapters.mjcf_copy import utf8_file
-from dyncheck.adapters.model_files import Format, ModelFile, urdf_inertials
+from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
     Dynamics,
@@ -51,143 +45,43 @@ from dyncheck.adapters.model_tree import (
     TreeJoint,
     lump,
 )
-from dyncheck.errors import EngineError, Unsupported
+from dyncheck.adapters.pybullet_files import (
+    ACCURACY_HINT,
+    ARMATURE_HINT,
+    DIAGONALIZATION,
+    FLAGS_NOTE,
+    FREE_BASE,
+    GRAVITY_HINT,
+    INERTIA_HINT,
+    MAX_LINKS,
+    Link,
+    defaulted,
+    load,
+    pose,
+    rotation_of,
+    zeroed,
+)
+from dyncheck.errors import Unsupported
 
 ENGINE = "pybullet"
 GRAVITY = np.array([0.0, 0.0, -9.81])
-_TYPES = {pb.JOINT_REVOLUTE: JointType.HINGE, pb.JOINT_PRISMATIC: JointType.SLIDE}
-_NAMES = {pb.JOINT_SPHERICAL: "spherical", pb.JOINT_PLANAR: "planar",
-          pb.JOINT_POINT2POINT: "point2point", pb.JOINT_GEAR: "gear"}
-FLAGS_NOTE = (
-    "pybullet: loadURDF with URDF_USE_INERTIA_FROM_FILE (without it PyBullet computes each "
-    "link's inertia from its collision shapes)"
+_TYPES = {pb.JOINT_REVOLUTE: JointType.HINGE, pb.JOINT_PRISMATIC: JointType.SLIDE,
+          pb.JOINT_SPHERICAL: JointType.BALL}
+_NAMES = {pb.JOINT_PLANAR: "planar", pb.JOINT_POINT2POINT: "point2point",
+          pb.JOINT_GEAR: "gear"}
+_ZERO = {pb.JOINT_REVOLUTE: (0.0,), pb.JOINT_PRISMATIC: (0.0,),
+         pb.JOINT_SPHERICAL: (0.0, 0.0, 0.0, 1.0)}
+"""A joint's coordinates at the reference configuration (a spherical joint's quaternion
+x-y-z-w: the identity)."""
+STEP = 1e-3
+"""The time step of the one ``stepSimulation`` whose velocity change gives PyBullet's
+forward dynamics on a multibody with a spherical joint, v̇ = (v₊ − v)/h: its semi-implicit
+Euler step is exactly that (no damping, no motor), to ε |v| / (h |v̇|) relative."""
+NO_INVERSE = (
+    "PyBullet's calculateInverseDynamics does not take a multibody with a spherical joint "
+    "(its Python API raises SystemError: it passes no multi-DoF joint to its inverse "
+    "dynamics, as its maintainers state in bullet3 PR #1381)"
 )
-GRAVITY_HINT = (
-    "PyBullet's MJCF reader does not read <option gravity> (a PyBullet user sets it with "
-    "setGravity; here 0 0 -9.81)"
-)
-ARMATURE_HINT = "PyBullet has no joint armature (rotor inertia): its M leaves it out"
-DIAGONALIZATION = 1e-6
-"""PyBullet's URDF importer stores a link's inertia as principal moments found by
-``btMatrix3x3::diagonalize(basis, 1e-6, 30)``: Jacobi rotations until every off-diagonal term
-is ≤ 1e-6 × the trace (then one more rotation); what is left is dropped."""
-ACCURACY_HINT = (
-    "PyBullet stores a link's inertia as principal moments from a Jacobi diagonalization "
-    "that stops once the off-diagonal terms are below 1e-6 of the trace (its URDF importer: "
-    "btMatrix3x3::diagonalize(basis, 1e-6, 30)), dropping them"
-)
-NO_INERTIAL = (
-    "PyBullet's URDF importer gives a link without <inertial> ({links}) a mass of 1 kg and a "
-    "unit inertia (its default; MuJoCo and Pinocchio give it none) (fix: give the link an "
-    "<inertial>, with mass 0 where it is a frame)"
-)
-ZEROED_INERTIA = (
-    "PyBullet's URDF importer sets the inertia of {links} to zero: it breaks the triangle "
-    "inequality I1 + I2 >= I3 (its warning: 'Bad inertia tensor properties, setting inertia "
-    "to zero') (fix: correct the file's inertia)"
-)
-INERTIA_HINT = (
-    "PyBullet's MJCF reader does not take a body's inertia from <inertial diaginertia> or "
-    "fullinertia (measured: zero, or computed from its geoms) (fix: check the URDF in "
-    "PyBullet, or give the bodies geoms whose inertia is the intended one)"
-)
-
-
-MAX_LINKS = 128
-"""PyBullet's client state holds at most 128 links (``MAX_NUM_LINKS`` =
-``MAX_DEGREE_OF_FREEDOM`` in its SharedMemoryPublic.h): ``getLinkState`` fails beyond."""
-_FREE = -1
-"""A moving base's link (PyBullet has no joint for it)."""
-
-
-def _rotation(quat_xyzw: tuple[float, ...]) -> np.ndarray:
-    return np.array(pb.getMatrixFromQuaternion(quat_xyzw), float).reshape(3, 3)
-
-
-def _pose(position: tuple[float, ...], quat_xyzw: tuple[float, ...]) -> np.ndarray:
-    pose = np.eye(4)
-    pose[:3, :3], pose[:3, 3] = _rotation(quat_xyzw), position
-    return pose
-
-
-@dataclass(frozen=True, kw_only=True)
-class _Link:
-    """One PyBullet link at the reference configuration, world axes."""
-
-    body: int
-    index: int
-    name: str
-    joint: str
-    kind: int
-    parent: int
-    axis: np.ndarray  # world axes
-    origin: np.ndarray  # link frame, world
-    rotation: np.ndarray
-    mass: float
-    com: np.ndarray
-    inertia: np.ndarray  # about the com, world axes
-    damping: float
-    limits: tuple[float, float]
-    offset: np.ndarray | None = None  # a moving base: link frame ← centre-of-mass frame
-
-
-def _load(client: int, source: ModelFile) -> list[int]:
-    """The file's multibodies; a URDF as the other engines get it, without geometry and
-    ``<mimic>`` (:func:`~dyncheck.adapters.model_files.read`): written to a file of its own
-    (``loadURDF`` reads files only), removed once loaded."""
-    try:
-        if source.format is Format.MJCF:
-            with utf8_file(source.path) as file:
-                bodies = list(pb.loadMJCF(str(file), physicsClientId=client))
-        else:
-            with tempfile.TemporaryDirectory(prefix="dyncheck-pybullet-") as folder:
-                copy = Path(folder) / "model.urdf"
-                copy.write_text(source.text, encoding="utf-8")
-                bodies = [pb.loadURDF(str(copy), useFixedBase=not source.floating,
-                                      flags=pb.URDF_USE_INERTIA_FROM_FILE,
-                                      physicsClientId=client)]
-    except pb.error as exc:
-        raise EngineError(f"pybullet refused {source.path}: {exc}") from None
-    if not bodies:
-        raise EngineError(f"pybullet refused {source.path}: no body loaded")
-    return bodies
-
-
-def _zeroed(source: ModelFile, links: list[_Link]) -> tuple[tuple[str, str, str], ...]:
-    """Why a URDF link's inertia reads zero: the file's breaks the triangle inequality
-    (PyBullet zeroes it), named on the joint that moves the link."""
-    bad = set()
-    for stated in urdf_inertials(source):
-        moments = np.linalg.eigvalsh(np.array(stated.inertia))
-        if moments[0] + moments[1] < moments[2] * (1.0 - 1e-12):
-            bad.add(stated.link)
-    joints = {link.name: link.joint for link in links}
-    return tuple((joints[name], "inertia", ZEROED_INERTIA.format(links=repr(name)))
-                 for name in sorted(bad) if name in joints)
-
-
-def _defaulted(source: ModelFile, links: list[_Link]) -> tuple[tuple[str, str, str], ...]:
-    """Why a joint's mass reads 1 kg more: a URDF link it carries has no ``<inertial>``."""
-    if source.format is not Format.URDF:
-        return ()
-    bare = {link.get("name", "") for link in ET.fromstring(source.text).findall("link")
-            if link.find("inertial") is None}
-    by_key = {(link.body, link.index): link for link in links}
-    out: dict[str, list[str]] = {}
-    for link in links:
-        if link.name not in bare:
-            continue
-        owner: _Link | None = link
-        while owner is not None and owner.kind == pb.JOINT_FIXED:
-            owner = by_key.get((owner.body, owner.parent))
-        if owner is not None:
-            out.setdefault(owner.joint, []).append(link.name)
-    why = {joint: NO_INERTIAL.format(links=", ".join(repr(n) for n in names))
-           for joint, names in out.items()}
-    return tuple((joint, field, text) for joint, text in why.items()
-                 for field in ("mass", "com", "inertia"))
-
-
 class PybulletModel(ModelEngine):
     """A PyBullet client holding the file's multibodies, and their neutral tree."""
 
@@ -200,8 +94,9 @@ class PybulletModel(ModelEngine):
         self.client = pb.connect(pb.DIRECT)
         self.gravity = GRAVITY.copy() if gravity is None else np.asarray(gravity, float)
         pb.setGravity(*self.gravity, physicsClientId=self.client)
-        self.bodies = _load(self.client, source)
-        self._movable: dict[int, list[int]] = {}
+        self.bodies = load(self.client, source)
+        self._movable: dict[int, list[tuple[int, int]]] = {}  # body → (joint, its type)
+        self._damping: dict[tuple[int, int], float] = {}  # (body, joint) → the file's
         self._floating = {body: self._moving_base(body) for body in self.bodies}
         self._root_name = "root_joint" if source.format is Format.URDF else ""
         links = [link for body in self.bodies for link in self._links(body)]
@@ -209,21 +104,24 @@ class PybulletModel(ModelEngine):
         hints: tuple[tuple[str, str, str], ...] = (("model", "armature", ARMATURE_HINT),)
         if source.format is Format.MJCF:
             hints += (("model", "gravity", GRAVITY_HINT), ("model", "inertia", INERTIA_HINT))
-        hints += _zeroed(source, links) + _defaulted(source, links)
+        hints += zeroed(source, links) + defaulted(source, links)
         if source.format is Format.URDF:
             hints += (("model", "inertia accuracy", ACCURACY_HINT),)
         self.tree = self._tree(links, notes, hints)
+        self._balls = any(kind == pb.JOINT_SPHERICAL for joints in self._movable.values()
+                          for _, kind in joints)
 
     def _moving_base(self, body: int) -> bool:
         """Whether PyBullet gave ``body`` a moving base: its mass matrix has 6 more rows than
         the body has joint coordinates."""
-        n = sum(pb.getJointInfo(body, j, physicsClientId=self.client)[2]
-                in (pb.JOINT_REVOLUTE, pb.JOINT_PRISMATIC)
-                for j in range(pb.getNumJoints(body, physicsClientId=self.client)))
-        mass = pb.calculateMassMatrix(body, [0.0] * n, physicsClientId=self.client)
-        return len(mass) != n
+        kinds = [pb.getJointInfo(body, j, physicsClientId=self.client)[2]
+                 for j in range(pb.getNumJoints(body, physicsClientId=self.client))]
+        q = [x for kind in kinds for x in _ZERO.get(kind, ())]
+        nv = sum(JointType(_TYPES[kind]).nv for kind in kinds if kind in _TYPES)
+        mass = pb.calculateMassMatrix(body, q, physicsClientId=self.client)
+        return len(mass) != nv
 
-    def _links(self, body: int) -> list[_Link]:
+    def _links(self, body: int) -> list[Link]:
         """The body's links at the reference configuration: joints at 0, a moving base's
         link frame at the world origin, unrotated (its centre-of-mass frame, whose pose
         PyBullet's base state holds, at the local inertial frame)."""
@@ -236,66 +134,83 @@ class PybulletModel(ModelEngine):
         base = pb.getDynamicsInfo(body, -1, physicsClientId=c)
         if self._floating[body]:
             pb.resetBasePositionAndOrientation(body, base[3], base[4], physicsClientId=c)
-            rotation = _rotation(base[4])
+            rotation = rotation_of(base[4])
             name = pb.getBodyInfo(body, physicsClientId=c)[0].decode()
-            out.append(_Link(
-                body=body, index=-1, name=name, joint=self._root_name or name, kind=_FREE,
+            out.append(Link(
+                body=body, index=-1, name=name, joint=self._root_name or name, kind=FREE_BASE,
                 parent=-2, axis=np.zeros(3), origin=np.zeros(3),
                 rotation=np.eye(3), mass=float(base[0]), com=np.array(base[3], float),
                 inertia=rotation @ np.diag(base[2]) @ rotation.T, damping=0.0,
-                limits=(0.0, -1.0), offset=_pose(base[3], base[4]),
+                limits=(0.0, -1.0), offset=pose(base[3], base[4]),
             ))
         for j in range(pb.getNumJoints(body, physicsClientId=c)):
             info = pb.getJointInfo(body, j, physicsClientId=c)
             if info[2] not in _TYPES and info[2] != pb.JOINT_FIXED:
                 raise Unsupported(f"pybullet joint type {_NAMES.get(info[2], info[2])} "
                                   f"({info[1].decode()!r}) is not checked")
-            pb.resetJointState(body, j, 0.0, 0.0, physicsClientId=c)
+            if info[2] == pb.JOINT_SPHERICAL:
+                pb.resetJointStateMultiDof(body, j, _ZERO[info[2]], [0.0] * 3,
+                                           physicsClientId=c)
+            else:
+                pb.resetJointState(body, j, 0.0, 0.0, physicsClientId=c)
         for j in range(pb.getNumJoints(body, physicsClientId=c)):
             info = pb.getJointInfo(body, j, physicsClientId=c)
             state = pb.getLinkState(body, j, computeForwardKinematics=True, physicsClientId=c)
             dyn = pb.getDynamicsInfo(body, j, physicsClientId=c)
-            com, com_rotation = np.array(state[0], float), _rotation(state[1])
-            local_rotation = _rotation(state[3])
+            com, com_rotation = np.array(state[0], float), rotation_of(state[1])
+            local_rotation = rotation_of(state[3])
             rotation = com_rotation @ local_rotation.T  # the link frame, from the com frame
             origin = com - rotation @ np.array(state[2], float)
-            out.append(_Link(
+            out.append(Link(
                 body=body, index=j, name=info[12].decode(), joint=info[1].decode(),
                 kind=info[2], parent=info[16],
-                axis=com_rotation @ np.array(info[13], float),  # given in the com frame
+                axis=(com_rotation @ np.array(info[13], float) if info[2] != pb.JOINT_SPHERICAL
+                      else np.zeros(3)),  # given in the com frame; a ball's: none
                 origin=origin, rotation=rotation, mass=float(dyn[0]), com=com,
                 inertia=com_rotation @ np.diag(dyn[2]) @ com_rotation.T,
+                moments=np.array(dyn[2], float),
                 damping=float(info[6]), limits=(float(info[8]), float(info[9])),
             ))
             if info[2] in _TYPES:
-                self._movable.setdefault(body, []).append(j)
+                self._movable.setdefault(body, []).append((j, info[2]))
+                self._damping[(body, j)] = float(info[6])
         return out
 
-    def _tree(self, links: list[_Link], notes: tuple[str, ...],
+    def _tree(self, links: list[Link], notes: tuple[str, ...],
               hints: tuple[tuple[str, str, str], ...]) -> ModelTree:
         by_key = {(link.body, link.index): link for link in links}
 
-        def mover(link: _Link | None) -> _Link | None:
+        def mover(link: Link | None) -> Link | None:
             """The nearest link at or above ``link`` that a joint moves (None: a fixed
             base)."""
             while link is not None and link.kind == pb.JOINT_FIXED:
                 link = by_key.get((link.body, link.parent))
             return link
 
-        carried: dict[tuple[int, int], list[_Link]] = {}
+        carried: dict[tuple[int, int], list[Link]] = {}
         for link in links:
             owner = mover(link)
             if owner is not None:
                 carried.setdefault((owner.body, owner.index), []).append(link)
         joints, q_at, v_at = [], 0, 0
         for link in links:
-            if link.kind not in _TYPES and link.kind != _FREE:
+            if link.kind not in _TYPES and link.kind != FREE_BASE:
                 continue
             parts = carried[(link.body, link.index)]
             mass, com, inertia = lump([p.mass for p in parts], [p.com for p in parts],
                                       [p.inertia for p in parts])
+            computed = None
+            if link.kind == pb.JOINT_SPHERICAL and link.moments is not None:
+                # its dynamics take the link's principal moments in the link's own axes,
+                # dropping its inertial frame's rotation (measured to 1e-13 against the
+                # rigid body's Euler equations with diag(moments): SPHERICAL_INERTIA)
+                axes = link.rotation @ np.diag(link.moments) @ link.rotation.T
+                computed = lump([p.mass for p in parts], [p.com for p in parts],
+                                [axes if p is link else p.inertia for p in parts])[2]
+                if np.abs(computed - inertia).max() <= 1e-12 * max(np.trace(inertia), 1e-300):
+                    computed = None
             parent = mover(by_key.get((link.body, link.parent)))
-            if link.kind == _FREE:
+            if link.kind == FREE_BASE:
                 assert link.offset is not None
                 joints.append(TreeJoint(
                     name=link.joint, type=JointType.FREE, parent=None,
@@ -310,14 +225,22 @@ class PybulletModel(ModelEngine):
                 continue
             lower, upper = link.limits
             kind = _TYPES[link.kind]
+            ball = kind is JointType.BALL
             joints.append(TreeJoint(
                 name=link.joint, type=kind, parent=parent.joint if parent else None,
                 body=link.name, axis=link.axis, anchor=link.origin,
-                frame=link.rotation, mass=mass, com=com, inertia=inertia, armature=(0.0,),
-                damping=(link.damping,), range=(lower, upper) if lower <= upper else None,
-                layout=Layout(q_start=q_at, v_start=v_at, nq=1, nv=1),
+                frame=link.rotation, mass=mass, com=com, inertia=inertia,
+                armature=(0.0,) * kind.nv, damping=(link.damping,) * kind.nv,
+                computed_inertia=computed,
+                range=(lower, upper) if lower <= upper and not ball else None,
+                # a spherical joint: q = quaternion x-y-z-w, ω in the child link's axes
+                # (measured: its M is constant in q alone on one joint; its stepped
+                # velocities agree with MuJoCo's ball joint to round-off)
+                layout=Layout(q_start=q_at, v_start=v_at, nq=4, nv=3, quat=Orientation.XYZW,
+                              angular_axes=Axes.LOCAL) if ball
+                else Layout(q_start=q_at, v_start=v_at, nq=1, nv=1),
             ))
-            q_at, v_at = q_at + 1, v_at + 1
+            q_at, v_at = q_at + kind.nq, v_at + kind.nv
         self._masses = [(link.body, link.index, link.mass) for link in links]
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=self.gravity.copy(),
                          nq=q_at, nv=v_at, notes=notes, hints=hints,
@@ -336,23 +259,28 @@ class PybulletModel(ModelEngine):
                 pb.setGravity(*held, physicsClientId=self.client)
         c, n, nv = self.client, len(q), self.tree.nv
         mass = np.zeros((n, nv, nv))
-        bias, inverse = np.zeros((n, nv)), np.zeros((n, nv))
+        bias, inverse, forward = np.zeros((n, nv)), np.zeros((n, nv)), np.zeros((n, nv))
         potential = np.zeros(n)
         for i in range(n):
             q_at = v_at = 0
             for body in self.bodies:
                 movable = self._movable.get(body, [])
-                base_q, base_v = (7, 6) if self._floating[body] else (0, 0)
-                qs = slice(q_at, q_at + base_q + len(movable))
-                vs = slice(v_at, v_at + base_v + len(movable))
+                base_q = 7 if self._floating[body] else 0
+                nq, nv_body = self._size(body)
+                qs, vs = slice(q_at, q_at + nq), slice(v_at, v_at + nv_body)
                 q_at, v_at = qs.stop, vs.stop
                 if vs.start == vs.stop:
                     continue
                 qb, vb, ab = (list(map(float, x)) for x in (q[i, qs], v[i, vs], a[i, vs]))
                 joints = qb[base_q:]
                 if base_q:  # its linear acceleration in the centre-of-mass frame's axes
-                    ab[3:6] = list(_rotation(tuple(qb[3:7])).T @ np.array(ab[3:6]))
+                    ab[3:6] = list(rotation_of(tuple(qb[3:7])).T @ np.array(ab[3:6]))
                 m = np.array(pb.calculateMassMatrix(body, joints, physicsClientId=c))
+                if any(kind == pb.JOINT_SPHERICAL for _, kind in movable):
+                    mass[i, vs, vs] = m
+                    bias[i, vs] = inverse[i, vs] = np.nan
+                    forward[i, vs] = self._stepped(body, qb, vb)
+                    continue
                 zero = [0.0] * len(vb)
                 h = np.array(pb.calculateInverseDynamics(body, qb, vb, zero, physicsClientId=c))
                 tau = np.array(pb.calculateInverseDynamics(body, qb, vb, ab, physicsClientId=c))
@@ -360,46 +288,152 @@ class PybulletModel(ModelEngine):
                     m, h, tau = _world_linear(np.array(qb[3:7]), m, h, tau)
                     pb.resetBasePositionAndOrientation(body, qb[:3], qb[3:7], physicsClientId=c)
                 mass[i, vs, vs], bias[i, vs], inverse[i, vs] = m, h, tau
-                for j, x in zip(movable, joints, strict=True):
-                    pb.resetJointState(body, j, x, 0.0, physicsClientId=c)
+                forward[i, vs] = -np.linalg.solve(m, h)
+                self._place(body, joints)
             potential[i] = -self.gravity @ sum((m * self._com(b, j) for b, j, m in self._masses
                                            if m > 0.0), np.zeros(3))
-        return Dynamics.at(v, mass_matrix=mass, bias=bias, inverse=inverse,
-                           potential=potential)
+        if not self._balls:  # (M⁻¹ h of the whole system: the values as before)
+            return Dynamics.at(v, mass_matrix=mass, bias=bias, inverse=inverse,
+                               potential=potential)
+        return Dynamics.at(v, mass_matrix=mass, bias=bias, inverse=inverse, forward=forward,
+                           potential=potential,
+                           unavailable=(("bias", NO_INVERSE), ("inverse", NO_INVERSE)))
+
+    def _place(self, body: int, joints: list[float], velocities: list[float] | None = None,
+               ) -> None:
+        """The body's joints at coordinates ``joints`` (a spherical joint's quaternion
+        x-y-z-w), at rest or at ``velocities``."""
+        c, at, dof = self.client, 0, 0
+        for j, kind in self._movable.get(body, []):
+            nq, nv = len(_ZERO[kind]), JointType(_TYPES[kind]).nv
+            rate = [0.0] * nv if velocities is None else velocities[dof : dof + nv]
+            if kind == pb.JOINT_SPHERICAL:
+                pb.resetJointStateMultiDof(body, j, joints[at : at + nq], rate,
+                                           physicsClientId=c)
+            else:
+                pb.resetJointState(body, j, joints[at], rate[0], physicsClientId=c)
+            at, dof = at + nq, dof + nv
+
+    def _free_motion(self, body: int, *, keep_joint_damping: bool = False) -> None:
+        """Every motor of the body off and its links' damping 0 (its joints' too, unless
+        ``keep_joint_damping``: the file's): what is left of a step is its semi-implicit
+        Euler of its articulated-body forward dynamics."""
+        c = self.client
+        pb.changeDynamics(body, -1, linearDamping=0.0, angularDamping=0.0, physicsClientId=c)
+        for j, kind in self._movable.get(body, []):
+            if kind == pb.JOINT_SPHERICAL:
+                pb.setJointMotorControlMultiDof(body, j, pb.POSITION_CONTROL,
+                                                targetPosition=list(_ZERO[kind]),
+                                                positionGain=0.0, velocityGain=0.0,
+                                                force=[0.0] * 3, physicsClientId=c)
+            else:
+                pb.setJointMotorControl2(body, j, pb.VELOCITY_CONTROL, force=0.0,
+                                         physicsClientId=c)
+            damping = self._damping[(body, j)] if keep_joint_damping else 0.0
+            pb.changeDynamics(body, j, linearDamping=0.0, angularDamping=0.0,
+                              jointDamping=damping, physicsClientId=c)
+
+    def _positions(self, body: int) -> list[float]:
+        out: list[float] = []
+        for j, kind in self._movable.get(body, []):
+            if kind == pb.JOINT_SPHERICAL:
+                out += pb.getJointStateMultiDof(body, j, physicsClientId=self.client)[0]
+            else:
+                out.append(pb.getJointState(body, j, physicsClientId=self.client)[0])
+        return out
+
+    def _velocities(self, body: int) -> list[float]:
+        out: list[float] = []
+        for j, kind in self._movable.get(body, []):
+            if kind == pb.JOINT_SPHERICAL:
+                out += pb.getJointStateMultiDof(body, j, physicsClientId=self.client)[1]
+            else:
+                out.append(pb.getJointState(body, j, physicsClientId=self.client)[1])
+        return out
+
+    def _stepped(self, body: int, q: list[float], v: list[float],
+                 tau: list[float] | None = None) -> np.ndarray:
+        """PyBullet's forward dynamics at τ (None: 0) of a fixed-base multibody, from one
+        ``stepSimulation`` of :data:`STEP` with τ applied by its torque-controlled motors
+        (a spherical joint's in its child link's axes, as its velocities); the body is put
+        back at (q, rest) after. Its calculateInverseDynamics fails on a spherical joint
+        (:data:`NO_INVERSE`): its h is not to be had, its forward dynamics are."""
+        if self._floating[body]:
+            raise Unsupported("pybullet: a moving base with a spherical joint is not stepped "
+                              "by dyncheck yet")
+        c, dof = self.client, 0
+        self._free_motion(body)
+        pb.setTimeStep(STEP, physicsClientId=c)
+        self._place(body, q, v)
+        for j, kind in self._movable.get(body, []):
+            nv = JointType(_TYPES[kind]).nv
+            applied = [0.0] * nv if tau is None else [float(x) for x in tau[dof : dof + nv]]
+            if kind == pb.JOINT_SPHERICAL:
+                pb.setJointMotorControlMultiDof(body, j, pb.TORQUE_CONTROL, force=applied,
+                                                physicsClientId=c)
+            else:
+                pb.setJointMotorControl2(body, j, pb.TORQUE_CONTROL, force=applied[0],
+                                         physicsClientId=c)
+            dof += nv
+        pb.stepSimulation(physicsClientId=c)
+        out = (np.array(self._velocities(body)) - np.array(v)) / STEP
+        self._place(body, q)
+        self._free_motion(body, keep_joint_damping=True)  # motors off, the file's damping
+        return out
+
+    def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """v̇ at τ: M⁻¹ (τ − h) from its calculateMassMatrix and calculateInverseDynamics; on
+        a multibody with a spherical joint, where the latter fails, from its steps
+        (:meth:`_stepped`)."""
+        if not self._balls:
+            return super().forward(q, v, tau)
+        out = np.zeros_like(v)
+        for i in range(len(q)):
+            q_at = v_at = 0
+            for body in self.bodies:
+                nq, nv = self._size(body)
+                out[i, v_at : v_at + nv] = self._stepped(
+                    body, [float(x) for x in q[i, q_at : q_at + nq]],
+                    [float(x) for x in v[i, v_at : v_at + nv]],
+                    [float(x) for x in tau[i, v_at : v_at + nv]])
+                q_at, v_at = q_at + nq, v_at + nv
+        return out
+
+    def _size(self, body: int) -> tuple[int, int]:
+        """The body's nq and nv (its moving base's included)."""
+        movable = self._movable.get(body, [])
+        base_q, base_v = (7, 6) if self._floating[body] else (0, 0)
+        return (base_q + sum(len(_ZERO[k]) for _, k in movable),
+                base_v + sum(JointType(_TYPES[k]).nv for _, k in movable))
 
     def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float,
                  steps: int) -> tuple[np.ndarray, np.ndarray]:
         """``steps`` calls of ``stepSimulation`` at ``setTimeStep(dt)`` from (q0, v0): q and v
         at every step, the start included. Stated as a PyBullet user writes it for free
-        motion: each joint's default velocity motor switched off
+        motion: each joint's default motor switched off
         (``setJointMotorControl2(VELOCITY_CONTROL, force=0)`` — it holds the joints
-        otherwise) and the multibody's default linear and angular damping (0.04) set to 0
-        (``changeDynamics``): what is left is its integrator, semi-implicit Euler
-        (v₊ = v + h v̇, q₊ = q + h v₊) of its articulated-body forward dynamics. Hinges and
-        slides on a fixed base."""
+        otherwise; a spherical joint's ``setJointMotorControlMultiDof`` with zero gains and
+        force) and the multibody's default linear and angular damping (0.04) set to 0
+        (``changeDynamics``), the file's joint damping kept: what is left is its integrator,
+        semi-implicit Euler (v₊ = v + h v̇, q₊ = q + h v₊) of its articulated-body forward
+        dynamics. A fixed base."""
         c = self.client
         if any(self._floating.values()):
             raise Unsupported("pybullet: a moving base is not stepped by dyncheck yet")
         pb.setTimeStep(dt, physicsClientId=c)
-        at = 0
+        q_at = v_at = 0
         for body in self.bodies:
-            pb.changeDynamics(body, -1, linearDamping=0.0, angularDamping=0.0,
-                              physicsClientId=c)
-            for j in self._movable.get(body, []):
-                pb.setJointMotorControl2(body, j, pb.VELOCITY_CONTROL, force=0.0,
-                                         physicsClientId=c)
-                pb.changeDynamics(body, j, linearDamping=0.0, angularDamping=0.0,
-                                  physicsClientId=c)
-                pb.resetJointState(body, j, float(q0[at]), float(v0[at]), physicsClientId=c)
-                at += 1
+            self._free_motion(body, keep_joint_damping=True)
+            nq, nv = self._size(body)
+            self._place(body, [float(x) for x in q0[q_at : q_at + nq]],
+                        [float(x) for x in v0[v_at : v_at + nv]])
+            q_at, v_at = q_at + nq, v_at + nv
         qs = np.zeros((steps + 1, len(q0)))
         vs = np.zeros((steps + 1, len(v0)))
 
         def read(k: int) -> None:
-            states = [pb.getJointState(body, j, physicsClientId=c) for body in self.bodies
-                      for j in self._movable.get(body, [])]
-            qs[k] = [x[0] for x in states]
-            vs[k] = [x[1] for x in states]
+            qs[k] = [x for body in self.bodies for x in self._positions(body)]
+            vs[k] = [x for body in self.bodies for x in self._velocities(body)]
 
         read(0)
         for k in range(1, steps + 1):
@@ -425,7 +459,7 @@ def _world_linear(quat_xyzw: np.ndarray, mass: np.ndarray, bias: np.ndarray,
     force in the frame's axes (reordered and rotated to world axes here, R F);
     ``calculateMassMatrix`` takes the linear velocity in the frame's axes (its M does not
     change with the base's orientation; mapped here by R)."""
-    rot = _rotation(tuple(quat_xyzw))
+    rot = rotation_of(tuple(quat_xyzw))
     t = np.eye(len(mass))
     t[3:6, 3:6] = rot.T
     order = np.r_[3:6, 0:3, 6:len(mass)]

@@ -52,6 +52,7 @@ from dyncheck.explain.parsers import (
     pinocchio_mjcf_options,
     pinocchio_top_level_bodies,
 )
+from dyncheck.explain.spherical import pybullet_spherical_inertia
 from dyncheck.explanations import Origin
 
 __all__ = ["DEMOS", "REQUIRES", "TUTORIALS", "Entry", "explain", "explain_cached", "not_selected",
@@ -87,6 +88,7 @@ DEMOS: dict[str, tuple[Callable[[], Entry], Origin]] = {
     "newton-several-joints-on-a-body": (newton_joint_order, Origin.ENGINE),
     "derivative-chart": (derivative_chart, Origin.MATHEMATICS),
     "pinocchio-composite-derivatives": (composite_derivatives, Origin.ENGINE),
+    "pybullet-spherical-inertia": (pybullet_spherical_inertia, Origin.ENGINE),
 }
 """Conventions demonstrated by a run of their own, with whose property each is; the others
 (point-mass inertia floor, MJCF gravity, held forces, soft constraints: :mod:`.explanations`)
@@ -118,6 +120,7 @@ REQUIRES: dict[str, tuple[str, ...]] = {
     "newton-free-joint-velocity": ("newton",),
     "pybullet-default-motors": ("pybullet",),
     "newton-several-joints-on-a-body": ("newton",),
+    "pybullet-spherical-inertia": ("pybullet",),
 }
 """Demonstrations that need an optional engine (MuJoCo and Pinocchio are core dependencies)."""
 

@@ -170,6 +170,9 @@ class Evaluator:
 
     effects: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
     """What its declared defects add to ``values`` (the chunk's states)."""
+    unavailable: dict[str, str] = field(default_factory=dict, repr=False)
+    """Quantity → why its engine does not compute it on this model (its limit, in its
+    words)."""
 
     @property
     def defects(self) -> tuple[str, ...]:
@@ -196,8 +199,11 @@ class Evaluator:
             return
         try:
             values = self.impl.evaluate(s)  # type: ignore[union-attr]
+            unavailable = self.impl.unavailable_quantities() \
+                if isinstance(self.impl, Implementation) else {}
+            self.unavailable.update(unavailable)
             for q, x in values.items():
-                if not np.all(np.isfinite(x)):
+                if q not in unavailable and not np.all(np.isfinite(x)):
                     raise FloatingPointError(f"non-finite {q}")
             self.values = values
             if isinstance(self.impl, Implementation):
@@ -267,6 +273,8 @@ class Status:
     defects: tuple[str, ...] = ()
     """What the implementation's engine is known to do wrong on this model (measured, named
     by its adapter): the evidence a failed row cites."""
+    unavailable: tuple[tuple[str, str], ...] = ()
+    """(quantity, why) where its engine does not compute a quantity on this model."""
 
     @property
     def ok(self) -> bool:
@@ -289,7 +297,9 @@ class Sweep:
             case=self.case,
             stats={k: st.merge(later.stats[k]) for k, st in self.stats.items()},
             condition=max(self.condition, later.condition),
-            status={n: st if st.error else later.status[n] for n, st in self.status.items()},
+            status={n: st if st.error else replace(later.status[n], unavailable=tuple(dict(
+                st.unavailable + later.status[n].unavailable).items()))
+                for n, st in self.status.items()},
         )
 
 
@@ -302,6 +312,10 @@ def _row(
         tol = conditioned(tol, st.sensitivity / st.scale, max(a.eps, b.eps))
     base: dict[str, Any] = dict(case=case, quantity=quantity, impl_a=a.name, impl_b=b.name,
                                 tolerance=tol.rtol, basis=tol.basis)
+    unavailable = [(x.name, why) for x in (a, b) for q, why in x.unavailable if q == quantity]
+    if unavailable and a.ok and b.ok:  # an engine's limit on this model, in its words
+        return Discrepancy.unmeasured(**base, verdict=Verdict.SKIPPED, note="; ".join(
+            f"{name} does not compute it here: {why}" for name, why in unavailable))
     if not (a.ok and b.ok):
         bad = a if not a.ok else b
         return Discrepancy.unmeasured(
@@ -388,7 +402,7 @@ def sweep(
             if va is not None and vb is not None and va != vb:
                 pa, pb = predict(va), predict(vb)
             for q in qs:
-                if (q, a, b) in stats:
+                if (q, a, b) in stats and q not in ea.unavailable and q not in eb.unavailable:
                     desired = ea.values[q]
                     if (a, q) not in scales:
                         scales[a, q] = float(np.abs(desired).max())
@@ -404,7 +418,7 @@ def sweep(
         offset += len(s)
     status = {
         n: Status(name=n, variant=e.variant, eps=e.eps, error=e.error, skipped=e.skipped,
-                  defects=e.defects)
+                  defects=e.defects, unavailable=tuple(e.unavailable.items()))
         for n, e in evals.items()
     }
     return Sweep(case=case.name, stats=stats, condition=condition, status=status)

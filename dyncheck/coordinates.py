@@ -13,9 +13,21 @@ With x̄ = x̄(x) the engine's coordinates as functions of the book's (2.2.2), J
 
 from __future__ import annotations
 
-from typing import Protocol
+from dataclasses import dataclass
+from typing import Any, Protocol
 
 import numpy as np
+
+from dyncheck.adapters import get_adapter
+from dyncheck.adapters.layout import (
+    from_engine,
+    to_engine,
+    velocity_frame_rates,
+    velocity_frames,
+)
+from dyncheck.adapters.model_tree import Layout, StateLayout
+from dyncheck.cases import Case
+from dyncheck.vocabulary import JointType
 
 
 class CoordinateMap(Protocol):
@@ -105,3 +117,63 @@ def bias_to_book(
 ) -> np.ndarray:
     """h = Jᵀ (h̄ + M̄ (∂²x̄/∂x∂x) v v)."""
     return force_to_book(cmap, q, he + _mv(Me, cmap.hessian_term(q, v)))
+
+
+@dataclass(frozen=True)
+class NativeMap:
+    """The case's map followed by the engine's storage of each joint (its
+    :class:`~dyncheck.adapters.model_tree.Layout`, mapped by :mod:`dyncheck.adapters.layout`):
+    quaternion order or chart, a free joint's layout, and the frames (or angle rates) of a
+    rotating joint's velocities, v_native = T v_canonical."""
+
+    base: Any
+    layouts: tuple[Layout, ...]
+    kinds: tuple[JointType, ...]
+
+    @classmethod
+    def of(cls, case: Case, engine: str, base: Any = None,
+           state_layout: StateLayout | None = None) -> NativeMap:
+        """``case``'s map (or ``base``) into the layout ``engine``'s adapter declares (or
+        ``state_layout``)."""
+        kinds = tuple(JointType(j.type) for j in case.multibody().joints)
+        layouts = tuple((state_layout or get_adapter(engine).state_layout).joints(kinds))
+        return cls(case.engine_map() if base is None else base, layouts, kinds)
+
+    @property
+    def description(self) -> str:
+        return self.base.description
+
+    def to_engine(self, q: np.ndarray) -> np.ndarray:
+        return to_engine(self.layouts, self.kinds, self.base.to_engine(q))
+
+    def to_book(self, qn: np.ndarray) -> np.ndarray:
+        return self.base.to_book(from_engine(self.layouts, self.kinds, qn))
+
+    def _frames(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """The canonical engine state of ``q`` and T there (None where T = 1)."""
+        qe = self.base.to_engine(q)
+        return qe, velocity_frames(self.layouts, self.kinds, qe)
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """T J: the case's Jacobian, then the engine's velocity frames."""
+        J = self.base.jacobian(q)
+        T = self._frames(q)[1]
+        return J if T is None else T @ J
+
+    def weight(self, q: np.ndarray) -> np.ndarray | None:
+        """W = T⁻ᵀ T⁻¹: least squares in the canonical coordinates (None where T = 1)."""
+        T = self._frames(q)[1]
+        if T is None:
+            return None
+        Tinv = np.linalg.inv(T)
+        return np.swapaxes(Tinv, -1, -2) @ Tinv
+
+    def hessian_term(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """T H + Ṫ J v: the frames' rotation adds to the (2.2.5)-type term."""
+        H = self.base.hessian_term(q, v)
+        qe, T = self._frames(q)
+        if T is None:
+            return H
+        ve = np.einsum("nij,nj->ni", self.base.jacobian(q), v)
+        rates = velocity_frame_rates(self.layouts, self.kinds, qe, ve, T)
+        return np.einsum("nij,nj->ni", T, H) + rates

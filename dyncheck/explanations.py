@@ -12,7 +12,12 @@ from dataclasses import dataclass
 from enum import Enum
 
 from dyncheck.check.derivative_pairs import DEFECT, READINGS
-from dyncheck.check.predicted import ARMATURE_AXES, BASE_GRAVITY, ROTOR_ENERGY
+from dyncheck.check.predicted import (
+    ARMATURE_AXES,
+    BASE_GRAVITY,
+    COMPUTED_INERTIA,
+    ROTOR_ENERGY,
+)
 from dyncheck.check.readings import READING
 from dyncheck.implementations import (
     ENGINE_DEFECT,
@@ -51,6 +56,20 @@ class Explanation:
 
 
 EXPLANATIONS: dict[str, Explanation] = {
+    COMPUTED_INERTIA: Explanation(
+        origin=Origin.ENGINE,
+        text="PyBullet 3.2.7's spherical joint computes with its child link's principal "
+        "moments taken in the link's own axes: the rotation of the link's inertial frame "
+        "(which its URDF importer finds by diagonalizing the tensor, and holds: "
+        "`getDynamicsInfo`) is dropped, in `calculateMassMatrix` and in `stepSimulation` "
+        "alike — measured to 1e-13 against Euler's equations with diag(moments) on a rigid "
+        "body with products of inertia (`dyncheck explain pybullet-spherical-inertia`). "
+        "The tree declares the inertia it computes with "
+        "(`TreeJoint.computed_inertia`); the general method on that inertia predicts the "
+        "difference per state, and a row is `explained` only where the residual is "
+        "round-off. Fix: align the link's inertial frame with its principal axes (a "
+        "diagonal tensor), or use a revolute chain.",
+    ),
     POINT_INERTIA: Explanation(
         origin=Origin.ENGINE,
         text="MuJoCo's compiler rejects a moving body whose mass or inertia is below mjMINVAL "

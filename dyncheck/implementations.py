@@ -28,21 +28,16 @@ from dyncheck.adapters import (
     get_adapter,
 )
 from dyncheck.adapters.base import Symbolic
-from dyncheck.adapters.layout import (
-    from_engine,
-    to_engine,
-    velocity_frame_rates,
-    velocity_frames,
-)
-from dyncheck.adapters.model_tree import Layout, StateLayout
+from dyncheck.adapters.model_tree import Dynamics
 from dyncheck.cases import Case, StateSample
+from dyncheck.coordinates import NativeMap
 from dyncheck.errors import UnknownName
 from dyncheck.reference.constraints import Softness
 from dyncheck.reference.derivations import derived, lambdified
 from dyncheck.reference.systems import SYSTEMS
 from dyncheck.reference.trajectory import solve
 from dyncheck.roster import IMPLEMENTATIONS
-from dyncheck.vocabulary import INSTANTANEOUS, JointType, Quantity
+from dyncheck.vocabulary import INSTANTANEOUS, Quantity
 
 CACHED = Symbolic(derive=derived, lambdify=lambdified)
 """What an adapter that derives its equations symbolically (sympy-mechanics) is handed: the
@@ -197,6 +192,11 @@ class Implementation(ABC):
         """Book-coordinate velocities of a run :meth:`simulate` made (None: none kept)."""
         return None
 
+    def unavailable_quantities(self) -> dict[str, str]:
+        """Quantity → why its engine does not compute it on this model (its values NaN in
+        :meth:`evaluate`): skipped rows stating the engine's limit in its words."""
+        return self.adapter.unavailable_quantities() if self.adapter is not None else {}
+
 
 class _Equations(Implementation):
     """An implementation backed by numeric book dynamics (printed or general)."""
@@ -244,66 +244,6 @@ class ReferenceImplementation(_Equations):
 
     def _build(self, case: Case) -> Any:
         return general_method(case)
-
-
-@dataclass(frozen=True)
-class NativeMap:
-    """The case's map followed by the engine's storage of each joint (its
-    :class:`~dyncheck.adapters.model_tree.Layout`, mapped by :mod:`dyncheck.adapters.layout`):
-    quaternion order or chart, a free joint's layout, and the frames (or angle rates) of a
-    rotating joint's velocities, v_native = T v_canonical."""
-
-    base: Any
-    layouts: tuple[Layout, ...]
-    kinds: tuple[JointType, ...]
-
-    @classmethod
-    def of(cls, case: Case, engine: str, base: Any = None,
-           state_layout: StateLayout | None = None) -> NativeMap:
-        """``case``'s map (or ``base``) into the layout ``engine``'s adapter declares (or
-        ``state_layout``)."""
-        kinds = tuple(JointType(j.type) for j in case.multibody().joints)
-        layouts = tuple((state_layout or get_adapter(engine).state_layout).joints(kinds))
-        return cls(case.engine_map() if base is None else base, layouts, kinds)
-
-    @property
-    def description(self) -> str:
-        return self.base.description
-
-    def to_engine(self, q: np.ndarray) -> np.ndarray:
-        return to_engine(self.layouts, self.kinds, self.base.to_engine(q))
-
-    def to_book(self, qn: np.ndarray) -> np.ndarray:
-        return self.base.to_book(from_engine(self.layouts, self.kinds, qn))
-
-    def _frames(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-        """The canonical engine state of ``q`` and T there (None where T = 1)."""
-        qe = self.base.to_engine(q)
-        return qe, velocity_frames(self.layouts, self.kinds, qe)
-
-    def jacobian(self, q: np.ndarray) -> np.ndarray:
-        """T J: the case's Jacobian, then the engine's velocity frames."""
-        J = self.base.jacobian(q)
-        T = self._frames(q)[1]
-        return J if T is None else T @ J
-
-    def weight(self, q: np.ndarray) -> np.ndarray | None:
-        """W = T⁻ᵀ T⁻¹: least squares in the canonical coordinates (None where T = 1)."""
-        T = self._frames(q)[1]
-        if T is None:
-            return None
-        Tinv = np.linalg.inv(T)
-        return np.swapaxes(Tinv, -1, -2) @ Tinv
-
-    def hessian_term(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """T H + Ṫ J v: the frames' rotation adds to the (2.2.5)-type term."""
-        H = self.base.hessian_term(q, v)
-        qe, T = self._frames(q)
-        if T is None:
-            return H
-        ve = np.einsum("nij,nj->ni", self.base.jacobian(q), v)
-        rates = velocity_frame_rates(self.layouts, self.kinds, qe, ve, T)
-        return np.einsum("nij,nj->ni", T, H) + rates
 
 
 class EngineImplementation(Implementation):
@@ -382,21 +322,53 @@ class EngineImplementation(Implementation):
 
     def effects(self, s: StateSample) -> dict[str, np.ndarray]:
         """The adapter's predicted defect effects, in the book's coordinates (a force by Jᵀ,
-        an acceleration by the linear part of its map)."""
+        an acceleration by the linear part of its map); an engine that computes with another
+        inertia than it holds (a loader's declared ``computed_inertia``), by the referee on
+        each (:func:`~dyncheck.check.predicted.computed_inertia_effect`)."""
         if not self.defects():
             return {}
         m, q = self.map, s.q
         qe, ve = m.to_engine(q), co.velocity_to_engine(m, q, s.v)
-        raw = self.adapter.defect_effects(
-            qe, ve, co.force_to_engine(m, q, s.tau), co.acceleration_to_engine(m, q, s.v, s.a))
-        out = {}
+        te, ae = co.force_to_engine(m, q, s.tau), co.acceleration_to_engine(m, q, s.v, s.a)
+        raw = self.adapter.defect_effects(qe, ve, te, ae)
+        out = self._inertia_effects(s, te=te, ae=ae)
         for quantity, delta in raw.items():
             if quantity == Quantity.FORWARD_DYNAMICS:
-                out[quantity] = (co.acceleration_to_book(m, q, s.v, delta)
-                                 - co.acceleration_to_book(m, q, s.v, np.zeros_like(delta)))
+                delta = (co.acceleration_to_book(m, q, s.v, delta)
+                         - co.acceleration_to_book(m, q, s.v, np.zeros_like(delta)))
             else:
-                out[quantity] = co.force_to_book(m, q, delta)
+                delta = co.force_to_book(m, q, delta)
+            out[quantity] = out.get(quantity, 0.0) + delta
         return out
+
+    def _inertia_effects(self, s: StateSample, *, te: np.ndarray,
+                         ae: np.ndarray) -> dict[str, np.ndarray]:
+        """What a file loader's engine computing with another inertia than it holds
+        changes, in the book's coordinates (its coordinates are the canonical ones)."""
+        from dyncheck.adapters.model_adapter import ModelAdapter
+        from dyncheck.check.computed import computed_inertia_effect
+
+        if not isinstance(self.adapter, ModelAdapter):
+            return {}
+        m, q, v = self.map, s.q, s.v
+        found = computed_inertia_effect(self.adapter.canon, self.adapter.tree, q=m.to_engine(q),
+                                        v=co.velocity_to_engine(m, q, v), a=ae)
+        if found is None:
+            return {}
+        before, after = found
+
+        def forward(d: Dynamics) -> np.ndarray:
+            return np.linalg.solve(d.mass_matrix, (te - d.bias)[..., None])[..., 0]
+
+        delta_m = after.mass_matrix - before.mass_matrix
+        return {
+            Quantity.MASS_MATRIX: co.mass_matrix_to_book(m, q, delta_m),
+            Quantity.BIAS_FORCES: co.bias_to_book(m, q, v, delta_m, after.bias - before.bias),
+            Quantity.FORWARD_DYNAMICS: co.acceleration_to_book(m, q, v, forward(after))
+            - co.acceleration_to_book(m, q, v, forward(before)),
+            Quantity.INVERSE_DYNAMICS: co.force_to_book(m, q, after.inverse - before.inverse),
+            Quantity.KINETIC_ENERGY: after.kinetic - before.kinetic,
+        }
 
     def engine_start(self) -> tuple[np.ndarray, np.ndarray]:
         """The case's initial state in engine coordinates (q, v)."""

@@ -58,11 +58,7 @@ external field, no integrators stepped: refused with the reason)."""
 MULTI_JOINT_CASES = sorted(
     n for n in CASES if any(len(b.joints) > 1 for b in get_case(n).multibody().bodies))
 """Cases with a body moved by several joints (Newton's MJCF importer fuses them into a D6)."""
-BALL_JOINT_CASES = sorted(
-    n for n in CASES if any(j.type == "ball" for j in get_case(n).multibody().joints))
-"""Cases with a ball joint (PyBullet's loader is checked on hinges, slides and a moving base)."""
-LOADER_LIMITS = {"newton": (MULTI_JOINT_CASES, "D6"),
-                 "pybullet": (BALL_JOINT_CASES, "spherical")}
+LOADER_LIMITS = {"newton": (MULTI_JOINT_CASES, "D6")}
 """A file loader's limit on the book's cases, and the word its refusal names it by."""
 FLOORED = ("mujoco", "pinocchio-mjcf", "drake", *PORTS, *FILE_LOADERS)
 """Engines given the case as a file (MJCF, or URDF for PyBullet), whose point masses carry

@@ -25,21 +25,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters.layout import Canonical
-from dyncheck.adapters.model_tree import Dynamics, JointType, ModelTree
+from dyncheck.adapters.model_tree import QUANTITY_OF, Dynamics, JointType, ModelTree
 from dyncheck.check.describe import depth, size
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
 from dyncheck.results import Verdict
 from dyncheck.vocabulary import Quantity
 
-QUANTITIES: dict[str, str] = {  # the quantity → the field of Dynamics holding it
-    Quantity.MASS_MATRIX: "mass_matrix",
-    Quantity.BIAS_FORCES: "bias",
-    Quantity.FORWARD_DYNAMICS: "forward",
-    Quantity.INVERSE_DYNAMICS: "inverse",
-    Quantity.KINETIC_ENERGY: "kinetic",
-    Quantity.POTENTIAL_ENERGY: "potential",
-}
+QUANTITIES: dict[str, str] = {q: f for f, q in QUANTITY_OF.items()}
+"""The quantity → the field of Dynamics holding it."""
 
 
 @dataclass(frozen=True)
@@ -195,6 +189,34 @@ def _candidates(known: Prediction | None, read: Prediction | None) -> list[Predi
     return out
 
 
+def _round_off(*, eps: float, depth: int, standing: float, vertices: float) -> tuple[float, str]:
+    """A pair's round-off bound and its basis: c ε × the tree's depth × max(1, X/ℓ), plus
+    the inertias' difference where one engine takes them from float32 mesh vertices."""
+    rtol = ROUNDOFF_FACTOR * eps * depth * standing + vertices
+    basis = f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth {depth}"
+    if standing > 1:
+        basis += f" x X/l {standing:.3g} (positions far from the origin)"
+    if vertices:
+        basis += f"; + {vertices:.2g}: one engine's inertia from float32 mesh vertices"
+    return rtol, basis
+
+
+def _unavailable_row(model: str, quantity: str,
+                     *sides: tuple[str, Dynamics]) -> CheckRow | None:
+    """A skipped row naming the engine(s) that do not compute ``quantity`` on this model
+    (their limit, in their words: :attr:`~dyncheck.adapters.model_tree.Dynamics.
+    unavailable`), or None."""
+    unavailable = [(name, why) for name, dyn in sides
+                   for field, why in dyn.unavailable if field == QUANTITIES[quantity]]
+    if not unavailable:
+        return None
+    return CheckRow(
+        model=model, section=Section.DYNAMICS, subject=quantity, field="max rel error",
+        impl_a=sides[0][0], impl_b=sides[1][0], value_a="", value_b="", error=0.0,
+        tolerance=0.0, basis="", verdict=Verdict.SKIPPED,
+        note="; ".join(f"{name} does not compute it here: {why}" for name, why in unavailable))
+
+
 def compare(
     model: str,
     tree: ModelTree,
@@ -229,6 +251,9 @@ def compare(
     rows = []
     for quantity in QUANTITIES:
         desired, actual = values(dyn_a, quantity), values(dyn_b, quantity)
+        if (limit := _unavailable_row(model, quantity, (name_a, dyn_a), (name_b, dyn_b))):
+            rows.append(limit)  # an engine's limit on this model: in its words
+            continue
         if np.isnan(desired).all() or np.isnan(actual).all():
             rows.append(CheckRow(
                 model=model, section=Section.DYNAMICS, subject=quantity, field="max rel error",
@@ -239,12 +264,7 @@ def compare(
         scale = max(float(np.abs(desired).max()), floor, 1e-300)
         errors = np.abs(actual - desired).max(axis=1)
         worst = int(np.argmax(errors))
-        rtol = ROUNDOFF_FACTOR * eps * d * standing + vertices
-        basis = f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth {d}"
-        if standing > 1:
-            basis += f" x X/l {standing:.3g} (positions far from the origin)"
-        if vertices:
-            basis += f"; + {vertices:.2g}: one engine's inertia from float32 mesh vertices"
+        rtol, basis = _round_off(eps=eps, depth=d, standing=standing, vertices=vertices)
         if floor >= float(np.abs(desired).max()) and floor_name:
             basis += f"; scale {floor_name} {floor:.3g} (the value's own is smaller)"
         if quantity == Quantity.FORWARD_DYNAMICS:

@@ -18,10 +18,12 @@ from dyncheck.adapters.model_files import (
 )
 from dyncheck.errors import EngineError, InvalidInput, UnknownName
 
-URDF_JOINTS = ("revolute", "continuous", "prismatic", "fixed", "floating")
-"""The URDF joint types every engine here reads alike (``floating``: a free joint in MuJoCo's
-and Pinocchio's parsers, given as one to Drake, whose parser leaves a free body; ``planar``
-is not: Pinocchio's parser maps it, MuJoCo's refuses or changes it)."""
+URDF_JOINTS = ("revolute", "continuous", "prismatic", "fixed", "floating", "spherical")
+"""The URDF joint types checked (``floating``: a free joint in MuJoCo's and Pinocchio's
+parsers, given as one to Drake, whose parser leaves a free body; ``spherical``, PyBullet's
+extension: a ball joint in PyBullet's and MuJoCo's parsers, refused by Pinocchio's and
+Drake's — their load rows say so; ``planar`` is not checked: Pinocchio's parser maps it,
+MuJoCo's refuses or changes it)."""
 MAX_STATES = 100_000
 ROBOTS_EXTRA = "example-robot-data"
 

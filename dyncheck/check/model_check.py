@@ -394,7 +394,11 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
 
 
 def _non_finite(dyn: Dynamics) -> list[str]:
-    return [f for f, value in vars(dyn).items() if not np.all(np.isfinite(value))]
+    """The fields with a non-finite value but those the engine said it failed to compute
+    (their rows say so in its words)."""
+    unavailable = {f for f, _ in dyn.unavailable}
+    return [f for f in QUANTITIES.values()
+            if f not in unavailable and not np.all(np.isfinite(getattr(dyn, f)))]
 
 
 def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch: States,

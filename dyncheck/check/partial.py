@@ -69,7 +69,7 @@ def restrict(dyn: Dynamics, columns: np.ndarray) -> Dynamics:
     return Dynamics(
         mass_matrix=dyn.mass_matrix[:, columns][:, :, columns], bias=dyn.bias[:, columns],
         forward=dyn.forward[:, columns], inverse=dyn.inverse[:, columns], kinetic=nan,
-        potential=nan,
+        potential=nan, unavailable=dyn.unavailable,
     )
 
 

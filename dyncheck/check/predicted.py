@@ -19,8 +19,9 @@ from dyncheck.adapters.model_tree import (
     reversed_rpy,
 )
 from dyncheck.cases.coordinate_maps import quat_to_matrix
-from dyncheck.check.dynamics import Prediction, States
-from dyncheck.check.readings import READING, canonical_armature
+from dyncheck.check.computed import canonical_armature, computed_inertia_effect
+from dyncheck.check.dynamics import Prediction, States, values
+from dyncheck.check.readings import READING
 from dyncheck.check.referee import ReferenceModel
 from dyncheck.vocabulary import Quantity
 
@@ -31,7 +32,11 @@ BASE_GRAVITY = "floating base's gravity resolved through reversed roll-pitch-yaw
 ARMATURE_AXES = "armature added in the engine's own velocity coordinates"
 """An engine adds a joint's armature A to its own equations, A v̇_e, with v_e = T v in axes
 that turn with the body (Pinocchio's free flyer: the linear velocity in body axes)."""
-PREDICTIONS = (ROTOR_ENERGY, BASE_GRAVITY, ARMATURE_AXES, READING)
+COMPUTED_INERTIA = "inertia computed with otherwise than held (a measured engine defect)"
+"""An engine's dynamics take a body's inertia otherwise than the tensor it holds (PyBullet's
+spherical joint: the link's principal moments in the link's axes, its inertial frame's
+rotation dropped): :attr:`~dyncheck.adapters.model_tree.TreeJoint.computed_inertia`."""
+PREDICTIONS = (ROTOR_ENERGY, BASE_GRAVITY, ARMATURE_AXES, READING, COMPUTED_INERTIA)
 """Every label a check's prediction carries (each registered in ``EXPLANATIONS``)."""
 
 
@@ -45,6 +50,8 @@ def differences(canon: Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
     for tree, sign in ((tree_b, 1.0), (tree_a, -1.0)):
         out |= base_gravity(canon, canonical_tree, tree, states, dyn_a, sign)
     armature = armature_axes(canon, tree_a, tree_b, states, dyn_a)
+    for tree, sign in ((tree_b, 1.0), (tree_a, -1.0)):
+        armature = _added(armature, inertia_computed(canon, tree, states, sign))
     for quantity, prediction in armature.items():
         mine = out.get(quantity)
         if mine is not None and mine.size.ndim == prediction.size.ndim:  # both act: they add
@@ -183,3 +190,34 @@ def base_gravity(canon: Canonical, canonical_tree: ModelTree, tree: ModelTree,
     return {Quantity.BIAS_FORCES: Prediction(size=delta, note=note, label=BASE_GRAVITY),
             Quantity.INVERSE_DYNAMICS: Prediction(size=delta, note=note, label=BASE_GRAVITY),
             Quantity.FORWARD_DYNAMICS: Prediction(size=forward, note=note, label=BASE_GRAVITY)}
+
+
+def _added(mine: dict[str, Prediction], more: dict[str, Prediction]) -> dict[str, Prediction]:
+    """Two sets of predictions of the same pair, summed where both act."""
+    out = dict(mine)
+    for quantity, prediction in more.items():
+        had = out.get(quantity)
+        out[quantity] = prediction if had is None else replace(
+            had, size=had.size + prediction.size, note=f"{had.note}; and {prediction.note}")
+    return out
+
+
+def inertia_computed(canon: Canonical, tree: ModelTree, states: States,
+                     sign: float) -> dict[str, Prediction]:
+    """Where ``tree``'s engine computes with another inertia than it holds: every quantity's
+    predicted difference per state (:func:`computed_inertia_effect`; ``sign`` +1 where the
+    engine is the pair's second)."""
+    found = computed_inertia_effect(canon, tree, q=states.q, v=states.v, a=states.a)
+    if found is None:
+        return {}
+    before, after = found
+    named = ", ".join(repr(j.name) for j in tree.joints if j.computed_inertia is not None)
+    note = (f"{tree.engine}'s dynamics take the inertia of {named} otherwise than it holds "
+            "it (its link's principal moments in the link's axes, the inertial frame's "
+            "rotation dropped; measured): predicted per state by the general method on the "
+            "inertia it computes with")
+    return {quantity: Prediction(size=sign * (values(after, quantity) - values(before, quantity)),
+                                 note=note, label=COMPUTED_INERTIA)
+            for quantity in (Quantity.MASS_MATRIX, Quantity.BIAS_FORCES,
+                             Quantity.FORWARD_DYNAMICS, Quantity.INVERSE_DYNAMICS,
+                             Quantity.KINETIC_ENERGY)}

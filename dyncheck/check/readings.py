@@ -17,11 +17,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from dyncheck.adapters.base import ModelEngine
-from dyncheck.adapters.model_tree import Dynamics, JointType, ModelTree, TreeJoint
+from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import partial
+from dyncheck.check.computed import bodies, canonical_armature
 from dyncheck.check.describe import placement
 from dyncheck.check.dynamics import QUANTITIES, Prediction, States, values
-from dyncheck.check.referee import TIE_STATES, ReferenceModel, bodies
+from dyncheck.check.referee import TIE_STATES, ReferenceModel
 from dyncheck.reference.recursive import RecursiveDynamics
 
 READING = "engines read the model differently (measured by the referee on each reading)"
@@ -29,15 +30,6 @@ READING = "engines read the model differently (measured by the referee on each r
 
 SUBSTITUTED = ("axis", "anchor", "mass", "com", "inertia", "armature")
 """The joint fields a substitution moves one at a time (with ``gravity`` and ``placement``)."""
-
-
-def canonical_armature(joint: TreeJoint) -> tuple[float, ...]:
-    """A joint's armature in the canonical order of its velocities (a free joint's linear
-    then angular; an engine holding the angular first declares it in its layout)."""
-    arm = tuple(joint.armature)
-    if joint.type is JointType.FREE and joint.layout.angular_first and len(arm) == 6:
-        return arm[3:] + arm[:3]
-    return arm
 
 
 def own_tree(canonical_tree: ModelTree, tree: ModelTree) -> ModelTree | None:
@@ -54,7 +46,8 @@ def own_tree(canonical_tree: ModelTree, tree: ModelTree) -> ModelTree | None:
         if mine.type is not theirs.type or mine.parent != theirs.parent:
             return None
         joints.append(replace(mine, layout=theirs.layout, armature=canonical_armature(mine),
-                              rotor_in_kinetic=True, gravity_frame=theirs.gravity_frame))
+                              rotor_in_kinetic=True, gravity_frame=theirs.gravity_frame,
+                              computed_inertia=None))
     return replace(tree, joints=tuple(joints), nq=canonical_tree.nq, nv=canonical_tree.nv)
 
 

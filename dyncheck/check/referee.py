@@ -20,10 +20,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
+from dyncheck.check.computed import bodies
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, standing
 from dyncheck.reference.recursive import RecursiveDynamics
-from dyncheck.reference.tree import Body, TreeDynamics
+from dyncheck.reference.tree import TreeDynamics
 from dyncheck.results import Verdict
 
 ENGINE = "reference"
@@ -31,18 +32,6 @@ TIE_STATES = 10
 """States at which the recursive algorithm is tied to the general method on every tree."""
 GENERAL = "reference (general method)"
 RECURSIVE = "reference (recursive)"
-
-
-def bodies(tree: ModelTree) -> list[Body]:
-    index = {j.name: i for i, j in enumerate(tree.joints)}
-    return [
-        Body(
-            kind=str(j.type), parent=-1 if j.parent is None else index[j.parent],
-            axis=j.axis, anchor=j.anchor, frame=j.frame, zero=j.layout.zero, mass=j.mass,
-            com=j.com, inertia=j.inertia, armature=j.armature,
-        )
-        for j in tree.joints
-    ]
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -13,8 +13,9 @@ from dyncheck.adapters.model_tree import StateLayout
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.comparison import compare_instantaneous
+from dyncheck.coordinates import NativeMap
 from dyncheck.explanations import Origin
-from dyncheck.implementations import EngineImplementation, NativeMap, make_implementation
+from dyncheck.implementations import EngineImplementation, make_implementation
 from dyncheck.vocabulary import Verdict
 
 

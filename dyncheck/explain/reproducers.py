@@ -152,6 +152,48 @@ print(f"observed position {observed.round(6).tolist()}")
 sys.exit(0 if gap <= 1e-5 else 1)  # float32 positions of size 1
 '''
 
+_PYBULLET_SPHERICAL = '''\
+"""PyBullet's spherical joint drops the rotation of its link's inertial frame: a rigid body
+with products of inertia, spun about its fixed centre of mass, accelerates as if its
+principal moments lay along the link's axes. Expected: Euler's equations with the stated
+tensor, w_dot = I^-1 (-w x I w). Exits 1 while the defect stands."""
+import os
+import sys
+import tempfile
+
+import numpy as np
+import pybullet as pb
+
+URDF = """<robot name="spinning"><link name="world"/>
+<link name="body"><inertial><mass value="2.0"/><inertia ixx="0.9" ixy="0.1" ixz="-0.05"
+iyy="1.4" iyz="0.08" izz="2.0"/></inertial></link>
+<joint name="ball" type="spherical"><parent link="world"/><child link="body"/></joint>
+</robot>"""
+TENSOR = np.array([[0.9, 0.1, -0.05], [0.1, 1.4, 0.08], [-0.05, 0.08, 2.0]])
+OMEGA = np.array([0.7, -1.3, 0.9])
+DT = 1e-4
+
+client = pb.connect(pb.DIRECT)
+with tempfile.TemporaryDirectory() as folder:
+    path = os.path.join(folder, "spinning.urdf")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(URDF)
+    body = pb.loadURDF(path, useFixedBase=True, flags=pb.URDF_USE_INERTIA_FROM_FILE)
+pb.setTimeStep(DT)
+pb.changeDynamics(body, 0, linearDamping=0.0, angularDamping=0.0)
+pb.setJointMotorControlMultiDof(body, 0, pb.POSITION_CONTROL, targetPosition=[0, 0, 0, 1],
+                                positionGain=0.0, velocityGain=0.0, force=[0.0] * 3)
+pb.resetJointStateMultiDof(body, 0, [0, 0, 0, 1], list(OMEGA))
+pb.stepSimulation()
+observed = (np.array(pb.getJointStateMultiDof(body, 0)[1]) - OMEGA) / DT
+expected = np.linalg.solve(TENSOR, -np.cross(OMEGA, TENSOR @ OMEGA))
+gap = float(np.abs(observed - expected).max() / np.abs(expected).max())
+print(f"pybullet {pb.getAPIVersion()}; held principal moments {pb.getDynamicsInfo(body, 0)[2]}")
+print(f"expected w_dot {expected.round(6).tolist()} (Euler's equations, the stated tensor)")
+print(f"observed w_dot {observed.round(6).tolist()} (one stepSimulation)")
+sys.exit(0 if gap <= 1e-8 else 1)
+'''
+
 REPRODUCERS: dict[str, Reproducer] = {
     "pinocchio-mjcf-options": Reproducer(
         engine="pinocchio", imports=frozenset({"numpy", "pinocchio"}),
@@ -161,6 +203,9 @@ REPRODUCERS: dict[str, Reproducer] = {
         script=_PINOCCHIO_COMPOSITE),
     "newton-several-joints-on-a-body": Reproducer(
         engine="newton", imports=frozenset({"numpy", "newton", "warp"}), script=_NEWTON_D6),
+    "pybullet-spherical-inertia": Reproducer(
+        engine="pybullet", imports=frozenset({"numpy", "pybullet"}),
+        script=_PYBULLET_SPHERICAL),
 }
 """Catalogue entry → its reproducer: the entries whose difference is an engine's defect (a
 documented input it drops, a derivative it gets wrong), not a convention it documents."""

@@ -21,8 +21,8 @@ from dyncheck.adapters import MODELS, RUN, get_adapter
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases import Case
+from dyncheck.coordinates import NativeMap
 from dyncheck.errors import EngineNotInstalled
-from dyncheck.implementations import NativeMap
 from dyncheck.results import Discrepancy
 from dyncheck.vocabulary import Verdict
 

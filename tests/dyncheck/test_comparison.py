@@ -296,7 +296,7 @@ def test_free_body_velocity_frame_ignored_is_caught():
     (v_world, ω_body) — the case's canonical state with the quaternion reordered but no
     frame change — must fail (M and T, rotation-invariant, cannot see it), and the correct
     map (T = diag(Rᵀ, 1), Ṫ v) must pass."""
-    from dyncheck.implementations import NativeMap
+    from dyncheck.coordinates import NativeMap
 
     case = get_case("rigid_body_free")
 
@@ -332,3 +332,29 @@ def test_drake_with_a_wrong_cord_is_caught(case_name):
     failed = {r.quantity for r in rows if r.verdict == "failed"}
     assert {"forward_dynamics", "constraint_force"} <= failed
     assert "mass_matrix" not in failed
+
+
+def test_a_quantity_an_engine_does_not_compute_is_its_limit_in_its_words():
+    """An engine that does not compute one quantity on a model (PyBullet's h on a spherical
+    joint) costs that quantity's rows only: skipped, stating its limit; the others are
+    measured as usual (here the reference against itself: passed)."""
+    from dyncheck.implementations import ReferenceImplementation
+
+    case = get_case("simple_pendulum")
+    why = "its inverse dynamics raise on this model"
+
+    class NoBias(ReferenceImplementation):
+        def evaluate(self, sample):
+            out = super().evaluate(sample)
+            out["bias_forces"] = np.full_like(out["bias_forces"], np.nan)
+            return out
+
+        def unavailable_quantities(self):
+            return {"bias_forces": why}
+
+    impls = {"reference": make_implementation("reference", case), "mujoco": NoBias(case)}
+    rows = {r.quantity: r for r in compare_instantaneous(case, impls, case.sample_states())}
+    assert rows["bias_forces"].verdict == "skipped"
+    assert rows["bias_forces"].note == f"mujoco does not compute it here: {why}"
+    others = [r for q, r in rows.items() if q != "bias_forces"]
+    assert others and all(r.verdict == "passed" for r in others)
