@@ -13,9 +13,16 @@ float32). M = ``calculateMassMatrix``, h = ``calculateInverseDynamics`` at v̇ =
 dynamics ``calculateInverseDynamics`` — which apply no joint damping (read back as a field);
 forward dynamics M⁻¹(−h); PyBullet computes no energies, so T = ½ vᵀ M v from its M and
 V = −Σ mᵢ g·xᵢ from its centres of mass (the definitions MuJoCo's ``mj_energyVel`` and
-``mj_energyPos`` use). Hinges, slides and a moving base (a spherical or planar joint: a
-skipped row naming it). A multibody per top-level body of an MJCF, their coordinates in the
-order loaded.
+``mj_energyPos`` use). Hinges, slides, spherical joints and a moving base (a planar joint:
+a skipped row naming it). A multibody per top-level body of an MJCF, their coordinates in
+the order loaded.
+
+A spherical joint: q = quaternion x-y-z-w, ω in the child link's axes (measured). Its
+``calculateInverseDynamics`` does not take a multibody with one (``NO_INVERSE``: h and the
+inverse dynamics are its stated limit, ``Dynamics.unavailable``); the forward dynamics come
+from one ``stepSimulation`` (:meth:`PybulletModel.forward`); and its dynamics take the link's
+principal moments in the link's axes, dropping the inertial frame's rotation — declared on
+the tree (``TreeJoint.computed_inertia``) so that the check predicts what that changes.
 
 A moving base (``--floating``; an MJCF's free body): PyBullet's state holds the pose of its
 centre-of-mass frame (:attr:`~dyncheck.adapters.model_tree.Layout.offset`), q = (p, quat
