@@ -316,7 +316,8 @@ class MujocoModel(ModelEngine):
             d.qacc[:] = a[i]
             mujoco.mj_inverse(m, d)
             out["inverse"][i] = d.qfrc_inverse
-        return Dynamics(mass_matrix=mass, kinetic=kinetic, potential=potential, **out)
+        return Dynamics(mass_matrix=mass, bias=out["bias"], forward=out["forward"],
+                        inverse=out["inverse"], kinetic=kinetic, potential=potential)
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
         """``mjd_inverseFD`` (one-sided differences of ``mj_inverse``, step

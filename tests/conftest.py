@@ -69,6 +69,19 @@ ENGINES = [e for e in ALL_ENGINES if e not in COUPLINGS_ONLY_ENGINES]
 """The engines every case runs in (where supported)."""
 
 
+NO_INVERSE = "calculateInverseDynamics does not take a multibody with a spherical joint"
+"""PyBullet's stated limit on a ball-joint case: its h and inverse dynamics (skipped rows)."""
+
+
+def quantity_limit(case: str, engine: str, quantity: str) -> str | None:
+    """The words a skipped row of ``quantity`` must contain where ``engine`` does not compute
+    it on ``case`` (its stated limit), or None."""
+    if engine == "pybullet" and case in BALL_CASES and quantity in ("bias_forces",
+                                                                     "inverse_dynamics"):
+        return NO_INVERSE
+    return None
+
+
 def supported(case: str, engine: str) -> bool:
     return unsupported_reason(case, engine) is None
 

@@ -25,7 +25,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from dyncheck.adapters import layout
+from dyncheck.adapters import layout, layout_batch
 from dyncheck.adapters.model_files import read
 from dyncheck.adapters.mujoco_model import MujocoModel
 from dyncheck.adapters.pinocchio_model import PinocchioModel
@@ -51,7 +51,7 @@ states = sample(canon, mujoco_box.tree, 10, 0)
 
 # %%
 mj = mujoco_box.derivatives(states.q, states.v, states.a)
-_, q, v, a = layout.engine_states(canon, pinocchio_box.tree, states.q, states.v, states.a)
+_, q, v, a = layout_batch.engine_states(canon, pinocchio_box.tree, states.q, states.v, states.a)
 pin_raw = pinocchio_box.derivatives(q, v, a)
 np.set_printoptions(precision=3, suppress=True, linewidth=110)
 print("MuJoCo    ∂v̇/∂q\n", mj.forward_q[0])

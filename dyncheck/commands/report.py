@@ -18,7 +18,7 @@ SHOWN = 20
 
 
 def report_command(args: argparse.Namespace) -> int:
-    from dyncheck import freshness, report
+    from dyncheck import report, report_check
     from dyncheck.run import resolve, run
 
     positive("--jobs", args.jobs)
@@ -28,20 +28,20 @@ def report_command(args: argparse.Namespace) -> int:
         if folder is not None and not (folder / "discrepancies.csv").is_file():
             raise InvalidInput(flag, str(folder), "a report folder written by `dyncheck run` "
                                "(it has no discrepancies.csv)")
-    committed = freshness.read_report(args.out)
+    committed = report_check.read_report(args.out)
     if args.run_dir is not None:
-        fresh = freshness.read_report(args.run_dir)
-        ran = freshness.ran_in(args.run_dir)
+        fresh = report_check.read_report(args.run_dir)
+        ran = report_check.ran_in(args.run_dir)
     else:
         cases, impls = resolve([], [], accelerators=args.accelerators)
         result = run(cases, impls, jobs=args.jobs, dask=args.dask, conventions=True)
         fresh, ran = report.rendered_text(result, args.out), list(result.ran)
-    old, new, left_out = (committed, fresh, []) if ran is None else freshness.narrowed(
+    old, new, left_out = (committed, fresh, []) if ran is None else report_check.narrowed(
         committed, fresh, ran)
     if left_out:
         print(f"not run here: {', '.join(left_out)}: their rows of {args.out} and the pages "
               "(each sums up every implementation) not compared")
-    moved = freshness.compare(old, new)
+    moved = report_check.compare(old, new)
     for m in moved[:SHOWN]:
         print(f"moved: {m}")
     if len(moved) > SHOWN:

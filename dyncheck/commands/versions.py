@@ -14,7 +14,7 @@ from dyncheck.workers import default_jobs
 
 def versions_command(args: argparse.Namespace) -> int:
     """Exit 0 (the matrix reports moves; it does not judge them)."""
-    from dyncheck import matrix
+    from dyncheck import versions
     from dyncheck.cases import get_case
     from dyncheck.explain.releases import EXPLANATIONS
     from dyncheck.results import write_atomic
@@ -24,20 +24,20 @@ def versions_command(args: argparse.Namespace) -> int:
         get_case(name)
     if args.bisect is not None:
         name, good, bad = args.bisect
-        first, moved = matrix.bisect(name, good, bad, cases=args.case, jobs=args.jobs,
+        first, moved = versions.bisect(name, good, bad, cases=args.case, jobs=args.jobs,
                                      log=log)
         print(f"first release that moved: {name} {first} ({len(moved)} rows)")
         print(moved.to_string(index=False))
         return 0
-    names = args.engine or list(matrix.ENGINES)
+    names = args.engine or list(versions.ENGINES)
     for name in names:
-        matrix.engine(name)
+        versions.engine(name)
     check_out_file("--out", args.out)
-    releases = sum(len(matrix.engine(name).releases) for name in names)
+    releases = sum(len(versions.engine(name).releases) for name in names)
     with Progress("versions", releases, quiet=args.quiet) as progress:
-        steps = matrix.matrix(names, cases=args.case, jobs=args.jobs, log=log,
+        steps = versions.matrix(names, cases=args.case, jobs=args.jobs, log=log,
                               reuse=args.reuse, progress=progress)
-    write_atomic(args.out, matrix.page(steps, notes=EXPLANATIONS))
+    write_atomic(args.out, versions.page(steps, notes=EXPLANATIONS))
     print(f"version matrix written to {args.out}")
     return 0
 

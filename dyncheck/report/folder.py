@@ -6,7 +6,6 @@ from __future__ import annotations
 from datetime import UTC, datetime
 from pathlib import Path
 
-from dyncheck.freshness import RAN, Moved, compare, narrowed, read_report
 from dyncheck.provenance import versions
 from dyncheck.report.figures import figures
 from dyncheck.report.pages import case_page, conventions_page, errata, index_page
@@ -14,6 +13,7 @@ from dyncheck.report.tables import (
     conservation_table,
     md,
 )
+from dyncheck.report_check import RAN, Moved, compare, narrowed, read_report
 from dyncheck.results import PROVENANCE, provenance_json, to_csv, write_together
 from dyncheck.run import RunResult
 
@@ -75,9 +75,9 @@ def rendered_text(result: RunResult, out: Path) -> dict[str, str]:
 
 def check(result: RunResult, out: Path) -> list[Moved]:
     """What moved between the committed report in ``out`` and what the code computes now,
-    compared on results, not bytes (:mod:`dyncheck.freshness`); a run of fewer
+    compared on results, not bytes (:mod:`dyncheck.report_check`); a run of fewer
     implementations than the report holds is compared on its own rows
-    (:func:`~dyncheck.freshness.narrowed`)."""
+    (:func:`~dyncheck.report_check.narrowed`)."""
     old, new, _ = narrowed(read_report(out), rendered_text(result, out), result.ran)
     return compare(old, new)
 

@@ -40,9 +40,9 @@ def test_full_default_run_has_no_failed_row_and_skips_only_with_a_stated_reason(
     """Nothing fails; every skipped row states a limit of an engine or of its loader: the
     ports' (a field evaluated at every stage — no mjcb_passive in MJX or MuJoCo Warp —, Warp's
     CPU step budget, Warp's derivatives: none), the file loaders' (Newton,
-    PyBullet: couplings, an external field, Newton's D6, PyBullet's spherical joint, a
-    rotation's trajectory not mapped back, no derivatives); Pinocchio's composite-joint
-    derivatives are explained by its declared defect, never skipped. RK4's step on a
+    PyBullet: couplings, an external field, Newton's D6, PyBullet's inverse dynamics on a
+    spherical joint, a rotation's trajectory not mapped back, no derivatives); Pinocchio's
+    composite-joint derivatives are explained by its declared defect, never skipped. RK4's step on a
     rotation is refereed (its Munthe-Kaas stages): passed on the four cases with a ball or
     free joint; so is implicitfast's on the standalone free body (its block solved with
     M + h ∂h/∂v, the referee's implicit step differentiated by Richardson extrapolation)."""
@@ -55,7 +55,8 @@ def test_full_default_run_has_no_failed_row_and_skips_only_with_a_stated_reason(
         "couplings": "couplings (tendon equalities) are constraints",
         "external field": "an external field (a force on a body) is not an input",
         "D6": "fused the joints of one body into a D6 joint",
-        "spherical": "joint type spherical",
+        "inverse dynamics": "calculateInverseDynamics does not take a multibody with a "
+        "spherical joint",
         "map back": "trajectory is not mapped back",
         "no derivatives": "offers no derivatives",
     }

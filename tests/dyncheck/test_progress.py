@@ -55,15 +55,15 @@ def test_versions_reports_one_line_per_release_and_quiet_silences_it(tmp_path, c
                                                                      monkeypatch):
     """Each engine release run (faked here: the matrix's own diffing on two stored runs)
     is a unit of ``versions``' progress, on stderr; the page on stdout only names the file."""
-    from dyncheck import matrix
+    from dyncheck import versions
 
-    from .test_matrix import _run
+    from .test_versions import _run
 
     runs = {r: _run(tmp_path / r, 1e-16, r) for r in ("1.0", "1.1")}
-    engine = matrix.engine("mujoco")
-    monkeypatch.setattr(matrix, "engine", lambda name: type(engine)(
+    engine = versions.engine("mujoco")
+    monkeypatch.setattr(versions, "engine", lambda name: type(engine)(
         **{**engine.__dict__, "releases": ("1.0", "1.1")}))
-    monkeypatch.setattr(matrix, "run_release", lambda eng, r, **kw: runs[r])
+    monkeypatch.setattr(versions, "run_release", lambda eng, r, **kw: runs[r])
     args = ["versions", "--engine", "mujoco", "--out", str(tmp_path / "v.md")]
     assert main(args) == 0
     out, err = capsys.readouterr()

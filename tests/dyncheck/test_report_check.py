@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from dyncheck import freshness
+from dyncheck import report_check
 from dyncheck.cli import main
 from dyncheck.results import to_csv
 
@@ -24,7 +24,7 @@ EPS = float(np.finfo(float).eps)
 
 @pytest.fixture(scope="module")
 def committed() -> dict[str, str]:
-    return freshness.read_report(REPORTS)
+    return report_check.read_report(REPORTS)
 
 
 def _frame(text: str) -> pd.DataFrame:
@@ -65,7 +65,7 @@ def other_machine(report: dict[str, str], seed: int = 0) -> dict[str, str]:
 def test_round_off_of_another_machine_passes(committed):
     perturbed = other_machine(committed)
     assert perturbed["discrepancies.csv"] != committed["discrepancies.csv"]
-    assert freshness.compare(committed, perturbed) == []
+    assert report_check.compare(committed, perturbed) == []
 
 
 def _edit(report: dict[str, str], name: str, edit) -> dict[str, str]:
@@ -85,7 +85,7 @@ def test_one_changed_verdict_fails(committed):
     def edit(d):
         d.loc[_first(d, verdict="passed"), "verdict"] = "failed"
 
-    moved = freshness.compare(committed, _edit(committed, "discrepancies.csv", edit))
+    moved = report_check.compare(committed, _edit(committed, "discrepancies.csv", edit))
     assert [m.field for m in moved] == ["verdict"]
 
 
@@ -95,12 +95,12 @@ def test_one_order_moved_by_a_tenth_fails(committed):
         i = int(np.flatnonzero(read.fillna(False).to_numpy(bool))[0])
         c.loc[i, "observed_order"] += 0.1
 
-    moved = freshness.compare(committed, _edit(committed, "convergence.csv", edit))
+    moved = report_check.compare(committed, _edit(committed, "convergence.csv", edit))
     assert [m.field for m in moved] == ["observed_order"]
 
 
 def test_removed_row_fails(committed):
-    moved = freshness.compare(
+    moved = report_check.compare(
         committed, _edit(committed, "discrepancies.csv", lambda d: d.drop(index=3))
     )
     assert [(m.field, m.new) for m in moved] == [("row", "vanished")]
@@ -113,21 +113,22 @@ def test_explained_difference_moved_by_one_percent_fails(committed):
         i = _first(d, verdict="explained", quantity="constraint_force")
         d.loc[i, ["max_rel_err", "max_abs_err"]] *= 1.01
 
-    moved = freshness.compare(committed, _edit(committed, "discrepancies.csv", edit))
+    moved = report_check.compare(committed, _edit(committed, "discrepancies.csv", edit))
     assert {m.field for m in moved} == {"max_rel_err", "max_abs_err"}
 
 
 def test_changed_page_word_and_number_fail(committed):
     page = committed["README.md"]
-    assert freshness.compare(committed, {**committed, "README.md": page.replace("passed", "x", 1)})
+    worded = page.replace("passed", "x", 1)
+    assert report_check.compare(committed, {**committed, "README.md": worded})
     bumped = re.sub(r"\b(1\.000)\b", "1.100", page, count=1)
     assert bumped != page
-    assert freshness.compare(committed, {**committed, "README.md": bumped})
+    assert report_check.compare(committed, {**committed, "README.md": bumped})
 
 
 def test_missing_page_fails(committed):
     fewer = {k: v for k, v in committed.items() if k != "printed-equations.md"}
-    moved = freshness.compare(committed, fewer)
+    moved = report_check.compare(committed, fewer)
     assert [(m.file, m.new) for m in moved] == [("printed-equations.md", "not written")]
 
 
@@ -135,7 +136,7 @@ def test_check_from_a_run_folder_on_another_machine(tmp_path, capsys):
     """`report --check --from DIR` compares two folders without running anything."""
     run_dir = tmp_path / "run"
     shutil.copytree(REPORTS, run_dir)
-    for name, text in other_machine(freshness.read_report(REPORTS), seed=1).items():
+    for name, text in other_machine(report_check.read_report(REPORTS), seed=1).items():
         (run_dir / name).write_text(text)
     assert main(["report", "--check", "--from", str(run_dir)]) == 0
     assert "up to date" in capsys.readouterr().out
@@ -207,7 +208,7 @@ def test_check_refuses_a_missing_folder_before_any_work(tmp_path, flag, capsys):
 
 F32_FLOOR = 64 * float(np.finfo(np.float32).eps) * 16_000
 """64 ε₃₂ × the longest run's 16 000 steps (torque_free, 4 s at 0.25 ms): derived here from
-the run's own bound for a float32 trajectory, independently of freshness.py."""
+the run's own bound for a float32 trajectory, independently of report_check.py."""
 
 
 def _clear_of_noise(c: pd.DataFrame, impl: str) -> int:
@@ -227,11 +228,11 @@ def _move_error(impl: str, factor: float):
 def test_a_float32_run_moved_within_its_round_off_passes(committed):
     """Two CPUs round a float32 (MJX) run differently: its error moves within 64 ε₃₂ N."""
     edited = _edit(committed, "convergence.csv", _move_error("mjx", 1.7))
-    assert freshness.compare(committed, edited) == []
+    assert report_check.compare(committed, edited) == []
 
 
 def test_the_same_move_of_a_float64_run_fails(committed):
-    moved = freshness.compare(
+    moved = report_check.compare(
         committed, _edit(committed, "convergence.csv", _move_error("mujoco", 1.7))
     )
     assert [m.field for m in moved] == ["error"]
@@ -241,7 +242,7 @@ def test_a_float32_run_moved_beyond_its_round_off_fails(committed):
     def edit(c):
         c.loc[_clear_of_noise(c, "mjx"), "error"] += 2 * F32_FLOOR
 
-    moved = freshness.compare(committed, _edit(committed, "convergence.csv", edit))
+    moved = report_check.compare(committed, _edit(committed, "convergence.csv", edit))
     assert [m.field for m in moved] == ["error"]
 
 
@@ -256,7 +257,7 @@ def test_a_tolerance_from_an_error_estimate_agrees_to_the_estimates_accuracy(
         rows = d[d.tolerance_basis.fillna("").str.contains("estimate") & (d.tolerance > 1e-9)]
         d.loc[rows.index[0], "tolerance"] *= factor
 
-    moved = freshness.compare(committed, _edit(committed, "discrepancies.csv", edit))
+    moved = report_check.compare(committed, _edit(committed, "discrepancies.csv", edit))
     assert [m.field for m in moved] == (["tolerance"] if fails else [])
 
 
@@ -267,7 +268,7 @@ def test_a_round_off_tolerance_moved_by_five_percent_fails(committed):
         rows = d[d.tolerance_basis.fillna("").str.startswith("round-off: 64 eps x cond")]
         d.loc[rows.index[0], "tolerance"] *= 1.05
 
-    moved = freshness.compare(committed, _edit(committed, "discrepancies.csv", edit))
+    moved = report_check.compare(committed, _edit(committed, "discrepancies.csv", edit))
     assert [m.field for m in moved] == ["tolerance"]
 
 
@@ -288,14 +289,14 @@ def test_a_page_compares_an_observed_order_only_in_the_asymptotic_range(
     cells = row.split("|")
     cells[5] = cells[5].replace(cells[5].strip(), f"{float(cells[5]) + 0.5:.3g}")
     edited = {**committed, "atwood.md": page.replace(row, "|".join(cells))}
-    moved = freshness.compare(committed, edited)
+    moved = report_check.compare(committed, edited)
     assert [m.file for m in moved] == (["atwood.md"] if fails else [])
 
 
 def test_a_page_number_of_a_float32_implementation_is_compared_at_float32():
     header = "| pair | atwood |\n|:--|:--|\n"
     old = {"x.md": header + "| mujoco vs mjx | passed 8.2e-07 |\n"}
-    assert freshness.compare(old, {"x.md": old["x.md"].replace("8.2e-07", "6.9e-07")}) == []
+    assert report_check.compare(old, {"x.md": old["x.md"].replace("8.2e-07", "6.9e-07")}) == []
     f64 = {"x.md": header + "| mujoco vs mjx-f64 | passed 8.2e-07 |\n"}
-    moved = freshness.compare(f64, {"x.md": f64["x.md"].replace("8.2e-07", "6.9e-07")})
+    moved = report_check.compare(f64, {"x.md": f64["x.md"].replace("8.2e-07", "6.9e-07")})
     assert [m.field for m in moved] == ["number 8.2e-07 -> 6.9e-07"]

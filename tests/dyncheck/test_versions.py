@@ -11,11 +11,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from dyncheck import diff, matrix
+from dyncheck import diff, versions
 from dyncheck.adapters import REGISTRY
 from dyncheck.errors import InvalidInput, UnknownName
-from dyncheck.matrix import ENGINES, constraints
 from dyncheck.results import PROVENANCE, to_csv
+from dyncheck.versions import ENGINES, constraints
 
 CONSTRAINTS = "numpy==2.4.6\nmujoco==4.0.0\nmujoco-core==4.0.0\nPyOpenGL==3.1.10\npin==4.1.0\n" \
     "cmeel-boost==1.90.0\neigenpy==3.13.0\ndrake==1.51.1\nMosek==11.1.2\npillow==13.0.0\n"
@@ -30,7 +30,7 @@ CONSTRAINTS = "numpy==2.4.6\nmujoco==4.0.0\nmujoco-core==4.0.0\nPyOpenGL==3.1.10
     ],
 )
 def test_constraints_leave_out_the_engine_family_only(engine, dropped, kept):
-    names = {ln.split("==")[0] for ln in matrix.constraints(matrix.ENGINES[engine],
+    names = {ln.split("==")[0] for ln in versions.constraints(versions.ENGINES[engine],
                                                             CONSTRAINTS).split()}
     assert not (names & dropped)
     assert kept <= names
@@ -40,8 +40,8 @@ def test_constraints_leave_out_the_engine_family_only(engine, dropped, kept):
 def test_a_release_series_needs_are_applied_to_its_environment_only(release, numpy_pinned):
     """Pinocchio 3.x cannot import beside numpy 2.4 (cmeel-boost < 1.90): its environment
     leaves numpy unpinned and bounds the libraries its wheels link; 4.x keeps every pin."""
-    eng = matrix.ENGINES["pinocchio"]
-    names = {ln.split("==")[0] for ln in matrix.constraints(eng, CONSTRAINTS, release).split()}
+    eng = versions.ENGINES["pinocchio"]
+    names = {ln.split("==")[0] for ln in versions.constraints(eng, CONSTRAINTS, release).split()}
     assert ("numpy" in names) is numpy_pinned
     assert "mujoco" in names
     required = {r for n in eng.needs_of(release) for r in n.require}
@@ -55,14 +55,14 @@ def test_pip_conflict_is_named_in_one_line():
         "    The user requested (constraint) numpy==2.4.6\n"
         "ERROR: ResolutionImpossible: for help visit https://pip.pypa.io\n"
     )
-    assert matrix._last_line(stderr) == (
+    assert versions._last_line(stderr) == (
         "cmeel-boost 1.89.0 depends on numpy<2.4 and >=2.3, but constraints.txt pins numpy==2.4.6"
     )
 
 
 def test_unknown_engine():
     with pytest.raises(UnknownName, match="unknown engine 'bullet'"):
-        matrix.engine("bullet")
+        versions.engine("bullet")
 
 
 def _run(folder: Path, error: float, release: str) -> Path:
@@ -81,32 +81,32 @@ RELEASES = ["1.0", "1.1", "1.2", "1.3", "1.4", "1.5"]
 def test_bisect_names_the_first_release_that_moved(tmp_path, monkeypatch):
     """Releases 1.0–1.2 agree with 1.0; from 1.3 on an error of 1e-9 appears."""
     runs = {r: _run(tmp_path / r, 1e-16 if r < "1.3" else 1e-9, r) for r in RELEASES}
-    monkeypatch.setattr(matrix, "run_release", lambda eng, r, **kw: runs[r])
-    first, moved = matrix.bisect("mujoco", "1.0", "1.5", releases=RELEASES, log=lambda m: None)
+    monkeypatch.setattr(versions, "run_release", lambda eng, r, **kw: runs[r])
+    first, moved = versions.bisect("mujoco", "1.0", "1.5", releases=RELEASES, log=lambda m: None)
     assert first == "1.3"
     assert list(moved["move"]) == [diff.Move.REGRESSED]
 
 
 def test_bisect_refuses_equal_or_reversed_releases(tmp_path, monkeypatch):
     runs = {r: _run(tmp_path / r, 1e-16, r) for r in RELEASES}
-    monkeypatch.setattr(matrix, "run_release", lambda eng, r, **kw: runs[r])
+    monkeypatch.setattr(versions, "run_release", lambda eng, r, **kw: runs[r])
     with pytest.raises(InvalidInput, match="two releases whose runs differ"):
-        matrix.bisect("mujoco", "1.0", "1.5", releases=RELEASES, log=lambda m: None)
+        versions.bisect("mujoco", "1.0", "1.5", releases=RELEASES, log=lambda m: None)
     with pytest.raises(InvalidInput, match="GOOD older than BAD"):
-        matrix.bisect("mujoco", "1.5", "1.0", releases=RELEASES, log=lambda m: None)
+        versions.bisect("mujoco", "1.5", "1.0", releases=RELEASES, log=lambda m: None)
     with pytest.raises(InvalidInput, match="a published release"):
-        matrix.bisect("mujoco", "0.9", "1.0", releases=RELEASES, log=lambda m: None)
+        versions.bisect("mujoco", "0.9", "1.0", releases=RELEASES, log=lambda m: None)
 
 
 def test_page_counts_moves_and_states_problems(tmp_path):
     a = diff.load(_run(tmp_path / "a", 1e-16, "1.0"), "A")
     b = diff.load(_run(tmp_path / "b", 1e-9, "1.1"), "B")
     steps = [
-        matrix.Step(engine="mujoco", old="1.0", new="1.1", table=diff.diff(a, b),
+        versions.Step(engine="mujoco", old="1.0", new="1.1", table=diff.diff(a, b),
                     also_changed=("numpy 2.3.5 -> 2.4.6",)),
-        matrix.Step(engine="mujoco", old="1.1", new="1.2", table=None, problem="no wheel"),
+        versions.Step(engine="mujoco", old="1.1", new="1.2", table=None, problem="no wheel"),
     ]
-    page = matrix.page(steps, notes={("mujoco", "1.0", "1.1"): "a changed compiler"})
+    page = versions.page(steps, notes={("mujoco", "1.0", "1.1"): "a changed compiler"})
     assert "### 1.0 → 1.1" in page and "**1** regressed" in page
     assert "**Explanation.** a changed compiler" in page
     assert "_not compared_: no wheel" in page
@@ -114,7 +114,7 @@ def test_page_counts_moves_and_states_problems(tmp_path):
 
 
 def test_page_states_each_engine_environment_needs():
-    page = matrix.page([matrix.Step(engine="pinocchio", old="3.9.0", new="4.0.0", table=None,
+    page = versions.page([versions.Step(engine="pinocchio", old="3.9.0", new="4.0.0", table=None,
                                     problem="x")])
     assert "- 3.x: `numpy` not pinned — " in page and "`cmeel-urdfdom<5`" in page
 
@@ -140,21 +140,21 @@ def test_a_run_of_some_cases_is_cached_apart_from_the_run_of_all(tmp_path, monke
     """A bisection over one case must not leave a one-case run where the matrix looks for
     the run of every case."""
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    monkeypatch.setattr(matrix, "environment", lambda eng, release, log: Path("python"))
-    monkeypatch.setattr(matrix, "_code_key", lambda: "k")
+    monkeypatch.setattr(versions, "environment", lambda eng, release, log: Path("python"))
+    monkeypatch.setattr(versions, "_code_key", lambda: "k")
 
     def fake_run(cmd, **kw):
         out = Path(cmd[cmd.index("--out") + 1])
         _run(out, 1e-16, "1.0")
         return type("R", (), {"returncode": 0, "stderr": ""})()
 
-    monkeypatch.setattr(matrix.subprocess, "run", fake_run)
-    eng = matrix.ENGINES["mujoco"]
-    some = matrix.run_release(eng, "1.0", cases=["pendulum"], log=lambda m: None)
-    every = matrix.run_release(eng, "1.0", log=lambda m: None)
+    monkeypatch.setattr(versions.subprocess, "run", fake_run)
+    eng = versions.ENGINES["mujoco"]
+    some = versions.run_release(eng, "1.0", cases=["pendulum"], log=lambda m: None)
+    every = versions.run_release(eng, "1.0", log=lambda m: None)
     assert some != every
     assert every.name == "mujoco-1.0"
-    assert matrix.run_release(eng, "1.0", cases=["pendulum"], log=lambda m: None) == some
+    assert versions.run_release(eng, "1.0", cases=["pendulum"], log=lambda m: None) == some
 
 
 @pytest.mark.parametrize("name", [n for n, r in REGISTRY.items() if r.releases])
@@ -182,7 +182,7 @@ def test_a_release_whose_engine_does_not_import_is_named_not_compared(tmp_path):
                  "multiarray failed to import); pip install ..."] * 2})
     path = tmp_path / "discrepancies.csv"
     rows.to_csv(path, index=False)
-    assert matrix._not_importable(path, ("eng",)) == "numpy.core.multiarray failed to import"
+    assert versions._not_importable(path, ("eng",)) == "numpy.core.multiarray failed to import"
     rows.loc[1, "note"] = "eng: couplings are not held"
     rows.to_csv(path, index=False)
-    assert matrix._not_importable(path, ("eng",)) == ""
+    assert versions._not_importable(path, ("eng",)) == ""
