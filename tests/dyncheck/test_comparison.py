@@ -37,6 +37,7 @@ from ..conftest import (
     FLOORED,
     FREE_CASES,
     PORTS,
+    SPHERICAL_CASES,
     quantity_limit,
     supported,
     unsupported_reason,
@@ -81,7 +82,7 @@ def test_against_reference(full_run, case, impl, quantity):
         # PyBullet's own: its free body's rounded tensor and gravity defect; on a spherical
         # joint the inertia it computes with (its dropped inertial frame: rigid_body_ball)
         engine_own = {INERTIA_STORED, ENGINE_DEFECT} if impl in FILE_LOADERS and \
-            (case in FREE_CASES or (impl == "pybullet" and case in BALL_CASES)) else set()
+            (case in FREE_CASES or (impl == "pybullet" and case in SPHERICAL_CASES)) else set()
         assert named <= {POINT_INERTIA, GRAVITY_DEFAULT, SOFT_CONSTRAINT} | engine_own and named
         if case in COUPLED_CASES:
             # slides never rotate: only the soft constraint can make a difference
