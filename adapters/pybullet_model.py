@@ -295,7 +295,8 @@ class PybulletModel(ModelEngine):
                     m, h, tau = _world_linear(np.array(qb[3:7]), m, h, tau)
                     pb.resetBasePositionAndOrientation(body, qb[:3], qb[3:7], physicsClientId=c)
                 mass[i, vs, vs], bias[i, vs], inverse[i, vs] = m, h, tau
-                forward[i, vs] = -np.linalg.solve(m, h)
+                if self._balls:  # (otherwise M⁻¹ h of the whole system, below)
+                    forward[i, vs] = -np.linalg.solve(m, h)
                 self._place(body, joints)
             potential[i] = -self.gravity @ sum((m * self._com(b, j) for b, j, m in self._masses
                                            if m > 0.0), np.zeros(3))
