@@ -23,6 +23,7 @@ from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
+from dyncheck.adapters.actuators import Actuation, InputJacobian
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, ModelTree, StateLayout, Transition
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import EngineError, Unsupported
@@ -305,6 +306,12 @@ class Offer(StrEnum):
     """``transition(q, v, a)``: the Jacobians of one step of each of its integrators."""
     STEPPING = "simulate"
     """``simulate(q0, v0, dt, steps)``: trajectories by its own stepping."""
+    ACTUATION = "actuation"
+    """``actuation(q, v, u)``: the generalized force of its actuators at controls u and its
+    forward dynamics with it (its tree's ``actuators`` say what it read)."""
+    INPUT_JACOBIAN = "input_jacobians"
+    """``input_jacobians(q, v, u)``: the Jacobians of one step of its integrators in the
+    controls, ∂x₊/∂u."""
 
 
 Answer = tuple[Any, float] | Exception
@@ -332,6 +339,10 @@ class ModelEngine(ABC):
     """Its implementation's name (the registry's): a class fact."""
     offers: frozenset[Offer] = frozenset()
     """A class fact (a proxy of an engine in another process copies its engine's)."""
+    no_actuation: str = ""
+    """Why it computes no actuator force where it does not offer
+    :attr:`Offer.ACTUATION` (its limit, or dyncheck's, in a sentence); empty: it holds no
+    actuator model, its input being the generalized force itself."""
     tree: ModelTree
     _answer: Answer
     _both: tuple[Answer, Answer]
@@ -356,11 +367,23 @@ class ModelEngine(ABC):
                  steps: int) -> tuple[np.ndarray, np.ndarray]:
         raise Unsupported(f"{self.engine} offers no stepping of its own")
 
+    def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
+        """Its actuators' generalized force at controls ``u`` (n, its tree's actuators) and
+        its forward dynamics with that force (its layout)."""
+        raise Unsupported(self.no_actuation or f"{self.engine} holds no actuators: its "
+                          "input is the generalized force itself")
+
+    def input_jacobians(self, q: np.ndarray, v: np.ndarray,
+                        u: np.ndarray) -> tuple[InputJacobian, ...]:
+        raise Unsupported(f"{self.engine} offers no step Jacobian in its controls")
+
     def request(self, kind: str, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Answer:
-        """One request of ``kind`` (``dynamics``, ``derivatives`` or ``transition``)
-        answered here, timed; its exception handed back, not raised."""
+        """One request of ``kind`` (``dynamics``, ``derivatives``, ``transition``,
+        ``actuation`` or ``input_jacobians``, whose ``a`` is the controls) answered here,
+        timed; its exception handed back, not raised."""
         method = {"dynamics": self.dynamics, "derivatives": self.derivatives,
-                  "transition": self.transition}[kind]
+                  "transition": self.transition, "actuation": self.actuation,
+                  "input_jacobians": self.input_jacobians}[kind]
         t0 = time.perf_counter()
         try:
             return method(q, v, a), time.perf_counter() - t0

@@ -41,6 +41,8 @@ from pydrake.multibody.tree import (
     QuaternionFloatingJoint,
 )
 
+from dyncheck.adapters import drake_actuators
+from dyncheck.adapters.actuators import Actuation
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.drake_hints import actuators, armature_hint, file_hints, ignored_frames
 from dyncheck.adapters.mjcf_copy import for_parser
@@ -204,7 +206,7 @@ class DrakeModel(ModelEngine):
     """A Drake plant and its neutral tree."""
 
     engine = ENGINE
-    offers = frozenset({Offer.DERIVATIVES})
+    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION})
 
     def __init__(self, source: ModelFile) -> None:
         self.plant, notes, self._damping = _plant(source)
@@ -215,6 +217,7 @@ class DrakeModel(ModelEngine):
             actuation.FixValue(self.context, np.zeros(self.plant.num_actuated_dofs()))
         self._acc = self.plant.get_generalized_acceleration_output_port()
         self._ad: Any = None  # the AutoDiffXd plant, made on the first derivatives asked for
+        self._actuated: Any = None  # the context of actuation (its PD controllers armed)
         self.tree = self._tree(notes)
 
     def _tree(self, notes: tuple[str, ...]) -> ModelTree:
@@ -290,14 +293,20 @@ class DrakeModel(ModelEngine):
             )
         gravity = np.asarray(plant.gravity_field().gravity_vector(), float)
         driven = actuators(self._source) if self._source.format is Format.MJCF else {}
-        hints = tuple(
-            (j.name, "armature", armature_hint(j, driven.get(j.name, [])))
-            for j in joints
-            if j.name not in reflected and self._source.format is Format.MJCF
-        ) + ignored_frames(notes) + file_hints(self._source)
+        hints = tuple((j.name, "armature", armature_hint(j, driven.get(j.name, [])))
+                      for j in joints if j.name not in reflected and self._source.format is
+                      Format.MJCF) + ignored_frames(notes) + file_hints(self._source) + \
+            drake_actuators.hints(plant, self._source, driven)
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
                          nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,
-                         hints=hints)
+                         hints=hints, actuators=drake_actuators.read(plant))
+
+    def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
+        """Drake's actuator force and forward dynamics at controls u
+        (:func:`drake_actuators.actuation`)."""
+        if self._actuated is None:
+            self._actuated = self.plant.CreateDefaultContext()
+        return drake_actuators.actuation(self.plant, self._actuated, q=q, v=v, u=u)
 
     @property
     def _reflected(self) -> dict[str, float]:

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from dyncheck.adapters.actuators import Actuator
 from dyncheck.vocabulary import JointType, Quantity
 
 
@@ -215,6 +216,10 @@ class ModelTree:
     mesh_rounding: Mapping[str, float] = field(default_factory=dict)
     """Joint → how far, relative, the mass, centre of mass and inertia its bodies take from
     meshes may lie from the file's digits (MuJoCo: vertices held in float32); absent: none."""
+    actuators: tuple[Actuator, ...] = ()
+    """Its actuators (:mod:`dyncheck.adapters.actuators`), in the order of its control
+    vector; none where it holds none, or holds no actuator model at all (its class does not
+    offer :attr:`~dyncheck.adapters.base.Offer.ACTUATION`)."""
     exact_meshes: ModelTree | None = None
     """The engine's reading with every mesh's volume and inertia computed exactly (MuJoCo:
     ``inertia="exact"`` instead of its default ``"legacy"``, which overcounts a non-convex

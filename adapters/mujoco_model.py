@@ -16,6 +16,7 @@ from dataclasses import dataclass, replace
 import mujoco
 import numpy as np
 
+from dyncheck.adapters import mujoco_actuators as actuators
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.mjcf_copy import inline, utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile
@@ -36,6 +37,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
+from dyncheck.adapters.mujoco_actuators import MujocoActuation
 from dyncheck.adapters.mujoco_api import (
     GYROSCOPIC_IMPLICIT,
     RK4_ON_GROUP,
@@ -185,11 +187,13 @@ def _total_mass_hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
     return tuple(("model", f, why) for f in ("mass", "inertia", "com"))
 
 
-class MujocoModel(ModelEngine):
+class MujocoModel(MujocoActuation, ModelEngine):
     """A compiled model and its neutral tree."""
 
     engine = ENGINE
-    offers = frozenset({Offer.DERIVATIVES, Offer.TRANSITION})
+    fd_step = FD_STEP
+    offers = frozenset({Offer.DERIVATIVES, Offer.TRANSITION, Offer.ACTUATION,
+                        Offer.INPUT_JACOBIAN})
 
     def __init__(self, source: ModelFile, *, exact_meshes: bool = False) -> None:
         self.model, notes, self._inertias = _compile(source, exact_meshes=exact_meshes)
@@ -293,6 +297,7 @@ class MujocoModel(ModelEngine):
         return ModelTree(
             engine=ENGINE, joints=tuple(joints), gravity=self._gravity.copy(),
             nq=m.nq, nv=m.nv, notes=notes, hints=self._hints,
+            actuators=actuators.read(m, [_joint_name(m, j) for j in range(m.njnt)]),
             mesh_rounding={name: bound for name, bound in by_joint.items() if bound > 0},
         )
 

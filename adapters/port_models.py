@@ -18,6 +18,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from dyncheck.adapters.actuators import Actuation, InputJacobian
 from dyncheck.adapters.base import Offer
 from dyncheck.adapters.model_files import ModelFile
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, derivatives
@@ -32,6 +33,8 @@ class PortModel(MujocoModel):
     offers = frozenset()  # a port's own derivatives where it has them (MJX's); no steps
     port: ClassVar[str] = ""
     """``module:class`` of the port's adapter (imported here only: JAX and Warp cost seconds)."""
+    no_actuation = ("the port's actuator forces are not compared yet (dyncheck evaluates its "
+                    "smooth dynamics only)")
 
     def __init__(self, source: ModelFile) -> None:
         super().__init__(source)
@@ -55,6 +58,14 @@ class PortModel(MujocoModel):
         return Dynamics.at(v, mass_matrix=raw["M"], bias=raw["bias"], forward=raw["qacc"],
                            inverse=raw["qfrc_inverse"], potential=potential)
 
+
+    def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
+        """Never the C engine's (which this class would inherit)."""
+        raise Unsupported(f"{self.engine}: {self.no_actuation}")
+
+    def input_jacobians(self, q: np.ndarray, v: np.ndarray,
+                        u: np.ndarray) -> tuple[InputJacobian, ...]:
+        raise Unsupported(f"{self.engine}: {self.no_actuation}")
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
         """The port's own derivatives, never the C engine's (which this class would inherit):

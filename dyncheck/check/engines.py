@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from dyncheck.adapters import MODELS, Registration
+from dyncheck.adapters.actuators import Actuation, InputJacobian
 from dyncheck.adapters.base import Answer, ModelEngine
 from dyncheck.adapters.model_files import ModelFile
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, Transition
@@ -339,6 +340,19 @@ class Isolated(ModelEngine):
         """The engine's Jacobians of one step of its integrators (:class:`Unsupported`
         where it offers none)."""
         self.submit(q, v, a, kind="transition")
+        return self.collect()[0]
+
+    def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
+        """The engine's actuator force at controls u (:class:`Unsupported` where it holds
+        no actuator model)."""
+        self.submit(q, v, u, kind="actuation")
+        return self.collect()[0]
+
+    def input_jacobians(self, q: np.ndarray, v: np.ndarray,
+                        u: np.ndarray) -> tuple[InputJacobian, ...]:
+        """The engine's Jacobians of one step in its controls (:class:`Unsupported` where
+        it offers none)."""
+        self.submit(q, v, u, kind="input_jacobians")
         return self.collect()[0]
 
     def collect(self) -> tuple[Any, float]:

@@ -25,7 +25,7 @@ from dyncheck.adapters import REGISTRY, layout, layout_batch
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials, urdf_welded
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
-from dyncheck.check import describe, inputs, partial, predicted, readings
+from dyncheck.check import actuation, describe, inputs, partial, predicted, readings
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.alignment import align_by_body
 from dyncheck.check.derivatives import expected_seconds
@@ -59,7 +59,7 @@ DERIVATIVES_NOTE = (
 SMOOTH_NOTE = (
     "smooth dynamics only: contacts, joint limits, equality constraints, actuators and passive "
     "forces (springs, damping) are left out of M, h, forward and inverse dynamics; damping and "
-    "armature are compared as fields of the model"
+    "armature are compared as fields of the model, actuators in their own section"
 )
 
 
@@ -130,6 +130,7 @@ def check_model(
     isolate: bool = True,
     limits: engine_processes.Limits | None = None,
     derivatives: bool = False,
+    actuators: bool = True,
     say: Callable[[str], None] | None = None,
 ) -> CheckResult:
     """Check one model file (see the module's docstring); bad input raises
@@ -137,7 +138,8 @@ def check_model(
     default) each engine runs in its own process, within ``limits`` (memory, seconds scaled to
     the model), so that one crashing, hanging or growing on the file costs only its rows
     (:mod:`dyncheck.check.engines`). ``derivatives`` adds the derivatives' rows
-    (:mod:`dyncheck.check.derivatives`), ``say`` hears the estimate of a derivative check
+    (:mod:`dyncheck.check.derivatives`), ``actuators`` the actuation section where the model has
+    actuators (:mod:`dyncheck.check.actuation`), ``say`` hears the estimate of a derivative check
     that will take a while (the command's progress)."""
     source_path = inputs.model_path(str(path))
     against_path = inputs.model_path(str(against)) if against is not None else None
@@ -160,7 +162,7 @@ def check_model(
             return _check(model, source_path, source, engines=engines, chosen=chosen,
                           states=states, seed=seed, floating=floating,
                           against_path=against_path, load_seconds=time.perf_counter() - t0,
-                          derivatives=derivatives, say=say)
+                          derivatives=derivatives, actuators=actuators, say=say)
     finally:
         engine_processes.stop(engines)
 
@@ -168,7 +170,7 @@ def check_model(
 def _check(model: str, source_path: Path, source: ModelFile, *,
            engines: dict[str, ModelEngine | NotLoaded], chosen: tuple[str, ...],
            states: int, seed: int, floating: bool, against_path: Path | None,
-           load_seconds: float, derivatives: bool = False,
+           load_seconds: float, derivatives: bool = False, actuators: bool = True,
            say: Callable[[str], None] | None = None) -> CheckResult:
     """The check's steps in order: what loaded, what each engine read and whether it is
     physically possible, the dynamics at the same states, every pair compared, and the
@@ -199,6 +201,13 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     seconds = {k: seconds[k] for k in ("load", REFEREE, *loaded) if k in seconds}
     rows.extend(_pairs(model, canon, canonical_tree, batch, loaded, parts, results, differing,
                        own))
+    if actuators and any(m.tree.actuators for m in loaded.values()):
+        t0 = time.perf_counter()
+        found, said = actuation.rows(model, canon=canon, canonical=canonical_tree, batch=batch,
+                                     loaded=loaded, seed=seed)
+        rows.extend(found)
+        notes.extend(said)
+        seconds["actuation"] = time.perf_counter() - t0
     if derivatives:
         t0 = time.perf_counter()
         expected = expected_seconds(states, canon.nv)

@@ -20,6 +20,8 @@ TITLES = {
     Section.DESCRIPTION: "Model reading (each engine's tree against MuJoCo's)",
     Section.VALIDITY: "Physical validity",
     Section.DYNAMICS: "Dynamics",
+    Section.ACTUATION: "Actuation (each engine's actuators against MuJoCo's; their force and "
+                       "step Jacobian in the controls against the referee)",
     Section.DERIVATIVES: "Derivatives (canonical chart; MuJoCo's by its own finite differences)",
 }
 
@@ -104,7 +106,7 @@ def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
     ]
     for section in Section:
         part = rows[rows["section"] == section.value]
-        if section is Section.DERIVATIVES and not len(part):
+        if section in (Section.DERIVATIVES, Section.ACTUATION) and not len(part):
             continue  # not asked for (--derivatives): no section that reads "none"
         lines += [f"## {TITLES[section]}", "",
                   _table(part, ["subject", "field", "impl_a", "impl_b", "error", "tolerance",

@@ -15,6 +15,7 @@ class Section(StrEnum):
     DESCRIPTION = "description"
     VALIDITY = "validity"
     DYNAMICS = "dynamics"
+    ACTUATION = "actuation"
     DERIVATIVES = "derivatives"
 
 

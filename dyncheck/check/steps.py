@@ -24,7 +24,7 @@ from dyncheck.results import Verdict
 from dyncheck.vocabulary import Integrator
 
 
-def _right_jacobian(phi: np.ndarray) -> np.ndarray:
+def right_jacobian(phi: np.ndarray) -> np.ndarray:
     """SO(3)'s right Jacobian J_r(φ): exp(φ + δ) = exp(φ) exp(J_r(φ) δ) to first order."""
     theta = float(np.linalg.norm(phi))
     cross = _skew(phi)
@@ -56,7 +56,7 @@ def euler_step(canon: Canonical, ref: Referee, states: States, h: float) -> np.n
             rows = slice(turning.start, turning.stop)
             phi = h * v_next[rows]
             turn = Rotation.from_rotvec(-phi).as_matrix()
-            jr = _right_jacobian(phi)
+            jr = right_jacobian(phi)
             dq_q[rows] = turn @ eye[rows] + jr @ dv_q[rows] * h
             dq_v[rows] = jr @ dv_v[rows] * h
         out[s] = np.block([[dq_q, dq_v], [dv_q, dv_v]])
@@ -182,7 +182,7 @@ def rk4_step(canon: Canonical, stages: list[tuple[States, Referee, np.ndarray]],
         for va in rotations:
             rows = slice(va, va + 3)
             moved[rows] = Rotation.from_rotvec(-theta[rows]).as_matrix() @ dq0[rows] \
-                + _right_jacobian(theta[rows]) @ dtheta[rows]
+                + right_jacobian(theta[rows]) @ dtheta[rows]
         return moved
 
     for s in range(n):

@@ -38,6 +38,17 @@ class Agreement(StrEnum):
     NOT_COMPARED = "computing not compared"
 
 
+class Controls(StrEnum):
+    """How the engine reads and computes the model's actuators (the actuation rows)."""
+
+    ALIKE = "reads the controls alike and computes their force as read"
+    DIFFERENTLY = "reads the controls differently"
+    DIFFER = "computes a control's force differently from what it read"
+    NOT_COMPARED = "controls not compared"
+    ABSENT = ""
+    """No actuation rows: the model has no actuator, or they were not asked for."""
+
+
 @dataclass(frozen=True, kw_only=True)
 class EngineVerdict:
     engine: str
@@ -45,11 +56,14 @@ class EngineVerdict:
     reading_why: str
     agreement: Agreement
     agreement_why: str
+    controls: Controls = Controls.ABSENT
+    controls_why: str = ""
 
     @property
     def ok(self) -> bool:
-        return self.reading is Reading.ALIKE and self.agreement in (Agreement.AGREE,
-                                                                    Agreement.EXPLAINED)
+        return self.reading is Reading.ALIKE and self.agreement in (
+            Agreement.AGREE, Agreement.EXPLAINED) and self.controls in (
+            Controls.ALIKE, Controls.NOT_COMPARED, Controls.ABSENT)
 
     def line(self) -> str:
         """One sentence: the reading, then the dynamics, each with its first reason."""
@@ -58,7 +72,11 @@ class EngineVerdict:
             return reading
         agreement = self.agreement.value + (f" ({self.agreement_why})"
                                             if self.agreement_why else "")
-        return f"{reading}; {agreement}"
+        if self.controls is Controls.ABSENT:
+            return f"{reading}; {agreement}"
+        controls = self.controls.value + (f" ({self.controls_why})" if self.controls_why
+                                          else "")
+        return f"{reading}; {agreement}; {controls}"
 
 
 def _first_notes(rows: pd.DataFrame, limit: int = 2) -> str:
@@ -136,6 +154,34 @@ def _agreement(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Agreeme
     return Agreement.AGREE, f"{judge}{tail}"
 
 
+COMPUTED = "max rel error"
+"""The field of an actuation row that compares computed values (the others, readings)."""
+
+
+def _controls(engine: str, rows: pd.DataFrame) -> tuple[Controls, str]:
+    """One rule, in this order: no actuation row of the engine → absent; its actuators read
+    differently from the canonical engine's (a failed reading row) → differently; its force
+    or step Jacobian failing against the referee on its own reading → differ; a skipped row
+    (no actuator model) → not compared; else alike."""
+    part = rows[(rows["section"] == Section.ACTUATION)
+                & ((rows["impl_a"] == engine) | (rows["impl_b"] == engine))]
+    if part.empty:
+        return Controls.ABSENT, ""
+    failed = part[part["verdict"] == Verdict.FAILED]
+    read = failed[(failed["impl_b"] == engine) & (failed["field"] != COMPUTED)]
+    if not read.empty:
+        fields = ", ".join(dict.fromkeys(read["field"]))
+        subjects = list(dict.fromkeys(read["subject"]))
+        where = f"{len(subjects)} actuators" if len(subjects) > 1 else repr(subjects[0])
+        return Controls.DIFFERENTLY, f"{fields} on {where}: {_first_notes(read, 1)}"
+    computed = failed[(failed["impl_a"] == REFEREE) & (failed["field"] == COMPUTED)]
+    if not computed.empty:
+        return Controls.DIFFER, _first_notes(computed, 1)
+    if (part["verdict"] == Verdict.SKIPPED).all():
+        return Controls.NOT_COMPARED, _first_notes(part, 1)
+    return Controls.ALIKE, ""
+
+
 def per_engine(rows: pd.DataFrame, impls: tuple[str, ...]) -> list[EngineVerdict]:
     """One verdict per engine asked for (the referee is the judge, not judged)."""
     loads = rows[(rows["section"] == Section.LOAD) & (rows["verdict"] == Verdict.PASSED)]
@@ -146,6 +192,10 @@ def per_engine(rows: pd.DataFrame, impls: tuple[str, ...]) -> list[EngineVerdict
             continue
         reading, reading_why = _reading(engine, rows, canonical)
         agreement, agreement_why = _agreement(engine, rows, canonical)
+        controls, controls_why = _controls(engine, rows)
+        if engine == canonical and controls is Controls.ALIKE:
+            controls_why = "the canonical reading"
         out.append(EngineVerdict(engine=engine, reading=reading, reading_why=reading_why,
-                                 agreement=agreement, agreement_why=agreement_why))
+                                 agreement=agreement, agreement_why=agreement_why,
+                                 controls=controls, controls_why=controls_why))
     return out

@@ -1,0 +1,131 @@
+"""An engine's actuators as the engine-neutral tree holds them: the control law on a joint, in
+MuJoCo's general form, which every engine's reading is mapped into.
+
+An actuator on a hinge or slide joint (a *joint transmission*) of gear g turns a control u
+into a generalized force on that joint,
+
+    τ = g · clamp(f, forcerange),   f = gain · a + bias,
+    gain = g₀ + g₁ L + g₂ L̇,       bias = b₀ + b₁ L + b₂ L̇,    L = g q,  L̇ = g v,
+
+with a = clamp(u, ctrlrange) where it has no activation dynamics, and otherwise its
+activation state (integrator: ȧ = u; filter: ȧ = (u − a)/t). A motor is gain (1, 0, 0),
+bias 0; a position servo gain (kp, 0, 0), bias (0, −kp, −kv); a velocity servo gain
+(kv, 0, 0), bias (0, 0, −kv). An engine that holds its actuators otherwise (Drake's joint
+actuator, whose input is the joint's effort and whose PD controller's target is a joint
+position) is read back into this form as it acts, so that two readings compare field by field.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+
+import numpy as np
+
+
+class Activation(StrEnum):
+    """An actuator's activation dynamics (MuJoCo's ``dyntype``)."""
+
+    NONE = "none"
+    INTEGRATOR = "integrator"
+    FILTER = "filter"
+    FILTER_EXACT = "filterexact"
+    OTHER = "other"
+    """Muscle or user dynamics: MuJoCo-only, not modelled here."""
+
+
+class Transmission(StrEnum):
+    """What the actuator drives."""
+
+    JOINT = "joint"
+    """A hinge or slide joint, scaled by the gear."""
+    OTHER = "other"
+    """A tendon, a site, a slider-crank, a body, a ball or free joint, a muscle's or a user's
+    force law: MuJoCo-only, stated once per model and not modelled here."""
+
+
+Range = tuple[float, float] | None
+"""(lower, upper) where limited; None where not."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class Actuator:
+    """One actuator as an engine holds it (see the module's docstring); ``joint`` is empty
+    where the transmission is not a joint's."""
+
+    name: str
+    joint: str
+    transmission: Transmission
+    gear: float
+    gain: tuple[float, float, float]
+    bias: tuple[float, float, float]
+    ctrl_range: Range
+    force_range: Range
+    activation: Activation = Activation.NONE
+    time_constant: float = 0.0
+    """A filter's t (s); 0 otherwise."""
+    act_range: Range = None
+    what: str = ""
+    """How the engine names it (``<position> 'elbow'``, Drake's ``JointActuator 'motor0'``)."""
+
+    @property
+    def modelled(self) -> bool:
+        """Whether the neutral control law above describes it (a joint transmission whose
+        activation is none, an integrator or a filter)."""
+        return (self.transmission is Transmission.JOINT
+                and self.activation is not Activation.OTHER)
+
+    def fields(self) -> dict[str, object]:
+        """The fields two readings compare, by name."""
+        return {"gear": self.gear, "gain": self.gain, "bias": self.bias,
+                "ctrlrange": self.ctrl_range, "forcerange": self.force_range,
+                "activation": self.activation.value, "time constant": self.time_constant}
+
+
+def shown_value(value: object) -> str:
+    """A field's value as a row shows it."""
+    if value is None:
+        return "unlimited"
+    if isinstance(value, tuple):
+        return "(" + ", ".join(shown_value(x) for x in value) + ")"
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return str(value)
+
+
+def same(a: object, b: object, *, rtol: float) -> bool:
+    """Whether two field values agree to ``rtol`` of their size (exactly for a name)."""
+    if a is None or b is None or isinstance(a, str) or isinstance(b, str):
+        return a == b
+    if isinstance(a, tuple) and isinstance(b, tuple) and any(
+            x is None or isinstance(x, tuple) for x in (*a, *b)):  # ranges of ranges
+        return len(a) == len(b) and all(same(x, y, rtol=rtol) for x, y in zip(a, b, strict=True))
+    x, y = np.atleast_1d(np.asarray(a, float)), np.atleast_1d(np.asarray(b, float))
+    scale = max(float(np.abs(x).max(initial=0.0)), float(np.abs(y).max(initial=0.0)), 1e-300)
+    finite = np.isfinite(x) & np.isfinite(y)
+    return bool(x.shape == y.shape and np.array_equal(np.isfinite(x), np.isfinite(y))
+                and np.all(np.abs(x - y)[finite] <= rtol * scale)
+                and np.array_equal(x[~finite], y[~finite]))
+
+
+@dataclass(frozen=True, kw_only=True)
+class Actuation:
+    """An engine's answer at a batch of states and controls, in its own layout: the
+    generalized force of its actuators τ (n, nv) and its forward dynamics with that force,
+    v̇ = M⁻¹ (τ − h) (n, nv)."""
+
+    tau: np.ndarray
+    forward: np.ndarray
+
+
+@dataclass(frozen=True, kw_only=True)
+class InputJacobian:
+    """An engine's Jacobian of one integrator step in its controls, ∂x₊/∂u with
+    x = (δq, v, act) in its chart (n, 2 nv + na, nu), by finite differences of step
+    ``fd_step`` and, for their error, of twice that step (``coarse``)."""
+
+    matrix: np.ndarray
+    coarse: np.ndarray
+    time_step: float
+    fd_step: float
+    integrator: str

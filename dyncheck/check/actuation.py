@@ -1,0 +1,342 @@
+"""The controls in a model check: does each engine read the file's actuators as the canonical
+engine does (field by field, in the neutral form of :mod:`dyncheck.adapters.actuators`), and
+does the same control make the same generalized force — each engine against the referee's
+actuator law on that engine's own reading (:mod:`dyncheck.reference.actuation`: does it
+compute what it read), and against the canonical engine (do they read it alike, measured).
+
+The controls are sampled per actuator over 1.5 times its control range about its centre (a
+third of them outside it: clamped), or, where the control is unlimited and the force is not,
+over 1.5 times the control that reaches the force bound (saturated); else in [−1, 1].
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from dyncheck.adapters import layout_batch
+from dyncheck.adapters.actuators import Activation, Actuator, same, shown_value
+from dyncheck.adapters.base import ModelEngine, Offer
+from dyncheck.adapters.layout import Canonical
+from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.check.dynamics import States
+from dyncheck.check.rows import CheckRow, Section
+from dyncheck.precision import EPS, ROUNDOFF_FACTOR
+from dyncheck.reference import actuation as law
+from dyncheck.results import Verdict
+
+REFEREE = "reference"
+FORCE = "actuator force"
+FIELD_RTOL = 1e-9
+"""Two readings of a field agree to this, relative (the file's digits, parsed twice)."""
+UNKNOWN = "cause unknown"
+DYNAMICS = {Activation.NONE: law.NONE, Activation.INTEGRATOR: law.INTEGRATOR,
+            Activation.FILTER: law.FILTER, Activation.FILTER_EXACT: law.FILTER_EXACT}
+
+
+def _row(model: str, *, subject: str, field: str, a: str, b: str, verdict: Verdict,
+         note: str, value_a: str = "", value_b: str = "", error: float = 0.0,
+         tolerance: float = 0.0, basis: str = "", worst: int = -1) -> CheckRow:
+    return CheckRow(model=model, section=Section.ACTUATION, subject=subject, field=field,
+                    impl_a=a, impl_b=b, value_a=value_a, value_b=value_b, error=error,
+                    tolerance=tolerance, basis=basis, verdict=verdict, note=note,
+                    worst_state=worst)
+
+
+def limits(actuator: Actuator) -> object:
+    """The bounds as they act: for a motor-like law (fixed gain, no bias) the force interval
+    both ranges leave, gain × control range ∩ force range; else the two ranges as given."""
+    if actuator.gain[1:] == (0.0, 0.0) and actuator.bias == (0.0, 0.0, 0.0) and \
+            actuator.activation is Activation.NONE:
+        low, high = -np.inf, np.inf
+        if actuator.ctrl_range is not None:
+            ends = sorted(actuator.gain[0] * np.array(actuator.ctrl_range))
+            low, high = ends[0], ends[1]
+        if actuator.force_range is not None:
+            low, high = max(low, actuator.force_range[0]), min(high, actuator.force_range[1])
+        return None if not (np.isfinite(low) or np.isfinite(high)) else (float(low), float(high))
+    return (actuator.ctrl_range, actuator.force_range)
+
+
+def compared_fields(actuator: Actuator) -> dict[str, object]:
+    """The fields two readings compare: gear, gain, bias, the acting bounds, activation."""
+    return {"gear": actuator.gear, "gain": actuator.gain, "bias": actuator.bias,
+            "limits": limits(actuator), "activation": actuator.activation.value,
+            "time constant": actuator.time_constant}
+
+
+def match(mine: tuple[Actuator, ...], theirs: tuple[Actuator, ...]) -> dict[int, int]:
+    """My actuator's place → theirs: by joint where every joint has at most one actuator on
+    both sides (engines name unnamed actuators their own way), else by name."""
+    def by_joint(acts: tuple[Actuator, ...]) -> dict[str, int]:
+        joints = [a.joint for a in acts if a.joint]
+        return {a.joint: k for k, a in enumerate(acts) if a.joint} \
+            if len(joints) == len(set(joints)) else {}
+    a, b = by_joint(mine), by_joint(theirs)
+    if a and b and len(a) == len([x for x in mine if x.joint]):
+        return {k: b[j] for j, k in a.items() if j in b}
+    names = {x.name: k for k, x in enumerate(theirs)}
+    return {k: names[x.name] for k, x in enumerate(mine) if x.name in names}
+
+
+def _hint(tree: ModelTree, actuator: str, field: str) -> str:
+    return tree.hint(actuator, field) or UNKNOWN
+
+
+def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[CheckRow]:
+    """Each actuator of ``other`` against the canonical reading: one passed row where every
+    field agrees, else a failed row per differing field with the engine's known reason
+    (its hint, premise checked) or "cause unknown"; an actuator one side lacks, a row."""
+    a, b = canonical.engine, other.engine
+    pairs = match(canonical.actuators, other.actuators)
+    rows = []
+    for k, mine in enumerate(canonical.actuators):
+        if k not in pairs:
+            rows.append(_row(model, subject=mine.name, field="actuator", a=a, b=b,
+                             value_a=mine.what, value_b="absent", verdict=Verdict.FAILED,
+                             note=_hint(other, "model", "actuator")))
+            continue
+        theirs = other.actuators[pairs[k]]
+        ours, found = compared_fields(mine), compared_fields(theirs)
+        differ = [f for f in ours if not same(ours[f], found[f], rtol=FIELD_RTOL)]
+        if not differ:
+            rows.append(_row(model, subject=mine.name, field="reading", a=a, b=b,
+                             value_a=mine.what, value_b=theirs.what, verdict=Verdict.PASSED,
+                             note=f"gear, gain, bias, limits and activation alike ({b}'s "
+                                  f"{theirs.what})"))
+        for f in differ:
+            rows.append(_row(model, subject=mine.name, field=f, a=a, b=b,
+                             value_a=shown_value(ours[f]), value_b=shown_value(found[f]),
+                             verdict=Verdict.FAILED, note=_hint(other, theirs.name, f)))
+    held = set(pairs.values())
+    for k, theirs in enumerate(other.actuators):
+        if k not in held:
+            rows.append(_row(model, subject=theirs.name, field="actuator", a=a, b=b,
+                             value_a="absent", value_b=theirs.what, verdict=Verdict.FAILED,
+                             note=_hint(other, theirs.name, "actuator")))
+    return rows
+
+
+def joint_actuators(tree: ModelTree) -> law.JointActuators | None:
+    """The referee's law of a tree's actuators in its own layout; None where one is outside
+    the neutral form (a tendon's, a muscle's: MuJoCo-only)."""
+    if not all(a.modelled for a in tree.actuators):
+        return None
+    acts = tree.actuators
+
+    def bounds(ranges: list[tuple[float, float] | None]) -> tuple[np.ndarray, np.ndarray]:
+        return (np.array([r[0] if r else -np.inf for r in ranges]),
+                np.array([r[1] if r else np.inf for r in ranges]))
+    ctrl, force, act = (bounds([getattr(a, f) for a in acts])
+                        for f in ("ctrl_range", "force_range", "act_range"))
+    return law.JointActuators(
+        dof=np.array([tree.joint(a.joint).layout.v_start for a in acts], int),
+        q_index=np.array([tree.joint(a.joint).layout.q_start for a in acts], int),
+        gear=np.array([a.gear for a in acts]), gain=np.array([a.gain for a in acts]),
+        bias=np.array([a.bias for a in acts]), ctrl_low=ctrl[0], ctrl_high=ctrl[1],
+        force_low=force[0], force_high=force[1],
+        dynamics=np.array([DYNAMICS[a.activation] for a in acts], int),
+        time_constant=np.array([a.time_constant for a in acts]),
+        act_low=act[0], act_high=act[1])
+
+
+def sample_controls(actuators: tuple[Actuator, ...], n: int, seed: int, *,
+                    spread: float = 1.5) -> np.ndarray:
+    """Controls (n, nu), see the module's docstring (``spread``: the interval's half-width
+    over the range's)."""
+    rng = np.random.default_rng(seed + 7919)
+    out = np.zeros((n, len(actuators)))
+    for k, a in enumerate(actuators):
+        centre, half = 0.0, 1.0
+        if a.ctrl_range is not None:
+            centre, half = sum(a.ctrl_range) / 2, max((a.ctrl_range[1] - a.ctrl_range[0]) / 2,
+                                                      1e-12)
+        elif a.force_range is not None and a.gain[0] != 0.0:
+            half = max(abs(a.force_range[0]), abs(a.force_range[1])) / abs(a.gain[0])
+        out[:, k] = centre + half * rng.uniform(-spread, spread, n)
+    return out
+
+
+@dataclass(frozen=True, kw_only=True)
+class Forces:
+    """One engine's answer at the sampled controls: its actuator force (its layout), the
+    controls in its actuators' order, and the states in its layout."""
+
+    tau: np.ndarray
+    controls: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    maps: list
+
+
+def controls_for(canonical: ModelTree, tree: ModelTree, u: np.ndarray) -> np.ndarray:
+    """The canonical controls in ``tree``'s actuators' order (0 where it holds an actuator
+    the canonical reading has not)."""
+    out = np.zeros((len(u), len(tree.actuators)))
+    for k, j in match(canonical.actuators, tree.actuators).items():
+        out[:, j] = u[:, k]
+    return out
+
+
+def force_rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
+               loaded: dict[str, ModelEngine], u: np.ndarray,
+               differing: dict[str, list[str]]) -> list[CheckRow]:
+    """Every actuated engine's force at the sampled states and controls: against the
+    referee's law on its own reading, and against the canonical engine (on the velocity
+    coordinates of the joints both hold)."""
+    rows: list[CheckRow] = []
+    found: dict[str, Forces] = {}
+    for engine, m in loaded.items():
+        if not m.tree.actuators and not canonical.actuators:
+            continue
+        if Offer.ACTUATION not in m.offers:
+            rows.append(_row(model, subject="model", field=FORCE, a=engine, b="",
+                             verdict=Verdict.SKIPPED, note=_unsupported(m)))
+            continue
+        maps, q_e, v_e, _ = layout_batch.engine_states(canon, m.tree, batch.q, batch.v,
+                                                       batch.a)
+        u_e = controls_for(canonical, m.tree, u)
+        try:
+            answer = m.actuation(q_e, v_e, u_e)
+        except Exception as exc:  # a failing engine costs its own rows
+            rows.append(_row(model, subject="model", field=FORCE, a=engine, b="",
+                             verdict=Verdict.FAILED, note=f"{type(exc).__name__}: {exc}"))
+            continue
+        found[engine] = Forces(tau=answer.tau, controls=u_e, q=q_e, v=v_e, maps=maps)
+        rows.extend(_against_referee(model, m.tree, found[engine]))
+    names = list(found)
+    for other in names[1:]:
+        rows.append(_pair(model, tree_a=loaded[names[0]].tree, a=found[names[0]],
+                          tree_b=loaded[other].tree, b=found[other], differing=differing))
+    return rows
+
+
+def _unsupported(m: ModelEngine) -> str:
+    try:
+        m.actuation(np.zeros((0, m.tree.nq)), np.zeros((0, m.tree.nv)), np.zeros((0, 0)))
+    except Exception as exc:
+        return str(exc)
+    return f"{m.engine} offers no actuator force"
+
+
+def _scale(acts: law.JointActuators, f: Forces) -> float:
+    """The size round-off is relative to: the largest |g| (|gain · a| + |bias terms|)."""
+    length = np.abs(acts.gear * f.q[:, acts.q_index])
+    speed = np.abs(acts.gear * f.v[:, acts.dof])
+    terms = (np.abs(acts.gain) @ np.ones(3)) * np.abs(f.controls) * (1 + length + speed) + \
+        np.abs(acts.bias[:, 0]) + np.abs(acts.bias[:, 1]) * length + np.abs(acts.bias[:, 2]) * speed
+    return max(float(np.max(np.abs(acts.gear) * terms, initial=0.0)), 1e-300)
+
+
+def _against_referee(model: str, tree: ModelTree, f: Forces) -> list[CheckRow]:
+    engine = tree.engine
+    acts = joint_actuators(tree)
+    if acts is None:
+        others = ", ".join(a.what for a in tree.actuators if not a.modelled)
+        return [_row(model, subject=FORCE, field="max rel error", a=REFEREE, b=engine,
+                     verdict=Verdict.SKIPPED,
+                     note=f"the referee models joint actuators only; {engine} holds {others}")]
+    expected = law.generalized_force(acts, f.q, f.v, f.controls, act=f.controls)
+    scale = _scale(acts, f)
+    off = np.abs(f.tau - expected)
+    tolerance = ROUNDOFF_FACTOR * max(EPS, tree.eps)
+    worst = int(np.argmax(off.max(axis=1))) if off.size else -1
+    error = float(off.max(initial=0.0)) / scale
+    ok = error <= tolerance
+    clamped = _clamped(acts, f)
+    return [_row(model, subject=FORCE, field="max rel error", a=REFEREE, b=engine,
+                 verdict=Verdict.PASSED if ok else Verdict.FAILED, error=error,
+                 tolerance=tolerance, worst=worst,
+                 basis=f"the referee's actuator law on {engine}'s own reading; round-off "
+                       f"{ROUNDOFF_FACTOR} eps of the largest term; {clamped}",
+                 note="" if ok else f"{engine} computes a force its reading does not give "
+                 f"(state {worst}: {off[worst].max():.3g}): {UNKNOWN}")]
+
+
+def _clamped(acts: law.JointActuators, f: Forces) -> str:
+    """How many sampled controls a bound held (what the rows exercised)."""
+    u = f.controls
+    ctrl = int(np.sum((u < acts.ctrl_low) | (u > acts.ctrl_high)))
+    raw = law.scalar_forces(acts, f.q, f.v, u, act=u)
+    force = int(np.sum(np.isclose(raw, acts.force_low) | np.isclose(raw, acts.force_high)))
+    return (f"{ctrl} controls clamped to their range, {force} forces held at their bound, of "
+            f"{u.size}")
+
+
+def _pair(model: str, *, tree_a: ModelTree, a: Forces, tree_b: ModelTree, b: Forces,
+          differing: dict[str, list[str]]) -> CheckRow:
+    """Two engines' forces on the hinges and slides both hold (by joint name)."""
+    cols_a, cols_b = [], []
+    for joint in tree_a.joints:
+        if joint.layout.nv == 1 and any(j.name == joint.name for j in tree_b.joints):
+            cols_a.append(joint.layout.v_start)
+            cols_b.append(tree_b.joint(joint.name).layout.v_start)
+    off = np.abs(a.tau[:, cols_a] - b.tau[:, cols_b])
+    scale = max(float(np.abs(a.tau).max(initial=0.0)), float(np.abs(b.tau).max(initial=0.0)),
+                1e-300)
+    tolerance = ROUNDOFF_FACTOR * max(EPS, tree_a.eps, tree_b.eps)
+    error = float(off.max(initial=0.0)) / scale
+    ok = error <= tolerance
+    read = differing.get(tree_b.engine, [])
+    note = ""
+    if not ok:
+        note = (f"{tree_b.engine} reads the controls differently ({', '.join(read)}: the "
+                "actuation reading rows); the force differs by that reading, measured here"
+                if read else UNKNOWN)
+    worst = int(np.argmax(off.max(axis=1))) if off.size else -1
+    return _row(model, subject=FORCE, field="max rel error", a=tree_a.engine, b=tree_b.engine,
+                verdict=Verdict.PASSED if ok else Verdict.FAILED, error=error,
+                tolerance=tolerance, worst=worst, note=note,
+                basis=f"the same controls as each reads them; round-off {ROUNDOFF_FACTOR} eps "
+                      "of the largest force")
+
+
+INPUT_STATES = 8
+"""The states at which the step's Jacobian in the controls is compared (its differences cost
+2 nu steps a state, twice)."""
+
+
+def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
+         loaded: dict[str, ModelEngine], seed: int) -> tuple[list[CheckRow], list[str]]:
+    """The actuation section: every engine's reading of the actuators against the canonical
+    one, every engine's force against the referee and the canonical engine, and the
+    canonical engine's step Jacobian in the controls against the chain rule; and the notes
+    that say what was left out."""
+    from dyncheck.check import input_jacobian
+    from dyncheck.check.referee import ReferenceModel
+
+    out: list[CheckRow] = []
+    notes = []
+    first = next(iter(loaded.values()))
+    unmodelled = [a.what for a in canonical.actuators if not a.modelled]
+    if unmodelled:
+        notes.append(f"actuators outside the neutral form, compared by no other engine and "
+                     f"not by the referee (MuJoCo-only): {', '.join(unmodelled)}")
+    differing: dict[str, list[str]] = {}
+    for engine, m in loaded.items():
+        if m is not first and Offer.ACTUATION in m.offers:
+            found = reading_rows(model, canonical, m.tree)
+            out.extend(found)
+            differing[engine] = sorted({r.field for r in found if r.verdict is Verdict.FAILED})
+    u = sample_controls(canonical.actuators, len(batch.q), seed)
+    out.extend(force_rows(model, canon=canon, canonical=canonical, batch=batch, loaded=loaded,
+                          u=u, differing=differing))
+    acts = joint_actuators(canonical)
+    if Offer.INPUT_JACOBIAN in first.offers and acts is not None and canonical.actuators:
+        k = min(INPUT_STATES, len(batch.q))
+        q, v = batch.q[:k], batch.v[:k]
+        inside = sample_controls(canonical.actuators, k, seed, spread=0.8)
+        reference = ReferenceModel(canonical).dynamics(q, v, np.zeros_like(v))
+        try:
+            found = first.input_jacobians(q, v, inside)
+        except Exception as exc:  # a failing engine costs its own rows
+            out.append(_row(model, subject="step Jacobian in the controls", field="B",
+                            a=first.engine, b="", verdict=Verdict.FAILED,
+                            note=f"{type(exc).__name__}: {exc}"))
+            found = ()
+        for jacobian in found:
+            out.append(input_jacobian.rows(
+                model, canon=canon, tree=canonical, acts=acts, mass=reference.mass_matrix,
+                bias=reference.bias, q=q, v=v, u=inside, found=jacobian))
+    return out, notes

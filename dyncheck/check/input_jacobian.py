@@ -1,0 +1,101 @@
+"""∂x₊/∂u in a model check: an engine's Jacobian of one step in its controls (MuJoCo's B, by
+``mjd_transitionFD``) against the chain rule through the referee — the book's general method
+on the engine's reading for M and h ((2.2.23)–(2.2.24)), the clean-room actuator law of
+:mod:`dyncheck.reference.actuation` for τ(u) —, differentiated in u by a complex step:
+
+    semi-implicit Euler:  v₊ = v + h M⁻¹ (τ(q, v, u) − h(q, v)),
+    implicitfast:         v₊ = v + h (M − h ∂τ/∂v)⁻¹ (τ(q, v, u) − h(q, v)),
+    q₊ = q ⊕ h v₊ (a rotation's tangent through J_r(h ω₊), as in :mod:`.steps`),
+    act₊ = act + h ȧ(u, act) (the filter's exact step where asked for),
+
+with the activation state equal to the control (as the engine's side sets it). The controls
+are sampled inside their ranges (a step's differences across a clamp's corner would measure
+neither side)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dyncheck.adapters.actuators import InputJacobian
+from dyncheck.adapters.layout import Canonical
+from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.check.describe import depth
+from dyncheck.check.rows import CheckRow, Section
+from dyncheck.check.steps import right_jacobian
+from dyncheck.precision import EPS, ROUNDOFF_FACTOR
+from dyncheck.reference import actuation as law
+from dyncheck.results import Verdict
+from dyncheck.vocabulary import Integrator, JointType
+
+COMPLEX_STEP = 1e-30
+"""The complex step in u: exact to round-off whatever its size (no subtraction)."""
+
+
+def chain_rule(canon: Canonical, acts: law.JointActuators, *, mass: np.ndarray,
+               bias: np.ndarray, q: np.ndarray, v: np.ndarray, u: np.ndarray, h: float,
+               integrator: str) -> np.ndarray:
+    """The referee's ∂x₊/∂u at one state (2 nv + na, nu), x = (δq, v, act)."""
+    nv, nu = len(v), len(u)
+    stateful = np.flatnonzero(acts.stateful)
+    out = np.zeros((2 * nv + len(stateful), nu))
+    implicit = integrator == Integrator.IMPLICITFAST
+    for k in range(nu):
+        pushed = u.astype(complex)
+        pushed[k] += 1j * COMPLEX_STEP
+        tau = law.generalized_force(acts, q[None], v[None], pushed[None], act=u[None])[0]
+        solve = mass - h * law.velocity_derivative(acts, q[None], v[None], pushed[None],
+                                                   act=u[None])[0] if implicit else mass
+        v_next = v + h * np.linalg.solve(solve, tau - bias)
+        act_next = law.activation_step(acts, pushed[None], u[None].astype(complex), h)[0]
+        dv = v_next.imag / COMPLEX_STEP
+        dq = h * dv
+        for j, kind in enumerate(canon.types):
+            vs = canon.v_start[j]
+            turning = slice(vs + 3, vs + 6) if kind is JointType.FREE else \
+                slice(vs, vs + 3) if kind is JointType.BALL else None
+            if turning is not None:
+                dq[turning] = right_jacobian(h * v_next.real[turning]) @ (h * dv[turning])
+        out[:nv, k], out[nv:2 * nv, k] = dq, dv
+        out[2 * nv:, k] = act_next.imag[stateful] / COMPLEX_STEP
+    return out
+
+
+def rows(model: str, *, canon: Canonical, tree: ModelTree, acts: law.JointActuators,
+         mass: np.ndarray, bias: np.ndarray, q: np.ndarray, v: np.ndarray, u: np.ndarray,
+         found: InputJacobian) -> CheckRow:
+    """The engine's B against :func:`chain_rule` at every state: one row. Tolerance as the
+    step Jacobian's (:func:`dyncheck.check.steps.step_rows`): round-off, the engine's
+    centered differences' error |B(2s) − B(s)|/3 and their round-off over 2 s, v₊'s
+    round-off amplified by κ(M)."""
+    h, engine = found.time_step, tree.engine
+    expected = np.stack([chain_rule(canon, acts, mass=mass[s], bias=bias[s], q=q[s], v=v[s],
+                                    u=u[s], h=h, integrator=found.integrator)
+                         for s in range(len(q))])
+    off = np.abs(found.matrix - expected)
+    scale = max(float(np.abs(expected).max(initial=0.0)), 1e-300)
+    x_scale = max(float(np.abs(q).max()), float(np.abs(v).max()), float(np.abs(u).max()), 1.0)
+    kappa = np.linalg.cond(mass)[:, None, None]
+    acceleration = np.abs(np.linalg.solve(mass, bias[..., None])[..., 0]).max(axis=1)
+    amplified = (2 * ROUNDOFF_FACTOR * EPS * depth(tree) * kappa * h
+                 * (acceleration[:, None, None] + x_scale) / (2 * found.fd_step))
+    fd = np.abs(found.coarse - found.matrix) / 3 + \
+        2 * ROUNDOFF_FACTOR * EPS * depth(tree) * x_scale / (2 * found.fd_step) + amplified
+    allowed = ROUNDOFF_FACTOR * EPS * depth(tree) * scale + fd
+    worst = np.unravel_index(int(np.argmax(off / allowed)), off.shape)
+    within = bool(np.all(off <= allowed))
+    return CheckRow(
+        model=model, section=Section.ACTUATION,
+        subject=f"step Jacobian in the controls ({found.integrator} at h = {h:g})",
+        field="max rel error", impl_a="reference", impl_b=engine, value_a="", value_b="",
+        error=float(off.max()) / scale, tolerance=float(allowed.max()) / scale,
+        basis=(f"the chain rule through the referee's M, h and actuator law (complex step "
+               f"in u); round-off {ROUNDOFF_FACTOR} eps x tree depth {depth(tree)}; + "
+               f"{engine}'s centered differences' error (steps {found.fd_step:g}, "
+               f"{2 * found.fd_step:g}); controls inside their ranges"),
+        verdict=Verdict.PASSED if within else Verdict.FAILED,
+        note="" if within else (
+            f"{engine} differs from the chain rule at state {worst[0]}, entry ({worst[1]}, "
+            f"{worst[2]}): {off[worst]:.3g} beyond its predicted {allowed[worst]:.3g}: "
+            "cause unknown"),
+        worst_state=int(worst[0]))
+
