@@ -11,6 +11,7 @@ dynamics is evaluated with its activation state equal to its control.
 from __future__ import annotations
 
 import copy
+import xml.etree.ElementTree as ET
 
 import mujoco
 import numpy as np
@@ -22,7 +23,14 @@ from dyncheck.adapters.actuators import (
     InputJacobian,
     Transmission,
 )
+from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.vocabulary import Integrator
+
+UNREAD_TRANSMISSIONS = (
+    "MuJoCo's URDF compiler makes no actuator of a URDF's <transmission> ({count} in the "
+    "file): MuJoCo holds none (fix: add <actuator> elements to an MJCF of the robot, e.g. the "
+    "one MuJoCo writes from the URDF with mj_saveLastXML)"
+)
 
 _DYNAMICS = {
     int(mujoco.mjtDyn.mjDYN_NONE): Activation.NONE,
@@ -96,6 +104,15 @@ def read(m: mujoco.MjModel, joint_names: list[str]) -> tuple[Actuator, ...]:
             act_range=_range(m.actuator_actlimited[k], m.actuator_actrange[k]),
             what=f"<{_kind(gain, bias)}> {name!r}" + (f" ({why})" if why else "")))
     return tuple(out)
+
+
+def file_hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
+    """Why MuJoCo holds no actuator the file states (a URDF's transmissions, counted on the
+    file)."""
+    if source.format is not Format.URDF:
+        return ()
+    count = len(ET.fromstring(source.text).findall("transmission"))
+    return (("model", "actuator", UNREAD_TRANSMISSIONS.format(count=count)),) if count else ()
 
 
 def _range(limited: object, bounds: np.ndarray) -> tuple[float, float] | None:

@@ -206,7 +206,7 @@ class MujocoModel(MujocoActuation, ModelEngine):
             self._hints: tuple[tuple[str, str, str], ...] = (("model", "gravity", GRAVITY_OFF),)
         else:
             self._hints = ()
-        self._hints += _total_mass_hints(source)
+        self._hints += _total_mass_hints(source) + actuators.file_hints(source)
         m.opt.disableflags |= int(_SMOOTH_ONLY)
         m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
         self.data = mujoco.MjData(m)

@@ -111,6 +111,9 @@ class NewtonModel(ModelEngine):
 
     engine = ENGINE
     offers = frozenset({Offer.STEPPING})
+    no_actuation = ("newton's joint drives are not compared yet (dyncheck's gap: the target "
+                    "stiffness, damping and effort limits its MJCF importer reads from "
+                    "<position>, <velocity> and <motor>)")
 
     def __init__(self, source: ModelFile) -> None:
         import newton

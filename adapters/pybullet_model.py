@@ -94,6 +94,9 @@ class PybulletModel(ModelEngine):
 
     engine = ENGINE
     offers = frozenset({Offer.STEPPING})
+    no_actuation = ("pybullet's motors are not compared yet (dyncheck's gap: the velocity motors "
+                    "its loaders put on every joint, and those a script sets with "
+                    "setJointMotorControl2)")
 
     def __init__(self, source: ModelFile, *, gravity: np.ndarray | None = None) -> None:
         """``gravity``: what the user sets with ``setGravity`` (a URDF states none; PyBullet's

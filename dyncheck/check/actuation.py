@@ -114,7 +114,8 @@ def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[Che
         if k not in held:
             rows.append(_row(model, subject=theirs.name, field="actuator", a=a, b=b,
                              value_a="absent", value_b=theirs.what, verdict=Verdict.FAILED,
-                             note=_hint(other, theirs.name, "actuator")))
+                             note=canonical.hint("model", "actuator")
+                             or _hint(other, theirs.name, "actuator")))
     return rows
 
 
@@ -188,8 +189,8 @@ def force_rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: Sta
     rows: list[CheckRow] = []
     found: dict[str, Forces] = {}
     for engine, m in loaded.items():
-        if not m.tree.actuators and not canonical.actuators:
-            continue
+        if Offer.ACTUATION in m.offers and not m.tree.actuators:
+            continue  # (its reading rows say it holds none)
         if Offer.ACTUATION not in m.offers:
             rows.append(_row(model, subject="model", field=FORCE, a=engine, b="",
                              verdict=Verdict.SKIPPED, note=_unsupported(m)))
@@ -309,18 +310,23 @@ def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
     out: list[CheckRow] = []
     notes = []
     first = next(iter(loaded.values()))
-    unmodelled = [a.what for a in canonical.actuators if not a.modelled]
+    offering = [m for m in loaded.values() if Offer.ACTUATION in m.offers]
+    holding = next(m.tree for m in loaded.values() if m.tree.actuators)
+    unmodelled = [a.what for a in holding.actuators if not a.modelled]
     if unmodelled:
         notes.append(f"actuators outside the neutral form, compared by no other engine and "
                      f"not by the referee (MuJoCo-only): {', '.join(unmodelled)}")
     differing: dict[str, list[str]] = {}
-    for engine, m in loaded.items():
-        if m is not first and Offer.ACTUATION in m.offers:
-            found = reading_rows(model, canonical, m.tree)
-            out.extend(found)
-            differing[engine] = sorted({r.field for r in found if r.verdict is Verdict.FAILED})
-    u = sample_controls(canonical.actuators, len(batch.q), seed)
-    out.extend(force_rows(model, canon=canon, canonical=canonical, batch=batch, loaded=loaded,
+    for m in offering[1:]:  # each reading against the first engine's that has actuators
+        found = reading_rows(model, offering[0].tree, m.tree)
+        out.extend(found)
+        differing[m.engine] = sorted({r.field for r in found if r.verdict is Verdict.FAILED})
+    if offering:
+        notes.append(f"actuators: each engine's reading compared with {offering[0].engine}'s; "
+                     f"controls sampled for {holding.engine}'s actuators (see "
+                     "dyncheck/check/actuation.py), each engine's matched to them by joint")
+    u = sample_controls(holding.actuators, len(batch.q), seed)
+    out.extend(force_rows(model, canon=canon, canonical=holding, batch=batch, loaded=loaded,
                           u=u, differing=differing))
     acts = joint_actuators(canonical)
     if Offer.INPUT_JACOBIAN in first.offers and acts is not None and canonical.actuators:
@@ -329,13 +335,13 @@ def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
         inside = sample_controls(canonical.actuators, k, seed, spread=0.8)
         reference = ReferenceModel(canonical).dynamics(q, v, np.zeros_like(v))
         try:
-            found = first.input_jacobians(q, v, inside)
+            jacobians = first.input_jacobians(q, v, inside)
         except Exception as exc:  # a failing engine costs its own rows
             out.append(_row(model, subject="step Jacobian in the controls", field="B",
                             a=first.engine, b="", verdict=Verdict.FAILED,
                             note=f"{type(exc).__name__}: {exc}"))
-            found = ()
-        for jacobian in found:
+            jacobians = ()
+        for jacobian in jacobians:
             out.append(input_jacobian.rows(
                 model, canon=canon, tree=canonical, acts=acts, mass=reference.mass_matrix,
                 bias=reference.bias, q=q, v=v, u=inside, found=jacobian))

@@ -45,6 +45,8 @@ class Controls(StrEnum):
     DIFFERENTLY = "reads the controls differently"
     DIFFER = "computes a control's force differently from what it read"
     NOT_COMPARED = "controls not compared"
+    NONE = "holds no actuators"
+    """It holds none where another engine holds some (its reading rows say why)."""
     ABSENT = ""
     """No actuation rows: the model has no actuator, or they were not asked for."""
 
@@ -167,6 +169,8 @@ def _controls(engine: str, rows: pd.DataFrame) -> tuple[Controls, str]:
                 & ((rows["impl_a"] == engine) | (rows["impl_b"] == engine))]
     if part.empty:
         return Controls.ABSENT, ""
+    if ((part["impl_a"] == engine) & (part["value_a"] == "absent")).all():
+        return Controls.NONE, _first_notes(part, 1)
     failed = part[part["verdict"] == Verdict.FAILED]
     read = failed[(failed["impl_b"] == engine) & (failed["field"] != COMPUTED)]
     if not read.empty:

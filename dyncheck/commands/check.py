@@ -6,7 +6,7 @@ import argparse
 import sys
 import tempfile
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from dyncheck.commands import flags
 from dyncheck.commands.flags import Command
@@ -103,6 +103,14 @@ def check_command(args: argparse.Namespace) -> int:
         return _check_all(args, _check_targets(args, Path(cases)), Path(cases))
 
 
+def _options(args: argparse.Namespace) -> dict[str, Any]:
+    """``check_model``'s keyword arguments from the command's flags."""
+    return {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
+            "floating": args.floating, "against": args.against, "isolate": not args.in_process,
+            "limits": _limits(args), "derivatives": args.derivatives,
+            "actuators": not args.no_actuators, "say": None if args.quiet else say}
+
+
 def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
                cases: Path) -> int:
     from functools import partial
@@ -114,9 +122,8 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     from dyncheck.progress import Progress
     from dyncheck.workers import each_unit
 
-    names = index.page_names([p for p, _ in targets])
-    names = [robot.replace("/", "__") if robot else name
-             for (_, robot), name in zip(targets, names, strict=True)]
+    names = [robot.replace("/", "__") if robot else name for (_, robot), name in
+             zip(targets, index.page_names([p for p, _ in targets]), strict=True)]
     several = len(targets) > 1
     base = index.common_folder([p for p, _ in targets])
     files = {name: f"robot {robot}" if robot else f"book case {p.stem}" if p.parent == cases
@@ -145,10 +152,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     ci_files(args, read)
     positive("--jobs", args.jobs)
     claim_out(args.out)  # every option checked: the folder held for this command
-    options = {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
-               "floating": args.floating, "against": args.against,
-               "isolate": not args.in_process, "limits": _limits(args),
-               "derivatives": args.derivatives, "say": None if args.quiet else say}
+    options = _options(args)
     units = [(name, partial(check_model, **options, name=robot or (name if several else None)),
               (str(path),)) for path, robot, name in valid]
     engines = tuple(i for i in implementations(tuple(args.impl) or None) if i != "reference")
@@ -210,6 +214,10 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--derivatives", action="store_true",
                    help="also compare the derivatives of the dynamics (d(forward)/d(q, v, tau), "
                    "d(inverse)/d(q, v)) of every engine that offers them with the referee's")
+    p.add_argument("--no-actuators", action="store_true",
+                   help="leave the actuators out (by default, where the model has actuators, "
+                   "each engine's reading of them, their force at sampled controls and MuJoCo's "
+                   "step Jacobian in the controls are compared)")
     p.add_argument("--against", type=path_arg, default=None, metavar="PATH",
                    help="also compare what MuJoCo reads with this other file (a previous version)")
     p.add_argument("--out", type=path_arg, default=Path("reports/check"), help="output folder")

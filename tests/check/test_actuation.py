@@ -1,0 +1,146 @@
+"""The actuation section of a model check (dyncheck/check/actuation.py,
+dyncheck/check/input_jacobian.py): each engine's reading of the actuators, their force against
+the referee's law and another engine, MuJoCo's B against the chain rule — and mutations that
+must fail."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from dyncheck.adapters import mujoco_actuators
+from dyncheck.check.model_check import check_model
+from dyncheck.check.verdicts import Controls, per_engine
+
+AXES = ("0 0 1", "0 1 0", "0 1 0", "0 0 1", "0 1 0", "0 0 1", "0 1 0")
+
+
+def arm(actuator: str) -> str:
+    """A 7-joint arm, every joint driven by ``actuator`` (``{j}``: its joint's name)."""
+    bodies, close = "", ""
+    for k, axis in enumerate(AXES):
+        bodies += (f'<body name="link{k}" pos="0 0 {0.1 if k else 0.3}">'
+                   f'<joint name="j{k}" type="hinge" axis="{axis}"/>'
+                   f'<geom type="capsule" fromto="0 0 0 0.02 0 0.1" size="0.03" '
+                   f'mass="{1.5 - 0.15 * k:g}"/>')
+        close += "</body>"
+    acts = "".join(actuator.format(j=f"j{k}") for k in range(len(AXES)))
+    return (f'<mujoco model="arm"><worldbody>{bodies}{close}</worldbody>'
+            f"<actuator>{acts}</actuator></mujoco>")
+
+
+SERVOS = ('<position joint="{j}" kp="50" kv="5" ctrlrange="-1.5 1.5" forcerange="-40 40"/>')
+MOTORS = '<motor joint="{j}" ctrlrange="-2 2" forcerange="-2 2"/>'
+
+
+@pytest.fixture(scope="module")
+def servo_arm(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("arm") / "servo_arm.xml"
+    path.write_text(arm(SERVOS))
+    return path
+
+
+def _rows(result, **match):
+    rows = result.rows[result.rows["section"] == "actuation"]
+    for column, value in match.items():
+        rows = rows[rows[column] == value]
+    return rows
+
+
+def test_b_against_the_chain_rule_on_a_servo_arm(servo_arm):
+    """MuJoCo's B (mjd_transitionFD) of an Euler and an implicitfast step of a 7-joint arm of
+    position servos agrees with the chain rule through the referee (independent: the book's
+    general method and the clean-room actuator law), within the finite differences' bound."""
+    result = check_model(servo_arm, impls=("mujoco", "reference"), states=8, isolate=False)
+    steps = _rows(result, impl_b="mujoco")
+    steps = steps[steps["subject"].str.startswith("step Jacobian in the controls")]
+    assert sorted(s.split("(")[1].split(" ")[0] for s in steps["subject"]) == [
+        "euler", "implicitfast"]
+    assert (steps["verdict"] == "passed").all(), steps[["subject", "error", "tolerance"]]
+    force = _rows(result, subject="actuator force", impl_a="reference", impl_b="mujoco")
+    assert list(force["verdict"]) == ["passed"]
+
+
+def test_a_gear_changed_by_one_percent_in_a_reading_fails(servo_arm, monkeypatch):
+    """Mutation: MuJoCo's reading of one actuator's gear 1 % off what it computes with — its
+    force against the referee on that reading fails, and so does its B."""
+    real = mujoco_actuators.read
+
+    def off(m, names):
+        found = real(m, names)
+        return (replace(found[0], gear=found[0].gear * 1.01), *found[1:])
+
+    monkeypatch.setattr(mujoco_actuators, "read", off)
+    result = check_model(servo_arm, impls=("mujoco", "reference"), states=8, isolate=False)
+    computed = _rows(result, impl_a="reference", impl_b="mujoco")
+    assert len(computed) == 3 and (computed["verdict"] == "failed").all()
+
+
+def test_drake_reads_a_servo_otherwise_with_its_cause(servo_arm):
+    """Drake's MJCF parser drops kv (it reads 'kd') and makes the ctrlrange an effort limit:
+    failed reading rows with those causes, and the force of the same controls differs from
+    MuJoCo's (measured) while Drake computes what it read (the referee on its reading)."""
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    result = check_model(servo_arm, impls=("mujoco", "drake", "reference"), states=20)
+    read = _rows(result, impl_b="drake", verdict="failed")
+    assert {"bias", "limits"} <= set(read["field"])
+    assert read[read["field"] == "bias"]["note"].str.contains("'kd'").all()
+    assert list(_rows(result, impl_a="reference", impl_b="drake")["verdict"]) == ["passed"]
+    assert list(_rows(result, impl_a="mujoco", impl_b="drake",
+                      subject="actuator force")["verdict"]) == ["failed"]
+    drake = next(v for v in per_engine(result.rows, result.impls) if v.engine == "drake")
+    assert drake.controls is Controls.DIFFERENTLY and "'kd'" in drake.line()
+
+
+def test_motors_drake_reads_alike_give_the_same_force(tmp_path):
+    """Gear-1 motors whose ctrlrange and forcerange agree: Drake's effort limit is that bound,
+    so it reads them alike and the same controls give MuJoCo's force (another engine as the
+    expected value), clamped in a third of the samples."""
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    path = tmp_path / "motor_arm.xml"
+    path.write_text(arm(MOTORS))
+    result = check_model(path, impls=("mujoco", "drake", "reference"), states=30)
+    assert (_rows(result, impl_b="drake")["verdict"] == "passed").all()
+    pair = _rows(result, impl_a="mujoco", impl_b="drake", subject="actuator force")
+    assert list(pair["verdict"]) == ["passed"]
+    basis = _rows(result, impl_a="reference", impl_b="mujoco")["basis"].iloc[0]
+    assert not basis.split("; ")[-1].startswith("0 controls clamped"), basis
+    drake = next(v for v in per_engine(result.rows, result.impls) if v.engine == "drake")
+    assert drake.controls is Controls.ALIKE
+
+
+def test_an_engine_without_actuators_says_so_once(servo_arm):
+    """Pinocchio holds no actuator model: one skipped row naming its limit, not one per
+    actuator."""
+    result = check_model(servo_arm, impls=("mujoco", "pinocchio"), states=5)
+    rows = _rows(result, impl_a="pinocchio")
+    assert list(rows["verdict"]) == ["skipped"]
+    assert "holds no actuators" in rows["note"].iloc[0]
+
+
+def test_no_actuators_leaves_the_section_out(servo_arm):
+    result = check_model(servo_arm, impls=("mujoco", "reference"), states=5, actuators=False)
+    assert _rows(result).empty
+
+
+def test_mujoco_holds_none_of_a_urdfs_transmissions(tmp_path):
+    """A URDF's <transmission> becomes a Drake joint actuator and no MuJoCo actuator: the
+    row names MuJoCo's URDF compiler (premise counted on the file)."""
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    path = tmp_path / "one.urdf"
+    path.write_text(
+        '<robot name="one"><link name="base"/><link name="l1"><inertial><mass value="1"/>'
+        '<origin xyz="0 0 0.5"/><inertia ixx="0.1" iyy="0.1" izz="0.01" ixy="0" ixz="0" '
+        'iyz="0"/></inertial></link><joint name="j1" type="revolute"><parent link="base"/>'
+        '<child link="l1"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="5" '
+        'velocity="1"/></joint><transmission name="t1"><type>transmission_interface/'
+        'SimpleTransmission</type><joint name="j1"><hardwareInterface>EffortJointInterface'
+        '</hardwareInterface></joint><actuator name="m1"><mechanicalReduction>1'
+        '</mechanicalReduction></actuator></transmission></robot>')
+    result = check_model(path, impls=("mujoco", "drake", "reference"), states=5)
+    absent = _rows(result, field="actuator", value_a="absent")
+    assert len(absent) == 1 and "URDF compiler" in absent["note"].iloc[0]
+    mujoco = next(v for v in per_engine(result.rows, result.impls) if v.engine == "mujoco")
+    assert mujoco.controls is Controls.NONE
