@@ -39,6 +39,7 @@ from dyncheck.explain.engine_defaults import (
     passive_damping,
     point_mass_floor,
 )
+from dyncheck.explain.actuators import drake_mjcf_actuators
 from dyncheck.explain.entry import Entry
 from dyncheck.explain.integrators import drake_fsal_caching, group_rk4, port_integrators
 from dyncheck.explain.moving import (
@@ -89,6 +90,7 @@ DEMOS: dict[str, tuple[Callable[[], Entry], Origin]] = {
     "derivative-chart": (derivative_chart, Origin.MATHEMATICS),
     "pinocchio-composite-derivatives": (composite_derivatives, Origin.ENGINE),
     "pybullet-spherical-inertia": (pybullet_spherical_inertia, Origin.ENGINE),
+    "drake-mjcf-actuators": (drake_mjcf_actuators, Origin.ENGINE),
 }
 """Conventions demonstrated by a run of their own, with whose property each is; the others
 (point-mass inertia floor, MJCF gravity, held forces, soft constraints: :mod:`.explanations`)
@@ -121,6 +123,7 @@ REQUIRES: dict[str, tuple[str, ...]] = {
     "pybullet-default-motors": ("pybullet",),
     "newton-several-joints-on-a-body": ("newton",),
     "pybullet-spherical-inertia": ("pybullet",),
+    "drake-mjcf-actuators": ("drake",),
 }
 """Demonstrations that need an optional engine (MuJoCo and Pinocchio are core dependencies)."""
 

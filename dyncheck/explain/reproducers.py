@@ -194,6 +194,44 @@ print(f"observed w_dot {observed.round(6).tolist()} (one stepSimulation)")
 sys.exit(0 if gap <= 1e-8 else 1)
 '''
 
+_DRAKE_SERVO = '''\
+"""Drake's MJCF parser misreads a <position> servo: it looks for its damping under 'kd',
+which MJCF does not have (the file's kv is lost), and takes its effort limit from the
+ctrlrange (a bound on the target position) as well as the forcerange. Expected: MuJoCo's
+documented servo, tau = clamp(kp (u - q) - kv v, forcerange). Exits 1 while it does not."""
+import sys
+
+import numpy as np
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant
+
+KP, KV, FORCES = 5.0, 2.0, 8.0
+MJCF = f"""<mujoco model="servo"><worldbody><body name="link" pos="0 0 1">
+<joint name="j" type="hinge" axis="0 1 0"/>
+<geom type="capsule" fromto="0 0 0 0 0 -0.5" size="0.05" mass="1"/></body></worldbody>
+<actuator><position name="servo" joint="j" kp="{KP:g}" kv="{KV:g}" ctrlrange="-1.5 1.5"
+forcerange="-{FORCES:g} {FORCES:g}"/></actuator></mujoco>"""
+STATES = ((0.1, 0.5, 1.2), (-0.4, -1.5, 0.3), (0.8, 0.2, -1.0), (0.0, 3.0, 0.9))  # q, v, u
+
+plant = MultibodyPlant(0.0)
+Parser(plant).AddModelsFromString(MJCF, "xml")
+plant.Finalize()
+context = plant.CreateDefaultContext()
+plant.get_actuation_input_port().FixValue(context, [0.0])
+desired = plant.get_desired_state_input_port(plant.GetModelInstanceByName("servo"))
+expected, observed = [], []
+for q, v, u in STATES:
+    plant.SetPositions(context, [q])
+    plant.SetVelocities(context, [v])
+    desired.FixValue(context, [u, 0.0])
+    observed.append(float(plant.get_net_actuation_output_port().Eval(context)[0]))
+    expected.append(float(np.clip(KP * (u - q) - KV * v, -FORCES, FORCES)))
+gap = float(np.abs(np.array(observed) - expected).max())
+print(f"expected servo torque {expected} (MuJoCo's <position>, kv and forcerange read)")
+print(f"observed servo torque {observed} (Drake's joint actuator as its MJCF parser made it)")
+sys.exit(0 if gap <= 1e-12 else 1)
+'''
+
 REPRODUCERS: dict[str, Reproducer] = {
     "pinocchio-mjcf-options": Reproducer(
         engine="pinocchio", imports=frozenset({"numpy", "pinocchio"}),
@@ -206,6 +244,8 @@ REPRODUCERS: dict[str, Reproducer] = {
     "pybullet-spherical-inertia": Reproducer(
         engine="pybullet", imports=frozenset({"numpy", "pybullet"}),
         script=_PYBULLET_SPHERICAL),
+    "drake-mjcf-actuators": Reproducer(
+        engine="drake", imports=frozenset({"numpy", "pydrake"}), script=_DRAKE_SERVO),
 }
 """Catalogue entry → its reproducer: the entries whose difference is an engine's defect (a
 documented input it drops, a derivative it gets wrong), not a convention it documents."""
