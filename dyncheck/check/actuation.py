@@ -87,8 +87,16 @@ def _hint(tree: ModelTree, actuator: str, field: str) -> str:
 def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[CheckRow]:
     """Each actuator of ``other`` against the canonical reading: one passed row where every
     field agrees, else a failed row per differing field with the engine's known reason
-    (its hint, premise checked) or "cause unknown"; an actuator one side lacks, a row."""
+    (its hint, premise checked) or "cause unknown"; an actuator one side lacks, a row — but
+    where the canonical engine holds none at all, one row: explained where its reason is
+    known (MuJoCo's URDF compiler makes no actuator: the format gives it none to read)."""
     a, b = canonical.engine, other.engine
+    why = canonical.hint("model", "actuator")
+    if not canonical.actuators and other.actuators:  # once, not once per actuator
+        return [_row(model, subject="model", field="actuators", a=a, b=b, value_a="none",
+                     value_b=f"{len(other.actuators)} ({other.actuators[0].what}, …)",
+                     verdict=Verdict.EXPLAINED if why else Verdict.FAILED,
+                     note=why or UNKNOWN)]
     pairs = match(canonical.actuators, other.actuators)
     rows = []
     for k, mine in enumerate(canonical.actuators):
@@ -114,8 +122,7 @@ def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[Che
         if k not in held:
             rows.append(_row(model, subject=theirs.name, field="actuator", a=a, b=b,
                              value_a="absent", value_b=theirs.what, verdict=Verdict.FAILED,
-                             note=canonical.hint("model", "actuator")
-                             or _hint(other, theirs.name, "actuator")))
+                             note=why or _hint(other, theirs.name, "actuator")))
     return rows
 
 

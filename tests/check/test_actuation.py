@@ -76,6 +76,8 @@ def test_a_gear_changed_by_one_percent_in_a_reading_fails(servo_arm, monkeypatch
     result = check_model(servo_arm, impls=("mujoco", "reference"), states=8, isolate=False)
     computed = _rows(result, impl_a="reference", impl_b="mujoco")
     assert len(computed) == 3 and (computed["verdict"] == "failed").all()
+    (mujoco,) = per_engine(result.rows, result.impls)
+    assert mujoco.controls is Controls.DIFFER and not mujoco.ok
 
 
 def test_drake_reads_a_servo_otherwise_with_its_cause(servo_arm):
@@ -118,6 +120,8 @@ def test_an_engine_without_actuators_says_so_once(servo_arm):
     rows = _rows(result, impl_a="pinocchio")
     assert list(rows["verdict"]) == ["skipped"]
     assert "holds no actuators" in rows["note"].iloc[0]
+    pinocchio = next(v for v in per_engine(result.rows, result.impls) if v.engine == "pinocchio")
+    assert pinocchio.controls is Controls.NOT_COMPARED
 
 
 def test_no_actuators_leaves_the_section_out(servo_arm):
@@ -126,8 +130,8 @@ def test_no_actuators_leaves_the_section_out(servo_arm):
 
 
 def test_mujoco_holds_none_of_a_urdfs_transmissions(tmp_path):
-    """A URDF's <transmission> becomes a Drake joint actuator and no MuJoCo actuator: the
-    row names MuJoCo's URDF compiler (premise counted on the file)."""
+    """A URDF's <transmission> becomes a Drake joint actuator and no MuJoCo actuator: one
+    explained row naming MuJoCo's URDF compiler (premise counted on the file)."""
     pytest.importorskip("pydrake", reason="the drake extra is not installed")
     path = tmp_path / "one.urdf"
     path.write_text(
@@ -140,7 +144,8 @@ def test_mujoco_holds_none_of_a_urdfs_transmissions(tmp_path):
         '</hardwareInterface></joint><actuator name="m1"><mechanicalReduction>1'
         '</mechanicalReduction></actuator></transmission></robot>')
     result = check_model(path, impls=("mujoco", "drake", "reference"), states=5)
-    absent = _rows(result, field="actuator", value_a="absent")
-    assert len(absent) == 1 and "URDF compiler" in absent["note"].iloc[0]
-    mujoco = next(v for v in per_engine(result.rows, result.impls) if v.engine == "mujoco")
-    assert mujoco.controls is Controls.NONE
+    (row,) = _rows(result, field="actuators", value_a="none").itertuples()
+    assert row.verdict == "explained" and "URDF compiler" in row.note and "(1 in" in row.note
+    verdicts = {v.engine: v for v in per_engine(result.rows, result.impls)}
+    assert verdicts["mujoco"].controls is Controls.NONE
+    assert verdicts["drake"].controls is Controls.EXPLAINED
