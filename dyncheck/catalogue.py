@@ -16,6 +16,7 @@ from functools import partial
 import numpy as np
 
 from dyncheck.errors import EngineNotInstalled, UnknownName
+from dyncheck.explain.actuators import drake_mjcf_actuators
 from dyncheck.explain.charts import composite_derivatives, derivative_chart
 from dyncheck.explain.constraints import (
     drake_equality,
@@ -39,7 +40,6 @@ from dyncheck.explain.engine_defaults import (
     passive_damping,
     point_mass_floor,
 )
-from dyncheck.explain.actuators import drake_mjcf_actuators
 from dyncheck.explain.entry import Entry
 from dyncheck.explain.integrators import drake_fsal_caching, group_rk4, port_integrators
 from dyncheck.explain.moving import (

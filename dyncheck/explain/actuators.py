@@ -50,9 +50,9 @@ def mujoco_forces() -> np.ndarray:
 def drake_forces(*, fixed: bool) -> np.ndarray:
     """Drake's net actuation at :data:`STATES` (the control its PD target), as its parser
     makes the servo or, ``fixed``, with the file's kv and forcerange set on it."""
+    from pydrake.multibody.parsing import Parser
     from pydrake.multibody.plant import MultibodyPlant
     from pydrake.multibody.tree import PdControllerGains
-    from pydrake.multibody.parsing import Parser
 
     plant = MultibodyPlant(0.0)
     Parser(plant).AddModelsFromString(SERVO, "xml")
