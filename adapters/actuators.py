@@ -7,6 +7,7 @@ into a generalized force on that joint,
     τ = g · clamp(f, forcerange),   f = gain · a + bias,
     gain = g₀ + g₁ L + g₂ L̇,       bias = b₀ + b₁ L + b₂ L̇,    L = g q,  L̇ = g v,
 
+(the sum of a joint's actuators' τ then held in the joint's own range, where it has one),
 with a = clamp(u, ctrlrange) where it has no activation dynamics, and otherwise its
 activation state (integrator: ȧ = u; filter: ȧ = (u − a)/t). A motor is gain (1, 0, 0),
 bias 0; a position servo gain (kp, 0, 0), bias (0, −kp, −kv); a velocity servo gain
@@ -65,6 +66,9 @@ class Actuator:
     time_constant: float = 0.0
     """A filter's t (s); 0 otherwise."""
     act_range: Range = None
+    joint_range: Range = None
+    """Its joint's bound on the sum of the forces of every actuator on it (MuJoCo's
+    ``actuatorfrcrange``; its URDF compiler makes one of a joint's ``<limit effort>``)."""
     what: str = ""
     """How the engine names it (``<position> 'elbow'``, Drake's ``JointActuator 'motor0'``)."""
 

@@ -67,8 +67,6 @@ def _unmodelled(m: mujoco.MjModel, k: int) -> str:
         return "its gain or bias is not affine (muscle, user or another law)"
     if int(m.actuator_dyntype[k]) not in _DYNAMICS or m.actuator_actearly[k]:
         return "its activation dynamics are not none, integrator or filter (or act early)"
-    if m.jnt_actfrclimited[joint]:
-        return "its joint's actuatorfrcrange clamps the actuators' sum"
     for extra in ("actuator_delay", "actuator_damping", "actuator_armature"):
         if hasattr(m, extra) and np.any(np.asarray(getattr(m, extra))[k] != 0):
             return f"its {extra.removeprefix('actuator_')} is not zero"
@@ -102,6 +100,8 @@ def read(m: mujoco.MjModel, joint_names: list[str]) -> tuple[Actuator, ...]:
             time_constant=float(m.actuator_dynprm[k, 0])
             if activation in (Activation.FILTER, Activation.FILTER_EXACT) else 0.0,
             act_range=_range(m.actuator_actlimited[k], m.actuator_actrange[k]),
+            joint_range=_range(m.jnt_actfrclimited[m.actuator_trnid[k, 0]],
+                               m.jnt_actfrcrange[m.actuator_trnid[k, 0]]) if jointed else None,
             what=f"<{_kind(gain, bias)}> {name!r}" + (f" ({why})" if why else "")))
     return tuple(out)
 

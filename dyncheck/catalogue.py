@@ -109,6 +109,7 @@ TUTORIALS: dict[str, str] = {
     "pybullet-inertia-source": "10_moving_to_pybullet",
     "pybullet-default-motors": "10_moving_to_pybullet",
     "newton-several-joints-on-a-body": "11_moving_to_newton",
+    "drake-mjcf-actuators": "12_the_same_action",
 }
 """The executed tutorial (``reports/tutorials/NAME.md``) that teaches an entry step by step."""
 

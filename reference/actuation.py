@@ -43,6 +43,9 @@ class JointActuators:
     time_constant: np.ndarray
     act_low: np.ndarray
     act_high: np.ndarray
+    joint_low: np.ndarray
+    joint_high: np.ndarray
+    """Each actuator's joint's bound on the sum of its actuators' τ (±inf where none)."""
 
     @property
     def stateful(self) -> np.ndarray:
@@ -73,18 +76,24 @@ def scalar_forces(acts: JointActuators, q: np.ndarray, v: np.ndarray, u: np.ndar
 
 def generalized_force(acts: JointActuators, q: np.ndarray, v: np.ndarray, u: np.ndarray, *,
                       act: np.ndarray | None = None) -> np.ndarray:
-    """τ (n, nv): every actuator's g · f on its joint's velocity coordinate, summed."""
+    """τ (n, nv): every actuator's g · f on its joint's velocity coordinate, summed, and held
+    in the joint's range."""
     forces = acts.gear * scalar_forces(acts, q, v, u, act=act)
     out = np.zeros((len(q), v.shape[1]), dtype=np.result_type(forces, float))
+    low, high = np.full(v.shape[1], -np.inf), np.full(v.shape[1], np.inf)
     for k, dof in enumerate(acts.dof):
         out[:, dof] += forces[:, k]
-    return out
+        low[dof], high[dof] = acts.joint_low[k], acts.joint_high[k]
+    return clamp(out, low, high)
 
 
 def velocity_derivative(acts: JointActuators, q: np.ndarray, v: np.ndarray, u: np.ndarray,
                         *, act: np.ndarray | None = None) -> np.ndarray:
     """∂τ/∂v (n, nv, nv) where no force bound holds: g² (g₂ a + b₂) on each actuator's
-    joint (0 where clamped) — the matrix an implicit-in-velocity step solves with."""
+    joint (0 where its forcerange holds it) — the matrix an implicit-in-velocity step solves
+    with. A joint's own range is not applied: MuJoCo's implicitfast differentiates the
+    actuators' forces before it (``mjd_actuator_vel``, engine_derivative.c), and this is that
+    integrator's definition."""
     length = acts.gear * q[:, acts.q_index]
     speed = acts.gear * v[:, acts.dof]
     driven = clamp(u, acts.ctrl_low, acts.ctrl_high)

@@ -46,17 +46,19 @@ def _row(model: str, *, subject: str, field: str, a: str, b: str, verdict: Verdi
 
 def limits(actuator: Actuator) -> object:
     """The bounds as they act: for a motor-like law (fixed gain, no bias) the force interval
-    both ranges leave, gain × control range ∩ force range; else the two ranges as given."""
+    the ranges leave, gain × control range ∩ force range ∩ the joint's range; else the three
+    ranges as given."""
     if actuator.gain[1:] == (0.0, 0.0) and actuator.bias == (0.0, 0.0, 0.0) and \
             actuator.activation is Activation.NONE:
         low, high = -np.inf, np.inf
         if actuator.ctrl_range is not None:
             ends = sorted(actuator.gain[0] * np.array(actuator.ctrl_range))
             low, high = ends[0], ends[1]
-        if actuator.force_range is not None:
-            low, high = max(low, actuator.force_range[0]), min(high, actuator.force_range[1])
+        for bound in (actuator.force_range, actuator.joint_range):
+            if bound is not None:
+                low, high = max(low, bound[0]), min(high, bound[1])
         return None if not (np.isfinite(low) or np.isfinite(high)) else (float(low), float(high))
-    return (actuator.ctrl_range, actuator.force_range)
+    return (actuator.ctrl_range, actuator.force_range, actuator.joint_range)
 
 
 def compared_fields(actuator: Actuator) -> dict[str, object]:
@@ -136,8 +138,8 @@ def joint_actuators(tree: ModelTree) -> law.JointActuators | None:
     def bounds(ranges: list[tuple[float, float] | None]) -> tuple[np.ndarray, np.ndarray]:
         return (np.array([r[0] if r else -np.inf for r in ranges]),
                 np.array([r[1] if r else np.inf for r in ranges]))
-    ctrl, force, act = (bounds([getattr(a, f) for a in acts])
-                        for f in ("ctrl_range", "force_range", "act_range"))
+    ctrl, force, act, joint = (bounds([getattr(a, f) for a in acts])
+                               for f in ("ctrl_range", "force_range", "act_range", "joint_range"))
     return law.JointActuators(
         dof=np.array([tree.joint(a.joint).layout.v_start for a in acts], int),
         q_index=np.array([tree.joint(a.joint).layout.q_start for a in acts], int),
@@ -146,7 +148,7 @@ def joint_actuators(tree: ModelTree) -> law.JointActuators | None:
         force_low=force[0], force_high=force[1],
         dynamics=np.array([DYNAMICS[a.activation] for a in acts], int),
         time_constant=np.array([a.time_constant for a in acts]),
-        act_low=act[0], act_high=act[1])
+        act_low=act[0], act_high=act[1], joint_low=joint[0], joint_high=joint[1])
 
 
 def sample_controls(actuators: tuple[Actuator, ...], n: int, seed: int, *,

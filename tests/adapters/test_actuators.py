@@ -124,3 +124,18 @@ def test_the_forward_dynamics_carry_the_force(files):
         smooth = engine.dynamics(q, v, np.zeros_like(v))
         moved = np.linalg.solve(smooth.mass_matrix, with_u.tau[..., None])[..., 0]
         assert with_u.forward - smooth.forward == pytest.approx(moved, rel=1e-12)
+
+
+def test_mujoco_reads_a_joints_actuator_force_range(tmp_path):
+    """A joint's actuatorfrcrange (what MuJoCo's URDF compiler makes of <limit effort>) holds
+    the sum of its actuators: a motor of gear 3 at u = 1 makes 3, held at 2."""
+    from dyncheck.adapters.mujoco_model import MujocoModel
+
+    path = tmp_path / "held.xml"
+    path.write_text(MJCF.replace('type="hinge"', 'type="hinge" actuatorfrcrange="-2 2"')
+                    .format(actuator='<motor joint="j" gear="3"/>'))
+    engine = MujocoModel(read(path))
+    (actuator,) = engine.tree.actuators
+    assert actuator.joint_range == (-2.0, 2.0) and actuator.transmission is Transmission.JOINT
+    tau = engine.actuation(np.array([[0.1]]), np.array([[0.0]]), np.array([[1.0]])).tau
+    assert float(tau[0, 0]) == 2.0

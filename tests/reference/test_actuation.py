@@ -19,7 +19,8 @@ def one(*, gear=1.0, gain=(1.0, 0.0, 0.0), bias=(0.0, 0.0, 0.0), ctrl=(-INF, INF
         gain=np.array([gain]), bias=np.array([bias]), ctrl_low=np.array([ctrl[0]]),
         ctrl_high=np.array([ctrl[1]]), force_low=np.array([force[0]]),
         force_high=np.array([force[1]]), dynamics=np.array([dynamics]),
-        time_constant=np.array([tc]), act_low=np.array([act[0]]), act_high=np.array([act[1]]))
+        time_constant=np.array([tc]), act_low=np.array([act[0]]), act_high=np.array([act[1]]),
+        joint_low=np.array([-INF]), joint_high=np.array([INF]))
 
 
 def tau(acts: law.JointActuators, q: float, v: float, u: float, act: float | None = None):
@@ -94,3 +95,19 @@ def test_a_complex_step_differentiates_through_the_clamps(u, slope):
     pushed = np.array([[u + 1e-30j]])
     found = law.generalized_force(acts, np.array([[0.2]]), np.array([[0.6]]), pushed)
     assert float(found[0, 0].imag / 1e-30) == pytest.approx(slope, rel=1e-15)
+
+
+def test_a_joints_range_holds_the_sum_of_its_actuators():
+    """Two motors on one joint, gears 1 and 2, controls 0.8 and 0.5: 0.8 + 2 · 0.5 = 1.8,
+    held at the joint's 1.5 (MuJoCo's actuatorfrcrange bounds the sum, not each)."""
+    two = law.JointActuators(
+        dof=np.array([0, 0]), q_index=np.array([0, 0]), gear=np.array([1.0, 2.0]),
+        gain=np.array([[1.0, 0, 0]] * 2), bias=np.zeros((2, 3)),
+        ctrl_low=np.full(2, -INF), ctrl_high=np.full(2, INF), force_low=np.full(2, -INF),
+        force_high=np.full(2, INF), dynamics=np.zeros(2, int), time_constant=np.zeros(2),
+        act_low=np.full(2, -INF), act_high=np.full(2, INF), joint_low=np.full(2, -1.5),
+        joint_high=np.full(2, 1.5))
+    found = law.generalized_force(two, np.zeros((1, 1)), np.zeros((1, 1)), np.array([[0.8, 0.5]]))
+    assert float(found[0, 0]) == 1.5
+    found = law.generalized_force(two, np.zeros((1, 1)), np.zeros((1, 1)), np.array([[0.1, 0.2]]))
+    assert float(found[0, 0]) == pytest.approx(0.5, rel=1e-15)
