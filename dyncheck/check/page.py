@@ -20,8 +20,8 @@ TITLES = {
     Section.DESCRIPTION: "Model reading (each engine's tree against MuJoCo's)",
     Section.VALIDITY: "Physical validity",
     Section.DYNAMICS: "Dynamics",
-    Section.ACTUATION: "Actuation (each engine's actuators against MuJoCo's; their force and "
-                       "step Jacobian in the controls against the referee)",
+    Section.ACTUATION: "Actuation (each engine's actuators against the first reading of them; "
+                       "their force and step Jacobian in the controls against the referee)",
     Section.DERIVATIVES: "Derivatives (canonical chart; MuJoCo's by its own finite differences)",
 }
 
