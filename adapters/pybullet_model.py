@@ -94,9 +94,11 @@ class PybulletModel(ModelEngine):
 
     engine = ENGINE
     offers = frozenset({Offer.STEPPING})
-    no_actuation = ("pybullet's motors are not compared yet (dyncheck's gap: the velocity motors "
-                    "its loaders put on every joint, and those a script sets with "
-                    "setJointMotorControl2)")
+    no_actuation = ("pybullet holds no actuator model (no control law of a file's actuators "
+                    "or transmissions): a script drives each joint with "
+                    "setJointMotorControl2 (TORQUE_CONTROL applies the torque it is given; "
+                    "its POSITION_CONTROL and VELOCITY_CONTROL motors are constraints, not a "
+                    "force law: tutorial 12)")
 
     def __init__(self, source: ModelFile, *, gravity: np.ndarray | None = None) -> None:
         """``gravity``: what the user sets with ``setGravity`` (a URDF states none; PyBullet's
