@@ -120,6 +120,9 @@ class Actuation:
 
     tau: np.ndarray
     forward: np.ndarray
+    floor: np.ndarray | None = None
+    """Per state, the size of what the engine subtracted to find τ (Newton: its net joint
+    force without the drives), which its round-off is relative to; None: nothing."""
 
 
 @dataclass(frozen=True, kw_only=True)

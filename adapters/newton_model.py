@@ -23,6 +23,8 @@ import warnings
 
 import numpy as np
 
+from dyncheck.adapters import newton_actuators
+from dyncheck.adapters.actuators import Actuation
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.mjcf_copy import utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile
@@ -110,10 +112,7 @@ class NewtonModel(ModelEngine):
     """A finalized Newton model on the CPU and its neutral tree."""
 
     engine = ENGINE
-    offers = frozenset({Offer.STEPPING})
-    no_actuation = ("newton's joint drives are not compared yet (dyncheck's gap: the target "
-                    "stiffness, damping and effort limits its MJCF importer reads from "
-                    "<position>, <velocity> and <motor>)")
+    offers = frozenset({Offer.STEPPING, Offer.ACTUATION})
 
     def __init__(self, source: ModelFile) -> None:
         import newton
@@ -246,9 +245,16 @@ class NewtonModel(ModelEngine):
             if named:
                 why = CORRECTED.format(bodies=", ".join(repr(b) for b in named))
                 hints.append((self._name(j), "inertia", why))
+        acts = newton_actuators.read(m, self.newton, [self._name(j) for j in range(m.joint_count)])
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
                          nq=m.joint_coord_count, nv=m.joint_dof_count, notes=notes, eps=EPS32,
-                         hints=tuple(hints))
+                         hints=(*hints, *newton_actuators.hints(m, acts)), actuators=acts)
+
+    def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
+        """Its drives' force by its Featherstone solver (:mod:`.newton_actuators`)."""
+        return newton_actuators.actuation(
+            self.model, self.newton, newton_actuators.drives(self.model, self.newton), q=q,
+            v=v, u=u)
 
     def _body(self, b: int) -> str:
         return _last(self.model.body_label[b])

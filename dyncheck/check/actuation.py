@@ -21,7 +21,7 @@ from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.check.dynamics import States
-from dyncheck.check.rows import CheckRow, Section
+from dyncheck.check.rows import COMPUTED, CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.reference import actuation as law
 from dyncheck.results import Verdict
@@ -178,6 +178,9 @@ class Forces:
     q: np.ndarray
     v: np.ndarray
     maps: list
+    floor: float = 0.0
+    """The size the engine's round-off is relative to beyond the force's own (its
+    :attr:`~dyncheck.adapters.actuators.Actuation.floor`)."""
 
 
 def controls_for(canonical: ModelTree, tree: ModelTree, u: np.ndarray) -> np.ndarray:
@@ -213,7 +216,9 @@ def force_rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: Sta
             rows.append(_row(model, subject="model", field=FORCE, a=engine, b="",
                              verdict=Verdict.FAILED, note=f"{type(exc).__name__}: {exc}"))
             continue
-        found[engine] = Forces(tau=answer.tau, controls=u_e, q=q_e, v=v_e, maps=maps)
+        found[engine] = Forces(tau=answer.tau, controls=u_e, q=q_e, v=v_e, maps=maps,
+                               floor=float(np.max(answer.floor, initial=0.0))
+                               if answer.floor is not None else 0.0)
         rows.extend(_against_referee(model, m.tree, found[engine]))
     names = list(found)
     for other in names[1:]:
@@ -244,22 +249,24 @@ def _against_referee(model: str, tree: ModelTree, f: Forces) -> list[CheckRow]:
     acts = joint_actuators(tree)
     if acts is None:
         others = ", ".join(a.what for a in tree.actuators if not a.modelled)
-        return [_row(model, subject=FORCE, field="max rel error", a=REFEREE, b=engine,
+        return [_row(model, subject=FORCE, field=COMPUTED, a=REFEREE, b=engine,
                      verdict=Verdict.SKIPPED,
                      note=f"the referee models joint actuators only; {engine} holds {others}")]
     expected = law.generalized_force(acts, f.q, f.v, f.controls, act=f.controls)
-    scale = _scale(acts, f)
+    scale = max(_scale(acts, f), f.floor)
     off = np.abs(f.tau - expected)
     tolerance = ROUNDOFF_FACTOR * max(EPS, tree.eps)
     worst = int(np.argmax(off.max(axis=1))) if off.size else -1
     error = float(off.max(initial=0.0)) / scale
     ok = error <= tolerance
     clamped = _clamped(acts, f)
-    return [_row(model, subject=FORCE, field="max rel error", a=REFEREE, b=engine,
+    return [_row(model, subject=FORCE, field=COMPUTED, a=REFEREE, b=engine,
                  verdict=Verdict.PASSED if ok else Verdict.FAILED, error=error,
                  tolerance=tolerance, worst=worst,
                  basis=f"the referee's actuator law on {engine}'s own reading; round-off "
-                       f"{ROUNDOFF_FACTOR} eps of the largest term; {clamped}",
+                       f"{ROUNDOFF_FACTOR} eps of the largest term"
+                       + (" (or of the net force it subtracted)" if f.floor else "")
+                       + f"; {clamped}",
                  note="" if ok else f"{engine} computes a force its reading does not give "
                  f"(state {worst}: {off[worst].max():.3g}): {UNKNOWN}")]
 
@@ -284,7 +291,7 @@ def _pair(model: str, *, tree_a: ModelTree, a: Forces, tree_b: ModelTree, b: For
             cols_b.append(tree_b.joint(joint.name).layout.v_start)
     off = np.abs(a.tau[:, cols_a] - b.tau[:, cols_b])
     scale = max(float(np.abs(a.tau).max(initial=0.0)), float(np.abs(b.tau).max(initial=0.0)),
-                1e-300)
+                a.floor, b.floor, 1e-300)
     tolerance = ROUNDOFF_FACTOR * max(EPS, tree_a.eps, tree_b.eps)
     error = float(off.max(initial=0.0)) / scale
     ok = error <= tolerance
@@ -295,7 +302,7 @@ def _pair(model: str, *, tree_a: ModelTree, a: Forces, tree_b: ModelTree, b: For
                 "actuation reading rows); the force differs by that reading, measured here"
                 if read else UNKNOWN)
     worst = int(np.argmax(off.max(axis=1))) if off.size else -1
-    return _row(model, subject=FORCE, field="max rel error", a=tree_a.engine, b=tree_b.engine,
+    return _row(model, subject=FORCE, field=COMPUTED, a=tree_a.engine, b=tree_b.engine,
                 verdict=Verdict.PASSED if ok else Verdict.FAILED, error=error,
                 tolerance=tolerance, worst=worst, note=note,
                 basis=f"the same controls as each reads them; round-off {ROUNDOFF_FACTOR} eps "
@@ -320,7 +327,9 @@ def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
     notes = []
     first = next(iter(loaded.values()))
     offering = [m for m in loaded.values() if Offer.ACTUATION in m.offers]
-    holding = next(m.tree for m in loaded.values() if m.tree.actuators)
+    holding = next((m.tree for m in loaded.values() if m.tree.actuators), None)
+    if holding is None:  # (only an engine whose dynamics failed held them: its row says so)
+        return out, notes
     unmodelled = [a.what for a in holding.actuators if not a.modelled]
     if unmodelled:
         notes.append(f"actuators outside the neutral form, compared by no other engine and "
@@ -343,12 +352,20 @@ def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
         q, v = batch.q[:k], batch.v[:k]
         inside = sample_controls(canonical.actuators, k, seed, spread=0.8)
         reference = ReferenceModel(canonical).dynamics(q, v, np.zeros_like(v))
+        subject = "step Jacobian in the controls"
+        if not (np.all(np.isfinite(reference.mass_matrix))
+                and np.all(np.isfinite(reference.bias))
+                and np.all(np.linalg.eigvalsh(reference.mass_matrix) > 0)):
+            out.append(_row(model, subject=subject, field=COMPUTED, a=REFEREE, b=first.engine,
+                            verdict=Verdict.SKIPPED, note="not compared: the referee's M is "
+                            "not positive definite or h not finite on this reading (the "
+                            "dynamics rows say why)"))
+            return out, notes
         try:
             jacobians = first.input_jacobians(q, v, inside)
         except Exception as exc:  # a failing engine costs its own rows
-            out.append(_row(model, subject="step Jacobian in the controls", field="B",
-                            a=first.engine, b="", verdict=Verdict.FAILED,
-                            note=f"{type(exc).__name__}: {exc}"))
+            out.append(_row(model, subject=subject, field=COMPUTED, a=REFEREE, b=first.engine,
+                            verdict=Verdict.FAILED, note=f"{type(exc).__name__}: {exc}"))
             jacobians = ()
         for jacobian in jacobians:
             out.append(input_jacobian.rows(

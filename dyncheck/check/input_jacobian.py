@@ -20,7 +20,7 @@ from dyncheck.adapters.actuators import InputJacobian
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.check.describe import depth
-from dyncheck.check.rows import CheckRow, Section
+from dyncheck.check.rows import COMPUTED, CheckRow, Section
 from dyncheck.check.steps import right_jacobian
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.reference import actuation as law
@@ -86,7 +86,7 @@ def rows(model: str, *, canon: Canonical, tree: ModelTree, acts: law.JointActuat
     return CheckRow(
         model=model, section=Section.ACTUATION,
         subject=f"step Jacobian in the controls ({found.integrator} at h = {h:g})",
-        field="max rel error", impl_a="reference", impl_b=engine, value_a="", value_b="",
+        field=COMPUTED, impl_a="reference", impl_b=engine, value_a="", value_b="",
         error=float(off.max()) / scale, tolerance=float(allowed.max()) / scale,
         basis=(f"the chain rule through the referee's M, h and actuator law (complex step "
                f"in u); round-off {ROUNDOFF_FACTOR} eps x tree depth {depth(tree)}; + "

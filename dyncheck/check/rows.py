@@ -41,6 +41,10 @@ class CheckRow:
     worst_state: int = -1
 
 
+COMPUTED = "max rel error"
+"""The field of a row that compares computed values, the largest relative error over the
+states (an actuation row's other fields compare readings)."""
+
 COLUMNS = [
     "model", "section", "subject", "field", "impl_a", "impl_b", "value_a", "value_b", "error",
     "tolerance", "basis", "verdict", "note", "worst_state",

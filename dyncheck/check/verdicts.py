@@ -12,7 +12,7 @@ from enum import StrEnum
 
 import pandas as pd
 
-from dyncheck.check.rows import Section
+from dyncheck.check.rows import COMPUTED, Section
 from dyncheck.results import Verdict
 
 REFEREE = "reference"
@@ -156,10 +156,6 @@ def _agreement(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Agreeme
     judge = ("the referee on its own reading" if REFEREE in partners
              else f"with {' and '.join(partners)}")
     return Agreement.AGREE, f"{judge}{tail}"
-
-
-COMPUTED = "max rel error"
-"""The field of an actuation row that compares computed values (the others, readings)."""
 
 
 def _controls(engine: str, rows: pd.DataFrame) -> tuple[Controls, str]:

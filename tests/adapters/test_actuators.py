@@ -26,6 +26,8 @@ MJCF = """<mujoco model="one">
 
 # kind: (element, (q, v, u), MuJoCo's fields by hand, MuJoCo's τ by hand,
 #        Drake's fields by hand or None where it ignores the element, Drake's τ by hand)
+# Newton's Featherstone solver applies only <position> and <velocity>, as drives
+# τ = ke (q_t − q) + kd (q̇_t − q̇) (newton/_src/solvers/featherstone/kernels.py, jcalc_tau)
 KINDS = {
     "motor with gear": (
         '<motor joint="j" gear="3"/>', (0.2, 0.5, 0.5),
@@ -108,6 +110,32 @@ def test_drake_reads_each_kind_as_worked_out(kind, files):
         assert getattr(actuator, name) == value, name
     tau = engine.actuation(*_state(kind)).tau
     assert float(tau[0, 0]) == pytest.approx(KINDS[kind][5], rel=1e-14)
+
+
+NEWTON = {  # kind: (fields by hand, τ by hand), None where its Featherstone solver ignores it
+    "position servo": (dict(gear=1.0, gain=(10.0, 0.0, 0.0), bias=(0.0, -10.0, -2.0),
+                            ctrl_range=None, force_range=None), 3.8),  # as MuJoCo's
+    "velocity servo": (dict(gear=1.0, gain=(4.0, 0.0, 0.0), bias=(0.0, 0.0, -4.0)), -1.2),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_newton_reads_each_kind_as_worked_out(kind, files):
+    pytest.importorskip("newton", reason="the newton extra is not installed")
+    from dyncheck.adapters.newton_model import NewtonModel
+
+    engine = NewtonModel(read(files[kind]))
+    if kind not in NEWTON:  # a <motor> or <general>: kept for its MuJoCo solver only
+        assert engine.tree.actuators == ()
+        assert "does not apply them" in (engine.tree.hint("model", "actuator") or "")
+        return
+    expected, tau = NEWTON[kind]
+    (actuator,) = engine.tree.actuators
+    for name, value in expected.items():
+        assert getattr(actuator, name) == value, name
+    found = engine.actuation(*_state(kind)).tau
+    assert float(found[0, 0]) == pytest.approx(tau, rel=1e-6)  # float32
 
 
 def test_the_forward_dynamics_carry_the_force(files):
