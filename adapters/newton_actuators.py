@@ -81,8 +81,10 @@ def read(model: Any, newton: Any, names: list[str]) -> tuple[Actuator, ...]:
 def hints(model: Any, actuators: tuple[Actuator, ...]) -> tuple[tuple[str, str, str], ...]:
     """Why Newton's drives read otherwise than the file's actuators, each premise checked on
     Newton's own model (its MuJoCo attributes: the file's actuators as imported)."""
-    labels = getattr(getattr(model, "mujoco", None), "actuator_label", None)
-    count = len(labels) if labels is not None else 0
+    try:  # (Newton's namespace of the MuJoCo attributes its importer keeps)
+        count = len(model.mujoco.actuator_label)
+    except (AttributeError, TypeError):  # a URDF: none
+        count = 0
     out = [(a.name, field, why) for a in actuators
            for field, why in (("gear", GEAR), ("limits", BOUNDS))]
     if count > len(actuators):
