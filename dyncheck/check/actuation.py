@@ -19,8 +19,9 @@ from dyncheck.adapters import layout_batch
 from dyncheck.adapters.actuators import Activation, Actuator, same, shown_value
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.layout import Canonical
-from dyncheck.adapters.model_tree import ModelTree
-from dyncheck.check.dynamics import States
+from dyncheck.adapters.model_tree import Dynamics, ModelTree
+from dyncheck.check.describe import depth
+from dyncheck.check.dynamics import States, condition
 from dyncheck.check.rows import COMPUTED, CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.reference import actuation as law
@@ -194,10 +195,13 @@ def controls_for(canonical: ModelTree, tree: ModelTree, u: np.ndarray) -> np.nda
 
 def force_rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
                loaded: dict[str, ModelEngine], u: np.ndarray,
-               differing: dict[str, list[str]]) -> list[CheckRow]:
+               differing: dict[str, list[str]], smooth: dict[str, Dynamics] | None = None,
+               own: dict[str, Dynamics] | None = None) -> list[CheckRow]:
     """Every actuated engine's force at the sampled states and controls: against the
     referee's law on its own reading, and against the canonical engine (on the velocity
-    coordinates of the joints both hold)."""
+    coordinates of the joints both hold); and what that force adds to its forward dynamics
+    (its ``smooth`` dynamics at τ = 0, canonical layout) against the referee's M⁻¹ τ on its
+    ``own`` reading."""
     rows: list[CheckRow] = []
     found: dict[str, Forces] = {}
     for engine, m in loaded.items():
@@ -220,6 +224,9 @@ def force_rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: Sta
                                floor=float(np.max(answer.floor, initial=0.0))
                                if answer.floor is not None else 0.0)
         rows.extend(_against_referee(model, m.tree, found[engine]))
+        if smooth and own and engine in smooth and engine in own:
+            rows.extend(_forward_row(model, m.tree, found[engine], forward=answer.forward,
+                                     smooth=smooth[engine], own=own[engine]))
     names = list(found)
     for other in names[1:]:
         rows.append(_pair(model, tree_a=loaded[names[0]].tree, a=found[names[0]],
@@ -271,6 +278,44 @@ def _against_referee(model: str, tree: ModelTree, f: Forces) -> list[CheckRow]:
                  f"(state {worst}: {off[worst].max():.3g}): {UNKNOWN}")]
 
 
+FORWARD = "forward dynamics with the control"
+
+
+def _forward_row(model: str, tree: ModelTree, f: Forces, *, forward: np.ndarray,
+                 smooth: Dynamics, own: Dynamics) -> list[CheckRow]:
+    """What the engine's control adds to its forward dynamics, v̇(u) − v̇(τ = 0) (both its
+    own, in the canonical layout: accelerations map by T⁻¹, where v_e = T v), against the
+    referee's M⁻¹ τ(u) on its own reading (forces map by Tᵀ). Round-off: the dynamics'
+    bound, c ε × depth × κ(M), relative to the larger of the increment and v̇ itself."""
+    acts = joint_actuators(tree)
+    if acts is None:
+        return []
+    t = np.array([s.t for s in f.maps])
+    tdot_v = np.array([s.tdot_v for s in f.maps])
+    with_u = np.linalg.solve(t, (forward - tdot_v)[..., None])[..., 0]
+    tau = (np.swapaxes(t, 1, 2) @ law.generalized_force(
+        acts, f.q, f.v, f.controls, act=f.controls)[..., None])[..., 0]
+    expected = np.linalg.solve(own.mass_matrix, tau[..., None])[..., 0]
+    found = with_u - smooth.forward
+    scale = max(float(np.abs(expected).max(initial=0.0)),
+                float(np.abs(smooth.forward).max(initial=0.0)), 1e-300)
+    kappa = condition(own.mass_matrix)
+    tolerance = ROUNDOFF_FACTOR * max(EPS, tree.eps) * depth(tree) * kappa
+    off = np.abs(found - expected)
+    error = float(off.max(initial=0.0)) / scale
+    worst = int(np.argmax(off.max(axis=1))) if off.size else -1
+    ok = error <= tolerance
+    engine = tree.engine
+    return [_row(model, subject=FORWARD, field=COMPUTED, a=REFEREE, b=engine,
+                 verdict=Verdict.PASSED if ok else Verdict.FAILED, error=error,
+                 tolerance=tolerance, worst=worst,
+                 basis=f"{engine}'s v̇(u) − v̇(τ = 0) against the referee's M⁻¹ τ(u) on its "
+                       f"own reading; round-off {ROUNDOFF_FACTOR} eps x tree depth "
+                       f"{depth(tree)} x cond(M) {kappa:.3g}, of max(|M⁻¹ τ|, |v̇|)",
+                 note="" if ok else f"{engine}'s forward dynamics do not take the force its "
+                 f"actuators report (state {worst}): {UNKNOWN}")]
+
+
 def _clamped(acts: law.JointActuators, f: Forces) -> str:
     """How many sampled controls a bound held (what the rows exercised)."""
     u = f.controls
@@ -315,7 +360,8 @@ INPUT_STATES = 8
 
 
 def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
-         loaded: dict[str, ModelEngine], seed: int) -> tuple[list[CheckRow], list[str]]:
+         loaded: dict[str, ModelEngine], seed: int, smooth: dict[str, Dynamics] | None = None,
+         own: dict[str, Dynamics] | None = None) -> tuple[list[CheckRow], list[str]]:
     """The actuation section: every engine's reading of the actuators against the canonical
     one, every engine's force against the referee and the canonical engine, and the
     canonical engine's step Jacobian in the controls against the chain rule; and the notes
@@ -345,7 +391,7 @@ def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
                      "dyncheck/check/actuation.py), each engine's matched to them by joint")
     u = sample_controls(holding.actuators, len(batch.q), seed)
     out.extend(force_rows(model, canon=canon, canonical=holding, batch=batch, loaded=loaded,
-                          u=u, differing=differing))
+                          u=u, differing=differing, smooth=smooth, own=own))
     acts = joint_actuators(canonical)
     if Offer.INPUT_JACOBIAN in first.offers and acts is not None and canonical.actuators:
         k = min(INPUT_STATES, len(batch.q))

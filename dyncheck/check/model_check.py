@@ -204,8 +204,10 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     if actuators and any(m.tree.actuators for m in loaded.values()):
         t0 = time.perf_counter()
         computed = {e: m for e, m in loaded.items() if e in results}  # (a failed one: its row)
-        found, said = actuation.rows(model, canon=canon, canonical=canonical_tree, batch=batch,
-                                     loaded=computed, seed=seed) if computed else ([], [])
+        found, said = actuation.rows(
+            model, canon=canon, canonical=canonical_tree, batch=batch, loaded=computed,
+            seed=seed, smooth=results, own={e: r.dynamics for e, r in own.items()},
+        ) if computed else ([], [])
         rows.extend(found)
         notes.extend(said)
         seconds["actuation"] = time.perf_counter() - t0

@@ -65,7 +65,8 @@ def test_b_against_the_chain_rule_on_a_servo_arm(servo_arm):
 
 def test_a_gear_changed_by_one_percent_in_a_reading_fails(servo_arm, monkeypatch):
     """Mutation: MuJoCo's reading of one actuator's gear 1 % off what it computes with — its
-    force against the referee on that reading fails, and so does its B."""
+    force against the referee on that reading fails, and so do its forward dynamics with the
+    control and its B."""
     real = mujoco_actuators.read
 
     def off(m, names):
@@ -74,8 +75,8 @@ def test_a_gear_changed_by_one_percent_in_a_reading_fails(servo_arm, monkeypatch
 
     monkeypatch.setattr(mujoco_actuators, "read", off)
     result = check_model(servo_arm, impls=("mujoco", "reference"), states=8, isolate=False)
-    computed = _rows(result, impl_a="reference", impl_b="mujoco")
-    assert len(computed) == 3 and (computed["verdict"] == "failed").all()
+    computed = _rows(result, impl_a="reference", impl_b="mujoco")  # force, v̇ with it, 2 B
+    assert len(computed) == 4 and (computed["verdict"] == "failed").all()
     (mujoco,) = per_engine(result.rows, result.impls)
     assert mujoco.controls is Controls.DIFFER and not mujoco.ok
 
@@ -89,7 +90,8 @@ def test_drake_reads_a_servo_otherwise_with_its_cause(servo_arm):
     read = _rows(result, impl_b="drake", verdict="failed")
     assert {"bias", "limits"} <= set(read["field"])
     assert read[read["field"] == "bias"]["note"].str.contains("'kd'").all()
-    assert list(_rows(result, impl_a="reference", impl_b="drake")["verdict"]) == ["passed"]
+    assert list(_rows(result, impl_a="reference", impl_b="drake")["verdict"]) == [
+        "passed", "passed"]  # its force, and its forward dynamics with it
     assert list(_rows(result, impl_a="mujoco", impl_b="drake",
                       subject="actuator force")["verdict"]) == ["failed"]
     drake = next(v for v in per_engine(result.rows, result.impls) if v.engine == "drake")
@@ -149,3 +151,26 @@ def test_mujoco_holds_none_of_a_urdfs_transmissions(tmp_path):
     verdicts = {v.engine: v for v in per_engine(result.rows, result.impls)}
     assert verdicts["mujoco"].controls is Controls.NONE
     assert verdicts["drake"].controls is Controls.EXPLAINED
+
+
+def test_a_forward_dynamics_that_drops_part_of_the_force_fails(servo_arm, monkeypatch):
+    """Mutation: MuJoCo's forward dynamics with the control shifted by 1 % of its size while
+    its reported force is kept — the force row passes, the forward-dynamics row fails (the
+    referee's M⁻¹ τ on its reading: the book's method and the clean-room law)."""
+    import numpy as np
+
+    from dyncheck.adapters.actuators import Actuation
+
+    real = mujoco_actuators.Actuated.actuation
+
+    def shifted(self, q, v, u):
+        found = real(self, q, v, u)
+        return Actuation(tau=found.tau, forward=found.forward
+                         + 0.01 * np.abs(found.forward).max())
+
+    monkeypatch.setattr(mujoco_actuators.Actuated, "actuation", shifted)
+    result = check_model(servo_arm, impls=("mujoco", "reference"), states=8, isolate=False)
+    assert list(_rows(result, subject="actuator force", impl_b="mujoco")["verdict"]) == [
+        "passed"]
+    assert list(_rows(result, subject="forward dynamics with the control")["verdict"]) == [
+        "failed"]
