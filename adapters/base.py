@@ -309,6 +309,9 @@ class Offer(StrEnum):
     ACTUATION = "actuation"
     """``actuation(q, v, u)``: the generalized force of its actuators at controls u and its
     forward dynamics with it (its tree's ``actuators`` say what it read)."""
+    CONTROL_DERIVATIVES = "control_derivatives"
+    """``control_derivatives(q, v, u)``: ∂v̇/∂u of its forward dynamics with its actuators,
+    its own (automatic differentiation)."""
     INPUT_JACOBIAN = "input_jacobians"
     """``input_jacobians(q, v, u)``: the Jacobians of one step of its integrators in the
     controls, ∂x₊/∂u."""
@@ -377,13 +380,18 @@ class ModelEngine(ABC):
                         u: np.ndarray) -> tuple[InputJacobian, ...]:
         raise Unsupported(f"{self.engine} offers no step Jacobian in its controls")
 
+    def control_derivatives(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """∂v̇/∂u (n, nv, its actuators) at each state and control, its layout."""
+        raise Unsupported(f"{self.engine} offers no derivative in its controls")
+
     def request(self, kind: str, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Answer:
         """One request of ``kind`` (``dynamics``, ``derivatives``, ``transition``,
         ``actuation`` or ``input_jacobians``, whose ``a`` is the controls) answered here,
         timed; its exception handed back, not raised."""
         method = {"dynamics": self.dynamics, "derivatives": self.derivatives,
                   "transition": self.transition, "actuation": self.actuation,
-                  "input_jacobians": self.input_jacobians}[kind]
+                  "input_jacobians": self.input_jacobians,
+                  "control_derivatives": self.control_derivatives}[kind]
         t0 = time.perf_counter()
         try:
             return method(q, v, a), time.perf_counter() - t0

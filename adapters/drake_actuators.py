@@ -37,6 +37,12 @@ EFFORT = (
     "a position servo, whose ctrlrange bounds the target position, that bounds its torque "
     "(fix: set the effort limit after parsing, JointActuator.set_effort_limit)"
 )
+PD_DROPPED = (
+    "Drake's scalar conversion to AutoDiffXd (MultibodyPlant.ToAutoDiffXd) drops the PD "
+    "gains of its joint actuators ({count} of {total} servos have none in the converted "
+    "plant, measured), so its derivatives in a servo's target are 0 (fix: set the gains on "
+    "the converted plant, JointActuator.set_controller_gains)"
+)
 IGNORED = (
     "Drake's MJCF parser reads only <motor> and <position> actuators and ignores {tags} with "
     "a warning (fix: write them as <motor> or <position>, or add the actuator in Drake)"
@@ -71,8 +77,17 @@ def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
         tuple[str, str, str], ...]:
     """(actuator, field, why) for what Drake is known to read otherwise, each premise
     checked on the plant (``tags``: the file's actuator elements per joint); actuator
-    ``model``: of the file's actuators Drake holds none of."""
+    ``model``: of the file's actuators Drake holds none of, and what its automatic
+    differentiation drops (measured on the plant converted)."""
     out = []
+    servos = [i for i in plant.GetJointActuatorIndices()
+              if plant.get_joint_actuator(i).has_controller()]
+    if servos:
+        converted = plant.ToAutoDiffXd()
+        dropped = sum(not converted.get_joint_actuator(i).has_controller() for i in servos)
+        if dropped:
+            out.append(("model", "control derivatives",
+                        PD_DROPPED.format(count=dropped, total=len(servos))))
     for index in plant.GetJointActuatorIndices():
         actuator = plant.get_joint_actuator(index)
         name, gear = actuator.name(), float(actuator.default_gear_ratio())
@@ -116,6 +131,32 @@ def actuation(plant: Any, context: Any, *, q: np.ndarray, v: np.ndarray,
         tau[s] = matrix @ net.Eval(context)
         forward[s] = acc.Eval(context)
     return Actuation(tau=tau, forward=forward)
+
+
+def control_derivatives(plant: Any, ad: Any, context: Any, *, q: np.ndarray, v: np.ndarray,
+                        u: np.ndarray) -> np.ndarray:
+    """∂v̇/∂u (n, nv, nu) by Drake's forward-mode automatic differentiation of its
+    generalized acceleration, the controls seeded (``ad``: ``plant`` as ``AutoDiffXd``, in a
+    ``context`` of its own, see :func:`actuation`; which actuator is a servo, whose control
+    is its target, is ``plant``'s fact: :data:`PD_DROPPED`)."""
+    from pydrake.autodiffutils import AutoDiffXd, ExtractGradient, InitializeAutoDiff
+
+    indices = list(ad.GetJointActuatorIndices())
+    servo = np.array([plant.get_joint_actuator(i).has_controller() for i in indices], bool)
+    port, desired = ad.get_actuation_input_port(), _desired_ports(ad, indices)
+    acc = ad.get_generalized_acceleration_output_port()
+    out = np.empty((len(q), ad.num_velocities(), len(indices)))
+    for s in range(len(q)):
+        seeded = InitializeAutoDiff(np.asarray(u[s], float))[:, 0]
+        zero = AutoDiffXd(0.0, np.zeros(len(indices)))
+        ad.SetPositions(context, [AutoDiffXd(x) for x in q[s]])
+        ad.SetVelocities(context, [AutoDiffXd(x) for x in v[s]])
+        port.FixValue(context, [zero if pd else seeded[k] for k, pd in enumerate(servo)])
+        for instance_port, members in desired.values():
+            target = [seeded[k] for k in members] + [zero] * len(members)
+            instance_port.FixValue(context, target)
+        out[s] = ExtractGradient(acc.Eval(context))
+    return out
 
 
 def _desired_ports(plant: Any, indices: list[Any]) -> dict[int, tuple[Any, list[int]]]:

@@ -206,7 +206,7 @@ class DrakeModel(ModelEngine):
     """A Drake plant and its neutral tree."""
 
     engine = ENGINE
-    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION})
+    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION, Offer.CONTROL_DERIVATIVES})
 
     def __init__(self, source: ModelFile) -> None:
         self.plant, notes, self._damping = _plant(source)
@@ -218,6 +218,7 @@ class DrakeModel(ModelEngine):
         self._acc = self.plant.get_generalized_acceleration_output_port()
         self._ad: Any = None  # the AutoDiffXd plant, made on the first derivatives asked for
         self._actuated: Any = None  # the context of actuation (its PD controllers armed)
+        self._ad_actuated: Any = None  # the same for the AutoDiffXd plant
         self.tree = self._tree(notes)
 
     def _tree(self, notes: tuple[str, ...]) -> ModelTree:
@@ -307,6 +308,16 @@ class DrakeModel(ModelEngine):
         if self._actuated is None:
             self._actuated = self.plant.CreateDefaultContext()
         return drake_actuators.actuation(self.plant, self._actuated, q=q, v=v, u=u)
+
+    def control_derivatives(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """Drake's ∂v̇/∂u by automatic differentiation (:mod:`.drake_actuators`)."""
+        if self._ad is None:
+            self._ad = self.plant.ToAutoDiffXd()
+            self._ad_context = self._ad.CreateDefaultContext()
+        if self._ad_actuated is None:
+            self._ad_actuated = self._ad.CreateDefaultContext()
+        return drake_actuators.control_derivatives(self.plant, self._ad, self._ad_actuated, q=q,
+                                                   v=v, u=u)
 
     @property
     def _reflected(self) -> dict[str, float]:

@@ -354,6 +354,37 @@ def _pair(model: str, *, tree_a: ModelTree, a: Forces, tree_b: ModelTree, b: For
                       "of the largest force")
 
 
+def _derivative_rows(model: str, *, canon: Canonical, holding: ModelTree, batch: States,
+                     loaded: dict[str, ModelEngine], seed: int,
+                     own: dict[str, Dynamics]) -> list[CheckRow]:
+    """Every engine's own ∂v̇/∂u where it offers one, against the referee on its reading, at
+    the first :data:`INPUT_STATES` states and controls inside their ranges."""
+    from dyncheck.check import input_jacobian
+
+    out = []
+    k = min(INPUT_STATES, len(batch.q))
+    inside = sample_controls(holding.actuators, k, seed, spread=0.8)
+    for engine, m in loaded.items():
+        acts = joint_actuators(m.tree)
+        if Offer.CONTROL_DERIVATIVES not in m.offers or not m.tree.actuators or \
+                acts is None or engine not in own:
+            continue
+        maps, q_e, v_e, _ = layout_batch.engine_states(canon, m.tree, batch.q[:k],
+                                                       batch.v[:k], batch.a[:k])
+        u_e = controls_for(holding, m.tree, inside)
+        try:
+            found = m.control_derivatives(q_e, v_e, u_e)
+        except Exception as exc:  # a failing engine costs its own rows
+            out.append(_row(model, subject=input_jacobian.CONTROL_DERIVATIVE, field=COMPUTED,
+                            a=REFEREE, b=engine, verdict=Verdict.FAILED,
+                            note=f"{type(exc).__name__}: {exc}"))
+            continue
+        out.append(input_jacobian.derivative_row(
+            model, tree=m.tree, acts=acts, maps=maps, q=q_e, v=v_e, u=u_e,
+            mass=own[engine].mass_matrix[:k], found=found))
+    return out
+
+
 INPUT_STATES = 8
 """The states at which the step's Jacobian in the controls is compared (its differences cost
 2 nu steps a state, twice)."""
@@ -392,6 +423,8 @@ def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
     u = sample_controls(holding.actuators, len(batch.q), seed)
     out.extend(force_rows(model, canon=canon, canonical=holding, batch=batch, loaded=loaded,
                           u=u, differing=differing, smooth=smooth, own=own))
+    out.extend(_derivative_rows(model, canon=canon, holding=holding, batch=batch,
+                                loaded=loaded, seed=seed, own=own or {}))
     acts = joint_actuators(canonical)
     if Offer.INPUT_JACOBIAN in first.offers and acts is not None and canonical.actuators:
         k = min(INPUT_STATES, len(batch.q))

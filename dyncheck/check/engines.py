@@ -355,6 +355,11 @@ class Isolated(ModelEngine):
         self.submit(q, v, u, kind="input_jacobians")
         return self.collect()[0]
 
+    def control_derivatives(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """The engine's ∂v̇/∂u (:class:`Unsupported` where it offers none)."""
+        self.submit(q, v, u, kind="control_derivatives")
+        return self.collect()[0]
+
     def collect(self) -> tuple[Any, float]:
         """The submitted batch's answer (dynamics or derivatives) and the seconds the engine
         spent on it."""

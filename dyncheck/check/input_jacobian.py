@@ -99,3 +99,41 @@ def rows(model: str, *, canon: Canonical, tree: ModelTree, acts: law.JointActuat
             "cause unknown"),
         worst_state=int(worst[0]))
 
+
+
+CONTROL_DERIVATIVE = "d(forward)/d(u)"
+
+
+def derivative_row(model: str, *, tree: ModelTree, acts: law.JointActuators, maps: list,
+                   q: np.ndarray, v: np.ndarray, u: np.ndarray, mass: np.ndarray,
+                   found: np.ndarray) -> CheckRow:
+    """An engine's own ∂v̇/∂u (its layout, mapped by T⁻¹, v_e = T v) against the referee's
+    M⁻¹ Tᵀ ∂τ/∂u on its reading (``mass``: the referee's M on it, canonical layout; ∂τ/∂u
+    of the clean-room law by a complex step). Round-off: c ε × depth × κ(M)."""
+    nu = u.shape[1]
+    dtau = np.zeros((len(q), v.shape[1], nu))
+    for k in range(nu):
+        pushed = u.astype(complex)
+        pushed[:, k] += 1j * COMPLEX_STEP
+        dtau[:, :, k] = law.generalized_force(acts, q, v, pushed, act=u).imag / COMPLEX_STEP
+    t = np.array([s.t for s in maps])
+    expected = np.linalg.solve(mass, np.swapaxes(t, 1, 2) @ dtau)
+    mapped = np.linalg.solve(t, found)
+    kappa = float(np.max(np.linalg.cond(mass), initial=1.0))
+    tolerance = ROUNDOFF_FACTOR * max(EPS, tree.eps) * depth(tree) * kappa
+    off = np.abs(mapped - expected)
+    scale = max(float(np.abs(expected).max(initial=0.0)), 1e-300)
+    error = float(off.max(initial=0.0)) / scale
+    worst = int(np.argmax(off.reshape(len(q), -1).max(axis=1))) if off.size else -1
+    ok = error <= tolerance
+    engine = tree.engine
+    return CheckRow(
+        model=model, section=Section.ACTUATION, subject=CONTROL_DERIVATIVE, field=COMPUTED,
+        impl_a="reference", impl_b=engine, value_a="", value_b="", error=error,
+        tolerance=tolerance,
+        basis=(f"{engine}'s own derivative against the referee's M⁻¹ ∂τ/∂u on its reading "
+               f"(complex step in u); round-off {ROUNDOFF_FACTOR} eps x tree depth "
+               f"{depth(tree)} x cond(M) {kappa:.3g}; controls inside their ranges"),
+        verdict=Verdict.PASSED if ok else Verdict.FAILED,
+        note="" if ok else (tree.hint("model", "control derivatives") or "cause unknown"),
+        worst_state=worst)

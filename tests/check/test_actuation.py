@@ -90,8 +90,9 @@ def test_drake_reads_a_servo_otherwise_with_its_cause(servo_arm):
     read = _rows(result, impl_b="drake", verdict="failed")
     assert {"bias", "limits"} <= set(read["field"])
     assert read[read["field"] == "bias"]["note"].str.contains("'kd'").all()
-    assert list(_rows(result, impl_a="reference", impl_b="drake")["verdict"]) == [
-        "passed", "passed"]  # its force, and its forward dynamics with it
+    judged = _rows(result, impl_a="reference", impl_b="drake").set_index("subject")["verdict"]
+    assert judged["actuator force"] == judged["forward dynamics with the control"] == "passed"
+    assert judged["d(forward)/d(u)"] == "failed"  # its ToAutoDiffXd drops the PD gains
     assert list(_rows(result, impl_a="mujoco", impl_b="drake",
                       subject="actuator force")["verdict"]) == ["failed"]
     drake = next(v for v in per_engine(result.rows, result.impls) if v.engine == "drake")
@@ -174,3 +175,24 @@ def test_a_forward_dynamics_that_drops_part_of_the_force_fails(servo_arm, monkey
         "passed"]
     assert list(_rows(result, subject="forward dynamics with the control")["verdict"]) == [
         "failed"]
+
+
+def test_drakes_derivative_in_a_servo_target_is_a_failed_row_with_its_cause(tmp_path):
+    """Drake's ToAutoDiffXd drops its joint actuators' PD gains (measured on the converted
+    plant): its ∂v̇/∂u in a servo's target is 0 where the referee's is M⁻¹ g kp (the book's
+    method and the clean-room law) — a failed row naming that, not a skipped one."""
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    path = tmp_path / "soft_servos.xml"
+    path.write_text(arm('<position joint="{j}" kp="2" ctrlrange="-20 20"/>'))
+    result = check_model(path, impls=("mujoco", "drake", "reference"), states=8)
+    (row,) = _rows(result, subject="d(forward)/d(u)", impl_b="drake").itertuples()
+    assert row.verdict == "failed" and "ToAutoDiffXd" in row.note and row.error > 0.5
+
+
+def test_drakes_derivative_in_a_motors_control_passes(tmp_path):
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    path = tmp_path / "motors.xml"
+    path.write_text(arm('<motor joint="{j}"/>'))
+    result = check_model(path, impls=("mujoco", "drake", "reference"), states=8)
+    (row,) = _rows(result, subject="d(forward)/d(u)", impl_b="drake").itertuples()
+    assert row.verdict == "passed", row
