@@ -41,7 +41,8 @@ PD_DROPPED = (
     "Drake's scalar conversion to AutoDiffXd (MultibodyPlant.ToAutoDiffXd) drops the PD "
     "gains of its joint actuators ({count} of {total} servos have none in the converted "
     "plant, measured), so its derivatives in a servo's target are 0 (fix: set the gains on "
-    "the converted plant, JointActuator.set_controller_gains)"
+    "the converted plant, JointActuator.set_controller_gains; dyncheck explain "
+    "drake-autodiff-pd-gains)"
 )
 IGNORED = (
     "Drake's MJCF parser reads only <motor> and <position> actuators and ignores {tags} with "

@@ -16,7 +16,7 @@ from functools import partial
 import numpy as np
 
 from dyncheck.errors import EngineNotInstalled, UnknownName
-from dyncheck.explain.actuators import drake_mjcf_actuators
+from dyncheck.explain.actuators import drake_autodiff_pd_gains, drake_mjcf_actuators
 from dyncheck.explain.charts import composite_derivatives, derivative_chart
 from dyncheck.explain.constraints import (
     drake_equality,
@@ -91,6 +91,7 @@ DEMOS: dict[str, tuple[Callable[[], Entry], Origin]] = {
     "pinocchio-composite-derivatives": (composite_derivatives, Origin.ENGINE),
     "pybullet-spherical-inertia": (pybullet_spherical_inertia, Origin.ENGINE),
     "drake-mjcf-actuators": (drake_mjcf_actuators, Origin.ENGINE),
+    "drake-autodiff-pd-gains": (drake_autodiff_pd_gains, Origin.ENGINE),
 }
 """Conventions demonstrated by a run of their own, with whose property each is; the others
 (point-mass inertia floor, MJCF gravity, held forces, soft constraints: :mod:`.explanations`)
@@ -125,6 +126,7 @@ REQUIRES: dict[str, tuple[str, ...]] = {
     "newton-several-joints-on-a-body": ("newton",),
     "pybullet-spherical-inertia": ("pybullet",),
     "drake-mjcf-actuators": ("drake",),
+    "drake-autodiff-pd-gains": ("drake",),
 }
 """Demonstrations that need an optional engine (MuJoCo and Pinocchio are core dependencies)."""
 

@@ -29,6 +29,9 @@ SERVO = f"""<mujoco model="servo">
   </actuator>
 </mujoco>
 """
+UNBOUNDED = SERVO.replace(f' ctrlrange="-{TARGETS:g} {TARGETS:g}"', "").replace(
+    f'\n              forcerange="-{FORCES:g} {FORCES:g}"', "")
+"""The servo without its ranges (Drake: no effort limit), for its derivative."""
 STATES = ((0.1, 0.5, 1.2), (-0.4, -1.5, 0.3), (0.8, 0.2, -1.0), (0.0, 3.0, 0.9))
 """(q, v, u): positions, velocities and targets inside the ctrlrange."""
 
@@ -98,4 +101,76 @@ def drake_mjcf_actuators() -> Entry:
         float(np.abs(parsed - expected).max()) / scale,
         float(np.abs(fixed - expected).max()) / scale,
         "relative error of Drake's servo torque against MuJoCo's",
+    )
+
+
+def _servo_plant(scalar: str, *, gains: bool = False):
+    """:data:`UNBOUNDED` in a double plant, or converted to AutoDiffXd (``scalar`` "ad"), with
+    the servo's gains set again on the converted plant where ``gains``; its context with
+    the state of :data:`STATES`' first row."""
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import MultibodyPlant
+    from pydrake.multibody.tree import PdControllerGains
+
+    plant = MultibodyPlant(0.0)
+    Parser(plant).AddModelsFromString(UNBOUNDED, "xml")
+    plant.Finalize()
+    if scalar == "ad":
+        plant = plant.ToAutoDiffXd()
+        if gains:  # (the converted plant is finalized: the gains are a parameter of it)
+            index = plant.GetJointActuatorIndices()[0]
+            plant.get_mutable_joint_actuator(index).set_controller_gains(
+                PdControllerGains(p=KP, d=KV))
+    return plant
+
+
+def _servo_slope(scalar: str, *, gains: bool = False) -> float:
+    """∂v̇/∂u of the servo at :data:`STATES`' second row (unsaturated): Drake's automatic
+    differentiation (``scalar`` "ad"), or centered differences of the double plant."""
+    from pydrake.autodiffutils import AutoDiffXd, ExtractGradient
+
+    plant = _servo_plant(scalar, gains=gains)
+    q, v, u = STATES[1]
+    context = plant.CreateDefaultContext()
+    desired = plant.get_desired_state_input_port(plant.GetModelInstanceByName("servo"))
+    accel = plant.get_generalized_acceleration_output_port()
+    if scalar == "ad":
+        plant.get_actuation_input_port().FixValue(context, [AutoDiffXd(0.0, [0.0])])
+        plant.SetPositions(context, [AutoDiffXd(q, [0.0])])
+        plant.SetVelocities(context, [AutoDiffXd(v, [0.0])])
+        desired.FixValue(context, [AutoDiffXd(u, [1.0]), AutoDiffXd(0.0, [0.0])])
+        return float(ExtractGradient(accel.Eval(context))[0, 0])
+    plant.get_actuation_input_port().FixValue(context, [0.0])
+    plant.SetPositions(context, [q])
+    plant.SetVelocities(context, [v])
+    ends = []
+    for target in (u + 1e-6, u - 1e-6):
+        desired.FixValue(context, [target, 0.0])
+        ends.append(float(accel.Eval(context)[0]))
+    return (ends[0] - ends[1]) / 2e-6
+
+
+def drake_autodiff_pd_gains() -> Entry:
+    """Drake's ∂v̇/∂(servo target) by automatic differentiation, as converted and with the
+    gains set again, against its own finite differences."""
+    from dyncheck.adapters.drake_model import parser_warnings
+
+    with parser_warnings():
+        expected = _servo_slope("double")
+        converted, fixed = _servo_slope("ad"), _servo_slope("ad", gains=True)
+    return Entry(
+        "drake-autodiff-pd-gains",
+        "A derivative of the dynamics in the controls (∂v̇/∂u, what a gradient-based "
+        "controller or a policy's training differentiates) must be the derivative of the "
+        "dynamics the simulator steps: for a PD servo, M⁻¹ kp with respect to its target.",
+        "Drake 1.51's MultibodyPlant.ToAutoDiffXd() drops the PD gains of its joint "
+        "actuators (has_controller() is false on the converted plant): its automatic "
+        "differentiation takes a servo's target as an unconnected input, and its ∂v̇/∂u is 0 "
+        "where the double plant's is M⁻¹ kp. Fix: set the gains again on the converted "
+        "plant (JointActuator.set_controller_gains). `dyncheck check` compares Drake's "
+        "∂v̇/∂u with the referee's and names this on the row.",
+        "Drake's AutoDiffXd plant as converted",
+        abs(converted - expected) / abs(expected),
+        abs(fixed - expected) / abs(expected),
+        "relative error of Drake's ∂v̇/∂(target) against its own finite differences",
     )

@@ -232,6 +232,54 @@ print(f"observed servo torque {observed} (Drake's joint actuator as its MJCF par
 sys.exit(0 if gap <= 1e-12 else 1)
 '''
 
+_DRAKE_AUTODIFF_PD = '''\
+"""Drake's MultibodyPlant.ToAutoDiffXd() drops the PD gains of its joint actuators: the
+derivative of the acceleration in a servo's target is 0 in the AutoDiffXd plant. Expected:
+the double plant's own centered differences (kp / M for one hinge). Exits 1 while the
+derivative is lost."""
+import sys
+
+import numpy as np
+from pydrake.autodiffutils import AutoDiffXd, ExtractGradient
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant
+
+MJCF = """<mujoco model="servo"><worldbody><body name="link" pos="0 0 1">
+<joint name="j" type="hinge" axis="0 1 0"/>
+<geom type="capsule" fromto="0 0 0 0 0 -0.5" size="0.05" mass="1"/></body></worldbody>
+<actuator><position name="servo" joint="j" kp="5" kv="2"/></actuator></mujoco>"""
+Q, V, TARGET = -0.4, -1.5, 0.3
+
+plant = MultibodyPlant(0.0)
+Parser(plant).AddModelsFromString(MJCF, "xml")
+plant.Finalize()
+context = plant.CreateDefaultContext()
+desired = plant.get_desired_state_input_port(plant.GetModelInstanceByName("servo"))
+plant.get_actuation_input_port().FixValue(context, [0.0])
+plant.SetPositions(context, [Q])
+plant.SetVelocities(context, [V])
+ends = []
+for target in (TARGET + 1e-6, TARGET - 1e-6):
+    desired.FixValue(context, [target, 0.0])
+    ends.append(float(plant.get_generalized_acceleration_output_port().Eval(context)[0]))
+expected = (ends[0] - ends[1]) / 2e-6
+
+ad = plant.ToAutoDiffXd()
+actuator = ad.get_joint_actuator(ad.GetJointActuatorIndices()[0])
+context = ad.CreateDefaultContext()
+ad.get_actuation_input_port().FixValue(context, [AutoDiffXd(0.0, [0.0])])
+ad.SetPositions(context, [AutoDiffXd(Q, [0.0])])
+ad.SetVelocities(context, [AutoDiffXd(V, [0.0])])
+ad.get_desired_state_input_port(ad.GetModelInstanceByName("servo")).FixValue(
+    context, [AutoDiffXd(TARGET, [1.0]), AutoDiffXd(0.0, [0.0])])
+observed = float(ExtractGradient(ad.get_generalized_acceleration_output_port().Eval(context))[0, 0])
+print(f"has_controller: double plant {plant.get_joint_actuator(actuator.index()).has_controller()}"
+      f", AutoDiffXd plant {actuator.has_controller()}")
+print(f"expected d(vdot)/d(target) {expected:.6g} (the double plant's centered differences)")
+print(f"observed d(vdot)/d(target) {observed:.6g} (ToAutoDiffXd, automatic differentiation)")
+sys.exit(0 if abs(observed - expected) <= 1e-6 * abs(expected) else 1)
+'''
+
 REPRODUCERS: dict[str, Reproducer] = {
     "pinocchio-mjcf-options": Reproducer(
         engine="pinocchio", imports=frozenset({"numpy", "pinocchio"}),
@@ -246,6 +294,8 @@ REPRODUCERS: dict[str, Reproducer] = {
         script=_PYBULLET_SPHERICAL),
     "drake-mjcf-actuators": Reproducer(
         engine="drake", imports=frozenset({"numpy", "pydrake"}), script=_DRAKE_SERVO),
+    "drake-autodiff-pd-gains": Reproducer(
+        engine="drake", imports=frozenset({"numpy", "pydrake"}), script=_DRAKE_AUTODIFF_PD),
 }
 """Catalogue entry → its reproducer: the entries whose difference is an engine's defect (a
 documented input it drops, a derivative it gets wrong), not a convention it documents."""
