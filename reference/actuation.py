@@ -60,7 +60,7 @@ def clamp(x: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
     return np.where(x.real < low, low, np.where(x.real > high, high, x))
 
 
-def _unclamped(acts: JointActuators, q: np.ndarray, v: np.ndarray, u: np.ndarray,
+def _unclamped(acts: JointActuators, q: np.ndarray, v: np.ndarray, u: np.ndarray, *,
                act: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
     """f = gain · a + bias before its range, and a, per actuator (n, k)."""
     length = acts.gear * q[:, acts.q_index]
@@ -77,7 +77,7 @@ def scalar_forces(acts: JointActuators, q: np.ndarray, v: np.ndarray, u: np.ndar
                   act: np.ndarray | None = None) -> np.ndarray:
     """f clamped to its range, per actuator (n, k), at states (q, v) (n, nq), (n, nv),
     controls u (n, k) and activation states ``act`` (n, k; used where stateful)."""
-    raw, _ = _unclamped(acts, q, v, u, act)
+    raw, _ = _unclamped(acts, q, v, u, act=act)
     return clamp(raw, acts.force_low, acts.force_high)
 
 
@@ -101,7 +101,7 @@ def velocity_derivative(acts: JointActuators, q: np.ndarray, v: np.ndarray, u: n
     with. A joint's own range is not applied: MuJoCo's implicitfast differentiates the
     actuators' forces before it (``mjd_actuator_vel``, engine_derivative.c), and this is that
     integrator's definition."""
-    raw, driven = _unclamped(acts, q, v, u, act)
+    raw, driven = _unclamped(acts, q, v, u, act=act)
     free = (raw.real >= acts.force_low) & (raw.real <= acts.force_high)
     slope = np.where(free, acts.gear**2 * (acts.gain[:, 2] * driven + acts.bias[:, 2]), 0.0)
     out = np.zeros((len(q), v.shape[1], v.shape[1]), dtype=np.result_type(slope, float))
