@@ -148,8 +148,8 @@ def control_derivatives(plant: Any, ad: Any, context: Any, *, q: np.ndarray, v: 
     acc = ad.get_generalized_acceleration_output_port()
     out = np.empty((len(q), ad.num_velocities(), len(indices)))
     for s in range(len(q)):
-        seeded = InitializeAutoDiff(np.asarray(u[s], float))[:, 0]
-        zero = AutoDiffXd(0.0, np.zeros(len(indices)))
+        seeded = InitializeAutoDiff(np.asarray(u[s], float))[:, 0]  # type: ignore[arg-type]
+        zero = AutoDiffXd(0.0, np.zeros(len(indices)))  # type: ignore[arg-type]  # (its stub)
         ad.SetPositions(context, [AutoDiffXd(x) for x in q[s]])
         ad.SetVelocities(context, [AutoDiffXd(x) for x in v[s]])
         port.FixValue(context, [zero if pd else seeded[k] for k, pd in enumerate(servo)])

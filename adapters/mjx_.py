@@ -167,7 +167,14 @@ def _derivatives(mx: Any, q: Any, v: Any, a: Any) -> dict[str, Any]:
     }
 
 
+def _actuate(mx: Any, q: Any, v: Any, u: Any, act: Any) -> dict[str, Any]:
+    """MJX's actuator force and acceleration at one state, control and activation."""
+    d = mjx.forward(mx, mjx.make_data(mx).replace(qpos=q, qvel=v, ctrl=u, act=act))
+    return {"qfrc_actuator": d.qfrc_actuator, "qacc": d.qacc}
+
+
 _EVALUATE = jax.jit(jax.vmap(_evaluate, in_axes=(None, 0, 0, 0, 0)))
+_ACTUATE = jax.jit(jax.vmap(_actuate, in_axes=(None, 0, 0, 0, 0)))
 _STRETCH = jax.jit(_stretch)
 _DERIVATIVES = jax.jit(jax.vmap(_derivatives, in_axes=(None, 0, 0, 0)))
 """Compiled once per model structure and precision, shared by every adapter: the model is an
@@ -201,7 +208,7 @@ class MJXAdapter(PortAdapter):
         static fields key the cache) and batch shape: left alone, a run of every case in one
         process reached the kernel's limit of 65 530 memory maps and died in XLA's LLVM
         ("Cannot allocate memory", then SIGSEGV)."""
-        for jitted in (_EVALUATE, _STRETCH, _DERIVATIVES):
+        for jitted in (_EVALUATE, _STRETCH, _DERIVATIVES, _ACTUATE):
             cast(Any, jitted).clear_cache()  # a method of jit's wrapper its stubs do not declare
 
     @staticmethod
@@ -247,6 +254,13 @@ class MJXAdapter(PortAdapter):
         with self._precision():
             args = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, tau, a))
             out = _EVALUATE(self.mx, *args)
+            return {k: np.asarray(x) for k, x in out.items()}
+
+    def _actuated(self, q: np.ndarray, v: np.ndarray, u: np.ndarray,
+                  act: np.ndarray) -> dict[str, np.ndarray]:
+        with self._precision():
+            args = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, u, act))
+            out = _ACTUATE(self.mx, *args)
             return {k: np.asarray(x) for k, x in out.items()}
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, np.ndarray]:

@@ -72,6 +72,24 @@ class PortAdapter(MuJoCoAdapter):
         computes them (float64 arrays of the port's numbers)."""
         return self._chunks(q, v, tau, a)
 
+    def actuate(self, q: np.ndarray, v: np.ndarray, u: np.ndarray,
+                act: np.ndarray) -> dict[str, np.ndarray]:
+        """Every state's ``qfrc_actuator`` and ``qacc`` at controls ``u`` and activation
+        states ``act`` as the port computes them (a port holding a model with actuation on:
+        :meth:`on_model`), :attr:`chunk` states a call (the last padded)."""
+        n = q.shape[0]
+        parts = []
+        for start in range(0, n, self.chunk):
+            idx = np.arange(start, start + self.chunk)
+            idx[idx >= n] = start
+            parts.append(self._actuated(q[idx], v[idx], u[idx], act[idx]))
+        return {k: np.concatenate([p[k] for p in parts])[:n].astype(float) for k in parts[0]}
+
+    def _actuated(self, q: np.ndarray, v: np.ndarray, u: np.ndarray,
+                  act: np.ndarray) -> dict[str, np.ndarray]:
+        """One chunk of :meth:`actuate` (a port that computes actuators overrides it)."""
+        raise Unsupported(f"{self.name} computes no actuator force here")
+
     def model_array(self, field: str) -> np.ndarray:
         """A model array as the port holds it (:meth:`_loaded`)."""
         return self._loaded(field)

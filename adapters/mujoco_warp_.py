@@ -154,6 +154,17 @@ class MuJoCoWarpAdapter(PortAdapter):
             out["qfrc_inverse"] = d.qfrc_inverse.numpy().copy()
         return out
 
+    def _actuated(self, q: np.ndarray, v: np.ndarray, u: np.ndarray,
+                  act: np.ndarray) -> dict[str, np.ndarray]:
+        with wp.ScopedDevice(self.device):
+            for name, values in (("qpos", q), ("qvel", v), ("ctrl", u), ("act", act)):
+                if values.shape[1]:
+                    self._assign(name, values)
+            self._assign("qfrc_applied", np.zeros_like(v))
+            mjw.forward(self.mw, self.dw)
+            return {"qfrc_actuator": self.dw.qfrc_actuator.numpy().copy(),
+                    "qacc": self.dw.qacc.numpy().copy()}
+
     def _efc_equality(self) -> np.ndarray:
         """efc.force of the equality rows, in equality order, per world."""
         neq = self.model.neq

@@ -42,15 +42,20 @@ BOUNDS = (
 
 
 def drives(model: Any, newton: Any) -> list[tuple[int, int]]:
-    """(joint, mode) of every driven hinge or slide, in joint order."""
+    """(joint, mode) of every driven hinge or slide, in joint order: a drive whose stiffness
+    and damping are both 0 (what Newton's URDF importer gives every joint) does nothing and
+    is none."""
     mode = model.joint_target_mode.numpy()
+    ke, kd = model.joint_target_ke.numpy(), model.joint_target_kd.numpy()
     starts, dofs = model.joint_qd_start.numpy(), model.joint_dof_count
-    none = int(newton.JointTargetMode.NONE)
+    modes = newton.JointTargetMode
     out = []
     for j in range(model.joint_count):
+        dof = int(starts[j])
         end = int(starts[j + 1]) if j + 1 < len(starts) else dofs
-        if end - int(starts[j]) == 1 and int(mode[starts[j]]) != none:
-            out.append((j, int(mode[starts[j]])))
+        kind = int(mode[dof]) if end - dof == 1 else int(modes.NONE)
+        if kind == int(modes.EFFORT) or (kind != int(modes.NONE) and (ke[dof] or kd[dof])):
+            out.append((j, kind))
     return out
 
 

@@ -12,10 +12,12 @@ bounds are the same formula with that ε.
 
 from __future__ import annotations
 
+import copy
 import importlib
 from dataclasses import replace
-from typing import ClassVar
+from typing import Any, ClassVar
 
+import mujoco
 import numpy as np
 
 from dyncheck.adapters.actuators import Actuation, InputJacobian
@@ -30,11 +32,10 @@ class PortModel(MujocoModel):
     """MuJoCo's reading of the file, computed on a port."""
 
     engine = ""
-    offers = frozenset()  # a port's own derivatives where it has them (MJX's); no steps
+    offers = frozenset({Offer.ACTUATION})  # its own derivatives where it has them (MJX's)
     port: ClassVar[str] = ""
     """``module:class`` of the port's adapter (imported here only: JAX and Warp cost seconds)."""
-    no_actuation = ("the port's actuator forces are not compared yet (dyncheck evaluates its "
-                    "smooth dynamics only)")
+    _actuated_port: Any = None
 
     def __init__(self, source: ModelFile) -> None:
         super().__init__(source)
@@ -60,12 +61,27 @@ class PortModel(MujocoModel):
 
 
     def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
-        """Never the C engine's (which this class would inherit)."""
-        raise Unsupported(f"{self.engine}: {self.no_actuation}")
+        """The port's own ``qfrc_actuator`` and ``qacc`` (never the C engine's, which this
+        class would inherit), on a second copy of MuJoCo's compiled model with actuation on
+        put on the port (the smooth dynamics' copy has it off); activation states set to the
+        controls, as on MuJoCo's side."""
+        m = self.model
+        if self._actuated_port is None:
+            actuated = copy.copy(m)
+            actuated.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_ACTUATION)
+            self._actuated_port = type(self.adapter).on_model(actuated)
+        act = np.zeros((len(q), m.na))
+        for k in range(m.nu):
+            if m.actuator_actadr[k] >= 0:
+                act[:, m.actuator_actadr[k]:m.actuator_actadr[k] + m.actuator_actnum[k]] = \
+                    u[:, k : k + 1]
+        raw = self._actuated_port.actuate(q, v, u, act)
+        return Actuation(tau=raw["qfrc_actuator"], forward=raw["qacc"])
 
     def input_jacobians(self, q: np.ndarray, v: np.ndarray,
                         u: np.ndarray) -> tuple[InputJacobian, ...]:
-        raise Unsupported(f"{self.engine}: {self.no_actuation}")
+        """Never the C engine's: the ports' step Jacobians are not taken here."""
+        raise Unsupported(f"{self.engine} offers no step Jacobian in its controls here")
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
         """The port's own derivatives, never the C engine's (which this class would inherit):
@@ -86,13 +102,13 @@ class PortModel(MujocoModel):
 
 class MjxModel(PortModel):
     engine = "mjx"
-    offers = frozenset({Offer.DERIVATIVES})
+    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION})
     port = "dyncheck.adapters.mjx_:MJXAdapter"
 
 
 class MjxF64Model(PortModel):
     engine = "mjx-f64"
-    offers = frozenset({Offer.DERIVATIVES})
+    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION})
     port = "dyncheck.adapters.mjx_:MJXF64Adapter"
 
 

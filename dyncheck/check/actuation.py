@@ -401,7 +401,7 @@ def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
     from dyncheck.check.referee import ReferenceModel
 
     out: list[CheckRow] = []
-    notes = []
+    notes: list[str] = []
     first = next(iter(loaded.values()))
     offering = [m for m in loaded.values() if Offer.ACTUATION in m.offers]
     holding = next((m.tree for m in loaded.values() if m.tree.actuators), None)

@@ -11,6 +11,8 @@ fixes a user can make in Drake.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from dyncheck.explain.entry import Entry
@@ -57,7 +59,7 @@ def drake_forces(*, fixed: bool) -> np.ndarray:
     from pydrake.multibody.plant import MultibodyPlant
     from pydrake.multibody.tree import PdControllerGains
 
-    plant = MultibodyPlant(0.0)
+    plant: Any = MultibodyPlant(0.0)  # (pydrake's stubs type its arrays wrongly)
     Parser(plant).AddModelsFromString(SERVO, "xml")
     if fixed:
         actuator = plant.get_mutable_joint_actuator(plant.GetJointActuatorIndices()[0])
@@ -69,10 +71,10 @@ def drake_forces(*, fixed: bool) -> np.ndarray:
     desired = plant.get_desired_state_input_port(plant.GetModelInstanceByName("servo"))
     out = []
     for q, v, u in STATES:
-        plant.SetPositions(context, [q])
-        plant.SetVelocities(context, [v])
+        plant.SetPositions(context, np.array([q]))
+        plant.SetVelocities(context, np.array([v]))
         desired.FixValue(context, [u, 0.0])
-        out.append(float(plant.get_net_actuation_output_port().Eval(context)[0]))
+        out.append(float(np.asarray(plant.get_net_actuation_output_port().Eval(context))[0]))
     return np.array(out)
 
 
@@ -104,7 +106,7 @@ def drake_mjcf_actuators() -> Entry:
     )
 
 
-def _servo_plant(scalar: str, *, gains: bool = False):
+def _servo_plant(scalar: str, *, gains: bool = False) -> Any:
     """:data:`UNBOUNDED` in a double plant, or converted to AutoDiffXd (``scalar`` "ad"), with
     the servo's gains set again on the converted plant where ``gains``; its context with
     the state of :data:`STATES`' first row."""
@@ -115,13 +117,14 @@ def _servo_plant(scalar: str, *, gains: bool = False):
     plant = MultibodyPlant(0.0)
     Parser(plant).AddModelsFromString(UNBOUNDED, "xml")
     plant.Finalize()
-    if scalar == "ad":
-        plant = plant.ToAutoDiffXd()
-        if gains:  # (the converted plant is finalized: the gains are a parameter of it)
-            index = plant.GetJointActuatorIndices()[0]
-            plant.get_mutable_joint_actuator(index).set_controller_gains(
-                PdControllerGains(p=KP, d=KV))
-    return plant
+    if scalar != "ad":
+        return plant
+    converted: Any = plant.ToAutoDiffXd()
+    if gains:  # (the converted plant is finalized: the gains are a parameter of it)
+        index = converted.GetJointActuatorIndices()[0]
+        converted.get_mutable_joint_actuator(index).set_controller_gains(
+            PdControllerGains(p=KP, d=KV))
+    return converted
 
 
 def _servo_slope(scalar: str, *, gains: bool = False) -> float:
@@ -135,14 +138,16 @@ def _servo_slope(scalar: str, *, gains: bool = False) -> float:
     desired = plant.get_desired_state_input_port(plant.GetModelInstanceByName("servo"))
     accel = plant.get_generalized_acceleration_output_port()
     if scalar == "ad":
-        plant.get_actuation_input_port().FixValue(context, [AutoDiffXd(0.0, [0.0])])
-        plant.SetPositions(context, [AutoDiffXd(q, [0.0])])
-        plant.SetVelocities(context, [AutoDiffXd(v, [0.0])])
-        desired.FixValue(context, [AutoDiffXd(u, [1.0]), AutoDiffXd(0.0, [0.0])])
+        still, seed = np.zeros(1), np.ones(1)
+        make: Any = AutoDiffXd  # (pydrake's stubs type its arrays wrongly)
+        plant.get_actuation_input_port().FixValue(context, [make(0.0, still)])
+        plant.SetPositions(context, [make(q, still)])
+        plant.SetVelocities(context, [make(v, still)])
+        desired.FixValue(context, [make(u, seed), make(0.0, still)])
         return float(ExtractGradient(accel.Eval(context))[0, 0])
     plant.get_actuation_input_port().FixValue(context, [0.0])
-    plant.SetPositions(context, [q])
-    plant.SetVelocities(context, [v])
+    plant.SetPositions(context, np.array([q]))
+    plant.SetVelocities(context, np.array([v]))
     ends = []
     for target in (u + 1e-6, u - 1e-6):
         desired.FixValue(context, [target, 0.0])

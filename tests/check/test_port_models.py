@@ -78,3 +78,30 @@ def test_mjxs_own_derivatives_agree_with_mujoco_c_and_the_referee(port):
     if port == "mjx":  # float32: the bound is float32's, and the errors are float32's
         assert rows["basis"].str.contains("float32 eps").all()
         assert rows["error"].max() > 1e-9
+
+
+SERVO = """<mujoco model="servo"><worldbody><body name="link" pos="0 0 1">
+<joint name="j" type="hinge" axis="0 1 0"/>
+<geom type="capsule" fromto="0 0 0 0 0 -0.5" size="0.05" mass="1"/></body></worldbody>
+<actuator><position joint="j" kp="5" kv="1" ctrlrange="-1 1" forcerange="-3 3"/></actuator>
+</mujoco>"""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("port", list(PORTS))
+def test_a_ports_own_actuator_force_agrees_with_the_referee_and_mujoco(port, tmp_path):
+    """The port's own qfrc_actuator and qacc (a copy of the model with actuation on, put on
+    the port; not the C engine's it would inherit) against the referee's actuator law on its
+    reading and MuJoCo C's force, within its precision."""
+    if not _installed(port):
+        pytest.skip(f"needs the extra that installs {port}")
+    path = tmp_path / "servo.xml"
+    path.write_text(SERVO)
+    result = check_model(path, impls=("reference", "mujoco", port), states=20)
+    rows = result.rows[(result.rows["section"] == "actuation") & (result.rows["impl_b"] == port)]
+    judged = rows.set_index(["impl_a", "subject"])["verdict"]
+    assert judged[("reference", "actuator force")] == "passed"
+    assert judged[("reference", "forward dynamics with the control")] == "passed"
+    assert judged[("mujoco", "actuator force")] == "passed"
+    if port != "mjx-f64":  # float32: the port's own numbers, not C's copied
+        assert rows[rows["impl_a"] == "mujoco"]["error"].max() > 1e-12
