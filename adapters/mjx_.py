@@ -167,14 +167,16 @@ def _derivatives(mx: Any, q: Any, v: Any, a: Any) -> dict[str, Any]:
     }
 
 
-def _actuate(mx: Any, q: Any, v: Any, u: Any, act: Any) -> dict[str, Any]:
-    """MJX's actuator force and acceleration at one state, control and activation."""
+def _actuate(mx: Any, q: Any, v: Any, inputs: tuple[Any, Any]) -> dict[str, Any]:
+    """MJX's actuator force and acceleration at one state and ``inputs``, its control and
+    activation state."""
+    u, act = inputs
     d = mjx.forward(mx, mjx.make_data(mx).replace(qpos=q, qvel=v, ctrl=u, act=act))
     return {"qfrc_actuator": d.qfrc_actuator, "qacc": d.qacc}
 
 
 _EVALUATE = jax.jit(jax.vmap(_evaluate, in_axes=(None, 0, 0, 0, 0)))
-_ACTUATE = jax.jit(jax.vmap(_actuate, in_axes=(None, 0, 0, 0, 0)))
+_ACTUATE = jax.jit(jax.vmap(_actuate, in_axes=(None, 0, 0, 0)))
 _STRETCH = jax.jit(_stretch)
 _DERIVATIVES = jax.jit(jax.vmap(_derivatives, in_axes=(None, 0, 0, 0)))
 """Compiled once per model structure and precision, shared by every adapter: the model is an
@@ -259,8 +261,8 @@ class MJXAdapter(PortAdapter):
     def _actuated(self, q: np.ndarray, v: np.ndarray, u: np.ndarray,
                   act: np.ndarray) -> dict[str, np.ndarray]:
         with self._precision():
-            args = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, u, act))
-            out = _ACTUATE(self.mx, *args)
+            q_, v_, u_, act_ = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, u, act))
+            out = _ACTUATE(self.mx, q_, v_, (u_, act_))
             return {k: np.asarray(x) for k, x in out.items()}
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, np.ndarray]:
