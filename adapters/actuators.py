@@ -79,38 +79,6 @@ class Actuator:
         return (self.transmission is Transmission.JOINT
                 and self.activation is not Activation.OTHER)
 
-    def fields(self) -> dict[str, object]:
-        """The fields two readings compare, by name."""
-        return {"gear": self.gear, "gain": self.gain, "bias": self.bias,
-                "ctrlrange": self.ctrl_range, "forcerange": self.force_range,
-                "activation": self.activation.value, "time constant": self.time_constant}
-
-
-def shown_value(value: object) -> str:
-    """A field's value as a row shows it."""
-    if value is None:
-        return "unlimited"
-    if isinstance(value, tuple):
-        return "(" + ", ".join(shown_value(x) for x in value) + ")"
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    return str(value)
-
-
-def same(a: object, b: object, *, rtol: float) -> bool:
-    """Whether two field values agree to ``rtol`` of their size (exactly for a name)."""
-    if a is None or b is None or isinstance(a, str) or isinstance(b, str):
-        return a == b
-    if isinstance(a, tuple) and isinstance(b, tuple) and any(
-            x is None or isinstance(x, tuple) for x in (*a, *b)):  # ranges of ranges
-        return len(a) == len(b) and all(same(x, y, rtol=rtol) for x, y in zip(a, b, strict=True))
-    x, y = np.atleast_1d(np.asarray(a, float)), np.atleast_1d(np.asarray(b, float))
-    scale = max(float(np.abs(x).max(initial=0.0)), float(np.abs(y).max(initial=0.0)), 1e-300)
-    finite = np.isfinite(x) & np.isfinite(y)
-    return bool(x.shape == y.shape and np.array_equal(np.isfinite(x), np.isfinite(y))
-                and np.all(np.abs(x - y)[finite] <= rtol * scale)
-                and np.array_equal(x[~finite], y[~finite]))
-
 
 @dataclass(frozen=True, kw_only=True)
 class Actuation:

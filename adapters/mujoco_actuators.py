@@ -119,22 +119,37 @@ def _range(limited: object, bounds: np.ndarray) -> tuple[float, float] | None:
     return (float(bounds[0]), float(bounds[1])) if limited else None
 
 
-class Actuated:
+def with_actuation(m: mujoco.MjModel) -> mujoco.MjModel:
     """A copy of the check's model with actuation enabled (constraints, springs and dampers
     off as in the check's)."""
+    actuated = copy.copy(m)
+    actuated.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_ACTUATION)
+    return actuated
+
+
+def activations(m: mujoco.MjModel, u: np.ndarray) -> np.ndarray:
+    """The activation states (n, na) the check sets at controls u (n, nu): each stateful
+    actuator's, its control's value."""
+    act = np.zeros((len(u), m.na))
+    for k in range(m.nu):
+        if m.actuator_actadr[k] >= 0:
+            start = m.actuator_actadr[k]
+            act[:, start : start + m.actuator_actnum[k]] = u[:, k : k + 1]
+    return act
+
+
+class Actuated:
+    """MuJoCo with :func:`with_actuation`'s copy of the check's model."""
 
     def __init__(self, m: mujoco.MjModel) -> None:
-        self.model = copy.copy(m)
-        self.model.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_ACTUATION)
+        self.model = with_actuation(m)
         self.data = mujoco.MjData(self.model)
 
     def _set(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> None:
-        m, d = self.model, self.data
+        d = self.data
         d.qpos[:], d.qvel[:], d.ctrl[:] = q, v, u
         d.qfrc_applied[:] = 0.0
-        for k in range(m.nu):  # an activation state: its control's value
-            if m.actuator_actadr[k] >= 0:
-                d.act[m.actuator_actadr[k] : m.actuator_actadr[k] + m.actuator_actnum[k]] = u[k]
+        d.act[:] = activations(self.model, u[None])[0]
 
     def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
         """``qfrc_actuator`` and ``qacc`` after ``mj_forward`` at each state and control."""

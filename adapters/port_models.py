@@ -12,18 +12,17 @@ bounds are the same formula with that ε.
 
 from __future__ import annotations
 
-import copy
 import importlib
 from dataclasses import replace
 from typing import Any, ClassVar
 
-import mujoco
 import numpy as np
 
 from dyncheck.adapters.actuators import Actuation, InputJacobian
 from dyncheck.adapters.base import Offer
 from dyncheck.adapters.model_files import ModelFile
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, derivatives
+from dyncheck.adapters.mujoco_actuators import activations, with_actuation
 from dyncheck.adapters.mujoco_model import MujocoModel
 from dyncheck.errors import Unsupported
 
@@ -65,17 +64,9 @@ class PortModel(MujocoModel):
         class would inherit), on a second copy of MuJoCo's compiled model with actuation on
         put on the port (the smooth dynamics' copy has it off); activation states set to the
         controls, as on MuJoCo's side."""
-        m = self.model
         if self._actuated_port is None:
-            actuated = copy.copy(m)
-            actuated.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_ACTUATION)
-            self._actuated_port = type(self.adapter).on_model(actuated)
-        act = np.zeros((len(q), m.na))
-        for k in range(m.nu):
-            if m.actuator_actadr[k] >= 0:
-                act[:, m.actuator_actadr[k]:m.actuator_actadr[k] + m.actuator_actnum[k]] = \
-                    u[:, k : k + 1]
-        raw = self._actuated_port.actuate(q, v, u, act)
+            self._actuated_port = type(self.adapter).on_model(with_actuation(self.model))
+        raw = self._actuated_port.actuate(q, v, u, activations(self.model, u))
         return Actuation(tau=raw["qfrc_actuator"], forward=raw["qacc"])
 
     def input_jacobians(self, q: np.ndarray, v: np.ndarray,

@@ -16,18 +16,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters import layout_batch
-from dyncheck.adapters.actuators import Activation, Actuator, same, shown_value
+from dyncheck.adapters.actuators import Activation, Actuator
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check.describe import depth
 from dyncheck.check.dynamics import States, condition
+from dyncheck.check.engines import REFEREE
 from dyncheck.check.rows import COMPUTED, CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.reference import actuation as law
 from dyncheck.results import Verdict
 
-REFEREE = "reference"
 FORCE = "actuator force"
 FIELD_RTOL = 1e-9
 """Two readings of a field agree to this, relative (the file's digits, parsed twice)."""
@@ -60,6 +60,32 @@ def limits(actuator: Actuator) -> object:
                 low, high = max(low, bound[0]), min(high, bound[1])
         return None if not (np.isfinite(low) or np.isfinite(high)) else (float(low), float(high))
     return (actuator.ctrl_range, actuator.force_range, actuator.joint_range)
+
+
+def shown_value(value: object) -> str:
+    """A field's value as a row shows it."""
+    if value is None:
+        return "unlimited"
+    if isinstance(value, tuple):
+        return "(" + ", ".join(shown_value(x) for x in value) + ")"
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return str(value)
+
+
+def same(a: object, b: object, *, rtol: float) -> bool:
+    """Whether two field values agree to ``rtol`` of their size (exactly for a name)."""
+    if a is None or b is None or isinstance(a, str) or isinstance(b, str):
+        return a == b
+    if isinstance(a, tuple) and isinstance(b, tuple) and any(
+            x is None or isinstance(x, tuple) for x in (*a, *b)):  # ranges of ranges
+        return len(a) == len(b) and all(same(x, y, rtol=rtol) for x, y in zip(a, b, strict=True))
+    x, y = np.atleast_1d(np.asarray(a, float)), np.atleast_1d(np.asarray(b, float))
+    scale = max(float(np.abs(x).max(initial=0.0)), float(np.abs(y).max(initial=0.0)), 1e-300)
+    finite = np.isfinite(x) & np.isfinite(y)
+    return bool(x.shape == y.shape and np.array_equal(np.isfinite(x), np.isfinite(y))
+                and np.all(np.abs(x - y)[finite] <= rtol * scale)
+                and np.array_equal(x[~finite], y[~finite]))
 
 
 def compared_fields(actuator: Actuator) -> dict[str, object]:
@@ -223,10 +249,20 @@ def force_rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: Sta
         found[engine] = Forces(tau=answer.tau, controls=u_e, q=q_e, v=v_e, maps=maps,
                                floor=float(np.max(answer.floor, initial=0.0))
                                if answer.floor is not None else 0.0)
-        rows.extend(_against_referee(model, m.tree, found[engine]))
+        acts = joint_actuators(m.tree)
+        if acts is None:
+            others = ", ".join(a.what for a in m.tree.actuators if not a.modelled)
+            rows.append(_row(model, subject=FORCE, field=COMPUTED, a=REFEREE, b=engine,
+                             verdict=Verdict.SKIPPED, note=f"the referee models joint "
+                             f"actuators only; {engine} holds {others}"))
+            continue
+        expected = law.generalized_force(acts, q_e, v_e, u_e, act=u_e)
+        rows.append(_against_referee(model, m.tree, found[engine], acts=acts,
+                                     expected=expected))
         if smooth and own and engine in smooth and engine in own:
-            rows.extend(_forward_row(model, m.tree, found[engine], forward=answer.forward,
-                                     smooth=smooth[engine], own=own[engine]))
+            rows.append(_forward_row(model, m.tree, found[engine], forward=answer.forward,
+                                     expected=expected, smooth=smooth[engine],
+                                     own=own[engine]))
     names = list(found)
     for other in names[1:]:
         rows.append(_pair(model, tree_a=loaded[names[0]].tree, a=found[names[0]],
@@ -251,15 +287,11 @@ def _scale(acts: law.JointActuators, f: Forces) -> float:
     return max(float(np.max(np.abs(acts.gear) * terms, initial=0.0)), 1e-300)
 
 
-def _against_referee(model: str, tree: ModelTree, f: Forces) -> list[CheckRow]:
+def _against_referee(model: str, tree: ModelTree, f: Forces, *, acts: law.JointActuators,
+                     expected: np.ndarray) -> CheckRow:
+    """The engine's force against ``expected``, the referee's law (``acts``) on its
+    reading."""
     engine = tree.engine
-    acts = joint_actuators(tree)
-    if acts is None:
-        others = ", ".join(a.what for a in tree.actuators if not a.modelled)
-        return [_row(model, subject=FORCE, field=COMPUTED, a=REFEREE, b=engine,
-                     verdict=Verdict.SKIPPED,
-                     note=f"the referee models joint actuators only; {engine} holds {others}")]
-    expected = law.generalized_force(acts, f.q, f.v, f.controls, act=f.controls)
     scale = max(_scale(acts, f), f.floor)
     off = np.abs(f.tau - expected)
     tolerance = ROUNDOFF_FACTOR * max(EPS, tree.eps)
@@ -267,7 +299,7 @@ def _against_referee(model: str, tree: ModelTree, f: Forces) -> list[CheckRow]:
     error = float(off.max(initial=0.0)) / scale
     ok = error <= tolerance
     clamped = _clamped(acts, f)
-    return [_row(model, subject=FORCE, field=COMPUTED, a=REFEREE, b=engine,
+    return _row(model, subject=FORCE, field=COMPUTED, a=REFEREE, b=engine,
                  verdict=Verdict.PASSED if ok else Verdict.FAILED, error=error,
                  tolerance=tolerance, worst=worst,
                  basis=f"the referee's actuator law on {engine}'s own reading; round-off "
@@ -275,45 +307,42 @@ def _against_referee(model: str, tree: ModelTree, f: Forces) -> list[CheckRow]:
                        + (" (or of the net force it subtracted)" if f.floor else "")
                        + f"; {clamped}",
                  note="" if ok else f"{engine} computes a force its reading does not give "
-                 f"(state {worst}: {off[worst].max():.3g}): {UNKNOWN}")]
+                 f"(state {worst}: {off[worst].max():.3g}): {UNKNOWN}")
 
 
 FORWARD = "forward dynamics with the control"
 
 
 def _forward_row(model: str, tree: ModelTree, f: Forces, *, forward: np.ndarray,
-                 smooth: Dynamics, own: Dynamics) -> list[CheckRow]:
+                 expected: np.ndarray, smooth: Dynamics, own: Dynamics) -> CheckRow:
     """What the engine's control adds to its forward dynamics, v̇(u) − v̇(τ = 0) (both its
     own, in the canonical layout: accelerations map by T⁻¹, where v_e = T v), against the
-    referee's M⁻¹ τ(u) on its own reading (forces map by Tᵀ). Round-off: the dynamics'
-    bound, c ε × depth × κ(M), relative to the larger of the increment and v̇ itself."""
-    acts = joint_actuators(tree)
-    if acts is None:
-        return []
+    referee's M⁻¹ τ(u) on its own reading (``expected``: the referee's τ(u) in the engine's
+    layout; forces map by Tᵀ). Round-off: the dynamics' bound, c ε × depth × κ(M), relative
+    to the larger of the increment and v̇ itself."""
     t = np.array([s.t for s in f.maps])
     tdot_v = np.array([s.tdot_v for s in f.maps])
     with_u = np.linalg.solve(t, (forward - tdot_v)[..., None])[..., 0]
-    tau = (np.swapaxes(t, 1, 2) @ law.generalized_force(
-        acts, f.q, f.v, f.controls, act=f.controls)[..., None])[..., 0]
-    expected = np.linalg.solve(own.mass_matrix, tau[..., None])[..., 0]
+    tau = (np.swapaxes(t, 1, 2) @ expected[..., None])[..., 0]
+    increment = np.linalg.solve(own.mass_matrix, tau[..., None])[..., 0]
     found = with_u - smooth.forward
-    scale = max(float(np.abs(expected).max(initial=0.0)),
+    scale = max(float(np.abs(increment).max(initial=0.0)),
                 float(np.abs(smooth.forward).max(initial=0.0)), 1e-300)
     kappa = condition(own.mass_matrix)
     tolerance = ROUNDOFF_FACTOR * max(EPS, tree.eps) * depth(tree) * kappa
-    off = np.abs(found - expected)
+    off = np.abs(found - increment)
     error = float(off.max(initial=0.0)) / scale
     worst = int(np.argmax(off.max(axis=1))) if off.size else -1
     ok = error <= tolerance
     engine = tree.engine
-    return [_row(model, subject=FORWARD, field=COMPUTED, a=REFEREE, b=engine,
+    return _row(model, subject=FORWARD, field=COMPUTED, a=REFEREE, b=engine,
                  verdict=Verdict.PASSED if ok else Verdict.FAILED, error=error,
                  tolerance=tolerance, worst=worst,
                  basis=f"{engine}'s v̇(u) − v̇(τ = 0) against the referee's M⁻¹ τ(u) on its "
                        f"own reading; round-off {ROUNDOFF_FACTOR} eps x tree depth "
                        f"{depth(tree)} x cond(M) {kappa:.3g}, of max(|M⁻¹ τ|, |v̇|)",
                  note="" if ok else f"{engine}'s forward dynamics do not take the force its "
-                 f"actuators report (state {worst}): {UNKNOWN}")]
+                 f"actuators report (state {worst}): {UNKNOWN}")
 
 
 def _clamped(acts: law.JointActuators, f: Forces) -> str:
@@ -355,15 +384,15 @@ def _pair(model: str, *, tree_a: ModelTree, a: Forces, tree_b: ModelTree, b: For
 
 
 def _derivative_rows(model: str, *, canon: Canonical, holding: ModelTree, batch: States,
-                     loaded: dict[str, ModelEngine], seed: int,
+                     loaded: dict[str, ModelEngine], inside: np.ndarray,
                      own: dict[str, Dynamics]) -> list[CheckRow]:
     """Every engine's own ∂v̇/∂u where it offers one, against the referee on its reading, at
-    the first :data:`INPUT_STATES` states and controls inside their ranges."""
+    the first :data:`INPUT_STATES` states and controls ``inside`` their ranges (for
+    ``holding``'s actuators)."""
     from dyncheck.check import input_jacobian
 
     out = []
-    k = min(INPUT_STATES, len(batch.q))
-    inside = sample_controls(holding.actuators, k, seed, spread=0.8)
+    k = len(inside)
     for engine, m in loaded.items():
         acts = joint_actuators(m.tree)
         if Offer.CONTROL_DERIVATIVES not in m.offers or not m.tree.actuators or \
@@ -398,8 +427,8 @@ def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
     canonical engine's step Jacobian in the controls against the chain rule; and the notes
     that say what was left out."""
     from dyncheck.check import input_jacobian
-    from dyncheck.check.referee import ReferenceModel
 
+    own = own or {}
     out: list[CheckRow] = []
     notes: list[str] = []
     first = next(iter(loaded.values()))
@@ -423,18 +452,19 @@ def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
     u = sample_controls(holding.actuators, len(batch.q), seed)
     out.extend(force_rows(model, canon=canon, canonical=holding, batch=batch, loaded=loaded,
                           u=u, differing=differing, smooth=smooth, own=own))
+    k = min(INPUT_STATES, len(batch.q))
+    inside = sample_controls(holding.actuators, k, seed, spread=0.8)
     out.extend(_derivative_rows(model, canon=canon, holding=holding, batch=batch,
-                                loaded=loaded, seed=seed, own=own or {}))
+                                loaded=loaded, inside=inside, own=own))
     acts = joint_actuators(canonical)
-    if Offer.INPUT_JACOBIAN in first.offers and acts is not None and canonical.actuators:
-        k = min(INPUT_STATES, len(batch.q))
+    if Offer.INPUT_JACOBIAN in first.offers and acts is not None and canonical.actuators \
+            and first.engine in own:  # (the referee on the canonical reading: own's first)
         q, v = batch.q[:k], batch.v[:k]
-        inside = sample_controls(canonical.actuators, k, seed, spread=0.8)
-        reference = ReferenceModel(canonical).dynamics(q, v, np.zeros_like(v))
+        inside = controls_for(holding, canonical, inside)
+        mass, bias = own[first.engine].mass_matrix[:k], own[first.engine].bias[:k]
         subject = "step Jacobian in the controls"
-        if not (np.all(np.isfinite(reference.mass_matrix))
-                and np.all(np.isfinite(reference.bias))
-                and np.all(np.linalg.eigvalsh(reference.mass_matrix) > 0)):
+        if not (np.all(np.isfinite(mass)) and np.all(np.isfinite(bias))
+                and np.all(np.linalg.eigvalsh(mass) > 0)):
             out.append(_row(model, subject=subject, field=COMPUTED, a=REFEREE, b=first.engine,
                             verdict=Verdict.SKIPPED, note="not compared: the referee's M is "
                             "not positive definite or h not finite on this reading (the "
@@ -448,6 +478,6 @@ def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
             jacobians = ()
         for jacobian in jacobians:
             out.append(input_jacobian.rows(
-                model, canon=canon, tree=canonical, acts=acts, mass=reference.mass_matrix,
-                bias=reference.bias, q=q, v=v, u=inside, found=jacobian))
+                model, canon=canon, tree=canonical, acts=acts, mass=mass, bias=bias, q=q, v=v,
+                u=inside, found=jacobian))
     return out, notes

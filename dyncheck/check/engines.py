@@ -293,8 +293,7 @@ class Isolated(ModelEngine):
         return self
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
-        self.submit(q, v, a)
-        return self.collect()[0]
+        return self._ask("dynamics", q, v, a)
 
     def submit(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, *,
                kind: str = "dynamics") -> None:
@@ -330,35 +329,35 @@ class Isolated(ModelEngine):
         answers, _ = self.collect()
         return answers
 
+    def _ask(self, kind: str, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Any:
+        """One request of ``kind`` (:meth:`ModelEngine.request`'s) submitted and awaited."""
+        self.submit(q, v, a, kind=kind)
+        return self.collect()[0]
+
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
         """The engine's derivatives (:class:`Unsupported` where it offers none)."""
-        self.submit(q, v, a, kind="derivatives")
-        return self.collect()[0]
+        return self._ask("derivatives", q, v, a)
 
     def transition(self, q: np.ndarray, v: np.ndarray,
                    a: np.ndarray) -> tuple[Transition, ...]:
         """The engine's Jacobians of one step of its integrators (:class:`Unsupported`
         where it offers none)."""
-        self.submit(q, v, a, kind="transition")
-        return self.collect()[0]
+        return self._ask("transition", q, v, a)
 
     def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
         """The engine's actuator force at controls u (:class:`Unsupported` where it holds
         no actuator model)."""
-        self.submit(q, v, u, kind="actuation")
-        return self.collect()[0]
+        return self._ask("actuation", q, v, u)
 
     def input_jacobians(self, q: np.ndarray, v: np.ndarray,
                         u: np.ndarray) -> tuple[InputJacobian, ...]:
         """The engine's Jacobians of one step in its controls (:class:`Unsupported` where
         it offers none)."""
-        self.submit(q, v, u, kind="input_jacobians")
-        return self.collect()[0]
+        return self._ask("input_jacobians", q, v, u)
 
     def control_derivatives(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> np.ndarray:
         """The engine's ∂v̇/∂u (:class:`Unsupported` where it offers none)."""
-        self.submit(q, v, u, kind="control_derivatives")
-        return self.collect()[0]
+        return self._ask("control_derivatives", q, v, u)
 
     def collect(self) -> tuple[Any, float]:
         """The submitted batch's answer (dynamics or derivatives) and the seconds the engine

@@ -21,11 +21,11 @@ from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.check.describe import depth
 from dyncheck.check.rows import COMPUTED, CheckRow, Section
-from dyncheck.check.steps import right_jacobian
+from dyncheck.check.steps import right_jacobian, rotations
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.reference import actuation as law
 from dyncheck.results import Verdict
-from dyncheck.vocabulary import Integrator, JointType
+from dyncheck.vocabulary import Integrator
 
 COMPLEX_STEP = 1e-30
 """The complex step in u: exact to round-off whatever its size (no subtraction)."""
@@ -49,12 +49,9 @@ def chain_rule(canon: Canonical, acts: law.JointActuators, *, mass: np.ndarray,
         act_next = law.activation_step(acts, pushed[None], u[None].astype(complex), h)[0]
         dv = v_next.imag / COMPLEX_STEP
         dq = h * dv
-        for j, kind in enumerate(canon.types):
-            vs = canon.v_start[j]
-            turning = slice(vs + 3, vs + 6) if kind is JointType.FREE else \
-                slice(vs, vs + 3) if kind is JointType.BALL else None
-            if turning is not None:
-                dq[turning] = right_jacobian(h * v_next.real[turning]) @ (h * dv[turning])
+        for va, _ in rotations(canon):  # a ball's, a free joint's angular velocity
+            turning = slice(va, va + 3)
+            dq[turning] = right_jacobian(h * v_next.real[turning]) @ (h * dv[turning])
         out[:nv, k], out[nv:2 * nv, k] = dq, dv
         out[2 * nv:, k] = act_next.imag[stateful] / COMPLEX_STEP
     return out

@@ -68,7 +68,7 @@ RK4_STAGES = ((0.0, 1.0 / 6), (0.5, 1.0 / 3), (0.5, 1.0 / 3), (1.0, 1.0 / 6))
 weight) — the classical method, as MuJoCo's ``mj_RungeKutta`` with N = 4."""
 
 
-def _rotations(canon: Canonical) -> list[tuple[int, int]]:
+def rotations(canon: Canonical) -> list[tuple[int, int]]:
     """(first velocity index, quaternion index) of every rotation: a ball joint's, a free
     joint's angular part (canonical: w first, turned on the right, body-frame δ)."""
     out = []
@@ -98,7 +98,7 @@ def advance(canon: Canonical, q: np.ndarray, theta: np.ndarray) -> np.ndarray:
     out = q.copy()
     vel, pos = _vectors(canon)
     out[:, pos] += theta[:, vel]
-    for va, qa in _rotations(canon):
+    for va, qa in rotations(canon):
         turn = np.stack([quat_exp(t) for t in theta[:, va : va + 3]])
         out[:, qa : qa + 4] = quat_mul(out[:, qa : qa + 4].T, turn.T).T
     return out
@@ -107,7 +107,7 @@ def advance(canon: Canonical, q: np.ndarray, theta: np.ndarray) -> np.ndarray:
 def _rates(canon: Canonical, theta: np.ndarray, v: np.ndarray) -> np.ndarray:
     """kᵢ = dexp⁻¹(θᵢ) vᵢ on every rotation (:func:`dexp_inv`), vᵢ elsewhere."""
     out = v.copy()
-    for va, _ in _rotations(canon):
+    for va, _ in rotations(canon):
         out[:, va : va + 3] = [dexp_inv(t, w) for t, w in
                                zip(theta[:, va : va + 3], v[:, va : va + 3], strict=True)]
     return out
@@ -170,7 +170,7 @@ def rk4_step(canon: Canonical, stages: list[tuple[States, Referee, np.ndarray]],
     coordinate adds (hinge and slide joints) R, J_r, D are 1 and E is 0: the classical
     chain rule."""
     n, nv = stages[0][0].v.shape
-    rotations = [va for va, _ in _rotations(canon)]
+    angular = [va for va, _ in rotations(canon)]
     eye = np.eye(nv)
     out = np.zeros((n, 2 * nv, 2 * nv))
     dq0 = np.hstack([eye, np.zeros((nv, nv))])
@@ -179,7 +179,7 @@ def rk4_step(canon: Canonical, stages: list[tuple[States, Referee, np.ndarray]],
     def turned(theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
         """d(q ⊕ θ) = R(θ)ᵀ dq + J_r(θ) dθ (rotations), dq + dθ (elsewhere)."""
         moved = dq0 + dtheta
-        for va in rotations:
+        for va in angular:
             rows = slice(va, va + 3)
             moved[rows] = Rotation.from_rotvec(-theta[rows]).as_matrix() @ dq0[rows] \
                 + right_jacobian(theta[rows]) @ dtheta[rows]
@@ -195,7 +195,7 @@ def rk4_step(canon: Canonical, stages: list[tuple[States, Referee, np.ndarray]],
             df = ref.derivatives.forward_q[s] @ turned(theta[s], dtheta) \
                 + ref.derivatives.forward_v[s] @ dv
             dk = dv.copy()
-            for va in rotations:
+            for va in angular:
                 rows = slice(va, va + 3)
                 d, e = dexp_inv_matrices(theta[s, rows], at.v[s, rows])
                 dk[rows] = d @ dv[rows] + e @ dtheta[rows]

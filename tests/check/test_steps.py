@@ -209,12 +209,12 @@ def _log(canon, centre, q):
     rotation's δ is the rotation vector of centre⁻¹ q."""
     from scipy.spatial.transform import Rotation
 
-    from dyncheck.check.steps import _rotations, _vectors
+    from dyncheck.check.steps import _vectors, rotations
 
     out = np.zeros(canon.nv)
     vel, pos = _vectors(canon)
     out[vel] = q[0, pos] - centre[0, pos]
-    for va, qa in _rotations(canon):
+    for va, qa in rotations(canon):
         a = Rotation.from_quat(centre[0, qa : qa + 4], scalar_first=True)
         b = Rotation.from_quat(q[0, qa : qa + 4], scalar_first=True)
         out[va : va + 3] = (a.inv() * b).as_rotvec()
