@@ -11,6 +11,7 @@ import os
 import shutil
 import stat
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +19,24 @@ from dyncheck.settings import Settings
 
 _TEMPORARY: dict[str, Path] = {}
 """Warp's temporary kernel folder of this process, where it has no checked one."""
+
+_AIMED: dict[str, Callable[[], None]] = {}
+"""How to point each engine that was aimed at a checked folder away from it again, by
+engine."""
+
+
+def aimed(engine: str, away: Callable[[], None]) -> None:
+    """Record that ``engine`` now writes into a checked folder, and how to stop it."""
+    _AIMED[engine] = away
+
+
+def released() -> None:
+    """Point every engine of this process away from the checked folders, when the command
+    that checked them ends: their settings are process-wide, so an engine used afterwards in
+    the same process (a library call, the next command of a test session) would otherwise
+    write entries that no manifest vouches for, and the next command would delete them."""
+    while _AIMED:
+        _AIMED.popitem()[1]()
 
 
 def private_folder(folder: Path) -> None:
@@ -75,3 +94,6 @@ def start_warp(wp: Any) -> None:
 
     wp.config.log_level = wp.LOG_ERROR
     wp.config.kernel_cache_dir = str(warp_folder(current()))
+    if folder(current(), "warp") is not None:
+        aimed("warp", lambda: setattr(wp.config, "kernel_cache_dir",
+                                      str(warp_folder(Settings(cache=False)))))

@@ -48,7 +48,7 @@ def _compile_cache() -> None:
     folder the command line checked (:mod:`dyncheck.compiled_caches`: XLA's cached
     executables are machine code, loaded as found) — none where there is no such folder.
     Both are JAX's, process-wide."""
-    from dyncheck.adapters.compiled import folder
+    from dyncheck.adapters.compiled import aimed, folder
 
     settings = current()
     platform = settings.device.split(":")[0] if settings.device else None
@@ -57,10 +57,22 @@ def _compile_cache() -> None:
     checked = folder(settings, "jax")
     if checked is not None and getattr(jax.config, "jax_compilation_cache_dir", None) \
             != str(checked):
-        jax.config.update("jax_compilation_cache_dir", str(checked))
-        jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
+        _aim_cache(str(checked))
+        aimed("jax", lambda: _aim_cache(None))
     elif checked is None and getattr(jax.config, "jax_compilation_cache_dir", None):
-        jax.config.update("jax_compilation_cache_dir", None)  # (an unchecked one: none)
+        _aim_cache(None)  # (an unchecked one: none)
+
+
+def _aim_cache(path: str | None) -> None:
+    """JAX's persistent cache in ``path`` (None: none). JAX opens its cache once, at the
+    first compilation, and keeps that folder whatever its setting says later (read in
+    ``jax._src.compilation_cache``), so the open one is reset with the setting."""
+    from jax.experimental.compilation_cache import compilation_cache
+
+    jax.config.update("jax_compilation_cache_dir", path)
+    if path is not None:
+        jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
+    compilation_cache.reset_cache()
 
 
 def _clear_trace_caches() -> None:

@@ -36,7 +36,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from dyncheck import store
-from dyncheck.adapters.compiled import private
+from dyncheck.adapters.compiled import private, released
 from dyncheck.settings import Settings
 
 ENGINES = ("jax", "warp")
@@ -165,7 +165,10 @@ def held(settings: Settings) -> Iterator[Settings]:
         import fcntl
 
         fcntl.flock(fd, fcntl.LOCK_SH)  # checked: held shared while the command runs
-        yield replace(settings, compiled=str(folder))
+        try:
+            yield replace(settings, compiled=str(folder))
+        finally:
+            released()  # no engine of this process writes there once the command ends
         _sign_all(folder, secret)  # (not after a failure: unsigned entries compile again)
     finally:
         os.close(fd)

@@ -6,11 +6,13 @@ it. Expected values: the files the test wrote and what a jitted function compute
 from __future__ import annotations
 
 import importlib.util
+import json
 import os
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from dyncheck import compiled_caches
@@ -161,3 +163,39 @@ def test_swapped_jax_entries_are_compiled_again_not_run(tmp_path):
         <= set(removed)
     assert run() == expected
     assert first.exists() and second.exists()  # compiled again
+
+
+AFTER_COMMAND = """
+import jax, jax.numpy as jnp
+from dyncheck import compiled_caches
+from dyncheck.adapters import mjx_
+from dyncheck.settings import Settings
+from dyncheck.workers import settled
+
+with compiled_caches.held(Settings()) as settings, settled(settings):
+    mjx_._compile_cache()
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0)
+    jax.config.update("jax_persistent_cache_min_entry_size_bytes", -1)
+    print(jax.jit(lambda y: y * 2 + 1)(jnp.arange(4.0)).tolist())
+print(jax.jit(lambda y: jnp.cos(y) - 5)(jnp.arange(4.0)).tolist())  # a library call after it
+with compiled_caches.held(Settings()):
+    pass
+"""
+
+
+@pytest.mark.skipif(importlib.util.find_spec("jax") is None, reason="needs the 'mjx' extra")
+def test_jax_writes_nothing_into_the_folder_once_the_command_ends(tmp_path):
+    """JAX keeps the cache folder it first opened whatever its setting says later: the
+    command's end points it away, so a function compiled after it (a library call, the next
+    command of a test session) leaves no entry that the next command finds unsigned and
+    deletes (CI's stop 69: "compiled code not vouched for" before a usage error)."""
+    env = {**os.environ, "JAX_PLATFORMS": "cpu", "DYNCHECK_CACHE": str(tmp_path / "cache"),
+           "DYNCHECK_CACHE_KEY": str(tmp_path / "key")}
+    done = subprocess.run([sys.executable, "-c", AFTER_COMMAND], capture_output=True,
+                          text=True, timeout=300, env=env)
+    assert done.returncode == 0, done.stderr[-2000:]
+    first, second = (json.loads(line) for line in done.stdout.split("\n")[:2])
+    assert first == [1.0, 3.0, 5.0, 7.0]
+    np.testing.assert_allclose(second, np.cos(range(4)) - 5, rtol=1e-6)  # (float32)
+    assert "not vouched" not in done.stderr, done.stderr
+    assert _entries(tmp_path / "cache" / "compiled" / "jax")  # the command's own, kept
