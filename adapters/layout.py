@@ -47,7 +47,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dyncheck.adapters.integrators import quat_mul
+from dyncheck.adapters.integrators import quat_conj, quat_mul
 from dyncheck.adapters.model_tree import (
     Axes,
     JointType,
@@ -226,6 +226,45 @@ def state_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray,
               v_c: np.ndarray) -> StateMap:
     """One state's map into ``tree``'s layout (real, or complex under a complex step)."""
     return mapper(canon, tree)(q_c, v_c)
+
+
+def canonical_states(canon: Canonical, tree: ModelTree, q_e: np.ndarray,
+                     v_e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Engine states (n, tree.nq), (n, tree.nv) back to canonical ones: :func:`state_map`
+    inverted joint by joint (a free joint's placement and offset undone, quaternions
+    renormalized), and v_c = T⁻¹ v_e with T at the canonical q found."""
+    joints = [tree.joint(name) for name in canon.names]
+    q_c = np.zeros((len(q_e), canon.nq))
+    for joint, kind, qs, zero in zip(joints, canon.types, canon.q_start, canon.zeros,
+                                     strict=True):
+        lay = joint.layout
+        chunk = q_e[:, lay.q_start : lay.q_start + lay.nq]
+        if kind in (JointType.HINGE, JointType.SLIDE):
+            value = np.arctan2(chunk[:, 1], chunk[:, 0]) if lay.cos_sin else chunk[:, 0]
+            q_c[:, qs] = value - lay.zero + zero
+        elif kind is JointType.BALL:
+            q_c[:, qs : qs + 4] = _quat_of_rpy(chunk) if lay.quat is Orientation.RPY else \
+                _unit(chunk[:, np.argsort(quat_order(lay.quat))])
+        else:
+            q_c[:, qs : qs + 7] = [_free_back(lay, row) for row in chunk]
+    to = mapper(canon, tree)
+    v_c = np.array([np.linalg.solve(to(q, np.zeros(canon.nv)).t, v)
+                    for q, v in zip(q_c, v_e, strict=True)]) if len(q_c) else \
+        np.zeros((0, canon.nv))
+    return q_c, v_c
+
+
+def _free_back(lay: Layout, q_e: np.ndarray) -> np.ndarray:
+    """A free joint's canonical (p, quat) from its q in the engine's layout (:func:`_free`
+    inverted: quat_e = P⁻¹ ⊗ quat ⊗ q(R_o), p_e = P_r⁻¹ (p + R o − P_p))."""
+    quat_e, p_e = (q_e[:4], q_e[4:]) if lay.quat_first else (q_e[3:], q_e[:3])
+    quat_e = _unit(quat_e[None, np.argsort(quat_order(lay.quat))])[0]
+    place_r, place_p = lay.placement[:3, :3], lay.placement[:3, 3]
+    turned = quat_mul(quat_from_matrix(place_r[None])[0], quat_e)
+    quat_w = quat_mul(turned, quat_conj(quat_from_matrix(lay.offset[None, :3, :3])[0]))
+    rot = quat_to_matrix(quat_w[None])[0]
+    p_w = place_r @ p_e + place_p - rot @ lay.offset[:3, 3]
+    return np.concatenate([p_w, quat_w])
 
 
 # Batched maps for the run's cases: canonical states (n, nq) and (n, nv) in the canonical

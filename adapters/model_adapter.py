@@ -32,7 +32,7 @@ import numpy as np
 
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.c_output import c_output_dropped
-from dyncheck.adapters.layout import Canonical
+from dyncheck.adapters.layout import Canonical, canonical_states
 from dyncheck.adapters.layout_batch import engine_states, to_canonical
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.model_files import Format, read
@@ -234,21 +234,34 @@ class ModelAdapter(Adapter):
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:
-        """The loader's own stepping (``simulate(q0, v0, dt, steps)`` in its layout), for
-        hinges and slides (whose coordinates map one to one)."""
+        """The loader's own stepping (``simulate(q0, v0, dt, steps)`` in its layout), its
+        states mapped back to the canonical layout (:func:`~.layout.canonical_states`)."""
         if integrator not in self.integrators:
             raise Unsupported(f"{self.name} offers no integrator {integrator!r}")
-        if any(t not in (JointType.HINGE, JointType.SLIDE) for t in self.canon.types):
-            raise Unsupported(f"{self.name}: a ball or free joint's trajectory is not mapped "
-                              "back from its layout yet")
         _, qe, ve, _ = engine_states(self.canon, self.tree, q0[None], v0[None],
                                      np.zeros_like(v0)[None])
         steps = round(duration / dt)
         q_e, v_e = self.engine.simulate(qe[0], ve[0], dt, steps)
-        at = [self.tree.joint(n).layout.q_start for n in self.canon.names]
-        dof = [self.tree.joint(n).layout.v_start for n in self.canon.names]
-        return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", q_e[:, at]),
-                          v_e[:, dof])
+        self._finite(q_e, v_e, dt)
+        q, v = canonical_states(self.canon, self.tree, q_e, v_e)
+        return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", q), v)
+
+    def _finite(self, q_e: np.ndarray, v_e: np.ndarray, dt: float) -> None:
+        """Raise, naming the step and the engine's own conditioning there, where its stepping
+        left the finite states (a run that diverged is a failed row with what was measured,
+        not a map of NaNs)."""
+        finite = np.isfinite(q_e).all(axis=1) & np.isfinite(v_e).all(axis=1)
+        if finite.all():
+            return
+        k = int(np.argmin(finite))
+        zero = np.zeros((1, self.tree.nv))
+        mass = self.engine.dynamics(q_e[k - 1 : k], zero, zero).mass_matrix[0]
+        eig = np.linalg.eigvalsh(mass)
+        raise FloatingPointError(
+            f"{self.name}'s step {k} of {len(q_e) - 1} (t = {k * dt:g} s) gave a non-finite "
+            f"state; its own mass matrix at the step before has eigenvalues {eig.min():.3g} to "
+            f"{eig.max():.3g}, condition number {eig.max() / eig.min():.3g} against 1/ε = "
+            f"{1 / self.eps:.3g} of its arithmetic")
 
     def raw_calls(self, qe: np.ndarray, ve: np.ndarray, te: np.ndarray,
                   ae: np.ndarray) -> Callable[[], None] | None:

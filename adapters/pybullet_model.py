@@ -28,7 +28,8 @@ A moving base (``--floating``; an MJCF's free body): PyBullet's state holds the 
 centre-of-mass frame (:attr:`~dyncheck.adapters.model_tree.Layout.offset`), q = (p, quat
 x-y-z-w), v = (ω in that frame's axes, the centre of mass's velocity in world axes) — the v
 ``calculateInverseDynamics`` takes; its other conventions, measured and mapped here, are in
-:func:`_world_linear`. Its ``calculateInverseDynamics`` resolves gravity in the base frame
+:func:`~.pybullet_base.world_linear`. Its ``calculateInverseDynamics`` resolves gravity in the
+base frame
 through the base orientation's roll, pitch, yaw composed in reverse order (measured to
 round-off against Pinocchio: :attr:`~dyncheck.adapters.model_tree.GravityFrame.RPY_REVERSED`),
 declared on the tree so that the check predicts the difference it makes.
@@ -52,6 +53,7 @@ from dyncheck.adapters.model_tree import (
     TreeJoint,
     lump,
 )
+from dyncheck.adapters.pybullet_base import base_state, place_base, world_linear
 from dyncheck.adapters.pybullet_files import (
     ACCURACY_HINT,
     ARMATURE_HINT,
@@ -297,7 +299,7 @@ class PybulletModel(ModelEngine):
                 h = np.array(pb.calculateInverseDynamics(body, qb, vb, zero, physicsClientId=c))
                 tau = np.array(pb.calculateInverseDynamics(body, qb, vb, ab, physicsClientId=c))
                 if base_q:
-                    m, h, tau = _world_linear(np.array(qb[3:7]), m, h, tau)
+                    m, h, tau = world_linear(np.array(qb[3:7]), m, h, tau)
                     pb.resetBasePositionAndOrientation(body, qb[:3], qb[3:7], physicsClientId=c)
                 mass[i, vs, vs], bias[i, vs], inverse[i, vs] = m, h, tau
                 if self._balls:  # (otherwise M⁻¹ h of the whole system, below)
@@ -429,24 +431,32 @@ class PybulletModel(ModelEngine):
         force) and the multibody's default linear and angular damping (0.04) set to 0
         (``changeDynamics``), the file's joint damping kept: what is left is its integrator,
         semi-implicit Euler (v₊ = v + h v̇, q₊ = q + h v₊) of its articulated-body forward
-        dynamics. A fixed base."""
+        dynamics. A moving base is placed and read through its base state
+        (``resetBaseVelocity``/``getBaseVelocity``: both velocities in world axes, mapped to
+        the layout's ω in the centre-of-mass frame's axes)."""
         c = self.client
-        if any(self._floating.values()):
-            raise Unsupported("pybullet: a moving base is not stepped by dyncheck yet")
         pb.setTimeStep(dt, physicsClientId=c)
         q_at = v_at = 0
         for body in self.bodies:
             self._free_motion(body, keep_joint_damping=True)
             nq, nv = self._size(body)
-            self._place(body, [float(x) for x in q0[q_at : q_at + nq]],
-                        [float(x) for x in v0[v_at : v_at + nv]])
+            qb, vb = ([float(x) for x in y[at : at + n]]
+                      for y, at, n in ((q0, q_at, nq), (v0, v_at, nv)))
+            if self._floating[body]:
+                place_base(self.client, body, qb[:7], vb[:6])
+                qb, vb = qb[7:], vb[6:]
+            self._place(body, qb, vb)
             q_at, v_at = q_at + nq, v_at + nv
         qs = np.zeros((steps + 1, len(q0)))
         vs = np.zeros((steps + 1, len(v0)))
 
         def read(k: int) -> None:
-            qs[k] = [x for body in self.bodies for x in self._positions(body)]
-            vs[k] = [x for body in self.bodies for x in self._velocities(body)]
+            states = [base_state(self.client, body) if self._floating[body] else ([], [])
+                      for body in self.bodies]
+            qs[k] = [x for body, (q, _) in zip(self.bodies, states, strict=True)
+                     for x in (*q, *self._positions(body))]
+            vs[k] = [x for body, (_, v) in zip(self.bodies, states, strict=True)
+                     for x in (*v, *self._velocities(body))]
 
         read(0)
         for k in range(1, steps + 1):
@@ -460,22 +470,3 @@ class PybulletModel(ModelEngine):
             return np.array(pb.getBasePositionAndOrientation(body, physicsClientId=c)[0])
         return np.array(pb.getLinkState(body, link, computeForwardKinematics=True,
                                         physicsClientId=c)[0])
-
-
-def _world_linear(quat_xyzw: np.ndarray, mass: np.ndarray, bias: np.ndarray,
-                  tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """A moving base's rows in one convention, v = (ω in the centre-of-mass frame's axes,
-    the centre of mass's velocity in world axes, joints) — the v ``calculateInverseDynamics``
-    takes. Measured against Pinocchio (gravity off, any base orientation: agreement to
-    round-off once mapped): ``calculateInverseDynamics`` takes the linear acceleration in the
-    frame's axes (mapped by the caller, Rᵀ v̇) and returns (force, torque, joints) with the
-    force in the frame's axes (reordered and rotated to world axes here, R F);
-    ``calculateMassMatrix`` takes the linear velocity in the frame's axes (its M does not
-    change with the base's orientation; mapped here by R)."""
-    rot = rotation_of(tuple(quat_xyzw))
-    t = np.eye(len(mass))
-    t[3:6, 3:6] = rot.T
-    order = np.r_[3:6, 0:3, 6:len(mass)]
-    bias, tau = bias[order], tau[order]
-    bias[3:6], tau[3:6] = rot @ bias[3:6], rot @ tau[3:6]
-    return t.T @ mass @ t, bias, tau

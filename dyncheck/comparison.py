@@ -57,7 +57,8 @@ def describe(v: Variant) -> str:
     if v.softness:
         tc, dr, *imp = v.softness
         soft = f", soft constraint solref {[tc, dr]} solimp {imp}"
-    held = f", inertia held {dict(v.inertia)} kg m^2" if v.inertia else ""
+    how = "it computes with" if v.inertia_computed else "held"
+    held = f", inertia {how} {dict(v.inertia)} kg m^2" if v.inertia else ""
     return (f"(point inertia {list(v.point_inertia)} kg m^2, gravity {list(v.gravity)} "
             f"m/s^2{held}{soft})")
 

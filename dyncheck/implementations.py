@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -109,6 +109,9 @@ class Variant:
     """A rigid body's inertia tensor as the implementation holds it, where its loader stored
     it rounded beyond a read-back's round-off (PyBullet: principal moments from a Jacobi
     diagonalization): the case's parameters ``I11`` … ``I23`` it replaces (book: none)."""
+    inertia_computed: bool = False
+    """:attr:`inertia` is the tensor the engine computes with, not the one it holds (a
+    declared defect: :attr:`~dyncheck.adapters.model_tree.TreeJoint.computed_inertia`)."""
 
     def conventions(self, other: Variant) -> list[str]:
         """Names of the conventions in which two variants differ."""
@@ -116,7 +119,8 @@ class Variant:
         if self.point_inertia != other.point_inertia:
             out.append(POINT_INERTIA)
         if self.inertia != other.inertia:
-            out.append(INERTIA_STORED)
+            out.append(ENGINE_DEFECT if self.inertia_computed or other.inertia_computed
+                       else INERTIA_STORED)
         if self.gravity != other.gravity:
             out.append(GRAVITY_DEFAULT)
         if self.softness != other.softness:
@@ -156,6 +160,13 @@ class Implementation(ABC):
     @abstractmethod
     def variant(self) -> Variant | None:
         """The model variant, or ``None`` when the model differs in a way not predicted."""
+
+    def computed_variant(self) -> Variant | None:
+        """The model the implementation steps: :meth:`variant` with the inertia its engine
+        computes with where a declared defect makes that another than it holds (what a
+        trajectory study integrates; the instantaneous rows predict the defect's effect on
+        the held model instead, :meth:`effects`)."""
+        return self.variant()
 
     @abstractmethod
     def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]: ...
@@ -293,6 +304,23 @@ class EngineImplementation(Implementation):
         if gravity[0] or gravity[1]:
             return None  # the reference models gravity along −z only
         return Variant(tuple(out), gravity, self.adapter.softness(), held)
+
+    def computed_variant(self) -> Variant | None:
+        """:meth:`variant` with a rigid body's tensor as its engine computes with it
+        (:attr:`~dyncheck.adapters.model_tree.TreeJoint.computed_inertia`, PyBullet's
+        principal moments in the link's axes), where it declares one."""
+        from dyncheck.adapters.model_adapter import ModelAdapter
+
+        held = self.variant()
+        if held is None or not held.inertia or not isinstance(self.adapter, ModelAdapter):
+            return held
+        computed = [j.computed_inertia for j in self.adapter.tree.joints
+                    if j.computed_inertia is not None]
+        if len(computed) != 1:
+            return held
+        tensor = np.asarray(computed[0], float)
+        return replace(held, inertia=tuple((k, float(tensor[i, j])) for k, i, j in TENSOR),
+                       inertia_computed=True)
 
     def _dynamics(self, q: np.ndarray, s: StateSample) -> dict[str, np.ndarray]:
         m = self.map

@@ -88,7 +88,7 @@ def study(
         if isinstance(impl, Exception):
             rows.append(unavailable(case, name, impl))
             continue
-        variant = variants[name] = impl.variant()
+        variant = variants[name] = impl.computed_variant()
         for integrator, dts in spec.steps.items():
             if integrator not in impl.integrators:
                 continue

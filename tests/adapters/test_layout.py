@@ -137,3 +137,58 @@ def test_the_batched_ball_map_is_the_one_state_map():
     batched = rpy_batch(rot)
     for i in range(30):
         np.testing.assert_allclose(batched[i], rpy_from_matrix(rot[i]), atol=1e-12)
+
+
+def _joint(name: str, kind: str, lay: Layout) -> object:
+    from dyncheck.adapters.model_tree import JointType, TreeJoint
+
+    zero3 = np.zeros(3)
+    return TreeJoint(name=name, type=JointType(kind), parent=None, body=name, axis=zero3,
+                     anchor=zero3, frame=np.eye(3), mass=1.0, com=zero3, inertia=np.eye(3),
+                     armature=(), damping=(), range=None, layout=lay)
+
+
+BALLS = [Layout.ball(quat=quat, angular_axes=axes) for quat, axes in itertools.product(
+    (Orientation.WXYZ, Orientation.XYZW, Orientation.RPY), (Axes.LOCAL, Axes.PARENT))]
+
+
+@pytest.mark.parametrize(("free", "ball"), list(zip(LAYOUTS, BALLS * 6, strict=False)),
+                         ids=range(len(BALLS) * 6))
+def test_engine_states_map_back_to_the_canonical_ones(free, ball):
+    """A trajectory stepped in an engine's layout comes back (``canonical_states``, for
+    Newton's and PyBullet's ball and free joints): expected, the canonical states that
+    ``state_map`` (held to finite differences above) took into that layout — a hinge stored
+    as (cos, sin) with a zero offset, a ball joint in each orientation and axes, a free joint
+    with a placement, an offset and a velocity point, in an engine order other than the
+    canonical one."""
+    from dataclasses import replace
+
+    from dyncheck.adapters.layout import Canonical, canonical_states, state_map
+    from dyncheck.adapters.model_tree import JointType, ModelTree
+
+    free = replace(free, q_start=0, v_start=0, placement=PLACEMENT)
+    ball = replace(ball, q_start=free.nq, v_start=6)
+    hinge = Layout(q_start=free.nq + ball.nq, v_start=9, nq=2, nv=1, cos_sin=True, zero=0.4)
+    tree = ModelTree(engine="toy", joints=(_joint("base", "free", free),
+                                           _joint("arm", "hinge", hinge),
+                                           _joint("wrist", "ball", ball)),
+                     gravity=np.zeros(3), nq=free.nq + ball.nq + 2, nv=10)
+    canon = Canonical(names=("base", "arm", "wrist"),
+                      types=(JointType.FREE, JointType.HINGE, JointType.BALL),
+                      q_start=(0, 7, 8), v_start=(0, 6, 7), nq=12, nv=10, zeros=(0.0, 0.1, 0.0))
+    quats = Rotation.random(16, random_state=5).as_quat()[:, [3, 0, 1, 2]]
+    balls = Rotation.random(16, random_state=6).as_quat()[:, [3, 0, 1, 2]]
+    q_c = np.concatenate([RNG.normal(size=(16, 3)), quats, RNG.uniform(-3, 3, (16, 1)), balls],
+                         axis=1)
+    v_c = RNG.normal(size=(16, 10))
+    maps = [state_map(canon, tree, q, v) for q, v in zip(q_c, v_c, strict=True)]
+    q_e = np.array([m.q for m in maps])
+    v_e = np.array([m.t @ v for m, v in zip(maps, v_c, strict=True)])
+    back_q, back_v = canonical_states(canon, tree, q_e, v_e)
+    sign = np.sign(np.sum(back_q[:, 3:7] * quats, axis=1, keepdims=True))  # q and −q alike
+    np.testing.assert_allclose(back_q[:, 3:7] * sign, quats, atol=1e-12)
+    ball_sign = np.sign(np.sum(back_q[:, 8:] * balls, axis=1, keepdims=True))
+    np.testing.assert_allclose(back_q[:, 8:] * ball_sign, balls, atol=1e-12)
+    np.testing.assert_allclose(back_q[:, :3], q_c[:, :3], atol=1e-12)
+    np.testing.assert_allclose(np.angle(np.exp(1j * (back_q[:, 7] - q_c[:, 7]))), 0, atol=1e-12)
+    np.testing.assert_allclose(back_v, v_c, atol=1e-12)
