@@ -139,13 +139,19 @@ class ModelAdapter(Adapter):
         """A free joint whose engine resolves gravity in its frame through another rotation
         than the state's (:class:`~.model_tree.GravityFrame`, declared on the tree); a joint
         whose engine computes with another inertia than it holds
-        (:attr:`~.model_tree.TreeJoint.computed_inertia`, declared on the tree)."""
+        (:attr:`~.model_tree.TreeJoint.computed_inertia`, declared on the tree); a body
+        whose joints the engine applies in another order than written (the tree's
+        ``as_written``, with its hint: Newton's D6 joint)."""
         computed = tuple(
             f"its dynamics take the inertia of {j.name!r} otherwise than it holds it (its "
             "link's principal moments in the link's axes, the inertial frame's rotation "
             "dropped; measured; predicted per state by the general method on the inertia it "
             "computes with)" for j in self.tree.joints if j.computed_inertia is not None)
-        return computed + tuple(
+        written = self.tree.as_written
+        order = () if written is None else tuple(
+            why for j, f, why in self.tree.hints if f == "parent"
+            and written.joint(j).parent != self.tree.joint(j).parent)[:1]
+        return computed + order + tuple(
             f"its dynamics resolve gravity in the frame of {j.name!r} through Rx(r) Ry(p) "
             "Rz(y) of the orientation's roll, pitch, yaw, the state's Rz(y) Ry(p) Rx(r) in "
             f"reverse order (GravityFrame.{j.gravity_frame.name}, measured; predicted per "

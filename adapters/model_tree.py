@@ -224,6 +224,10 @@ class ModelTree:
     """The engine's reading with every mesh's volume and inertia computed exactly (MuJoCo:
     ``inertia="exact"`` instead of its default ``"legacy"``, which overcounts a non-convex
     mesh's volume, or ``"convex"``, the hull's); None where that changes no body."""
+    as_written: ModelTree | None = None
+    """The reading with the joints of each body in the order the file writes them, where the
+    engine applies them in another (Newton's D6 joint: slides first); None where it applies
+    them as written. The referee on both measures what the order changes."""
 
     def hint(self, joint: str, name: str) -> str | None:
         for wanted in (joint, "model"):

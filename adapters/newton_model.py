@@ -20,6 +20,7 @@ v = (velocity of the child's centre of mass, angular velocity), both in the pare
 from __future__ import annotations
 
 import warnings
+from dataclasses import replace
 
 import numpy as np
 
@@ -38,6 +39,7 @@ from dyncheck.adapters.model_tree import (
     TreeJoint,
     lump,
 )
+from dyncheck.adapters.newton_d6 import D6_ORDER, d6_chain, written_order
 from dyncheck.errors import EngineError, Unsupported
 
 ENGINE = "newton"
@@ -126,13 +128,10 @@ class NewtonModel(ModelEngine):
                  int(newton.JointType.BALL): JointType.BALL,
                  int(newton.JointType.FREE): JointType.FREE}
         fixed = int(newton.JointType.FIXED)
+        self.d6 = int(newton.JointType.D6)
+        self._text = source.text if source.format is Format.MJCF else ""
         for j, t in enumerate(self.types):
-            if int(t) == int(newton.JointType.D6):
-                raise Unsupported(
-                    f"newton fused the joints of one body into a D6 joint ({self._name(j)!r}), "
-                    "which applies their slides first whatever the written order: not checked "
-                    "(dyncheck explain newton-several-joints-on-a-body)")
-            if int(t) not in kinds and int(t) != fixed:
+            if int(t) not in kinds and int(t) not in (fixed, self.d6):
                 raise Unsupported(f"newton joint type {newton.JointType(int(t)).name} "
                                   f"({self._name(j)!r}) is not checked")
         self.kinds, self.fixed = kinds, fixed
@@ -198,23 +197,34 @@ class NewtonModel(ModelEngine):
             owner = mover(b)
             if owner is not None:
                 carried.setdefault(owner, []).append(b)
-        joints = []
+        joints: list[TreeJoint] = []
         self._masses = mass.astype(float)
         self._coms = com.astype(float)
+        fused = {j: self._fused(j) for j, t in enumerate(self.types) if int(t) == self.d6}
+        last = {j: chain[-1][0] for j, chain in fused.items()}
         for j, t in enumerate(self.types):
             kind = self.kinds.get(int(t))
-            if kind is None:
+            if kind is None and j not in fused:
                 continue
             parts = carried.get(j, [])
-            masses = [float(mass[b]) for b in parts]
-            coms = [bodies[b][:3, :3] @ com[b] + bodies[b][:3, 3] for b in parts]
-            tensors = [bodies[b][:3, :3] @ inertia[b] @ bodies[b][:3, :3].T for b in parts]
-            total, centre, tensor = lump(masses, coms, tensors)
+            total, centre, tensor = lump(
+                [float(mass[b]) for b in parts],
+                [bodies[b][:3, :3] @ com[b] + bodies[b][:3, 3] for b in parts],
+                [bodies[b][:3, :3] @ inertia[b] @ bodies[b][:3, :3].T for b in parts])
             frame = bodies[child[j]] @ _pose(x_c[j])
+            above = mover(int(parent[j]))
+            if j in fused:
+                joints += d6_chain(fused[j], frame=frame, body=self._body(int(child[j])),
+                                   axes=axes[self.v_start[j] : self.v_start[j + 1]],
+                                   parent=None if above is None else last.get(above,
+                                                                              self._name(above)),
+                                   lumped=(total, centre, tensor),
+                                   starts=(int(self.q_start[j]), int(self.v_start[j])))
+                continue
+            assert kind is not None
             qs, vs = int(self.q_start[j]), int(self.v_start[j])
             nv = kind.nv
             dofs = slice(vs, vs + nv)
-            above = mover(int(parent[j]))
             limited = nv == 1 and abs(lower[vs]) < NO_LIMIT and abs(upper[vs]) < NO_LIMIT
             if kind is JointType.FREE:
                 layout = Layout(q_start=qs, v_start=vs, nq=7, nv=6, quat=Orientation.XYZW,
@@ -228,7 +238,7 @@ class NewtonModel(ModelEngine):
                 layout = Layout(q_start=qs, v_start=vs, nq=1, nv=1)
             joints.append(TreeJoint(
                 name=self._name(j), type=kind,
-                parent=None if above is None else self._name(above),
+                parent=None if above is None else last.get(above, self._name(above)),
                 body=self._body(int(child[j])),
                 axis=frame[:3, :3] @ axes[vs] if nv == 1 else np.zeros(3),
                 anchor=frame[:3, 3], frame=frame[:3, :3], mass=total, com=centre,
@@ -237,7 +247,14 @@ class NewtonModel(ModelEngine):
                 range=(float(lower[vs]), float(upper[vs])) if limited else None,
                 layout=layout,
             ))
-        gravity = np.asarray(m.gravity.numpy()[0], float)
+        return self._finished(joints, notes, carried=carried, fused=fused)
+
+    def _finished(self, joints: list[TreeJoint], notes: tuple[str, ...], *,
+                  carried: dict[int, list[int]],
+                  fused: dict[int, list[tuple[str, JointType]]]) -> ModelTree:
+        """The tree of ``joints`` with its hints (inertias Newton corrected, fused joints'
+        order), actuators and, where it fused joints, their written order."""
+        m, child = self.model, self.model.joint_child.numpy()
         hints: list[tuple[str, str, str]] = []
         for j in range(len(self.types)):
             named = [self._body(b) for b in carried.get(j, [])
@@ -246,9 +263,43 @@ class NewtonModel(ModelEngine):
                 why = CORRECTED.format(bodies=", ".join(repr(b) for b in named))
                 hints.append((self._name(j), "inertia", why))
         acts = newton_actuators.read(m, self.newton, [self._name(j) for j in range(m.joint_count)])
-        return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
+        for j, chain in fused.items():
+            why = D6_ORDER.format(body=self._body(int(child[j])),
+                                  written=" ".join(self._name(j).split("_")),
+                                  applied=" ".join(n for n, _ in chain))
+            hints += [(name, f, why) for name, _ in chain
+                      for f in ("parent", "mass", "com", "inertia")]
+        tree = ModelTree(engine=ENGINE, joints=tuple(joints),
+                         gravity=np.asarray(m.gravity.numpy()[0], float),
                          nq=m.joint_coord_count, nv=m.joint_dof_count, notes=notes, eps=EPS32,
                          hints=(*hints, *newton_actuators.hints(m, acts)), actuators=acts)
+        if not fused:
+            return tree
+        return replace(tree, as_written=written_order(
+            tree, [self._name(j).split("_") for j in fused]))
+
+    def _fused(self, j: int) -> list[tuple[str, JointType]]:
+        """The joints Newton's MJCF importer fused into D6 joint ``j``, in the order it
+        applies them — its linear axes first, then its angular ones, each group in the
+        written order (``jcalc_transform``: translate, then rotate by the angular axes
+        composed intrinsically) — named from its label (the written names joined by "_"),
+        their kinds from the file."""
+        import xml.etree.ElementTree as ET
+
+        n_lin, n_ang = (int(x) for x in self.model.joint_dof_dim.numpy()[j])
+        names = self._name(j).split("_")
+        written = {e.get("name"): e.get("type", "hinge")
+                   for e in ET.fromstring(self._text).iter("joint")} if self._text else {}
+        slides = [n for n in names if written.get(n) == "slide"]
+        hinges = [n for n in names if written.get(n) == "hinge"]
+        if len(names) != n_lin + n_ang or len(slides) != n_lin or len(hinges) != n_ang:
+            raise Unsupported(f"newton fused joints into a D6 joint ({self._name(j)!r}) whose "
+                              "joints its label and the file do not name unambiguously")
+        axes = self.model.joint_axis.numpy()[self.v_start[j] + n_lin : self.v_start[j + 1]]
+        if np.abs(axes @ axes.T - np.eye(n_ang)).max() > 1e-6:
+            raise Unsupported(f"newton's D6 joint {self._name(j)!r} has angular axes that are "
+                              "not orthogonal, which it orthonormalizes: not mapped")
+        return [(n, JointType.SLIDE) for n in slides] + [(n, JointType.HINGE) for n in hinges]
 
     def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
         """Its drives' force by its Featherstone solver (:mod:`.newton_actuators`)."""

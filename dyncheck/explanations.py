@@ -19,13 +19,6 @@ from dyncheck.check.predicted import (
     ROTOR_ENERGY,
 )
 from dyncheck.check.readings import READING
-from dyncheck.implementations import (
-    ENGINE_DEFECT,
-    GRAVITY_DEFAULT,
-    INERTIA_STORED,
-    POINT_INERTIA,
-    SOFT_CONSTRAINT,
-)
 from dyncheck.studies import (
     CHARTS_DIFFER,
     GYROSCOPIC_IMPLICIT,
@@ -33,6 +26,13 @@ from dyncheck.studies import (
     NAIVE_GROUP_RK4,
     PRE_ASYMPTOTIC,
     TRUNCATION,
+)
+from dyncheck.variants import (
+    ENGINE_DEFECT,
+    GRAVITY_DEFAULT,
+    INERTIA_STORED,
+    POINT_INERTIA,
+    SOFT_CONSTRAINT,
 )
 
 

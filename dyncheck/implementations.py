@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -28,7 +28,8 @@ from dyncheck.adapters import (
     get_adapter,
 )
 from dyncheck.adapters.base import Symbolic
-from dyncheck.adapters.model_tree import Dynamics
+from dyncheck.adapters.layout import Canonical
+from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.cases import Case, StateSample
 from dyncheck.coordinates import NativeMap
 from dyncheck.errors import UnknownName
@@ -37,6 +38,7 @@ from dyncheck.reference.derivations import derived, lambdified
 from dyncheck.reference.systems import SYSTEMS
 from dyncheck.reference.trajectory import solve
 from dyncheck.roster import IMPLEMENTATIONS
+from dyncheck.variants import TENSOR, Variant, book_variant
 from dyncheck.vocabulary import INSTANTANEOUS, Quantity
 
 CACHED = Symbolic(derive=derived, lambdify=lambdified)
@@ -92,56 +94,6 @@ def general_method(case: Case, variant: Variant | None = None):
 def printed_equations(case: Case):
     """The equations exactly as the book prints them."""
     return SYSTEMS[case.name].printed_equations(case.params())
-
-
-@dataclass(frozen=True)
-class Variant:
-    """How an implementation's model departs from the book's, as far as the reference can
-    predict it: the isotropic rotational inertia (kg·m², about the centre of mass) each body
-    carries where the book has a point mass (book: zero), and the gravity vector (m/s²) the
-    implementation actually uses (book: the case's)."""
-
-    point_inertia: tuple[float, ...]
-    gravity: tuple[float, float, float]
-    softness: tuple[float, ...] | None = None
-    """None: couplings held exactly; else a soft constraint's (solref, solimp)."""
-    inertia: tuple[tuple[str, float], ...] = ()
-    """A rigid body's inertia tensor as the implementation holds it, where its loader stored
-    it rounded beyond a read-back's round-off (PyBullet: principal moments from a Jacobi
-    diagonalization): the case's parameters ``I11`` … ``I23`` it replaces (book: none)."""
-    inertia_computed: bool = False
-    """:attr:`inertia` is the tensor the engine computes with, not the one it holds (a
-    declared defect: :attr:`~dyncheck.adapters.model_tree.TreeJoint.computed_inertia`)."""
-
-    def conventions(self, other: Variant) -> list[str]:
-        """Names of the conventions in which two variants differ."""
-        out = []
-        if self.point_inertia != other.point_inertia:
-            out.append(POINT_INERTIA)
-        if self.inertia != other.inertia:
-            out.append(ENGINE_DEFECT if self.inertia_computed or other.inertia_computed
-                       else INERTIA_STORED)
-        if self.gravity != other.gravity:
-            out.append(GRAVITY_DEFAULT)
-        if self.softness != other.softness:
-            out.append(SOFT_CONSTRAINT)
-        return out
-
-
-POINT_INERTIA = "point-mass inertia floor"
-INERTIA_STORED = "inertia tensor stored rounded by the loader"
-ENGINE_DEFECT = "engine defect declared by its adapter"
-TENSOR = (("I11", 0, 0), ("I22", 1, 1), ("I33", 2, 2), ("I12", 0, 1), ("I13", 0, 2),
-          ("I23", 1, 2))
-"""A rigid body case's parameters naming its inertia tensor's entries."""
-GRAVITY_DEFAULT = "MJCF gravity option not read"
-SOFT_CONSTRAINT = "soft constraint (MuJoCo solref/solimp impedance model)"
-
-
-def book_variant(case: Case) -> Variant:
-    """The book's model: point masses, the case's gravity."""
-    mb = case.multibody()
-    return Variant((0.0,) * len(mb.bodies), tuple(float(x) for x in mb.gravity))
 
 
 class Implementation(ABC):
@@ -351,8 +303,9 @@ class EngineImplementation(Implementation):
     def effects(self, s: StateSample) -> dict[str, np.ndarray]:
         """The adapter's predicted defect effects, in the book's coordinates (a force by Jᵀ,
         an acceleration by the linear part of its map); an engine that computes with another
-        inertia than it holds (a loader's declared ``computed_inertia``), by the referee on
-        each (:func:`~dyncheck.check.predicted.computed_inertia_effect`)."""
+        inertia than it holds (a loader's declared ``computed_inertia``) or applies a body's
+        joints in another order than written (its tree's ``as_written``), by the referee on
+        each (:func:`~dyncheck.check.computed.computing_effect`)."""
         if not self.defects():
             return {}
         m, q = self.map, s.q
@@ -371,32 +324,14 @@ class EngineImplementation(Implementation):
 
     def _inertia_effects(self, s: StateSample, *, te: np.ndarray,
                          ae: np.ndarray) -> dict[str, np.ndarray]:
-        """What a file loader's engine computing with another inertia than it holds
-        changes, in the book's coordinates (its coordinates are the canonical ones)."""
+        """What a file loader's engine computing otherwise than the file says changes
+        (:func:`_book_effects`)."""
         from dyncheck.adapters.model_adapter import ModelAdapter
-        from dyncheck.check.computed import computed_inertia_effect
 
         if not isinstance(self.adapter, ModelAdapter):
             return {}
-        m, q, v = self.map, s.q, s.v
-        found = computed_inertia_effect(self.adapter.canon, self.adapter.tree, q=m.to_engine(q),
-                                        v=co.velocity_to_engine(m, q, v), a=ae)
-        if found is None:
-            return {}
-        before, after = found
-
-        def forward(d: Dynamics) -> np.ndarray:
-            return np.linalg.solve(d.mass_matrix, (te - d.bias)[..., None])[..., 0]
-
-        delta_m = after.mass_matrix - before.mass_matrix
-        return {
-            Quantity.MASS_MATRIX: co.mass_matrix_to_book(m, q, delta_m),
-            Quantity.BIAS_FORCES: co.bias_to_book(m, q, v, delta_m, after.bias - before.bias),
-            Quantity.FORWARD_DYNAMICS: co.acceleration_to_book(m, q, v, forward(after))
-            - co.acceleration_to_book(m, q, v, forward(before)),
-            Quantity.INVERSE_DYNAMICS: co.force_to_book(m, q, after.inverse - before.inverse),
-            Quantity.KINETIC_ENERGY: after.kinetic - before.kinetic,
-        }
+        return _book_effects(self.adapter.canon, self.adapter.tree, self.map, s,
+                            rest=self.case.rest(), te=te, ae=ae)
 
     def engine_start(self) -> tuple[np.ndarray, np.ndarray]:
         """The case's initial state in engine coordinates (q, v)."""
@@ -460,6 +395,40 @@ class EngineImplementation(Implementation):
         """Book-coordinate configurations of an error-controlled run at times ``t``."""
         qe0, ve0 = self.engine_start()
         return self.map.to_book(self.adapter.solve(qe0, ve0, t, rtol).q)
+
+
+def _book_effects(canon: Canonical, tree: ModelTree, m: NativeMap, s: StateSample, *,
+                 rest: np.ndarray, te: np.ndarray, ae: np.ndarray) -> dict[str, np.ndarray]:
+    """What a file loader's engine computing otherwise than the file says changes (an inertia
+    it computes with in place of the one it holds, a body's joints applied in another order
+    than written): the general method on each (:func:`~dyncheck.check.computed.
+    computing_effect`), in the book's coordinates (the engine's are the canonical ones), V
+    relative to ``rest`` as :meth:`Implementation.evaluate` gives it."""
+    from dyncheck.check.computed import computing_effect
+
+    q, v = s.q, s.v
+    found = computing_effect(canon, tree, q=m.to_engine(q), v=co.velocity_to_engine(m, q, v),
+                             a=ae)
+    still = np.zeros((1, canon.nv))
+    at_rest = computing_effect(canon, tree, q=m.to_engine(rest[None]), v=still, a=still)
+    if found is None or at_rest is None:
+        return {}
+    before, after = found
+    shift = at_rest[1].potential - at_rest[0].potential
+
+    def forward(d: Dynamics) -> np.ndarray:
+        return np.linalg.solve(d.mass_matrix, (te - d.bias)[..., None])[..., 0]
+
+    delta_m = after.mass_matrix - before.mass_matrix
+    return {
+        Quantity.MASS_MATRIX: co.mass_matrix_to_book(m, q, delta_m),
+        Quantity.BIAS_FORCES: co.bias_to_book(m, q, v, delta_m, after.bias - before.bias),
+        Quantity.FORWARD_DYNAMICS: co.acceleration_to_book(m, q, v, forward(after))
+        - co.acceleration_to_book(m, q, v, forward(before)),
+        Quantity.INVERSE_DYNAMICS: co.force_to_book(m, q, after.inverse - before.inverse),
+        Quantity.KINETIC_ENERGY: after.kinetic - before.kinetic,
+        Quantity.POTENTIAL_ENERGY: after.potential - before.potential - shift,
+    }
 
 
 def make_implementation(name: str, case: Case) -> Implementation:

@@ -8,6 +8,7 @@ inertia computed with against the general method on the inertia held."""
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
@@ -46,20 +47,79 @@ def canonical_armature(joint: TreeJoint) -> tuple[float, ...]:
 
 
 def canonical_reading(canon: Canonical, tree: ModelTree) -> ModelTree:
-    """An engine's reading in the canonical joint order and state layout (MuJoCo's), its
-    armature in the canonical order: what the general method evaluates at canonical
-    states."""
+    """An engine's reading in the canonical state layout (MuJoCo's), its armature in the
+    canonical order: what the general method evaluates at canonical states. Its joints in
+    the canonical order where each follows its parent there, else (an engine that chains a
+    body's joints in another order: Newton's D6) parents first, each joint's layout still
+    its canonical place (:func:`general` gathers the columns)."""
     places = StateLayout().joints(list(canon.types))
-    joints = tuple(replace(tree.joint(name), layout=place,
-                           armature=canonical_armature(tree.joint(name)))
-                   for name, place in zip(canon.names, places, strict=True))
-    return replace(tree, joints=joints, nq=canon.nq, nv=canon.nv)
+    joints = [replace(tree.joint(name), layout=place,
+                      armature=canonical_armature(tree.joint(name)))
+              for name, place in zip(canon.names, places, strict=True)]
+    return replace(tree, joints=parents_first(joints), nq=canon.nq, nv=canon.nv)
+
+
+def parents_first(joints: list[TreeJoint]) -> tuple[TreeJoint, ...]:
+    """``joints`` in their order, except that a joint whose parent comes later waits for
+    it (the general method takes each body after its parent)."""
+    names = {j.name for j in joints}
+    placed: set[str | None] = {None}
+    out: list[TreeJoint] = []
+    pending = list(joints)
+    while pending:
+        ready = next((j for j in pending if j.parent in placed or j.parent not in names),
+                     pending[0])  # (a cycle cannot come from a tree: taken as it is)
+        pending.remove(ready)
+        placed.add(ready.name)
+        out.append(ready)
+    return tuple(out)
+
+
+def _columns(tree: ModelTree) -> tuple[np.ndarray, np.ndarray] | None:
+    """The columns of q and v that the tree's joints take, in their order (their layouts'
+    places); None where that is q and v as they are."""
+    qi = np.concatenate([np.arange(j.layout.q_start, j.layout.q_start + j.layout.nq)
+                         for j in tree.joints]) if tree.joints else np.zeros(0, int)
+    vi = np.concatenate([np.arange(j.layout.v_start, j.layout.v_start + j.layout.nv)
+                         for j in tree.joints]) if tree.joints else np.zeros(0, int)
+    if np.array_equal(qi, np.arange(len(qi))) and np.array_equal(vi, np.arange(len(vi))):
+        return None
+    return qi, vi
+
+
+class Gathered:
+    """One of the referee's methods on a tree whose joint order is not its layout's (a body's
+    joints chained in another order than the canonical engine's: Newton's D6), at canonical
+    states: the columns gathered in the tree's order, M and h put back in the layout's."""
+
+    def __init__(self, method: Any, columns: tuple[np.ndarray, np.ndarray]) -> None:
+        self.method, (self.qi, self.vi) = method, columns
+        self.back = np.argsort(self.vi)
+
+    def at_states(self, q: np.ndarray, v: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        mass, bias, kinetic, potential = self.method.at_states(q[:, self.qi], v[:, self.vi])
+        return mass[:, self.back][:, :, self.back], bias[:, self.back], kinetic, potential
+
+    def reach(self, q: np.ndarray) -> tuple[float, float]:
+        out: tuple[float, float] = self.method.reach(q[:, self.qi])
+        return out
+
+
+def in_layout(method: Any, tree: ModelTree) -> Any:
+    """``method`` (the general method or the recursive algorithm, built on ``tree``'s joints
+    in their order) taking canonical states: itself where the order is the layout's, else
+    :class:`Gathered`."""
+    columns = _columns(tree)
+    return method if columns is None else Gathered(method, columns)
 
 
 def general(tree: ModelTree, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
     """The general method on ``tree`` (canonical layout) at the states: M, h, T, V, the
-    forward dynamics at τ = 0 and the inverse dynamics at v̇ = a."""
-    mass, bias, kinetic, potential = TreeDynamics(bodies(tree), tree.gravity).at_states(q, v)
+    forward dynamics at τ = 0 and the inverse dynamics at v̇ = a (columns gathered in the
+    tree's joint order and put back, where that is another: :func:`in_layout`)."""
+    solver = in_layout(TreeDynamics(bodies(tree), tree.gravity), tree)
+    mass, bias, kinetic, potential = solver.at_states(q, v)
     return Dynamics(mass_matrix=mass, bias=bias,
                     forward=np.linalg.solve(mass, -bias[..., None])[..., 0],
                     inverse=np.einsum("sij,sj->si", mass, a) + bias,
@@ -80,3 +140,21 @@ def computed_inertia_effect(canon: Canonical, tree: ModelTree, *, q: np.ndarray,
         j if j.computed_inertia is None else replace(j, inertia=j.computed_inertia)
         for j in held.joints))
     return general(held, q, v, a), general(computes, q, v, a)
+
+
+def computing_effect(canon: Canonical, tree: ModelTree, *, q: np.ndarray, v: np.ndarray,
+                     a: np.ndarray) -> tuple[Dynamics, Dynamics] | None:
+    """The general method on what the file says as ``tree``'s engine read it — its joints in
+    the written order (:attr:`~dyncheck.adapters.model_tree.ModelTree.as_written`), the
+    inertia it holds — and on what the engine computes with — its joints as it applies
+    them, the inertia it computes with —, at canonical states; None where the two are one."""
+    written = tree.as_written if tree.as_written is not None else tree
+    if tree.as_written is None and all(j.computed_inertia is None for j in tree.joints):
+        return None
+    if not set(canon.names) <= {j.name for j in tree.joints}:
+        return None
+    computes = canonical_reading(canon, tree)
+    computes = replace(computes, joints=tuple(
+        j if j.computed_inertia is None else replace(j, inertia=j.computed_inertia)
+        for j in computes.joints))
+    return general(canonical_reading(canon, written), q, v, a), general(computes, q, v, a)

@@ -19,7 +19,7 @@ import numpy as np
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import partial
-from dyncheck.check.computed import bodies, canonical_armature
+from dyncheck.check.computed import bodies, canonical_armature, in_layout, parents_first
 from dyncheck.check.describe import placement
 from dyncheck.check.dynamics import QUANTITIES, Prediction, States, values
 from dyncheck.check.referee import TIE_STATES, ReferenceModel
@@ -34,21 +34,24 @@ SUBSTITUTED = ("axis", "anchor", "mass", "com", "inertia", "armature")
 
 def own_tree(canonical_tree: ModelTree, tree: ModelTree) -> ModelTree | None:
     """``tree`` (an engine's reading, joints already matched by name) in the canonical
-    engine's joint order and state layout, so that the referee evaluates it at the same
-    canonical states; None where its joints are not the canonical ones (other names, types or
-    parents: that engine holds another tree, which the description rows report)."""
+    engine's state layout and joint order, so that the referee evaluates it at the same
+    canonical states — parents first where the engine chains a body's joints in another
+    order (Newton's D6: the referee gathers the columns, :func:`~.computed.in_layout`); None
+    where its joints are not the canonical ones (other names or types: that engine holds
+    another tree, which the description rows report)."""
     names = [j.name for j in canonical_tree.joints]
     if sorted(j.name for j in tree.joints) != sorted(names):
         return None
     joints = []
     for name in names:
         mine, theirs = tree.joint(name), canonical_tree.joint(name)
-        if mine.type is not theirs.type or mine.parent != theirs.parent:
+        if mine.type is not theirs.type:
             return None
         joints.append(replace(mine, layout=theirs.layout, armature=canonical_armature(mine),
                               rotor_in_kinetic=True, gravity_frame=theirs.gravity_frame,
                               computed_inertia=None))
-    return replace(tree, joints=tuple(joints), nq=canonical_tree.nq, nv=canonical_tree.nv)
+    return replace(tree, joints=parents_first(joints), nq=canonical_tree.nq,
+                   nv=canonical_tree.nv)
 
 
 def same_dynamics_fields(a: ModelTree, b: ModelTree) -> bool:
@@ -67,8 +70,8 @@ def _body_equal(x: object, y: object) -> bool:
 def _quick(tree: ModelTree, states: States) -> dict[str, np.ndarray]:
     """The referee's quantities on ``tree`` at ``states`` (the recursive algorithm: the
     substitutions' cheap evaluation; its tie to the general method is the page's row)."""
-    mass, bias, kinetic, potential = RecursiveDynamics(bodies(tree), tree.gravity).at_states(
-        states.q, states.v)
+    mass, bias, kinetic, potential = in_layout(
+        RecursiveDynamics(bodies(tree), tree.gravity), tree).at_states(states.q, states.v)
     with np.errstate(all="ignore"):
         try:
             forward = np.linalg.solve(mass, -bias[..., None])[..., 0]
@@ -81,14 +84,14 @@ def _quick(tree: ModelTree, states: States) -> dict[str, np.ndarray]:
 
 
 def _substituted(a: ModelTree, b: ModelTree, group: str) -> ModelTree:
-    """``a`` with ``b``'s values of one field group (both in the same order)."""
+    """``a`` with ``b``'s values of one field group (joints matched by name)."""
     if group == "gravity":
         return replace(a, gravity=b.gravity)
     if group == "mass":  # the body's mass with its centre and inertia kept
-        return replace(a, joints=tuple(replace(x, mass=y.mass)
-                                       for x, y in zip(a.joints, b.joints, strict=True)))
-    return replace(a, joints=tuple(replace(x, **{group: getattr(y, group)})
-                                   for x, y in zip(a.joints, b.joints, strict=True)))
+        return replace(a, joints=tuple(replace(x, mass=b.joint(x.name).mass)
+                                       for x in a.joints))
+    return replace(a, joints=tuple(replace(x, **{group: getattr(b.joint(x.name), group)})
+                                   for x in a.joints))
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
-from dyncheck.check.computed import bodies
+from dyncheck.check.computed import bodies, in_layout
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, standing
 from dyncheck.reference.recursive import RecursiveDynamics
@@ -92,7 +92,7 @@ def tie(general: TreeDynamics, recursive: RecursiveDynamics, depth: int, q: np.n
 
 def standing_of(tree: ModelTree, q: np.ndarray) -> float:
     """max(1, X/ℓ) of ``tree`` at the states ``q`` (:func:`dyncheck.precision.standing`)."""
-    return standing(*RecursiveDynamics(bodies(tree), tree.gravity).reach(q))
+    return standing(*in_layout(RecursiveDynamics(bodies(tree), tree.gravity), tree).reach(q))
 
 
 class ReferenceModel:
@@ -106,8 +106,8 @@ class ReferenceModel:
         from dyncheck.check.describe import depth
 
         self.tree = tree
-        self.solver = TreeDynamics(bodies(tree), tree.gravity)
-        self.recursive = RecursiveDynamics(bodies(tree), tree.gravity)
+        self.solver = in_layout(TreeDynamics(bodies(tree), tree.gravity), tree)
+        self.recursive = in_layout(RecursiveDynamics(bodies(tree), tree.gravity), tree)
         self.depth = depth(tree)
         self.tie: Tie | None = None
 

@@ -7,17 +7,12 @@ import numpy as np
 
 from dyncheck.cases import Case
 from dyncheck.cases.multibody import ROTATING
-from dyncheck.implementations import (
-    EngineImplementation,
-    Implementation,
-    Variant,
-    book_variant,
-    general_method,
-)
+from dyncheck.implementations import EngineImplementation, Implementation, general_method
 from dyncheck.results import Discrepancy, Verdict
 from dyncheck.studies.order import finest_pair, observed_orders
 from dyncheck.studies.references import References, difference
 from dyncheck.tolerances import ORDER_SLACK, REFERENCE_MARGIN, accumulated, first_near_max
+from dyncheck.variants import Variant, book_variant
 from dyncheck.vocabulary import Quantity
 
 ADAPTIVE_RTOL = 1e-13

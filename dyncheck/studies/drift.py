@@ -11,11 +11,12 @@ from dyncheck.adapters.integrators import STEPPERS
 from dyncheck.cases import Case
 from dyncheck.cases.coordinate_maps import EulerAngleMap
 from dyncheck.comparison import soft_factor
-from dyncheck.implementations import SOFT_CONSTRAINT, Implementation, Variant, general_method
+from dyncheck.implementations import Implementation, general_method
 from dyncheck.reference import rigid
 from dyncheck.results import Discrepancy, Verdict
 from dyncheck.studies.references import References
 from dyncheck.tolerances import accumulated, first_near_max
+from dyncheck.variants import SOFT_CONSTRAINT, Variant
 from dyncheck.vocabulary import Quantity
 
 

@@ -14,7 +14,7 @@ from dyncheck.cases import NOMINAL_ORDER, Case
 from dyncheck.cases.multibody import ROTATING
 from dyncheck.comparison import soft_factor
 from dyncheck.errors import DyncheckError, EngineNotInstalled, Unsupported
-from dyncheck.implementations import Implementation, Variant, compared
+from dyncheck.implementations import Implementation, compared
 from dyncheck.results import Discrepancy, Verdict
 from dyncheck.studies.labels import CHARTS_DIFFER, GYROSCOPIC_IMPLICIT, NAIVE_GROUP_RK4
 from dyncheck.studies.references import References, difference
@@ -26,6 +26,7 @@ from dyncheck.tolerances import (
     first_near_max,
     roundoff_floor,
 )
+from dyncheck.variants import Variant
 from dyncheck.vocabulary import Integrator, Quantity, is_rk4
 
 

@@ -12,8 +12,9 @@ from dyncheck import coordinates as co
 from dyncheck.adapters.integrators import Addresses, integrate
 from dyncheck.cases import Case
 from dyncheck.cases.coordinate_maps import CoordinateMap
-from dyncheck.implementations import Variant, general_method, reference_trajectory
+from dyncheck.implementations import general_method, reference_trajectory
 from dyncheck.measured_cache import reused
+from dyncheck.variants import Variant
 from dyncheck.vocabulary import Integrator
 
 T = TypeVar("T")

@@ -22,8 +22,6 @@ from dyncheck.implementations import (
     IMPLEMENTATIONS,
     EngineImplementation,
     Implementation,
-    Variant,
-    book_variant,
     general_method,
 )
 from dyncheck.results import ConvergencePoint, Discrepancy, Verdict
@@ -41,6 +39,7 @@ from dyncheck.tolerances import (
     first_near_max,
     roundoff_floor,
 )
+from dyncheck.variants import Variant, book_variant
 from dyncheck.vocabulary import Integrator, Quantity, is_rk4
 
 

@@ -11,13 +11,8 @@ import pytest
 from dyncheck.adapters import get_adapter
 from dyncheck.cases import get_case
 from dyncheck.errors import EngineNotInstalled
-from dyncheck.implementations import (
-    ENGINE_DEFECT,
-    INERTIA_STORED,
-    book_variant,
-    general_method,
-    make_implementation,
-)
+from dyncheck.implementations import general_method, make_implementation
+from dyncheck.variants import ENGINE_DEFECT, INERTIA_STORED, book_variant
 
 from ..conftest import CASE_NAMES, FILE_LOADERS, supported
 

@@ -15,16 +15,14 @@ from dyncheck.cases import StateSample, get_case
 from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.comparison import GRAVITY_DEFAULT, POINT_INERTIA, compare_instantaneous
 from dyncheck.implementations import (
-    ENGINE_DEFECT,
     IMPLEMENTATIONS,
-    INERTIA_STORED,
     QUANTITIES,
-    SOFT_CONSTRAINT,
     compared,
     make_implementation,
     quantities,
 )
 from dyncheck.results import DISCREPANCY_KEY, Discrepancy, table
+from dyncheck.variants import ENGINE_DEFECT, INERTIA_STORED, SOFT_CONSTRAINT
 
 from ..conftest import (
     ALL_ENGINES,

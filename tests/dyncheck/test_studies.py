@@ -9,7 +9,6 @@ import pytest
 from dyncheck.adapters import FLOAT32, REGISTRY
 from dyncheck.cases import NOMINAL_ORDER, get_case
 from dyncheck.comparison import GRAVITY_DEFAULT
-from dyncheck.implementations import SOFT_CONSTRAINT
 from dyncheck.studies import (
     CONTROLLED,
     CONTROLLED_ACCURACIES,
@@ -17,6 +16,7 @@ from dyncheck.studies import (
     PRE_ASYMPTOTIC,
     observed_orders,
 )
+from dyncheck.variants import SOFT_CONSTRAINT
 
 from ..conftest import (
     ALL_ENGINES,
@@ -237,8 +237,8 @@ def test_discrete_prediction_steps_quaternion_states_at_order_four(case_name):
     for the ball joint, on the rotation group) converge to the reference trajectory at order 4
     (the classical RK4 order; an additive update of the quaternion could not even run: nq = 4,
     nv = 3). Needed wherever an engine's rows fail their order and the prediction is asked."""
-    from dyncheck.implementations import book_variant
     from dyncheck.studies import References, difference
+    from dyncheck.variants import book_variant
 
     case = get_case(case_name)
     refs = References(case)
@@ -257,8 +257,8 @@ def test_discrete_prediction_refused_where_the_book_coordinates_lose_the_spin():
     """The spherical pendulum's (φ, θ) fix the rod, not the spin about it, which a ball joint
     stepped on the rotation group acquires: the prediction is refused (the row keeps its
     verdict, with the reason), never made from the wrong body frame."""
-    from dyncheck.implementations import book_variant
     from dyncheck.studies import References
+    from dyncheck.variants import book_variant
 
     case = get_case("spherical_pendulum")
     refs = References(case)
@@ -291,9 +291,9 @@ def test_references_are_read_back_to_the_last_bit(empty_cache, monkeypatch):
     """A second study's references — DOP853 and the general method stepped by an integrator —
     come from the cache equal to the first's to the last bit, without solving or stepping
     again (both refused here); ``--no-cache`` computes them (the refusal is met)."""
-    from dyncheck.implementations import book_variant
     from dyncheck.settings import Settings
     from dyncheck.studies import references
+    from dyncheck.variants import book_variant
     from dyncheck.workers import settled
 
     case = get_case("simple_pendulum")
