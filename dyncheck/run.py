@@ -31,6 +31,7 @@ from dyncheck.results import (
     table,
 )
 from dyncheck.roster import ON_A_CPU
+from dyncheck.skipped import once_per_case
 from dyncheck.studies import TrajectoryFigures, study
 from dyncheck.studies.derivatives import derivative_rows
 from dyncheck.vocabulary import Verdict
@@ -219,7 +220,7 @@ def run(
             engines |= used
             if what in slices:
                 r = rows_of(reduce(Sweep.merge, (done[i] for i in slices[what]))) + r
-            rows += r
+            rows += once_per_case(r)  # an engine's limit on the case: one row
             points += p
             figures[what] = f
             if drawn:

@@ -253,8 +253,10 @@ def newton_joint_order() -> Entry:
         "Newton 1.8's MJCF importer fuses a body's joints into one D6 joint whose slides come "
         "first (applied in the parent's frame) and hinges after, whatever the written order: "
         "a hinge written before a slide no longer turns it. MuJoCo, Pinocchio and Drake "
-        "apply them as written; dyncheck check names Newton's D6 and skips it. Fix: one "
-        "joint per body (or the slides written first).",
+        "apply them as written; dyncheck reads Newton's D6 as the chain it applies and "
+        "measures the order's effect with the referee on both orders (the rows explained, "
+        "or failed where they go beyond it). Fix: one joint per body (or the slides written "
+        "first).",
         "Newton's reading of three joints on one body",
         errors[0],
         errors[1],
