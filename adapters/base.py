@@ -315,6 +315,16 @@ class Offer(StrEnum):
     INPUT_JACOBIAN = "input_jacobians"
     """``input_jacobians(q, v, u)``: the Jacobians of one step of its integrators in the
     controls, ∂x₊/∂u."""
+    BODY_FORCES = "body_forces"
+    """``body_forces(q, v, field)``: the generalized force of forces at bodies' centres of
+    mass (a :data:`Field`), its own (its Jacobians or its solver's sum); and
+    ``simulate(..., field=)`` applying them at every step through its stepping API."""
+
+
+Field = Callable[[dict[str, np.ndarray]], dict[str, np.ndarray]]
+"""Forces on bodies: each body's centre of mass in world axes, by the body's name, to the
+force (world axes, at that centre) on it — a book case's external field, evaluated at the
+positions the engine itself computes."""
 
 
 Answer = tuple[Any, float] | Exception
@@ -366,9 +376,14 @@ class ModelEngine(ABC):
                    a: np.ndarray) -> tuple[Transition, ...]:
         raise Unsupported(f"{self.engine} offers no step Jacobians")
 
-    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float,
-                 steps: int) -> tuple[np.ndarray, np.ndarray]:
+    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
+                 field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
         raise Unsupported(f"{self.engine} offers no stepping of its own")
+
+    def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
+        """The generalized force (n, nv, its layout) of ``field`` at each state
+        (:attr:`Offer.BODY_FORCES`)."""
+        raise Unsupported(f"{self.engine}: its model takes no force on a body")
 
     def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
         """Its actuators' generalized force at controls ``u`` (n, its tree's actuators) and

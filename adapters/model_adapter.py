@@ -10,12 +10,14 @@ run's coordinate maps start from) by :mod:`.layout` — the same loader, tree an
 Forward dynamics at τ is M⁻¹(τ − h) from the engine's M and h mapped to the canonical layout
 (these loaders offer M and h; the engine's own forward dynamics is M⁻¹(−h) likewise);
 T = ½ vᵀ M v and V as the loader computes them. A URDF states no gravity: the case's is
-given to the loader (``gravity=``), as its user would set it. What the loader cannot hold
-— couplings (constraints), an external field — is refused before any work (a skipped row
-naming it). Its ``integrators`` are the registration's: the engine's own stepping, named by
-the definition it is (Newton's Featherstone solver and PyBullet's ``stepSimulation`` are
-semi-implicit Euler, MuJoCo's ``euler``, on hinges and slides; measured by the order studies
-against the reference's discrete map of that definition).
+given to the loader (``gravity=``), as its user would set it. An external field (a force
+on a body at its centre of mass) enters through the engine's own means where its class
+offers them (:attr:`~.base.Offer.BODY_FORCES`: its Jacobians or its solver's sum for the
+generalized force, its stepping API at every step); couplings (constraints) are refused
+before any work (a skipped row naming it). Its ``integrators`` are the registration's: the
+engine's own stepping, named by the definition it is (Newton's Featherstone solver and
+PyBullet's ``stepSimulation`` are semi-implicit Euler, MuJoCo's ``euler``; measured by the
+order studies against the reference's discrete map of that definition).
 """
 
 from __future__ import annotations
@@ -24,13 +26,14 @@ import importlib
 import importlib.metadata
 import tempfile
 from collections.abc import Callable
+from dataclasses import replace
 from functools import partial
 from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
 
-from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.base import Adapter, Field, LoadedBody, Offer, Trajectory
 from dyncheck.adapters.c_output import c_output_dropped
 from dyncheck.adapters.layout import Canonical, canonical_states
 from dyncheck.adapters.layout_batch import engine_states, to_canonical
@@ -65,9 +68,10 @@ class ModelAdapter(Adapter):
         if model.couplings:
             raise Unsupported(f"{self.name}: couplings (tendon equalities) are constraints; "
                               "its file loader is checked on the smooth dynamics of a tree")
-        if model.central_mu:
-            raise Unsupported(f"{self.name}: an external field (a force on a body) is not an "
-                              "input of its file loader")
+        if model.central_mu and Offer.BODY_FORCES not in self.loader.offers:
+            raise Unsupported(f"{self.name}: its model takes no force on a body (an external "
+                              "field)")
+        self.field: Field | None = _field(model) if model.central_mu else None
         urdf = self.run_format is Format.URDF
         text = to_urdf(model) if urdf else to_mjcf(model)
         with tempfile.TemporaryDirectory(prefix="dyncheck-case-") as folder:
@@ -201,6 +205,9 @@ class ModelAdapter(Adapter):
     ) -> dict[str, np.ndarray]:
         maps, qe, ve, ae = engine_states(self.canon, self.tree, q, v, a)
         d = to_canonical(maps, self.engine.dynamics(qe, ve, ae))
+        pushed = self._pushed(maps, qe, ve)
+        tau = tau + pushed
+        d = replace(d, inverse=d.inverse - pushed)
         unavailable = dict(d.unavailable)
         self._unavailable = {QUANTITY_OF[field]: why for field, why in unavailable.items()}
         if "bias" in unavailable:  # its own forward dynamics at τ, mapped: v̇_e = T v̇ + Ṫ v
@@ -213,6 +220,15 @@ class ModelAdapter(Adapter):
             forward = np.linalg.solve(d.mass_matrix, (tau - d.bias)[..., None])[..., 0]
         return self._outputs(d.mass_matrix, d.bias, forward, d.inverse, d.kinetic,
                              d.potential)
+
+    def _pushed(self, maps: list[Any], qe: np.ndarray, ve: np.ndarray) -> np.ndarray:
+        """The case's external field's generalized force in the canonical layout (τ_c =
+        Tᵀ τ_e), as the engine computes it (:meth:`~.base.ModelEngine.body_forces`); zero
+        without a field."""
+        if self.field is None:
+            return np.zeros((len(qe), self.canon.nv))
+        engine = self.engine.body_forces(qe, ve, self.field)
+        return np.einsum("sji,sj->si", np.array([m.t for m in maps]), engine)
 
     def unavailable_quantities(self) -> dict[str, str]:
         return self._unavailable
@@ -228,7 +244,8 @@ class ModelAdapter(Adapter):
         return self.evaluate_all(q, v, tau, np.zeros_like(v))[Quantity.FORWARD_DYNAMICS]
 
     def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        return self._dynamics(q, v, a).inverse
+        maps, qe, ve, _ = engine_states(self.canon, self.tree, q, v, a)
+        return self._dynamics(q, v, a).inverse - self._pushed(maps, qe, ve)
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         return self._dynamics(q, v, np.zeros_like(v)).kinetic
@@ -247,7 +264,7 @@ class ModelAdapter(Adapter):
         _, qe, ve, _ = engine_states(self.canon, self.tree, q0[None], v0[None],
                                      np.zeros_like(v0)[None])
         steps = round(duration / dt)
-        q_e, v_e = self.engine.simulate(qe[0], ve[0], dt, steps)
+        q_e, v_e = self.engine.simulate(qe[0], ve[0], dt, steps, field=self.field)
         self._finite(q_e, v_e, dt)
         q, v = canonical_states(self.canon, self.tree, q_e, v_e)
         return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", q), v)
@@ -275,6 +292,14 @@ class ModelAdapter(Adapter):
         to it is dyncheck's, timed in the adapter's row)."""
         _, q, v, a = engine_states(self.canon, self.tree, qe, ve, ae)
         return partial(self.engine.dynamics, q, v, a)
+
+
+def _field(model: Multibody) -> Field:
+    """The case's central field (:meth:`~dyncheck.cases.multibody.Multibody.central_force`)
+    on each of its bodies, at the centres of mass the engine gives."""
+    masses = {body.name: body.mass for body in model.bodies}
+    return lambda where: {name: model.central_force(masses[name], at)
+                          for name, at in where.items() if name in masses}
 
 
 def for_engine(name: str, *, package: str, model: str, run: Format, float32: bool,

@@ -21,12 +21,13 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
 from dyncheck.adapters import newton_actuators
 from dyncheck.adapters.actuators import Actuation
-from dyncheck.adapters.base import ModelEngine, Offer
+from dyncheck.adapters.base import Field, ModelEngine, Offer
 from dyncheck.adapters.mjcf_copy import utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
@@ -114,7 +115,7 @@ class NewtonModel(ModelEngine):
     """A finalized Newton model on the CPU and its neutral tree."""
 
     engine = ENGINE
-    offers = frozenset({Offer.STEPPING, Offer.ACTUATION})
+    offers = frozenset({Offer.STEPPING, Offer.ACTUATION, Offer.BODY_FORCES})
 
     def __init__(self, source: ModelFile) -> None:
         import newton
@@ -263,6 +264,8 @@ class NewtonModel(ModelEngine):
                 why = CORRECTED.format(bodies=", ".join(repr(b) for b in named))
                 hints.append((self._name(j), "inertia", why))
         acts = newton_actuators.read(m, self.newton, [self._name(j) for j in range(m.joint_count)])
+        fused = {j: chain for j, chain in fused.items()  # (slides only: applied as written)
+                 if [n for n, _ in chain] != self._name(j).split("_")}
         for j, chain in fused.items():
             why = D6_ORDER.format(body=self._body(int(child[j])),
                                   written=" ".join(self._name(j).split("_")),
@@ -296,7 +299,7 @@ class NewtonModel(ModelEngine):
             raise Unsupported(f"newton fused joints into a D6 joint ({self._name(j)!r}) whose "
                               "joints its label and the file do not name unambiguously")
         axes = self.model.joint_axis.numpy()[self.v_start[j] + n_lin : self.v_start[j + 1]]
-        if np.abs(axes @ axes.T - np.eye(n_ang)).max() > 1e-6:
+        if n_ang > 1 and np.abs(axes @ axes.T - np.eye(n_ang)).max() > 1e-6:
             raise Unsupported(f"newton's D6 joint {self._name(j)!r} has angular axes that are "
                               "not orthogonal, which it orthonormalizes: not mapped")
         return [(n, JointType.SLIDE) for n in slides] + [(n, JointType.HINGE) for n in hinges]
@@ -345,12 +348,14 @@ class NewtonModel(ModelEngine):
         return Dynamics.at(v, mass_matrix=mass, bias=bias, inverse=inverse,
                            potential=potential)
 
-    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float,
-                 steps: int) -> tuple[np.ndarray, np.ndarray]:
+    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
+                 field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
         """``steps`` steps of Newton's Featherstone solver (``SolverFeatherstone``: forward
         dynamics by the articulated-body algorithm, then semi-implicit Euler, v₊ = v + h v̇,
         q₊ = q + h v₊ on hinges and slides), from (q0, v0), no control, no contacts: q and v
-        at every step, the start included (float64 from Newton's float32)."""
+        at every step, the start included (float64 from Newton's float32). ``field``: forces
+        on bodies at the centres of mass its state holds at each step's start, given as its
+        ``State.body_f`` (world axes, at the centre of mass)."""
         model, newton = self.model, self.newton
         solver = newton.solvers.SolverFeatherstone(model)
         now, after, control = model.state(), model.state(), model.control()
@@ -362,10 +367,48 @@ class NewtonModel(ModelEngine):
         qs[0], vs[0] = now.joint_q.numpy(), now.joint_qd.numpy()
         for k in range(1, steps + 1):
             now.clear_forces()
+            if field is not None:
+                self._apply(now, field)
             solver.step(now, after, control, None, dt)
             now, after = after, now
             qs[k], vs[k] = now.joint_q.numpy(), now.joint_qd.numpy()
         return qs, vs
+
+    def _apply(self, state: Any, field: Field) -> None:
+        """``field`` at the centres of mass of ``state``'s bodies (its ``body_q``), written
+        to its ``body_f`` (linear force first, world axes, at the centre of mass)."""
+        assert state.body_q is not None and state.body_f is not None
+        poses = state.body_q.numpy()
+        index = {self._body(b): b for b in range(self.model.body_count)}
+        where = {}
+        for name in index:
+            pose = _pose(poses[index[name]])
+            where[name] = pose[:3, :3] @ self._coms[index[name]] + pose[:3, 3]
+        wrench = np.zeros((self.model.body_count, 6), np.float32)
+        for name, force in field(where).items():
+            wrench[index[name], :3] = force
+        state.body_f.assign(wrench)
+
+    def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
+        """The field's generalized force by its Featherstone solver: its net joint force
+        ``joint_tau`` of one step with the field in ``body_f`` minus without (float32)."""
+        model, newton = self.model, self.newton
+        solver = newton.solvers.SolverFeatherstone(model)
+        now, after, control = model.state(), model.state(), model.control()
+        out = np.zeros((len(q), model.joint_dof_count))
+        for i in range(len(q)):
+            taus = []
+            for forced in (True, False):
+                now.joint_q.assign(q[i].astype(np.float32))
+                now.joint_qd.assign(v[i].astype(np.float32))
+                newton.eval_fk(model, now.joint_q, now.joint_qd, now)
+                now.clear_forces()
+                if forced:
+                    self._apply(now, field)
+                solver.step(now, after, control, None, 1e-3)
+                taus.append(solver.joint_tau.numpy().astype(float))
+            out[i] = taus[0] - taus[1]
+        return out
 
     def _articulation_dofs(self) -> list[np.ndarray]:
         """Each articulation's velocity indices, in Newton's order."""

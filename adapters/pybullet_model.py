@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 
-from dyncheck.adapters.base import ModelEngine, Offer
+from dyncheck.adapters.base import Field, ModelEngine, Offer
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -70,6 +70,7 @@ from dyncheck.adapters.pybullet_files import (
     rotation_of,
     zeroed,
 )
+from dyncheck.adapters.pybullet_forces import apply_field, field_force, named_links
 from dyncheck.errors import Unsupported
 
 ENGINE = "pybullet"
@@ -95,7 +96,7 @@ class PybulletModel(ModelEngine):
     """A PyBullet client holding the file's multibodies, and their neutral tree."""
 
     engine = ENGINE
-    offers = frozenset({Offer.STEPPING})
+    offers = frozenset({Offer.STEPPING, Offer.BODY_FORCES})
     no_actuation = ("pybullet holds no actuator model (no control law of a file's actuators "
                     "or transmissions): a script drives each joint with "
                     "setJointMotorControl2 (TORQUE_CONTROL applies the torque it is given; "
@@ -421,8 +422,8 @@ class PybulletModel(ModelEngine):
         return (base_q + sum(len(_ZERO[k]) for _, k in movable),
                 base_v + sum(JointType(_TYPES[k]).nv for _, k in movable))
 
-    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float,
-                 steps: int) -> tuple[np.ndarray, np.ndarray]:
+    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
+                 field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
         """``steps`` calls of ``stepSimulation`` at ``setTimeStep(dt)`` from (q0, v0): q and v
         at every step, the start included. Stated as a PyBullet user writes it for free
         motion: each joint's default motor switched off
@@ -433,7 +434,8 @@ class PybulletModel(ModelEngine):
         semi-implicit Euler (v₊ = v + h v̇, q₊ = q + h v₊) of its articulated-body forward
         dynamics. A moving base is placed and read through its base state
         (``resetBaseVelocity``/``getBaseVelocity``: both velocities in world axes, mapped to
-        the layout's ω in the centre-of-mass frame's axes)."""
+        the layout's ω in the centre-of-mass frame's axes). ``field``: forces on links at
+        their centres of mass at each step's start (:func:`~.pybullet_forces.apply_field`)."""
         c = self.client
         pb.setTimeStep(dt, physicsClientId=c)
         q_at = v_at = 0
@@ -458,11 +460,32 @@ class PybulletModel(ModelEngine):
             vs[k] = [x for body, (_, v) in zip(self.bodies, states, strict=True)
                      for x in (*v, *self._velocities(body))]
 
+        links = named_links(c, self.bodies) if field is not None else {}
         read(0)
         for k in range(1, steps + 1):
+            if field is not None:
+                apply_field(c, links, field)
             pb.stepSimulation(physicsClientId=c)
             read(k)
         return qs, vs
+
+    def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
+        """The field's generalized force by its ``calculateJacobian`` (fixed bases)."""
+        links = named_links(self.client, self.bodies)
+        out = np.zeros((len(q), self.tree.nv))
+        for i in range(len(q)):
+            q_at = v_at = 0
+            for body in self.bodies:
+                nq, nv = self._size(body)
+                if self._floating[body] or self._balls:
+                    raise Unsupported("pybullet: a force on a moving base or through a "
+                                      "spherical joint is not mapped by dyncheck")
+                joints = [float(x) for x in q[i, q_at : q_at + nq]]
+                self._place(body, joints)
+                out[i, v_at : v_at + nv] = field_force(
+                    self.client, body, joints=joints, links=links, field=field)
+                q_at, v_at = q_at + nq, v_at + nv
+        return out
 
     def _com(self, body: int, link: int) -> np.ndarray:
         c = self.client

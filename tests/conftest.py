@@ -53,12 +53,9 @@ NO_COUPLINGS: tuple[str, ...] = ()
 PORTS = ("mjx", "mjx-f64", "mujoco-warp")
 """MuJoCo's ports: no passive-force callback, so no external field evaluated per stage."""
 FILE_LOADERS = tuple(n for n, r in adapters.REGISTRY.items() if r.run)
-"""Engines whose book cases go through their loader of a user's file (no couplings, no
-external field, no integrators stepped: refused with the reason)."""
-MULTI_JOINT_CASES = sorted(
-    n for n in CASES if any(len(b.joints) > 1 for b in get_case(n).multibody().bodies))
-"""Cases with a body moved by several joints (Newton's MJCF importer fuses them into a D6)."""
-LOADER_LIMITS = {"newton": (MULTI_JOINT_CASES, "D6")}
+"""Engines whose book cases go through their loader of a user's file (no couplings: refused
+with the reason)."""
+LOADER_LIMITS: dict[str, tuple[tuple[str, ...], str]] = {}
 """A file loader's limit on the book's cases, and the word its refusal names it by."""
 FLOORED = ("mujoco", "pinocchio-mjcf", "drake", *PORTS, *FILE_LOADERS)
 """Engines given the case as a file (MJCF, or URDF for PyBullet), whose point masses carry
@@ -105,8 +102,6 @@ def unsupported_reason(case: str, engine: str) -> str | None:
         return "couplings"
     if engine in FILE_LOADERS and case in COUPLED_CASES:
         return "couplings"
-    if engine in FILE_LOADERS and case in FIELD_CASES:
-        return "external field"
     cases, word = LOADER_LIMITS.get(engine, ((), ""))
     if case in cases:
         return word

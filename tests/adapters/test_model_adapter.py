@@ -132,3 +132,26 @@ def test_a_run_that_leaves_the_finite_states_names_its_step():
     q0, v0 = EngineImplementation(case, get_adapter("mujoco")).engine_start()
     with pytest.raises(FloatingPointError, match=r"step \d+ of 1000 .* condition number"):
         cls(case.multibody()).simulate(q0, v0, 2.0, 2e-3, "euler")
+
+
+@pytest.mark.parametrize("engine", FILE_LOADERS)
+def test_an_external_field_enters_through_the_engine_s_own_means(engine):
+    """Kepler's central field on the particle (three slides x, y, z): the engine computes its
+    generalized force (PyBullet's calculateJacobian, Newton's Featherstone joint_tau with the
+    force in body_f minus without), so its inverse dynamics at rest is −m g − F(r) with
+    F = −μ m r/|r|³ (the closed form; g the gravity the engine loaded — Newton keeps its
+    default for MJCF), to the engine's round-off."""
+    cls = _adapter_class(engine)
+    case = get_case("kepler")
+    spec = case.multibody()
+    adapter = cls(spec)
+    rng = np.random.default_rng(11)
+    q = rng.uniform(0.5, 2.0, size=(6, 3)) * rng.choice([-1.0, 1.0], size=(6, 3))
+    zero = np.zeros_like(q)
+    mass = spec.bodies[0].mass
+    expected = np.array([-mass * adapter.loaded_gravity() - spec.central_force(mass, r)
+                         for r in q])
+    got = adapter.inverse(q, zero, zero)
+    scale = np.abs(expected).max()
+    assert np.abs(got - expected).max() <= 64 * np.finfo(cls.dtype).eps * scale
+    assert np.abs(spec.central_force(mass, q[0])).max() > 1e3 * 64 * np.finfo(cls.dtype).eps
