@@ -120,9 +120,11 @@ EXPLANATIONS: dict[str, Explanation] = {
     ),
     GRAVITY_DEFAULT: Explanation(
         origin=Origin.ENGINE,
-        text="Pinocchio's MJCF parser (`pin.buildModelFromMJCF`, Pinocchio 4.1) does not read "
-        "`<option gravity>`: the loaded model keeps Pinocchio's default (0, 0, −9.81) m/s² "
-        "whatever the file says (measured: the loaded `model.gravity` is read back). It is "
+        text="Pinocchio's MJCF parser (`pin.buildModelFromMJCF`, Pinocchio 4.1) and Newton's "
+        "MJCF importer (`ModelBuilder.add_mjcf`, Newton 1.8) do not read `<option gravity>`: "
+        "the loaded model keeps the engine's default (0, 0, −9.81) m/s² whatever the file "
+        "says (measured: the loaded `model.gravity` is read back; in the book's cases it "
+        "shows on `kepler`, whose field is the only force). It is "
         "invisible where the case's gravity is the default and a failure of the model "
         "elsewhere; the reference predicts it exactly by evaluating the general method with "
         "the gravity the engine actually holds.",
