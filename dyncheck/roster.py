@@ -7,7 +7,11 @@ from collections.abc import Collection
 
 from dyncheck.adapters import ACCELERATORS, ENGINE_EXTRAS, RUN
 
-BOOK_SIDE: tuple[str, ...] = ("reference", "book")
+REFEREE = "reference"
+"""The referee's name: the book's general method (2.2.23)–(2.2.26), implemented clean-room
+in ``reference/``, on every row that judges an engine."""
+
+BOOK_SIDE: tuple[str, ...] = (REFEREE, "book")
 """The book's side: the general method (2.2.23)–(2.2.26) and the printed equations."""
 
 IMPLEMENTATIONS: tuple[str, ...] = (*BOOK_SIDE, *RUN)

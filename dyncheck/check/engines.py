@@ -39,12 +39,12 @@ from dyncheck.adapters.model_files import ModelFile
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, Transition
 from dyncheck.confinement import confine
 from dyncheck.errors import DyncheckError, EngineError, Unsupported
+from dyncheck.roster import REFEREE
 from dyncheck.settings import Settings, current, in_force
 from dyncheck.workers import at_end, ending, start_method
 
 ENGINES: dict[str, Registration] = dict(MODELS)
 """The engines that load a user's file: their registrations (:data:`~dyncheck.adapters.MODELS`)."""
-REFEREE = "reference"
 IMPLEMENTATIONS = (REFEREE, *ENGINES)
 PORTS = tuple(name for name, r in ENGINES.items() if r.on_request)
 """Checked only when asked for (``--impl mjx``): compiling a model for a port takes seconds

@@ -26,8 +26,9 @@ from dyncheck.precision import EPS, ROUNDOFF_FACTOR, standing
 from dyncheck.reference.recursive import RecursiveDynamics
 from dyncheck.reference.tree import TreeDynamics
 from dyncheck.results import Verdict
+from dyncheck.roster import REFEREE
 
-ENGINE = "reference"
+ENGINE = REFEREE
 TIE_STATES = 10
 """States at which the recursive algorithm is tied to the general method on every tree."""
 GENERAL = "reference (general method)"

@@ -14,8 +14,7 @@ import pandas as pd
 
 from dyncheck.check.rows import COMPUTED, Section
 from dyncheck.results import Verdict
-
-REFEREE = "reference"
+from dyncheck.roster import REFEREE
 
 
 class Reading(StrEnum):

@@ -24,9 +24,9 @@ from dyncheck.cases import Case
 from dyncheck.coordinates import NativeMap
 from dyncheck.errors import EngineNotInstalled
 from dyncheck.results import Discrepancy
+from dyncheck.roster import REFEREE
 from dyncheck.vocabulary import Verdict
 
-REFEREE = "reference"
 TREE_ONLY = ("the smooth dynamics of the case's MJCF tree (its couplings and external field "
              "are not part of them)")
 
