@@ -280,11 +280,14 @@ class ModelAdapter(Adapter):
         zero = np.zeros((1, self.tree.nv))
         mass = self.engine.dynamics(q_e[k - 1 : k], zero, zero).mass_matrix[0]
         eig = np.linalg.eigvalsh(mass)
+        kappa = eig.max() / eig.min() if eig.min() > 0 else np.inf
         raise FloatingPointError(
             f"{self.name}'s step {k} of {len(q_e) - 1} (t = {k * dt:g} s) gave a non-finite "
             f"state; its own mass matrix at the step before has eigenvalues {eig.min():.3g} to "
-            f"{eig.max():.3g}, condition number {eig.max() / eig.min():.3g} against 1/ε = "
-            f"{1 / self.eps:.3g} of its arithmetic")
+            f"{eig.max():.3g}, condition number {kappa:.3g} against 1/ε = {1 / self.eps:.3g} "
+            "of its arithmetic" + (" (beyond it, a factorization of M in that precision can "
+                                   "lose every digit of its smallest pivot)"
+                                   if kappa * self.eps > 1 else ""))
 
     def raw_calls(self, qe: np.ndarray, ve: np.ndarray, te: np.ndarray,
                   ae: np.ndarray) -> Callable[[], None] | None:
