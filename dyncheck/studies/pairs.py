@@ -119,11 +119,15 @@ def _frame_pair(
     if len(dts) < 2 or any((e, integrator, dt) not in runs for e in (a, b) for dt in dts[:2]):
         why = "the two maps differ in definition and fewer than two steps ran"
         return _no_numbers(case, a, b, integrator, dts[0], Verdict.FAILED, convention, why)
+    try:
+        shifts = [None if model is None else model(dt) for dt in dts[:2]]
+    except ValueError:  # no discrete prediction in the book's chart here: the maps alone
+        shifts, model = [None, None], None
     d = []
-    for dt in dts[:2]:
+    for dt, shift in zip(dts[:2], shifts, strict=True):
         qa, qb = runs[a, integrator, dt], runs[b, integrator, dt]
-        d.append(float((difference(case, qb, qa) if model is None else
-                        difference(case, qb - qa, model(dt))).max()))
+        d.append(float((difference(case, qb, qa) if shift is None else
+                        difference(case, qb - qa, shift)).max()))
     scale_q = float(np.abs(runs[a, integrator, dts[0]]).max())
     if eps > EPS:
         steps = round(case.trajectory.duration / dts[1])
