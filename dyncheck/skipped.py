@@ -21,9 +21,10 @@ def _engine(note: str, rows: list[Discrepancy]) -> str:
 
 def once_per_case(rows: list[Discrepancy]) -> list[Discrepancy]:
     """``rows`` with the skipped rows of one case that give one reason merged into one: the
-    engine whose limit it is as ``impl_b``, the partners it was not compared with as
-    ``impl_a``, the quantities (and the integrator and step where they are one) it leaves
-    uncompared as ``quantity``. The other rows as they are, in their order."""
+    engine whose limit it is as ``impl_b`` (no ``impl_a``: the row is the engine's, whatever
+    partners a run had, so that a run of fewer engines finds it alike), the quantities (and
+    the integrator and step where they are one) it leaves uncompared as ``quantity``. The
+    other rows as they are, in their order."""
     out: list[Discrepancy] = []
     groups: dict[tuple[str, str], list[Discrepancy]] = {}
     for row in rows:
@@ -33,11 +34,10 @@ def once_per_case(rows: list[Discrepancy]) -> list[Discrepancy]:
             groups.setdefault((row.case, row.note), []).append(row)
     for (_, note), group in groups.items():
         engine = _engine(note, group)
-        partners = sorted({s for r in group for s in (r.impl_a, r.impl_b) if s and s != engine})
         one = {(r.integrator, r.dt if not math.isnan(r.dt) else None) for r in group}
         integrator, dt = next(iter(one)) if len(one) == 1 else ("", None)
         out.append(replace(
             group[0], quantity=", ".join(sorted({r.quantity for r in group})),
-            impl_a=", ".join(partners), impl_b=engine, integrator=integrator,
+            impl_a="", impl_b=engine, integrator=integrator,
             dt=math.nan if dt is None else dt))
     return out
