@@ -61,11 +61,11 @@ from dyncheck.adapters.pybullet_files import (
     FLAGS_NOTE,
     FREE_BASE,
     GRAVITY_HINT,
-    INERTIA_HINT,
     MAX_LINKS,
     Link,
     defaulted,
     load,
+    mjcf_hints,
     pose,
     rotation_of,
     zeroed,
@@ -74,6 +74,10 @@ from dyncheck.adapters.pybullet_forces import apply_field, field_force, named_li
 from dyncheck.errors import Unsupported
 
 ENGINE = "pybullet"
+MJCF_EPS = float(np.finfo(np.float32).eps)
+"""PyBullet's MJCF reader holds the file's numbers rounded to float32 (measured: a body at
+``pos`` 1 with a child at −0.6 stands at 1 − float32(0.6), a capsule's centre at
+float32(0.7)): its readings of an MJCF, and the dynamics it computes from them, carry ε₃₂."""
 GRAVITY = np.array([0.0, 0.0, -9.81])
 _TYPES = {pb.JOINT_REVOLUTE: JointType.HINGE, pb.JOINT_PRISMATIC: JointType.SLIDE,
           pb.JOINT_SPHERICAL: JointType.BALL}
@@ -114,11 +118,12 @@ class PybulletModel(ModelEngine):
         self._damping: dict[tuple[int, int], float] = {}  # (body, joint) → the file's
         self._floating = {body: self._moving_base(body) for body in self.bodies}
         self._root_name = "root_joint" if source.format is Format.URDF else ""
+        self._read_eps = MJCF_EPS if source.format is Format.MJCF else float(np.finfo(float).eps)
         links = [link for body in self.bodies for link in self._links(body)]
         notes = (FLAGS_NOTE,) if source.format is Format.URDF else ()
         hints: tuple[tuple[str, str, str], ...] = (("model", "armature", ARMATURE_HINT),)
         if source.format is Format.MJCF:
-            hints += (("model", "gravity", GRAVITY_HINT), ("model", "inertia", INERTIA_HINT))
+            hints += (("model", "gravity", GRAVITY_HINT), *mjcf_hints(source))
         hints += zeroed(source, links) + defaulted(source, links)
         if source.format is Format.URDF:
             hints += (("model", "inertia accuracy", ACCURACY_HINT),)
@@ -258,7 +263,7 @@ class PybulletModel(ModelEngine):
             q_at, v_at = q_at + kind.nq, v_at + kind.nv
         self._masses = [(link.body, link.index, link.mass) for link in links]
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=self.gravity.copy(),
-                         nq=q_at, nv=v_at, notes=notes, hints=hints,
+                         nq=q_at, nv=v_at, notes=notes, hints=hints, eps=self._read_eps,
                          inertia_accuracy=DIAGONALIZATION)
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, *,

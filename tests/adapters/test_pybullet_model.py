@@ -114,3 +114,37 @@ def test_a_corrupted_inertia_fails_in_pybullet_naming_the_body(tmp_path):
     row = _rows(result, section="description", impl_b="pybullet", field="inertia")
     assert list(row["verdict"]) == ["failed"]
     assert "'bad_link'" in row["note"].iloc[0] and "triangle" in row["note"].iloc[0]
+
+
+DENSITY_MJCF = """<mujoco model="dense">
+  <default><geom density="500"/></default>
+  <worldbody>
+    <body name="a" pos="0 0 1">
+      <joint name="j1" type="hinge" axis="0 1 0"/>
+      <geom type="sphere" size="0.1"/>
+      <body name="b" pos="0 0 -0.6">
+        <joint name="j2" type="hinge" axis="1 0 0"/>
+        <inertial pos="0 0 -0.2" mass="1" diaginertia="0.01 0.02 0.03"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""
+
+
+def test_a_misread_mass_is_blamed_only_where_the_file_shows_the_premise(tmp_path):
+    """#63: PyBullet's MJCF reader weighs a geom at density 1000: the mass row of the body
+    whose geoms say 500 reads twice MuJoCo's (the closed form: 1000/500 of
+    500 · 4/3 π 0.1³) and names the density; the <inertial diaginertia> hint only on the
+    body that has one, never on a body whose file has none."""
+
+    path = tmp_path / "dense.xml"
+    path.write_text(DENSITY_MJCF, encoding="utf-8")
+    rows = check_model(path, impls=("mujoco", "pybullet"), states=5, actuators=False).rows
+    described = rows[rows.section == "description"]
+    mass = described[(described.subject == "j1") & (described.field == "mass")]
+    assert len(mass) == 1 and "density" in mass.note.iloc[0] and "500" in mass.note.iloc[0]
+    sphere = 500 * 4 / 3 * np.pi * 0.1**3
+    assert float(mass.value_a.iloc[0]) == pytest.approx(sphere, rel=1e-6)
+    assert float(mass.value_b.iloc[0]) == pytest.approx(2 * sphere, rel=1e-6)
+    j1 = described[described.subject == "j1"]
+    assert not j1.note.str.contains("diaginertia").any()
