@@ -113,8 +113,10 @@ for label, error in position_error.items():
 # file it does not move at all — its slide r is applied before the hinge, along the unturned
 # x axis, and the hinge then turns the particle about its own centre. One joint per body
 # (two nearly massless carrier bodies) gives Newton MuJoCo's kinematics to float32.
-# `dyncheck check` names Newton's D6 and leaves it out rather than compare two different
-# models.
+# `dyncheck check` reads Newton's D6 as the chain it applies (slides, then hinges), judges
+# Newton on that reading, and measures what the order changes with the referee on both
+# orders: the description rows name the D6, the dynamics rows between Newton and MuJoCo are
+# explained by the two readings.
 #
 # ## 2 · float32
 #
