@@ -29,11 +29,11 @@ from collections.abc import Callable
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 import numpy as np
 
-from dyncheck.adapters.base import Adapter, Field, LoadedBody, Offer, Trajectory
+from dyncheck.adapters.base import Adapter, Field, LoadedBody, ModelEngine, Offer, Trajectory
 from dyncheck.adapters.c_output import c_output_dropped
 from dyncheck.adapters.layout import Canonical, canonical_states
 from dyncheck.adapters.layout_batch import engine_states, to_canonical
@@ -68,7 +68,8 @@ class ModelAdapter(Adapter):
         if model.couplings:
             raise Unsupported(f"{self.name}: couplings (tendon equalities) are constraints; "
                               "its file loader is checked on the smooth dynamics of a tree")
-        if model.central_mu and Offer.BODY_FORCES not in self.loader.offers:
+        offers = cast(type[ModelEngine], self.loader).offers  # (a loader is a ModelEngine)
+        if model.central_mu and Offer.BODY_FORCES not in offers:
             raise Unsupported(f"{self.name}: its model takes no force on a body (an external "
                               "field)")
         self.field: Field | None = _field(model) if model.central_mu else None

@@ -55,4 +55,5 @@ SOFT_CONSTRAINT = "soft constraint (MuJoCo solref/solimp impedance model)"
 def book_variant(case: Case) -> Variant:
     """The book's model: point masses, the case's gravity."""
     mb = case.multibody()
-    return Variant((0.0,) * len(mb.bodies), tuple(float(x) for x in mb.gravity))
+    gx, gy, gz = (float(x) for x in mb.gravity)
+    return Variant((0.0,) * len(mb.bodies), (gx, gy, gz))
