@@ -364,3 +364,23 @@ def test_a_quantity_an_engine_does_not_compute_is_its_limit_in_its_words():
     assert rows["bias_forces"].note == f"mujoco does not compute it here: {why}"
     others = [r for q, r in rows.items() if q != "bias_forces"]
     assert others and all(r.verdict == "passed" for r in others)
+
+
+@pytest.mark.parametrize(("own_scale", "verdict"), [(2.59e9, "explained"), (1.0, "failed")])
+def test_a_defect_s_residual_is_bounded_by_the_round_off_of_its_own_values(own_scale, verdict):
+    """#63: where a declared defect makes an engine compute another model (Newton's D6 puts a
+    point mass on a hinge's axis: its v̇ reaches 2.6e9 where MuJoCo's is ~40), the residual
+    after prediction carries the round-off of the engine's own values, c ε₃₂ max|values|
+    (2.6e9 · 64 · 1.19e-7 ≈ 2e4 here, against a residual of 580); where its own values are
+    no larger than the book's, the bound stays the book's and a residual of 580 fails."""
+    from dyncheck.comparison import PairStats, Status, _row
+
+    eps32 = float(np.finfo(np.float32).eps)
+    st = PairStats(scale=42.0, residual=580.0, predicted=2.6e9, effects=True,
+                   own_scale=own_scale, records=[(0, 2.6e9, "")])
+    a = Status(name="mujoco", variant=None, eps=float(np.finfo(float).eps), error="",
+               skipped=False)
+    b = Status(name="newton", variant=None, eps=eps32, error="", skipped=False,
+               defects=("a body's joints applied slides first",))
+    row = _row("cylindrical_coordinates", "forward_dynamics", a, b, st, condition=1.0)
+    assert row.verdict == verdict
