@@ -25,7 +25,7 @@ import numpy as np
 
 from dyncheck.adapters.actuators import Actuation, InputJacobian
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, ModelTree, StateLayout, Transition
-from dyncheck.cases.multibody import Multibody
+from dyncheck.cases.multibody import Coupling, Multibody
 from dyncheck.errors import EngineError, Unsupported
 from dyncheck.vocabulary import Quantity
 
@@ -315,6 +315,10 @@ class Offer(StrEnum):
     INPUT_JACOBIAN = "input_jacobians"
     """``input_jacobians(q, v, u)``: the Jacobians of one step of its integrators in the
     controls, ∂x₊/∂u."""
+    COUPLINGS = "couplings"
+    """``couple(couplings)``: a book case's couplings (linear equalities between joints) as
+    the engine's own constraints, which its forward dynamics and stepping then hold, and
+    ``constraint_forces(q, v, τ)`` their multipliers."""
     BODY_FORCES = "body_forces"
     """``body_forces(q, v, field)``: the generalized force of forces at bodies' centres of
     mass (a :data:`Field`), its own (its Jacobians or its solver's sum); and
@@ -379,6 +383,15 @@ class ModelEngine(ABC):
     def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
                  field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
         raise Unsupported(f"{self.engine} offers no stepping of its own")
+
+    def couple(self, couplings: Sequence[Coupling]) -> None:
+        """Hold ``couplings`` from now on (:attr:`Offer.COUPLINGS`)."""
+        raise Unsupported(f"{self.engine}: its model holds no coupling between joints")
+
+    def constraint_forces(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """The couplings' multipliers f (n, couplings) of its forward dynamics at τ, in the
+        sign of M v̇ + h = τ + Cᵀ f (:attr:`Offer.COUPLINGS`)."""
+        raise Unsupported(f"{self.engine}: its model holds no coupling between joints")
 
     def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
         """The generalized force (n, nv, its layout) of ``field`` at each state

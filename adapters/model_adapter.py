@@ -65,10 +65,10 @@ class ModelAdapter(Adapter):
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
-        if model.couplings:
-            raise Unsupported(f"{self.name}: couplings (tendon equalities) are constraints; "
-                              "its file loader is checked on the smooth dynamics of a tree")
         offers = cast(type[ModelEngine], self.loader).offers  # (a loader is a ModelEngine)
+        if model.couplings and Offer.COUPLINGS not in offers:
+            raise Unsupported(f"{self.name}: its model holds no coupling between joints (the "
+                              "equality constraints of the book's cords)")
         if model.central_mu and Offer.BODY_FORCES not in offers:
             raise Unsupported(f"{self.name}: its model takes no force on a body (an external "
                               "field)")
@@ -83,6 +83,8 @@ class ModelAdapter(Adapter):
                 else {}
             with c_output_dropped():  # an engine's banner and importer warnings (C)
                 self.engine = self.loader(source, **options)
+        if model.couplings:
+            self.engine.couple(model.couplings)  # (refused, in its words, where it cannot)
         self.tree: ModelTree = self.engine.tree
         self.inertia_rounded = self.tree.inertia_accuracy > 0.0
         self.canon, self._carriers = self._canonical(model)
@@ -107,7 +109,10 @@ class ModelAdapter(Adapter):
                 q_start.append(nq)
                 v_start.append(nv)
                 nq, nv = nq + NQ[kind], nv + NV[kind]
-            carriers.append(next(j for j in self.tree.joints if j.name == names[-1]))
+            mine = [self.tree.joint(n) for n in names[len(names) - len(body.joints):]]
+            parents = {j.parent for j in mine}
+            # the body's last joint as the engine chains them (Newton's D6: a hinge)
+            carriers.append(next(j for j in mine if j.name not in parents))
         canon = Canonical(names=tuple(names), types=tuple(types), q_start=tuple(q_start),
                           v_start=tuple(v_start), nq=nq, nv=nv, zeros=(0.0,) * len(names))
         return canon, carriers
@@ -211,16 +216,23 @@ class ModelAdapter(Adapter):
         d = replace(d, inverse=d.inverse - pushed)
         unavailable = dict(d.unavailable)
         self._unavailable = {QUANTITY_OF[field]: why for field, why in unavailable.items()}
-        if "bias" in unavailable:  # its own forward dynamics at τ, mapped: v̇_e = T v̇ + Ṫ v
-            t = np.array([m.t for m in maps])
+        constraint = None
+        if "bias" in unavailable or self.spec.couplings:  # its own forward dynamics at τ
+            t = np.array([m.t for m in maps])  # (mapped: v̇_e = T v̇ + Ṫ v)
             tdot_v = np.array([m.tdot_v for m in maps])
             tau_e = np.linalg.solve(np.swapaxes(t, 1, 2), tau[..., None])[..., 0]
             forward = np.linalg.solve(t, (self.engine.forward(qe, ve, tau_e)
                                           - tdot_v)[..., None])[..., 0]
+            if self.spec.couplings:  # its constraints' multipliers in that same step
+                constraint = self.engine.constraint_forces(qe, ve, tau_e)
         else:
             forward = np.linalg.solve(d.mass_matrix, (tau - d.bias)[..., None])[..., 0]
         return self._outputs(d.mass_matrix, d.bias, forward, d.inverse, d.kinetic,
-                             d.potential)
+                             d.potential, constraint)
+
+    def constraint_force(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """The couplings' multipliers as the engine's constraints give them."""
+        return self.evaluate_all(q, v, tau, np.zeros_like(v))[Quantity.CONSTRAINT_FORCE]
 
     def _pushed(self, maps: list[Any], qe: np.ndarray, ve: np.ndarray) -> np.ndarray:
         """The case's external field's generalized force in the canonical layout (τ_c =

@@ -37,6 +37,8 @@ declared on the tree so that the check predicts the difference it makes.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import pybullet as pb
 
@@ -54,6 +56,7 @@ from dyncheck.adapters.model_tree import (
     lump,
 )
 from dyncheck.adapters.pybullet_base import base_state, place_base, world_linear
+from dyncheck.adapters.pybullet_couplings import Gear, gears, multipliers
 from dyncheck.adapters.pybullet_files import (
     ACCURACY_HINT,
     ARMATURE_HINT,
@@ -71,6 +74,8 @@ from dyncheck.adapters.pybullet_files import (
     zeroed,
 )
 from dyncheck.adapters.pybullet_forces import apply_field, field_force, named_links
+from dyncheck.adapters.pybullet_state import KINDS, REST, PybulletState
+from dyncheck.cases.multibody import Coupling
 from dyncheck.errors import Unsupported
 
 ENGINE = "pybullet"
@@ -79,14 +84,8 @@ MJCF_EPS = float(np.finfo(np.float32).eps)
 ``pos`` 1 with a child at −0.6 stands at 1 − float32(0.6), a capsule's centre at
 float32(0.7)): its readings of an MJCF, and the dynamics it computes from them, carry ε₃₂."""
 GRAVITY = np.array([0.0, 0.0, -9.81])
-_TYPES = {pb.JOINT_REVOLUTE: JointType.HINGE, pb.JOINT_PRISMATIC: JointType.SLIDE,
-          pb.JOINT_SPHERICAL: JointType.BALL}
 _NAMES = {pb.JOINT_PLANAR: "planar", pb.JOINT_POINT2POINT: "point2point",
           pb.JOINT_GEAR: "gear"}
-_ZERO = {pb.JOINT_REVOLUTE: (0.0,), pb.JOINT_PRISMATIC: (0.0,),
-         pb.JOINT_SPHERICAL: (0.0, 0.0, 0.0, 1.0)}
-"""A joint's coordinates at the reference configuration (a spherical joint's quaternion
-x-y-z-w: the identity)."""
 STEP = 1e-3
 """The time step of the one ``stepSimulation`` whose velocity change gives PyBullet's
 forward dynamics on a multibody with a spherical joint, v̇ = (v₊ − v)/h: its semi-implicit
@@ -96,11 +95,11 @@ NO_INVERSE = (
     "(its Python API raises SystemError: it passes no multi-DoF joint to its inverse "
     "dynamics, as its maintainers state in bullet3 PR #1381)"
 )
-class PybulletModel(ModelEngine):
+class PybulletModel(PybulletState, ModelEngine):
     """A PyBullet client holding the file's multibodies, and their neutral tree."""
 
     engine = ENGINE
-    offers = frozenset({Offer.STEPPING, Offer.BODY_FORCES})
+    offers = frozenset({Offer.STEPPING, Offer.BODY_FORCES, Offer.COUPLINGS})
     no_actuation = ("pybullet holds no actuator model (no control law of a file's actuators "
                     "or transmissions): a script drives each joint with "
                     "setJointMotorControl2 (TORQUE_CONTROL applies the torque it is given; "
@@ -130,14 +129,15 @@ class PybulletModel(ModelEngine):
         self.tree = self._tree(links, notes, hints)
         self._balls = any(kind == pb.JOINT_SPHERICAL for joints in self._movable.values()
                           for _, kind in joints)
+        self._gears: list[Gear] = []
 
     def _moving_base(self, body: int) -> bool:
         """Whether PyBullet gave ``body`` a moving base: its mass matrix has 6 more rows than
         the body has joint coordinates."""
         kinds = [pb.getJointInfo(body, j, physicsClientId=self.client)[2]
                  for j in range(pb.getNumJoints(body, physicsClientId=self.client))]
-        q = [x for kind in kinds for x in _ZERO.get(kind, ())]
-        nv = sum(JointType(_TYPES[kind]).nv for kind in kinds if kind in _TYPES)
+        q = [x for kind in kinds for x in REST.get(kind, ())]
+        nv = sum(JointType(KINDS[kind]).nv for kind in kinds if kind in KINDS)
         mass = pb.calculateMassMatrix(body, q, physicsClientId=self.client)
         return len(mass) != nv
 
@@ -165,11 +165,11 @@ class PybulletModel(ModelEngine):
             ))
         for j in range(pb.getNumJoints(body, physicsClientId=c)):
             info = pb.getJointInfo(body, j, physicsClientId=c)
-            if info[2] not in _TYPES and info[2] != pb.JOINT_FIXED:
+            if info[2] not in KINDS and info[2] != pb.JOINT_FIXED:
                 raise Unsupported(f"pybullet joint type {_NAMES.get(info[2], info[2])} "
                                   f"({info[1].decode()!r}) is not checked")
             if info[2] == pb.JOINT_SPHERICAL:
-                pb.resetJointStateMultiDof(body, j, _ZERO[info[2]], [0.0] * 3,
+                pb.resetJointStateMultiDof(body, j, REST[info[2]], [0.0] * 3,
                                            physicsClientId=c)
             else:
                 pb.resetJointState(body, j, 0.0, 0.0, physicsClientId=c)
@@ -191,7 +191,7 @@ class PybulletModel(ModelEngine):
                 moments=np.array(dyn[2], float),
                 damping=float(info[6]), limits=(float(info[8]), float(info[9])),
             ))
-            if info[2] in _TYPES:
+            if info[2] in KINDS:
                 self._movable.setdefault(body, []).append((j, info[2]))
                 self._damping[(body, j)] = float(info[6])
         return out
@@ -214,7 +214,7 @@ class PybulletModel(ModelEngine):
                 carried.setdefault((owner.body, owner.index), []).append(link)
         joints, q_at, v_at = [], 0, 0
         for link in links:
-            if link.kind not in _TYPES and link.kind != FREE_BASE:
+            if link.kind not in KINDS and link.kind != FREE_BASE:
                 continue
             parts = carried[(link.body, link.index)]
             mass, com, inertia = lump([p.mass for p in parts], [p.com for p in parts],
@@ -244,7 +244,7 @@ class PybulletModel(ModelEngine):
                 q_at, v_at = q_at + 7, v_at + 6
                 continue
             lower, upper = link.limits
-            kind = _TYPES[link.kind]
+            kind = KINDS[link.kind]
             ball = kind is JointType.BALL
             joints.append(TreeJoint(
                 name=link.joint, type=kind, parent=parent.joint if parent else None,
@@ -320,58 +320,6 @@ class PybulletModel(ModelEngine):
                            potential=potential,
                            unavailable=(("bias", NO_INVERSE), ("inverse", NO_INVERSE)))
 
-    def _place(self, body: int, joints: list[float], velocities: list[float] | None = None,
-               ) -> None:
-        """The body's joints at coordinates ``joints`` (a spherical joint's quaternion
-        x-y-z-w), at rest or at ``velocities``."""
-        c, at, dof = self.client, 0, 0
-        for j, kind in self._movable.get(body, []):
-            nq, nv = len(_ZERO[kind]), JointType(_TYPES[kind]).nv
-            rate = [0.0] * nv if velocities is None else velocities[dof : dof + nv]
-            if kind == pb.JOINT_SPHERICAL:
-                pb.resetJointStateMultiDof(body, j, joints[at : at + nq], rate,
-                                           physicsClientId=c)
-            else:
-                pb.resetJointState(body, j, joints[at], rate[0], physicsClientId=c)
-            at, dof = at + nq, dof + nv
-
-    def _free_motion(self, body: int, *, keep_joint_damping: bool = False) -> None:
-        """Every motor of the body off and its links' damping 0 (its joints' too, unless
-        ``keep_joint_damping``: the file's): what is left of a step is its semi-implicit
-        Euler of its articulated-body forward dynamics."""
-        c = self.client
-        pb.changeDynamics(body, -1, linearDamping=0.0, angularDamping=0.0, physicsClientId=c)
-        for j, kind in self._movable.get(body, []):
-            if kind == pb.JOINT_SPHERICAL:
-                pb.setJointMotorControlMultiDof(body, j, pb.POSITION_CONTROL,
-                                                targetPosition=list(_ZERO[kind]),
-                                                positionGain=0.0, velocityGain=0.0,
-                                                force=[0.0] * 3, physicsClientId=c)
-            else:
-                pb.setJointMotorControl2(body, j, pb.VELOCITY_CONTROL, force=0.0,
-                                         physicsClientId=c)
-            damping = self._damping[(body, j)] if keep_joint_damping else 0.0
-            pb.changeDynamics(body, j, linearDamping=0.0, angularDamping=0.0,
-                              jointDamping=damping, physicsClientId=c)
-
-    def _positions(self, body: int) -> list[float]:
-        out: list[float] = []
-        for j, kind in self._movable.get(body, []):
-            if kind == pb.JOINT_SPHERICAL:
-                out += pb.getJointStateMultiDof(body, j, physicsClientId=self.client)[0]
-            else:
-                out.append(pb.getJointState(body, j, physicsClientId=self.client)[0])
-        return out
-
-    def _velocities(self, body: int) -> list[float]:
-        out: list[float] = []
-        for j, kind in self._movable.get(body, []):
-            if kind == pb.JOINT_SPHERICAL:
-                out += pb.getJointStateMultiDof(body, j, physicsClientId=self.client)[1]
-            else:
-                out.append(pb.getJointState(body, j, physicsClientId=self.client)[1])
-        return out
-
     def _stepped(self, body: int, q: list[float], v: list[float],
                  tau: list[float] | None = None) -> np.ndarray:
         """PyBullet's forward dynamics at τ (None: 0) of a fixed-base multibody, from one
@@ -387,7 +335,7 @@ class PybulletModel(ModelEngine):
         pb.setTimeStep(STEP, physicsClientId=c)
         self._place(body, q, v)
         for j, kind in self._movable.get(body, []):
-            nv = JointType(_TYPES[kind]).nv
+            nv = JointType(KINDS[kind]).nv
             applied = [0.0] * nv if tau is None else [float(x) for x in tau[dof : dof + nv]]
             if kind == pb.JOINT_SPHERICAL:
                 pb.setJointMotorControlMultiDof(body, j, pb.TORQUE_CONTROL, force=applied,
@@ -404,11 +352,25 @@ class PybulletModel(ModelEngine):
 
     def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """v̇ at τ: M⁻¹ (τ − h) from its calculateMassMatrix and calculateInverseDynamics; on
-        a multibody with a spherical joint, where the latter fails, from its steps
-        (:meth:`_stepped`)."""
-        if not self._balls:
+        a multibody with a spherical joint, where the latter fails, or with couplings (its
+        gear constraints act in its step), from its steps (:meth:`_stepped`)."""
+        if not self._balls and not self._gears:
             return super().forward(q, v, tau)
-        out = np.zeros_like(v)
+        return self._steps(q, v, tau)[0]
+
+    def couple(self, couplings: Sequence[Coupling]) -> None:
+        """The couplings as its gear constraints (:mod:`.pybullet_couplings`)."""
+        joints = {pb.getJointInfo(body, j, physicsClientId=self.client)[1].decode(): (body, j)
+                  for body in self.bodies for j, _ in self._movable.get(body, [])}
+        self._gears = gears(self.client, joints, couplings)
+
+    def constraint_forces(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """Its gears' multipliers in the step that gives :meth:`forward`."""
+        return self._steps(q, v, tau)[1]
+
+    def _steps(self, q: np.ndarray, v: np.ndarray,
+               tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        out, forces = np.zeros_like(v), np.zeros((len(q), len(self._gears)))
         for i in range(len(q)):
             q_at = v_at = 0
             for body in self.bodies:
@@ -418,14 +380,9 @@ class PybulletModel(ModelEngine):
                     [float(x) for x in v[i, v_at : v_at + nv]],
                     [float(x) for x in tau[i, v_at : v_at + nv]])
                 q_at, v_at = q_at + nq, v_at + nv
-        return out
-
-    def _size(self, body: int) -> tuple[int, int]:
-        """The body's nq and nv (its moving base's included)."""
-        movable = self._movable.get(body, [])
-        base_q, base_v = (7, 6) if self._floating[body] else (0, 0)
-        return (base_q + sum(len(_ZERO[k]) for _, k in movable),
-                base_v + sum(JointType(_TYPES[k]).nv for _, k in movable))
+                held = [k for k, g in enumerate(self._gears) if g.body == body]
+                forces[i, held] = multipliers(self.client, [self._gears[k] for k in held])
+        return out, forces
 
     def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
                  field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:

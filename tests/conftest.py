@@ -53,8 +53,8 @@ NO_COUPLINGS: tuple[str, ...] = ()
 PORTS = ("mjx", "mjx-f64", "mujoco-warp")
 """MuJoCo's ports: no passive-force callback, so no external field evaluated per stage."""
 FILE_LOADERS = tuple(n for n, r in adapters.REGISTRY.items() if r.run)
-"""Engines whose book cases go through their loader of a user's file (no couplings: refused
-with the reason)."""
+"""Engines whose book cases go through their loader of a user's file (couplings where the
+engine has constraints for them: PyBullet's gears, of two joints)."""
 LOADER_LIMITS: dict[str, tuple[tuple[str, ...], str]] = {}
 """A file loader's limit on the book's cases, and the word its refusal names it by."""
 FLOORED = ("mujoco", "pinocchio-mjcf", "drake", *PORTS, *FILE_LOADERS)
@@ -101,7 +101,11 @@ def unsupported_reason(case: str, engine: str) -> str | None:
     if case not in COUPLED_CASES and engine in COUPLINGS_ONLY_ENGINES:
         return "couplings"
     if engine in FILE_LOADERS and case in COUPLED_CASES:
-        return "couplings"
+        widest = max(len(c.coefs) for c in get_case(case).multibody().couplings)
+        if engine == "newton":  # (its Featherstone solver has no equality constraints)
+            return "no coupling between joints"
+        if widest > 2:  # (PyBullet's gear constraint couples two joints)
+            return "couples"
     cases, word = LOADER_LIMITS.get(engine, ((), ""))
     if case in cases:
         return word

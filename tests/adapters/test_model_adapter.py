@@ -10,7 +10,7 @@ import pytest
 
 from dyncheck.adapters import get_adapter
 from dyncheck.cases import get_case
-from dyncheck.errors import EngineNotInstalled
+from dyncheck.errors import EngineNotInstalled, Unsupported
 from dyncheck.implementations import general_method, make_implementation
 from dyncheck.variants import ENGINE_DEFECT, INERTIA_STORED, book_variant
 
@@ -36,7 +36,12 @@ def test_the_bodies_read_back_are_the_cases(case, engine):
             np.asarray(body.inertia, float)
         assert loaded.mass == body.mass
         assert np.abs(loaded.inertia - stated).max() <= 64 * adapter.eps * np.abs(stated).max()
-    assert np.array_equal(adapter.loaded_gravity(), np.asarray(spec.gravity, float))
+    # Newton's MJCF importer keeps its default gravity whatever <option gravity> says (the
+    # convention "MJCF gravity option not read", explained on kepler's rows)
+    if engine == "newton":  # (float32: its −9.81 rounded)
+        assert np.allclose(adapter.loaded_gravity(), [0.0, 0.0, -9.81], rtol=1e-7, atol=0)
+    else:
+        assert np.array_equal(adapter.loaded_gravity(), np.asarray(spec.gravity, float))
 
 
 def test_pybullets_held_tensor_is_its_variant_and_predicts_its_mass_matrix():
@@ -155,3 +160,26 @@ def test_an_external_field_enters_through_the_engine_s_own_means(engine):
     scale = np.abs(expected).max()
     assert np.abs(got - expected).max() <= 64 * np.finfo(cls.dtype).eps * scale
     assert np.abs(spec.central_force(mass, q[0])).max() > 1e3 * 64 * np.finfo(cls.dtype).eps
+
+
+def test_pybullet_holds_a_two_joint_coupling_as_its_gear_constraint():
+    """#63: the Atwood machine's cord (y1 + y2 = 0) as PyBullet's gear constraint: its own
+    step gives the closed forms — v̇1 = (m1 − m2) g/(m1 + m2), the cord's multiplier
+    f = −2 m1 m2 g/(m1 + m2) (M v̇ + h = τ + Cᵀ f, a taut cord's f is minus its tension) —
+    to round-off at rest and at speed; a cord of three joints is no gear, refused in
+    PyBullet's words."""
+    cls = _adapter_class("pybullet")
+    spec = get_case("atwood").multibody()
+    adapter = cls(spec)
+    m1, m2 = (b.mass for b in spec.bodies)
+    g = 9.81
+    q = np.array([[0.0, 0.0], [0.3, -0.3]])
+    v = np.array([[0.0, 0.0], [1.5, -1.5]])
+    tau = np.zeros_like(v)
+    out = adapter.evaluate_all(q, v, tau, np.zeros_like(v))
+    accel = (m1 - m2) * g / (m1 + m2)
+    np.testing.assert_allclose(out["forward_dynamics"], [[accel, -accel]] * 2, rtol=1e-12)
+    np.testing.assert_allclose(out["constraint_force"], [[-2 * m1 * m2 * g / (m1 + m2)]] * 2,
+                               rtol=1e-12)
+    with pytest.raises(Unsupported, match="couples 3"):
+        cls(get_case("compound_pulley").multibody())
