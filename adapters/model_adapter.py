@@ -290,6 +290,9 @@ class ModelAdapter(Adapter):
         if finite.all():
             return
         k = int(np.argmin(finite))
+        if k == 0:
+            raise FloatingPointError(f"{self.name}: the start state is not finite in its "
+                                     "arithmetic (beyond its largest number)")
         zero = np.zeros((1, self.tree.nv))
         mass = self.engine.dynamics(q_e[k - 1 : k], zero, zero).mass_matrix[0]
         eig = np.linalg.eigvalsh(mass)

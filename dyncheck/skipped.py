@@ -12,11 +12,14 @@ from dyncheck.vocabulary import Verdict
 
 def _engine(note: str, rows: list[Discrepancy]) -> str:
     """The engine whose limit ``note`` states: the one of the rows' sides the note begins
-    with (its own words: "newton: …", "pybullet does not compute it here: …"), else the
-    checked side."""
+    with (its own words: "newton: …", "pybullet does not compute it here: …") or names in
+    quotes, else the first checked side."""
     sides = {side for r in rows for side in (r.impl_a, r.impl_b) if side}
-    named = [s for s in sides if note.startswith((f"{s}:", f"{s} "))]
-    return max(named, key=len) if named else rows[0].impl_b
+    named = [s for s in sides if note.startswith((f"{s}:", f"{s} "))] or \
+        [s for s in sides if f"'{s}'" in note]  # ("implementation 'pinocchio' needs …")
+    if named:
+        return max(named, key=len)
+    return next((side for r in rows for side in (r.impl_b, r.impl_a) if side), "")
 
 
 def once_per_case(rows: list[Discrepancy]) -> list[Discrepancy]:

@@ -8,6 +8,7 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import pandas as pd
 import pytest
 from filelock import FileLock
 from hypothesis import settings
@@ -80,6 +81,24 @@ def quantity_limit(case: str, engine: str, quantity: str) -> str | None:
                                                                           "inverse_dynamics"):
         return NO_INVERSE
     return None
+
+
+def pair_rows(d: pd.DataFrame, *, case: str, quantity: str, impl_a: str, impl_b: str,
+              integrator: str | None = None) -> pd.DataFrame:
+    """The rows of one pair and quantity — or, where an engine's limit on the case made them
+    one skipped row (dyncheck/skipped.py: no partner, its quantities listed), that row."""
+    chosen = (d.case == case) & (d.quantity == quantity) & (d.impl_a == impl_a) & \
+        (d.impl_b == impl_b)
+    if integrator is not None:
+        chosen &= d.integrator == integrator
+    if chosen.any():
+        return d[chosen]
+    covers = d.quantity.astype(str).map(lambda listed: quantity in listed.split(", "))
+    merged = d[(d.case == case) & (d.verdict == "skipped") & (d.impl_a.fillna("") == "")
+               & d.impl_b.isin([impl_a, impl_b]) & covers]
+    if integrator is not None:
+        merged = merged[merged.integrator.fillna("").isin(["", integrator])]
+    return merged
 
 
 def supported(case: str, engine: str) -> bool:

@@ -44,3 +44,13 @@ def test_other_reasons_and_other_cases_stay_apart():
         ("free", "newton: a step budget")]
     assert all(r.impl_b == "newton" for r in out)
     assert all(math.isnan(r.dt) for r in out)
+
+
+def test_an_engine_named_in_quotes_is_the_row_s_engine():
+    """A missing engine's rows say "implementation 'pinocchio' needs 'pin'": the merged row
+    is pinocchio's, whichever side its rows had it on (a derivative row has no partner)."""
+    why = "implementation 'pinocchio' needs 'pin', which is not installed; pip install pin"
+    rows = [_skip("derivatives", "pinocchio", "", why), _skip("trajectory", "reference",
+                                                              "pinocchio", why)]
+    (merged,) = once_per_case(rows)
+    assert merged.impl_b == "pinocchio" and merged.quantity == "derivatives, trajectory"
