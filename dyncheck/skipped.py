@@ -16,7 +16,7 @@ def _engine(note: str, rows: list[Discrepancy]) -> str:
     quotes, else the first checked side."""
     sides = {side for r in rows for side in (r.impl_a, r.impl_b) if side}
     named = [s for s in sides if note.startswith((f"{s}:", f"{s} "))] or \
-        [s for s in sides if f"'{s}'" in note]  # ("implementation 'pinocchio' needs …")
+        [s for s in sides if f"'{s}'" in note]  # ("implementation 'NAME' needs …")
     if named:
         return max(named, key=len)
     return next((side for r in rows for side in (r.impl_b, r.impl_a) if side), "")
