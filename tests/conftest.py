@@ -56,6 +56,11 @@ PORTS = ("mjx", "mjx-f64", "mujoco-warp")
 FILE_LOADERS = tuple(n for n, r in adapters.REGISTRY.items() if r.run)
 """Engines whose book cases go through their loader of a user's file (couplings where the
 engine has constraints for them: PyBullet's gears, of two joints)."""
+MULTI_JOINT_CASES = sorted(
+    n for n in CASES if any(len(b.joints) > 1 for b in get_case(n).multibody().bodies)
+    and any(j.type != "slide" for j in get_case(n).multibody().joints))
+"""Cases with a body moved by several joints, hinges among them (Newton's MJCF importer
+fuses them into a D6 that applies the slides first: read as that chain, explained)."""
 LOADER_LIMITS: dict[str, tuple[tuple[str, ...], str]] = {}
 """A file loader's limit on the book's cases, and the word its refusal names it by."""
 FLOORED = ("mujoco", "pinocchio-mjcf", "drake", *PORTS, *FILE_LOADERS)
