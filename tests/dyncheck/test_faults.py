@@ -9,6 +9,7 @@ Faults that need a real run, a killed process or a crashing engine have their ow
 
 from __future__ import annotations
 
+import csv
 import dataclasses
 import errno
 import io
@@ -78,11 +79,22 @@ def _data_lines(text: str) -> list[str]:
     return [ln for ln in text.splitlines() if not ln.startswith("#")]
 
 
+def _rows(text: str) -> list[list[str]]:
+    """The CSV's rows, parsed (a merged skipped row's quantities are one quoted field)."""
+    return list(csv.reader(_data_lines(text)))
+
+
+def _written(rows: list[list[str]]) -> str:
+    out = io.StringIO()
+    csv.writer(out, lineterminator="\n").writerows(rows)
+    return out.getvalue()
+
+
 def _column(text: str, name: str, value: str) -> str:
-    lines = _data_lines(text)
-    k = lines[0].split(",").index(name)
-    rows = [",".join(value if i == k else f for i, f in enumerate(r.split(","))) for r in lines[1:]]
-    return "\n".join([lines[0], *rows]) + "\n"
+    rows = _rows(text)
+    k = rows[0].index(name)
+    return _written([rows[0], *([value if i == k else f for i, f in enumerate(r)]
+                                for r in rows[1:])])
 
 
 def _headed_half(text: str) -> str:
@@ -93,10 +105,9 @@ def _headed_half(text: str) -> str:
 
 
 def _drop_column(text: str, name: str) -> str:
-    lines = _data_lines(text)
-    k = lines[0].split(",").index(name)
-    return "\n".join(",".join(f for i, f in enumerate(r.split(",")) if i != k)
-                     for r in lines) + "\n"
+    rows = _rows(text)
+    k = rows[0].index(name)
+    return _written([[f for i, f in enumerate(r) if i != k] for r in rows])
 
 
 def _raise(exc: BaseException) -> Callable[..., object]:
