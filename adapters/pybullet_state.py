@@ -60,23 +60,22 @@ class PybulletState:
             pb.changeDynamics(body, j, linearDamping=0.0, angularDamping=0.0,
                               jointDamping=damping, physicsClientId=c)
 
-    def _positions(self, body: int) -> list[float]:
+    def _joint_states(self, body: int, which: int) -> list[float]:
+        """The body's joint coordinates (``which`` 0) or velocities (1), a spherical joint's
+        through its multi-DoF state."""
         out: list[float] = []
         for j, kind in self._movable.get(body, []):
             if kind == pb.JOINT_SPHERICAL:
-                out += pb.getJointStateMultiDof(body, j, physicsClientId=self.client)[0]
+                out += pb.getJointStateMultiDof(body, j, physicsClientId=self.client)[which]
             else:
-                out.append(pb.getJointState(body, j, physicsClientId=self.client)[0])
+                out.append(pb.getJointState(body, j, physicsClientId=self.client)[which])
         return out
 
+    def _positions(self, body: int) -> list[float]:
+        return self._joint_states(body, 0)
+
     def _velocities(self, body: int) -> list[float]:
-        out: list[float] = []
-        for j, kind in self._movable.get(body, []):
-            if kind == pb.JOINT_SPHERICAL:
-                out += pb.getJointStateMultiDof(body, j, physicsClientId=self.client)[1]
-            else:
-                out.append(pb.getJointState(body, j, physicsClientId=self.client)[1])
-        return out
+        return self._joint_states(body, 1)
 
     def _size(self, body: int) -> tuple[int, int]:
         """The body's nq and nv (its moving base's included)."""
