@@ -4,7 +4,8 @@ the engine's issue tracker (``dyncheck explain NAME --reproducer FILE``).
 Each script uses only its engine, numpy and the standard library, holds its model inline,
 prints the expected and the observed value and exits 1 while the defect stands (0 once an
 engine release fixes it). ``tests/dyncheck/explain/test_reproducers.py`` runs every one in
-an isolated interpreter (``python -I``) and checks its imports, so a release that fixes a
+a fresh virtual environment holding only its engine and numpy (with what they require) and
+checks its imports, so a release that fixes a
 defect is noticed when the engine is upgraded. The expected values come from the physics
 (a closed form, or the engine's own finite differences), never from another engine.
 """
