@@ -6,7 +6,8 @@ other library at the version of ``constraints.txt``, dyncheck itself installed f
 checkout without its dependency ranges (so that releases outside the stated range can be
 tried — that is how the range is proved). In each, ``dyncheck run`` on the engine's
 implementations (and the book's) writes a run folder, also cached (keyed by the release and
-dyncheck's commit). Consecutive releases are then compared with :mod:`dyncheck.diff`, and
+dyncheck's commit), and the engine's defects' reproducers run there (:mod:`dyncheck.reproduced`:
+the page names the release whose reproducer first passes, the one that fixed the defect). Consecutive releases are then compared with :mod:`dyncheck.diff`, and
 ``reports/versions.md`` says, per engine, what moved between which releases and by how much.
 
 ``--bisect ENGINE GOOD BAD``: the releases published between two (``pip index versions``) are
@@ -29,7 +30,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from dyncheck import diff
+from dyncheck import diff, reproduced
 from dyncheck.adapters import REGISTRY, Needs
 from dyncheck.errors import DyncheckError, InvalidInput, UnknownName
 from dyncheck.progress import Progress
@@ -201,6 +202,8 @@ def run_release(
     key = _code_key()
     out = cache_root() / "runs" / key / f"{eng.name}-{release}{subset}"
     if (out / "discrepancies.csv").exists() and not key.endswith("+dirty"):
+        if not (out / reproduced.FILE).exists():
+            reproduced.reproduce(environment(eng, release, log=log), eng.impls, out)
         return out
     python = environment(eng, release, log=log)
     impls = [x for i in ("reference", "book", *eng.impls) for x in ("--impl", i)]
@@ -215,6 +218,8 @@ def run_release(
     missing = _not_importable(out / "discrepancies.csv", eng.impls)
     if missing:
         raise ReleaseFailed(eng.name, release, f"the engine does not import there: {missing}")
+    log(f"running the reproducers of {eng.name}'s defects under {release}")
+    reproduced.reproduce(python, eng.impls, out)
     return out
 
 
@@ -254,6 +259,11 @@ class Step:
     also_changed: tuple[str, ...] = ()
     """Other libraries whose versions differ between the two environments (``name old ->
     new``; a release's :class:`Needs` can move one)."""
+    fixed: tuple[str, ...] = ()
+    """Engine defects (catalogue entries with a reproducer) that stand under ``old`` and are
+    fixed under ``new``: ``new`` is the release that fixed them."""
+    back: tuple[str, ...] = ()
+    """Engine defects fixed under ``old`` that stand again under ``new``."""
 
 
 def matrix(
@@ -277,9 +287,12 @@ def matrix(
             if progress is not None:
                 progress.done(f"{name} {release}")
         for (old, a, pa), (new, b, pb) in itertools.pairwise(runs):
+            was, now = reproduced.load(a), reproduced.load(b)
+            defects = {"fixed": reproduced.changed(was, now, to=reproduced.Outcome.FIXED),
+                       "back": reproduced.changed(was, now, to=reproduced.Outcome.STANDS)}
             if a is None or b is None:
                 steps.append(Step(engine=name, old=old, new=new, table=None,
-                                  problem=pa or pb))
+                                  problem=pa or pb, **defects))
                 continue
             ta, tb = diff.load(a, "RUN_A"), diff.load(b, "RUN_B")
             made_by = " and ".join(dict.fromkeys(
@@ -288,7 +301,7 @@ def matrix(
             also = tuple(c for c in diff.version_changes(ta.versions, tb.versions)
                          if c.split()[0].replace("_", " ") not in own)
             steps.append(Step(engine=name, old=old, new=new, table=diff.diff(ta, tb),
-                              made_by=made_by, also_changed=also))
+                              made_by=made_by, also_changed=also, **defects))
     return steps
 
 
@@ -318,7 +331,7 @@ def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None
                 + f" — {n.reason}." for n in needs]
             lines += [""]
         for s in (s for s in steps if s.engine == name):
-            lines += [f"### {s.old} → {s.new}", ""]
+            lines += [f"### {s.old} → {s.new}", "", *_defect_lines(s)]
             if s.table is None:
                 lines += [f"_not compared_: {s.problem}", ""]
                 continue
@@ -333,6 +346,19 @@ def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None
             grouped = _grouped(diff.moved(s.table))
             lines += [grouped.to_markdown(index=False) if len(grouped) else "_nothing moved_", ""]
     return "\n".join(lines)
+
+
+def _defect_lines(step: Step) -> list[str]:
+    """The engine defects a step fixed or brought back, each by its catalogue name (its
+    reproducer: ``dyncheck explain NAME --reproducer FILE``)."""
+    lines = []
+    for names, said, before, after in ((step.fixed, "Fixed", "fails", "passes"),
+                                       (step.back, "Back", "passes", "fails")):
+        if names:
+            lines += [f"**{said} in {step.new}**: " + ", ".join(f"`{n}`" for n in names)
+                      + f" (its reproducer {before} under {step.old} and {after} under "
+                      f"{step.new}).", ""]
+    return lines
 
 
 def _grouped(moved: pd.DataFrame) -> pd.DataFrame:

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from dyncheck import diff, versions
+from dyncheck import diff, reproduced, versions
 from dyncheck.adapters import REGISTRY
 from dyncheck.errors import InvalidInput, UnknownName
 from dyncheck.results import PROVENANCE, to_csv
@@ -186,3 +186,27 @@ def test_a_release_whose_engine_does_not_import_is_named_not_compared(tmp_path):
     rows.loc[1, "note"] = "eng: couplings are not held"
     rows.to_csv(path, index=False)
     assert versions._not_importable(path, ("eng",)) == ""
+
+
+def test_the_matrix_names_the_release_that_fixed_an_engine_defect(tmp_path, monkeypatch):
+    """Synthetic runs of MuJoCo's committed releases, each with its reproducers' outcomes: a
+    defect whose reproducer fails (exit 1) under the first two releases and passes under the
+    third is fixed in the third — the step into it says so, the others do not; one that
+    passes and then fails again is named back."""
+    releases = versions.ENGINES["mujoco"].releases
+    assert len(releases) >= 3
+    runs = {}
+    for i, r in enumerate(releases):
+        runs[r] = _run(tmp_path / r, 1e-16, r)
+        outcomes = {"some-defect": "stands" if i < 2 else "fixed",
+                    "other-defect": "fixed" if i < 2 else "stands"}
+        (runs[r] / reproduced.FILE).write_text(json.dumps(outcomes))
+    monkeypatch.setattr(versions, "run_release", lambda eng, r, **kw: runs[r])
+    steps = versions.matrix(["mujoco"], log=lambda m: None)
+    assert [s.fixed for s in steps] == [(), ("some-defect",), *[()] * (len(steps) - 2)]
+    assert [s.back for s in steps] == [(), ("other-defect",), *[()] * (len(steps) - 2)]
+    page = versions.page(steps)
+    assert (f"**Fixed in {releases[2]}**: `some-defect` (its reproducer fails under "
+            f"{releases[1]} and passes under {releases[2]})") in page
+    assert f"**Back in {releases[2]}**: `other-defect`" in page
+    assert page.count("**Fixed in") == 1

@@ -123,6 +123,7 @@ def test_a_reproducer_is_standalone_and_fails_while_its_defect_stands(name, tmp_
     done = subprocess.run([str(python), "-I", str(path)], capture_output=True, text=True,
                           cwd=tmp_path, timeout=600)
     assert done.returncode == 1, done.stdout + done.stderr  # the defect of the pinned release
+    assert "Traceback" not in done.stderr, done.stderr  # its own exit, not an exception's
     assert "expected" in done.stdout and "observed" in done.stdout
 
 
