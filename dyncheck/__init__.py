@@ -34,16 +34,17 @@ from dyncheck.vocabulary import Integrator, JointType, Quantity, Verdict
 
 if TYPE_CHECKING:
     from dyncheck.cases import get_case
-    from dyncheck.check.model_check import CheckResult, check_model
+    from dyncheck.check.model_check import check_model
+    from dyncheck.check.rows import CheckResult
     from dyncheck.results import Discrepancy
-    from dyncheck.run import RunResult
     from dyncheck.run import run as run_cases
+    from dyncheck.run_result import RunResult
 
 LAZY = {
     "check_model": ("dyncheck.check.model_check", "check_model"),
-    "CheckResult": ("dyncheck.check.model_check", "CheckResult"),
+    "CheckResult": ("dyncheck.check.rows", "CheckResult"),
     "run_cases": ("dyncheck.run", "run"),
-    "RunResult": ("dyncheck.run", "RunResult"),
+    "RunResult": ("dyncheck.run_result", "RunResult"),
     "get_case": ("dyncheck.cases", "get_case"),
     "Discrepancy": ("dyncheck.results", "Discrepancy"),
 }

@@ -15,7 +15,7 @@ Measured in one process, one run, medians of repeats (time.perf_counter):
 Peak memory of a sweep is measured in a fresh child process per size (its max RSS).
 
 With ``--jobs N`` or ``--dask ADDRESS`` the sweep is also run as a run cuts a large one: in
-slices of states (units of work, :func:`dyncheck.run.run`'s ``sweep_slice``) on this process
+slices of states (units of work, :func:`dyncheck.slices.sweep_slice`) on this process
 and on the workers, timed whole (the workers' start-up and their implementations' builds
 included, as a run pays them), its merged rows required to be the same CSV bytes in both.
 Timings are not test assertions; they go to ``benchmark.csv`` and ``benchmark.md``.
@@ -230,7 +230,7 @@ def sliced_sweep(
     from dyncheck.comparison import Sweep
     from dyncheck.comparison import rows as rows_of
     from dyncheck.results import DISCREPANCY_KEY, Discrepancy, table
-    from dyncheck.run import STATES_PER_UNIT, sweep_slice
+    from dyncheck.slices import STATES_PER_UNIT, sweep_slice
     from dyncheck.workers import LOCAL, run_units
 
     per_unit = min(STATES_PER_UNIT, -(-states // (2 * max(jobs, 1))))

@@ -10,10 +10,8 @@ from __future__ import annotations
 
 import dataclasses
 import importlib.metadata
-from collections.abc import Callable, Collection
+from collections.abc import Callable, Collection, Sequence
 from functools import partial
-
-import numpy as np
 
 from dyncheck.errors import EngineNotInstalled, UnknownName
 from dyncheck.explain.actuators import drake_autodiff_pd_gains, drake_mjcf_actuators
@@ -40,7 +38,7 @@ from dyncheck.explain.engine_defaults import (
     passive_damping,
     point_mass_floor,
 )
-from dyncheck.explain.entry import Entry
+from dyncheck.explain.entry import TUTORIALS, Entry, render
 from dyncheck.explain.integrators import drake_fsal_caching, group_rk4, port_integrators
 from dyncheck.explain.moving import (
     newton_free_velocity,
@@ -55,6 +53,7 @@ from dyncheck.explain.parsers import (
 )
 from dyncheck.explain.spherical import pybullet_spherical_inertia
 from dyncheck.explanations import Origin
+from dyncheck.workers import Unit, run_units
 
 __all__ = ["DEMOS", "REQUIRES", "TUTORIALS", "Entry", "explain", "explain_cached", "not_selected",
            "render"]
@@ -96,23 +95,6 @@ DEMOS: dict[str, tuple[Callable[[], Entry], Origin]] = {
 """Conventions demonstrated by a run of their own, with whose property each is; the others
 (point-mass inertia floor, MJCF gravity, held forces, soft constraints: :mod:`.explanations`)
 are measured by ``dyncheck run`` and explained in its report."""
-
-
-TUTORIALS: dict[str, str] = {
-    "quaternion-storage-order": "01_quaternion_order",
-    "free-body-velocity-frames": "02_free_joint_velocity_frames",
-    "relative-vs-absolute-angles": "03_absolute_vs_relative_angles",
-    "soft-vs-exact-constraints": "05_soft_constraints",
-    "pinocchio-mjcf-options": "06_what_parsers_read",
-    "drake-mjcf-options": "06_what_parsers_read",
-    "rk4-on-the-rotation-group": "07_integrators_on_rotations",
-    "derivative-chart": "09_derivatives_in_charts",
-    "pybullet-inertia-source": "10_moving_to_pybullet",
-    "pybullet-default-motors": "10_moving_to_pybullet",
-    "newton-several-joints-on-a-body": "11_moving_to_newton",
-    "drake-mjcf-actuators": "12_the_same_action",
-}
-"""The executed tutorial (``reports/tutorials/NAME.md``) that teaches an entry step by step."""
 
 
 REQUIRES: dict[str, tuple[str, ...]] = {
@@ -238,38 +220,25 @@ def explain_cached(
     an engine built for accelerators (Newton compiles its kernels for ~30 s on a CPU, MJX
     traces for ~8 s) say so instead, unless ``name`` asks for one of them."""
     from dyncheck.roster import ON_A_CPU
-    from dyncheck.workers import run_units
 
     selected = None if accelerators or name is not None else ON_A_CPU
     done = run_units([(n, _entry, (n, selected)) for n in _names(name)], jobs=jobs)
     return [entry for entry, _ in done], sum(found for _, found in done)
 
 
-def render(entries: list[Entry]) -> str:
-    lines = []
-    for e in entries:
-        if e.skipped:
-            lines += [f"## {e.name}", "", f"- Skipped: {e.skipped}.", ""]
-            continue
-        if e.failed:
-            lines += [f"## {e.name}", "", f"- **Failed**: {e.failed}", ""]
-            continue
-        lines += [
-            f"## {e.name}",
-            "",
-            e.what,
-            "",
-            f"- Whose property: {e.origin.value if e.origin else 'unknown'}",
-            f"- Where the engines stand: {e.engines}",
-            f"- Naive ({e.naive}): "
-            + (
-                f"{e.unit} {e.naive_error:.3g}"
-                if np.isfinite(e.naive_error)
-                else "fails outright (a quantity is singular)"
-            ),
-            f"- Correct mapping: {e.unit} {e.correct_error:.3g}",
-        ]
-        if e.name in TUTORIALS:
-            lines.append(f"- Tutorial: reports/tutorials/{TUTORIALS[e.name]}.md")
-        lines.append("")
-    return "\n".join(lines)
+def _convention(name: str, impl_names: Sequence[str]) -> tuple[list[Entry], dict[str, str]]:
+    """One demonstration of the conventions catalogue (a unit of work), with the versions of
+    the engines it uses; read back from the cache when measured before with the
+    same dyncheck, engines and machine (``--no-cache``: measured afresh); skipped when it needs
+    an optional engine the run leaves out (:func:`not_selected`)."""
+    skipped = not_selected(name, impl_names)
+    if skipped is not None:
+        return [skipped], {}
+    entry, used, _ = measured_entry(name)
+    return [entry], used
+
+
+def units(impl_names: Sequence[str]) -> list[Unit]:
+    """The catalogue's demonstrations as units of work of a run (``dyncheck run``'s
+    ``conventions``), one each, left out where they need an engine outside ``impl_names``."""
+    return [(f"conventions: {name}", _convention, (name, list(impl_names))) for name in DEMOS]

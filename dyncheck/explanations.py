@@ -11,20 +11,19 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 
-from dyncheck.check.derivative_pairs import DEFECT, READINGS
-from dyncheck.check.predicted import (
+from dyncheck.labels import (
     ARMATURE_AXES,
     BASE_GRAVITY,
-    COMPUTED_INERTIA,
-    ROTOR_ENERGY,
-)
-from dyncheck.check.readings import READING
-from dyncheck.studies import (
     CHARTS_DIFFER,
+    COMPUTED_INERTIA,
+    DEFECT,
     GYROSCOPIC_IMPLICIT,
     HELD_FORCE,
     NAIVE_GROUP_RK4,
     PRE_ASYMPTOTIC,
+    READING,
+    READINGS,
+    ROTOR_ENERGY,
     TRUNCATION,
 )
 from dyncheck.variants import (

@@ -3,23 +3,19 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 from functools import partial, reduce
 
 import pandas as pd
 
 from dyncheck.adapters import ACCELERATORS
 from dyncheck.cases import Case, get_case
-from dyncheck.catalogue import DEMOS, Entry, measured_entry, not_selected
 from dyncheck.closed_forms import closed_form_rows
 from dyncheck.comparison import Sweep, sweep
 from dyncheck.comparison import rows as rows_of
 from dyncheck.errors import UnknownName
+from dyncheck.explain.entry import Entry
 from dyncheck.implementations import (
     IMPLEMENTATIONS,
-    Implementation,
-    implementations_for,
-    make_implementation,
 )
 from dyncheck.progress import Progress
 from dyncheck.provenance import engine_versions
@@ -31,38 +27,12 @@ from dyncheck.results import (
     table,
 )
 from dyncheck.roster import ON_A_CPU
+from dyncheck.run_result import RunResult
 from dyncheck.skipped import once_per_case
+from dyncheck.slices import STATES_PER_UNIT, built, sweep_slice
 from dyncheck.studies import TrajectoryFigures, study
 from dyncheck.studies.derivatives import derivative_rows
-from dyncheck.vocabulary import Verdict
 from dyncheck.workers import Unit, run_units
-
-
-@dataclass
-class RunResult:
-    cases: list[Case]
-    discrepancies: pd.DataFrame
-    convergence: pd.DataFrame
-    figures: dict[str, TrajectoryFigures]
-    parser_notes: dict[str, list[str]]
-    """Per implementation, what its MJCF parser said it ignores (its own warnings)."""
-    conventions: list[Entry] | None = None
-    """The conventions catalogue's demonstrations, run with the cases (its report page), or
-    None where the run did not include them."""
-    pngs: dict[str, dict[str, bytes]] = field(default_factory=dict)
-    """Per case, its figures (kind → PNG) where the run rendered them in its units of work."""
-    engines: dict[str, str] = field(default_factory=dict)
-    """The versions of the engines the units of work used (provenance name → version,
-    :func:`dyncheck.provenance.engine_versions`)."""
-    ran: tuple[str, ...] = IMPLEMENTATIONS
-    """The implementations the run was asked for (the others have no rows: one line says
-    which, :func:`dyncheck.roster.not_run`)."""
-
-    @property
-    def failed(self) -> bool:
-        """A row failed, or a conventions demonstration raised."""
-        lost = any(e.failed for e in self.conventions or ())
-        return lost or bool((self.discrepancies["verdict"] == Verdict.FAILED).any())
 
 
 def resolve(
@@ -82,55 +52,6 @@ def resolve(
     return cases, impls
 
 
-STATES_PER_UNIT = 1 << 17
-"""A case sweeping more states than this cuts its instantaneous comparison into slices of this
-many states, each a unit of work (on another worker, its memory flat: it streams its slice in
-chunks); the slices' sweeps merge in order into the same rows as one pass."""
-
-_BUILT: dict[tuple[str, tuple[str, ...]], dict[str, Implementation | Exception]] = {}
-"""Implementations built in this process, by case and names: a worker that sweeps several
-slices of a case loads its engines once."""
-
-
-def _release() -> None:
-    """Drop the implementations built in this process, and what their engines compiled."""
-    engines = {type(adapter) for built in _BUILT.values() for impl in built.values()
-               if not isinstance(impl, Exception) and (adapter := impl.adapter) is not None}
-    _BUILT.clear()
-    for engine in engines:
-        engine.release_compiled()
-
-
-def _implementations(
-    case: Case, impl_names: Sequence[str], notes: dict[str, set[str]] | None = None
-) -> dict[str, Implementation | Exception]:
-    """The case's implementations (an implementation that cannot be built is its exception,
-    reported as rows); ``notes`` collects what each MJCF parser said it ignores."""
-    key = (repr(case), tuple(impl_names))
-    if key not in _BUILT:
-        impls: dict[str, Implementation | Exception] = {}
-        for name in implementations_for(case, tuple(impl_names)):
-            try:
-                impls[name] = make_implementation(name, case)
-            except Exception as exc:  # reported as a row, the run goes on
-                impls[name] = exc
-        _release()  # one case's engines at a time
-        _BUILT[key] = impls
-    impls = _BUILT[key]
-    if notes is not None:
-        for name, impl in impls.items():
-            adapter = impl.adapter if isinstance(impl, Implementation) else None
-            if adapter is not None:
-                notes.setdefault(name, set()).update(adapter.parser_warnings)
-    return impls
-
-
-def sweep_slice(case: Case, impl_names: Sequence[str], n: int, start: int, stop: int) -> Sweep:
-    """The instantaneous comparison over states [start, stop) of ``n`` (a unit of work)."""
-    impls = _implementations(case, impl_names)
-    return sweep(case, impls, case.iter_states(n, start=start, stop=stop), offset=start)
-
-
 Render = Callable[[Case, TrajectoryFigures, pd.DataFrame], dict[str, bytes]]
 """Draws a case's figures from its study and its convergence table (kind → PNG)."""
 
@@ -144,7 +65,7 @@ def _run_case(
     ``render`` where given, and the versions of the engines it used; ``sliced``: the
     instantaneous comparison is left to :func:`sweep_slice` units."""
     notes: dict[str, set[str]] = {}
-    impls = _implementations(case, impl_names, notes)
+    impls = built(case, impl_names, notes)
     rows = [] if sliced else rows_of(sweep(case, impls, case.iter_states(states)))
     n = case.n_states if states is None else min(states, case.n_states)
     rows += derivative_rows(case, impl_names, n)  # at the case's own states (or fewer)
@@ -155,18 +76,6 @@ def _run_case(
     return rows + trajectory_rows + closed_form_rows(case), points, figures, notes, pngs, used
 
 
-def _convention(name: str, impl_names: Sequence[str]) -> tuple[list[Entry], dict[str, str]]:
-    """One demonstration of the conventions catalogue (a unit of work), with the versions of
-    the engines it uses; read back from the cache when measured before with the
-    same dyncheck, engines and machine (``--no-cache``: measured afresh); skipped when it needs
-    an optional engine the run leaves out (:func:`~dyncheck.catalogue.not_selected`)."""
-    skipped = not_selected(name, impl_names)
-    if skipped is not None:
-        return [skipped], {}
-    entry, used, _ = measured_entry(name)
-    return [entry], used
-
-
 def run(
     cases: Sequence[Case],
     impl_names: Sequence[str],
@@ -174,7 +83,7 @@ def run(
     states: int | None = None,
     jobs: int = 1,
     dask: str | None = None,
-    conventions: bool = False,
+    conventions: Sequence[Unit] | None = None,
     progress: Progress | None = None,
     states_per_unit: int = STATES_PER_UNIT,
     render: Render | None = None,
@@ -185,7 +94,10 @@ def run(
     :func:`dyncheck.workers.executor`); results do not depend on where they ran. An
     implementation that cannot be built (not installed, unsupported, raising) becomes skipped
     or failed rows, never an aborted run. ``render`` (the report's figures) draws each case's
-    figures in its unit of work, beside the other cases'."""
+    figures in its unit of work, beside the other cases'. ``conventions``: the catalogue's
+    demonstrations as units of work, composed by the command that wants them
+    (:func:`dyncheck.catalogue.units`; each gives its entries and the engine versions it
+    used), run beside the cases; None: the run leaves the catalogue out."""
     units: list[Unit] = []
     slices: dict[str, list[int]] = {}  # case → the indices of its slice units
     for case in cases:
@@ -200,9 +112,8 @@ def run(
                 slices[case.name].append(len(units))
                 units.append((f"{case.name} states {start}..{stop - 1}", sweep_slice,
                               (case, list(impl_names), n, start, stop)))
-    if conventions:
-        units += [(f"conventions: {name}", _convention, (name, list(impl_names)))
-                  for name in DEMOS]
+    first_convention = len(units)
+    units += conventions or ()
     done = run_units(units, jobs=jobs, dask=dask, progress=progress)
     rows: list[Discrepancy] = []
     points: list[ConvergencePoint] = []
@@ -211,8 +122,8 @@ def run(
     notes: dict[str, set[str]] = {}
     entries: list[Entry] = []
     engines: dict[str, str] = {}
-    for (what, fn, _args), out in zip(units, done, strict=True):
-        if fn is _convention:
+    for i, ((what, fn, _args), out) in enumerate(zip(units, done, strict=True)):
+        if i >= first_convention:
             entries += out[0]
             engines |= out[1]
         elif fn is not sweep_slice:  # a case; its slices' sweeps merged in order
@@ -233,7 +144,7 @@ def run(
         table(points, ConvergencePoint, CONVERGENCE_KEY),
         figures,
         {k: sorted(v) for k, v in notes.items() if v},
-        entries if conventions else None,
+        entries if conventions is not None else None,
         pngs,
         engines,
         tuple(impl_names),

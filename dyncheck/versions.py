@@ -7,7 +7,8 @@ checkout without its dependency ranges (so that releases outside the stated rang
 tried — that is how the range is proved). In each, ``dyncheck run`` on the engine's
 implementations (and the book's) writes a run folder, also cached (keyed by the release and
 dyncheck's commit), and the engine's defects' reproducers run there (:mod:`dyncheck.reproduced`:
-the page names the release whose reproducer first passes, the one that fixed the defect). Consecutive releases are then compared with :mod:`dyncheck.diff`, and
+the page names the release whose reproducer first passes, the one that fixed the defect).
+Consecutive releases are then compared with :mod:`dyncheck.diff`, and
 ``reports/versions.md`` says, per engine, what moved between which releases and by how much.
 
 ``--bisect ENGINE GOOD BAD``: the releases published between two (``pip index versions``) are

@@ -19,7 +19,7 @@ from dyncheck.cases import CASES, get_case
 from dyncheck.workers import exit_without_collecting
 
 if TYPE_CHECKING:
-    from dyncheck.run import RunResult
+    from dyncheck.run_result import RunResult
 
 exit_without_collecting()  # each test process (xdist's workers too): ~3 s with every engine loaded
 
@@ -166,7 +166,10 @@ def _full_run() -> RunResult:
     assert not adapters.MISSING, f"engines not installed: {adapters.MISSING}"
     # two worker processes: the same results as one (test_jobs_give_identical_results), in
     # about half the wall time on CI's two cores
-    return run([get_case(n) for n in CASE_NAMES], IMPLEMENTATIONS, jobs=2, conventions=True)
+    from dyncheck import catalogue
+
+    return run([get_case(n) for n in CASE_NAMES], IMPLEMENTATIONS, jobs=2,
+               conventions=catalogue.units(IMPLEMENTATIONS))
 
 
 @pytest.fixture

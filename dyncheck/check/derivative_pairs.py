@@ -17,6 +17,7 @@ from dyncheck.check.derivative_charts import FIELDS
 from dyncheck.check.describe import depth
 from dyncheck.check.dynamics import condition
 from dyncheck.check.rows import CheckRow, Section
+from dyncheck.labels import DEFECT, READINGS
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
 from dyncheck.results import Verdict
 
@@ -123,16 +124,13 @@ OWN_DIFFERENCES = ("{engine}'s analytic derivative is beyond the bound ({raw}); 
                    "finite differences agree: {defect}")
 """The note of a derivative row explained by an engine's declared defect
 (:attr:`Derivatives.defect`): its own finite differences within the bound."""
-DEFECT = "engine's analytic derivatives unlike its own finite differences"
-"""The label of such a row (an engine defect, measured on the row)."""
-READINGS = "engines' readings differ (derivatives)"
-"""The label of a derivative row explained by two readings of the model
-(:func:`across_readings`)."""
+
 
 
 def label(row: CheckRow) -> str:
     """The label of an explained derivative row, from the known cause its note states: a
-    declared defect (:data:`DEFECT`) or two readings (:data:`READINGS`); empty otherwise."""
+    declared defect (:data:`~dyncheck.labels.DEFECT`) or two readings
+    (:data:`~dyncheck.labels.READINGS`); empty otherwise."""
     if row.verdict is not Verdict.EXPLAINED:
         return ""
     causes = {"its own finite differences agree": DEFECT,

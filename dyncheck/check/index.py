@@ -12,8 +12,8 @@ from pathlib import Path
 import pandas as pd
 
 from dyncheck.adapters.model_files import ROOT_TAG, Format
-from dyncheck.check.model_check import CheckResult
 from dyncheck.check.page import counts
+from dyncheck.check.rows import CheckResult
 from dyncheck.check.verdicts import Agreement, EngineVerdict, Reading, per_engine
 from dyncheck.errors import InvalidInput
 from dyncheck.escaping import markdown, markdown_link, markdown_table, shown

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -41,7 +41,7 @@ from dyncheck.check.dynamics import (
 )
 from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
 from dyncheck.check.referee import ReferenceModel, standing_of
-from dyncheck.check.rows import COLUMNS, CheckRow, Section
+from dyncheck.check.rows import COLUMNS, CheckResult, CheckRow, Section
 from dyncheck.errors import InvalidInput, UnknownName
 from dyncheck.escaping import shown
 from dyncheck.results import Verdict
@@ -71,32 +71,6 @@ IN_PROCESS_NOTE = (
     "worker's default) cannot start processes, so an engine crashing on this file would take "
     "the worker with it (start the workers with distributed.worker.daemon set to False)."
 )
-
-
-@dataclass(frozen=True, kw_only=True)
-class CheckResult:
-    """The rows of one model's check (a DataFrame, :data:`~dyncheck.check.rows.COLUMNS`)."""
-
-    model: str
-    path: Path
-    rows: pd.DataFrame
-    notes: tuple[str, ...]
-    seconds: dict[str, float] = field(default_factory=dict)
-    states: int = 0
-    impls: tuple[str, ...] = ()
-    """The implementations asked for (their versions are the page's provenance)."""
-
-    @property
-    def ok(self) -> bool:
-        return not (self.rows["verdict"] == Verdict.FAILED).any()
-
-    def failures(self) -> str:
-        failed = self.rows[self.rows["verdict"] == Verdict.FAILED]
-        return "\n".join(
-            f"{r.section} {r.subject} {r.field} {r.impl_a}/{r.impl_b}: {r.value_a} vs "
-            f"{r.value_b} (error {r.error:.3g}) {r.note}"
-            for r in failed.itertuples()
-        )
 
 
 def implementations(impls: tuple[str, ...] | None) -> tuple[str, ...]:

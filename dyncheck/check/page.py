@@ -9,8 +9,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from dyncheck.check.model_check import CheckResult
-from dyncheck.check.rows import Section
+from dyncheck.check.rows import CheckResult, Section
 from dyncheck.check.verdicts import per_engine
 from dyncheck.escaping import markdown, markdown_code, markdown_table
 from dyncheck.results import PROVENANCE, Verdict, provenance_json, to_csv, write_together

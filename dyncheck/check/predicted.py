@@ -21,21 +21,10 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.check.computed import canonical_armature, computed_inertia_effect
 from dyncheck.check.dynamics import Prediction, States, values
-from dyncheck.check.readings import READING
 from dyncheck.check.referee import ReferenceModel
+from dyncheck.labels import ARMATURE_AXES, BASE_GRAVITY, COMPUTED_INERTIA, READING, ROTOR_ENERGY
 from dyncheck.vocabulary import Quantity
 
-ROTOR_ENERGY = "rotor energy left out of the kinetic energy"
-"""An engine holds a joint's armature in M but leaves its rotor energy ½ a v² out of T."""
-BASE_GRAVITY = "floating base's gravity resolved through reversed roll-pitch-yaw"
-"""PyBullet 3.2.7 resolves gravity in a floating base's frame through Rx(r) Ry(p) Rz(y)."""
-ARMATURE_AXES = "armature added in the engine's own velocity coordinates"
-"""An engine adds a joint's armature A to its own equations, A v̇_e, with v_e = T v in axes
-that turn with the body (Pinocchio's free flyer: the linear velocity in body axes)."""
-COMPUTED_INERTIA = "inertia computed with otherwise than held (a measured engine defect)"
-"""An engine's dynamics take a body's inertia otherwise than the tensor it holds (PyBullet's
-spherical joint: the link's principal moments in the link's axes, its inertial frame's
-rotation dropped): :attr:`~dyncheck.adapters.model_tree.TreeJoint.computed_inertia`."""
 PREDICTIONS = (ROTOR_ENERGY, BASE_GRAVITY, ARMATURE_AXES, READING, COMPUTED_INERTIA)
 """Every label a check's prediction carries (each registered in ``EXPLANATIONS``)."""
 

@@ -23,10 +23,8 @@ from dyncheck.check.computed import bodies, canonical_armature, in_layout, paren
 from dyncheck.check.describe import placement
 from dyncheck.check.dynamics import QUANTITIES, Prediction, States, values
 from dyncheck.check.referee import TIE_STATES, ReferenceModel
+from dyncheck.labels import READING
 from dyncheck.reference.recursive import RecursiveDynamics
-
-READING = "engines read the model differently (measured by the referee on each reading)"
-"""The label of a pair's difference that the referee on each engine's reading accounts for."""
 
 SUBSTITUTED = ("axis", "anchor", "mass", "com", "inertia", "armature")
 """The joint fields a substitution moves one at a time (with ``gravity`` and ``placement``)."""

@@ -1,9 +1,13 @@
-"""The rows of a model check, one record type for every section."""
+"""The rows of a model check, one record type for every section, and the check's result
+(:class:`CheckResult`: its rows as a table, read by its page and the index)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import StrEnum
+from pathlib import Path
+
+import pandas as pd
 
 from dyncheck.results import Verdict
 
@@ -49,3 +53,29 @@ COLUMNS = [
     "model", "section", "subject", "field", "impl_a", "impl_b", "value_a", "value_b", "error",
     "tolerance", "basis", "verdict", "note", "worst_state",
 ]
+
+
+@dataclass(frozen=True, kw_only=True)
+class CheckResult:
+    """The rows of one model's check (a DataFrame, :data:`~dyncheck.check.rows.COLUMNS`)."""
+
+    model: str
+    path: Path
+    rows: pd.DataFrame
+    notes: tuple[str, ...]
+    seconds: dict[str, float] = field(default_factory=dict)
+    states: int = 0
+    impls: tuple[str, ...] = ()
+    """The implementations asked for (their versions are the page's provenance)."""
+
+    @property
+    def ok(self) -> bool:
+        return not (self.rows["verdict"] == Verdict.FAILED).any()
+
+    def failures(self) -> str:
+        failed = self.rows[self.rows["verdict"] == Verdict.FAILED]
+        return "\n".join(
+            f"{r.section} {r.subject} {r.field} {r.impl_a}/{r.impl_b}: {r.value_a} vs "
+            f"{r.value_b} (error {r.error:.3g}) {r.note}"
+            for r in failed.itertuples()
+        )

@@ -18,7 +18,7 @@ SHOWN = 20
 
 
 def report_command(args: argparse.Namespace) -> int:
-    from dyncheck import report, report_check
+    from dyncheck import catalogue, report, report_check
     from dyncheck.run import resolve, run
 
     positive("--jobs", args.jobs)
@@ -34,7 +34,8 @@ def report_command(args: argparse.Namespace) -> int:
         ran = report_check.ran_in(args.run_dir)
     else:
         cases, impls = resolve([], [], accelerators=args.accelerators)
-        result = run(cases, impls, jobs=args.jobs, dask=args.dask, conventions=True)
+        result = run(cases, impls, jobs=args.jobs, dask=args.dask,
+                     conventions=catalogue.units(impls))
         fresh, ran = report.rendered_text(result, args.out), list(result.ran)
     old, new, left_out = (committed, fresh, []) if ran is None else report_check.narrowed(
         committed, fresh, ran)

@@ -23,7 +23,7 @@ from dyncheck.vocabulary import Verdict
 
 
 def run_command(args: argparse.Namespace) -> int:
-    from dyncheck import baseline, report
+    from dyncheck import baseline, catalogue, report
     from dyncheck.report.figures import cached_figures as draw_figures
     from dyncheck.run import resolve, run
 
@@ -43,7 +43,8 @@ def run_command(args: argparse.Namespace) -> int:
 
     with Progress("run", quiet=args.quiet) as progress:
         result = run(cases, impls, states=args.states, jobs=args.jobs, dask=args.dask,
-                     conventions=not args.cases, progress=progress, render=draw_figures)
+                     conventions=None if args.cases else catalogue.units(impls),
+                     progress=progress, render=draw_figures)
     report.write(result, args.out)
     from dyncheck.ci_outputs import RUN, split
 

@@ -12,7 +12,8 @@ from dyncheck.adapters import get_adapter
 from dyncheck.adapters.model_tree import Orientation
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import LinearMap
-from dyncheck.explain.entry import Entry, map_demo, pin_mjcf, worst
+from dyncheck.explain.entry import Entry
+from dyncheck.explain.measure import map_demo, pin_mjcf, worst
 
 
 def relative_angles() -> Entry:

@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from dyncheck.cases import get_case
-from dyncheck.explain.entry import Entry, pin_mjcf
+from dyncheck.explain.entry import Entry
+from dyncheck.explain.measure import pin_mjcf
 
 
 def mujoco_defaults() -> Entry:

@@ -1,22 +1,14 @@
-"""A catalogue entry (:class:`Entry`) and the measurements the demonstrations share: the
-worst error of an engine against the reference under a coordinate map, and Pinocchio's MJCF
-loader."""
+"""A catalogue entry (:class:`Entry`), the tutorial that teaches it, and its text on the
+conventions page (``dyncheck explain`` prints the same). The measurements the demonstrations
+share are :mod:`.measure`'s."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
-from dyncheck.adapters.model_tree import StateLayout
-from dyncheck.cases import get_case
-from dyncheck.cases.coordinate_maps import LinearMap
-from dyncheck.comparison import compare_instantaneous
-from dyncheck.coordinates import NativeMap
 from dyncheck.explanations import Origin
-from dyncheck.implementations import EngineImplementation, make_implementation
-from dyncheck.vocabulary import Verdict
 
 
 @dataclass(frozen=True)
@@ -38,55 +30,48 @@ class Entry:
     """Whose property the convention is (set from :data:`DEMOS`)."""
 
 
-def worst(case_name: str, engine: str, cmap=None,
-          state_layout: StateLayout | None = None) -> float:
-    """Largest relative error of ``engine`` against the reference over the instantaneous
-    quantities, with the case's map replaced by ``cmap`` or the engine's storage conventions
-    by ``state_layout`` (the other kept)."""
-    case = get_case(case_name)
-    impl = make_implementation(engine, case)
-    if cmap is not None or state_layout is not None:
-        assert isinstance(impl, EngineImplementation)
-        impl.map = NativeMap.of(case, engine, cmap, state_layout)
-    impls = {"reference": make_implementation("reference", case), engine: impl}
-    rows = compare_instantaneous(case, impls, case.sample_states())
-    errors = [r.max_rel_err for r in rows if r.verdict != Verdict.EXPLAINED or cmap is not None]
-    if cmap is not None and any(r.verdict == Verdict.FAILED and np.isnan(r.max_rel_err)
-                                for r in rows):
-        return float("inf")  # the naive map made a quantity fail outright (singular, NaN)
-    return float(np.nanmax(errors))
+TUTORIALS: dict[str, str] = {
+    "quaternion-storage-order": "01_quaternion_order",
+    "free-body-velocity-frames": "02_free_joint_velocity_frames",
+    "relative-vs-absolute-angles": "03_absolute_vs_relative_angles",
+    "soft-vs-exact-constraints": "05_soft_constraints",
+    "pinocchio-mjcf-options": "06_what_parsers_read",
+    "drake-mjcf-options": "06_what_parsers_read",
+    "rk4-on-the-rotation-group": "07_integrators_on_rotations",
+    "derivative-chart": "09_derivatives_in_charts",
+    "pybullet-inertia-source": "10_moving_to_pybullet",
+    "pybullet-default-motors": "10_moving_to_pybullet",
+    "newton-several-joints-on-a-body": "11_moving_to_newton",
+    "drake-mjcf-actuators": "12_the_same_action",
+}
+"""The executed tutorial (``reports/tutorials/NAME.md``) that teaches an entry step by step."""
 
 
-def map_demo(
-    name: str, case: str, engine: str, naive: LinearMap, what: str, engines: str
-) -> Entry:
-    return Entry(
-        name, what, engines, naive.description, worst(case, engine, naive), worst(case, engine)
-    )
-
-
-def pin_mjcf(xml: str):
-    from dyncheck.adapters.pinocchio_ import load_mjcf
-
-    return load_mjcf(xml)
-
-
-def beside_mujoco(mjcf: str, other: Any, states: int) -> tuple[Any, Any, Any, Any]:
-    """An MJCF written here loaded by MuJoCo's and another engine's check loader (``other``,
-    a class of :mod:`dyncheck.adapters`), the canonical layout (MuJoCo's) and ``states``
-    sampled states: (mujoco, other, canonical, states)."""
-    import tempfile
-    from pathlib import Path
-
-    from dyncheck.adapters import layout
-    from dyncheck.adapters.model_files import read
-    from dyncheck.adapters.mujoco_model import MujocoModel
-    from dyncheck.check.dynamics import sample
-
-    with tempfile.TemporaryDirectory(prefix="dyncheck-explain-") as folder:
-        path = Path(folder) / "model.xml"
-        path.write_text(mjcf, encoding="utf-8")
-        source = read(path)
-        mine, theirs = MujocoModel(source), other(source)
-    canon = layout.canonical(mine.tree)
-    return mine, theirs, canon, sample(canon, mine.tree, states, 0)
+def render(entries: list[Entry]) -> str:
+    lines = []
+    for e in entries:
+        if e.skipped:
+            lines += [f"## {e.name}", "", f"- Skipped: {e.skipped}.", ""]
+            continue
+        if e.failed:
+            lines += [f"## {e.name}", "", f"- **Failed**: {e.failed}", ""]
+            continue
+        lines += [
+            f"## {e.name}",
+            "",
+            e.what,
+            "",
+            f"- Whose property: {e.origin.value if e.origin else 'unknown'}",
+            f"- Where the engines stand: {e.engines}",
+            f"- Naive ({e.naive}): "
+            + (
+                f"{e.unit} {e.naive_error:.3g}"
+                if np.isfinite(e.naive_error)
+                else "fails outright (a quantity is singular)"
+            ),
+            f"- Correct mapping: {e.unit} {e.correct_error:.3g}",
+        ]
+        if e.name in TUTORIALS:
+            lines.append(f"- Tutorial: reports/tutorials/{TUTORIALS[e.name]}.md")
+        lines.append("")
+    return "\n".join(lines)

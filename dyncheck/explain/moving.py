@@ -10,7 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from dyncheck.explain.entry import Entry, beside_mujoco
+from dyncheck.explain.entry import Entry
+from dyncheck.explain.measure import beside_mujoco
 from dyncheck.vocabulary import Quantity
 
 ARM = """<robot name="arm">

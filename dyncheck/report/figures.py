@@ -16,9 +16,7 @@ from dyncheck.cases import Case
 from dyncheck.measured_cache import reused
 from dyncheck.reference.derivations import value_bytes
 from dyncheck.results import to_csv
-from dyncheck.studies import (
-    TrajectoryFigures,
-)
+from dyncheck.studies.order import TrajectoryFigures
 from dyncheck.vocabulary import Integrator
 
 if TYPE_CHECKING:

@@ -15,7 +15,7 @@ from dyncheck.report.tables import (
 )
 from dyncheck.report_check import RAN, Moved, compare, narrowed, read_report
 from dyncheck.results import PROVENANCE, provenance_json, to_csv, write_together
-from dyncheck.run import RunResult
+from dyncheck.run_result import RunResult
 
 
 def render(

@@ -6,8 +6,9 @@ from __future__ import annotations
 import pandas as pd
 
 from dyncheck.cases import Case
-from dyncheck.catalogue import Entry
+from dyncheck.explain.entry import Entry
 from dyncheck.explanations import EXPLANATIONS
+from dyncheck.labels import TRUNCATION
 from dyncheck.provenance import versions
 from dyncheck.report.tables import (
     conservation_matrix,
@@ -21,12 +22,8 @@ from dyncheck.report.tables import (
 )
 from dyncheck.results import MEANINGS
 from dyncheck.roster import not_run
-from dyncheck.run import RunResult
-from dyncheck.studies import (
-    CONTROLLED,
-    CONTROLLED_ACCURACIES,
-    TRUNCATION,
-)
+from dyncheck.run_result import RunResult
+from dyncheck.studies.controlled import CONTROLLED, CONTROLLED_ACCURACIES
 from dyncheck.tolerances import BASES, ORDER_SLACK
 from dyncheck.vocabulary import Quantity, Verdict
 
@@ -339,7 +336,7 @@ def index_page(result: RunResult, *, date: str) -> str:
 def conventions_page(entries: list[Entry] | None) -> str:
     """The catalogue's demonstrations the run made (``dyncheck explain`` prints the same), or
     a note where the run left them out (a run of selected cases)."""
-    from dyncheck.catalogue import render
+    from dyncheck.explain.entry import render
 
     head = [
         "# Conventions catalogue",

@@ -20,12 +20,11 @@ integrator's truncation error, reported with its size, not a failure.
 The study is split by what it measures: :mod:`.references` (the reference trajectories and
 the general method stepped like an engine), :mod:`.order` (observed orders, figure data),
 :mod:`.drift` (energy, momentum, cord drift), :mod:`.controlled` (error-controlled runs),
-:mod:`.pairs` (engine against engine), :mod:`.labels` (the findings' names) and
+:mod:`.pairs` (engine against engine) and
 :mod:`.study` (one case, all of them).
 """
 
-from dyncheck.studies.controlled import CONTROLLED, CONTROLLED_ACCURACIES
-from dyncheck.studies.labels import (
+from dyncheck.labels import (
     CHARTS_DIFFER,
     GYROSCOPIC_IMPLICIT,
     HELD_FORCE,
@@ -33,6 +32,7 @@ from dyncheck.studies.labels import (
     PRE_ASYMPTOTIC,
     TRUNCATION,
 )
+from dyncheck.studies.controlled import CONTROLLED, CONTROLLED_ACCURACIES
 from dyncheck.studies.order import TrajectoryFigures, finest_pair, observed_orders
 from dyncheck.studies.references import References, difference
 from dyncheck.studies.study import study

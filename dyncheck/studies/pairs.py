@@ -16,8 +16,8 @@ from dyncheck.cases.multibody import ROTATING
 from dyncheck.comparison import soft_factor
 from dyncheck.errors import DyncheckError, EngineNotInstalled, Unsupported
 from dyncheck.implementations import Implementation, compared
+from dyncheck.labels import CHARTS_DIFFER, GYROSCOPIC_IMPLICIT, NAIVE_GROUP_RK4
 from dyncheck.results import Discrepancy, Verdict
-from dyncheck.studies.labels import CHARTS_DIFFER, GYROSCOPIC_IMPLICIT, NAIVE_GROUP_RK4
 from dyncheck.studies.references import References, difference
 from dyncheck.tolerances import (
     EPS,

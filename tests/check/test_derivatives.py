@@ -236,7 +236,8 @@ def test_pinocchios_composite_joint_derivatives_are_its_measured_defect(tmp_path
     own finite differences agree — explained by the declared defect, never failed or
     skipped; every other pair passes (expected: the referee, and MuJoCo's finite
     differences, which see no composite joint)."""
-    from dyncheck.check.derivative_pairs import DEFECT, label
+    from dyncheck.check.derivative_pairs import label
+    from dyncheck.labels import DEFECT
 
     path = tmp_path / "walker.xml"
     path.write_text(COMPOSITE)

@@ -147,7 +147,7 @@ def test_programmatic_pinocchio_needs_no_explanation(full_run):
         & (d.integrator != "rk4-held-force")
         & ~d.case.isin(BALL_CASES)  # a point mass on a ball joint needs the inertia floor
     ]
-    from dyncheck.check.derivative_pairs import DEFECT
+    from dyncheck.labels import DEFECT
 
     # its derivatives of a composite joint: its own declared defect, measured on the row
     assert ((rows.verdict == "passed") | (rows.convention == DEFECT)).all()
@@ -289,7 +289,10 @@ def test_missing_engine_is_skipped_never_passed(monkeypatch, tmp_path, pretend_m
 
     pretend_missing("drake", "No module named 'pydrake'")
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path / "cache"))  # no entry measured with it
-    result = run([get_case("simple_pendulum")], ["reference", "drake"], conventions=True)
+    from dyncheck import catalogue
+
+    impls = ["reference", "drake"]
+    result = run([get_case("simple_pendulum")], impls, conventions=catalogue.units(impls))
     d = result.discrepancies
     rows = d[(d.impl_a == "drake") | (d.impl_b == "drake")]
     assert len(rows) > 0 and (rows.verdict == "skipped").all()

@@ -109,9 +109,10 @@ def test_a_second_run_reads_its_conventions_back_with_their_engines(counted, mon
     import dyncheck.run as run_module
     from dyncheck.cases import get_case
 
-    monkeypatch.setattr(run_module, "DEMOS", {NAME: catalogue.DEMOS[NAME]})
+    monkeypatch.setattr(catalogue, "DEMOS", {NAME: catalogue.DEMOS[NAME]})
     runs = [
-        run_module.run([get_case("simple_pendulum")], ["reference"], conventions=True)
+        run_module.run([get_case("simple_pendulum")], ["reference"],
+                       conventions=catalogue.units(["reference"]))
         for _ in range(2)
     ]
     assert len(counted) == 1

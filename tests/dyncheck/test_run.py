@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from dyncheck.cases import get_case
-from dyncheck.run import _implementations, _release
+from dyncheck.slices import _release, built
 
 IMPLS = ["reference", "mjx"]
 
@@ -16,7 +16,7 @@ def test_moving_to_the_next_case_frees_the_compiled_programs_of_the_last():
     """MJX's jitted functions keep one program per model: after cases A then B the cache must
     hold what B alone compiles (measured from an empty cache), not A's programs as well — a
     full run in one process otherwise ran out of memory maps and crashed. Each case's
-    implementations are built as a run builds them (:func:`_implementations`, which releases
+    implementations are built as a run builds them (:func:`~dyncheck.slices.built`, which releases
     the last case's) and compile both programs: a batch of states and a stepped run."""
     pytest.importorskip("mujoco.mjx", reason="the extra 'mjx' (pip install 'dyncheck[mjx]')")
     from dyncheck.adapters import mjx_
@@ -26,7 +26,7 @@ def test_moving_to_the_next_case_frees_the_compiled_programs_of_the_last():
 
     def use(name: str) -> None:
         case = get_case(name)
-        mjx = _implementations(case, IMPLS)["mjx"]
+        mjx = built(case, IMPLS)["mjx"]
         mjx.evaluate(case.sample_states(16))
         mjx.simulate(case.trajectory.steps["euler"][0], "euler")
 
@@ -69,10 +69,10 @@ def test_a_catalogue_entry_whose_engine_is_left_out_is_skipped_without_running(m
 
     demos = {"drake-fsal-caching": (never, catalogue.DEMOS["drake-fsal-caching"][1]),
              "hinge-axis-sign": catalogue.DEMOS["hinge-axis-sign"]}
-    monkeypatch.setattr(run_module, "DEMOS", demos)
     monkeypatch.setattr(catalogue, "DEMOS", demos)
-    result = run_module.run([get_case("simple_pendulum")], ["reference", "mujoco"],
-                            conventions=True)
+    impls = ["reference", "mujoco"]
+    result = run_module.run([get_case("simple_pendulum")], impls,
+                            conventions=catalogue.units(impls))
     drake, hinge = result.conventions
     assert drake.skipped == "not run: drake (left out by --impl)" and not drake.failed
     assert hinge == catalogue.explain("hinge-axis-sign")[0] and not hinge.skipped

@@ -134,12 +134,12 @@ def test_a_sweep_cut_into_slices_gives_the_same_csv_as_one_pass(dask):
 def test_conventions_catalogue_entries_are_units_of_work(jobs, monkeypatch):
     """The catalogue's entries run beside the cases (in a pool with jobs=2) and come back in
     the catalogue's order, equal to the entries run directly (NaN where one has no number)."""
-    import dyncheck.run as run_module
     from dyncheck import catalogue
 
     names = ("degrees-vs-radians", "hinge-axis-sign")
-    monkeypatch.setattr(run_module, "DEMOS", {n: catalogue.DEMOS[n] for n in names})
-    result = run([get_case("simple_pendulum")], ["reference"], jobs=jobs, conventions=True)
+    monkeypatch.setattr(catalogue, "DEMOS", {n: catalogue.DEMOS[n] for n in names})
+    result = run([get_case("simple_pendulum")], ["reference"], jobs=jobs,
+                 conventions=catalogue.units(["reference"]))
     direct = [entry for n in names for entry in catalogue.explain(n)]
     assert [e.name for e in result.conventions] == list(names)
     pd.testing.assert_frame_equal(pd.DataFrame(result.conventions), pd.DataFrame(direct))
