@@ -30,8 +30,9 @@ from dyncheck.roster import ON_A_CPU
 from dyncheck.run_result import RunResult
 from dyncheck.skipped import once_per_case
 from dyncheck.slices import STATES_PER_UNIT, built, sweep_slice
-from dyncheck.studies import TrajectoryFigures, study
 from dyncheck.studies.derivatives import derivative_rows
+from dyncheck.studies.order import TrajectoryFigures
+from dyncheck.studies.study import study
 from dyncheck.workers import Unit, run_units
 
 

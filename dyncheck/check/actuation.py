@@ -20,13 +20,13 @@ from dyncheck.adapters.actuators import Activation, Actuator
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
-from dyncheck.check.describe import depth
-from dyncheck.check.dynamics import States, condition
+from dyncheck.check.computed import depth
 from dyncheck.check.engines import REFEREE
 from dyncheck.check.rows import COMPUTED, CheckRow, Section
+from dyncheck.check.states import States, condition
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.reference import actuation as law
-from dyncheck.results import Verdict
+from dyncheck.vocabulary import Verdict
 
 FORCE = "actuator force"
 FIELD_RTOL = 1e-9

@@ -158,3 +158,11 @@ def computing_effect(canon: Canonical, tree: ModelTree, *, q: np.ndarray, v: np.
         j if j.computed_inertia is None else replace(j, inertia=j.computed_inertia)
         for j in computes.joints))
     return general(canonical_reading(canon, written), q, v, a), general(computes, q, v, a)
+
+
+def depth(tree: ModelTree) -> int:
+    """The number of joints on the longest chain from the world."""
+    level: dict[str | None, int] = {None: 0}
+    for j in tree.joints:  # parents come first in every engine's order
+        level[j.name] = level.get(j.parent, 0) + 1
+    return max(level.values())

@@ -27,7 +27,7 @@ from dyncheck.adapters.model_tree import (
 )
 from dyncheck.adapters.model_tree import derivatives as collect
 from dyncheck.cases.coordinate_maps import quat_to_matrix
-from dyncheck.check.dynamics import States
+from dyncheck.check.states import States
 
 FIELDS = ("forward_q", "forward_v", "forward_tau", "inverse_q", "inverse_v")
 
@@ -193,3 +193,30 @@ def to_canonical(canon: Canonical, tree: ModelTree, states: States, found: Deriv
         out["forward_v"][s] = t_inv @ (found.forward_v[s] @ t - d_tdot_v)
         out["forward_tau"][s] = t_inv @ found.forward_tau[s] @ t_inv.T
     return collect(out, method=found.method, step=found.step)
+
+
+def skew(x: np.ndarray) -> np.ndarray:
+    """[x]×: the matrix of x × ·."""
+    return np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
+
+
+def right_jacobian(phi: np.ndarray) -> np.ndarray:
+    """SO(3)'s right Jacobian J_r(φ): exp(φ + δ) = exp(φ) exp(J_r(φ) δ) to first order."""
+    theta = float(np.linalg.norm(phi))
+    cross = skew(phi)
+    if theta < 1e-8:
+        return np.eye(3) - 0.5 * cross
+    return (np.eye(3) - (1 - np.cos(theta)) / theta**2 * cross
+            + (theta - np.sin(theta)) / theta**3 * cross @ cross)
+
+
+def rotations(canon: Canonical) -> list[tuple[int, int]]:
+    """(first velocity index, quaternion index) of every rotation: a ball joint's, a free
+    joint's angular part (canonical: w first, turned on the right, body-frame δ)."""
+    out = []
+    for kind, qs, vs in zip(canon.types, canon.q_start, canon.v_start, strict=True):
+        if kind is JointType.BALL:
+            out.append((vs, qs))
+        elif kind is JointType.FREE:
+            out.append((vs + 3, qs + 3))
+    return out

@@ -13,13 +13,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from dyncheck.adapters.model_tree import Derivatives, ModelTree
+from dyncheck.check.computed import depth
 from dyncheck.check.derivative_charts import FIELDS
-from dyncheck.check.describe import depth
-from dyncheck.check.dynamics import condition
 from dyncheck.check.rows import CheckRow, Section
+from dyncheck.check.states import condition
 from dyncheck.labels import DEFECT, READINGS
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
-from dyncheck.results import Verdict
+from dyncheck.vocabulary import Verdict
 
 if TYPE_CHECKING:
     from dyncheck.check.derivative_referee import Referee

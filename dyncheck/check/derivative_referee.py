@@ -18,10 +18,10 @@ import numpy as np
 
 from dyncheck.adapters.model_tree import Derivatives, ModelTree
 from dyncheck.adapters.model_tree import derivatives as collect
+from dyncheck.check.computed import depth
 from dyncheck.check.derivative_charts import perturb
-from dyncheck.check.describe import depth
-from dyncheck.check.dynamics import States
 from dyncheck.check.referee import TIE_STATES, ReferenceModel, Tie, tie
+from dyncheck.check.states import States
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, standing
 
 STEP = 4e-3

@@ -37,10 +37,10 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.check.derivative_charts import same_layout, to_canonical
 from dyncheck.check.derivative_pairs import across_readings, after_defects, compare
 from dyncheck.check.derivative_referee import Referee, first, referee, step_states
-from dyncheck.check.dynamics import States
 from dyncheck.check.rows import CheckRow, Section
+from dyncheck.check.states import States
 from dyncheck.check.steps import step_rows
-from dyncheck.results import Verdict
+from dyncheck.vocabulary import Verdict
 
 
 def _row(model: str, engine: str, verdict: Verdict, note: str) -> CheckRow:

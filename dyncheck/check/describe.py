@@ -20,18 +20,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from dyncheck.adapters.model_tree import JointType, ModelTree, TreeJoint
+from dyncheck.check.computed import depth
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
-from dyncheck.results import Verdict
-from dyncheck.vocabulary import Quantity
-
-
-def depth(tree: ModelTree) -> int:
-    """The number of joints on the longest chain from the world."""
-    level: dict[str | None, int] = {None: 0}
-    for j in tree.joints:  # parents come first in every engine's order
-        level[j.name] = level.get(j.parent, 0) + 1
-    return max(level.values())
+from dyncheck.vocabulary import Quantity, Verdict
 
 
 def size(tree: ModelTree) -> float:

@@ -26,21 +26,15 @@ import numpy as np
 
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import QUANTITY_OF, Dynamics, JointType, ModelTree
-from dyncheck.check.describe import depth, size
+from dyncheck.check.computed import depth
+from dyncheck.check.describe import size
 from dyncheck.check.rows import CheckRow, Section
+from dyncheck.check.states import States, condition
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
-from dyncheck.results import Verdict
-from dyncheck.vocabulary import Quantity
+from dyncheck.vocabulary import Quantity, Verdict
 
 QUANTITIES: dict[str, str] = {q: f for f, q in QUANTITY_OF.items()}
 """The quantity → the field of Dynamics holding it."""
-
-
-@dataclass(frozen=True)
-class States:
-    q: np.ndarray
-    v: np.ndarray
-    a: np.ndarray
 
 
 DEFAULT_INTERVAL = {JointType.HINGE: (-np.pi, np.pi), JointType.SLIDE: (-1.0, 1.0)}
@@ -135,19 +129,6 @@ def floors(tree: ModelTree, dyn: Dynamics, states: States) -> dict[str, tuple[fl
         Quantity.KINETIC_ENERGY: (energy, "max(T, m g L)"),
         Quantity.POTENTIAL_ENERGY: (energy, "max(T, m g L)"),
     }
-
-
-def condition(mass: np.ndarray) -> float:
-    """The largest condition number of M over the states (the symmetric M's eigenvalues:
-    a fifth of the SVD's cost; an indefinite M from a broken model still gives |λ|
-    max/min)."""
-    with np.errstate(all="ignore"):
-        symmetric = 0.5 * (mass + np.swapaxes(mass, -1, -2))
-        eig = np.abs(np.linalg.eigvalsh(symmetric))
-        if not np.all(np.isfinite(eig)):
-            return float(np.linalg.cond(mass).max())
-        ratio = eig.max(axis=-1) / eig.min(axis=-1)
-        return float(np.nan_to_num(ratio, nan=np.inf).max()) if eig.size else 1.0
 
 
 def values(dyn: Dynamics, quantity: str) -> np.ndarray:

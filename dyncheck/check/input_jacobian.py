@@ -19,13 +19,12 @@ import numpy as np
 from dyncheck.adapters.actuators import InputJacobian
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import ModelTree
-from dyncheck.check.describe import depth
+from dyncheck.check.computed import depth
+from dyncheck.check.derivative_charts import right_jacobian, rotations
 from dyncheck.check.rows import COMPUTED, CheckRow, Section
-from dyncheck.check.steps import right_jacobian, rotations
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.reference import actuation as law
-from dyncheck.results import Verdict
-from dyncheck.vocabulary import Integrator
+from dyncheck.vocabulary import Integrator, Verdict
 
 COMPLEX_STEP = 1e-30
 """The complex step in u: exact to round-off whatever its size (no subtraction)."""

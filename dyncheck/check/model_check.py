@@ -44,8 +44,7 @@ from dyncheck.check.referee import ReferenceModel, standing_of
 from dyncheck.check.rows import COLUMNS, CheckResult, CheckRow, Section
 from dyncheck.errors import InvalidInput, UnknownName
 from dyncheck.escaping import shown
-from dyncheck.results import Verdict
-from dyncheck.vocabulary import Quantity
+from dyncheck.vocabulary import Quantity, Verdict
 
 DERIVATIVES_NOTE = (
     "derivatives (the per-engine lines above include them): d(forward)/d(q, v, tau) at tau = 0 "

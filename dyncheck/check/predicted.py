@@ -20,8 +20,9 @@ from dyncheck.adapters.model_tree import (
 )
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.check.computed import canonical_armature, computed_inertia_effect
-from dyncheck.check.dynamics import Prediction, States, values
+from dyncheck.check.dynamics import Prediction, values
 from dyncheck.check.referee import ReferenceModel
+from dyncheck.check.states import States
 from dyncheck.labels import ARMATURE_AXES, BASE_GRAVITY, COMPUTED_INERTIA, READING, ROTOR_ENERGY
 from dyncheck.vocabulary import Quantity
 

@@ -25,8 +25,8 @@ from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, standing
 from dyncheck.reference.recursive import RecursiveDynamics
 from dyncheck.reference.tree import TreeDynamics
-from dyncheck.results import Verdict
 from dyncheck.roster import REFEREE
+from dyncheck.vocabulary import Verdict
 
 ENGINE = REFEREE
 TIE_STATES = 10
@@ -104,7 +104,7 @@ class ReferenceModel:
     engine = ENGINE
 
     def __init__(self, tree: ModelTree) -> None:
-        from dyncheck.check.describe import depth
+        from dyncheck.check.computed import depth
 
         self.tree = tree
         self.solver = in_layout(TreeDynamics(bodies(tree), tree.gravity), tree)

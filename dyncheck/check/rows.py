@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from dyncheck.results import Verdict
+from dyncheck.vocabulary import Verdict
 
 
 class Section(StrEnum):

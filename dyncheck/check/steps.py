@@ -14,24 +14,14 @@ from scipy.spatial.transform import Rotation
 from dyncheck.adapters.integrators import dexp_inv, quat_conj, quat_exp, quat_mul
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import JointType, ModelTree, Transition
+from dyncheck.check.computed import depth
+from dyncheck.check.derivative_charts import right_jacobian, rotations, skew
 from dyncheck.check.derivative_referee import Referee, referee
-from dyncheck.check.describe import depth
-from dyncheck.check.dynamics import States
 from dyncheck.check.rows import CheckRow, Section
+from dyncheck.check.states import States
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.reference.recursive import RecursiveDynamics
-from dyncheck.results import Verdict
-from dyncheck.vocabulary import Integrator
-
-
-def right_jacobian(phi: np.ndarray) -> np.ndarray:
-    """SO(3)'s right Jacobian J_r(φ): exp(φ + δ) = exp(φ) exp(J_r(φ) δ) to first order."""
-    theta = float(np.linalg.norm(phi))
-    cross = _skew(phi)
-    if theta < 1e-8:
-        return np.eye(3) - 0.5 * cross
-    return (np.eye(3) - (1 - np.cos(theta)) / theta**2 * cross
-            + (theta - np.sin(theta)) / theta**3 * cross @ cross)
+from dyncheck.vocabulary import Integrator, Verdict
 
 
 def euler_step(canon: Canonical, ref: Referee, states: States, h: float) -> np.ndarray:
@@ -66,18 +56,6 @@ def euler_step(canon: Canonical, ref: Referee, states: States, h: float) -> np.n
 RK4_STAGES = ((0.0, 1.0 / 6), (0.5, 1.0 / 3), (0.5, 1.0 / 3), (1.0, 1.0 / 6))
 """RK4's tableau as (cᵢ: the stage's offset along the previous stage's slope, bᵢ: its
 weight) — the classical method, as MuJoCo's ``mj_RungeKutta`` with N = 4."""
-
-
-def rotations(canon: Canonical) -> list[tuple[int, int]]:
-    """(first velocity index, quaternion index) of every rotation: a ball joint's, a free
-    joint's angular part (canonical: w first, turned on the right, body-frame δ)."""
-    out = []
-    for kind, qs, vs in zip(canon.types, canon.q_start, canon.v_start, strict=True):
-        if kind is JointType.BALL:
-            out.append((vs, qs))
-        elif kind is JointType.FREE:
-            out.append((vs + 3, qs + 3))
-    return out
 
 
 def _vectors(canon: Canonical) -> tuple[list[int], list[int]]:
@@ -125,19 +103,15 @@ def _dexp_inv_k(angle: float) -> tuple[float, float]:
     return float(k), float(dk)
 
 
-def _skew(x: np.ndarray) -> np.ndarray:
-    return np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
-
-
 def dexp_inv_matrices(theta: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """D = ∂(dexp⁻¹(θ) v)/∂v and E = ∂(dexp⁻¹(θ) v)/∂θ of one rotation, from
     dexp⁻¹(θ) v = v + ½ θ × v + k(|θ|) θ × (θ × v): D = 1 + ½ [θ]× + k [θ]×², E = −½ [v]× +
     k ((θ·v) 1 + θ vᵀ − 2 v θᵀ) + k′ (θ × (θ × v)) θᵀ/|θ|."""
     angle = float(np.linalg.norm(theta))
     k, dk = _dexp_inv_k(angle)
-    cross = _skew(theta)
+    cross = skew(theta)
     d = np.eye(3) + 0.5 * cross + k * cross @ cross
-    e = -0.5 * _skew(v) + k * (float(theta @ v) * np.eye(3) + np.outer(theta, v)
+    e = -0.5 * skew(v) + k * (float(theta @ v) * np.eye(3) + np.outer(theta, v)
                                - 2 * np.outer(v, theta))
     if angle > 0:
         e += dk * np.outer(np.cross(theta, np.cross(theta, v)), theta / angle)

@@ -13,8 +13,8 @@ from enum import StrEnum
 import pandas as pd
 
 from dyncheck.check.rows import COMPUTED, Section
-from dyncheck.results import Verdict
 from dyncheck.roster import REFEREE
+from dyncheck.vocabulary import Verdict
 
 
 class Reading(StrEnum):

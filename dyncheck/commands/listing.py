@@ -6,6 +6,7 @@ import argparse
 
 from dyncheck.commands.flags import Command
 from dyncheck.errors import EngineNotInstalled
+from dyncheck.studies.order import CONTROLLED
 
 
 def installed_version(package: str) -> str | None:
@@ -30,7 +31,7 @@ def engine_line(name: str) -> str:
     if adapter.adaptive:
         steps.append("dop853 (scipy, error-controlled)")
     if adapter.error_controlled:
-        steps.append("rk3-controlled (its own runge_kutta3, error-controlled)")
+        steps.append(f"{CONTROLLED} (its own runge_kutta3, error-controlled)")
     return f"{ENGINE_PACKAGES[name]} {adapter.version()}; integrators: {', '.join(steps)}"
 
 

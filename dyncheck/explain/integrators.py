@@ -50,7 +50,7 @@ the ~13 000-19 000 they take at 1e-10 (measured: 1.0 s instead of 3.7 s for the 
 def drake_fsal_caching() -> Entry:
     """Drake's error-controlled integrators on the compound pendulum's MultibodyPlant with the
     context's cache on (Drake's default) and off: caching must never change a result."""
-    from dyncheck.studies import References
+    from dyncheck.studies.references import References
 
     case = get_case("compound_pendulum")
     impl = make_implementation("drake", case)

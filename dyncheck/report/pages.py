@@ -23,7 +23,7 @@ from dyncheck.report.tables import (
 from dyncheck.results import MEANINGS
 from dyncheck.roster import not_run
 from dyncheck.run_result import RunResult
-from dyncheck.studies.controlled import CONTROLLED, CONTROLLED_ACCURACIES
+from dyncheck.studies.order import CONTROLLED, CONTROLLED_ACCURACIES
 from dyncheck.tolerances import BASES, ORDER_SLACK
 from dyncheck.vocabulary import Quantity, Verdict
 

@@ -9,8 +9,7 @@ import pandas as pd
 from dyncheck.escaping import markdown_table
 from dyncheck.results import SEVERITY
 from dyncheck.run_result import RunResult
-from dyncheck.studies.controlled import CONTROLLED, CONTROLLED_ACCURACIES
-from dyncheck.studies.order import finest_pair
+from dyncheck.studies.order import CONTROLLED, CONTROLLED_ACCURACIES, finest_pair
 from dyncheck.vocabulary import ALONG_RUNS, Quantity, Verdict
 
 TRAJECTORY_QUANTITIES = ALONG_RUNS

@@ -32,8 +32,13 @@ from dyncheck.labels import (
     PRE_ASYMPTOTIC,
     TRUNCATION,
 )
-from dyncheck.studies.controlled import CONTROLLED, CONTROLLED_ACCURACIES
-from dyncheck.studies.order import TrajectoryFigures, finest_pair, observed_orders
+from dyncheck.studies.order import (
+    CONTROLLED,
+    CONTROLLED_ACCURACIES,
+    TrajectoryFigures,
+    finest_pair,
+    observed_orders,
+)
 from dyncheck.studies.references import References, difference
 from dyncheck.studies.study import study
 

@@ -9,7 +9,12 @@ from dyncheck.cases import Case
 from dyncheck.cases.multibody import ROTATING
 from dyncheck.implementations import EngineImplementation, Implementation, general_method
 from dyncheck.results import Discrepancy, Verdict
-from dyncheck.studies.order import finest_pair, observed_orders
+from dyncheck.studies.order import (
+    CONTROLLED,
+    CONTROLLED_ACCURACIES,
+    finest_pair,
+    observed_orders,
+)
 from dyncheck.studies.references import References, difference
 from dyncheck.tolerances import ORDER_SLACK, REFERENCE_MARGIN, accumulated, first_near_max
 from dyncheck.variants import Variant, book_variant
@@ -68,9 +73,6 @@ def adaptive(
     )
 
 
-CONTROLLED = "rk3-controlled"
-CONTROLLED_ACCURACIES = (1e-7, 1e-8, 1e-9, 1e-10)
-"""Target accuracies ε of an engine's error-controlled integrator, a decade apart."""
 
 
 def controlled(

@@ -54,7 +54,7 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
     from dyncheck.check import derivatives, engines
     from dyncheck.check.alignment import align_by_body
     from dyncheck.check.derivative_pairs import label
-    from dyncheck.check.dynamics import States
+    from dyncheck.check.states import States
 
     names = [n for n in MODELS if n in impl_names]
     if not names:

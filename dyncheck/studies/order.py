@@ -7,6 +7,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+CONTROLLED = "rk3-controlled"
+"""The integrator column of an engine's error-controlled runs (Drake's runge_kutta3)."""
+CONTROLLED_ACCURACIES = (1e-7, 1e-8, 1e-9, 1e-10)
+"""Target accuracies ε of an engine's error-controlled integrator, a decade apart."""
+
 
 def observed_orders(dts: list[float], errors: list[float]) -> list[float]:
     """p between consecutive steps; NaN for the first."""

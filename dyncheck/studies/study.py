@@ -26,9 +26,9 @@ from dyncheck.implementations import (
 )
 from dyncheck.labels import HELD_FORCE, NAIVE_GROUP_RK4, PRE_ASYMPTOTIC, TRUNCATION
 from dyncheck.results import ConvergencePoint, Discrepancy, Verdict
-from dyncheck.studies.controlled import CONTROLLED, adaptive, controlled
+from dyncheck.studies.controlled import adaptive, controlled
 from dyncheck.studies.drift import drift_row, energy_drift, momentum_drift
-from dyncheck.studies.order import TrajectoryFigures, finest_pair, observed_orders
+from dyncheck.studies.order import CONTROLLED, TrajectoryFigures, finest_pair, observed_orders
 from dyncheck.studies.pairs import engine_pairs, unavailable
 from dyncheck.studies.references import References, difference
 from dyncheck.tolerances import (

@@ -15,10 +15,10 @@ import pytest
 from dyncheck.adapters.model_files import read
 from dyncheck.adapters.mujoco_model import MujocoModel
 from dyncheck.check import predicted
-from dyncheck.check.dynamics import States
 from dyncheck.check.model_check import check_model
 from dyncheck.check.readings import effect, own_tree
 from dyncheck.check.referee import ReferenceModel
+from dyncheck.check.states import States
 from dyncheck.check.verdicts import Agreement, Reading, per_engine
 
 HINGE = """<mujoco model="h"><option gravity="{g}"/><worldbody><body name="a" pos="0 0 1">

@@ -153,9 +153,10 @@ def test_the_rk4_chain_rule_on_rotations_is_the_derivative_of_the_step_itself():
     from dyncheck.adapters.model_files import read
     from dyncheck.check.derivative_charts import perturb
     from dyncheck.check.derivative_referee import referee
-    from dyncheck.check.dynamics import States, sample
+    from dyncheck.check.dynamics import sample
     from dyncheck.check.engines import load
     from dyncheck.check.referee import ReferenceModel
+    from dyncheck.check.states import States
     from dyncheck.check.steps import rk4_stages, rk4_step
 
     tree = load("mujoco", read(MODELS / "mixed.xml")).tree
@@ -209,7 +210,8 @@ def _log(canon, centre, q):
     rotation's δ is the rotation vector of centre⁻¹ q."""
     from scipy.spatial.transform import Rotation
 
-    from dyncheck.check.steps import _vectors, rotations
+    from dyncheck.check.derivative_charts import rotations
+    from dyncheck.check.steps import _vectors
 
     out = np.zeros(canon.nv)
     vel, pos = _vectors(canon)
