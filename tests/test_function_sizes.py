@@ -12,10 +12,8 @@ ROOT = Path(__file__).resolve().parents[1]
 MOST_LINES = 80
 
 LONG = {
-    "dyncheck/report/pages.py:index_page": 123,
     "reference/tree.py:_at_chunk": 119,
     "dyncheck/check/derivatives.py:rows": 93,
-    "dyncheck/check/describe.py:diff": 105,
     "dyncheck/check/derivative_referee.py:referee": 93,
     "adapters/sympy_mechanics.py:_derive": 92,
     "dyncheck/check/model_check.py:_dynamics": 85,
@@ -24,7 +22,7 @@ LONG = {
 """The functions over :data:`MOST_LINES` lines when the budget was set, with their length
 then (issue #62: to be split)."""
 
-MANY_POSITIONAL = 99
+MANY_POSITIONAL = 98
 """How many functions took five or more positional arguments (``self`` not counted) when the
 ratchet was set."""
 

@@ -1,7 +1,7 @@
-"""Step 3 and 4 of a model check: what each engine read (the neutral trees compared field by
-field, joints matched by name) and whether it is physically possible (§2.2: the inertia
-tensor (2.2.39) of real matter is positive semi-definite and its principal moments obey the
-triangle inequality, Iₐ + I_b ≥ I_c, because each is a sum of m (r² − rᵢ²) ≥ 0 terms).
+"""Step 3 of a model check: what each engine read (the neutral trees compared field by field,
+joints matched by name; a field read differently explained only by a known cause whose
+premise holds, :data:`KNOWN_CAUSES`). Whether each body is physically possible (step 4) is
+:mod:`.validity`'s.
 
 Tolerances: every field is the file's numbers carried through a chain of rigid transforms
 (one per joint and fused link above it), so two parsers of the same text differ by round-off
@@ -14,7 +14,7 @@ parallel-axis term: 1e-8 kg m² of a point mass 1 m from its pivot to ~1e-16 abs
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -22,7 +22,7 @@ import numpy as np
 from dyncheck.adapters.model_tree import JointType, ModelTree, TreeJoint
 from dyncheck.check.computed import depth
 from dyncheck.check.rows import CheckRow, Section
-from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
+from dyncheck.precision import ROUNDOFF_FACTOR, eps_name
 from dyncheck.vocabulary import Quantity, Verdict
 
 
@@ -33,7 +33,7 @@ def size(tree: ModelTree) -> float:
     return max([1e-3, *(float(np.linalg.norm(p)) for p in points)])
 
 
-def _fmt(value: object) -> str:
+def shown_value(value: object) -> str:
     if isinstance(value, np.ndarray):
         text = np.array2string(value, precision=6, separator=" ", max_line_width=10**6)
         return " ".join(text.split())
@@ -171,12 +171,12 @@ def _placement_row(a: ModelTree, b: ModelTree, moved: Placement,
     that changes gravity's direction in the model is a difference of the dynamics."""
     if not moved.turned:
         return Verdict.EXPLAINED, SHIFTED.format(a=a.engine, b=b.engine,
-                                                 t=_fmt(moved.translation))
+                                                 t=shown_value(moved.translation))
     from scipy.spatial.transform import Rotation  # (a placement found: rare; 0.3 s import)
 
     rotvec = Rotation.from_matrix(moved.rotation).as_rotvec()
     angle = float(np.degrees(np.linalg.norm(rotvec)))
-    axis = _fmt(rotvec / np.linalg.norm(rotvec))
+    axis = shown_value(rotvec / np.linalg.norm(rotvec))
     g = a.gravity
     g_scale = float(np.linalg.norm(g))
     kept = g_scale == 0 or float(np.abs(moved.rotation @ g - g).max()) <= tol * g_scale
@@ -184,7 +184,7 @@ def _placement_row(a: ModelTree, b: ModelTree, moved: Placement,
         else GRAVITY_TURNED
     t = moved.translation
     note = TURNED.format(a=a.engine, b=b.engine, angle=angle, axis=axis, effect=effect,
-                         t=f" and moved by {_fmt(t)} m" if np.abs(t).max() > tol * size(a)
+                         t=f" and moved by {shown_value(t)} m" if np.abs(t).max() > tol * size(a)
                          else "")
     why = b.hint("model", "placement") or a.hint("model", "placement")
     return (Verdict.EXPLAINED if kept else Verdict.FAILED), note + (f": {why}" if why else "")
@@ -202,99 +202,176 @@ def diff(model: str, a: ModelTree, b: ModelTree,
     rtol = ROUNDOFF_FACTOR * eps * max(depth(a), depth(b))
     basis = f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth {max(depth(a), depth(b))}"
     length = size(a)
-    rows: list[CheckRow] = []
     moved = placement(a, b, rtol * length)
-
-    def row(subject: str, field: str, va: object, vb: object, err: float, tol: float,
-            verdict: Verdict, note: str = "") -> None:
-        rows.append(
-            CheckRow(
-                model=model, section=Section.DESCRIPTION, subject=subject, field=field,
-                impl_a=a.engine, impl_b=b.engine, value_a=_fmt(va), value_b=_fmt(vb),
-                error=err, tolerance=tol, basis=basis if tol else "", verdict=verdict, note=note,
-            )
-        )
-
     names_a, names_b = [j.name for j in a.joints], [j.name for j in b.joints]
+    found = _presence(a, b, names_a, names_b)
+    if moved is not None:
+        found.append(_placement(a, b, moved, rtol=rtol, length=length))
+    compared = 0
+    for ja in a.joints:
+        if ja.name in names_b:
+            jb = b.joint(ja.name) if moved is None else moved.undo(b.joint(ja.name))
+            more, n = _joint(a, b, ja, jb, scale=_Scale(rtol=rtol, length=length),
+                             invalid=invalid)
+            found += more
+            compared += n
+    gravity_err = float(np.abs(a.gravity - b.gravity).max())
+    if gravity_err > rtol * max(1.0, float(np.abs(a.gravity).max())):
+        found.append(("model", "gravity", a.gravity, b.gravity, gravity_err, rtol,
+                      Verdict.FAILED, a.hint("model", "gravity") or b.hint("model", "gravity")
+                      or ""))
+    if names_a != names_b and set(names_a) == set(names_b):
+        found.append(("model", "joint order", " ".join(names_a), " ".join(names_b), 0.0, 0.0,
+                      Verdict.PASSED, "the engines order the joints differently; matched by "
+                      "name"))
+    if not any(f[6] is Verdict.FAILED for f in found):
+        found.append(("model", "all fields", f"{len(a.joints)} joints",
+                      f"{len(b.joints)} joints", 0.0, rtol, Verdict.PASSED,
+                      f"{compared} fields agree to round-off"))
+    return [CheckRow(model=model, section=Section.DESCRIPTION, subject=subject, field=field,
+                     impl_a=a.engine, impl_b=b.engine, value_a=shown_value(va),
+                     value_b=shown_value(vb), error=err, tolerance=tol,
+                     basis=basis if tol else "", verdict=verdict, note=note)
+            for subject, field, va, vb, err, tol, verdict, note in found]
+
+
+_Found = tuple[str, str, object, object, float, float, Verdict, str]
+"""One difference before it is a row: subject, field, the two values, error, tolerance,
+verdict, note."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class _Scale:
+    """The round-off bound of a comparison of two trees and the model's length scale."""
+
+    rtol: float
+    length: float
+
+
+def _presence(a: ModelTree, b: ModelTree, names_a: list[str],
+              names_b: list[str]) -> list[_Found]:
+    """A joint one engine holds and the other does not (with its reading's hint)."""
+    found: list[_Found] = []
     for name in names_a:
         if name not in names_b:
             why = b.hint(name, "joint") or b.hint("model", "joint")
-            row(name, "joint", "present", "absent", np.inf, 0.0, Verdict.FAILED,
-                f"{b.engine} has no joint {name!r}" + (f": {why}" if why else ""))
-    for name in names_b:
-        if name not in names_a:
-            row(name, "joint", "absent", "present", np.inf, 0.0, Verdict.FAILED,
-                f"{a.engine} has no joint {name!r}")
-    compared = 0
-    if moved is not None:
-        verdict, note = _placement_row(a, b, moved, rtol)
-        from scipy.spatial.transform import Rotation
+            found.append((name, "joint", "present", "absent", np.inf, 0.0, Verdict.FAILED,
+                          f"{b.engine} has no joint {name!r}" + (f": {why}" if why else "")))
+    found += [(name, "joint", "absent", "present", np.inf, 0.0, Verdict.FAILED,
+               f"{a.engine} has no joint {name!r}") for name in names_b if name not in names_a]
+    return found
 
-        turn = Rotation.from_matrix(moved.rotation).as_rotvec()  # (t, the turn's rotation
-        shown = np.concatenate([moved.translation, turn]) if moved.turned \
-            else moved.translation  # vector) where turned, t alone where not
-        row("model", "placement", np.zeros_like(shown), shown,
+
+def _placement(a: ModelTree, b: ModelTree, moved: Placement, *, rtol: float,
+               length: float) -> _Found:
+    """The one row of a model placed elsewhere as a whole: (t, the turn's rotation vector)
+    where turned, t alone where not."""
+    from scipy.spatial.transform import Rotation
+
+    verdict, note = _placement_row(a, b, moved, rtol)
+    turn = Rotation.from_matrix(moved.rotation).as_rotvec()
+    shown = np.concatenate([moved.translation, turn]) if moved.turned else moved.translation
+    return ("model", "placement", np.zeros_like(shown), shown,
             max(float(np.abs(moved.translation).max()) / length, float(np.abs(turn).max())),
             rtol, verdict, note)
-    for ja in a.joints:
-        if ja.name not in names_b:
-            continue
-        jb = b.joint(ja.name)
-        if moved is not None:
-            jb = moved.undo(jb)
-        if ja.type is not jb.type:
-            row(ja.name, "type", ja.type, jb.type, np.inf, 0.0, Verdict.FAILED)
-            continue
-        if ja.parent != jb.parent:
-            gone = ja.parent is not None and ja.parent not in names_b
-            row(ja.name, "parent", ja.parent, jb.parent, np.inf, 0.0, Verdict.FAILED,
-                f"follows from joint {ja.parent!r}, which {b.engine} has not" if gone else
-                b.hint(ja.name, "parent") or "")
-        if (ja.range is None) != (jb.range is None) or (
-            ja.range is not None and jb.range is not None
-            and np.abs(np.subtract(ja.range, jb.range)).max() > rtol * max(1.0, *map(abs, ja.range))
-        ):
-            known = b.hint(ja.name, "range") or a.hint(ja.name, "range") or (
-                (b.hint("model", "slide range") or a.hint("model", "slide range"))
-                if ja.type is JointType.SLIDE else None)
-            row(ja.name, "range", ja.range, jb.range, np.inf, 0.0, Verdict.FAILED,
-                "joint limits read differently (the dynamics leave limits out; states are "
-                f"sampled within {a.engine}'s)" + (f": {known}" if known else ""))
-        for field, va, vb, err, scale in _compare(ja, jb, length):
-            compared += 1
-            stored = _stored_inertia(a, b, jb) if field == "inertia" else None
-            if err > rtol * scale and stored is not None and err <= rtol * scale + stored[0]:
-                row(ja.name, field, va, vb, err / scale, rtol, Verdict.EXPLAINED,
-                    f"{stored[1]}: predicted up to {stored[0] / scale:.3g} of the scale")
-            elif err > rtol * scale and field in BODY_FIELDS and not (
-                    b.hint(ja.name, field) or a.hint(ja.name, field)) and \
-                    err <= (rtol + (mesh := _mesh_bound(a, b, ja.name, field))) * scale:
-                row(ja.name, field, va, vb, err / scale, rtol, Verdict.EXPLAINED,
-                    MESH_ROUNDING.format(field=field, bound=rtol + mesh))
-            elif err > rtol * scale and (exact := _exact_meshes(a, b, ja, jb, field,
-                                                                 length, rtol)):
-                row(ja.name, field, va, vb, err / scale, rtol, Verdict.EXPLAINED,
-                    EXACT_MESHES.format(a=a.engine, b=b.engine, size=err / scale,
-                                        off=exact))
-            elif err > rtol * scale:
-                known = b.hint(ja.name, field) or a.hint(ja.name, field)
-                if not known and field in BODY_FIELDS and ja.body in invalid:
-                    known = FOLLOWS_FROM_INVALID.format(body=ja.body, why=invalid[ja.body],
-                                                        a=a.engine, b=b.engine)
-                row(ja.name, field, va, vb, err / scale, rtol, Verdict.FAILED,
-                    known or f"{a.engine} and {b.engine} read {ja.name!r} ({ja.body}) "
-                    "differently")
-    gravity_err = float(np.abs(a.gravity - b.gravity).max())
-    if gravity_err > rtol * max(1.0, float(np.abs(a.gravity).max())):
-        row("model", "gravity", a.gravity, b.gravity, gravity_err, rtol, Verdict.FAILED,
-            a.hint("model", "gravity") or b.hint("model", "gravity") or "")
-    if names_a != names_b and set(names_a) == set(names_b):
-        row("model", "joint order", " ".join(names_a), " ".join(names_b), 0.0, 0.0,
-            Verdict.PASSED, "the engines order the joints differently; matched by name")
-    if not any(r.verdict is Verdict.FAILED for r in rows):
-        row("model", "all fields", f"{len(a.joints)} joints", f"{len(b.joints)} joints", 0.0,
-            rtol, Verdict.PASSED, f"{compared} fields agree to round-off")
-    return rows
+
+
+def _joint(a: ModelTree, b: ModelTree, ja: TreeJoint, jb: TreeJoint, *, scale: _Scale,
+           invalid: Mapping[str, str]) -> tuple[list[_Found], int]:
+    """The differences of one joint read by both (type, parent, range, then each field with
+    its known cause), and how many fields were compared."""
+    rtol = scale.rtol
+    if ja.type is not jb.type:
+        return [(ja.name, "type", ja.type, jb.type, np.inf, 0.0, Verdict.FAILED, "")], 0
+    found: list[_Found] = []
+    if ja.parent != jb.parent:
+        gone = ja.parent is not None and ja.parent not in [j.name for j in b.joints]
+        found.append((ja.name, "parent", ja.parent, jb.parent, np.inf, 0.0, Verdict.FAILED,
+                      f"follows from joint {ja.parent!r}, which {b.engine} has not" if gone
+                      else b.hint(ja.name, "parent") or ""))
+    if (ja.range is None) != (jb.range is None) or (
+        ja.range is not None and jb.range is not None
+        and np.abs(np.subtract(ja.range, jb.range)).max() > rtol * max(1.0, *map(abs, ja.range))
+    ):
+        known = b.hint(ja.name, "range") or a.hint(ja.name, "range") or (
+            (b.hint("model", "slide range") or a.hint("model", "slide range"))
+            if ja.type is JointType.SLIDE else None)
+        found.append((ja.name, "range", ja.range, jb.range, np.inf, 0.0, Verdict.FAILED,
+                      "joint limits read differently (the dynamics leave limits out; states "
+                      f"are sampled within {a.engine}'s)" + (f": {known}" if known else "")))
+    compared = 0
+    for field, va, vb, err, size_of in _compare(ja, jb, scale.length):
+        compared += 1
+        if err > rtol * size_of:
+            at = _Differs(a=a, b=b, ja=ja, jb=jb, field=field, err=err, size=size_of,
+                          scale=scale)
+            verdict, note = _cause(at, invalid)
+            found.append((ja.name, field, va, vb, err / size_of, rtol, verdict, note))
+    return found, compared
+
+
+@dataclass(frozen=True, kw_only=True)
+class _Differs:
+    """One field of one joint that two readings give differently beyond round-off."""
+
+    a: ModelTree
+    b: ModelTree
+    ja: TreeJoint
+    jb: TreeJoint
+    field: str
+    err: float
+    size: float
+    """The field's own scale (the error relative to it is the row's)."""
+    scale: _Scale
+
+    @property
+    def hinted(self) -> str | None:
+        return self.b.hint(self.ja.name, self.field) or self.a.hint(self.ja.name, self.field)
+
+
+def _stored(at: _Differs) -> str | None:
+    """An inertia an engine stores otherwise (its own rounding, predicted)."""
+    stored = _stored_inertia(at.a, at.b, at.jb) if at.field == "inertia" else None
+    if stored is not None and at.err <= at.scale.rtol * at.size + stored[0]:
+        return f"{stored[1]}: predicted up to {stored[0] / at.size:.3g} of the scale"
+    return None
+
+
+def _meshes_rounded(at: _Differs) -> str | None:
+    """A body's mass properties from meshes, within the meshes' rounding bound."""
+    if at.field not in BODY_FIELDS or at.hinted:
+        return None
+    bound = at.scale.rtol + _mesh_bound(at.a, at.b, at.ja.name, at.field)
+    return MESH_ROUNDING.format(field=at.field, bound=bound) if at.err <= bound * at.size \
+        else None
+
+
+def _meshes_exact(at: _Differs) -> str | None:
+    """Mass properties one engine computes from the meshes exactly, the other otherwise."""
+    exact = _exact_meshes(at.a, at.b, at.ja, at.jb, at.field, at.scale.length, at.scale.rtol)
+    return EXACT_MESHES.format(a=at.a.engine, b=at.b.engine, size=at.err / at.size,
+                               off=exact) if exact else None
+
+
+KNOWN_CAUSES: tuple[Callable[[_Differs], str | None], ...] = (
+    _stored, _meshes_rounded, _meshes_exact)
+"""The causes that explain a field read differently, tried in order: each gives its note
+(with its predicted or measured size) where its premise holds on the two readings."""
+
+
+def _cause(at: _Differs, invalid: Mapping[str, str]) -> tuple[Verdict, str]:
+    """Explained by the first known cause that holds; otherwise failed, naming the reading's
+    hint, the invalid body it follows from, or the two engines."""
+    for cause in KNOWN_CAUSES:
+        note = cause(at)
+        if note:
+            return Verdict.EXPLAINED, note
+    known = at.hinted
+    if not known and at.field in BODY_FIELDS and at.ja.body in invalid:
+        known = FOLLOWS_FROM_INVALID.format(body=at.ja.body, why=invalid[at.ja.body],
+                                            a=at.a.engine, b=at.b.engine)
+    return Verdict.FAILED, known or (f"{at.a.engine} and {at.b.engine} read {at.ja.name!r} "
+                                     f"({at.ja.body}) differently")
 
 
 BODY_FIELDS = frozenset({"mass", "com", "inertia"})
@@ -368,82 +445,3 @@ FOLLOWS_FROM_INVALID = (
     "follows from {body}'s invalid inertia (its validity row: {why}): {a} and {b} repair or "
     "keep an impossible tensor differently; fix the file's inertia and this row goes with it"
 )
-
-FIXES = {
-    "mass": "fix: give the body a positive mass, or merge a massless link into its parent",
-    "finite": "fix: write finite numbers for the mass and the inertia",
-    "inertia": "fix: a physical inertia tensor has non-negative principal moments (check the "
-    "signs of the products of inertia: URDF's ixy is +∫xy dm, some exporters write −)",
-    "triangle": "fix: raise the smaller principal moments until I1 + I2 >= I3 (MuJoCo's "
-    "<compiler balanceinertia=\"true\"/> does this), or recompute the tensor from the "
-    "link's geometry",
-}
-"""A fix hint for each violated condition of :func:`validity` (the page shows it first)."""
-
-
-def _violation(mass: float, inertia: np.ndarray,
-               eps: float = EPS) -> tuple[str, object, float, float, str] | None:
-    """(field, value, error, tolerance, note) of the first violated condition, or None."""
-    if not mass > 0.0:
-        return "mass", mass, abs(mass), 0.0, f"mass {mass:g} (must be > 0)"
-    if not np.isfinite(mass) or not np.all(np.isfinite(inertia)):
-        return ("finite", mass, float("inf"), 0.0,
-                f"mass {mass:g} or inertia {_fmt(np.asarray(inertia).ravel())} not finite")
-    scale = float(np.abs(inertia).max()) or 1.0  # eigenvalues of I/scale: no overflow at 1e308
-    unit = np.asarray(inertia, float) / scale
-    moments = np.linalg.eigvalsh(0.5 * (unit + unit.T)) * scale
-    if not np.all(np.isfinite(moments)):
-        return ("finite", mass, float("inf"), 0.0,
-                f"principal moments of inertia {_fmt(np.asarray(inertia).ravel())} overflow")
-    tol = ROUNDOFF_FACTOR * eps * max(float(np.abs(moments).sum()), 1e-300)
-    if moments[0] < -tol:
-        return ("inertia", moments, -float(moments[0]), tol,
-                f"principal moments {_fmt(moments)}: not positive semi-definite (2.2.39)")
-    if moments[0] + moments[1] < moments[2] - tol:
-        return ("triangle", moments, float(moments[2] - moments[0] - moments[1]), tol,
-                f"principal moments {_fmt(moments)} break I1 + I2 >= I3 (2.2.39)")
-    return None
-
-
-def validity(
-    model: str, holder: str, bodies: list[tuple[str, float, np.ndarray]], *, eps: float = EPS
-) -> list[CheckRow]:
-    """Positive mass, positive semi-definite inertia, triangle inequality for each
-    ``(name, mass, inertia)`` an engine holds (its rigid groups) or the file states (a URDF's
-    links): a failed row per violation, else one passed row. Massless, inertia-less links
-    (frames) are not bodies and are skipped."""
-    rows: list[CheckRow] = []
-    checked = 0
-    for name, mass, inertia in bodies:
-        if mass == 0.0 and not np.any(inertia):
-            continue
-        checked += 1
-        found = _violation(mass, inertia, eps)
-        if found is not None:
-            field, value, err, tol, note = found
-            note = f"{note}; {FIXES[field]}"
-            rows.append(
-                CheckRow(
-                    model=model, section=Section.VALIDITY, subject=name, field=field,
-                    impl_a=holder, impl_b="", value_a=_fmt(value), value_b="", error=err,
-                    tolerance=tol,
-                    basis=f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x trace(I)" if tol
-                    else "",
-                    verdict=Verdict.FAILED, note=note,
-                )
-            )
-    if not rows:
-        rows.append(
-            CheckRow(
-                model=model, section=Section.VALIDITY, subject="model",
-                field="mass, inertia, triangle", impl_a=holder, impl_b="",
-                value_a=f"{checked} bodies", value_b="", error=0.0, tolerance=0.0, basis="",
-                verdict=Verdict.PASSED, note="positive mass, positive semi-definite inertia, "
-                "triangle inequality",
-            )
-        )
-    return rows
-
-
-def tree_bodies(tree: ModelTree) -> list[tuple[str, float, np.ndarray]]:
-    return [(j.body, j.mass, j.inertia) for j in tree.joints]

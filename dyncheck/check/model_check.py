@@ -25,7 +25,7 @@ from dyncheck.adapters import REGISTRY, layout, layout_batch
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials, urdf_welded
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
-from dyncheck.check import actuation, describe, inputs, partial, predicted, readings
+from dyncheck.check import actuation, describe, inputs, partial, predicted, readings, validity
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.alignment import align_by_body
 from dyncheck.check.derivatives import expected_seconds
@@ -242,13 +242,13 @@ def _readings(model: str, source: ModelFile, loaded: dict[str, ModelEngine],
     welded = urdf_welded(source)
     stated = [i for i in urdf_inertials(source) if i.link not in welded]
     if stated:
-        rows.extend(describe.validity(model, "file", [
+        rows.extend(validity.validity(model, "file", [
             (i.link, i.mass, np.array(i.inertia)) for i in stated]))
     if welded & {i.link for i in urdf_inertials(source)}:
         notes.append("links welded to the world (" + ", ".join(sorted(map(shown, welded)))
                      + "): their inertials enter no compared quantity and are not checked")
     for engine, m in loaded.items():
-        rows.extend(describe.validity(model, engine, describe.tree_bodies(m.tree),
+        rows.extend(validity.validity(model, engine, validity.tree_bodies(m.tree),
                                       eps=m.tree.eps))
     invalid: dict[str, str] = {}  # body -> its first failed validity row (the file's first)
     for r in rows:

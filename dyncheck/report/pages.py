@@ -209,13 +209,15 @@ def errata(d: pd.DataFrame) -> tuple[str, pd.DataFrame]:
 
 
 def index_page(result: RunResult, *, date: str) -> str:
-    d, conv = result.discrepancies, result.convergence
-    made_with = versions(result.engines)
-    prov = pd.DataFrame({"item": ["date (UTC)", *made_with], "value": [date, *made_with.values()]})
-    failed = d[d.verdict.isin([Verdict.FAILED, Verdict.SKIPPED])]
-    explained = d.loc[d.verdict == Verdict.EXPLAINED, "convention"]
-    used = sorted({c for cell in explained for c in cell.split("; ") if c} | {TRUNCATION})
-    lines = [
+    """``reports/README.md``: how to read the rows, the provenance, the matrices of verdicts
+    and the rows that failed or were skipped, and the conventions that explain differences."""
+    return "\n".join([*_opening(result), *_provenance(result, date=date), *_matrices(result),
+                      *_closing(result)])
+
+
+def _opening(result: RunResult) -> list[str]:
+    """The index's title, contents and how to read a row."""
+    return [
         "# dyncheck verification report",
         "",
         f"The reference is {BOOK}, implemented clean-room; every case below is run in every "
@@ -246,14 +248,30 @@ def index_page(result: RunResult, *, date: str) -> str:
         "",
         *[f"- *{term.starts}…*: {term.meaning}" for term in BASES],
         "",
+    ]
+
+
+def _provenance(result: RunResult, *, date: str) -> list[str]:
+    """The versions that made the run, and its verdicts per case."""
+    made_with = versions(result.engines)
+    prov = pd.DataFrame({"item": ["date (UTC)", *made_with], "value": [date, *made_with.values()]})
+    return [
         "### Provenance",
         "",
         md(prov),
         "",
         "### Verdicts per case (rows of discrepancies.csv)",
         "",
-        md(summary(d)),
+        md(summary(result.discrepancies)),
         "",
+    ]
+
+
+def _matrices(result: RunResult) -> list[str]:
+    """The matrices of worst verdicts and errors: instantaneous, trajectories, orders,
+    error-controlled runs, conservation."""
+    d, conv = result.discrepancies, result.convergence
+    return [
         "### Instantaneous quantities: worst verdict and relative error, pair × case",
         "",
         md(family_matrix(d, trajectories=False)),
@@ -287,6 +305,17 @@ def index_page(result: RunResult, *, date: str) -> str:
         "",
         md(conservation_matrix(result)),
         "",
+    ]
+
+
+def _closing(result: RunResult) -> list[str]:
+    """The printed equations' check, the failed or skipped rows, what the parsers ignore,
+    the conventions that explain differences and the case pages."""
+    d = result.discrepancies
+    failed = d[d.verdict.isin([Verdict.FAILED, Verdict.SKIPPED])]
+    explained = d.loc[d.verdict == Verdict.EXPLAINED, "convention"]
+    used = sorted({c for cell in explained for c in cell.split("; ") if c} | {TRUNCATION})
+    return [
         "### The book's printed equations of motion against the general method",
         "",
         "(The errata of §2.2 formula by formula, derivation steps and exercises included: "
@@ -330,7 +359,6 @@ def index_page(result: RunResult, *, date: str) -> str:
         *[f"- [{c.title}]({c.name}.md)" for c in result.cases],
         "",
     ]
-    return "\n".join(lines)
 
 
 def conventions_page(entries: list[Entry] | None) -> str:
