@@ -37,7 +37,7 @@ def _states(case, n: int):
 
 def _raw_c(adapter, qe, ve, te, ae) -> float:
     """Seconds per state of the loop ``dyncheck bench`` times for MuJoCo C."""
-    from dyncheck.bench import _raw_mujoco
+    from dyncheck.bench.engines import _raw_mujoco
 
     loop = _raw_mujoco(adapter, qe, ve, te, ae)
     t0 = time.perf_counter()

@@ -136,7 +136,7 @@ def test_the_readmes_counts_are_the_committed_reports():
 def test_the_readmes_timings_are_the_command_timings_page():
     """The seconds the README gives its two commands are `dyncheck bench --suite`'s
     (reports/benchmark-suite.csv), rounded to the second (#45 item 4, #61 item 6)."""
-    from dyncheck.bench_suite import MAIN, SECOND
+    from dyncheck.bench.suite import MAIN, SECOND
 
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     timed = pd.read_csv(ROOT / "reports" / "benchmark-suite.csv").set_index("command")
@@ -256,7 +256,7 @@ def test_the_readmes_main_command_installs_the_extras_the_suite_times():
     """`dyncheck bench --suite` times the README's main command by installing
     ``MAIN_EXTRAS``, its second by adding ``ACCELERATOR_EXTRAS``: the README's first two
     commands must install exactly those."""
-    from dyncheck.bench_suite import ACCELERATOR_EXTRAS, MAIN_EXTRAS
+    from dyncheck.bench.suite import ACCELERATOR_EXTRAS, MAIN_EXTRAS
 
     first, second = [line for line in (ROOT / "README.md").read_text().splitlines()
                      if "pip install" in line][:2]

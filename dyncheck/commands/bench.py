@@ -17,13 +17,13 @@ from dyncheck.commands.options import (
 
 
 def bench_command(args: argparse.Namespace) -> int:
-    from dyncheck import bench
+    from dyncheck.bench import engines as bench
     from dyncheck.cases import get_case
 
     check_out(args.out)
     if args.suite:
         claim_out(args.out)
-        from dyncheck import bench_suite
+        from dyncheck.bench import suite as bench_suite
 
         print(bench_suite.main(args.out))
         return 0

@@ -6,7 +6,6 @@ import argparse
 
 from dyncheck.commands.flags import Command
 from dyncheck.errors import EngineNotInstalled
-from dyncheck.studies.order import CONTROLLED
 
 
 def installed_version(package: str) -> str | None:
@@ -22,6 +21,7 @@ def installed_version(package: str) -> str | None:
 def engine_line(name: str) -> str:
     """An engine imported: its version (and device, for a port) and its integrators."""
     from dyncheck.adapters import ENGINE_PACKAGES, get_adapter
+    from dyncheck.studies.order import CONTROLLED  # (the studies' package imports sympy)
 
     try:
         adapter = get_adapter(name)

@@ -178,7 +178,7 @@ def test_bad_states_option(tmp_path, capsys):
 def test_bench_writes_its_tables(tmp_path, monkeypatch, selection, parts):
     """The benchmark runs end to end on the implementations selected, each of them in its
     rows (timings are not asserted: they are not tests)."""
-    from dyncheck import bench
+    from dyncheck.bench import engines as bench
 
     monkeypatch.setattr(bench, "implementations_for", lambda case: list(selection))
     argv = ["bench", "simple_pendulum", "--states", "200", "--repeats", "1", "--memory"]

@@ -103,7 +103,7 @@ def test_killed_run_leaves_previous_report_intact(tmp_path):
 
 def test_memory_probe_does_not_wait_on_a_dead_child():
     """The child dies (an unknown case raises in it) before reporting: an error, not a hang."""
-    from dyncheck.bench import peak_memory_kib
+    from dyncheck.bench.engines import peak_memory_kib
     from dyncheck.errors import EngineError
 
     with pytest.raises(EngineError, match="died"):

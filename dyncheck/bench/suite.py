@@ -2,7 +2,7 @@
 a fresh process, wall-clock seconds on this machine — against the targets of issues #19 and
 #45 (the README's main command, its install included, ≤ 120 s from empty caches).
 
-The engines' per-state costs are :mod:`dyncheck.bench`'s; this page is about the whole
+The engines' per-state costs are :mod:`dyncheck.bench.engines`'s; this page is about the whole
 commands (imports, symbolic derivations, trajectory studies, figures, writing the report) and,
 in a source checkout, the README's test command and the quick test loop, as CI runs them on a
 machine whose caches are empty (JAX's compiled programs included).
@@ -52,7 +52,7 @@ which ``dyncheck run --accelerators`` adds to the run."""
 VENV_PYTHON = "{tmp}/venv/bin/python"
 
 
-CHECKOUT = Path(__file__).resolve().parents[1]
+CHECKOUT = Path(__file__).resolve().parents[2]
 """The folder that holds the ``dyncheck`` package: a source checkout has ``tests/`` there."""
 
 

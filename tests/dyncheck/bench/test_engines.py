@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from dyncheck import bench, workers
+from dyncheck import workers
+from dyncheck.bench import engines as bench
 from dyncheck.cases import get_case
 from dyncheck.cli import main
 from dyncheck.errors import EngineError

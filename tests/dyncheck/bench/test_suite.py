@@ -6,7 +6,7 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from dyncheck.bench_suite import Program, Step, measure, write
+from dyncheck.bench.suite import Program, Step, measure, write
 
 
 @pytest.fixture(autouse=True)
@@ -42,7 +42,7 @@ def test_each_step_starts_cold_unless_marked_warm(monkeypatch):
     own; a step marked warm gets the folder of the step before it."""
     import subprocess
 
-    from dyncheck import bench_suite
+    from dyncheck.bench import suite as bench_suite
 
     seen = []
 
@@ -73,7 +73,7 @@ def test_a_test_step_runs_pytest_in_the_checkout(tmp_path, monkeypatch):
 
 
 def test_a_test_step_outside_a_checkout_is_skipped_never_timed(tmp_path, monkeypatch):
-    from dyncheck import bench_suite
+    from dyncheck.bench import suite as bench_suite
 
     monkeypatch.setattr(bench_suite, "CHECKOUT", tmp_path)  # an installed package: no tests/
     table = measure((Step(what="tests", argv=("-q",), program=Program.PYTEST, target_s=1.0),
@@ -91,7 +91,7 @@ def test_the_install_step_makes_a_new_environment_from_the_checkout(monkeypatch)
     the README's command, not run: it takes a minute)."""
     import subprocess
 
-    from dyncheck import bench_suite
+    from dyncheck.bench import suite as bench_suite
 
     seen = []
     monkeypatch.setattr(bench_suite.subprocess, "run", lambda argv, **kw: seen.append(argv)
