@@ -1,6 +1,6 @@
 """Where an engine keeps the machine code it compiles for this work (JAX's persistent
 compilation cache, Warp's kernel cache): the folder the command line checked
-(:mod:`dyncheck.compiled_caches`, handed to the work as :attr:`dyncheck.settings.Settings.
+(:mod:`dyncheck.cache.compiled`, handed to the work as :attr:`dyncheck.settings.Settings.
 compiled`), or none — Warp then compiles into a private temporary folder of the process,
 removed at exit, never into its own default under the home folder."""
 

@@ -16,7 +16,7 @@ if in one tangent space (MuJoCo C before 4.0; order 2 on ball and free joints), 
 derivative") — no gyroscopic derivative on a free body (MuJoCo C ≥ 3.11 has one).
 
 JAX's persistent compilation cache is switched on in the folder the command line checked
-(:mod:`dyncheck.compiled_caches`: private to this user, every entry vouched for by an
+(:mod:`dyncheck.cache.compiled`: private to this user, every entry vouched for by an
 authenticated manifest before JAX sees it — its entries are machine code that XLA loads as
 found), so a second run does not compile again; never under ``--no-cache``.
 """
@@ -45,7 +45,7 @@ def _compile_cache() -> None:
     """JAX's settings for this work, made when an MJX model is first put on the device
     (before anything compiles), never by importing this module: its platform where the
     command names a device (``--device``), and its persistent compilation cache in the
-    folder the command line checked (:mod:`dyncheck.compiled_caches`: XLA's cached
+    folder the command line checked (:mod:`dyncheck.cache.compiled`: XLA's cached
     executables are machine code, loaded as found) — none where there is no such folder.
     Both are JAX's, process-wide."""
     from dyncheck.adapters.compiled import aimed, folder

@@ -12,7 +12,7 @@ The device is Warp's: ``cpu`` unless ``--device`` (or ``DYNCHECK_DEVICE``) names
 On the CPU every kernel launch costs ~0.1 ms, so a step costs ~10 ms (Euler) to ~40 ms (RK4)
 even on a pendulum (measured); runs longer than ``CPU_STEPS`` are left to a GPU, where one
 step is a captured CUDA graph. Warp's kernel cache keeps compiled kernels across runs in the
-folder the command line checked (:mod:`dyncheck.compiled_caches`), never in Warp's own
+folder the command line checked (:mod:`dyncheck.cache.compiled`), never in Warp's own
 default under the home folder; without one (``--no-cache``), in a temporary folder.
 """
 

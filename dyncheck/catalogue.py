@@ -192,9 +192,9 @@ def measure(name: str) -> tuple[Entry, dict[str, str]]:
 
 def measured_entry(name: str) -> tuple[Entry, dict[str, str], bool]:
     """:func:`measure`, or what it returned before with the same source, engines and machine
-    (:mod:`dyncheck.measured_cache`; a failed entry is measured every time); with whether it
+    (:mod:`dyncheck.cache.measured`; a failed entry is measured every time); with whether it
     was read back."""
-    from dyncheck.measured_cache import measured
+    from dyncheck.cache.measured import measured
 
     (entry, used), found = measured(
         "explain", name, partial(measure, name), keep=lambda r: not r[0].failed, expect=tuple

@@ -107,8 +107,8 @@ def _main(argv: Sequence[str] | None) -> int:
         args = _parser().parse_args(argv)
     except SystemExit as exc:  # --help (0) or a one-line usage error (2), already printed
         return int(exc.code or 0)
+    from dyncheck.cache.compiled import held
     from dyncheck.commands.options import settings_of
-    from dyncheck.compiled_caches import held
     from dyncheck.workers import settled
 
     try:

@@ -32,7 +32,7 @@ class Settings:
     """``cache``: read and write the disk cache; ``device``: where MuJoCo's ports compute
     (``cpu``, ``cuda``, ``cuda:N``; None: each port's default — the CPU for Warp, JAX's
     default device for MJX); ``compiled``: the folder of the compiled-code caches the
-    command line checked (:mod:`dyncheck.compiled_caches`; None: none used)."""
+    command line checked (:mod:`dyncheck.cache.compiled`; None: none used)."""
 
     cache: bool = True
     device: str | None = None

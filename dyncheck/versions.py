@@ -33,10 +33,10 @@ import pandas as pd
 
 from dyncheck import diff, reproduced
 from dyncheck.adapters import REGISTRY, Needs
+from dyncheck.cache.store import cache_root
 from dyncheck.errors import DyncheckError, InvalidInput, UnknownName
 from dyncheck.progress import Progress
 from dyncheck.settings import current
-from dyncheck.store import cache_root
 from dyncheck.vocabulary import Verdict
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -280,10 +280,10 @@ Unit = tuple[str, Callable[..., Any], tuple[Any, ...]]
 @contextmanager
 def settled(settings: Settings) -> Iterator[None]:
     """``settings`` in force for the work inside (:func:`dyncheck.settings.current`), and the
-    reference handed its store: the disk cache (:class:`dyncheck.store.DiskStore`), or none
+    reference handed its store: the disk cache (:class:`dyncheck.cache.store.DiskStore`), or none
     under ``--no-cache``."""
+    from dyncheck.cache.store import DiskStore
     from dyncheck.reference.derivations import STORE
-    from dyncheck.store import DiskStore
 
     token = STORE.set(DiskStore() if settings.cache else None)
     try:

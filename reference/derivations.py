@@ -4,7 +4,7 @@ A derivation (a metric, Christoffel symbols, the canonical form M, h of (2.2.26)
 as its sympy result under the user's cache folder, keyed by what it is derived from (the
 ``srepr`` of its inputs), sympy's version and the content of this package's source — an
 edit of any derivation, or another sympy, derives afresh. The store is the caller's:
-:data:`STORE`, set by the comparison layer (``dyncheck.store.DiskStore``, whose entries are
+:data:`STORE`, set by the comparison layer (``dyncheck.cache.store.DiskStore``, whose entries are
 authenticated data: a file placed in the cache folder by anyone else is never deserialized);
 unset (``--no-cache``, or this package used alone), everything is derived afresh.
 

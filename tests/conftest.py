@@ -189,7 +189,7 @@ def pretend_missing(monkeypatch):
 def empty_cache(monkeypatch, tmp_path):
     """An empty cache folder (derivations, measured demonstrations, figures), read and written
     (``--no-cache`` off), with the fingerprint computed afresh before and after the test."""
-    from dyncheck import measured_cache
+    from dyncheck.cache import measured as measured_cache
 
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
     clear = measured_cache.fingerprint.cache_clear  # (a test may replace the function)

@@ -211,7 +211,7 @@ NOT_ENGINES = {
     ("dyncheck/studies/drift.py", "inertia"): "a case (rigid cases hold one)",
     ("dyncheck/studies/controlled.py", "polynomial_degree"): "the reference's general method",
     ("dyncheck/studies/study.py", "polynomial_degree"): "the reference's general method",
-    ("dyncheck/store.py", "__name__"): "a type named in a message",
+    ("dyncheck/cache/store.py", "__name__"): "a type named in a message",
     ("dyncheck/workers.py", "sched_getaffinity"): "the platform's os module",
     ("dyncheck/workers.py", "_processes"): "concurrent.futures' pool",
 }

@@ -12,8 +12,8 @@ from typing import TYPE_CHECKING, TypeVar
 import numpy as np
 import pandas as pd
 
+from dyncheck.cache.measured import reused
 from dyncheck.cases import Case
-from dyncheck.measured_cache import reused
 from dyncheck.reference.derivations import value_bytes
 from dyncheck.results import to_csv
 from dyncheck.studies.order import TrajectoryFigures

@@ -10,10 +10,10 @@ import numpy as np
 
 from dyncheck import coordinates as co
 from dyncheck.adapters.integrators import Addresses, integrate
+from dyncheck.cache.measured import reused
 from dyncheck.cases import Case
 from dyncheck.cases.coordinate_maps import CoordinateMap
 from dyncheck.implementations import general_method, reference_trajectory
-from dyncheck.measured_cache import reused
 from dyncheck.variants import Variant
 from dyncheck.vocabulary import Integrator
 
@@ -51,7 +51,7 @@ class References:
 
     def _stored(self, what: str, key: tuple, compute: Callable[[], T]) -> T:
         """``compute()``, or what an earlier run stored for the same case and ``key`` with the
-        same dyncheck, libraries and machine (:func:`~dyncheck.measured_cache.reused`: the
+        same dyncheck, libraries and machine (:func:`~dyncheck.cache.measured.reused`: the
         same inputs give the same numbers, read back to the last bit), so that a second run
         steps no reference; ``--no-cache`` computes afresh."""
         label = f"{self.case.name}-{what}"

@@ -1713,14 +1713,14 @@ DEDICATED = (
      "limit", "tests/check/test_fuzz.py::test_mutated_models_never_traceback_or_hang"),
     ("two entries of JAX's compilation cache swapped", "both deleted before JAX sees the "
      "folder (its manifest does not vouch for them), compiled again, the right values — they "
-     "were loaded and run", "tests/dyncheck/test_compiled_caches.py::"
+     "were loaded and run", "tests/dyncheck/cache/test_compiled.py::"
      "test_swapped_jax_entries_are_compiled_again_not_run"),
     ("a compiled-code entry changed, planted, or a link", "deleted before any engine starts "
-     "(a link never followed), one line on stderr", "tests/dyncheck/test_compiled_caches.py::"
+     "(a link never followed), one line on stderr", "tests/dyncheck/cache/test_compiled.py::"
      "test_swapped_changed_and_planted_entries_are_deleted"),
     ("a compiled-code manifest missing, forged or signed with another key", "nothing in the "
      "folder trusted: every entry compiled again",
-     "tests/dyncheck/test_compiled_caches.py::test_without_an_authentic_manifest_nothing_is_"
+     "tests/dyncheck/cache/test_compiled.py::test_without_an_authentic_manifest_nothing_is_"
      "trusted"),
     ("--out in use by another dyncheck", "refused at once, one line naming the process that "
      "holds it, nothing written, exit 2 — two commands interleaved their pages and CSVs",
@@ -1731,7 +1731,7 @@ DEDICATED = (
      "tests/dyncheck/test_ci_outputs.py::test_a_refused_model_is_a_failed_test_case"),
     ("a compiled-code folder others can write", "not used: JAX keeps no persistent cache, "
      "Warp compiles into a temporary folder (it wrote ~/.cache/warp even under --no-cache)",
-     "tests/dyncheck/test_compiled_caches.py::test_a_folder_others_can_write_is_not_used"),
+     "tests/dyncheck/cache/test_compiled.py::test_a_folder_others_can_write_is_not_used"),
 )
 
 OBSERVED: dict[int, tuple[int, str]] = {}

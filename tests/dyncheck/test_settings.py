@@ -10,10 +10,10 @@ from pathlib import Path
 
 import pytest
 
+from dyncheck.cache.store import DiskStore
 from dyncheck.errors import InvalidInput
 from dyncheck.reference import derivations
 from dyncheck.settings import DEVICE, NO_CACHE, Settings, current, from_environment
-from dyncheck.store import DiskStore
 from dyncheck.workers import run_units, settled
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -11,7 +11,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from dyncheck import measured_cache
+from dyncheck.cache import measured as measured_cache
 from dyncheck.cases import get_case
 from dyncheck.report import figures as module
 from dyncheck.results import CONVERGENCE_KEY, ConvergencePoint, table

@@ -3,7 +3,7 @@
 A demonstration of the conventions catalogue is a deterministic function of dyncheck's source
 and data, the installed engines and numerical libraries, the Python and the machine (the same
 inputs give the same numbers). :func:`measured` stores its result under the user's cache
-folder (:func:`~dyncheck.store.cache_root`) keyed by a hash of all of them, so
+folder (:func:`~dyncheck.cache.store.cache_root`) keyed by a hash of all of them, so
 that a second ``dyncheck explain`` prints without running the engines, while an upgrade of any
 engine, an edit of any file of dyncheck or another machine measures afresh. A case's figures
 are kept the same way (:func:`~dyncheck.report.figures.cached_figures`, the plotted data part
@@ -27,8 +27,8 @@ from pathlib import Path
 from typing import TypeVar
 
 from dyncheck.adapters import ENGINE_PACKAGES
+from dyncheck.cache.store import cache_root, cached
 from dyncheck.settings import current
-from dyncheck.store import cache_root, cached
 
 T = TypeVar("T")
 
@@ -101,7 +101,7 @@ def measured(
     is false (a demonstration that failed) is returned but never stored. ``latest_only``:
     storing a result removes what other fingerprints stored under ``kind`` (for large results
     — a case's figures — that would otherwise pile up with every edit of dyncheck). What is
-    read back must be an ``expect`` (:func:`~dyncheck.store.cached`)."""
+    read back must be an ``expect`` (:func:`~dyncheck.cache.store.cached`)."""
     if not current().cache:  # before the fingerprint: it reads every file of dyncheck
         return measure(), False
     path = path_for(kind, name)

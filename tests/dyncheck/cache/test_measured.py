@@ -1,4 +1,4 @@
-"""The cache of measured demonstrations (dyncheck/measured_cache.py): a second `dyncheck
+"""The cache of measured demonstrations (dyncheck/cache/measured.py): a second `dyncheck
 explain` reads back what the first measured, and anything that could change a number — an
 engine's version, a file of dyncheck, --no-cache, a failure — measures afresh.
 
@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import pytest
 
-from dyncheck import catalogue, measured_cache
+from dyncheck import catalogue
+from dyncheck.cache import measured as measured_cache
 from dyncheck.cli import main
 
 NAME = "hinge-axis-sign"

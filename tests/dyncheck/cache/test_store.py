@@ -1,4 +1,4 @@
-"""The cache's store (dyncheck/store.py) on a hostile cache folder: nothing placed there by
+"""The cache's store (dyncheck/cache/store.py) on a hostile cache folder: nothing placed there by
 anyone else is ever run, and what it holds costs a recomputation, never a wrong result.
 
 Expected values: the results computed without any cache (the ``compute`` functions), and a
@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from dyncheck import store
+from dyncheck.cache import store
 from dyncheck.settings import NO_CACHE
 
 

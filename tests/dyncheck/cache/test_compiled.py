@@ -1,4 +1,4 @@
-"""The compiled-code caches (dyncheck/compiled_caches.py): an entry the authenticated manifest
+"""The compiled-code caches (dyncheck/cache/compiled.py): an entry the authenticated manifest
 does not vouch for is deleted before an engine sees the folder — swapped, changed, planted,
 a link — and JAX, given the checked folder, compiles such an entry again instead of running
 it. Expected values: the files the test wrote and what a jitted function computes."""
@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from dyncheck import compiled_caches
 from dyncheck.adapters import compiled
+from dyncheck.cache import compiled as compiled_caches
 from dyncheck.settings import Settings
 
 SECRET = b"k" * 32
@@ -167,7 +167,7 @@ def test_swapped_jax_entries_are_compiled_again_not_run(tmp_path):
 
 AFTER_COMMAND = """
 import jax, jax.numpy as jnp
-from dyncheck import compiled_caches
+from dyncheck.cache import compiled as compiled_caches
 from dyncheck.adapters import mjx_
 from dyncheck.settings import Settings
 from dyncheck.workers import settled

@@ -1,6 +1,6 @@
 """The caches of compiled machine code dyncheck points an engine at — JAX's persistent
 compilation cache (MJX) and Warp's kernel cache (MuJoCo Warp, Newton) — under the same guard
-as the disk store (:mod:`dyncheck.store`): what they hold is loaded and run as found, so a
+as the disk store (:mod:`dyncheck.cache.store`): what they hold is loaded and run as found, so a
 folder restored from another branch's CI cache, or edited by anyone, must never reach them
 unchecked.
 
@@ -35,8 +35,8 @@ from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 
-from dyncheck import store
 from dyncheck.adapters.compiled import private, released
+from dyncheck.cache import store
 from dyncheck.settings import Settings
 
 ENGINES = ("jax", "warp")
