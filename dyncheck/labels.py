@@ -1,6 +1,6 @@
 """The name of every finding that explains a row, one home: the producers (the trajectory
 studies, the check's predictions and readings, the derivative pairs) attach them, and
-:mod:`dyncheck.explanations` gives each its text and origin. Plain strings at the bottom of
+:mod:`dyncheck.explain.explanations` gives each its text and origin. Plain strings at the bottom of
 the import graph, so that neither side imports the other for a name."""
 
 from __future__ import annotations

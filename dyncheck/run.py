@@ -97,7 +97,7 @@ def run(
     or failed rows, never an aborted run. ``render`` (the report's figures) draws each case's
     figures in its unit of work, beside the other cases'. ``conventions``: the catalogue's
     demonstrations as units of work, composed by the command that wants them
-    (:func:`dyncheck.catalogue.units`; each gives its entries and the engine versions it
+    (:func:`dyncheck.explain.catalogue.units`; each gives its entries and the engine versions it
     used), run beside the cases; None: the run leaves the catalogue out."""
     units: list[Unit] = []
     slices: dict[str, list[int]] = {}  # case → the indices of its slice units

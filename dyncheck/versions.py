@@ -289,11 +289,11 @@ def matrix(
                 progress.done(f"{name} {release}")
         for (old, a, pa), (new, b, pb) in itertools.pairwise(runs):
             was, now = reproduced.load(a), reproduced.load(b)
-            defects = {"fixed": reproduced.changed(was, now, to=reproduced.Outcome.FIXED),
-                       "back": reproduced.changed(was, now, to=reproduced.Outcome.STANDS)}
+            fixed = reproduced.changed(was, now, to=reproduced.Outcome.FIXED)
+            back = reproduced.changed(was, now, to=reproduced.Outcome.STANDS)
             if a is None or b is None:
                 steps.append(Step(engine=name, old=old, new=new, table=None,
-                                  problem=pa or pb, **defects))
+                                  problem=pa or pb, fixed=fixed, back=back))
                 continue
             ta, tb = diff.load(a, "RUN_A"), diff.load(b, "RUN_B")
             made_by = " and ".join(dict.fromkeys(
@@ -302,7 +302,7 @@ def matrix(
             also = tuple(c for c in diff.version_changes(ta.versions, tb.versions)
                          if c.split()[0].replace("_", " ") not in own)
             steps.append(Step(engine=name, old=old, new=new, table=diff.diff(ta, tb),
-                              made_by=made_by, also_changed=also, **defects))
+                              made_by=made_by, also_changed=also, fixed=fixed, back=back))
     return steps
 
 

@@ -166,7 +166,7 @@ def _full_run() -> RunResult:
     assert not adapters.MISSING, f"engines not installed: {adapters.MISSING}"
     # two worker processes: the same results as one (test_jobs_give_identical_results), in
     # about half the wall time on CI's two cores
-    from dyncheck import catalogue
+    from dyncheck.explain import catalogue
 
     return run([get_case(n) for n in CASE_NAMES], IMPLEMENTATIONS, jobs=2,
                conventions=catalogue.units(IMPLEMENTATIONS))

@@ -57,8 +57,8 @@ def test_commands_are_found():
 
 
 def _explain_names() -> set[str]:
-    from dyncheck.catalogue import DEMOS
     from dyncheck.errata.page import load
+    from dyncheck.explain.catalogue import DEMOS
 
     return set(DEMOS) | {f"erratum-{f.id}" for f in load()[1]}
 

@@ -143,7 +143,7 @@ def values(dyn: Dynamics, quantity: str) -> np.ndarray:
 class Prediction:
     """A predicted difference and why, for a pair and a quantity: per state, its size (n,)
     or the difference b − a itself (n, k), component by component; ``label`` the property
-    that predicts it, as :data:`dyncheck.explanations.EXPLANATIONS` registers it."""
+    that predicts it, as :data:`dyncheck.explain.explanations.EXPLANATIONS` registers it."""
 
     size: np.ndarray
     note: str

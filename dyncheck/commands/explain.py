@@ -17,7 +17,7 @@ from dyncheck.workers import default_jobs
 
 
 def explain_command(args: argparse.Namespace) -> int:
-    from dyncheck.catalogue import explain_cached, render
+    from dyncheck.explain.catalogue import explain_cached, render
 
     if args.name is not None and args.name.startswith("erratum-"):
         from dyncheck.errata import page

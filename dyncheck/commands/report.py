@@ -18,7 +18,8 @@ SHOWN = 20
 
 
 def report_command(args: argparse.Namespace) -> int:
-    from dyncheck import catalogue, report, report_check
+    from dyncheck import report, report_check
+    from dyncheck.explain import catalogue
     from dyncheck.run import resolve, run
 
     positive("--jobs", args.jobs)

@@ -23,7 +23,8 @@ from dyncheck.vocabulary import Verdict
 
 
 def run_command(args: argparse.Namespace) -> int:
-    from dyncheck import baseline, catalogue, report
+    from dyncheck import baseline, report
+    from dyncheck.explain import catalogue
     from dyncheck.report.figures import cached_figures as draw_figures
     from dyncheck.run import resolve, run
 

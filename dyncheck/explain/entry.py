@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dyncheck.explanations import Origin
+from dyncheck.explain.explanations import Origin
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ import pandas as pd
 
 from dyncheck.cases import Case
 from dyncheck.explain.entry import Entry
-from dyncheck.explanations import EXPLANATIONS
+from dyncheck.explain.explanations import EXPLANATIONS
 from dyncheck.labels import TRUNCATION
 from dyncheck.provenance import versions
 from dyncheck.report.tables import (

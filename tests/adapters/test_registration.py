@@ -17,7 +17,7 @@ from dyncheck.adapters import REGISTRY
 
 ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = ("dyncheck", "adapters", "cases", "reference")
-TEACHING = ("dyncheck/catalogue.py", "dyncheck/explain/")
+TEACHING = ("dyncheck/explain/",)
 """The conventions catalogue and its demonstrations name the engines they teach about (and
 the engines a demonstration needs): not a second home of a registration."""
 FORMATS = ("adapters/model_files.py",)

@@ -289,7 +289,7 @@ def test_missing_engine_is_skipped_never_passed(monkeypatch, tmp_path, pretend_m
 
     pretend_missing("drake", "No module named 'pydrake'")
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path / "cache"))  # no entry measured with it
-    from dyncheck import catalogue
+    from dyncheck.explain import catalogue
 
     impls = ["reference", "drake"]
     result = run([get_case("simple_pendulum")], impls, conventions=catalogue.units(impls))

@@ -62,7 +62,7 @@ def test_a_catalogue_entry_whose_engine_is_left_out_is_skipped_without_running(m
     their demonstration never runs (it would load Drake); an entry that needs only the core
     engines runs as ``dyncheck explain`` runs it."""
     import dyncheck.run as run_module
-    from dyncheck import catalogue
+    from dyncheck.explain import catalogue
 
     def never() -> catalogue.Entry:
         raise AssertionError("the demonstration of an engine left out ran")

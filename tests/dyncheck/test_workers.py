@@ -134,7 +134,7 @@ def test_a_sweep_cut_into_slices_gives_the_same_csv_as_one_pass(dask):
 def test_conventions_catalogue_entries_are_units_of_work(jobs, monkeypatch):
     """The catalogue's entries run beside the cases (in a pool with jobs=2) and come back in
     the catalogue's order, equal to the entries run directly (NaN where one has no number)."""
-    from dyncheck import catalogue
+    from dyncheck.explain import catalogue
 
     names = ("degrees-vs-radians", "hinge-axis-sign")
     monkeypatch.setattr(catalogue, "DEMOS", {n: catalogue.DEMOS[n] for n in names})

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import pytest
 
-from dyncheck import catalogue, tutorials
+from dyncheck import tutorials
+from dyncheck.explain import catalogue
 
 pytestmark = pytest.mark.slow  # each tutorial executed in a Jupyter kernel
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import pytest
 
-from dyncheck import catalogue
 from dyncheck.cache import measured as measured_cache
 from dyncheck.cli import main
+from dyncheck.explain import catalogue
 
 NAME = "hinge-axis-sign"
 

@@ -20,8 +20,8 @@ import pytest
 from packaging.requirements import Requirement
 
 from dyncheck.adapters import REGISTRY
-from dyncheck.catalogue import DEMOS
 from dyncheck.cli import main
+from dyncheck.explain.catalogue import DEMOS
 from dyncheck.explain.reproducers import REPRODUCERS
 
 

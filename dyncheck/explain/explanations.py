@@ -2,8 +2,9 @@
 
 A difference is ``explained`` only by a property of an engine, of the book or of the
 mathematics, with its predicted size — never by a defect of dyncheck's own code (those are
-fixed). :class:`Origin` says which; ``tests/dyncheck/test_explanations.py`` fails if any explained
-row of a run carries a label that is missing here or whose origin is dyncheck itself.
+fixed). :class:`Origin` says which; ``tests/dyncheck/explain/test_explanations.py`` fails if
+any explained row of a run carries a label that is missing here or whose origin is dyncheck
+itself.
 """
 
 from __future__ import annotations

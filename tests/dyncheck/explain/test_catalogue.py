@@ -8,10 +8,10 @@ import re
 import numpy as np
 import pytest
 
-from dyncheck import catalogue
 from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.cli import main
 from dyncheck.errors import UnknownName
+from dyncheck.explain import catalogue
 from dyncheck.explain.measure import worst
 
 MAP_DEMOS = [

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import pytest
 
-from dyncheck import catalogue
 from dyncheck.check.predicted import PREDICTIONS
-from dyncheck.explanations import EXPLANATIONS, Origin
+from dyncheck.explain import catalogue
+from dyncheck.explain.explanations import EXPLANATIONS, Origin
 
-from ..conftest import PORTS
+from ...conftest import PORTS
 
 
 def test_every_explained_row_names_a_registered_property(full_run):
