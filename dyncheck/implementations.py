@@ -46,16 +46,13 @@ CACHED = Symbolic(derive=derived, lambdify=lambdified)
 reference's disk caches of derivations and of their compiled code — the cache, not the
 derivation, is shared (adapters cannot import the reference)."""
 
-QUANTITIES: tuple[str, ...] = INSTANTANEOUS
-"""``constraint_force`` exists only for cases with couplings: the cords' tensions (N), from
-the forward-dynamics solve at the sampled τ."""
-
-
 def quantities(case: Case) -> tuple[str, ...]:
-    """The quantities compared for ``case``."""
+    """The quantities compared for ``case`` (the vocabulary's instantaneous ones;
+    ``constraint_force``, the cords' tensions (N) from the forward-dynamics solve at the
+    sampled τ, only where the case has couplings)."""
     if case.multibody().couplings:
-        return QUANTITIES
-    return tuple(q for q in QUANTITIES if q != Quantity.CONSTRAINT_FORCE)
+        return INSTANTANEOUS
+    return tuple(q for q in INSTANTANEOUS if q != Quantity.CONSTRAINT_FORCE)
 
 
 

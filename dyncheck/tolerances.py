@@ -25,9 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dyncheck.implementations import QUANTITIES
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
-from dyncheck.vocabulary import Quantity
+from dyncheck.vocabulary import INSTANTANEOUS, Quantity
 
 
 @dataclass(frozen=True)
@@ -52,7 +51,7 @@ def instantaneous(
     """The tolerance for ``quantity``; ``condition`` = max κ(M) over the states, ``soft``
     the :func:`soft_condition` of a soft-constraint solve in the pair (1 if none), ``eps``
     the unit round-off of the pair's less precise implementation."""
-    if quantity not in QUANTITIES:
+    if quantity not in INSTANTANEOUS:
         raise KeyError(quantity)
     unit = eps_name(eps)
     if quantity in (Quantity.FORWARD_DYNAMICS, Quantity.CONSTRAINT_FORCE):
@@ -120,7 +119,7 @@ trajectory's own error estimate."""
 
 def check_coverage() -> None:
     """Every quantity has a tolerance (fails loudly when a quantity is added without one)."""
-    for q in QUANTITIES:
+    for q in INSTANTANEOUS:
         instantaneous(q, 1.0)
 
 

@@ -13,7 +13,7 @@ ROOT = Path(__file__).resolve().parents[1]
 FOLDERS = {"dyncheck": "dyncheck", "reference": "dyncheck.reference",
            "adapters": "dyncheck.adapters", "cases": "dyncheck.cases"}
 
-HEIGHT = 11
+HEIGHT = 10
 """The longest import chain among the modules under ``dyncheck/`` today (ratchet: lower it
 when a change lowers it; the goal is 9)."""
 

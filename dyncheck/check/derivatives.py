@@ -37,6 +37,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.check.derivative_charts import same_layout, to_canonical
 from dyncheck.check.derivative_pairs import across_readings, after_defects, compare
 from dyncheck.check.derivative_referee import Referee, first, referee, step_states
+from dyncheck.check.dynamics import tie_row
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.check.states import States
 from dyncheck.check.steps import step_rows
@@ -116,7 +117,7 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, Mo
     seconds["d reference"] = time.perf_counter() - t0
     trusted = with_referee and ref.tie.agrees
     if with_referee and not trusted:  # never silently trusted: its rows give way to this one
-        out.append(replace(ref.tie.row(model), section=Section.DERIVATIVES))
+        out.append(replace(tie_row(ref.tie, model), section=Section.DERIVATIVES))
     found: dict[str, Derivatives] = {"reference": ref.derivatives} if trusted else {}
     # the engines still stepping (MuJoCo's derivatives and steps in one request) last: the
     # others' derivatives are mapped meanwhile

@@ -28,6 +28,7 @@ from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import QUANTITY_OF, Dynamics, JointType, ModelTree
 from dyncheck.check.computed import depth
 from dyncheck.check.describe import size
+from dyncheck.check.referee import GENERAL, RECURSIVE, Tie
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.check.states import States, condition
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
@@ -274,3 +275,24 @@ def compare(
             )
         )
     return rows
+
+
+def tie_row(tie: Tie, model: str) -> CheckRow:
+    """The referee's tie (:class:`~dyncheck.check.referee.Tie`) as a row of the dynamics
+    section (failed: the referee disagrees with itself, and the general method gave every
+    number on the page)."""
+    served = ("the recursive algorithm gave the referee's M, h and dynamics at every "
+              "state and its derivatives" if tie.agrees else
+              "the referee's two methods disagree: the general method gave every "
+              "number on this page; the referee's derivatives are not to be trusted")
+    return CheckRow(
+        model=model, section=Section.DYNAMICS, subject="referee",
+        field="recursive Newton-Euler against the general method (M, h)",
+        impl_a=GENERAL, impl_b=RECURSIVE, value_a="", value_b="",
+        error=max(tie.mass_error, tie.bias_error), tolerance=tie.tolerance,
+        basis=(f"round-off: {ROUNDOFF_FACTOR} eps x tree depth"
+               + (f" x X/l {tie.standing:.3g} (the general method's momenta about the "
+                  "world origin)" if tie.standing > 1 else "")
+               + f", at {tie.states} states"),
+        verdict=Verdict.PASSED if tie.agrees else Verdict.FAILED,
+        note=f"M {tie.mass_error:.3g}, h {tie.bias_error:.3g}; {served}")

@@ -33,15 +33,15 @@ from dyncheck.check.derivatives import rows as derivative_rows
 from dyncheck.check.dynamics import (
     QUANTITIES,
     Prediction,
-    States,
     compare,
-    condition,
     sample,
     sampled_note,
+    tie_row,
 )
 from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
 from dyncheck.check.referee import ReferenceModel, standing_of
 from dyncheck.check.rows import COLUMNS, CheckResult, CheckRow, Section
+from dyncheck.check.states import States, condition
 from dyncheck.errors import InvalidInput, UnknownName
 from dyncheck.escaping import shown
 from dyncheck.vocabulary import Quantity, Verdict
@@ -327,7 +327,7 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
         assert referee.tie is not None
         if with_referee:
             results[REFEREE] = on_canonical
-            rows.append(referee.tie.row(model))
+            rows.append(tie_row(referee.tie, model))
         readings.own_readings(canonical_tree, batch, loaded, parts, on_canonical, own)
     except Exception as exc:  # the referee failing on a tree costs its own rows too
         rows.append(_row(model, Section.DYNAMICS, REFEREE, Verdict.FAILED,

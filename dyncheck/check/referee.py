@@ -21,12 +21,10 @@ import numpy as np
 
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check.computed import bodies, in_layout
-from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, standing
 from dyncheck.reference.recursive import RecursiveDynamics
 from dyncheck.reference.tree import TreeDynamics
 from dyncheck.roster import REFEREE
-from dyncheck.vocabulary import Verdict
 
 ENGINE = REFEREE
 TIE_STATES = 10
@@ -49,25 +47,6 @@ class Tie:
     @property
     def agrees(self) -> bool:
         return max(self.mass_error, self.bias_error) <= self.tolerance
-
-    def row(self, model: str) -> CheckRow:
-        """The tie as a row of the dynamics section (failed: the referee disagrees with
-        itself, and the general method gave every number on the page)."""
-        served = ("the recursive algorithm gave the referee's M, h and dynamics at every "
-                  "state and its derivatives" if self.agrees else
-                  "the referee's two methods disagree: the general method gave every "
-                  "number on this page; the referee's derivatives are not to be trusted")
-        return CheckRow(
-            model=model, section=Section.DYNAMICS, subject="referee",
-            field="recursive Newton-Euler against the general method (M, h)",
-            impl_a=GENERAL, impl_b=RECURSIVE, value_a="", value_b="",
-            error=max(self.mass_error, self.bias_error), tolerance=self.tolerance,
-            basis=(f"round-off: {ROUNDOFF_FACTOR} eps x tree depth"
-                   + (f" x X/l {self.standing:.3g} (the general method's momenta about the "
-                      "world origin)" if self.standing > 1 else "")
-                   + f", at {self.states} states"),
-            verdict=Verdict.PASSED if self.agrees else Verdict.FAILED,
-            note=f"M {self.mass_error:.3g}, h {self.bias_error:.3g}; {served}")
 
 
 def tie(general: TreeDynamics, recursive: RecursiveDynamics, depth: int, q: np.ndarray,

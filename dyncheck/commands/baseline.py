@@ -16,7 +16,8 @@ from dyncheck.commands.options import (
 
 def baseline_command(args: argparse.Namespace) -> int:
     """Write the baseline; show what changed against the previous one."""
-    from dyncheck import baseline, report
+    from dyncheck import baseline
+    from dyncheck.provenance import versions
     from dyncheck.run import resolve, run
 
     check_out_file("--out", args.out)
@@ -27,7 +28,7 @@ def baseline_command(args: argparse.Namespace) -> int:
     if previous is not None:
         changes = baseline.compare(result.discrepancies, previous, cases=[c.name for c in cases])
         print(changes.to_string(index=False) if len(changes) else "no change")
-    baseline.write(result.discrepancies, args.out, versions=report.versions(result.engines))
+    baseline.write(result.discrepancies, args.out, versions=versions(result.engines))
     print(f"baseline written to {args.out} ({len(result.discrepancies)} rows)")
     return 0
 

@@ -18,8 +18,9 @@ SHOWN = 20
 
 
 def report_command(args: argparse.Namespace) -> int:
-    from dyncheck import report, report_check
+    from dyncheck import report_check
     from dyncheck.explain import catalogue
+    from dyncheck.report import folder as report
     from dyncheck.run import resolve, run
 
     positive("--jobs", args.jobs)

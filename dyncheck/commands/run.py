@@ -23,8 +23,10 @@ from dyncheck.vocabulary import Verdict
 
 
 def run_command(args: argparse.Namespace) -> int:
-    from dyncheck import baseline, report
+    from dyncheck import baseline
     from dyncheck.explain import catalogue
+    from dyncheck.provenance import versions
+    from dyncheck.report import folder as report
     from dyncheck.report.figures import cached_figures as draw_figures
     from dyncheck.run import resolve, run
 
@@ -49,7 +51,7 @@ def run_command(args: argparse.Namespace) -> int:
     report.write(result, args.out)
     from dyncheck.ci_outputs import RUN, split
 
-    write_ci(args, split(result.discrepancies, RUN), RUN, report.versions(result.engines))
+    write_ci(args, split(result.discrepancies, RUN), RUN, versions(result.engines))
     counts = result.discrepancies["verdict"].value_counts()
     left_out = None if args.impl else not_run(impls)  # (what --impl names is chosen)
     if left_out is not None:
@@ -68,7 +70,7 @@ def run_command(args: argparse.Namespace) -> int:
             if regressed
             else f"no regression against {args.baseline}"
         )
-        moved = baseline.version_changes(args.baseline, report.versions(result.engines))
+        moved = baseline.version_changes(args.baseline, versions(result.engines))
         print(
             "versions changed since the baseline: " + ", ".join(moved)
             if moved

@@ -16,13 +16,13 @@ from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.comparison import GRAVITY_DEFAULT, POINT_INERTIA, compare_instantaneous
 from dyncheck.implementations import (
     IMPLEMENTATIONS,
-    QUANTITIES,
     compared,
     make_implementation,
     quantities,
 )
 from dyncheck.results import DISCREPANCY_KEY, Discrepancy, table
 from dyncheck.variants import ENGINE_DEFECT, INERTIA_STORED, SOFT_CONSTRAINT
+from dyncheck.vocabulary import INSTANTANEOUS
 
 from ..conftest import (
     ALL_ENGINES,
@@ -53,7 +53,7 @@ def _expected_rows(case: str, impl: str, quantity: str) -> bool:
     return not (case not in COUPLED_CASES and impl in COUPLINGS_ONLY_ENGINES)
 
 
-@pytest.mark.parametrize("quantity", QUANTITIES)
+@pytest.mark.parametrize("quantity", INSTANTANEOUS)
 @pytest.mark.parametrize("impl", ["book", *ALL_ENGINES])
 @pytest.mark.parametrize("case", CASE_NAMES)
 def test_against_reference(full_run, case, impl, quantity):
@@ -132,7 +132,7 @@ def test_every_instantaneous_pair_is_passed_or_explained(full_run):
                 reasons += [quantity_limit(case, n, q) for n in (a, b)]
                 assert all(any(r and re.search(r, note) for r in reasons)
                            for note in rows.note), rows
-    inst = d[d.quantity.isin(QUANTITIES)]
+    inst = d[d.quantity.isin(INSTANTANEOUS)]
     assert (inst.verdict != "skipped").sum() == measured  # no row beyond the pairs
 
 
@@ -284,7 +284,7 @@ def test_worst_state_is_reported_and_reproducible():
 def test_missing_engine_is_skipped_never_passed(monkeypatch, tmp_path, pretend_missing):
     """An engine that is not installed gives `skipped` rows with the pip hint, never `passed`,
     and the report (with its conventions catalogue) is still written."""
-    from dyncheck import report
+    from dyncheck.report import folder as report
     from dyncheck.run import run
 
     pretend_missing("drake", "No module named 'pydrake'")

@@ -121,7 +121,8 @@ def _patch_run_then_write(error: OSError) -> Callable[[pytest.MonkeyPatch, Path]
     """The run itself replaced (its cost is not the point); the report's write fails."""
 
     def patch(mp: pytest.MonkeyPatch, tmp: Path) -> None:
-        from dyncheck import report, run
+        from dyncheck import run
+        from dyncheck.report import folder as report
 
         mp.setattr(run, "run", lambda *a, **k: None)
         mp.setattr(report, "write", _raise(error))
