@@ -257,8 +257,9 @@ class ModelAdapter(Adapter):
         return self.evaluate_all(q, v, tau, np.zeros_like(v))[Quantity.FORWARD_DYNAMICS]
 
     def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        maps, qe, ve, _ = engine_states(self.canon, self.tree, q, v, a)
-        return self._dynamics(q, v, a).inverse - self._pushed(maps, qe, ve)
+        maps, qe, ve, ae = engine_states(self.canon, self.tree, q, v, a)  # (mapped once)
+        d = to_canonical(maps, self.engine.dynamics(qe, ve, ae))
+        return d.inverse - self._pushed(maps, qe, ve)
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         return self._dynamics(q, v, np.zeros_like(v)).kinetic
