@@ -21,6 +21,7 @@ MuJoCo's ceiling (solimp d = 0.9999 everywhere).
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from dataclasses import replace
 from typing import ClassVar
 
 import mujoco
@@ -30,6 +31,7 @@ from dyncheck.adapters import REGISTRY, mujoco_api
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.mujoco_api import INTEGRATORS, full_inertia
+from dyncheck.adapters.mujoco_dynamics import Around, evaluate
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import EngineError, Unsupported
 from dyncheck.vocabulary import Integrator
@@ -192,36 +194,27 @@ class MuJoCoAdapter(Adapter):
     def evaluate_all(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
     ) -> dict[str, np.ndarray]:
-        """One ``mj_forward`` (M, h, v̇, energies) and one ``mj_inverse`` per state: the
-        calls of :meth:`_set`, :meth:`forward` and :meth:`_inverse_one`, written out with
-        ``mjData``'s arrays bound once (a small model's state costs ~6 µs: the method calls
-        and attribute reads around the two engine calls were a fifth of it)."""
+        """One ``mj_forward`` (M, h, v̇, energies) and one ``mj_inverse`` per state
+        (:func:`~.mujoco_dynamics.evaluate`), the field's force held in ``xfrc_applied`` and
+        taken from the inverse dynamics, the couplings' forces read after each forward."""
         m, d = self.model, self.data
-        n, nv = v.shape
-        M = np.empty((n, nv, nv))
-        bias, fwd, inv = np.empty((n, nv)), np.empty((n, nv)), np.empty((n, nv))
-        energy = np.empty((n, 2))
-        force = np.empty((n, m.neq)) if self.spec.couplings else None
-        field = bool(self.spec.central_mu)
-        qpos, qvel, qfrc, qacc = d.qpos, d.qvel, d.qfrc_applied, d.qacc
-        qbias, qinv, en = d.qfrc_bias, d.qfrc_inverse, d.energy
-        forward, inverse, kinematics = mujoco.mj_forward, mujoco.mj_inverse, mujoco.mj_kinematics
-        for k in range(n):
-            qpos[:], qvel[:], qfrc[:] = q[k], v[k], tau[k]
-            if field:
-                kinematics(m, d)
+        force = np.empty((len(q), m.neq)) if self.spec.couplings else None
+        around = Around()
+        if self.spec.central_mu:
+            def held(d: mujoco.MjData) -> None:
+                mujoco.mj_kinematics(m, d)
                 self._field_xfrc(d)
-            forward(m, d)
-            full_inertia(m, d, M[k])
-            bias[k], fwd[k], energy[k] = qbias, qacc, en
-            if force is not None:
+
+            around = replace(around, before=held, taken_from_inverse=lambda d: (
+                self._field_generalized(d, np.zeros(m.nv))))
+        if force is not None:
+            def tensions(k: int, d: mujoco.MjData) -> None:
                 force[k] = self._equality_force(d)
-            qacc[:] = a[k]
-            inverse(m, d)
-            inv[k] = qinv
-            if field:
-                inv[k] -= self._field_generalized(d, np.zeros(nv))
-        return self._outputs(M, bias, fwd, inv, energy[:, 1], energy[:, 0], force)
+
+            around = replace(around, after_forward=tensions)
+        e = evaluate(m, d, q=q, v=v, tau=tau, a=a, around=around)
+        return self._outputs(e.mass, e.bias, e.forward, e.inverse, e.kinetic, e.potential,
+                             force)
 
     def simulate(
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str

@@ -44,6 +44,7 @@ from dyncheck.adapters.mujoco_api import (
     full_inertia,
     mujoco_warnings,
 )
+from dyncheck.adapters.mujoco_dynamics import evaluate
 from dyncheck.adapters.mujoco_meshes import TEXT_MESHES, mesh_rounding
 from dyncheck.errors import EngineError
 from dyncheck.vocabulary import Integrator
@@ -305,24 +306,9 @@ class MujocoModel(MujocoActuation, ModelEngine):
         return self.model.qpos0.copy()
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
-        m, d = self.model, self.data
-        n, nv = len(q), m.nv
-        out = {k: np.empty((n, nv)) for k in ("bias", "forward", "inverse")}
-        mass = np.empty((n, nv, nv))
-        kinetic, potential = np.empty(n), np.empty(n)
-        for i in range(n):
-            d.qpos[:], d.qvel[:] = q[i], v[i]
-            d.qfrc_applied[:] = 0.0
-            mujoco.mj_forward(m, d)
-            full_inertia(m, d, mass[i])
-            out["bias"][i] = d.qfrc_bias
-            out["forward"][i] = d.qacc
-            kinetic[i], potential[i] = d.energy[1], d.energy[0]
-            d.qacc[:] = a[i]
-            mujoco.mj_inverse(m, d)
-            out["inverse"][i] = d.qfrc_inverse
-        return Dynamics(mass_matrix=mass, bias=out["bias"], forward=out["forward"],
-                        inverse=out["inverse"], kinetic=kinetic, potential=potential)
+        e = evaluate(self.model, self.data, q=q, v=v, tau=np.zeros_like(v), a=a)
+        return Dynamics(mass_matrix=e.mass, bias=e.bias, forward=e.forward, inverse=e.inverse,
+                        kinetic=e.kinetic, potential=e.potential)
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
         """``mjd_inverseFD`` (one-sided differences of ``mj_inverse``, step
