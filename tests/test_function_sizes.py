@@ -16,7 +16,6 @@ LONG = {
     "dyncheck/check/derivatives.py:rows": 93,
     "dyncheck/check/derivative_referee.py:referee": 93,
     "adapters/sympy_mechanics.py:_derive": 92,
-    "dyncheck/check/model_check.py:_dynamics": 85,
     "reference/recursive.py:inverse_along": 83,
 }
 """The functions over :data:`MOST_LINES` lines when the budget was set, with their length

@@ -301,25 +301,9 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
     on every engine's own: ``own``); a failing engine, or one returning a non-finite value,
     costs its own row."""
     results: dict[str, Dynamics] = {}
-    pending = {}
     failures: dict[str, str] = {}  # engine → why its dynamics failed
-    for engine, m in loaded.items():
-        if engine in unmatched:
-            rows.append(_row(model, Section.DYNAMICS, engine, Verdict.SKIPPED,
-                             "its joints do not match the canonical engine's (description rows)",
-                             field="dynamics"))
-            continue
-        t0 = time.perf_counter()
-        part = parts[engine]
-        on = batch if part is None else partial.states(batch, part)
-        maps, q_e, v_e, a_e = layout_batch.engine_states(
-            canon if part is None else layout.canonical(part.tree), m.tree, on.q, on.v, on.a)
-        seconds[engine] = seconds.get(engine, 0.0) + time.perf_counter() - t0  # the map's
-        try:  # (an engine in its own process computes while the referee does; its answer
-            m.submit(q_e, v_e, a_e)  # comes with its own seconds)
-            pending[engine] = (m, maps)
-        except Exception as exc:  # an engine failing mid-way costs its own rows
-            failures[engine] = f"{type(exc).__name__}: {exc}"
+    pending = _submitted(model, canon, batch, loaded, parts=parts, unmatched=unmatched,
+                         rows=rows, seconds=seconds, failures=failures)
     t0 = time.perf_counter()
     try:  # the referee serves the readings' comparison even where its rows are not asked for
         referee = ReferenceModel(canonical_tree)
@@ -341,6 +325,45 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
             seconds[engine] += took
         except Exception as exc:
             failures[engine] = f"{type(exc).__name__}: {exc}"
+    rows += _failed(model, failures, loaded, own)
+    results = {name: results[name] for name in (REFEREE, *loaded) if name in results}
+    return _defined(model, results, loaded, own, rows=rows)
+
+
+def _submitted(model: str, canon: layout.Canonical, batch: States,
+               loaded: dict[str, ModelEngine], *, parts: dict[str, partial.Part | None],
+               unmatched: list[str], rows: list[CheckRow], seconds: dict[str, float],
+               failures: dict[str, str]) -> dict[str, tuple[ModelEngine, list]]:
+    """Each engine handed the states in its own layout (an engine in its own process
+    computes while the referee does; its answer comes with its own seconds): engine → (it,
+    the states' maps). An engine whose joints do not match is a skipped row; one failing
+    mid-way, its entry in ``failures``."""
+    pending = {}
+    for engine, m in loaded.items():
+        if engine in unmatched:
+            rows.append(_row(model, Section.DYNAMICS, engine, Verdict.SKIPPED,
+                             "its joints do not match the canonical engine's (description rows)",
+                             field="dynamics"))
+            continue
+        t0 = time.perf_counter()
+        part = parts[engine]
+        on = batch if part is None else partial.states(batch, part)
+        maps, q_e, v_e, a_e = layout_batch.engine_states(
+            canon if part is None else layout.canonical(part.tree), m.tree, on.q, on.v, on.a)
+        seconds[engine] = seconds.get(engine, 0.0) + time.perf_counter() - t0  # the map's
+        try:
+            m.submit(q_e, v_e, a_e)
+            pending[engine] = (m, maps)
+        except Exception as exc:  # an engine failing mid-way costs its own rows
+            failures[engine] = f"{type(exc).__name__}: {exc}"
+    return pending
+
+
+def _failed(model: str, failures: dict[str, str], loaded: dict[str, ModelEngine],
+            own: dict[str, readings.Reading]) -> list[CheckRow]:
+    """An engine whose dynamics failed: skipped where the referee on the same reading finds
+    them undefined (not finite), failed otherwise."""
+    rows = []
     for engine, message in failures.items():
         judge = own.get(engine, own.get(next(iter(loaded))))
         undefined = _non_finite(judge.dynamics) if judge is not None else []
@@ -350,7 +373,14 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
              f"{', '.join(undefined)} on the same reading are not finite), and {engine} "
              f"refused to compute them: {message}") if undefined else message,
             field="dynamics"))
-    results = {name: results[name] for name in (REFEREE, *loaded) if name in results}
+    return rows
+
+
+def _defined(model: str, results: dict[str, Dynamics], loaded: dict[str, ModelEngine],
+             own: dict[str, readings.Reading], *, rows: list[CheckRow]) -> dict[str, Dynamics]:
+    """The results with finite values only: the model's own fault (the referee's values not
+    finite on the canonical reading) one failed row; an engine's non-finite value skipped
+    where the referee's on the same reading is not finite either, failed otherwise."""
     undefined = _non_finite(own[next(iter(loaded))].dynamics) if own else []
     if undefined:  # the model's own fault, measured by the referee: one failed row
         singular = (QUANTITIES[Quantity.FORWARD_DYNAMICS] in undefined
