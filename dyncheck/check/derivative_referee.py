@@ -12,7 +12,7 @@ v̇ = FD(q, v, 0), which follows from differentiating τ = ID(q, v, FD(q, v, τ)
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -23,6 +23,10 @@ from dyncheck.check.derivative_charts import perturb
 from dyncheck.check.referee import TIE_STATES, ReferenceModel, Tie, tie
 from dyncheck.check.states import States
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, standing
+
+if TYPE_CHECKING:
+    from dyncheck.adapters.layout import Canonical
+    from dyncheck.reference.recursive import RecursiveDynamics
 
 STEP = 4e-3
 """The largest central-difference step of the implicit step's Richardson extrapolation
@@ -101,7 +105,6 @@ def referee(tree: ModelTree, states: States, *, bounds: bool = True,
     model = ReferenceModel(tree)
     solver = model.recursive
     q, v, a = states.q, states.v, states.a
-    n, nv = v.shape
     with np.errstate(all="ignore"):
         # M and h from the general method (the root of trust): its M sums mᵢ Jᵢᵀ Jᵢ with no
         # parallel-axis cancellation, which costs composite bodies the digits of a tiny
@@ -116,30 +119,56 @@ def referee(tree: ModelTree, states: States, *, bounds: bool = True,
     with np.errstate(all="ignore"):
         inverse_mass = np.linalg.inv(mass)
         forward = -np.einsum("sij,sj->si", inverse_mass, bias)
-        offsets = (0.0, CURVE, -CURVE) if bounds else (0.0,)
-        # every complex-stepped state at once: (offset, k) states, two accelerations
-        q_c = np.stack([perturb(canon, q, k, t + 1j * ETA) for t in offsets for k in range(nv)])
-        columns = np.tile(np.arange(nv), len(offsets))
-        acc = np.stack([a, forward] if bounds else [forward])
-        rows_q = solver.inverse_along(q, v, acc, columns, q_along=q_c)  # (offset·k, acc, s, i)
-        d_q = np.moveaxis((rows_q.imag / ETA).reshape(len(offsets), nv, len(acc), n, nv), 2, 0)
-        if not bounds:  # the forward acceleration's only: the inverse ones left zero
-            d_q = np.concatenate([np.zeros_like(d_q), d_q])
-        v_c = v[None] + 1j * ETA * np.eye(nv)[:, None, :]  # (k, s, i)
-        d_v = solver.inverse_along(q, v, np.zeros_like(v), np.arange(nv), v_along=v_c)
-        d_v = np.transpose(d_v.imag / ETA, (1, 2, 0))
-        second_v = np.zeros((n, nv, nv))
-        if bounds:
-            unit = np.broadcast_to(np.eye(nv)[:, None, :], (nv, n, nv))
-            second_v = np.transpose(2 * solver.inverse_along(
-                q, np.zeros_like(v), np.zeros_like(v), np.arange(nv), v_along=unit,
-                gravity=False), (1, 2, 0))
+        d_q, d_v, second_v = _complex_steps(canon, solver, states, forward, bounds=bounds)
     depth_ = depth(tree)
     rtol = ROUNDOFF_FACTOR * EPS * depth_
     tau_scale = np.maximum(np.abs(bias).max(axis=1), np.abs(
         np.einsum("sij,sj->si", mass, a)).max(axis=1))
     roundoff = rtol * np.maximum(tau_scale, 1e-300)
     spread = max(1.0, float(np.abs(v).max()))
+    out, error, second_q, third_q = _assembled(d_q, d_v, inverse_mass, rtol=rtol, bounds=bounds)
+    return Referee(
+        derivatives=collect(out, method="recursive Newton-Euler differentiated by a complex "
+                            "step (exact to round-off; tied to the general method)"),
+        error=error, second_q=second_q, third_q=third_q, second_v=second_v,
+        inverse_mass=inverse_mass, roundoff=roundoff, roundoff_v=roundoff / spread,
+        forward=forward, tie=tied, standing=standing(*solver.reach(q)))
+
+
+def _complex_steps(canon: Canonical, solver: RecursiveDynamics, states: States,
+                   forward: np.ndarray, *, bounds: bool
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The recursion's τ complex-stepped along every coordinate of q (at the offsets 0, ±
+    :data:`CURVE` along it where ``bounds``) at v̇ = a and at the forward acceleration, and
+    along every coordinate of v; and ∂²τ/∂v_k² = 2 h₀(q, e_k). Shapes: (acc, offset, k, s,
+    i), (s, i, k), (s, i, k)."""
+    q, v, a = states.q, states.v, states.a
+    n, nv = v.shape
+    offsets = (0.0, CURVE, -CURVE) if bounds else (0.0,)
+    # every complex-stepped state at once: (offset, k) states, two accelerations
+    q_c = np.stack([perturb(canon, q, k, t + 1j * ETA) for t in offsets for k in range(nv)])
+    columns = np.tile(np.arange(nv), len(offsets))
+    acc = np.stack([a, forward] if bounds else [forward])
+    rows_q = solver.inverse_along(q, v, acc, columns, q_along=q_c)  # (offset·k, acc, s, i)
+    d_q = np.moveaxis((rows_q.imag / ETA).reshape(len(offsets), nv, len(acc), n, nv), 2, 0)
+    if not bounds:  # the forward acceleration's only: the inverse ones left zero
+        d_q = np.concatenate([np.zeros_like(d_q), d_q])
+    v_c = v[None] + 1j * ETA * np.eye(nv)[:, None, :]  # (k, s, i)
+    d_v = solver.inverse_along(q, v, np.zeros_like(v), np.arange(nv), v_along=v_c)
+    d_v = np.transpose(d_v.imag / ETA, (1, 2, 0))
+    second_v = np.zeros((n, nv, nv))
+    if bounds:
+        unit = np.broadcast_to(np.eye(nv)[:, None, :], (nv, n, nv))
+        second_v = np.transpose(2 * solver.inverse_along(
+            q, np.zeros_like(v), np.zeros_like(v), np.arange(nv), v_along=unit,
+            gravity=False), (1, 2, 0))
+    return d_q, d_v, second_v
+
+
+def _assembled(d_q: np.ndarray, d_v: np.ndarray, inverse_mass: np.ndarray, *, rtol: float,
+               bounds: bool) -> tuple[dict[str, np.ndarray], ...]:
+    """The derivatives (the forward ones by −M⁻¹ ∂τ), their round-off, and the second and
+    third derivatives along the chart (central differences of the exact first ones)."""
     out: dict[str, np.ndarray] = {}
     error: dict[str, np.ndarray] = {}
     second_q: dict[str, np.ndarray] = {}
@@ -169,9 +198,4 @@ def referee(tree: ModelTree, states: States, *, bounds: bool = True,
     error["forward_v"] = np.abs(inverse_mass) @ error["inverse_v"]
     out["forward_tau"] = inverse_mass
     error["forward_tau"] = np.zeros_like(inverse_mass)
-    return Referee(
-        derivatives=collect(out, method="recursive Newton-Euler differentiated by a complex "
-                            "step (exact to round-off; tied to the general method)"),
-        error=error, second_q=second_q, third_q=third_q, second_v=second_v,
-        inverse_mass=inverse_mass, roundoff=roundoff, roundoff_v=roundoff / spread,
-        forward=forward, tie=tied, standing=standing(*solver.reach(q)))
+    return out, error, second_q, third_q
