@@ -13,7 +13,6 @@ MOST_LINES = 80
 
 LONG = {
     "reference/tree.py:_at_chunk": 119,
-    "dyncheck/check/derivatives.py:rows": 93,
     "adapters/sympy_mechanics.py:_derive": 92,
     "reference/recursive.py:inverse_along": 83,
 }

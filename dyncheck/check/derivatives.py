@@ -27,6 +27,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import replace
 
+import numpy as np
+
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import (
@@ -41,6 +43,7 @@ from dyncheck.check.dynamics import tie_row
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.check.states import States
 from dyncheck.check.steps import step_rows
+from dyncheck.errors import Unsupported
 from dyncheck.vocabulary import Verdict
 
 
@@ -89,7 +92,6 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, Mo
     import time
 
     from dyncheck.adapters import layout_batch
-    from dyncheck.errors import Unsupported
 
     seconds = {} if seconds is None else seconds
     names = (["reference"] if with_referee else []) + list(engines)
@@ -122,17 +124,8 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, Mo
     # the engines still stepping (MuJoCo's derivatives and steps in one request) last: the
     # others' derivatives are mapped meanwhile
     for name, engine in sorted(engines.items(), key=lambda item: item[0] in both):
-        if name in both:
-            try:
-                own_part, step_part = engine.collect_both()
-            except Exception as exc:  # its process died: its rows say so
-                own_part = step_part = exc
-            own = own_part if isinstance(own_part, Exception) else own_part[0]
-            if isinstance(own_part, tuple):
-                seconds[f"d {name}"] = own_part[1]
-            stepping[name] = step_part if isinstance(step_part, Exception) else step_part[0]
-        else:
-            own = _collect(engine, name, seconds)
+        own = _answer(engine, name, stepping=stepping, seconds=seconds) if name in both \
+            else _collect(engine, name, seconds)
         if isinstance(own, Unsupported):
             out.append(_row(model, name, Verdict.SKIPPED, str(own)))
         elif isinstance(own, Exception):  # an engine failing costs its own rows
@@ -141,31 +134,63 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, Mo
             assert isinstance(own, Derivatives)
             t0 = time.perf_counter()
             try:
-                if own.chart is DerivativeChart.TANGENT and canonical_layout[name]:
-                    found[name] = own  # its layout is the canonical one: nothing to map
-                else:
-                    values = engine.dynamics(*inputs[name])
-                    mine = engine.tree
-                    mapped = to_canonical(canon, mine, states, own, values)
-                    if own.own_differences is not None:
-                        mapped = replace(mapped, defect=own.defect, own_differences=to_canonical(
-                            canon, mine, states, own.own_differences, values))
-                    found[name] = mapped
+                found[name] = _canonical(canon, engine, states, own, inputs=inputs[name],
+                                         same=canonical_layout[name])
             except Exception as exc:  # an engine failing costs its own rows
                 out.append(_row(model, name, Verdict.FAILED, f"{type(exc).__name__}: {exc}"))
             seconds["d map"] = seconds.get("d map", 0.0) + time.perf_counter() - t0
-    for name, steps in stepping.items():
-        if not trusted or isinstance(steps, Unsupported):
-            continue  # no trusted referee, or no steps offered
-        if isinstance(steps, Exception):  # costs its own row
-            out.append(_row(model, name, Verdict.FAILED, f"{type(steps).__name__}: {steps}"))
-            continue
-        for step in steps:  # type: ignore[attr-defined]
-            out.extend(step_rows(model, canon, tree, first(states, at_steps),
-                                 first(ref, at_steps), name, step, of=len(states.q)))
+    if trusted:  # (no trusted referee: no step rows)
+        for name, steps in stepping.items():
+            out += _stepping_rows(model, canon, tree, name, steps=steps, states=states,
+                                  ref=ref, at_steps=at_steps)
     order = [n for n in names if n in found]
     out.extend(_pair_rows(model, tree, order=order, found=found, engines=engines, ref=ref,
                           own_refs=own_refs))
+    return out
+
+
+def _answer(engine: ModelEngine, name: str, *, stepping: dict[str, object],
+            seconds: dict[str, float]) -> object:
+    """The derivatives of an engine asked for them and its step Jacobians in one request
+    (its process died: the exception, for both); the Jacobians go to ``stepping``."""
+    try:
+        own_part, step_part = engine.collect_both()
+    except Exception as exc:  # its process died: its rows say so
+        own_part = step_part = exc
+    if isinstance(own_part, tuple):
+        seconds[f"d {name}"] = own_part[1]
+    stepping[name] = step_part if isinstance(step_part, Exception) else step_part[0]
+    return own_part if isinstance(own_part, Exception) else own_part[0]
+
+
+def _canonical(canon: Canonical, engine: ModelEngine, states: States, own: Derivatives, *,
+               inputs: tuple[np.ndarray, ...], same: bool) -> Derivatives:
+    """An engine's derivatives in the canonical layout and chart (as given where its layout
+    is the canonical one and its chart the tangent one: nothing to map), its own finite
+    differences mapped with them."""
+    if own.chart is DerivativeChart.TANGENT and same:
+        return own
+    values = engine.dynamics(*inputs)
+    mine = engine.tree
+    mapped = to_canonical(canon, mine, states, own, values)
+    if own.own_differences is not None:
+        mapped = replace(mapped, defect=own.defect, own_differences=to_canonical(
+            canon, mine, states, own.own_differences, values))
+    return mapped
+
+
+def _stepping_rows(model: str, canon: Canonical, tree: ModelTree, name: str, *, steps: object,
+                   states: States, ref: Referee, at_steps: int) -> list[CheckRow]:
+    """An engine's step Jacobians against the referee's chain rule (none where it offers no
+    steps; one failed row where they failed)."""
+    if isinstance(steps, Unsupported):
+        return []
+    if isinstance(steps, Exception):  # costs its own row
+        return [_row(model, name, Verdict.FAILED, f"{type(steps).__name__}: {steps}")]
+    out: list[CheckRow] = []
+    for step in steps:  # type: ignore[attr-defined]
+        out.extend(step_rows(model, canon, tree, first(states, at_steps),
+                             first(ref, at_steps), name, step, of=len(states.q)))
     return out
 
 
