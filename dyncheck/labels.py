@@ -1,9 +1,12 @@
 """The name of every finding that explains a row, one home: the producers (the trajectory
 studies, the check's predictions and readings, the derivative pairs) attach them, and
-:mod:`dyncheck.explain.explanations` gives each its text and origin. Plain strings at the bottom of
-the import graph, so that neither side imports the other for a name."""
+:mod:`dyncheck.explain.explanations` gives each its text and :class:`Origin`. Plain strings
+(and that enum) at the bottom of the import graph, so that neither side imports the other
+for a name."""
 
 from __future__ import annotations
+
+from enum import Enum
 
 # The trajectory studies (dyncheck.studies)
 TRUNCATION = "integrator truncation error"
@@ -35,3 +38,16 @@ derivative beyond the bound, its own finite differences within it (measured on t
 READINGS = "engines' readings differ (derivatives)"
 """The label of a derivative row explained by two readings of the model
 (:func:`dyncheck.check.derivative_pairs.across_readings`)."""
+
+
+class Origin(Enum):
+    """Whose property a difference is."""
+
+    ENGINE = "engine"
+    """A definition, default or parser behaviour of an engine (documented or measured)."""
+    BOOK = "book"
+    """How the book writes a system (its coordinates, its idealizations)."""
+    MATHEMATICS = "mathematics"
+    """A property of the numerical method or of the equations themselves."""
+    DYNCHECK = "dyncheck"
+    """dyncheck's own code: never a valid explanation (fix the code)."""

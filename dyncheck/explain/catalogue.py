@@ -39,7 +39,6 @@ from dyncheck.explain.engine_defaults import (
     point_mass_floor,
 )
 from dyncheck.explain.entry import TUTORIALS, Entry, render
-from dyncheck.explain.explanations import Origin
 from dyncheck.explain.integrators import drake_fsal_caching, group_rk4, port_integrators
 from dyncheck.explain.moving import (
     newton_free_velocity,
@@ -53,6 +52,7 @@ from dyncheck.explain.parsers import (
     pinocchio_top_level_bodies,
 )
 from dyncheck.explain.spherical import pybullet_spherical_inertia
+from dyncheck.labels import Origin
 from dyncheck.workers import Unit, run_units
 
 __all__ = ["DEMOS", "REQUIRES", "TUTORIALS", "Entry", "explain", "explain_cached", "not_selected",

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dyncheck.explain.explanations import Origin
+from dyncheck.labels import Origin
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,6 @@ itself.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import Enum
 
 from dyncheck.labels import (
     ARMATURE_AXES,
@@ -26,6 +25,7 @@ from dyncheck.labels import (
     READINGS,
     ROTOR_ENERGY,
     TRUNCATION,
+    Origin,
 )
 from dyncheck.variants import (
     ENGINE_DEFECT,
@@ -34,19 +34,6 @@ from dyncheck.variants import (
     POINT_INERTIA,
     SOFT_CONSTRAINT,
 )
-
-
-class Origin(Enum):
-    """Whose property a difference is."""
-
-    ENGINE = "engine"
-    """A definition, default or parser behaviour of an engine (documented or measured)."""
-    BOOK = "book"
-    """How the book writes a system (its coordinates, its idealizations)."""
-    MATHEMATICS = "mathematics"
-    """A property of the numerical method or of the equations themselves."""
-    DYNCHECK = "dyncheck"
-    """dyncheck's own code: never a valid explanation (fix the code)."""
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -7,7 +7,8 @@ import pytest
 
 from dyncheck.check.predicted import PREDICTIONS
 from dyncheck.explain import catalogue
-from dyncheck.explain.explanations import EXPLANATIONS, Origin
+from dyncheck.explain.explanations import EXPLANATIONS
+from dyncheck.labels import Origin
 
 from ...conftest import PORTS
 
