@@ -35,7 +35,7 @@ import numpy as np
 
 from dyncheck.adapters.base import Adapter, Field, LoadedBody, ModelEngine, Offer, Trajectory
 from dyncheck.adapters.c_output import c_output_dropped
-from dyncheck.adapters.layout import Canonical, canonical_states
+from dyncheck.adapters.layout import Canonical, StateMap, canonical_states
 from dyncheck.adapters.layout_batch import engine_states, to_canonical
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.model_files import Format, read
@@ -202,15 +202,20 @@ class ModelAdapter(Adapter):
         return self._held(np.asarray(self.tree.gravity, float),
                           np.asarray(self.spec.gravity, float))
 
-    def _dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
+    def _mapped(self, q: np.ndarray, v: np.ndarray,
+                a: np.ndarray) -> tuple[Dynamics, list[StateMap], np.ndarray, np.ndarray]:
+        """The engine's dynamics at the states mapped into its layout, back in the canonical
+        one; with the states' maps and the engine's q and v (for the field's force)."""
         maps, qe, ve, ae = engine_states(self.canon, self.tree, q, v, a)
-        return to_canonical(maps, self.engine.dynamics(qe, ve, ae))
+        return to_canonical(maps, self.engine.dynamics(qe, ve, ae)), maps, qe, ve
+
+    def _dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
+        return self._mapped(q, v, a)[0]
 
     def evaluate_all(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
     ) -> dict[str, np.ndarray]:
-        maps, qe, ve, ae = engine_states(self.canon, self.tree, q, v, a)
-        d = to_canonical(maps, self.engine.dynamics(qe, ve, ae))
+        d, maps, qe, ve = self._mapped(q, v, a)
         pushed = self._pushed(maps, qe, ve)
         tau = tau + pushed
         d = replace(d, inverse=d.inverse - pushed)
@@ -257,8 +262,7 @@ class ModelAdapter(Adapter):
         return self.evaluate_all(q, v, tau, np.zeros_like(v))[Quantity.FORWARD_DYNAMICS]
 
     def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        maps, qe, ve, ae = engine_states(self.canon, self.tree, q, v, a)  # (mapped once)
-        d = to_canonical(maps, self.engine.dynamics(qe, ve, ae))
+        d, maps, qe, ve = self._mapped(q, v, a)
         return d.inverse - self._pushed(maps, qe, ve)
 
     def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
