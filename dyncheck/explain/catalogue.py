@@ -202,13 +202,19 @@ def measured_entry(name: str) -> tuple[Entry, dict[str, str], bool]:
     return entry, used, found
 
 
-def _entry(name: str, selected: Collection[str] | None) -> tuple[Entry, bool]:
-    """One entry of ``dyncheck explain`` (a unit of work): measured or read back, or skipped
-    where it needs an engine left out of ``selected`` (None: every engine)."""
-    skipped = None if selected is None else not_selected(name, selected, "dyncheck explain")
+def _selected_entry(name: str, selected: Collection[str] | None,
+                    command: str) -> tuple[Entry, dict[str, str], bool]:
+    """:func:`measured_entry`, or the entry skipped where it needs an engine left out of
+    ``selected`` (None: every engine) by ``command`` (no versions, not read back)."""
+    skipped = None if selected is None else not_selected(name, selected, command)
     if skipped is not None:
-        return skipped, False
-    entry, _, found = measured_entry(name)
+        return skipped, {}, False
+    return measured_entry(name)
+
+
+def _entry(name: str, selected: Collection[str] | None) -> tuple[Entry, bool]:
+    """One entry of ``dyncheck explain`` (a unit of work), with whether it was read back."""
+    entry, _, found = _selected_entry(name, selected, "dyncheck explain")
     return entry, found
 
 
@@ -231,10 +237,7 @@ def _convention(name: str, impl_names: Sequence[str]) -> tuple[list[Entry], dict
     the engines it uses; read back from the cache when measured before with the
     same dyncheck, engines and machine (``--no-cache``: measured afresh); skipped when it needs
     an optional engine the run leaves out (:func:`not_selected`)."""
-    skipped = not_selected(name, impl_names)
-    if skipped is not None:
-        return [skipped], {}
-    entry, used, _ = measured_entry(name)
+    entry, used, _ = _selected_entry(name, impl_names, "dyncheck run")
     return [entry], used
 
 
