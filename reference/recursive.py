@@ -212,7 +212,20 @@ class RecursiveDynamics(Tree):
         if v_along is not None:  # (K, ..., B, nv) → (..., K, B, nv)
             v_along = np.moveaxis(np.broadcast_to(v_along, (k_all, *lead, rows, self.nv)), 0,
                                   -3)
-        nb = len(self.bodies)
+        sel, state, force_rows = self._outward_along(q, v, a, columns, root=root,
+                                                     q_along=q_along, v_along=v_along)
+        tau = self._inward_along(sel, state, force_rows, shape=(*lead, k_all, rows, self.nv),
+                                 dtype=dtype, moved=q_along is not None)
+        return np.moveaxis(tau + self.armature * a[..., None, :, :], -3, 0)
+
+    def _outward_along(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, columns: np.ndarray,
+                       *, root: np.ndarray, q_along: np.ndarray | None,
+                       v_along: np.ndarray | None) -> tuple[list[np.ndarray], list, list]:
+        """:meth:`inverse_along`'s outward pass: per body, the states (indices into K) it is
+        evaluated on (its ancestors' columns; its base last), its pose, columns, velocity and
+        acceleration on them, and its force (v, a broadcast to (..., B, nv); v_along moved to
+        (..., K, B, nv))."""
+        rows, lead = len(q), v.shape[:-2]
         sel: list[np.ndarray] = []  # per body: the states (indices into K) it is evaluated on
         state: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         force_rows: list[np.ndarray | None] = []
@@ -250,8 +263,16 @@ class RecursiveDynamics(Tree):
             vel, acc = np.broadcast_to(vel, common), np.broadcast_to(acc, common)
             state.append((rot, trans, cols, vel, acc))
             force_rows.append(self._force(j, rot, trans, vel, acc))
+        return sel, state, force_rows
+
+    def _inward_along(self, sel: list[np.ndarray], state: list, force_rows: list, *,
+                      shape: tuple[int, ...], dtype: np.dtype, moved: bool) -> np.ndarray:
+        """:meth:`inverse_along`'s inward pass on every state: a body's force where it was not
+        evaluated is its base one; the forces summed inward, projected on each joint's columns
+        (``moved``: poses differ per state). τ of shape (..., K, B, nv)."""
+        nb, k_all = len(self.bodies), shape[-3]
         # inward, on every state: a body's force where it was not evaluated is its base one
-        tau = np.zeros((*lead, k_all, rows, self.nv), dtype)
+        tau = np.zeros(shape, dtype)
         total: list[np.ndarray | None] = [None] * nb
         for j in reversed(range(nb)):
             body = self.bodies[j]
@@ -264,14 +285,14 @@ class RecursiveDynamics(Tree):
             if mine_total is None:
                 continue
             cols = state[j][2]
-            cols = cols[every] if q_along is not None else cols
+            cols = cols[every] if moved else cols
             vs, own = self.v_start[j], NV[body.kind]
             tau[..., vs : vs + own] = (np.swapaxes(cols, -1, -2) @ mine_total[..., None])[..., 0]
             if body.parent >= 0:
                 parent_total = total[body.parent]
                 total[body.parent] = mine_total if parent_total is None \
                     else parent_total + mine_total
-        return np.moveaxis(tau + self.armature * a[..., None, :, :], -3, 0)
+        return tau
 
     def _placed(self, j: int, rot: np.ndarray, trans: np.ndarray
                 ) -> tuple[np.ndarray, np.ndarray] | None:
