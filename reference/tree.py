@@ -131,6 +131,11 @@ class Tree:
         ]
 
 
+_Column = tuple[slice, np.ndarray, "np.ndarray | None"]
+"""A joint's velocity columns on each row: their span in v, the columns (angular or linear),
+and the pivot of angular ones (None: linear)."""
+
+
 class TreeDynamics(Tree):
     """M, h, forward and inverse dynamics, T and V of a tree of :class:`Body` records."""
 
@@ -179,6 +184,42 @@ class TreeDynamics(Tree):
                     maps[ancestor] = rows[to_parent]
             self.rows_of.append(maps)
 
+    def _moved(self, body: Body, q: np.ndarray, xj: np.ndarray, *,
+               parent: tuple[np.ndarray, np.ndarray], qs: int, vs: int, own: int
+               ) -> tuple[np.ndarray, np.ndarray, list[_Column]]:
+        """A joint's body pose (R, t) on each row of :meth:`_at_chunk`, its parent's pose
+        ``parent`` and its chart coordinates ``xj`` given, with its velocity columns: (span,
+        angular columns, pivot) or (span, linear columns, None)."""
+        rp, tp = parent
+        anchor = np.asarray(body.anchor, float)
+        pivot = np.einsum("srij,j->sri", rp, anchor) + tp
+        span = slice(vs, vs + own)
+        if body.kind in ("hinge", "slide"):
+            axis = np.einsum("srij,j->sri", rp, body.axis)
+            coordinate = (q[:, qs] - body.zero)[:, None] + xj[..., 0]
+            columns = [(span, axis[..., None], pivot if body.kind == "hinge" else None)]
+        if body.kind == "hinge":
+            rot = rp @ rotation(body.axis, coordinate)
+            trans = pivot - np.einsum("srij,j->sri", rot, anchor)
+        elif body.kind == "slide":
+            rot = np.asarray(rp)
+            trans = tp + coordinate[..., None] * axis
+        elif body.kind == "ball":
+            e, jr = _exp_and_jr(xj)
+            current = body.frame @ _quat_matrix(q[:, qs : qs + 4])[:, None] @ e
+            rot = rp @ current @ body.frame.T
+            trans = pivot - np.einsum("srij,j->sri", rot, anchor)
+            columns = [(span, rp @ current @ jr, pivot)]
+        else:  # free: q = (p, quat) world pose; x = (dp, ξ)
+            e, jr = _exp_and_jr(xj[..., 3:])
+            world = _quat_matrix(q[:, qs + 3 : qs + 7])[:, None] @ e
+            position = q[:, None, qs : qs + 3] + xj[..., :3]
+            rot = world @ body.frame.T
+            trans = position - np.einsum("srij,j->sri", rot, anchor)
+            columns = [(slice(vs, vs + 3), np.broadcast_to(np.eye(3), rot.shape), None),
+                       (slice(vs + 3, vs + 6), world @ jr, position)]
+        return rot, trans, columns
+
     def _at_chunk(
         self, q: np.ndarray, v: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -226,33 +267,8 @@ class TreeDynamics(Tree):
                 rp = np.broadcast_to(np.eye(3), (ns, n + 2, 3, 3))
                 tp = np.zeros((ns, n + 2, 3))
                 omega = vel = np.zeros((ns, n + 2, 3), complex)
-            anchor = np.asarray(body.anchor, float)
-            pivot = np.einsum("srij,j->sri", rp, anchor) + tp
-            span = slice(vs, vs + own)
-            if body.kind in ("hinge", "slide"):
-                axis = np.einsum("srij,j->sri", rp, body.axis)
-                coordinate = (q[:, qs] - body.zero)[:, None] + xj[..., 0]
-                columns = [(span, axis[..., None], pivot if body.kind == "hinge" else None)]
-            if body.kind == "hinge":
-                rot = rp @ rotation(body.axis, coordinate)
-                trans = pivot - np.einsum("srij,j->sri", rot, anchor)
-            elif body.kind == "slide":
-                rot = np.asarray(rp)
-                trans = tp + coordinate[..., None] * axis
-            elif body.kind == "ball":
-                e, jr = _exp_and_jr(xj)
-                current = body.frame @ _quat_matrix(q[:, qs : qs + 4])[:, None] @ e
-                rot = rp @ current @ body.frame.T
-                trans = pivot - np.einsum("srij,j->sri", rot, anchor)
-                columns = [(span, rp @ current @ jr, pivot)]
-            else:  # free: q = (p, quat) world pose; x = (dp, ξ)
-                e, jr = _exp_and_jr(xj[..., 3:])
-                world = _quat_matrix(q[:, qs + 3 : qs + 7])[:, None] @ e
-                position = q[:, None, qs : qs + 3] + xj[..., :3]
-                rot = world @ body.frame.T
-                trans = position - np.einsum("srij,j->sri", rot, anchor)
-                columns = [(slice(vs, vs + 3), np.broadcast_to(np.eye(3), rot.shape), None),
-                           (slice(vs + 3, vs + 6), world @ jr, position)]
+            rot, trans, columns = self._moved(body, q, xj, parent=(rp, tp), qs=qs, vs=vs,
+                                              own=own)
             for part, w, point in columns:  # the twist: the parent's plus this joint's
                 turn = np.einsum("srik,sk->sri", w, v[:, part])
                 if point is None:
