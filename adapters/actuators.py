@@ -97,10 +97,16 @@ class Actuation:
 class InputJacobian:
     """An engine's Jacobian of one integrator step in its controls, ∂x₊/∂u with
     x = (δq, v, act) in its chart (n, 2 nv + na, nu), by finite differences of step
-    ``fd_step`` and, for their error, of twice that step (``coarse``)."""
+    ``fd_step`` and, for their error, of twice that step (``coarse``); or, where ``fd_step``
+    is 0, by automatic differentiation (exact to round-off: ``coarse`` is ``matrix``)."""
 
     matrix: np.ndarray
     coarse: np.ndarray
     time_step: float
     fd_step: float
     integrator: str
+
+    @property
+    def differentiated(self) -> bool:
+        """Whether it is automatic differentiation's (no truncation error)."""
+        return self.fd_step == 0.0

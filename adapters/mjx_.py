@@ -156,6 +156,26 @@ def _plus(mx: Any, q: Any, dq: Any) -> Any:
     return jnp.concatenate(parts)
 
 
+def _tangent(m: mujoco.MjModel, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
+    """Columns dq (n, nq, k) of qpos at q (n, nq) in MuJoCo's chart (n, nv, k): a ball's or
+    free joint's quaternion column as 2 vec(q* ⊗ dq) (body axes), the rest as they are."""
+    free, ball = int(mujoco.mjtJoint.mjJNT_FREE), int(mujoco.mjtJoint.mjJNT_BALL)
+    out, qi = [], 0
+    for kind in map(int, m.jnt_type):
+        if kind == free:
+            out.append(dq[:, qi:qi + 3])
+            qi += 3
+        if kind in (free, ball):
+            w, x = q[:, qi, None, None], q[:, qi + 1:qi + 4, None]  # q* = (w, −x)
+            dw, dx = dq[:, qi:qi + 1], dq[:, qi + 1:qi + 4]
+            out.append(2 * (w * dx - dw * x - np.cross(x, dx, axis=1)))
+            qi += 4
+        else:
+            out.append(dq[:, qi:qi + 1])
+            qi += 1
+    return np.concatenate(out, axis=1)
+
+
 def _derivatives(mx: Any, q: Any, v: Any, a: Any) -> dict[str, Any]:
     """JAX's forward-mode derivatives (``jacfwd``) of MJX's forward dynamics at τ = 0 with
     respect to q (MuJoCo's chart), v and τ, and of its inverse dynamics at v̇ = a with respect
@@ -187,8 +207,25 @@ def _actuate(mx: Any, q: Any, v: Any, inputs: tuple[Any, Any]) -> dict[str, Any]
     return {"qfrc_actuator": d.qfrc_actuator, "qacc": d.qacc}
 
 
+def _input_jacobian(mx: Any, q: Any, v: Any, inputs: tuple[Any, Any]) -> dict[str, Any]:
+    """JAX's ``jacfwd`` of one ``mjx.step`` (the model's integrator and time step) in the
+    controls at one state and ``inputs``, its control and activation state: the next qpos
+    (nq, nu), qvel (nv, nu) and act (na, nu), and the next qpos itself (the point where the
+    quaternions' columns are mapped into MuJoCo's chart)."""
+    u, act = inputs
+
+    def step(uu: Any) -> tuple[Any, Any]:
+        d = mjx.make_data(mx).replace(qpos=q, qvel=v, ctrl=uu, act=act)
+        new = mjx.step(mx, d)
+        return (new.qpos, new.qvel, new.act), new.qpos
+
+    (dq, dv, dact), q_next = jax.jacfwd(step, has_aux=True)(u)
+    return {"qpos": dq, "qvel": dv, "act": dact, "q_next": q_next}
+
+
 _EVALUATE = jax.jit(jax.vmap(_evaluate, in_axes=(None, 0, 0, 0, 0)))
 _ACTUATE = jax.jit(jax.vmap(_actuate, in_axes=(None, 0, 0, 0)))
+_INPUT_JACOBIAN = jax.jit(jax.vmap(_input_jacobian, in_axes=(None, 0, 0, 0)))
 _STRETCH = jax.jit(_stretch)
 _DERIVATIVES = jax.jit(jax.vmap(_derivatives, in_axes=(None, 0, 0, 0)))
 """Compiled once per model structure and precision, shared by every adapter: the model is an
@@ -222,7 +259,7 @@ class MJXAdapter(PortAdapter):
         static fields key the cache) and batch shape: left alone, a run of every case in one
         process reached the kernel's limit of 65 530 memory maps and died in XLA's LLVM
         ("Cannot allocate memory", then SIGSEGV)."""
-        for jitted in (_EVALUATE, _STRETCH, _DERIVATIVES, _ACTUATE):
+        for jitted in (_EVALUATE, _STRETCH, _DERIVATIVES, _ACTUATE, _INPUT_JACOBIAN):
             cast(Any, jitted).clear_cache()  # a method of jit's wrapper its stubs do not declare
 
     @staticmethod
@@ -276,6 +313,22 @@ class MJXAdapter(PortAdapter):
             q_, v_, u_, act_ = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, u, act))
             out = _ACTUATE(self.mx, q_, v_, (u_, act_))
             return {k: np.asarray(x) for k, x in out.items()}
+
+    def input_jacobian(self, q: np.ndarray, v: np.ndarray, u: np.ndarray, act: np.ndarray,
+                       *, integrator: str) -> np.ndarray:
+        """The port's own B = ∂x₊/∂u of one ``mjx.step`` by ``integrator`` at the model's time
+        step (:func:`_input_jacobian`), x = (δq, v, act) in MuJoCo's chart (n, 2 nv + na, nu):
+        a quaternion's column dq₊ mapped to the body-axes tangent 2 vec(q₊* ⊗ dq₊), the
+        derivative of ``mj_differentiatePos`` from the nominal q₊."""
+        with self._precision():
+            opt = self.mx.opt.replace(integrator=mjx.IntegratorType(
+                int(INTEGRATORS[integrator])))
+            mx = self.mx.replace(opt=opt)
+            q_, v_, u_, act_ = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, u, act))
+            out = {k: np.asarray(x, dtype=float)
+                   for k, x in _INPUT_JACOBIAN(mx, q_, v_, (u_, act_)).items()}
+        tangent = _tangent(self.model, out["q_next"], out["qpos"])
+        return np.concatenate([tangent, out["qvel"], out["act"]], axis=1)
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, np.ndarray]:
         """The port's own derivatives at a batch of states (:func:`_derivatives`: JAX's

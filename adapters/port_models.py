@@ -22,7 +22,7 @@ from dyncheck.adapters.actuators import Actuation, InputJacobian
 from dyncheck.adapters.base import Offer
 from dyncheck.adapters.model_files import ModelFile
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, derivatives
-from dyncheck.adapters.mujoco_actuators import activations, with_actuation
+from dyncheck.adapters.mujoco_actuators import STEPS, activations, with_actuation
 from dyncheck.adapters.mujoco_model import MujocoModel
 from dyncheck.errors import Unsupported
 
@@ -64,15 +64,32 @@ class PortModel(MujocoModel):
         class would inherit), on a second copy of MuJoCo's compiled model with actuation on
         put on the port (the smooth dynamics' copy has it off); activation states set to the
         controls, as on MuJoCo's side."""
-        if self._actuated_port is None:
-            self._actuated_port = type(self.adapter).on_model(with_actuation(self.model))
-        raw = self._actuated_port.actuate(q, v, u, activations(self.model, u))
+        raw = self._actuated().actuate(q, v, u, activations(self.model, u))
         return Actuation(tau=raw["qfrc_actuator"], forward=raw["qacc"])
 
     def input_jacobians(self, q: np.ndarray, v: np.ndarray,
                         u: np.ndarray) -> tuple[InputJacobian, ...]:
-        """Never the C engine's: the ports' step Jacobians are not taken here."""
-        raise Unsupported(f"{self.engine} offers no step Jacobian in its controls here")
+        """The port's own B = ∂x₊/∂u of one Euler and one implicitfast step, never the C
+        engine's (which this class would inherit): MJX's by JAX's ``jacfwd`` through
+        ``mjx.step`` on the copy with actuation on, activation states set to the controls as
+        on MuJoCo's side; a port without derivatives (MuJoCo Warp) is refused."""
+        if Offer.INPUT_JACOBIAN not in self.offers:
+            raise Unsupported(f"{self.engine} offers no step Jacobian in its controls (its "
+                              "kernels are not differentiated)")
+        port = self._actuated()
+        act = activations(self.model, u)
+        out = []
+        for name, _ in STEPS:
+            found = port.input_jacobian(q, v, u, act, integrator=name)
+            out.append(InputJacobian(matrix=found, coarse=found, fd_step=0.0, integrator=name,
+                                     time_step=float(self.model.opt.timestep)))
+        return tuple(out)
+
+    def _actuated(self) -> Any:
+        """The port holding a copy of the model with actuation on (made once)."""
+        if self._actuated_port is None:
+            self._actuated_port = type(self.adapter).on_model(with_actuation(self.model))
+        return self._actuated_port
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
         """The port's own derivatives, never the C engine's (which this class would inherit):
@@ -93,13 +110,13 @@ class PortModel(MujocoModel):
 
 class MjxModel(PortModel):
     engine = "mjx"
-    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION})
+    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION, Offer.INPUT_JACOBIAN})
     port = "dyncheck.adapters.mjx_:MJXAdapter"
 
 
 class MjxF64Model(PortModel):
     engine = "mjx-f64"
-    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION})
+    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION, Offer.INPUT_JACOBIAN})
     port = "dyncheck.adapters.mjx_:MJXF64Adapter"
 
 

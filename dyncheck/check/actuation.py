@@ -1,6 +1,6 @@
 """The controls in a model check: does each engine read the file's actuators as the canonical
-engine does (field by field, in the neutral form of :mod:`dyncheck.adapters.actuators`), and
-does the same control make the same generalized force — each engine against the referee's
+engine does (field by field: :mod:`dyncheck.check.actuator_readings`), and does the same
+control make the same generalized force — each engine against the referee's
 actuator law on that engine's own reading (:mod:`dyncheck.reference.actuation`: does it
 compute what it read), and against the canonical engine (do they read it alike, measured).
 
@@ -20,139 +20,19 @@ from dyncheck.adapters.actuators import Activation, Actuator
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
+from dyncheck.check.actuator_readings import UNKNOWN, match, reading_rows
+from dyncheck.check.actuator_readings import section_row as _row
 from dyncheck.check.computed import depth
 from dyncheck.check.engines import REFEREE
-from dyncheck.check.rows import COMPUTED, CheckRow, Section
+from dyncheck.check.rows import COMPUTED, CheckRow
 from dyncheck.check.states import States, condition
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.reference import actuation as law
 from dyncheck.vocabulary import Verdict
 
 FORCE = "actuator force"
-FIELD_RTOL = 1e-9
-"""Two readings of a field agree to this, relative (the file's digits, parsed twice)."""
-UNKNOWN = "cause unknown"
 DYNAMICS = {Activation.NONE: law.NONE, Activation.INTEGRATOR: law.INTEGRATOR,
             Activation.FILTER: law.FILTER, Activation.FILTER_EXACT: law.FILTER_EXACT}
-
-
-def _row(model: str, *, subject: str, field: str, a: str, b: str, verdict: Verdict,
-         note: str, value_a: str = "", value_b: str = "", error: float = 0.0,
-         tolerance: float = 0.0, basis: str = "", worst: int = -1) -> CheckRow:
-    return CheckRow(model=model, section=Section.ACTUATION, subject=subject, field=field,
-                    impl_a=a, impl_b=b, value_a=value_a, value_b=value_b, error=error,
-                    tolerance=tolerance, basis=basis, verdict=verdict, note=note,
-                    worst_state=worst)
-
-
-def limits(actuator: Actuator) -> object:
-    """The bounds as they act: for a motor-like law (fixed gain, no bias) the force interval
-    the ranges leave, gain × control range ∩ force range ∩ the joint's range; else the three
-    ranges as given."""
-    if actuator.gain[1:] == (0.0, 0.0) and actuator.bias == (0.0, 0.0, 0.0) and \
-            actuator.activation is Activation.NONE:
-        low, high = -np.inf, np.inf
-        if actuator.ctrl_range is not None:
-            ends = sorted(actuator.gain[0] * np.array(actuator.ctrl_range))
-            low, high = ends[0], ends[1]
-        for bound in (actuator.force_range, actuator.joint_range):
-            if bound is not None:
-                low, high = max(low, bound[0]), min(high, bound[1])
-        return None if not (np.isfinite(low) or np.isfinite(high)) else (float(low), float(high))
-    return (actuator.ctrl_range, actuator.force_range, actuator.joint_range)
-
-
-def shown_value(value: object) -> str:
-    """A field's value as a row shows it."""
-    if value is None:
-        return "unlimited"
-    if isinstance(value, tuple):
-        return "(" + ", ".join(shown_value(x) for x in value) + ")"
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    return str(value)
-
-
-def same(a: object, b: object, *, rtol: float) -> bool:
-    """Whether two field values agree to ``rtol`` of their size (exactly for a name)."""
-    if a is None or b is None or isinstance(a, str) or isinstance(b, str):
-        return a == b
-    if isinstance(a, tuple) and isinstance(b, tuple) and any(
-            x is None or isinstance(x, tuple) for x in (*a, *b)):  # ranges of ranges
-        return len(a) == len(b) and all(same(x, y, rtol=rtol) for x, y in zip(a, b, strict=True))
-    x, y = np.atleast_1d(np.asarray(a, float)), np.atleast_1d(np.asarray(b, float))
-    scale = max(float(np.abs(x).max(initial=0.0)), float(np.abs(y).max(initial=0.0)), 1e-300)
-    finite = np.isfinite(x) & np.isfinite(y)
-    return bool(x.shape == y.shape and np.array_equal(np.isfinite(x), np.isfinite(y))
-                and np.all(np.abs(x - y)[finite] <= rtol * scale)
-                and np.array_equal(x[~finite], y[~finite]))
-
-
-def compared_fields(actuator: Actuator) -> dict[str, object]:
-    """The fields two readings compare: gear, gain, bias, the acting bounds, activation."""
-    return {"gear": actuator.gear, "gain": actuator.gain, "bias": actuator.bias,
-            "limits": limits(actuator), "activation": actuator.activation.value,
-            "time constant": actuator.time_constant}
-
-
-def match(mine: tuple[Actuator, ...], theirs: tuple[Actuator, ...]) -> dict[int, int]:
-    """My actuator's place → theirs: by joint where every joint has at most one actuator on
-    both sides (engines name unnamed actuators their own way), else by name."""
-    def by_joint(acts: tuple[Actuator, ...]) -> dict[str, int]:
-        joints = [a.joint for a in acts if a.joint]
-        return {a.joint: k for k, a in enumerate(acts) if a.joint} \
-            if len(joints) == len(set(joints)) else {}
-    a, b = by_joint(mine), by_joint(theirs)
-    if a and b and len(a) == len([x for x in mine if x.joint]):
-        return {k: b[j] for j, k in a.items() if j in b}
-    names = {x.name: k for k, x in enumerate(theirs)}
-    return {k: names[x.name] for k, x in enumerate(mine) if x.name in names}
-
-
-def _hint(tree: ModelTree, actuator: str, field: str) -> str:
-    return tree.hint(actuator, field) or UNKNOWN
-
-
-def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[CheckRow]:
-    """Each actuator of ``other`` against the canonical reading: one passed row where every
-    field agrees, else a failed row per differing field with the engine's known reason
-    (its hint, premise checked) or "cause unknown"; an actuator one side lacks, a row — but
-    where the canonical engine holds none at all, one row: explained where its reason is
-    known (MuJoCo's URDF compiler makes no actuator: the format gives it none to read)."""
-    a, b = canonical.engine, other.engine
-    why = canonical.hint("model", "actuator")
-    if not canonical.actuators and other.actuators:  # once, not once per actuator
-        return [_row(model, subject="model", field="actuators", a=a, b=b, value_a="none",
-                     value_b=f"{len(other.actuators)} ({other.actuators[0].what}, …)",
-                     verdict=Verdict.EXPLAINED if why else Verdict.FAILED,
-                     note=why or UNKNOWN)]
-    pairs = match(canonical.actuators, other.actuators)
-    rows = []
-    for k, mine in enumerate(canonical.actuators):
-        if k not in pairs:
-            rows.append(_row(model, subject=mine.name, field="actuator", a=a, b=b,
-                             value_a=mine.what, value_b="absent", verdict=Verdict.FAILED,
-                             note=_hint(other, "model", "actuator")))
-            continue
-        theirs = other.actuators[pairs[k]]
-        ours, found = compared_fields(mine), compared_fields(theirs)
-        differ = [f for f in ours if not same(ours[f], found[f], rtol=FIELD_RTOL)]
-        if not differ:
-            rows.append(_row(model, subject=mine.name, field="reading", a=a, b=b,
-                             value_a=mine.what, value_b=theirs.what, verdict=Verdict.PASSED,
-                             note=f"gear, gain, bias, limits and activation alike ({b}'s "
-                                  f"{theirs.what})"))
-        for f in differ:
-            rows.append(_row(model, subject=mine.name, field=f, a=a, b=b,
-                             value_a=shown_value(ours[f]), value_b=shown_value(found[f]),
-                             verdict=Verdict.FAILED, note=_hint(other, theirs.name, f)))
-    held = set(pairs.values())
-    for k, theirs in enumerate(other.actuators):
-        if k not in held:
-            rows.append(_row(model, subject=theirs.name, field="actuator", a=a, b=b,
-                             value_a="absent", value_b=theirs.what, verdict=Verdict.FAILED,
-                             note=why or _hint(other, theirs.name, "actuator")))
-    return rows
 
 
 def joint_actuators(tree: ModelTree) -> law.JointActuators | None:
@@ -423,15 +303,13 @@ def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
          loaded: dict[str, ModelEngine], seed: int, smooth: dict[str, Dynamics] | None = None,
          own: dict[str, Dynamics] | None = None) -> tuple[list[CheckRow], list[str]]:
     """The actuation section: every engine's reading of the actuators against the canonical
-    one, every engine's force against the referee and the canonical engine, and the
-    canonical engine's step Jacobian in the controls against the chain rule; and the notes
+    one, every engine's force against the referee and the canonical engine, and every
+    engine's own step Jacobian in the controls against the chain rule; and the notes
     that say what was left out."""
-    from dyncheck.check import input_jacobian
 
     own = own or {}
     out: list[CheckRow] = []
     notes: list[str] = []
-    first = next(iter(loaded.values()))
     offering = [m for m in loaded.values() if Offer.ACTUATION in m.offers]
     holding = next((m.tree for m in loaded.values() if m.tree.actuators), None)
     if holding is None:  # (only an engine whose dynamics failed held them: its row says so)
@@ -456,28 +334,53 @@ def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
     inside = sample_controls(holding.actuators, k, seed, spread=0.8)
     out.extend(_derivative_rows(model, canon=canon, holding=holding, batch=batch,
                                 loaded=loaded, inside=inside, own=own))
-    acts = joint_actuators(canonical)
-    if Offer.INPUT_JACOBIAN in first.offers and acts is not None and canonical.actuators \
-            and first.engine in own:  # (the referee on the canonical reading: own's first)
-        q, v = batch.q[:k], batch.v[:k]
-        inside = controls_for(holding, canonical, inside)
-        mass, bias = own[first.engine].mass_matrix[:k], own[first.engine].bias[:k]
-        subject = "step Jacobian in the controls"
+    out.extend(_input_jacobian_rows(model, canon=canon, holding=holding, batch=batch,
+                                    loaded=loaded, inside=inside, own=own))
+    return out, notes
+
+
+def _input_jacobian_rows(model: str, *, canon: Canonical, holding: ModelTree, batch: States,
+                         loaded: dict[str, ModelEngine], inside: np.ndarray,
+                         own: dict[str, Dynamics]) -> list[CheckRow]:
+    """Every engine's own step Jacobian in the controls where it offers one (MuJoCo's by
+    finite differences, MJX's by JAX), against the chain rule through the referee on its
+    reading (``own``) at the first :data:`INPUT_STATES` states, controls ``inside`` their
+    ranges; compared in the canonical layout, which a MuJoCo-family engine's is."""
+    from dyncheck.check import input_jacobian
+
+    out = []
+    k = len(inside)
+    q, v = batch.q[:k], batch.v[:k]
+    subject = "step Jacobian in the controls"
+    for engine, m in loaded.items():
+        acts = joint_actuators(m.tree)
+        if Offer.INPUT_JACOBIAN not in m.offers or acts is None or not m.tree.actuators \
+                or engine not in own:
+            continue
+        maps, q_e, _, _ = layout_batch.engine_states(canon, m.tree, q, v, batch.a[:k])
+        if not (np.array_equal(q_e, q) and all(np.array_equal(s.t, np.eye(len(s.t)))
+                                               for s in maps)):
+            out.append(_row(model, subject=subject, field=COMPUTED, a=REFEREE, b=engine,
+                            verdict=Verdict.SKIPPED, note=f"not compared: {engine}'s "
+                            "layout is not the canonical reading's, and dyncheck maps no "
+                            "step Jacobian between charts"))
+            continue
+        mass, bias = own[engine].mass_matrix[:k], own[engine].bias[:k]
         if not (np.all(np.isfinite(mass)) and np.all(np.isfinite(bias))
                 and np.all(np.linalg.eigvalsh(mass) > 0)):
-            out.append(_row(model, subject=subject, field=COMPUTED, a=REFEREE, b=first.engine,
+            out.append(_row(model, subject=subject, field=COMPUTED, a=REFEREE, b=engine,
                             verdict=Verdict.SKIPPED, note="not compared: the referee's M is "
                             "not positive definite or h not finite on this reading (the "
                             "dynamics rows say why)"))
-            return out, notes
+            continue
+        u = controls_for(holding, m.tree, inside)
         try:
-            jacobians = first.input_jacobians(q, v, inside)
+            jacobians = m.input_jacobians(q, v, u)
         except Exception as exc:  # a failing engine costs its own rows
-            out.append(_row(model, subject=subject, field=COMPUTED, a=REFEREE, b=first.engine,
+            out.append(_row(model, subject=subject, field=COMPUTED, a=REFEREE, b=engine,
                             verdict=Verdict.FAILED, note=f"{type(exc).__name__}: {exc}"))
-            jacobians = ()
-        for jacobian in jacobians:
-            out.append(input_jacobian.rows(
-                model, canon=canon, tree=canonical, acts=acts, mass=mass, bias=bias, q=q, v=v,
-                u=inside, found=jacobian))
-    return out, notes
+            continue
+        out.extend(input_jacobian.rows(model, canon=canon, tree=m.tree, acts=acts, mass=mass,
+                                       bias=bias, q=q, v=v, u=u, found=found)
+                   for found in jacobians)
+    return out

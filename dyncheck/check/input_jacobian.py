@@ -1,6 +1,7 @@
 """∂x₊/∂u in a model check: an engine's Jacobian of one step in its controls (MuJoCo's B, by
-``mjd_transitionFD``) against the chain rule through the referee — the book's general method
-on the engine's reading for M and h ((2.2.23)–(2.2.24)), the clean-room actuator law of
+``mjd_transitionFD``; MJX's, by JAX's ``jacfwd`` through ``mjx.step``) against the chain
+rule through the referee — the book's general method on the engine's reading for M and h
+((2.2.23)–(2.2.24)), the clean-room actuator law of
 :mod:`dyncheck.reference.actuation` for τ(u) —, differentiated in u by a complex step:
 
     semi-implicit Euler:  v₊ = v + h M⁻¹ (τ(q, v, u) − h(q, v)),
@@ -60,23 +61,36 @@ def rows(model: str, *, canon: Canonical, tree: ModelTree, acts: law.JointActuat
          mass: np.ndarray, bias: np.ndarray, q: np.ndarray, v: np.ndarray, u: np.ndarray,
          found: InputJacobian) -> CheckRow:
     """The engine's B against :func:`chain_rule` at every state: one row. Tolerance as the
-    step Jacobian's (:func:`dyncheck.check.steps.step_rows`): round-off, the engine's
-    centered differences' error |B(2s) − B(s)|/3 and their round-off over 2 s, v₊'s
-    round-off amplified by κ(M)."""
+    step Jacobian's (:func:`dyncheck.check.steps.step_rows`): round-off in the engine's ε,
+    and for finite differences their error |B(2s) − B(s)|/3 and their round-off over 2 s,
+    v₊'s round-off amplified by κ(M); for automatic differentiation (MJX's), the round-off of
+    h M⁻¹ ∂τ/∂u, c ε × depth × κ(M) of the largest entry."""
     h, engine = found.time_step, tree.engine
     expected = np.stack([chain_rule(canon, acts, mass=mass[s], bias=bias[s], q=q[s], v=v[s],
                                     u=u[s], h=h, integrator=found.integrator)
                          for s in range(len(q))])
     off = np.abs(found.matrix - expected)
     scale = max(float(np.abs(expected).max(initial=0.0)), 1e-300)
-    x_scale = max(float(np.abs(q).max()), float(np.abs(v).max()), float(np.abs(u).max()), 1.0)
+    eps = max(EPS, tree.eps)
     kappa = np.linalg.cond(mass)[:, None, None]
-    acceleration = np.abs(np.linalg.solve(mass, bias[..., None])[..., 0]).max(axis=1)
-    amplified = (2 * ROUNDOFF_FACTOR * EPS * depth(tree) * kappa * h
-                 * (acceleration[:, None, None] + x_scale) / (2 * found.fd_step))
-    fd = np.abs(found.coarse - found.matrix) / 3 + \
-        2 * ROUNDOFF_FACTOR * EPS * depth(tree) * x_scale / (2 * found.fd_step) + amplified
-    allowed = ROUNDOFF_FACTOR * EPS * depth(tree) * scale + fd
+    roundoff = ROUNDOFF_FACTOR * eps * depth(tree)
+    if found.differentiated:
+        allowed = roundoff * kappa * scale * np.ones_like(off)
+        method = (f"{engine}'s automatic differentiation: round-off {ROUNDOFF_FACTOR} eps "
+                  f"{eps:.3g} x tree depth {depth(tree)} x cond(M) (up to "
+                  f"{float(kappa.max()):.3g})")
+    else:
+        x_scale = max(float(np.abs(q).max()), float(np.abs(v).max()),
+                      float(np.abs(u).max()), 1.0)
+        acceleration = np.abs(np.linalg.solve(mass, bias[..., None])[..., 0]).max(axis=1)
+        amplified = (2 * roundoff * kappa * h * (acceleration[:, None, None] + x_scale)
+                     / (2 * found.fd_step))
+        fd = np.abs(found.coarse - found.matrix) / 3 + \
+            2 * roundoff * x_scale / (2 * found.fd_step) + amplified
+        allowed = roundoff * scale + fd
+        method = (f"round-off {ROUNDOFF_FACTOR} eps x tree depth {depth(tree)}; + "
+                  f"{engine}'s centered differences' error (steps {found.fd_step:g}, "
+                  f"{2 * found.fd_step:g})")
     worst = np.unravel_index(int(np.argmax(off / allowed)), off.shape)
     within = bool(np.all(off <= allowed))
     return CheckRow(
@@ -85,9 +99,7 @@ def rows(model: str, *, canon: Canonical, tree: ModelTree, acts: law.JointActuat
         field=COMPUTED, impl_a="reference", impl_b=engine, value_a="", value_b="",
         error=float(off.max()) / scale, tolerance=float(allowed.max()) / scale,
         basis=(f"the chain rule through the referee's M, h and actuator law (complex step "
-               f"in u); round-off {ROUNDOFF_FACTOR} eps x tree depth {depth(tree)}; + "
-               f"{engine}'s centered differences' error (steps {found.fd_step:g}, "
-               f"{2 * found.fd_step:g}); controls inside their ranges"),
+               f"in u); {method}; controls inside their ranges"),
         verdict=Verdict.PASSED if within else Verdict.FAILED,
         note="" if within else (
             f"{engine} differs from the chain rule at state {worst[0]}, entry ({worst[1]}, "

@@ -46,7 +46,8 @@ def test_a_port_agrees_with_mujoco_and_the_referee_within_its_precision(port):
 def test_a_port_never_passes_off_mujoco_cs_derivatives_as_its_own():
     """A port's model class inherits MuJoCo C's loader, derivatives included: a port without
     derivatives of its own (MuJoCo Warp) must refuse them (a skipped row) rather than answer
-    with the C engine's under the port's name; no port's step Jacobian is checked."""
+    with the C engine's under the port's name, its step Jacobian in the state and, where it
+    has no derivatives, in the controls too."""
     from types import SimpleNamespace
 
     from dyncheck.adapters.port_models import MjxModel, MujocoWarpModel
@@ -58,6 +59,8 @@ def test_a_port_never_passes_off_mujoco_cs_derivatives_as_its_own():
         port.derivatives(None, None, None)
     with pytest.raises(Unsupported, match="mjx: the port's step Jacobian"):
         object.__new__(MjxModel).transition(None, None, None)
+    with pytest.raises(Unsupported, match="mujoco-warp offers no step Jacobian in its controls"):
+        port.input_jacobians(None, None, None)
 
 
 @pytest.mark.slow
@@ -105,3 +108,50 @@ def test_a_ports_own_actuator_force_agrees_with_the_referee_and_mujoco(port, tmp
     assert judged[("mujoco", "actuator force")] == "passed"
     if port != "mjx-f64":  # float32: the port's own numbers, not C's copied
         assert rows[rows["impl_a"] == "mujoco"]["error"].max() > 1e-12
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("port", ["mjx", "mjx-f64"])
+def test_mjxs_own_step_jacobian_in_the_controls_agrees_with_the_chain_rule(port):
+    """#64 item 3: MJX's B = ∂x₊/∂u (JAX's jacfwd through one mjx.step, a ball's and a free
+    body's quaternion columns mapped to MuJoCo's chart) of an Euler and an implicitfast step
+    against the chain rule through the referee (the book's general method and the clean-room
+    actuator law, differentiated by a complex step: independent), on a ball, a hinge, a
+    slide with a filter's activation state and a free body; float32 within its bound."""
+    if not _installed(port):
+        pytest.skip(f"needs the extra that installs {port}")
+    result = check_model(MODELS / "actuated_ball_free.xml", impls=("reference", "mujoco", port),
+                         states=4)
+    rows = result.rows[result.rows["subject"].str.startswith("step Jacobian in the controls")
+                       & (result.rows["impl_b"] == port)]
+    assert sorted(s.split("(")[1].split(" ")[0] for s in rows["subject"]) == [
+        "euler", "implicitfast"]
+    assert (rows["verdict"] == "passed").all(), rows[["subject", "error", "tolerance", "note"]]
+    assert rows["basis"].str.contains("automatic differentiation").all()
+    if port == "mjx":  # float32's own numbers, not float64's
+        assert rows["error"].max() > 1e-9
+
+
+@pytest.mark.slow
+def test_a_quaternion_column_mapped_without_its_factor_two_fails(monkeypatch):
+    """A mutation of MJX's chart map (the quaternion's tangent halved: the columns of
+    ∂q₊/∂u read as a rotation vector without the factor 2 of 2 vec(q* ⊗ dq)) fails the
+    float64 row: the comparison sees the ball's and the free body's rows."""
+    if not _installed("mjx-f64"):
+        pytest.skip("needs the extra that installs mjx-f64")
+    from dyncheck.adapters import mjx_
+
+    tangent = mjx_._tangent
+
+    def halved(m, q, dq):
+        out = tangent(m, q, dq)
+        out[:, :3] /= 2  # the ball joint's rotation columns
+        return out
+
+    monkeypatch.setattr(mjx_, "_tangent", halved)
+    result = check_model(MODELS / "actuated_ball_free.xml",
+                         impls=("reference", "mujoco", "mjx-f64"), states=4,
+                         isolate=False)  # (the mutation is in this process)
+    rows = result.rows[result.rows["subject"].str.startswith("step Jacobian in the controls")
+                       & (result.rows["impl_b"] == "mjx-f64")]
+    assert len(rows) == 2 and (rows["verdict"] == "failed").all()
