@@ -34,13 +34,12 @@ from dyncheck.check.dynamics import (
     QUANTITIES,
     Prediction,
     compare,
-    sample,
-    sampled_note,
     tie_row,
 )
 from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
 from dyncheck.check.referee import ReferenceModel, standing_of
 from dyncheck.check.rows import COLUMNS, CheckResult, CheckRow, Section
+from dyncheck.check.sampling import sample, sampled_note
 from dyncheck.check.states import States, condition
 from dyncheck.errors import InvalidInput, UnknownName
 from dyncheck.escaping import shown

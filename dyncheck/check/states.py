@@ -1,6 +1,7 @@
-"""The states a check samples (:class:`States`, drawn by :func:`dyncheck.check.dynamics.sample`)
-and the conditioning of M over them (:func:`condition`, which scales the round-off bounds):
-held apart from the comparisons, since every section of the check takes them."""
+"""The states a check samples (:class:`States`, drawn by
+:func:`dyncheck.check.sampling.sample`) and the conditioning of M over them
+(:func:`condition`, which scales the round-off bounds): held apart from the comparisons,
+since every section of the check takes them."""
 
 from __future__ import annotations
 

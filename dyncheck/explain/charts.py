@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from dyncheck.explain.entry import Entry
-from dyncheck.explain.measure import beside_mujoco
+from dyncheck.explain.loaders import beside_mujoco
 
 FALLING = ("<mujoco><worldbody><body name='box' pos='0 0 1'><freejoint name='root'/>"
            "<inertial pos='0.2 -0.1 0.05' mass='1.5' diaginertia='0.1 0.2 0.3'/></body>"

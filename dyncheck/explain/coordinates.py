@@ -9,11 +9,42 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters import get_adapter
-from dyncheck.adapters.model_tree import Orientation
+from dyncheck.adapters.model_tree import Orientation, StateLayout
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import LinearMap
+from dyncheck.comparison import compare_instantaneous
+from dyncheck.coordinates import NativeMap
 from dyncheck.explain.entry import Entry
-from dyncheck.explain.measure import map_demo, pin_mjcf, worst
+from dyncheck.explain.loaders import pin_mjcf
+from dyncheck.implementations import EngineImplementation, make_implementation
+from dyncheck.vocabulary import Verdict
+
+
+def worst(case_name: str, engine: str, cmap=None,
+          state_layout: StateLayout | None = None) -> float:
+    """Largest relative error of ``engine`` against the reference over the instantaneous
+    quantities, with the case's map replaced by ``cmap`` or the engine's storage conventions
+    by ``state_layout`` (the other kept)."""
+    case = get_case(case_name)
+    impl = make_implementation(engine, case)
+    if cmap is not None or state_layout is not None:
+        assert isinstance(impl, EngineImplementation)
+        impl.map = NativeMap.of(case, engine, cmap, state_layout)
+    impls = {"reference": make_implementation("reference", case), engine: impl}
+    rows = compare_instantaneous(case, impls, case.sample_states())
+    errors = [r.max_rel_err for r in rows if r.verdict != Verdict.EXPLAINED or cmap is not None]
+    if cmap is not None and any(r.verdict == Verdict.FAILED and np.isnan(r.max_rel_err)
+                                for r in rows):
+        return float("inf")  # the naive map made a quantity fail outright (singular, NaN)
+    return float(np.nanmax(errors))
+
+
+def map_demo(
+    name: str, case: str, engine: str, naive: LinearMap, what: str, engines: str
+) -> Entry:
+    return Entry(
+        name, what, engines, naive.description, worst(case, engine, naive), worst(case, engine)
+    )
 
 
 def relative_angles() -> Entry:

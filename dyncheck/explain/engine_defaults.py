@@ -7,7 +7,7 @@ import numpy as np
 
 from dyncheck.cases import get_case
 from dyncheck.explain.entry import Entry
-from dyncheck.explain.measure import pin_mjcf
+from dyncheck.explain.loaders import pin_mjcf
 
 
 def mujoco_defaults() -> Entry:

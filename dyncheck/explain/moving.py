@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from dyncheck.explain.entry import Entry
-from dyncheck.explain.measure import beside_mujoco
+from dyncheck.explain.loaders import beside_mujoco
 from dyncheck.vocabulary import Quantity
 
 ARM = """<robot name="arm">

@@ -7,7 +7,7 @@ import numpy as np
 
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.explain.entry import Entry
-from dyncheck.explain.measure import pin_mjcf
+from dyncheck.explain.loaders import pin_mjcf
 
 
 def pinocchio_top_level_bodies() -> Entry:

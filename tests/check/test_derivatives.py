@@ -71,7 +71,7 @@ def test_the_pendulum_derivatives_are_the_books_closed_form(tmp_path):
     from dyncheck.adapters.model_files import read
     from dyncheck.adapters.pinocchio_model import PinocchioModel
     from dyncheck.check import derivative_charts, derivative_referee
-    from dyncheck.check.dynamics import sample
+    from dyncheck.check.sampling import sample
 
     model = PinocchioModel(read(path))
     canon = layout.canonical(model.tree)

@@ -109,27 +109,3 @@ def test_drake_is_compared_on_a_model_with_equality_constraints(tmp_path):
     drake = rows[(rows["section"] == "dynamics") & (rows["impl_b"] == "drake")]
     assert len(drake) == 12 and set(drake["verdict"]) == {"passed"}, drake
     assert any("without its equality constraints (1 <connect>)" in n for n in result.notes)
-
-
-NO_BOUNDS = """<robot name="nolim">
-  <link name="base"><inertial><mass value="2"/>
-    <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.04"/></inertial></link>
-  <link name="arm"><inertial><origin xyz="0.1 0 0"/><mass value="1"/>
-    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.025"/></inertial></link>
-  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/>
-    <origin xyz="0 0.2 0"/><axis xyz="0 0 1"/><limit effort="1" velocity="1"/></joint>
-</robot>"""
-
-
-def test_a_range_of_no_width_is_replaced_by_the_default_and_said(tmp_path):
-    """A URDF <limit> without lower and upper: Pinocchio reads (0, 0) (measured). As the
-    canonical engine its range would hold the joint at 0 in every state; the states are
-    drawn on (−π, π) instead and the page says so, per joint (the issue's statement)."""
-    path = tmp_path / "nolim.urdf"
-    path.write_text(NO_BOUNDS)
-    result = check_model(path, states=30, impls=("reference", "pinocchio"))
-    note = next(n for n in result.notes if n.startswith("sampled configurations"))
-    assert "j [-3.142, 3.142] (its range (0, 0) has no width: the default drawn)" in note
-    result = check_model(path, states=30, impls=("reference", "mujoco"))  # MuJoCo: unlimited
-    note = next(n for n in result.notes if n.startswith("sampled configurations"))
-    assert note.endswith("j [-3.142, 3.142]")

@@ -153,9 +153,9 @@ def test_the_rk4_chain_rule_on_rotations_is_the_derivative_of_the_step_itself():
     from dyncheck.adapters.model_files import read
     from dyncheck.check.derivative_charts import perturb
     from dyncheck.check.derivative_referee import referee
-    from dyncheck.check.dynamics import sample
     from dyncheck.check.engines import load
     from dyncheck.check.referee import ReferenceModel
+    from dyncheck.check.sampling import sample
     from dyncheck.check.states import States
     from dyncheck.check.steps import rk4_stages, rk4_step
 

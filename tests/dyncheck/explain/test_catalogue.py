@@ -12,7 +12,7 @@ from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.cli import main
 from dyncheck.errors import UnknownName
 from dyncheck.explain import catalogue
-from dyncheck.explain.measure import worst
+from dyncheck.explain.coordinates import worst
 
 MAP_DEMOS = [
     "relative-vs-absolute-angles",
