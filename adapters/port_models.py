@@ -64,7 +64,7 @@ class PortModel(MujocoModel):
         class would inherit), on a second copy of MuJoCo's compiled model with actuation on
         put on the port (the smooth dynamics' copy has it off); activation states set to the
         controls, as on MuJoCo's side."""
-        raw = self._actuated().actuate(q, v, u, activations(self.model, u))
+        raw = self._actuation_port().actuate(q, v, u, activations(self.model, u))
         return Actuation(tau=raw["qfrc_actuator"], forward=raw["qacc"])
 
     def input_jacobians(self, q: np.ndarray, v: np.ndarray,
@@ -76,7 +76,7 @@ class PortModel(MujocoModel):
         if Offer.INPUT_JACOBIAN not in self.offers:
             raise Unsupported(f"{self.engine} offers no step Jacobian in its controls (its "
                               "kernels are not differentiated)")
-        port = self._actuated()
+        port = self._actuation_port()
         act = activations(self.model, u)
         out = []
         for name, _ in STEPS:
@@ -85,7 +85,7 @@ class PortModel(MujocoModel):
                                      time_step=float(self.model.opt.timestep)))
         return tuple(out)
 
-    def _actuated(self) -> Any:
+    def _actuation_port(self) -> Any:
         """The port holding a copy of the model with actuation on (made once)."""
         if self._actuated_port is None:
             self._actuated_port = type(self.adapter).on_model(with_actuation(self.model))
