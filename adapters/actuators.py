@@ -45,6 +45,11 @@ class Transmission(StrEnum):
     force law: MuJoCo-only, stated once per model and not modelled here."""
 
 
+EULER_DAMPING = "euler's implicit damping"
+"""The hint an engine's tree carries where its Euler step applies the joints' damping
+implicitly, (M + h D), though the model's dampers are disabled (the premise checked: some
+joint is damped): the step Jacobian in the controls is then predicted with it."""
+
 Range = tuple[float, float] | None
 """(lower, upper) where limited; None where not."""
 

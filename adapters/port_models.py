@@ -18,7 +18,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from dyncheck.adapters.actuators import Actuation, InputJacobian
+from dyncheck.adapters.actuators import EULER_DAMPING, Actuation, InputJacobian
 from dyncheck.adapters.base import Offer
 from dyncheck.adapters.model_files import ModelFile
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, derivatives
@@ -35,6 +35,12 @@ class PortModel(MujocoModel):
     port: ClassVar[str] = ""
     """``module:class`` of the port's adapter (imported here only: JAX and Warp cost seconds)."""
     _actuated_port: Any = None
+    euler_damps_when_disabled: ClassVar[bool] = False
+    """Whether the port's Euler step applies the joints' damping implicitly, (M + h D),
+    though the model disables its dampers (MJX: read in ``mujoco/mjx/_src/forward.py``,
+    ``euler`` tests only the eulerdamp flag; measured on a damped pendulum, mujoco-mjx
+    3.17.0: its B is h/(M + h d) with or without ``<flag damper="disable">``, where MuJoCo C
+    gives h/M)."""
 
     def __init__(self, source: ModelFile) -> None:
         super().__init__(source)
@@ -47,7 +53,20 @@ class PortModel(MujocoModel):
             f"{self.engine}: MuJoCo's compiled model put on the port ({adapter.version()}), "
             f"computing in {np.dtype(adapter.dtype).name} (round-off bounds with eps "
             f"{eps:.3g}); energies from the port's M and centres of mass",
-        ))
+        ), hints=(*self.tree.hints, *self._euler_damping(adapter.version())))
+
+    def _euler_damping(self, version: str) -> tuple[tuple[str, str, str], ...]:
+        """The hint :data:`~.actuators.EULER_DAMPING` where its premise holds on the model:
+        the port damps implicitly in its Euler step, and some joint is damped."""
+        damped = np.flatnonzero(self.model.dof_damping > 0)
+        if not self.euler_damps_when_disabled or not len(damped):
+            return ()
+        return (("model", EULER_DAMPING, (
+            f"{self.engine}'s euler integrator applies the joints' damping implicitly, "
+            f"(M + h D) v₊ = …, though the model's dampers are off in the smooth dynamics "
+            f"({len(damped)} damped degrees of freedom; {version}: its euler tests only the "
+            "eulerdamp flag, where MuJoCo C also skips it when dampers are disabled). Fix: "
+            "set <flag eulerdamp=\"disable\"/> to step as MuJoCo C does without damping")),)
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
         raw = self.adapter.raw(q, v, np.zeros_like(v), a)
@@ -110,12 +129,14 @@ class PortModel(MujocoModel):
 
 class MjxModel(PortModel):
     engine = "mjx"
+    euler_damps_when_disabled = True
     offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION, Offer.INPUT_JACOBIAN})
     port = "dyncheck.adapters.mjx_:MJXAdapter"
 
 
 class MjxF64Model(PortModel):
     engine = "mjx-f64"
+    euler_damps_when_disabled = True
     offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION, Offer.INPUT_JACOBIAN})
     port = "dyncheck.adapters.mjx_:MJXF64Adapter"
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters import layout_batch
-from dyncheck.adapters.actuators import Activation, Actuator
+from dyncheck.adapters.actuators import EULER_DAMPING, Activation, Actuator
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
@@ -380,7 +380,17 @@ def _input_jacobian_rows(model: str, *, canon: Canonical, holding: ModelTree, ba
             out.append(_row(model, subject=subject, field=COMPUTED, a=REFEREE, b=engine,
                             verdict=Verdict.FAILED, note=f"{type(exc).__name__}: {exc}"))
             continue
+        damping = _damping(canon, m.tree) if m.tree.hint("model", EULER_DAMPING) else None
         out.extend(input_jacobian.rows(model, canon=canon, tree=m.tree, acts=acts, mass=mass,
-                                       bias=bias, q=q, v=v, u=u, found=found)
+                                       bias=bias, q=q, v=v, u=u, found=found, damping=damping)
                    for found in jacobians)
+    return out
+
+
+def _damping(canon: Canonical, tree: ModelTree) -> np.ndarray:
+    """The joints' damping per degree of freedom, in the canonical layout."""
+    out = np.zeros(canon.nv)
+    for name, start in zip(canon.names, canon.v_start, strict=True):
+        held = tree.joint(name).damping
+        out[start:start + len(held)] = held
     return out

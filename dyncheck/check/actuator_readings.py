@@ -98,8 +98,10 @@ def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[Che
     """Each actuator of ``other`` against the canonical reading: one passed row where every
     field agrees, else a failed row per differing field with the engine's known reason
     (its hint, premise checked) or "cause unknown"; an actuator one side lacks, a row — but
-    where the canonical engine holds none at all, one row: explained where its reason is
-    known (MuJoCo's URDF compiler makes no actuator: the format gives it none to read)."""
+    none for one outside the neutral form (a tendon's, a muscle's: MuJoCo-only, named once
+    in the section's note), and where the canonical engine holds none at all, one row:
+    explained where its reason is known (MuJoCo's URDF compiler makes no actuator: the
+    format gives it none to read)."""
     a, b = canonical.engine, other.engine
     why = canonical.hint("model", "actuator")
     if not canonical.actuators and other.actuators:  # once, not once per actuator
@@ -110,6 +112,8 @@ def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[Che
     pairs = match(canonical.actuators, other.actuators)
     rows = []
     for k, mine in enumerate(canonical.actuators):
+        if not mine.modelled:  # MuJoCo-only (a tendon's, a muscle's): stated once per model
+            continue
         if k not in pairs:
             rows.append(section_row(model, subject=mine.name, field="actuator", a=a, b=b,
                              value_a=mine.what, value_b="absent", verdict=Verdict.FAILED,
@@ -129,7 +133,7 @@ def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[Che
                              verdict=Verdict.FAILED, note=_hint(other, theirs.name, f)))
     held = set(pairs.values())
     for k, theirs in enumerate(other.actuators):
-        if k not in held:
+        if k not in held and theirs.modelled:
             rows.append(section_row(model, subject=theirs.name, field="actuator", a=a, b=b,
                              value_a="absent", value_b=theirs.what, verdict=Verdict.FAILED,
                              note=why or _hint(other, theirs.name, "actuator")))

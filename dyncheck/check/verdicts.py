@@ -43,6 +43,8 @@ class Controls(StrEnum):
     ALIKE = "reads the controls alike and computes their force as read"
     DIFFERENTLY = "reads the controls differently"
     EXPLAINED = "reads the controls differently only as explained"
+    STEPS_AS_EXPLAINED = "reads the controls alike; its step differs only as explained"
+    """A computed row explained by a known property of the engine (MJX's Euler damping)."""
     DIFFER = "computes a control's force differently from what it read"
     NOT_COMPARED = "controls not compared"
     NONE = "holds no actuators"
@@ -65,8 +67,8 @@ class EngineVerdict:
     def ok(self) -> bool:
         return self.reading is Reading.ALIKE and self.agreement in (
             Agreement.AGREE, Agreement.EXPLAINED) and self.controls in (
-            Controls.ALIKE, Controls.EXPLAINED, Controls.NONE, Controls.NOT_COMPARED,
-            Controls.ABSENT)
+            Controls.ALIKE, Controls.EXPLAINED, Controls.STEPS_AS_EXPLAINED, Controls.NONE,
+            Controls.NOT_COMPARED, Controls.ABSENT)
 
     def line(self) -> str:
         """One sentence: the reading, then the dynamics, each with its first reason."""
@@ -161,8 +163,9 @@ def _controls(engine: str, rows: pd.DataFrame) -> tuple[Controls, str]:
     """One rule, in this order: no actuation row of the engine → absent; its actuators read
     differently from the canonical engine's (a failed reading row) → differently; its force
     or step Jacobian failing against the referee on its own reading → differ; a skipped row
-    (no actuator model) → not compared; read differently as explained → explained; else
-    alike. An engine holding none where another holds some (its only row) → none."""
+    (no actuator model) → not compared; read differently as explained → explained; its
+    computed rows explained (a known property of its step) → steps as explained; else alike.
+    An engine holding none where another holds some (its only row) → none."""
     part = rows[(rows["section"] == Section.ACTUATION)
                 & ((rows["impl_a"] == engine) | (rows["impl_b"] == engine))]
     if part.empty:
@@ -182,8 +185,11 @@ def _controls(engine: str, rows: pd.DataFrame) -> tuple[Controls, str]:
     if (part["verdict"] == Verdict.SKIPPED).all():
         return Controls.NOT_COMPARED, _first_notes(part, 1)
     explained = part[(part["verdict"] == Verdict.EXPLAINED) & (part["impl_b"] == engine)]
+    reading = explained[explained["field"] != COMPUTED]
+    if not reading.empty:
+        return Controls.EXPLAINED, _first_notes(reading, 1)
     if not explained.empty:
-        return Controls.EXPLAINED, _first_notes(explained, 1)
+        return Controls.STEPS_AS_EXPLAINED, _first_notes(explained, 1)
     return Controls.ALIKE, ""
 
 

@@ -155,3 +155,69 @@ def test_a_quaternion_column_mapped_without_its_factor_two_fails(monkeypatch):
     rows = result.rows[result.rows["subject"].str.startswith("step Jacobian in the controls")
                        & (result.rows["impl_b"] == "mjx-f64")]
     assert len(rows) == 2 and (rows["verdict"] == "failed").all()
+
+
+DAMPED = """<mujoco model="damped"><option timestep="0.02"/><worldbody>
+<body name="pole" pos="0 0 .6"><joint name="hinge" type="hinge" axis="0 1 0" damping="0.1"/>
+<geom type="sphere" pos="0 0 0.5" size="0.05" mass="1"/></body></worldbody>
+<actuator><motor joint="hinge" ctrlrange="-1 1"/></actuator></mujoco>"""
+
+
+@pytest.mark.slow
+def test_mjxs_euler_damping_is_explained_by_its_predicted_size(tmp_path, monkeypatch):
+    """MJX's Euler step damps a joint implicitly though the check's model disables its
+    dampers (mujoco-mjx 3.17.0's forward.euler tests only eulerdamp; MuJoCo C skips it):
+    its B differs from the chain rule by h d / (M + h d), worked out by hand for a point
+    mass on a 0.5 m pole (M = 0.25 + 0.001 kg m², d = 0.1, h = 0.02: 0.00791) — an explained
+    row whose note gives that size; the same B without the engine's declared property fails
+    with "cause unknown" (the explanation is not a blanket)."""
+    if not _installed("mjx-f64"):
+        pytest.skip("needs the extra that installs mjx-f64")
+    path = tmp_path / "damped.xml"
+    path.write_text(DAMPED)
+    mass = 0.25 + 0.4 * 0.05 ** 2
+    by_hand = 0.02 * 0.1 / (mass + 0.02 * 0.1)
+
+    def euler_row(result):
+        rows = result.rows[(result.rows["impl_b"] == "mjx-f64") & result.rows[
+            "subject"].str.startswith("step Jacobian in the controls (euler")]
+        assert len(rows) == 1
+        return rows.iloc[0]
+
+    row = euler_row(check_model(path, impls=("reference", "mujoco", "mjx-f64"), states=4,
+                                isolate=False))
+    assert row["verdict"] == "explained" and "eulerdamp" in row["note"]
+    assert row["error"] == pytest.approx(by_hand, rel=1e-6)
+    assert f"predicted {by_hand:.3g}" in row["note"]
+    from dyncheck.adapters.port_models import MjxF64Model
+
+    monkeypatch.setattr(MjxF64Model, "euler_damps_when_disabled", False)
+    row = euler_row(check_model(path, impls=("reference", "mujoco", "mjx-f64"), states=4,
+                                isolate=False))
+    assert row["verdict"] == "failed" and row["note"].endswith("cause unknown")
+
+
+TOUCH = """<mujoco model="touch"><worldbody><body name="pole" pos="0 0 1">
+<joint name="hinge" type="hinge" axis="0 1 0"/><geom type="capsule" fromto="0 0 0 0 0 -0.5"
+size="0.03" mass="1"/><site name="tip" pos="0 0 -0.5" size="0.05"/></body></worldbody>
+<sensor><touch site="tip"/><accelerometer site="tip"/></sensor></mujoco>"""
+
+
+@pytest.mark.slow
+def test_a_model_with_a_touch_sensor_is_computed_on_mjx():
+    """A touch sensor (dm_control's finger, hopper and humanoid have them) made MJX's
+    inverse dynamics fail with constraints off (mujoco-mjx 3.17.0's sensor_acc indexes the
+    empty efc_force: every MJX row a failure). Sensors feed nothing back into the dynamics,
+    so the check's model disables them as it does contacts: MJX's rows are computed and
+    agree with MuJoCo C and the referee."""
+    if not _installed("mjx-f64"):
+        pytest.skip("needs the extra that installs mjx-f64")
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "touch.xml"
+        path.write_text(TOUCH)
+        result = check_model(path, impls=("reference", "mujoco", "mjx-f64"), states=4)
+    rows = result.rows[(result.rows["section"] == "dynamics")
+                       & (result.rows["impl_b"] == "mjx-f64")]
+    assert len(rows) == 12 and (rows["verdict"] == "passed").all(), rows[["subject", "note"]]

@@ -9,8 +9,8 @@ import pandas as pd
 import pytest
 
 from dyncheck.check.model_check import check_model
-from dyncheck.check.rows import COLUMNS, Section
-from dyncheck.check.verdicts import Agreement, Reading, per_engine
+from dyncheck.check.rows import COLUMNS, COMPUTED, Section
+from dyncheck.check.verdicts import Agreement, Controls, Reading, per_engine
 from dyncheck.results import Verdict
 
 IMPLS = ("reference", "mujoco", "pinocchio", "drake")
@@ -129,3 +129,28 @@ def test_settotalmass_is_the_named_reason_masses_read_differently(tmp_path):
     for engine in ("pinocchio", "drake"):
         assert verdicts[engine].reading is Reading.DIFFERENTLY
         assert "settotalmass" in verdicts[engine].reading_why
+
+
+def _actuation(verdict, field, b="mjx"):
+    row = _row(Section.ACTUATION, "reference", b, verdict, subject="step Jacobian")
+    row["field"] = field
+    return row
+
+
+@pytest.mark.parametrize(("rows", "expected"), [
+    ([(Verdict.PASSED, COMPUTED)], Controls.ALIKE),
+    ([(Verdict.PASSED, COMPUTED), (Verdict.EXPLAINED, COMPUTED)], Controls.STEPS_AS_EXPLAINED),
+    ([(Verdict.EXPLAINED, "gear"), (Verdict.EXPLAINED, COMPUTED)], Controls.EXPLAINED),
+    ([(Verdict.EXPLAINED, COMPUTED), (Verdict.FAILED, COMPUTED)], Controls.DIFFER),
+])
+def test_an_explained_step_is_not_a_reading_of_the_controls(rows, expected):
+    """The controls' rule (synthetic rows): an engine whose only explained actuation rows are
+    computed ones (its step, explained by a known property: MJX's Euler damping) reads the
+    controls alike and says its step differs as explained; an explained reading row keeps
+    'reads the controls differently only as explained'; a failed computed row wins."""
+    loads = [_row(Section.LOAD, e, "", Verdict.PASSED, subject="model") for e in
+             ("mujoco", "mjx")]
+    frame = _frame(*loads, *(_actuation(v, f) for v, f in rows))
+    verdict = _by_engine(frame, ("reference", "mujoco", "mjx"))["mjx"]
+    assert verdict.controls is expected
+
