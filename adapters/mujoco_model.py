@@ -4,8 +4,9 @@ Smooth dynamics only: constraints (contacts, limits, equalities), actuation and 
 (springs, dampers) are disabled in ``opt.disableflags``, and so are sensors (outputs, which
 feed nothing back; MJX's inverse dynamics fails on a touch sensor when constraints are off —
 mujoco-mjx 3.17.0, ``sensor_acc`` indexes the empty ``efc_force``, found on dm_control's
-finger, hopper and humanoid); damping and armature are read back as model fields. M = ``mj_fullM`` (armature included), h = ``qfrc_bias``, forward
-dynamics ``qacc`` at zero applied force, inverse ``mj_inverse``, energies ``mjENBL_ENERGY``.
+finger, hopper and humanoid); damping and armature are read back as model fields.
+M = ``mj_fullM`` (armature included), h = ``qfrc_bias``, forward dynamics ``qacc`` at zero
+applied force, inverse ``mj_inverse``, energies ``mjENBL_ENERGY``.
 State layout: a quaternion (w, x, y, z); a free joint q = (p, quat), v = (linear in world
 axes, angular in local axes); a ball joint v = angular velocity in local axes.
 """
