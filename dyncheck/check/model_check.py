@@ -25,7 +25,16 @@ from dyncheck.adapters import REGISTRY, layout, layout_batch
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials, urdf_welded
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
-from dyncheck.check import actuation, describe, inputs, partial, predicted, readings, validity
+from dyncheck.check import (
+    actuation,
+    describe,
+    inputs,
+    partial,
+    partial_pairs,
+    predicted,
+    readings,
+    validity,
+)
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.alignment import align_by_body
 from dyncheck.check.derivatives import expected_seconds
@@ -436,10 +445,9 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
     factor = standing_of(canonical_tree, batch.q)  # how far from the origin it stands
     for i, a in enumerate(order):
         for b in order[i + 1 :]:
-            dofs = {n: _held(parts.get(n)) for n in (a, b)}
             eps = max(trees[a].eps, trees[b].eps)
             mesh = vertices if (a in rounded) != (b in rounded) else 0.0
-            if dofs[a] is None and dofs[b] is None:
+            if parts.get(a) is None and parts.get(b) is None:
                 judged_on = ""
                 dyn_a, tree_a = results[a], trees[a]
                 if a == REFEREE and b in own:  # the referee on b's own reading
@@ -458,16 +466,10 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
                                     kappa=kappas.get(a), vertices=mesh, standing=factor,
                                     judged_on=judged_on))
                 continue
-            common = np.arange(canon.nv)
-            for held in dofs.values():
-                common = np.intersect1d(common, held) if held is not None else common
-            on = States(q=batch.q, v=batch.v[:, common], a=batch.a[:, common])
-            rows.extend(compare(
-                model, canonical_tree,
-                name_a=a, dyn_a=partial.restrict(results[a], partial.columns(dofs[a], common)),
-                name_b=b, dyn_b=partial.restrict(results[b], partial.columns(dofs[b], common)),
-                explanations={}, readings={}, states=on, eps=eps, vertices=mesh,
-                standing=factor))
+            rows.extend(partial_pairs.rows(
+                model, canonical_tree, a=a, b=b, batch=batch, results=results, trees=trees,
+                parts=parts, loaded=loaded, own=own, differing=differing, eps=eps,
+                vertices=mesh, standing=factor))
     return rows
 
 
@@ -482,10 +484,6 @@ def _reading_effect(canonical_tree: ModelTree, a: str, b: str, own: dict[str, re
     found = readings.effect(canonical_tree, a, own[a].tree, own[a].dynamics, b, own[b].tree,
                             own[b].dynamics, batch, groups)
     return {q: p for q in QUANTITIES if (p := found.prediction(q)) is not None}
-
-
-def _held(part: partial.Part | None) -> np.ndarray | None:
-    return None if part is None else part.v
 
 
 def _against(model: str, mine: ModelTree, other: ModelFile) -> list[CheckRow]:
