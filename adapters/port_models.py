@@ -12,10 +12,12 @@ bounds are the same formula with that ε.
 
 from __future__ import annotations
 
+import copy
 import importlib
 from dataclasses import replace
 from typing import Any, ClassVar
 
+import mujoco
 import numpy as np
 
 from dyncheck.adapters.actuators import EULER_DAMPING, Actuation, InputJacobian
@@ -46,10 +48,15 @@ class PortModel(MujocoModel):
         super().__init__(source)
         module, cls = self.port.split(":")
         adapter = getattr(importlib.import_module(module), cls)
-        self.adapter = adapter.on_model(self.model)
+        colliding = int(np.count_nonzero(self.model.geom_contype | self.model.geom_conaffinity))
+        self.adapter = adapter.on_model(_collisionless(self.model))
         eps = float(np.finfo(adapter.dtype).eps)
         self.tree = replace(self.tree, engine=self.engine, eps=eps, notes=(
             *self.tree.notes,
+            *([f"{self.engine}: given the model with its {colliding} colliding geoms' contype "
+               "and conaffinity set to 0 (MJX 3.17.0 refuses a geom pair it cannot collide, "
+               "(ellipsoid, box), with contacts disabled too; the smooth dynamics use no "
+               "collision)"] if colliding else []),
             f"{self.engine}: MuJoCo's compiled model put on the port ({adapter.version()}), "
             f"computing in {np.dtype(adapter.dtype).name} (round-off bounds with eps "
             f"{eps:.3g}); energies from the port's M and centres of mass",
@@ -107,7 +114,8 @@ class PortModel(MujocoModel):
     def _actuation_port(self) -> Any:
         """The port holding a copy of the model with actuation on (made once)."""
         if self._actuated_port is None:
-            self._actuated_port = type(self.adapter).on_model(with_actuation(self.model))
+            self._actuated_port = type(self.adapter).on_model(
+                _collisionless(with_actuation(self.model)))
         return self._actuated_port
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
@@ -125,6 +133,16 @@ class PortModel(MujocoModel):
 
     def transition(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> tuple:
         raise Unsupported(f"{self.engine}: the port's step Jacobian is not checked yet")
+
+
+def _collisionless(m: mujoco.MjModel) -> mujoco.MjModel:
+    """A copy of the check's model in which no geom collides (contype, conaffinity 0):
+    nothing the smooth dynamics compute changes, and a port that refuses a geom pair it
+    cannot collide (MJX 3.17.0's put_model, even with contacts disabled) loads it."""
+    copied = copy.copy(m)
+    copied.geom_contype[:] = 0
+    copied.geom_conaffinity[:] = 0
+    return copied
 
 
 class MjxModel(PortModel):
