@@ -126,7 +126,9 @@ def rotor_energy(canon: Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
                  tree_b: ModelTree, v: np.ndarray) -> Prediction | None:
     """The kinetic energies' predicted difference where one engine counts a joint's rotor
     energy ½ aᵢ vᵢ² and the other does not (both hold the armature in M): ½ Σ aᵢ vᵢ² over
-    those joints, aᵢ as the canonical engine read it (a magnitude per state)."""
+    those joints, aᵢ as the canonical engine read it — the difference b − a itself per state
+    (n, 1), signed (b leaves it out: −), so that it adds to another prediction of the pair
+    (the readings' measured effect, :func:`~.dynamics._candidates`)."""
     names = [n for n in canon.names
              if tree_a.joint(n).rotor_in_kinetic != tree_b.joint(n).rotor_in_kinetic
              and any(canonical_tree.joint(n).armature)]
@@ -136,11 +138,13 @@ def rotor_energy(canon: Canonical, canonical_tree: ModelTree, tree_a: ModelTree,
     for n in names:
         k = canon.names.index(n)
         armature = canonical_tree.joint(n).armature
-        weights[canon.v_start[k] : canon.v_start[k] + len(armature)] = armature
+        sign = 1.0 if tree_b.joint(n).rotor_in_kinetic else -1.0
+        weights[canon.v_start[k] : canon.v_start[k] + len(armature)] = sign * np.asarray(
+            armature)
     without = [t.engine for t in (tree_a, tree_b)
                if not all(t.joint(n).rotor_in_kinetic for n in names)]
     return Prediction(
-        size=0.5 * np.einsum("i,ni,ni->n", weights, v, v),
+        size=0.5 * np.einsum("i,ni,ni->n", weights, v, v)[:, None],
         note=f"{' and '.join(without)}'s kinetic energy leaves out the rotor energy "
         f"½ Σ aᵢ vᵢ² of {', '.join(names)}, which its M holds (predicted per state from the "
         "armature)",
