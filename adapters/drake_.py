@@ -55,9 +55,9 @@ from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import LogVectorOutput
 
-from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.drake_model import parser_warnings
+from dyncheck.adapters.drake_registration import REGISTRATIONS
 from dyncheck.adapters.linalg import kkt
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.model_tree import Axes, Layout, Orientation, StateLayout
@@ -131,7 +131,7 @@ class DrakeAdapter(Adapter):
     joint a ``QuaternionFloatingJoint``, q = (w, x, y, z, p), v = (ω, v) in world axes."""
     package: ClassVar[str] = "drake"
     error_controlled: ClassVar[bool] = True
-    integrators: ClassVar[tuple[str, ...]] = REGISTRY["drake"].integrators
+    integrators: ClassVar[tuple[str, ...]] = REGISTRATIONS["drake"].integrators
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)

@@ -34,7 +34,7 @@ import mujoco
 import numpy as np
 from mujoco import mjx
 
-from dyncheck.adapters import REGISTRY
+from dyncheck.adapters.mjx_registration import REGISTRATIONS
 from dyncheck.adapters.mujoco_api import INTEGRATORS
 from dyncheck.adapters.mujoco_port import STEPS, PortAdapter
 from dyncheck.cases.multibody import Multibody
@@ -237,7 +237,7 @@ class MJXAdapter(PortAdapter):
 
     name: ClassVar[str] = "mjx"
     package: ClassVar[str] = "mujoco-mjx"
-    integrators: ClassVar[tuple[str, ...]] = REGISTRY["mjx"].integrators
+    integrators: ClassVar[tuple[str, ...]] = REGISTRATIONS["mjx"].integrators
     rk4_group_order: ClassVar[int] = 2
     gyroscopic_implicit: ClassVar[bool] = False
     dtype: ClassVar[type[np.floating]] = np.float32

@@ -27,11 +27,12 @@ from typing import ClassVar
 import mujoco
 import numpy as np
 
-from dyncheck.adapters import REGISTRY, mujoco_api
+from dyncheck.adapters import mujoco_api
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.mujoco_api import INTEGRATORS, full_inertia
 from dyncheck.adapters.mujoco_dynamics import Around, evaluate
+from dyncheck.adapters.mujoco_registration import REGISTRATIONS
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import EngineError, Unsupported
 from dyncheck.vocabulary import Integrator
@@ -47,7 +48,7 @@ _DIVERGED = (
 class MuJoCoAdapter(Adapter):
     name: ClassVar[str] = "mujoco"
     package: ClassVar[str] = "mujoco"
-    integrators: ClassVar[tuple[str, ...]] = REGISTRY["mujoco"].integrators
+    integrators: ClassVar[tuple[str, ...]] = REGISTRATIONS["mujoco"].integrators
     couplings_with_field: ClassVar[bool] = True
     """Tendon equalities and xfrc_applied coexist in one MuJoCo model."""
     gyroscopic_implicit: ClassVar[bool] = mujoco_api.GYROSCOPIC_IMPLICIT

@@ -31,10 +31,10 @@ import mujoco_warp as mjw
 import numpy as np
 import warp as wp
 
-from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.base import Trajectory
 from dyncheck.adapters.mujoco_api import INTEGRATORS
 from dyncheck.adapters.mujoco_port import CHUNK, PortAdapter
+from dyncheck.adapters.mujoco_warp_registration import REGISTRATIONS
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import Unsupported
 from dyncheck.settings import current
@@ -87,7 +87,7 @@ class MuJoCoWarpAdapter(PortAdapter):
 
     name: ClassVar[str] = "mujoco-warp"
     package: ClassVar[str] = "mujoco-warp"
-    integrators: ClassVar[tuple[str, ...]] = REGISTRY["mujoco-warp"].integrators
+    integrators: ClassVar[tuple[str, ...]] = REGISTRATIONS["mujoco-warp"].integrators
     rk4_group_order: ClassVar[int] = 4
     gyroscopic_implicit: ClassVar[bool] = True
     dtype: ClassVar[type[np.floating]] = np.float32

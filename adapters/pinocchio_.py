@@ -28,11 +28,11 @@ from typing import ClassVar
 import numpy as np
 import pinocchio as pin
 
-from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.integrators import Addresses, cross, integrate, solve_on_group
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.model_tree import Axes, Layout, Orientation, StateLayout
+from dyncheck.adapters.pinocchio_registration import REGISTRATIONS
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.cases.multibody import Joint, Multibody
 from dyncheck.vocabulary import Integrator
@@ -103,7 +103,7 @@ class PinocchioAdapter(Adapter):
     """``JointModelSpherical``: q (x, y, z, w), ω in the joint's local frame; free-flyer q
     (p, x, y, z, w), v (v, ω) both in the body frame (programmatic or from MJCF)."""
     package: ClassVar[str] = "pin"
-    integrators: ClassVar[tuple[str, ...]] = REGISTRY["pinocchio"].integrators
+    integrators: ClassVar[tuple[str, ...]] = REGISTRATIONS["pinocchio"].integrators
     adaptive: ClassVar[bool] = True
 
     def __init__(self, model: Multibody) -> None:

@@ -28,7 +28,6 @@ import numpy as np
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.base import (
     AFRESH,
     Adapter,
@@ -39,6 +38,7 @@ from dyncheck.adapters.base import (
 from dyncheck.adapters.integrators import integrate
 from dyncheck.adapters.linalg import solve
 from dyncheck.adapters.model_tree import Axes, Layout, Orientation, StateLayout
+from dyncheck.adapters.sympy_registration import REGISTRATIONS
 from dyncheck.cases.multibody import ROTATING, Multibody
 from dyncheck.vocabulary import Integrator
 
@@ -199,7 +199,7 @@ class SympyMechanicsAdapter(Adapter):
         free=Layout.free(quat=Orientation.EULER, angular_axes=Axes.RATES))
     """dyncheck's own model: a rotating body in Example 9's angles, velocities their rates."""
     package: ClassVar[str] = "sympy"
-    integrators: ClassVar[tuple[str, ...]] = REGISTRY["sympy-mechanics"].integrators
+    integrators: ClassVar[tuple[str, ...]] = REGISTRATIONS["sympy-mechanics"].integrators
     """MuJoCo's definitions (:mod:`.integrators`): semi-implicit Euler, shared with every
     engine including Drake, and RK4. Each step costs Python-level evaluations of the
     lambdified equations."""

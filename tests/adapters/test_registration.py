@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from dyncheck.adapters import REGISTRY
+from dyncheck.adapters import BUILT_IN, REGISTRY
 
 ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = ("dyncheck", "adapters", "cases", "reference")
@@ -24,16 +24,18 @@ FORMATS = ("adapters/model_files.py",)
 """The file formats' module: MJCF's root element is ``<mujoco>``, a format's word, not an
 engine's name."""
 LEGACY: dict[str, int] = {}
-"""Engine-name literals allowed outside the registry, the engine's modules and the teaching
-texts: none (5a550eb had 61 in 11 files, #62's review 28 more; the version matrix's engines
-and the bench's raw loops are now the registrations' and the adapters' own)."""
+"""Engine-name literals allowed outside the engine's modules (its registration's among them)
+and the teaching texts: none (5a550eb had 61 in 11 files, #62's review 28 more; the version
+matrix's engines and the bench's raw loops are now the registrations' and the adapters'
+own)."""
 
 
 def _own(name: str) -> set[str]:
+    """The engine's modules: its adapter's, its loader's and its registration's."""
     reg = REGISTRY[name]
     modules = {m for m in (reg.module, (reg.model or "").split(":")[0]) if m}
-    return {"adapters/__init__.py"} | {
-        m.removeprefix("dyncheck.").replace(".", "/") + ".py" for m in modules}
+    modules |= {m.__name__ for m in BUILT_IN if name in m.REGISTRATIONS}
+    return {m.removeprefix("dyncheck.").replace(".", "/") + ".py" for m in modules}
 
 
 def _literals(name: str, root: Path = ROOT) -> list[str]:

@@ -1,0 +1,30 @@
+"""Pinocchio's registrations (:mod:`.pinocchio_`, :mod:`.pinocchio_model`): importable without
+Pinocchio; stepped by MuJoCo's integrators' definitions."""
+
+from __future__ import annotations
+
+from dyncheck.adapters.mujoco_registration import MUJOCO_C
+from dyncheck.adapters.registration import A, Needs, Registration
+
+REGISTRATIONS: dict[str, Registration] = {
+    "pinocchio": Registration(
+        module=A + "pinocchio_", cls="PinocchioAdapter", package="pin", integrators=MUJOCO_C,
+        model=A + "pinocchio_model:PinocchioModel", label="pinocchio",
+        releases=("3.4.0", "3.7.0", "3.9.0", "4.0.0", "4.1.0"),
+        released_with=("libpinocchio", "cmeel", "coal", "libcoal", "eigenpy",
+                       "jrl-cmakemodules"),
+        needs=(
+            Needs(series="3.", unpin=("numpy",),
+                  reason="Pinocchio 3.x needs cmeel-boost < 1.90, whose wheels are built "
+                  "against numpy < 2.4: numpy resolves to the newest 2.3"),
+            Needs(series="3.", require=("cmeel-urdfdom<5", "cmeel-tinyxml2<11"),
+                  reason="Pinocchio 3.x wheels link liburdfdom 4 and libtinyxml2 10 but "
+                  "do not bound cmeel-urdfdom or cmeel-tinyxml2 (the newest fail to "
+                  "import: `liburdfdom_sensor.so.4.0: cannot open shared object file`)"),
+        ),
+    ),
+    "pinocchio-mjcf": Registration(
+        module=A + "pinocchio_", cls="PinocchioMJCFAdapter", package="pin",
+        integrators=MUJOCO_C,
+    ),
+}

@@ -1,0 +1,89 @@
+"""An engine's registration: the facts about an engine implementation that are needed before
+(or without) importing it — where its adapter and loader are, its package and extra, its
+integrators, its releases. Each engine declares its own in ``adapters/<engine>_registration.py``
+beside its code (importable without the engine); an installed package adds one through the
+``dyncheck.engines`` entry points (:data:`dyncheck.adapters.ENTRY_POINTS`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from dyncheck.adapters.model_files import Format
+
+A = "dyncheck.adapters."
+"""The package the built-in engines' modules are in."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class Needs:
+    """What a series of an engine's releases needs beyond ``constraints.txt`` to import at
+    all (``dyncheck versions``): pins left out (``unpin``, the whole environment then
+    resolves around the release) and requirements added (``require``), with the packaging
+    fact that forces them."""
+
+    series: str
+    """A release prefix: ``"3."`` is every 3.x release."""
+    unpin: tuple[str, ...] = ()
+    require: tuple[str, ...] = ()
+    reason: str
+
+    def applies(self, release: str) -> bool:
+        return release.startswith(self.series)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Registration:
+    """One engine implementation: where its adapter is, and the facts about its installation
+    that are needed before (or without) importing it."""
+
+    package: str
+    """The pip package that provides the engine (its version is read from its metadata)."""
+    module: str | None = None
+    """Where its adapter of a book case is (``dyncheck run``); None: not in the run."""
+    cls: str | None = None
+    integrators: tuple[str, ...] = ()
+    """The fixed-step integrators its ``simulate`` accepts (its adapter's ``integrators``):
+    known without importing the engine (a test session's parameters)."""
+    extra: str | None = None
+    """The optional extra of dyncheck that installs it (core engines: None)."""
+    ports: str | None = None
+    """The engine this one is a port of: then compared with that engine, the reference and its
+    own package's other builds only, not with every other engine."""
+    float32: bool = False
+    """Whether it computes in float32 (its adapter's ``dtype``): the report check derives its
+    rows' round-off bands from float32's ε without importing the engine."""
+    model: str | None = None
+    """``module:class`` of its loader of a user's file (``dyncheck check``); None: not in
+    the check."""
+    on_request: bool = False
+    """Checked only when asked for (``--impl``): a port (compiling a model for it takes
+    seconds to minutes on a CPU), or an engine a user names when moving a model to it."""
+    accelerator: bool = False
+    """Built for accelerators (a GPU): ``dyncheck run`` leaves it out unless asked for
+    (``--accelerators``, or ``--impl NAME``). On a CPU it dominates a run (MJX traces and
+    XLA-compiles each case and precision, ~25 s a case on two cores; Newton launches ~15 Warp
+    kernels a step, ~1.4 ms a step from Python: 21 s of one case's trajectory studies), so the
+    README's first command runs the engines a CPU runs in seconds, and these a second one."""
+    label: str | None = None
+    """Its engine's name in a report's provenance, where its adapter reports the version
+    (one implementation per engine)."""
+    canonical: bool = False
+    """The check's canonical engine: first in the check, whose tree the others meet."""
+    couplings_only: bool = False
+    """Differs from another implementation only in how couplings are held: run on cases with
+    couplings only (elsewhere it would repeat that one under a second name)."""
+    releases: tuple[str, ...] = ()
+    """The releases the committed version matrix runs (``dyncheck versions``; the other
+    registrations of its package are run with it)."""
+    released_with: tuple[str, ...] = ()
+    """Packages released with it, left out of the constraints in the version matrix so that
+    they follow the release under test."""
+    needs: tuple[Needs, ...] = ()
+    """What some of its releases need to be installed (:class:`Needs`)."""
+    native: Format | None = None
+    """The file format the engine defines (MuJoCo's MJCF): its refusal of a file in that
+    format is the file's fault, and ends the check with the engine's message."""
+    run: Format | None = None
+    """An engine without a run adapter of its own (``module``): the format a book case is
+    written in for its file loader (``model``), which then serves ``dyncheck run`` too
+    (:mod:`.model_adapter`); a loader given URDF takes the case's ``gravity=``."""
