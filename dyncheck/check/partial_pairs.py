@@ -44,7 +44,7 @@ def rows(model: str, canonical_tree: ModelTree, *, a: str, b: str, batch: States
     partial: against the referee, the referee on its reading of its part (with the computing
     conventions it declares); against a whole engine, the measured effect of the two reading
     the part differently. Two partial engines: on the joints both hold, nothing predicted."""
-    held = {n: None if parts.get(n) is None else parts[n].v for n in (a, b)}
+    held = {n: None if (p := parts.get(n)) is None else p.v for n in (a, b)}
     common = np.arange(canonical_tree.nv)
     for columns in held.values():
         common = np.intersect1d(common, columns) if columns is not None else common
