@@ -107,6 +107,38 @@ def _derive(model: Multibody) -> Equations:
     N = me.ReferenceFrame("N")
     O = me.Point("O")
     O.set_vel(N, 0)
+    particles, gravity_loads, field_loads, V = _bodies(model, q, N, O)
+    T = me.kinetic_energy(N, *particles)
+    qs, vs = sp.symbols(f"x0:{n}"), sp.symbols(f"v0:{n}")
+    plain = dict(zip(qd, vs, strict=True)) | dict(zip(q, qs, strict=True))
+
+    def forcing(loads: list) -> sp.Matrix:
+        lm = me.LagrangesMethod(T, q, forcelist=loads or None, frame=N)
+        lm.form_lagranges_equations()
+        return lm.mass_matrix, lm.forcing
+
+    M, F_free = forcing(gravity_loads)
+    K_exprs: list[sp.Expr] = []
+    rhs_exprs: list[sp.Expr] = []
+    if model.couplings:
+        K_exprs, rhs_exprs = _constrained(model, T, q, gravity_loads, N, plain)
+    M_exprs = [e.subs(plain) for e in M]
+    h_exprs = [(-e).subs(plain) for e in F_free]
+    field_exprs: list[sp.Expr] = []
+    if field_loads:
+        _, F_field = forcing(gravity_loads + field_loads)
+        field_exprs = [(a - b).subs(plain) for a, b in zip(F_field, F_free, strict=True)]
+    return Equations(
+        M=tuple(M_exprs), h=tuple(h_exprs), field=tuple(field_exprs), K=tuple(K_exprs),
+        rhs=tuple(rhs_exprs), ncons=len(model.couplings), T=T.subs(plain), V=V.subs(plain))
+
+
+def _bodies(model: Multibody, q: list, N: me.ReferenceFrame,
+            O: me.Point) -> tuple[list, list, list, sp.Expr]:
+    """Every body as a particle or a rigid body at its centre of mass, placed through its
+    joints (a free joint's position in its parent's axes, then Example 9's angles; a hinge
+    about its axis; a slide along it), with its gravity load, the central field's where
+    the model has one, and the potential energy: (bodies, gravity loads, field loads, V)."""
     frames = {None: N}
     points = {None: O}
     particles, gravity_loads, field_loads, V = [], [], [], sp.Integer(0)
@@ -138,58 +170,49 @@ def _derive(model: Multibody) -> Equations:
         com.set_vel(N, r.dt(N))
         frame.set_ang_vel(N, frame.ang_vel_in(N))
         m = sp.Rational(float(body.mass))
-        I = model.body_inertia(body)  # a point mass on a ball joint carries the floor
-        if not I.any():
-            particles.append(me.Particle(body.name, com, m))
-        else:
-            dyad = me.inertia(
-                frame,
-                *(
-                    sp.Rational(float(x))
-                    for x in (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[1, 2], I[0, 2])
-                ),
-            )
-            particles.append(me.RigidBody(body.name, com, frame, m, (dyad, com)))
+        particles.append(_body(model, body, com=com, frame=frame, mass=m))
         gravity_loads.append((com, m * g))
         V -= m * g.dot(r)
         if model.central_mu:
             dist = sp.sqrt(r.dot(r))
             field_loads.append((com, -sp.Rational(float(model.central_mu)) * m * r / dist**3))
         frames[body.name], points[body.name] = frame, point
-    T = me.kinetic_energy(N, *particles)
-    qs, vs = sp.symbols(f"x0:{n}"), sp.symbols(f"v0:{n}")
-    plain = dict(zip(qd, vs, strict=True)) | dict(zip(q, qs, strict=True))
+    return particles, gravity_loads, field_loads, V
 
-    def forcing(loads: list) -> sp.Matrix:
-        lm = me.LagrangesMethod(T, q, forcelist=loads or None, frame=N)
-        lm.form_lagranges_equations()
-        return lm.mass_matrix, lm.forcing
 
-    M, F_free = forcing(gravity_loads)
-    K_exprs: list[sp.Expr] = []
-    rhs_exprs: list[sp.Expr] = []
-    if model.couplings:
-        # the cords as holonomic constraints: LagrangesMethod adds multipliers λ with
-        # M q̈ − Φᵀ λ = F and the constraints' second derivative Φ q̈ = −Φ̇ q̇
-        index = {j.name: i for i, j in enumerate(model.joints)}
-        cons = [
-            sum(sp.Rational(float(c)) * q[index[j]] for j, c in cp.coefs)
-            for cp in model.couplings
-        ]
-        lm = me.LagrangesMethod(T, q, hol_coneqs=cons, forcelist=gravity_loads, frame=N)
-        lm.form_lagranges_equations()
-        K = lm.mass_matrix_full[n:, n:]
-        rhs = lm.forcing_full[n:, :]
-        K_exprs, rhs_exprs = [e.subs(plain) for e in K], [e.subs(plain) for e in rhs]
-    M_exprs = [e.subs(plain) for e in M]
-    h_exprs = [(-e).subs(plain) for e in F_free]
-    field_exprs: list[sp.Expr] = []
-    if field_loads:
-        _, F_field = forcing(gravity_loads + field_loads)
-        field_exprs = [(a - b).subs(plain) for a, b in zip(F_field, F_free, strict=True)]
-    return Equations(
-        M=tuple(M_exprs), h=tuple(h_exprs), field=tuple(field_exprs), K=tuple(K_exprs),
-        rhs=tuple(rhs_exprs), ncons=len(model.couplings), T=T.subs(plain), V=V.subs(plain))
+def _body(model: Multibody, body: Any, *, com: me.Point, frame: me.ReferenceFrame,
+          mass: sp.Expr) -> Any:
+    """A particle where the body has no inertia about its centre of mass, else a rigid
+    body with its inertia dyadic in its own frame."""
+    I = model.body_inertia(body)  # a point mass on a ball joint carries the floor
+    if not I.any():
+        return me.Particle(body.name, com, mass)
+    dyad = me.inertia(
+        frame,
+        *(
+            sp.Rational(float(x))
+            for x in (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[1, 2], I[0, 2])
+        ),
+    )
+    return me.RigidBody(body.name, com, frame, mass, (dyad, com))
+
+
+def _constrained(model: Multibody, T: sp.Expr, q: list, loads: list, N: me.ReferenceFrame,
+                 plain: dict) -> tuple[list[sp.Expr], list[sp.Expr]]:
+    """The cords as holonomic constraints: LagrangesMethod adds multipliers λ with
+    M q̈ − Φᵀ λ = F and the constraints' second derivative Φ q̈ = −Φ̇ q̇ — the lower block of
+    its full mass matrix and forcing, in plain symbols."""
+    n = model.nv
+    index = {j.name: i for i, j in enumerate(model.joints)}
+    cons = [
+        sum(sp.Rational(float(c)) * q[index[j]] for j, c in cp.coefs)
+        for cp in model.couplings
+    ]
+    lm = me.LagrangesMethod(T, q, hol_coneqs=cons, forcelist=loads, frame=N)
+    lm.form_lagranges_equations()
+    K = lm.mass_matrix_full[n:, n:]
+    rhs = lm.forcing_full[n:, :]
+    return [e.subs(plain) for e in K], [e.subs(plain) for e in rhs]
 
 
 class SympyMechanicsAdapter(Adapter):

@@ -13,7 +13,6 @@ MOST_LINES = 80
 
 LONG = {
     "reference/tree.py:_at_chunk": 94,
-    "adapters/sympy_mechanics.py:_derive": 92,
 }
 """The functions over :data:`MOST_LINES` lines when the budget was set, with their length
 then (issue #62: to be split)."""
