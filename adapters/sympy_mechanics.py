@@ -121,7 +121,8 @@ def _derive(model: Multibody) -> Equations:
     K_exprs: list[sp.Expr] = []
     rhs_exprs: list[sp.Expr] = []
     if model.couplings:
-        K_exprs, rhs_exprs = _constrained(model, T, q, gravity_loads, N, plain)
+        K_exprs, rhs_exprs = _constrained(model, T=T, q=q, loads=gravity_loads, N=N,
+                                          plain=plain)
     M_exprs = [e.subs(plain) for e in M]
     h_exprs = [(-e).subs(plain) for e in F_free]
     field_exprs: list[sp.Expr] = []
@@ -197,8 +198,8 @@ def _body(model: Multibody, body: Any, *, com: me.Point, frame: me.ReferenceFram
     return me.RigidBody(body.name, com, frame, mass, (dyad, com))
 
 
-def _constrained(model: Multibody, T: sp.Expr, q: list, loads: list, N: me.ReferenceFrame,
-                 plain: dict) -> tuple[list[sp.Expr], list[sp.Expr]]:
+def _constrained(model: Multibody, *, T: sp.Expr, q: list, loads: list,
+                 N: me.ReferenceFrame, plain: dict) -> tuple[list[sp.Expr], list[sp.Expr]]:
     """The cords as holonomic constraints: LagrangesMethod adds multipliers λ with
     M q̈ − Φᵀ λ = F and the constraints' second derivative Φ q̈ = −Φ̇ q̇ — the lower block of
     its full mass matrix and forcing, in plain symbols."""

@@ -136,6 +136,22 @@ _Column = tuple[slice, np.ndarray, "np.ndarray | None"]
 and the pivot of angular ones (None: linear)."""
 
 
+@dataclass(frozen=True, kw_only=True)
+class _Sums:
+    """What :meth:`TreeDynamics._at_chunk` adds up over the bodies of a chunk of states (its
+    arrays filled in place): M, h and V; the joints' real columns at the unperturbed row
+    (angular, pivot, linear); each subtree's momentum P and L at the v row."""
+
+    mass: np.ndarray
+    h: np.ndarray
+    potential: np.ndarray
+    angular0: np.ndarray
+    pivot0: np.ndarray
+    linear0: np.ndarray
+    momentum: np.ndarray
+    spin_sum: np.ndarray
+
+
 class TreeDynamics(Tree):
     """M, h, forward and inverse dynamics, T and V of a tree of :class:`Body` records."""
 
@@ -239,19 +255,18 @@ class TreeDynamics(Tree):
         c_b + 2 rows each."""
         ns, nv = len(q), self.nv
         nb = len(self.bodies)
-        mass = np.tile(np.diag(self.armature).astype(float), (ns, 1, 1))
-        h = np.zeros((ns, nv))
-        potential = np.zeros(ns)
+        sums = _Sums(
+            mass=np.tile(np.diag(self.armature).astype(float), (ns, 1, 1)),
+            h=np.zeros((ns, nv)), potential=np.zeros(ns),
+            angular0=np.zeros((ns, 3, nv)), pivot0=np.zeros((ns, 3, nv)),
+            linear0=np.zeros((ns, 3, nv)),
+            momentum=np.zeros((nb, ns, 3), complex),  # P of the subtree, at the v row
+            spin_sum=np.zeros((nb, ns, 3), complex))  # L about the origin, at the v row
         step = 1j * STEP
         poses: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []  # R t Ω V
         # per joint, at its v row (complex) and its unperturbed row (real): columns as
         # (angular (S, 3, k), pivot (S, 3)) or (linear (S, 3, k), None), with their span
         at_v: list[list[tuple[slice, np.ndarray, np.ndarray | None]]] = []
-        angular0 = np.zeros((ns, 3, nv))
-        pivot0 = np.zeros((ns, 3, nv))
-        linear0 = np.zeros((ns, 3, nv))
-        momentum = np.zeros((nb, ns, 3), complex)  # P of the subtree, at the v row
-        spin_sum = np.zeros((nb, ns, 3), complex)  # L about the origin, at the v row
         for j, body in enumerate(self.bodies):
             cols = self.ancestor_columns[j]
             n, own = len(cols), NV[body.kind]
@@ -276,41 +291,57 @@ class TreeDynamics(Tree):
                 else:
                     omega = omega + turn
                     vel = vel + np.cross(point, turn)
-                angular0[..., part] = w[:, -1].real if point is not None else 0.0
-                linear0[..., part] = w[:, -1].real if point is None else 0.0
+                sums.angular0[..., part] = w[:, -1].real if point is not None else 0.0
+                sums.linear0[..., part] = w[:, -1].real if point is None else 0.0
                 if point is not None:
-                    pivot0[..., part] = point[:, -1, :, None].real
+                    sums.pivot0[..., part] = point[:, -1, :, None].real
             at_v.append([(part, w[:, n], None if point is None else point[:, n])
                          for part, w, point in columns])
             poses.append((rot, trans, omega, vel))
-            if body.mass == 0.0 and not np.any(body.inertia):
-                continue
-            com = np.einsum("srij,j->sri", rot, body.com) + trans
-            cdot = vel + np.cross(omega, com)
-            local = np.einsum("srji,srj->sri", rot, omega) @ body.inertia  # (I₀ symmetric)
-            spin = np.einsum("srij,srj->sri", rot, local)  # I ω in world axes
-            twice_t = (body.mass * np.einsum("sri,sri->sr", cdot, cdot)
-                       + np.einsum("sri,sri->sr", omega, spin))
-            h[:, cols] -= 0.5 * twice_t[:, :n].imag / STEP
-            momentum[j] += body.mass * cdot[:, n]
-            spin_sum[j] += np.cross(com[:, n], body.mass * cdot[:, n]) + spin[:, n]
-            # M, gravity and V at the unperturbed row, from the joints' real columns
-            com0, rot0 = com[:, -1].real, rot[:, -1].real
-            jw = angular0[..., cols]
-            arm = com0[..., None] - pivot0[..., cols]
-            jc = linear0[..., cols] + np.cross(jw, arm, axis=1)
-            inertia = rot0 @ body.inertia @ np.swapaxes(rot0, 1, 2)
-            mass[:, cols[:, None], cols[None, :]] += (
-                body.mass * np.swapaxes(jc, 1, 2) @ jc + np.swapaxes(jw, 1, 2) @ inertia @ jw)
-            h[:, cols] -= body.mass * np.einsum("j,sjc->sc", self.gravity, jc)
-            potential -= body.mass * (com0 @ self.gravity)
-        for j in reversed(range(nb)):  # each joint against the momentum of what it carries
+            if body.mass != 0.0 or np.any(body.inertia):
+                self._add_body(j, body, sums, pose=(rot, trans, omega, vel), n=n)
+        self._inward(sums, at_v)
+        kinetic = 0.5 * np.einsum("si,sij,sj->s", v, sums.mass, v)
+        return sums.mass, sums.h, kinetic, sums.potential
+
+    def _add_body(self, j: int, body: Body, sums: _Sums, *,
+                  pose: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], n: int) -> None:
+        """Body j's terms (see :meth:`_at_chunk`), added into ``sums``: h's ∂_i T from its
+        2T at the stepped rows, its momentum at the v row, and M, gravity and V at the
+        unperturbed row from its ancestors' real columns."""
+        rot, trans, omega, vel = pose
+        cols = self.ancestor_columns[j]
+        com = np.einsum("srij,j->sri", rot, body.com) + trans
+        cdot = vel + np.cross(omega, com)
+        local = np.einsum("srji,srj->sri", rot, omega) @ body.inertia  # (I₀ symmetric)
+        spin = np.einsum("srij,srj->sri", rot, local)  # I ω in world axes
+        twice_t = (body.mass * np.einsum("sri,sri->sr", cdot, cdot)
+                   + np.einsum("sri,sri->sr", omega, spin))
+        sums.h[:, cols] -= 0.5 * twice_t[:, :n].imag / STEP
+        sums.momentum[j] += body.mass * cdot[:, n]
+        sums.spin_sum[j] += np.cross(com[:, n], body.mass * cdot[:, n]) + spin[:, n]
+        # M, gravity and V at the unperturbed row, from the joints' real columns
+        com0, rot0 = com[:, -1].real, rot[:, -1].real
+        jw = sums.angular0[..., cols]
+        arm = com0[..., None] - sums.pivot0[..., cols]
+        jc = sums.linear0[..., cols] + np.cross(jw, arm, axis=1)
+        inertia = rot0 @ body.inertia @ np.swapaxes(rot0, 1, 2)
+        sums.mass[:, cols[:, None], cols[None, :]] += (
+            body.mass * np.swapaxes(jc, 1, 2) @ jc + np.swapaxes(jw, 1, 2) @ inertia @ jw)
+        sums.h[:, cols] -= body.mass * np.einsum("j,sjc->sc", self.gravity, jc)
+        sums.potential[:] -= body.mass * (com0 @ self.gravity)
+
+    def _inward(self, sums: _Sums,
+                at_v: list[list[tuple[slice, np.ndarray, np.ndarray | None]]]) -> None:
+        """h's (g v)_i terms: each joint against the momentum of what it carries, summed
+        from the leaves inward."""
+        for j in reversed(range(len(self.bodies))):
             parent = self.bodies[j].parent
             if parent >= 0:
-                momentum[parent] += momentum[j]
-                spin_sum[parent] += spin_sum[j]
+                sums.momentum[parent] += sums.momentum[j]
+                sums.spin_sum[parent] += sums.spin_sum[j]
             for part, w, point in at_v[j]:
-                arm = momentum[j] if point is None else spin_sum[j] - np.cross(point, momentum[j])
-                h[:, part] += np.einsum("sik,si->sk", w, arm).imag / STEP
-        kinetic = 0.5 * np.einsum("si,sij,sj->s", v, mass, v)
-        return mass, h, kinetic, potential
+                arm = sums.momentum[j] if point is None else \
+                    sums.spin_sum[j] - np.cross(point, sums.momentum[j])
+                sums.h[:, part] += np.einsum("sik,si->sk", w, arm).imag / STEP
+
