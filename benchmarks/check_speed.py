@@ -72,8 +72,8 @@ def scale(folder: Path, repeats: int) -> tuple[pd.DataFrame, dict[str, float]]:
     from dyncheck.adapters.model_files import read
     from dyncheck.adapters.mujoco_model import MujocoModel
     from dyncheck.check.derivative_referee import referee
-    from dyncheck.check.dynamics import sample
     from dyncheck.check.referee import ReferenceModel
+    from dyncheck.check.sampling import sample
 
     rows = []
     families = {"chain": (chain, (10, 25, 50, 100, 200, 400)),

@@ -30,7 +30,7 @@ from dyncheck.adapters.model_files import read
 from dyncheck.adapters.mujoco_model import MujocoModel
 from dyncheck.adapters.pinocchio_model import PinocchioModel
 from dyncheck.check import derivatives
-from dyncheck.check.dynamics import sample
+from dyncheck.check.sampling import sample
 from dyncheck.explain.charts import FALLING
 
 print(FALLING)

@@ -9,6 +9,7 @@ part: a field read differently (a gravity flag, a geom's mass) was "cause unknow
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 
 import numpy as np
 
@@ -29,6 +30,7 @@ def part_reading(batch: States, part: partial.Part, tree: ModelTree) -> readings
     own = readings.own_tree(part.tree, tree)
     if own is None:
         return None
+    own = _in_part(own, part)
     on = partial.states(batch, part)
     with np.errstate(all="ignore"):
         return readings.Reading(tree=own, dynamics=ReferenceModel(own).dynamics(on.q, on.v,
@@ -76,6 +78,18 @@ def rows(model: str, canonical_tree: ModelTree, *, a: str, b: str, batch: States
                    vertices=vertices, standing=standing, judged_on=judged_on)
 
 
+def _in_part(tree: ModelTree, part: partial.Part) -> ModelTree:
+    """A reading of a part with each joint's place in q and v counted within the part's
+    canonical layout (its joints keep the whole model's places, which index past the part's
+    own coordinates)."""
+    places = layout.canonical(part.tree)
+    at = {name: k for k, name in enumerate(places.names)}
+    return replace(tree, joints=tuple(
+        replace(j, layout=replace(j.layout, q_start=places.q_start[at[j.name]],
+                                  v_start=places.v_start[at[j.name]]))
+        for j in tree.joints))
+
+
 def _whole_on_part(part: partial.Part, whole: ModelTree, held: ModelTree,
                    batch: States) -> readings.Reading | None:
     """The referee on a whole engine's reading (``whole``, canonical layout) of the joints
@@ -84,6 +98,7 @@ def _whole_on_part(part: partial.Part, whole: ModelTree, held: ModelTree,
     tree = readings.own_tree(part.tree, kept.tree) if kept is not None else None
     if tree is None:
         return None
+    tree = _in_part(tree, part)
     with np.errstate(all="ignore"):
         return readings.Reading(tree=tree, dynamics=ReferenceModel(tree).dynamics(
             batch.q, batch.v, batch.a))
