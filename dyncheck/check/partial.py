@@ -22,8 +22,8 @@ from dyncheck.check.states import States
 
 @dataclass(frozen=True, kw_only=True)
 class Part:
-    """The joints an engine holds, as a tree of their own, and where their coordinates sit
-    in the canonical q and v."""
+    """The joints an engine holds, as a tree of their own (each joint's layout placed in the
+    part's q and v), and where their coordinates sit in the canonical q and v."""
 
     tree: ModelTree
     q: np.ndarray
@@ -48,7 +48,8 @@ def common_part(canonical: ModelTree, tree: ModelTree) -> Part | None:
             if held[j.name].type is not j.type or (j.parent is not None
                                                    and j.parent not in held):
                 return None
-            kept.append(j)
+            # its place in the part's own q and v (a reading of the part is laid out there)
+            kept.append(replace(j, layout=replace(j.layout, q_start=len(q), v_start=len(v))))
             q.extend(range(q_at, q_at + NQ[j.type]))
             v.extend(range(v_at, v_at + NV[j.type]))
         else:

@@ -9,7 +9,6 @@ part: a field read differently (a gravity flag, a geom's mass) was "cause unknow
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import replace
 
 import numpy as np
 
@@ -30,7 +29,6 @@ def part_reading(batch: States, part: partial.Part, tree: ModelTree) -> readings
     own = readings.own_tree(part.tree, tree)
     if own is None:
         return None
-    own = _in_part(own, part)
     on = partial.states(batch, part)
     with np.errstate(all="ignore"):
         return readings.Reading(tree=own, dynamics=ReferenceModel(own).dynamics(on.q, on.v,
@@ -68,7 +66,7 @@ def rows(model: str, canonical_tree: ModelTree, *, a: str, b: str, batch: States
             explanations = predicted.differences(layout.canonical(part.tree), part.tree,
                                                  reading.tree, trees[b], mine, reading.dynamics)
         elif reading is not None and whole in own:
-            theirs = _whole_on_part(part, own[whole].tree, reading.tree, mine)
+            theirs = _whole_on_part(batch, part, own[whole].tree, reading.tree)
             if theirs is not None:
                 first, second = (theirs, reading) if name == b else (reading, theirs)
                 effect = _effect(a, b, first=first, second=second, batch=mine,
@@ -78,30 +76,12 @@ def rows(model: str, canonical_tree: ModelTree, *, a: str, b: str, batch: States
                    vertices=vertices, standing=standing, judged_on=judged_on)
 
 
-def _in_part(tree: ModelTree, part: partial.Part) -> ModelTree:
-    """A reading of a part with each joint's place in q and v counted within the part's
-    canonical layout (its joints keep the whole model's places, which index past the part's
-    own coordinates)."""
-    places = layout.canonical(part.tree)
-    at = {name: k for k, name in enumerate(places.names)}
-    return replace(tree, joints=tuple(
-        replace(j, layout=replace(j.layout, q_start=places.q_start[at[j.name]],
-                                  v_start=places.v_start[at[j.name]]))
-        for j in tree.joints))
-
-
-def _whole_on_part(part: partial.Part, whole: ModelTree, held: ModelTree,
-                   batch: States) -> readings.Reading | None:
+def _whole_on_part(batch: States, part: partial.Part, whole: ModelTree,
+                   held: ModelTree) -> readings.Reading | None:
     """The referee on a whole engine's reading (``whole``, canonical layout) of the joints
     the partial engine holds (``held``), at the part's coordinates."""
     kept = partial.common_part(whole, held)
-    tree = readings.own_tree(part.tree, kept.tree) if kept is not None else None
-    if tree is None:
-        return None
-    tree = _in_part(tree, part)
-    with np.errstate(all="ignore"):
-        return readings.Reading(tree=tree, dynamics=ReferenceModel(tree).dynamics(
-            batch.q, batch.v, batch.a))
+    return part_reading(batch, part, kept.tree) if kept is not None else None
 
 
 def _effect(a: str, b: str, *, first: readings.Reading, second: readings.Reading,
