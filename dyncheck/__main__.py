@@ -1,3 +1,189 @@
-from dyncheck.cli import console
+"""The ``dyncheck`` command line: ``list``, ``run``, ``check``, ``diff``, ``versions``,
+``tutorials``, ``report``, ``explain``, ``errata``, ``baseline`` and ``bench`` — one module for
+``python -m dyncheck`` and the ``dyncheck`` script (the script's entry point is
+:func:`console`).
 
-raise SystemExit(console())
+Exit status: 0 when nothing failed unexplained, 1 when a check failed (or regressed against a
+baseline, or the committed report is stale), 2 for bad usage or bad input (a one-line message
+naming the argument and the value).
+
+Here: the parser, built from the commands' records, and the handling of errors and signals
+every command shares. Each command — its flags, help, example and handler (which validates
+its arguments before any work and calls the module that does it) — is one module of
+:mod:`dyncheck.commands`, named as the command (``list``: ``listing``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Sequence
+from typing import NoReturn, TextIO
+
+from dyncheck.commands import (
+    baseline,
+    bench,
+    check,
+    diff,
+    errata,
+    explain,
+    listing,
+    report,
+    run,
+    tutorials,
+    versions,
+)
+from dyncheck.commands.options import one_line
+from dyncheck.errors import DyncheckError, InvalidInput, Terminated
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (``dyncheck: error: …``, exit 2), no usage dump."""
+
+    def error(self, message: str) -> NoReturn:
+        where = self.prog.removeprefix("dyncheck").strip()
+        print(f"dyncheck: error: {where + ': ' if where else ''}{message}", file=sys.stderr)
+        raise SystemExit(2)
+
+
+COMMANDS = {c.name: c for c in (
+    listing.COMMAND, run.COMMAND, check.COMMAND, diff.COMMAND, versions.COMMAND,
+    tutorials.COMMAND, report.COMMAND, explain.COMMAND, errata.COMMAND, baseline.COMMAND,
+    bench.COMMAND)}
+"""Every subcommand, in the order ``--help`` lists them: each is its module's
+:class:`~dyncheck.commands.flags.Command` (flags, help, example and handler together)."""
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = _Parser(
+        prog="dyncheck",
+        description="A textbook's tensor dynamics (its general method and printed equations) "
+        "against MuJoCo, Pinocchio and Drake: every discrepancy measured and explained.",
+        epilog="exit status: 0 nothing failed unexplained; 1 a check failed, regressed or "
+        "moved; 2 bad usage or input (one line naming the argument and value). "
+        "`dyncheck COMMAND --help` shows an example of each command.",
+    )
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    for command in COMMANDS.values():
+        one = sub.add_parser(command.name, help=command.help,
+                             epilog=f"example: {command.example}")
+        command.arguments(one)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    from dyncheck.workers import on_sigterm, scratch
+
+    deep_walks()
+    with on_sigterm(), scratch():
+        return _main(argv)
+
+
+def deep_walks() -> None:
+    """Python's recursion limit raised for the model walks, which recurse body by body, so
+    that a tree :data:`~dyncheck.check.inputs.MAX_NESTING` deep is walked (3.11's
+    Python-to-Python calls take no C stack); deeper ones are refused up front."""
+    sys.setrecursionlimit(max(sys.getrecursionlimit(), 10_000))
+
+
+def _address_space(args: argparse.Namespace) -> None:
+    """A limit on this process's address space (``ulimit -v``) below what the command needs
+    (:data:`dyncheck.confinement.FLOOR_MIB`, measured) is refused before any work: the engines
+    would otherwise abort in C++ (``std::bad_alloc``, exit 134) or fail their rows as if the
+    model were at fault."""
+    from dyncheck.confinement import address_space_mib, floor_mib
+
+    have = address_space_mib()
+    need = floor_mib(args.command, tuple(getattr(args, "impl", ()) or ()))
+    if have is not None and need is not None and have < need:
+        raise InvalidInput("ulimit -v", f"{have} MiB", f"at least {need} MiB for "
+                           f"`dyncheck {args.command}` (measured: its engines need that much "
+                           "address space to load); raise it, e.g. ulimit -v unlimited")
+
+
+def _main(argv: Sequence[str] | None) -> int:
+    from dyncheck.workers import end_now
+
+    try:
+        args = _parser().parse_args(argv)
+    except SystemExit as exc:  # --help (0) or a one-line usage error (2), already printed
+        return int(exc.code or 0)
+    from dyncheck.cache.compiled import held
+    from dyncheck.commands.options import settings_of
+    from dyncheck.workers import settled
+
+    try:
+        _address_space(args)
+        # handed to every unit of work (dyncheck.settings), with the compiled-code folder
+        # checked before any engine runs and signed when the command ends
+        with held(settings_of(args)) as settings, settled(settings):
+            return COMMANDS[args.command].handler(args)
+    except DyncheckError as exc:
+        print(f"dyncheck: error: {one_line(str(exc))}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # a write that failed mid-way (disk full, file-size limit)
+        where = exc.filename or "output"
+        print(f"dyncheck: error: cannot write {where}: {exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except Terminated:
+        end_now()
+        print("dyncheck: terminated (nothing half-written)", file=sys.stderr)
+        return 143
+    except KeyboardInterrupt:
+        end_now()
+        print("dyncheck: interrupted (nothing half-written)", file=sys.stderr)
+        return 130
+    finally:
+        from dyncheck.commands.options import release_outs
+
+        release_outs()  # the output folders this command held (claim_out)
+
+
+def console() -> int:
+    """The ``dyncheck`` command: :func:`main` in a process that exits without a last garbage
+    collection (:func:`dyncheck.workers.exit_without_collecting`), its output to a reader
+    that may leave (:class:`_LeavingReader`)."""
+    from dyncheck.workers import exit_without_collecting
+
+    exit_without_collecting()
+    sys.stdout = _LeavingReader(sys.stdout)
+    return main()
+
+
+class _LeavingReader:
+    """``sys.stdout`` for a reader that may go away — ``dyncheck check FOLDER | head``: a
+    write to the closed pipe raised ``BrokenPipeError``, which ended the check after the
+    first model ('cannot write output: Broken pipe', exit 2, the other pages never
+    written). Now the rest of the output goes to /dev/null and the command finishes with
+    its own exit status."""
+
+    def __init__(self, stream: TextIO) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            self._drop()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            self._drop()
+
+    def _drop(self) -> None:
+        """The stream's file descriptor pointed at /dev/null: what is buffered, and the
+        interpreter's last flush, go nowhere without an error."""
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, self._stream.fileno())
+        os.close(devnull)
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(self._stream, name)
+
+
+if __name__ == "__main__":
+    raise SystemExit(console())

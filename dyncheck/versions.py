@@ -101,7 +101,7 @@ def constraints(eng: Engine, text: str, release: str = "") -> str:
 
 
 SOURCES = ("reference", "adapters", "cases", "dyncheck", ":(exclude)dyncheck/versions.py",
-           ":(exclude)dyncheck/cli.py", ":(exclude)dyncheck/diff.py")
+           ":(exclude)dyncheck/__main__.py", ":(exclude)dyncheck/diff.py")
 """The code whose content keys the cached runs (the matrix's own code and pages left out)."""
 
 
@@ -210,7 +210,7 @@ def run_release(
     impls = [x for i in ("reference", "book", *eng.impls) for x in ("--impl", i)]
     log(f"running {eng.name} {release}")
     result = subprocess.run(
-        [str(python), "-m", "dyncheck.cli", "run", *cases, *impls, "--jobs", str(jobs),
+        [str(python), "-m", "dyncheck", "run", *cases, *impls, "--jobs", str(jobs),
          "--out", str(out), *(() if current().cache else ("--no-cache",))],
         capture_output=True, text=True, check=False,
     )

@@ -201,7 +201,7 @@ def empty_cache(monkeypatch, tmp_path):
 def cache_on():
     """Every test under the command line's default settings (the disk cache read and
     written, the reference handed its store), as ``dyncheck`` runs: tests call the library
-    directly, not through :func:`dyncheck.cli.main`."""
+    directly, not through :func:`dyncheck.__main__.main`."""
     from dyncheck.settings import Settings
     from dyncheck.workers import settled
 

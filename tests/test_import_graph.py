@@ -13,9 +13,9 @@ ROOT = Path(__file__).resolve().parents[1]
 FOLDERS = {"dyncheck": "dyncheck", "reference": "dyncheck.reference",
            "adapters": "dyncheck.adapters", "cases": "dyncheck.cases"}
 
-HEIGHT = 10
+HEIGHT = 9
 """The longest import chain among the modules under ``dyncheck/`` today (ratchet: lower it
-when a change lowers it; the goal is 9)."""
+when a change lowers it; #62's goal of 9 is met)."""
 
 
 def modules(root: Path = ROOT, folders: dict[str, str] = FOLDERS) -> dict[str, Path]:

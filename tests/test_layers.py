@@ -200,7 +200,7 @@ def test_no_module_asks_an_implementation_for_its_engine_by_duck_typing():
 
 
 NOT_ENGINES = {
-    ("dyncheck/cli.py", "impl"): "an argparse namespace: commands differ in their flags",
+    ("dyncheck/__main__.py", "impl"): "an argparse namespace: commands differ in their flags",
     ("dyncheck/commands/options.py", "device"): "an argparse namespace",
     ("dyncheck/commands/options.py", "out"): "an argparse namespace",
     ("dyncheck/commands/options.py", "no_cache"): "an argparse namespace",

@@ -166,3 +166,10 @@ def depth(tree: ModelTree) -> int:
     for j in tree.joints:  # parents come first in every engine's order
         level[j.name] = level.get(j.parent, 0) + 1
     return max(level.values())
+
+
+def size(tree: ModelTree) -> float:
+    """The model's length scale: the largest distance of a joint or centre of mass from the
+    origin (at least 1 mm)."""
+    points = [j.anchor for j in tree.joints] + [j.com for j in tree.joints if j.mass > 0]
+    return max([1e-3, *(float(np.linalg.norm(p)) for p in points)])

@@ -20,17 +20,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from dyncheck.adapters.model_tree import JointType, ModelTree, TreeJoint
-from dyncheck.check.computed import depth
+from dyncheck.check.computed import depth, size
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import ROUNDOFF_FACTOR, eps_name
 from dyncheck.vocabulary import Quantity, Verdict
-
-
-def size(tree: ModelTree) -> float:
-    """The model's length scale: the largest distance of a joint or centre of mass from the
-    origin (at least 1 mm)."""
-    points = [j.anchor for j in tree.joints] + [j.com for j in tree.joints if j.mass > 0]
-    return max([1e-3, *(float(np.linalg.norm(p)) for p in points)])
 
 
 def shown_value(value: object) -> str:

@@ -18,8 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters.model_tree import QUANTITY_OF, Dynamics, ModelTree
-from dyncheck.check.computed import depth
-from dyncheck.check.describe import size
+from dyncheck.check.computed import depth, size
 from dyncheck.check.referee import GENERAL, RECURSIVE, Tie
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.check.states import States, condition

@@ -80,7 +80,7 @@ def model_path(text: str) -> Path:
 
 MAX_NESTING = 2000
 """The deepest tree the check walks (its walks recurse body by body: Python's recursion
-limit is raised for them, :func:`dyncheck.cli.main`); a deeper one is refused up front."""
+limit is raised for them, :func:`dyncheck.__main__.main`); a deeper one is refused up front."""
 
 
 def nesting(root: ET.Element) -> int:

@@ -13,7 +13,7 @@ from dyncheck.workers import JOB_MEMORY, default_jobs
 
 @dataclass(frozen=True, kw_only=True)
 class Command:
-    """One subcommand of ``dyncheck``: the command line (:mod:`dyncheck.cli`) adds a parser
+    """One subcommand of ``dyncheck``: the command line (:mod:`dyncheck.__main__`) adds a parser
     per record, with ``arguments`` adding its flags and ``example`` under its ``--help``."""
 
     name: str

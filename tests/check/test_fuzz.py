@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from dyncheck.__main__ import main
 from dyncheck.check import engines
-from dyncheck.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 SOURCES = [

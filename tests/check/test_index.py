@@ -12,9 +12,9 @@ from pathlib import Path
 
 import pytest
 
+from dyncheck.__main__ import main
 from dyncheck.check import index
 from dyncheck.check.inputs import ModelFileError
-from dyncheck.cli import main
 
 CHAIN = ('<mujoco model="{n}"><worldbody><body name="b" pos="0 0 1"><joint name="j" '
          'type="hinge" axis="0 1 0"/><inertial pos="0 0 -0.2" mass="1" '

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from dyncheck.cli import main
+from dyncheck.__main__ import main
 
 MODELS = Path(__file__).parent / "models"
 URDF = (MODELS / "branches.urdf").read_text()

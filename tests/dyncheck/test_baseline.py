@@ -9,9 +9,9 @@ import pandas as pd
 import pytest
 
 from dyncheck import baseline
+from dyncheck.__main__ import main
 from dyncheck.cases import get_case
 from dyncheck.cases.pendulums import SimplePendulum
-from dyncheck.cli import main
 from dyncheck.errors import InvalidInput
 from dyncheck.report import folder as report
 from dyncheck.results import DISCREPANCY_KEY

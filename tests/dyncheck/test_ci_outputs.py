@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from dyncheck.cli import main
+from dyncheck.__main__ import main
 
 MODELS = Path(__file__).resolve().parents[1] / "check" / "models"
 

@@ -8,7 +8,7 @@ import sys
 import pandas as pd
 import pytest
 
-from dyncheck.cli import main
+from dyncheck.__main__ import main
 from dyncheck.results import ConvergencePoint, Discrepancy
 
 
@@ -111,7 +111,7 @@ def test_list_imports_no_engine():
     import importlib.metadata
 
     code = (
-        "import sys; from dyncheck.cli import main; main(['list']); "
+        "import sys; from dyncheck.__main__ import main; main(['list']); "
         "print(sorted(m for m in ('jax', 'warp', 'pydrake', 'pinocchio', 'mujoco', 'sympy') "
         "if m in sys.modules))"
     )
@@ -192,7 +192,7 @@ def test_bench_writes_its_tables(tmp_path, monkeypatch, selection, parts):
 
 
 def test_help_lists_every_command_in_full_with_an_example(capsys):
-    from dyncheck.cli import COMMANDS
+    from dyncheck.__main__ import COMMANDS
 
     assert main(["--help"]) == 0
     top = capsys.readouterr().out

@@ -17,7 +17,7 @@ import pandas as pd
 import pytest
 
 from dyncheck import diff
-from dyncheck.cli import main
+from dyncheck.__main__ import main
 from dyncheck.results import PROVENANCE, to_csv
 
 DTS = [1e-3, 5e-4, 2.5e-4, 1.25e-4]

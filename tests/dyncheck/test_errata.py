@@ -9,7 +9,7 @@ import re
 import pytest
 import sympy as sp
 
-from dyncheck.cli import main
+from dyncheck.__main__ import main
 from dyncheck.errata import cayley, checks, frenet, inventory, page, rotation
 
 ROOT = inventory.STORED.parents[2]

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import pytest
 
+from dyncheck.__main__ import main
 from dyncheck.cases import get_case
 from dyncheck.cases.multibody import Body, Joint
-from dyncheck.cli import main
 from dyncheck.errors import DyncheckError
 
 ROOT = Path(__file__).resolve().parents[2]

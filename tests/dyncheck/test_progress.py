@@ -6,7 +6,7 @@ from __future__ import annotations
 import io
 import re
 
-from dyncheck.cli import main
+from dyncheck.__main__ import main
 from dyncheck.progress import Progress
 
 

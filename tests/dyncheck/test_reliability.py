@@ -15,9 +15,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from dyncheck.__main__ import main
 from dyncheck.adapters import REGISTRY, get_adapter
 from dyncheck.cases import get_case
-from dyncheck.cli import main
 from dyncheck.errors import EngineError
 from dyncheck.run import run
 
@@ -125,7 +125,7 @@ def test_an_engine_whose_package_is_not_installed_is_skipped_not_a_crash(tmp_pat
         f"def gone(name):\n    if name == {package!r}: raise md.PackageNotFoundError(name)\n"
         "    return real(name)\n"
         f"md.distribution = gone; sys.modules[{package!r}] = None\n"
-        "from dyncheck.cli import main\n"
+        "from dyncheck.__main__ import main\n"
         f"raise SystemExit(main(['run', 'simple_pendulum', '--impl', 'reference', '--impl', "
         f"{engine!r}, '--jobs', '1', '--quiet', '--out', {str(out)!r}]))"
     )
@@ -145,7 +145,7 @@ def test_missing_engine_costs_only_its_rows(tmp_path):
     out = tmp_path / "rep"
     code = (
         "import sys; sys.modules['pinocchio'] = None\n"
-        "from dyncheck.cli import main\n"
+        "from dyncheck.__main__ import main\n"
         "impls = ['--impl', 'reference', '--impl', 'mujoco', '--impl', 'pinocchio',"
         " '--impl', 'pinocchio-mjcf']\n"
         f"raise SystemExit(main(['run', 'simple_pendulum', *impls, '--out', {str(out)!r}]))"

@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 
 from dyncheck import report_check
-from dyncheck.cli import main
+from dyncheck.__main__ import main
 from dyncheck.results import to_csv
 
 REPORTS = Path(__file__).resolve().parents[2] / "reports"

@@ -162,7 +162,7 @@ def test_dask_without_the_extra_names_the_extra(monkeypatch):
 
 def test_cli_refuses_an_unreachable_scheduler_before_any_work(tmp_path, monkeypatch, capsys):
     pytest.importorskip("distributed", reason="the extra 'dask' (pip install 'dyncheck[dask]')")
-    from dyncheck.cli import main
+    from dyncheck.__main__ import main
 
     monkeypatch.setattr(workers, "CONNECT_SECONDS", 0.2)  # refused at once: no wait needed
     out = tmp_path / "rep"
@@ -183,7 +183,7 @@ def test_check_of_several_models_on_workers_writes_the_same_csv_bytes(where, tmp
     workers start each model's engine processes) against the same check in this process."""
     if "--dask" in where:
         pytest.importorskip("distributed", reason="the extra 'dask' (pip install 'dyncheck[dask]')")
-    from dyncheck.cli import main
+    from dyncheck.__main__ import main
 
     here, there = tmp_path / "here", tmp_path / "there"
     assert main(["check", *MODELS, "--states", "20", "--out", str(here)]) == 0

@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 
 from dyncheck import workers
+from dyncheck.__main__ import main
 from dyncheck.bench import engines as bench
 from dyncheck.cases import get_case
-from dyncheck.cli import main
 from dyncheck.errors import EngineError
 
 IMPLS = ("reference", "mujoco")

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import pytest
 
+from dyncheck.__main__ import main
 from dyncheck.cache import measured as measured_cache
-from dyncheck.cli import main
 from dyncheck.explain import catalogue
 
 NAME = "hinge-axis-sign"

@@ -8,8 +8,8 @@ import re
 import numpy as np
 import pytest
 
+from dyncheck.__main__ import main
 from dyncheck.cases.coordinate_maps import LinearMap
-from dyncheck.cli import main
 from dyncheck.errors import UnknownName
 from dyncheck.explain import catalogue
 from dyncheck.explain.coordinates import worst

@@ -19,8 +19,8 @@ from pathlib import Path
 import pytest
 from packaging.requirements import Requirement
 
+from dyncheck.__main__ import main
 from dyncheck.adapters import REGISTRY
-from dyncheck.cli import main
 from dyncheck.explain.catalogue import DEMOS
 from dyncheck.explain.reproducers import REPRODUCERS
 
