@@ -44,6 +44,15 @@ class Trajectory:
     v: np.ndarray
 
 
+@dataclass(frozen=True, kw_only=True)
+class Steps:
+    """An error-controlled run's step counts: steps taken, and steps shrunk by its error
+    control."""
+
+    taken: int
+    shrunk: int
+
+
 @dataclass(frozen=True)
 class LoadedBody:
     """A body's mass (kg) and inertia about its centre of mass (kg·m², body axes) as the engine
@@ -131,6 +140,14 @@ class Adapter(ABC):
     rk4_group_order: ClassVar[int] = 4
     """RK4's order on a rotating joint as the engine defines its stages there (2 where it
     sums stage velocities across tangent spaces: MJX, MuJoCo before 4.0)."""
+    @classmethod
+    def steps_in_a_chart(cls) -> bool:
+        """Whether its stepping advances a rotating joint in coordinates of its own (angles, a
+        quaternion's components: q₊ = q + h N(q) v), not along the rotation group: its runs
+        then differ from another engine's by O(h) there. An adapter's is its layout's: a
+        ball joint held in angles."""
+        return cls.state_layout.charted
+
     error_controlled: ClassVar[bool] = False
     """Whether the engine offers error-controlled integration of its own
     (``simulate_controlled``: Drake's)."""
@@ -305,7 +322,11 @@ class Offer(StrEnum):
     TRANSITION = "transition"
     """``transition(q, v, a)``: the Jacobians of one step of each of its integrators."""
     STEPPING = "simulate"
-    """``simulate(q0, v0, dt, steps)``: trajectories by its own stepping."""
+    """``simulate(q0, v0, dt, steps, integrator=)``: trajectories by its own stepping, with
+    each of its registration's integrators."""
+    CONTROLLED_STEPPING = "simulate_controlled"
+    """``simulate_controlled(q0, v0, period, samples, accuracy=)``: a trajectory by its own
+    error-controlled integrator at a target accuracy, and its step counts."""
     ACTUATION = "actuation"
     """``actuation(q, v, u)``: the generalized force of its actuators at controls u and its
     forward dynamics with it (its tree's ``actuators`` say what it read)."""
@@ -361,6 +382,14 @@ class ModelEngine(ABC):
     :attr:`Offer.ACTUATION` (its limit, or dyncheck's, in a sentence); empty: it holds no
     actuator model, its input being the generalized force itself."""
     tree: ModelTree
+    steps_in_a_chart: bool = False
+    """A class fact: its stepping (:attr:`Offer.STEPPING`) advances a ball or free joint's own
+    coordinates (roll-pitch-yaw angles, a quaternion's four components: q₊ = q + h N(q) v),
+    not along the rotation group as MuJoCo's Euler does (its runs then differ from another
+    engine's by O(h) on a rotating body)."""
+    parser_warnings: tuple[str, ...] = ()
+    """Its parser's own warnings on the file, verbatim (Drake's: what it ignores); the
+    tree's ``notes`` hold them summarized, with dyncheck's own notes on the reading."""
     _answer: Answer
     _both: tuple[Answer, Answer]
 
@@ -381,8 +410,19 @@ class ModelEngine(ABC):
         raise Unsupported(f"{self.engine} offers no step Jacobians")
 
     def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
-                 field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
+                 integrator: str, field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """``steps`` steps of ``dt`` by ``integrator`` (one of its registration's), q and v at
+        every step, the start included (:attr:`Offer.STEPPING`)."""
         raise Unsupported(f"{self.engine} offers no stepping of its own")
+
+    def simulate_controlled(self, q0: np.ndarray, v0: np.ndarray, period: float, samples: int,
+                            *, accuracy: float, scheme: str | None = None, caching: bool = True,
+                            field: Field | None = None) -> tuple[np.ndarray, np.ndarray, Steps]:
+        """Its error-controlled run at ``accuracy`` (``scheme``: its own name of one of its
+        error-controlled integrators, None its default; ``caching``: its computation cache,
+        which must not change a result), q and v every ``period`` for ``samples`` periods,
+        and its step counts (:attr:`Offer.CONTROLLED_STEPPING`)."""
+        raise Unsupported(f"{self.engine} offers no error-controlled stepping of its own")
 
     def couple(self, couplings: Sequence[Coupling]) -> None:
         """Hold ``couplings`` from now on (:attr:`Offer.COUPLINGS`)."""

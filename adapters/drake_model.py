@@ -25,7 +25,7 @@ import logging
 import re
 import tempfile
 import xml.etree.ElementTree as ET
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -41,9 +41,9 @@ from pydrake.multibody.tree import (
     QuaternionFloatingJoint,
 )
 
-from dyncheck.adapters import drake_actuators
+from dyncheck.adapters import drake_actuators, drake_simulation
 from dyncheck.adapters.actuators import Actuation
-from dyncheck.adapters.base import ModelEngine, Offer
+from dyncheck.adapters.base import Field, ModelEngine, Offer, Steps
 from dyncheck.adapters.drake_hints import actuators, armature_hint, file_hints, ignored_frames
 from dyncheck.adapters.mjcf_copy import for_parser
 from dyncheck.adapters.model_files import Format, ModelFile
@@ -62,6 +62,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
+from dyncheck.cases.multibody import Coupling
 from dyncheck.errors import DyncheckError, EngineError, Unsupported
 
 ENGINE = "drake"
@@ -98,7 +99,20 @@ def parser_warnings() -> Iterator[list[str]]:
         log.propagate = propagate
 
 
-def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str, tuple]]:
+def parse_xml(xml: str, time_step: float = 0.0) -> tuple[MultibodyPlant, list[str]]:
+    """Drake's MJCF parser on ``xml`` as it is (no copy made for it), and its warnings: the
+    parser itself, as the catalogue's demonstrations measure it."""
+    plant = MultibodyPlant(time_step)
+    with parser_warnings() as warnings:
+        Parser(plant).AddModelsFromString(xml, "xml")
+    plant.Finalize()
+    return plant, warnings
+
+
+def _plant(source: ModelFile) -> tuple[MultibodyPlant, list[str], tuple[str, ...],
+                                       dict[str, tuple]]:
+    """The finalized plant, its parser's warnings, the notes on the reading, and each
+    joint's damping (zeroed in the plant)."""
     plant = MultibodyPlant(0.0)
     notes: list[str] = []
     with parser_warnings() as warnings, tempfile.TemporaryDirectory() as meshes:
@@ -137,7 +151,7 @@ def _plant(source: ModelFile) -> tuple[MultibodyPlant, tuple[str, ...], dict[str
             damping[joint.name()] = tuple(float(x) for x in joint.default_damping_vector())
             joint.set_default_damping_vector(np.zeros(joint.num_velocities()))
     plant.Finalize()
-    return plant, tuple(notes), damping
+    return plant, warnings, tuple(notes), damping
 
 
 def _summary(warnings: list[str]) -> list[str]:
@@ -206,10 +220,14 @@ class DrakeModel(ModelEngine):
     """A Drake plant and its neutral tree."""
 
     engine = ENGINE
-    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION, Offer.CONTROL_DERIVATIVES})
+    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION, Offer.CONTROL_DERIVATIVES,
+                        Offer.STEPPING, Offer.CONTROLLED_STEPPING, Offer.COUPLINGS,
+                        Offer.BODY_FORCES})
+    steps_in_a_chart = True  # its integrators advance q = (roll, pitch, yaw) and (w, x, y, z, p)
 
     def __init__(self, source: ModelFile) -> None:
-        self.plant, notes, self._damping = _plant(source)
+        self.plant, said, notes, self._damping = _plant(source)
+        self.parser_warnings = tuple(dict.fromkeys(said))
         self._source = source
         self.context = self.plant.CreateDefaultContext()
         actuation = self.plant.get_actuation_input_port()
@@ -218,6 +236,7 @@ class DrakeModel(ModelEngine):
         self._acc = self.plant.get_generalized_acceleration_output_port()
         self._ad: Any = None  # the AutoDiffXd plant, made on the first derivatives asked for
         self._actuated: Any = None  # the context of actuation (its PD controllers armed)
+        self._rows: np.ndarray | None = None  # the couplings C v = 0 it holds (Drake's order)
         self._ad_actuated: Any = None  # the same for the AutoDiffXd plant
         self.tree = self._tree(notes)
 
@@ -301,6 +320,62 @@ class DrakeModel(ModelEngine):
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
                          nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,
                          hints=hints, actuators=drake_actuators.read(plant))
+
+    def couple(self, couplings: Sequence[Coupling]) -> None:
+        """The couplings closed with Drake's M and h (:mod:`.drake_simulation`: Drake's
+        continuous plant enforces no constraint)."""
+        self._rows = drake_simulation.coupling_matrix(self.plant, couplings)
+
+    def _closed(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, which: int) -> np.ndarray:
+        """v̇ (``which`` 0) or the multipliers (1) of the couplings' KKT solve per state."""
+        assert self._rows is not None
+        plant, ctx = self.plant, self.context
+        out = np.empty((len(q), plant.num_velocities() if which == 0 else len(self._rows)))
+        for i in range(len(q)):
+            plant.SetPositions(ctx, q[i])
+            plant.SetVelocities(ctx, v[i])
+            out[i] = drake_simulation.closed(plant, ctx, tau[i], self._rows)[which]
+        return out
+
+    def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """v̇ at τ: with couplings, their KKT solve; else M⁻¹ (τ − h)."""
+        if self._rows is None:
+            return super().forward(q, v, tau)
+        return self._closed(q, v, tau, 0)
+
+    def constraint_forces(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        if self._rows is None:
+            return super().constraint_forces(q, v, tau)
+        return self._closed(q, v, tau, 1)
+
+    def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
+        """Σ Jᵀ F of the field at each state (Drake's translational Jacobians)."""
+        plant, ctx = self.plant, self.context
+        held = drake_simulation.bodies(plant)
+        out = np.empty((len(q), plant.num_velocities()))
+        for i in range(len(q)):
+            plant.SetPositions(ctx, q[i])
+            plant.SetVelocities(ctx, v[i])
+            out[i] = drake_simulation.generalized(plant, ctx, field, held)
+        return out
+
+    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
+                 integrator: str, field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Drake's own fixed-step integrator (:data:`.drake_simulation.INTEGRATORS`)."""
+        q, v, _ = drake_simulation.simulate(
+            self.plant, q0, v0, samples=steps, period=dt,
+            scheme=drake_simulation.INTEGRATORS[integrator], dt=dt, field=field,
+            rows=self._rows)
+        return q, v
+
+    def simulate_controlled(self, q0: np.ndarray, v0: np.ndarray, period: float, samples: int,
+                            *, accuracy: float, scheme: str | None = None, caching: bool = True,
+                            field: Field | None = None) -> tuple[np.ndarray, np.ndarray, Steps]:
+        """Drake's error-controlled integration (default ``runge_kutta3``, the Simulator's)."""
+        return drake_simulation.simulate(
+            self.plant, q0, v0, samples=samples, period=period,
+            scheme=scheme or drake_simulation.CONTROLLED, dt=None, accuracy=accuracy,
+            caching=caching, field=field, rows=self._rows)
 
     def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
         """Drake's actuator force and forward dynamics at controls u

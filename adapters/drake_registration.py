@@ -1,19 +1,20 @@
-"""Drake's registration (:mod:`.drake_`, :mod:`.drake_model`): importable without pydrake."""
+"""Drake's registration (:mod:`.drake_model`, which also serves ``dyncheck run``): importable
+without pydrake."""
 
 from __future__ import annotations
 
+from dyncheck.adapters.model_files import Format
 from dyncheck.adapters.registration import A, Registration
 from dyncheck.vocabulary import Integrator
 
 REGISTRATIONS: dict[str, Registration] = {
     "drake": Registration(
-        module=A + "drake_",
-        cls="DrakeAdapter",
         package="drake",
         extra="drake",
         integrators=(Integrator.EULER, Integrator.RK2, Integrator.RK3),
         model=A + "drake_model:DrakeModel",
         label="drake",
+        run=Format.MJCF,
         releases=("1.40.0", "1.45.0", "1.51.1"),
         released_with=("mosek",),
     ),

@@ -33,7 +33,15 @@ from typing import Any, ClassVar, cast
 
 import numpy as np
 
-from dyncheck.adapters.base import Adapter, Field, LoadedBody, ModelEngine, Offer, Trajectory
+from dyncheck.adapters.base import (
+    Adapter,
+    Field,
+    LoadedBody,
+    ModelEngine,
+    Offer,
+    Steps,
+    Trajectory,
+)
 from dyncheck.adapters.c_output import c_output_dropped
 from dyncheck.adapters.layout import Canonical, StateMap, canonical_states
 from dyncheck.adapters.layout_batch import engine_states, to_canonical
@@ -86,6 +94,7 @@ class ModelAdapter(Adapter):
         if model.couplings:
             self.engine.couple(model.couplings)  # (refused, in its words, where it cannot)
         self.tree: ModelTree = self.engine.tree
+        self.parser_warnings = self.engine.parser_warnings
         self.inertia_rounded = self.tree.inertia_accuracy > 0.0
         self.canon, self._carriers = self._canonical(model)
         self._unavailable: dict[str, str] = {}
@@ -173,6 +182,12 @@ class ModelAdapter(Adapter):
         through the reversed roll-pitch-yaw (:attr:`GravityFrame.RPY_REVERSED`)."""
         return [(k, j) for k, j in enumerate(self.tree.joint(n) for n in self.canon.names)
                 if j.type is JointType.FREE and j.gravity_frame is GravityFrame.RPY_REVERSED]
+
+    @classmethod
+    def steps_in_a_chart(cls) -> bool:
+        """Its loader's stepping fact (:attr:`~.base.ModelEngine.steps_in_a_chart`): the
+        run's states are in the canonical layout, the engine's stepping is its own."""
+        return cast(type[ModelEngine], cls.loader).steps_in_a_chart
 
     @classmethod
     def version(cls) -> str:
@@ -282,10 +297,27 @@ class ModelAdapter(Adapter):
         _, qe, ve, _ = engine_states(self.canon, self.tree, q0[None], v0[None],
                                      np.zeros_like(v0)[None])
         steps = round(duration / dt)
-        q_e, v_e = self.engine.simulate(qe[0], ve[0], dt, steps, field=self.field)
+        q_e, v_e = self.engine.simulate(qe[0], ve[0], dt, steps, integrator=integrator,
+                                        field=self.field)
         self._finite(q_e, v_e, dt)
         q, v = canonical_states(self.canon, self.tree, q_e, v_e)
         return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", q), v)
+
+    def simulate_controlled(self, q0: np.ndarray, v0: np.ndarray, duration: float,
+                            grid: float, accuracy: float, scheme: str | None = None,
+                            caching: bool = True) -> tuple[Trajectory, Steps]:
+        """The loader's own error-controlled run (:attr:`~.base.Offer.CONTROLLED_STEPPING`)
+        at ``accuracy``, sampled every ``grid`` seconds, its states mapped back to the
+        canonical layout, and its step counts."""
+        _, qe, ve, _ = engine_states(self.canon, self.tree, q0[None], v0[None],
+                                     np.zeros_like(v0)[None])
+        samples = round(duration / grid)
+        q_e, v_e, steps = self.engine.simulate_controlled(
+            qe[0], ve[0], grid, samples, accuracy=accuracy, scheme=scheme, caching=caching,
+            field=self.field)
+        self._finite(q_e, v_e, grid)
+        q, v = canonical_states(self.canon, self.tree, q_e, v_e)
+        return Trajectory(np.arange(samples + 1) * grid, self._check("simulate", q), v), steps
 
     def _finite(self, q_e: np.ndarray, v_e: np.ndarray, dt: float) -> None:
         """Raise, naming the step and the engine's own conditioning there, where its stepping
@@ -335,5 +367,6 @@ def for_engine(name: str, *, package: str, model: str, run: Format, float32: boo
         loader = getattr(importlib.import_module(module), cls)
     attrs = {"name": name, "package": package, "loader": loader, "run_format": run,
              "dtype": np.float32 if float32 else np.float64, "integrators": integrators,
+             "error_controlled": Offer.CONTROLLED_STEPPING in loader.offers,
              "__module__": __name__}
     return type(f"{cls}Adapter", (ModelAdapter,), attrs)

@@ -349,7 +349,7 @@ class NewtonModel(ModelEngine):
                            potential=potential)
 
     def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
-                 field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
+                 integrator: str, field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
         """``steps`` steps of Newton's Featherstone solver (``SolverFeatherstone``: forward
         dynamics by the articulated-body algorithm, then semi-implicit Euler, v₊ = v + h v̇,
         q₊ = q + h v₊ on hinges and slides), from (q0, v0), no control, no contacts: q and v

@@ -385,7 +385,7 @@ class PybulletModel(PybulletState, ModelEngine):
         return out, forces
 
     def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
-                 field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
+                 integrator: str, field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
         """``steps`` calls of ``stepSimulation`` at ``setTimeStep(dt)`` from (q0, v0): q and v
         at every step, the start included. Stated as a PyBullet user writes it for free
         motion: each joint's default motor switched off

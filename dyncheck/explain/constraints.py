@@ -104,11 +104,11 @@ def drake_equality() -> Entry:
     from pydrake.multibody.plant import DiscreteContactApproximation, MultibodyPlant
     from pydrake.systems.analysis import Simulator
 
-    from dyncheck.adapters.drake_ import DrakeAdapter
+    from dyncheck.adapters.drake_model import parse_xml
 
     (m1, m2, g), h = ATWOOD, 1e-3
     book = (m1 - m2) * g / (m1 + m2)  # Example 6
-    loaded, warnings = DrakeAdapter.parse_xml(atwood_xml())  # continuous plant
+    loaded, warnings = parse_xml(atwood_xml())  # continuous plant
     ctx = loaded.CreateDefaultContext()
     free_fall = float(loaded.get_generalized_acceleration_output_port().Eval(ctx)[0])
     ignored = sum("tendon" in w for w in warnings)

@@ -15,7 +15,7 @@ from dyncheck.vocabulary import Integrator
 def leaf_system_run(
     adapter, q0: np.ndarray, v0: np.ndarray, duration: float, eps: float, max_step: float
 ):
-    """The Drake adapter's forward dynamics as a plain LeafSystem (state (q, v), misc
+    """Drake's run adapter's forward dynamics as a plain LeafSystem (state (q, v), misc
     continuous state) under runge_kutta5 at ``eps``, caching on: q at ``duration``."""
     from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
     from pydrake.systems.framework import LeafSystem

@@ -77,7 +77,7 @@ def drake_mjcf_options() -> Entry:
     import mujoco
     from pydrake.math import RigidTransform
 
-    from dyncheck.adapters.drake_ import DrakeAdapter
+    from dyncheck.adapters.drake_model import parse_xml
 
     xml = (
         "<mujoco model='m'><compiler eulerseq='zyx'/>"
@@ -87,7 +87,7 @@ def drake_mjcf_options() -> Entry:
         "</worldbody></mujoco>"
     )
     m = mujoco.MjModel.from_xml_string(xml)
-    plant, warnings = DrakeAdapter.parse_xml(xml)
+    plant, warnings = parse_xml(xml)
     joint = plant.GetJointByName("j")
     X = joint.frame_on_parent().CalcPoseInBodyFrame(plant.CreateDefaultContext())
     R_dk = RigidTransform(X).rotation().matrix()

@@ -32,9 +32,10 @@ from dyncheck.vocabulary import Integrator, Quantity, is_rk4
 
 
 def _charted(name: str) -> bool:
-    """Whether an implementation holds a ball joint in angles (a chart), not a quaternion."""
+    """Whether an implementation steps a rotating joint in coordinates of its own (a chart:
+    angles, a quaternion's components), not along the rotation group."""
     try:
-        return get_adapter(name).state_layout.charted
+        return get_adapter(name).steps_in_a_chart()
     except DyncheckError:  # the reference, the book, an engine that is not installed
         return False
 

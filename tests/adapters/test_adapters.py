@@ -276,40 +276,13 @@ def test_batched_path_equals_per_quantity_methods(adapter_and_states):
         assert_allclose(batched[key], value, rtol=0, atol=atol, err_msg=key)
 
 
-@pytest.mark.parametrize("case_name", ["compound_pendulum", "compound_pulley", "kepler"])
-def test_drake_batch_through_its_coordinate_permutation_is_the_native_one(case_name):
-    """Where Drake's coordinates are the spec's in its order (every case here) the batch
-    passes states as they are; the general path gathers them through the permutation to
-    Drake's order. On the identity permutation the two must agree to the last bit — with
-    cords (the KKT solve) and with a field (the external forces) too."""
-    from dyncheck.coordinates import velocity_to_engine
-
-    adapter = _adapter(case_name, "drake")
-    assert adapter._native
-    case = get_case(case_name)
-    cmap, rng = case.engine_map(), np.random.default_rng(5)
-    qb = rng.uniform(*case.q_bounds(), (8, case.ndof))
-    vb = rng.uniform(-3, 3, (8, case.ndof))
-    q, v = cmap.to_engine(qb), velocity_to_engine(cmap, qb, vb)
-    tau, a = rng.uniform(-5, 5, v.shape), rng.uniform(-5, 5, v.shape)
-    native = adapter.evaluate_all(q, v, tau, a)
-    adapter._native = False
-    try:
-        permuted = adapter.evaluate_all(q, v, tau, a)
-    finally:
-        adapter._native = True
-    assert set(native) == set(permuted)
-    for key in native:
-        np.testing.assert_array_equal(permuted[key], native[key], err_msg=key)
-
-
 def test_drake_parser_ignores_the_tendon_equality():
     """Measured: Drake's MJCF parser warns that it ignores <tendon> and the tendon equality,
-    and loads no constraint — why the Drake adapter closes the cords itself (a KKT solve with
+    and loads no constraint — why Drake's loader closes the cords itself (a KKT solve with
     Drake's M and h)."""
-    from dyncheck.adapters.drake_ import DrakeAdapter
+    from dyncheck.adapters.drake_model import parse_xml
 
-    plant, warnings = DrakeAdapter.parse_xml(to_mjcf(get_case("atwood").multibody()))
+    plant, warnings = parse_xml(to_mjcf(get_case("atwood").multibody()))
     assert plant.num_velocities() == 2 and plant.num_constraints() == 0
     assert any("'tendon' found as a child of 'equality'" in w for w in warnings)
 
@@ -334,9 +307,12 @@ def test_registered_integrators_are_those_the_engine_maps(engine):
     from dyncheck.adapters.integrators import STEPPERS
 
     entry = REGISTRY[engine]
-    if entry.module is None:  # a file loader's run adapter: its stepping, by definition
+    if entry.module is None:  # a file loader's run adapter: its own schemes (Drake's scheme
+        # names), or one stepping whose definition is the reference's (semi-implicit Euler)
         assert get_adapter(engine).integrators == entry.integrators
-        assert set(entry.integrators) <= set(STEPPERS)
+        own = {"drake": "dyncheck.adapters.drake_simulation"}.get(engine)
+        mapped = importlib.import_module(own).INTEGRATORS if own else STEPPERS
+        assert set(entry.integrators) <= set(mapped), set(entry.integrators) - set(mapped)
         return
     module = importlib.import_module(entry.module)
     # the engine's own table (Drake's scheme names), MuJoCo's one table for the C engine

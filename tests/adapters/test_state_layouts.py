@@ -195,13 +195,23 @@ def test_pinocchio_free_flyer_velocity_is_body_frame(name):
     assert get_adapter(name).state_layout.free.linear_axes is Axes.LOCAL
 
 
+def _drake(case_name: str, canonical: np.ndarray):
+    """Drake's loader of the case's MJCF, and the canonical configuration in Drake's q as
+    its run maps it (:func:`~dyncheck.adapters.layout_batch.engine_states`)."""
+    from dyncheck.adapters.layout_batch import engine_states
+
+    adapter = make_implementation("drake", get_case(case_name)).adapter
+    zero = np.zeros((1, adapter.canon.nv))
+    return adapter, engine_states(adapter.canon, adapter.tree, canonical[None], zero, zero)[1][0]
+
+
 def test_drake_ball_joint_is_rpy_with_world_angular_velocity():
     """Drake's BallRpyJoint: q = (r, p, y) with R = R_z(y) R_y(p) R_x(r); v = ω in world
     axes. Checked on the plant Drake's parser builds from the spherical pendulum's MJCF."""
-    case = get_case("spherical_pendulum")
-    adapter = make_implementation("drake", case).adapter
-    plant, ctx = adapter.plant, adapter.context
-    q = to_engine("drake", case.multibody(), ROT[None])[0]
+    from dyncheck.adapters.layout import canonical_states
+
+    adapter, q = _drake("spherical_pendulum", ROT)
+    plant, ctx = adapter.engine.plant, adapter.engine.context
     assert q.shape == (3,)
     plant.SetPositions(ctx, q)
     plant.SetVelocities(ctx, OMEGA)
@@ -210,17 +220,15 @@ def test_drake_ball_joint_is_rpy_with_world_angular_velocity():
     assert_allclose(R, quat_to_matrix(ROT[None])[0], atol=1e-14)
     w = plant.EvalBodySpatialVelocityInWorld(ctx, body).rotational()
     assert_allclose(w, OMEGA, atol=1e-15)  # v is ω in world axes, not body axes
-    back = from_engine("drake", case.multibody(), q[None])[0]
+    back = canonical_states(adapter.canon, adapter.tree, q[None], np.zeros((1, 3)))[0][0]
     assert_allclose(quat_to_matrix(back[None])[0], quat_to_matrix(ROT[None])[0], atol=1e-14)
 
 
 def test_drake_free_joint_is_quaternion_first_world_velocities():
     """Drake's QuaternionFloatingJoint: q = (w, x, y, z, p), v = (ω, v), both world axes."""
-    case = get_case("rigid_body_free")
-    adapter = make_implementation("drake", case).adapter
-    plant, ctx = adapter.plant, adapter.context
     canonical = np.concatenate([[0.1, 0.2, 0.3], ROT])
-    q = to_engine("drake", case.multibody(), canonical[None])[0]
+    adapter, q = _drake("rigid_body_free", canonical)
+    plant, ctx = adapter.engine.plant, adapter.engine.context
     assert_allclose(q, np.concatenate([ROT, [0.1, 0.2, 0.3]]))
     plant.SetPositions(ctx, q)
     plant.SetVelocities(ctx, np.concatenate([OMEGA, V_LIN]))
