@@ -326,15 +326,19 @@ class DrakeModel(ModelEngine):
         continuous plant enforces no constraint)."""
         self._rows = drake_simulation.coupling_matrix(self.plant, couplings)
 
+    def _at(self, q: np.ndarray, v: np.ndarray) -> Iterator[int]:
+        """Each state's index, its plant context set to that state."""
+        for i in range(len(q)):
+            self.plant.SetPositions(self.context, q[i])
+            self.plant.SetVelocities(self.context, v[i])
+            yield i
+
     def _closed(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, which: int) -> np.ndarray:
         """v̇ (``which`` 0) or the multipliers (1) of the couplings' KKT solve per state."""
         assert self._rows is not None
-        plant, ctx = self.plant, self.context
-        out = np.empty((len(q), plant.num_velocities() if which == 0 else len(self._rows)))
-        for i in range(len(q)):
-            plant.SetPositions(ctx, q[i])
-            plant.SetVelocities(ctx, v[i])
-            out[i] = drake_simulation.closed(plant, ctx, tau[i], self._rows)[which]
+        out = np.empty((len(q), self.plant.num_velocities() if which == 0 else len(self._rows)))
+        for i in self._at(q, v):
+            out[i] = drake_simulation.closed(self.plant, self.context, tau[i], self._rows)[which]
         return out
 
     def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
@@ -350,13 +354,10 @@ class DrakeModel(ModelEngine):
 
     def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
         """Σ Jᵀ F of the field at each state (Drake's translational Jacobians)."""
-        plant, ctx = self.plant, self.context
-        held = drake_simulation.bodies(plant)
-        out = np.empty((len(q), plant.num_velocities()))
-        for i in range(len(q)):
-            plant.SetPositions(ctx, q[i])
-            plant.SetVelocities(ctx, v[i])
-            out[i] = drake_simulation.generalized(plant, ctx, field, held)
+        held = drake_simulation.bodies(self.plant)
+        out = np.empty((len(q), self.plant.num_velocities()))
+        for i in self._at(q, v):
+            out[i] = drake_simulation.generalized(self.plant, self.context, field, held)
         return out
 
     def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
@@ -412,9 +413,7 @@ class DrakeModel(ModelEngine):
         bias, forward, inverse = (np.empty((n, nv)) for _ in range(3))
         kinetic, potential = np.empty(n), np.empty(n)
         forces = MultibodyForces(plant)
-        for i in range(n):
-            plant.SetPositions(ctx, q[i])
-            plant.SetVelocities(ctx, v[i])
+        for i in self._at(q, v):
             mass[i] = plant.CalcMassMatrix(ctx)
             bias[i] = plant.CalcBiasTerm(ctx) - plant.CalcGravityGeneralizedForces(ctx)
             forward[i] = self._acc.Eval(ctx)

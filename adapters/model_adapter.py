@@ -294,14 +294,9 @@ class ModelAdapter(Adapter):
         states mapped back to the canonical layout (:func:`~.layout.canonical_states`)."""
         if integrator not in self.integrators:
             raise Unsupported(f"{self.name} offers no integrator {integrator!r}")
-        _, qe, ve, _ = engine_states(self.canon, self.tree, q0[None], v0[None],
-                                     np.zeros_like(v0)[None])
-        steps = round(duration / dt)
-        q_e, v_e = self.engine.simulate(qe[0], ve[0], dt, steps, integrator=integrator,
-                                        field=self.field)
-        self._finite(q_e, v_e, dt)
-        q, v = canonical_states(self.canon, self.tree, q_e, v_e)
-        return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", q), v)
+        q_e, v_e = self.engine.simulate(*self._engine_start(q0, v0), dt, round(duration / dt),
+                                        integrator=integrator, field=self.field)
+        return self._trajectory(q_e, v_e, dt)
 
     def simulate_controlled(self, q0: np.ndarray, v0: np.ndarray, duration: float,
                             grid: float, accuracy: float, scheme: str | None = None,
@@ -309,15 +304,23 @@ class ModelAdapter(Adapter):
         """The loader's own error-controlled run (:attr:`~.base.Offer.CONTROLLED_STEPPING`)
         at ``accuracy``, sampled every ``grid`` seconds, its states mapped back to the
         canonical layout, and its step counts."""
+        q_e, v_e, steps = self.engine.simulate_controlled(
+            *self._engine_start(q0, v0), grid, round(duration / grid), accuracy=accuracy,
+            scheme=scheme, caching=caching, field=self.field)
+        return self._trajectory(q_e, v_e, grid), steps
+
+    def _engine_start(self, q0: np.ndarray, v0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A run's start (canonical layout) in the engine's layout."""
         _, qe, ve, _ = engine_states(self.canon, self.tree, q0[None], v0[None],
                                      np.zeros_like(v0)[None])
-        samples = round(duration / grid)
-        q_e, v_e, steps = self.engine.simulate_controlled(
-            qe[0], ve[0], grid, samples, accuracy=accuracy, scheme=scheme, caching=caching,
-            field=self.field)
-        self._finite(q_e, v_e, grid)
+        return qe[0], ve[0]
+
+    def _trajectory(self, q_e: np.ndarray, v_e: np.ndarray, period: float) -> Trajectory:
+        """The engine's states every ``period`` from the start, finite (:meth:`_finite`),
+        in the canonical layout (:func:`~.layout.canonical_states`)."""
+        self._finite(q_e, v_e, period)
         q, v = canonical_states(self.canon, self.tree, q_e, v_e)
-        return Trajectory(np.arange(samples + 1) * grid, self._check("simulate", q), v), steps
+        return Trajectory(np.arange(len(q_e)) * period, self._check("simulate", q), v)
 
     def _finite(self, q_e: np.ndarray, v_e: np.ndarray, dt: float) -> None:
         """Raise, naming the step and the engine's own conditioning there, where its stepping
