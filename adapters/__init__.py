@@ -87,7 +87,8 @@ ENGINE_PORTS: dict[str, str] = {n: r.ports for n, r in REGISTRY.items() if r.por
 FLOAT32: frozenset[str] = frozenset(n for n, r in REGISTRY.items() if r.float32)
 """Engine implementations that compute in float32."""
 MODELS: dict[str, Registration] = dict(sorted(
-    ((n, r) for n, r in REGISTRY.items() if r.model), key=lambda item: not item[1].canonical))
+    ((n, r) for n, r in REGISTRY.items() if r.model and r.checks_files),
+    key=lambda item: not item[1].canonical))
 """The engines that load a user's file (``dyncheck check``), the canonical one first, the
 others in :data:`REGISTRY`'s order."""
 COUPLINGS_ONLY: frozenset[str] = frozenset(n for n, r in REGISTRY.items() if r.couplings_only)
@@ -116,9 +117,7 @@ def _load(name: str) -> None:
             except importlib.metadata.PackageNotFoundError:
                 raise ImportError(f"No module named {entry.package!r}") from None
 
-            _ADAPTERS[name] = for_engine(name, package=entry.package, model=entry.model,
-                                         run=entry.run, float32=entry.float32,
-                                         integrators=entry.integrators)
+            _ADAPTERS[name] = for_engine(name, entry)
             return
         assert entry.module is not None and entry.cls is not None, name
         _ADAPTERS[name] = getattr(importlib.import_module(entry.module), entry.cls)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import time
 from abc import ABC, abstractmethod
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any, ClassVar, TypeVar
@@ -312,7 +312,6 @@ class Adapter(ABC):
         return None
 
 
-
 class Offer(StrEnum):
     """What an engine computes beyond its dynamics (:attr:`ModelEngine.offers`)."""
 
@@ -321,9 +320,15 @@ class Offer(StrEnum):
     or finite differences)."""
     TRANSITION = "transition"
     """``transition(q, v, a)``: the Jacobians of one step of each of its integrators."""
+    FORWARD = "forward"
+    """``forward(q, v, τ)``: its own forward dynamics at τ (Pinocchio's ABA), which a run
+    compares, rather than M⁻¹ (τ − h) from its M and h."""
     STEPPING = "simulate"
     """``simulate(q0, v0, dt, steps, integrator=)``: trajectories by its own stepping, with
     each of its registration's integrators."""
+    SOLVING = "solve"
+    """``solve(q0, v0, t_eval, rtol=)``: a trajectory by scipy's error-controlled DOP853 on its
+    own forward dynamics (an engine with no integrator of its own)."""
     CONTROLLED_STEPPING = "simulate_controlled"
     """``simulate_controlled(q0, v0, period, samples, accuracy=)``: a trajectory by its own
     error-controlled integrator at a target accuracy, and its step counts."""
@@ -387,6 +392,9 @@ class ModelEngine(ABC):
     coordinates (roll-pitch-yaw angles, a quaternion's four components: q₊ = q + h N(q) v),
     not along the rotation group as MuJoCo's Euler does (its runs then differ from another
     engine's by O(h) on a rotating body)."""
+    definitions: ClassVar[Mapping[str, str]] = {}
+    """A class fact: its integrators whose run is another's here (name → the definition it
+    runs: Pinocchio's ``implicitfast`` is ``euler``, nothing damped); one run serves both."""
     parser_warnings: tuple[str, ...] = ()
     """Its parser's own warnings on the file, verbatim (Drake's: what it ignores); the
     tree's ``notes`` hold them summarized, with dyncheck's own notes on the reading."""
@@ -397,8 +405,8 @@ class ModelEngine(ABC):
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics: ...
 
     def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        """v̇ at τ (its layout): M⁻¹ (τ − h) from :meth:`dynamics`; an engine that computes
-        its forward dynamics otherwise (where its h fails) says so by overriding it."""
+        """v̇ at τ (its layout): M⁻¹ (τ − h) from :meth:`dynamics`, overridden where it has its
+        own (:attr:`Offer.FORWARD`) or its h fails."""
         d = self.dynamics(q, v, np.zeros_like(v))
         return np.linalg.solve(d.mass_matrix, (tau - d.bias)[..., None])[..., 0]
 
@@ -423,6 +431,11 @@ class ModelEngine(ABC):
         which must not change a result), q and v every ``period`` for ``samples`` periods,
         and its step counts (:attr:`Offer.CONTROLLED_STEPPING`)."""
         raise Unsupported(f"{self.engine} offers no error-controlled stepping of its own")
+
+    def solve(self, q0: np.ndarray, v0: np.ndarray, t_eval: np.ndarray, *, rtol: float,
+              field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """q, v at ``t_eval``: scipy's DOP853, rtol = atol = ``rtol`` (:attr:`Offer.SOLVING`)."""
+        raise Unsupported(f"{self.engine} offers no error-controlled integration")
 
     def couple(self, couplings: Sequence[Coupling]) -> None:
         """Hold ``couplings`` from now on (:attr:`Offer.COUPLINGS`)."""

@@ -58,6 +58,7 @@ from dyncheck.adapters.model_tree import (
     TreeJoint,
     reversed_rpy,
 )
+from dyncheck.adapters.registration import Registration
 from dyncheck.adapters.urdf import root_is_free, to_urdf
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.cases.multibody import Multibody
@@ -70,6 +71,8 @@ class ModelAdapter(Adapter):
 
     run_format: ClassVar[Format]
     loader: ClassVar[type]
+    as_stated: ClassVar[bool] = False
+    """The registration's :attr:`~.registration.Registration.as_stated`."""
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
@@ -87,8 +90,11 @@ class ModelAdapter(Adapter):
             path = Path(folder) / f"{model.name}.{'urdf' if urdf else 'xml'}"
             path.write_text(text, encoding="utf-8")
             source = read(path, floating=urdf and root_is_free(model))
-            options: dict[str, Any] = {"gravity": np.asarray(model.gravity, float)} if urdf \
-                else {}
+            options: dict[str, Any] = {"gravity": np.asarray(model.gravity, float)} \
+                if urdf or self.as_stated else {}
+            if self.as_stated:
+                options["inertias"] = {body.name: model.body_inertia(body)
+                                       for body in model.bodies if body.is_point_mass}
             with c_output_dropped():  # an engine's banner and importer warnings (C)
                 self.engine = self.loader(source, **options)
         if model.couplings:
@@ -106,11 +112,14 @@ class ModelAdapter(Adapter):
         names, types, q_start, v_start, nq, nv = [], [], [], [], 0, 0
         carriers = []
         for body in model.bodies:
-            for joint in body.joints:
+            held = [j for j in self.tree.joints if j.body == body.name]
+            for k, joint in enumerate(body.joints):
                 kind = JointType(joint.type)
                 found = next((j for j in self.tree.joints if j.name == joint.name
                               or (kind is JointType.FREE and j.type is kind
                                   and j.body == body.name)), None)
+                if found is None and len(held) == len(body.joints) and held[k].type is kind:
+                    found = held[k]  # named its own way (Pinocchio's composite joint)
                 if found is None:
                     raise Unsupported(f"{self.name}: joint {joint.name!r} not found as loaded")
                 names.append(found.name)
@@ -183,6 +192,14 @@ class ModelAdapter(Adapter):
         return [(k, j) for k, j in enumerate(self.tree.joint(n) for n in self.canon.names)
                 if j.type is JointType.FREE and j.gravity_frame is GravityFrame.RPY_REVERSED]
 
+    @property
+    def _offers(self) -> frozenset[Offer]:
+        return cast(type[ModelEngine], self.loader).offers
+
+    def definition(self, integrator: str) -> str:
+        """Its loader's :attr:`~.base.ModelEngine.definitions`."""
+        return cast(type[ModelEngine], self.loader).definitions.get(integrator, integrator)
+
     @classmethod
     def steps_in_a_chart(cls) -> bool:
         """Its loader's stepping fact (:attr:`~.base.ModelEngine.steps_in_a_chart`): the
@@ -237,7 +254,8 @@ class ModelAdapter(Adapter):
         unavailable = dict(d.unavailable)
         self._unavailable = {QUANTITY_OF[field]: why for field, why in unavailable.items()}
         constraint = None
-        if "bias" in unavailable or self.spec.couplings:  # its own forward dynamics at τ
+        if "bias" in unavailable or self.spec.couplings or Offer.FORWARD in self._offers:
+            # its own forward dynamics at τ
             t = np.array([m.t for m in maps])  # (mapped: v̇_e = T v̇ + Ṫ v)
             tdot_v = np.array([m.tdot_v for m in maps])
             tau_e = np.linalg.solve(np.swapaxes(t, 1, 2), tau[..., None])[..., 0]
@@ -296,7 +314,7 @@ class ModelAdapter(Adapter):
             raise Unsupported(f"{self.name} offers no integrator {integrator!r}")
         q_e, v_e = self.engine.simulate(*self._engine_start(q0, v0), dt, round(duration / dt),
                                         integrator=integrator, field=self.field)
-        return self._trajectory(q_e, v_e, dt)
+        return self._trajectory(q_e, v_e, np.arange(len(q_e)) * dt)
 
     def simulate_controlled(self, q0: np.ndarray, v0: np.ndarray, duration: float,
                             grid: float, accuracy: float, scheme: str | None = None,
@@ -307,7 +325,14 @@ class ModelAdapter(Adapter):
         q_e, v_e, steps = self.engine.simulate_controlled(
             *self._engine_start(q0, v0), grid, round(duration / grid), accuracy=accuracy,
             scheme=scheme, caching=caching, field=self.field)
-        return self._trajectory(q_e, v_e, grid), steps
+        return self._trajectory(q_e, v_e, np.arange(len(q_e)) * grid), steps
+
+    def solve(self, q0: np.ndarray, v0: np.ndarray, t_eval: np.ndarray, rtol: float) -> Trajectory:
+        """The loader's DOP853 run (:attr:`~.base.Offer.SOLVING`) at ``t_eval``, its states
+        mapped back to the canonical layout."""
+        q_e, v_e = self.engine.solve(*self._engine_start(q0, v0), t_eval, rtol=rtol,
+                                     field=self.field)
+        return self._trajectory(q_e, v_e, t_eval)
 
     def _engine_start(self, q0: np.ndarray, v0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """A run's start (canonical layout) in the engine's layout."""
@@ -315,14 +340,14 @@ class ModelAdapter(Adapter):
                                      np.zeros_like(v0)[None])
         return qe[0], ve[0]
 
-    def _trajectory(self, q_e: np.ndarray, v_e: np.ndarray, period: float) -> Trajectory:
-        """The engine's states every ``period`` from the start, finite (:meth:`_finite`),
-        in the canonical layout (:func:`~.layout.canonical_states`)."""
-        self._finite(q_e, v_e, period)
+    def _trajectory(self, q_e: np.ndarray, v_e: np.ndarray, t: np.ndarray) -> Trajectory:
+        """The engine's states at times ``t``, finite (:meth:`_finite`), in the canonical
+        layout (:func:`~.layout.canonical_states`)."""
+        self._finite(q_e, v_e, t)
         q, v = canonical_states(self.canon, self.tree, q_e, v_e)
-        return Trajectory(np.arange(len(q_e)) * period, self._check("simulate", q), v)
+        return Trajectory(t, self._check("simulate", q), v)
 
-    def _finite(self, q_e: np.ndarray, v_e: np.ndarray, dt: float) -> None:
+    def _finite(self, q_e: np.ndarray, v_e: np.ndarray, t: np.ndarray) -> None:
         """Raise, naming the step and the engine's own conditioning there, where its stepping
         left the finite states (a run that diverged is a failed row with what was measured,
         not a map of NaNs)."""
@@ -338,7 +363,7 @@ class ModelAdapter(Adapter):
         eig = np.linalg.eigvalsh(mass)
         kappa = eig.max() / eig.min() if eig.min() > 0 else np.inf
         raise FloatingPointError(
-            f"{self.name}'s step {k} of {len(q_e) - 1} (t = {k * dt:g} s) gave a non-finite "
+            f"{self.name}'s step {k} of {len(q_e) - 1} (t = {t[k]:g} s) gave a non-finite "
             f"state; its own mass matrix at the step before has eigenvalues {eig.min():.3g} to "
             f"{eig.max():.3g}, condition number {kappa:.3g} against 1/ε = {1 / self.eps:.3g} "
             "of its arithmetic" + (" (beyond it, a factorization of M in that precision can "
@@ -361,15 +386,17 @@ def _field(model: Multibody) -> Field:
                           for name, at in where.items() if name in masses}
 
 
-def for_engine(name: str, *, package: str, model: str, run: Format, float32: bool,
-               integrators: tuple[str, ...]) -> type[Adapter]:
+def for_engine(name: str, registration: Registration) -> type[Adapter]:
     """The run adapter of the engine registered as ``name`` (its loader ``module:class``
     imported here: an ImportError says the engine is missing)."""
-    module, cls = model.split(":")
+    assert registration.model is not None and registration.run is not None, name
+    module, cls = registration.model.split(":")
     with c_output_dropped():  # an engine's import may print a banner of its own (C)
         loader = getattr(importlib.import_module(module), cls)
-    attrs = {"name": name, "package": package, "loader": loader, "run_format": run,
-             "dtype": np.float32 if float32 else np.float64, "integrators": integrators,
+    attrs = {"name": name, "package": registration.package, "loader": loader,
+             "run_format": registration.run, "as_stated": registration.as_stated,
+             "dtype": np.float32 if registration.float32 else np.float64,
+             "integrators": registration.integrators,
              "error_controlled": Offer.CONTROLLED_STEPPING in loader.offers,
-             "__module__": __name__}
+             "adaptive": Offer.SOLVING in loader.offers, "__module__": __name__}
     return type(f"{cls}Adapter", (ModelAdapter,), attrs)

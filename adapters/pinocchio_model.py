@@ -15,12 +15,16 @@ joint v = (linear, angular), both in local axes; an unbounded revolute joint q =
 
 from __future__ import annotations
 
+import tempfile
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
+from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 import pinocchio as pin
 
-from dyncheck.adapters.base import ModelEngine, Offer
+from dyncheck.adapters.base import Field, ModelEngine, Offer
 from dyncheck.adapters.mjcf_copy import inline, utf8_file
 from dyncheck.adapters.model_files import Format, ModelFile
 from dyncheck.adapters.model_tree import (
@@ -37,7 +41,10 @@ from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
 from dyncheck.adapters.pinocchio_mjcf import BARE_BODY, bare_bodies, hints, later_defaults
+from dyncheck.adapters.pinocchio_simulation import Stepping
+from dyncheck.cases.multibody import Coupling
 from dyncheck.errors import EngineError, Unsupported
+from dyncheck.vocabulary import Integrator
 
 ENGINE = "pinocchio"
 _HINGE = ("JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned")
@@ -57,6 +64,15 @@ def _type(shortname: str) -> JointType:
     if shortname == "JointModelFreeFlyer":
         return JointType.FREE
     raise Unsupported(f"pinocchio joint type {shortname} is not checked")
+
+
+def parse_xml(xml: str) -> pin.Model:
+    """``pin.buildModelFromMJCF`` on MJCF text, through a private temporary file (the
+    catalogue's demonstrations)."""
+    with tempfile.TemporaryDirectory(prefix="dyncheck-pinocchio-") as folder:
+        path = Path(folder) / "model.xml"
+        path.write_text(xml, encoding="utf-8")
+        return pin.buildModelFromMJCF(str(path))
 
 
 def _load(source: ModelFile) -> pin.Model:
@@ -127,21 +143,80 @@ def _components(m: pin.Model, d: pin.Data, i: int) -> list[tuple]:
     return out
 
 
+def _held_bodies(m: pin.Model) -> dict[str, int]:
+    """Each moving body's name → the joint that carries it: the first body frame of each
+    joint (a body welded to another shares its joint, whose inertia holds both)."""
+    out: dict[int, str] = {}
+    for frame in m.frames:
+        if frame.type == pin.FrameType.BODY and frame.parentJoint > 0:
+            out.setdefault(int(frame.parentJoint), frame.name)
+    return {name: j for j, name in out.items()}
+
+
+def _state_inertias(m: pin.Model, inertias: Mapping[str, np.ndarray]) -> None:
+    """Each named body's rotational inertia about its centre of mass set as given (body axes),
+    its mass and centre kept: what a format floors (MJCF's point masses) held exactly."""
+    frames = [f for f in m.frames if f.type == pin.FrameType.BODY]
+    for name, tensor in inertias.items():
+        frame = next((f for f in frames if f.name == name), None)
+        if frame is None or frame.parentJoint == 0:
+            raise Unsupported(f"pinocchio: no moving body {name!r} to give an inertia")
+        if sum(f.parentJoint == frame.parentJoint for f in frames) > 1:
+            raise Unsupported(f"pinocchio: body {name!r} shares its joint with a welded body")
+        held = m.inertias[frame.parentJoint]
+        rotation = frame.placement.rotation
+        m.inertias[frame.parentJoint] = pin.Inertia(
+            held.mass, held.lever, rotation @ np.asarray(tensor, float) @ rotation.T)
+
+
 class PinocchioModel(ModelEngine):
-    """A Pinocchio model and its neutral tree."""
+    """A Pinocchio model and its neutral tree. Options (the run's, :mod:`.model_adapter`):
+    ``gravity`` as the model's (its MJCF parser reads none), ``inertias`` (body name → its
+    rotational inertia about its centre of mass, body axes) in place of the file's: the
+    book's point masses exact, as a model built in code holds them.
+
+    It has no time integrator: :mod:`.pinocchio_simulation` steps its forward dynamics by
+    MuJoCo's integrators' definitions and scipy's DOP853."""
 
     engine = ENGINE
-    offers = frozenset({Offer.DERIVATIVES})
+    offers = frozenset({Offer.DERIVATIVES, Offer.FORWARD, Offer.STEPPING, Offer.SOLVING,
+                        Offer.COUPLINGS, Offer.BODY_FORCES})
+    definitions: ClassVar[Mapping[str, str]] = {Integrator.IMPLICITFAST: Integrator.EULER}
+    """Its ``implicitfast`` is ``euler``: it applies no damping and has no actuators (D = 0,
+    :mod:`.integrators`)."""
 
-    def __init__(self, source: ModelFile) -> None:
+    def __init__(self, source: ModelFile, *, gravity: np.ndarray | None = None,
+                 inertias: Mapping[str, np.ndarray] | None = None) -> None:
         self.model = _load(source)
+        if gravity is not None:
+            self.model.gravity = pin.Motion(np.asarray(gravity, float), np.zeros(3))
+        _state_inertias(self.model, inertias or {})
         self.data = self.model.createData()
+        self._rows: np.ndarray | None = None
         notes: tuple[str, ...] = ()
         self._hints = hints(source, frozenset(
             f.name for f in self.model.frames if f.type == pin.FrameType.BODY))
         if source.floating and source.format is Format.URDF:
             notes = ("pinocchio: JointModelFreeFlyer 'root_joint' at the URDF root",)
         self.tree = self._tree(notes)
+        self.stepping = self._stepper()  # its v̇ in MuJoCo's layout, and its runs there
+
+    def _stepper(self) -> Stepping:
+        """Its stepping in MuJoCo's layout (:mod:`.pinocchio_simulation`)."""
+        joints = sorted(self.tree.joints, key=lambda j: j.layout.q_start)
+        held = [(name, j, np.array(self.model.inertias[j].lever))
+                for name, j in _held_bodies(self.model).items()]
+        return Stepping(self.model, self.data, [str(j.type) for j in joints], held=held,
+                        rows=self._rows)
+
+    def _steppable(self) -> Stepping:
+        """Its stepping, refused where a joint's coordinates are not MuJoCo's in another
+        order (an unbounded revolute joint's (cos θ, sin θ))."""
+        unbounded = [j.name for j in self.tree.joints if j.layout.cos_sin]
+        if unbounded:
+            raise Unsupported(f"pinocchio: dyncheck steps no unbounded revolute joint "
+                              f"(cos θ, sin θ): {', '.join(unbounded)}")
+        return self.stepping
 
     def _tree(self, notes: tuple[str, ...]) -> ModelTree:
         m, d = self.model, self.data
@@ -262,6 +337,63 @@ class PinocchioModel(ModelEngine):
                        f"composite joint ({composite[0]!r}: a body with several joints) differ "
                        "from its own finite differences, an engine defect (`dyncheck explain "
                        "pinocchio-composite-derivatives`)")
+
+    def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """v̇ at τ: ``aba``; with couplings their KKT solve (``forwardDynamics``)."""
+        out = np.empty((len(q), self.model.nv))
+        for i in range(len(q)):
+            out[i] = self.stepping.accelerate(q[i], v[i], tau[i])
+        return out
+
+    def couple(self, couplings: Sequence[Coupling]) -> None:
+        """The couplings as the constant Jacobian C of Pinocchio's constrained forward
+        dynamics (its MJCF parser drops a tendon equality: ``dyncheck explain
+        pinocchio-mjcf-equality``), its joints named as in the file."""
+        rows = np.zeros((len(couplings), self.model.nv))
+        names = {j.name: j for j in self.tree.joints}
+        for k, coupling in enumerate(couplings):
+            for name, coefficient in coupling.coefs:
+                if name not in names:
+                    raise Unsupported(f"pinocchio: no joint {name!r} to couple")
+                rows[k, names[name].layout.v_start] += coefficient
+        self._rows = rows
+        self.stepping = self._stepper()
+
+    def constraint_forces(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """``data.lambda_c`` of the constrained forward dynamics at τ."""
+        if self._rows is None:
+            raise Unsupported("pinocchio: its model holds no coupling between joints")
+        out = np.empty((len(q), len(self._rows)))
+        for i in range(len(q)):
+            self.stepping.accelerate(q[i], v[i], tau[i])
+            out[i] = self.data.lambda_c
+        return out
+
+    def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
+        """Σ Jᵀ F of the field as Pinocchio's external forces give it: ``rnea`` without them
+        minus ``rnea`` with them (τ = M v̇ + h − Σ Jᵀ F)."""
+        m, d = self.model, self.data
+        zero = np.zeros(m.nv)
+        out = np.empty((len(q), m.nv))
+        for i in range(len(q)):
+            fext = self.stepping.external(q[i], field)
+            free = pin.rnea(m, d, q[i], v[i], zero).copy()
+            out[i] = free - pin.rnea(m, d, q[i], v[i], zero, fext)
+        return out
+
+    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
+                 integrator: str, field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """MuJoCo's definition of ``integrator`` on Pinocchio's forward dynamics
+        (:meth:`.pinocchio_simulation.Stepping.simulate`)."""
+        return self._steppable().simulate(q0, v0, dt, steps, integrator=integrator,
+                                          field=field)
+
+    def solve(self, q0: np.ndarray, v0: np.ndarray, t_eval: np.ndarray, *, rtol: float,
+              field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """scipy's DOP853 on Pinocchio's forward dynamics
+        (:meth:`.pinocchio_simulation.Stepping.solve`)."""
+        return self._steppable().solve(q0, v0, t_eval, rtol=rtol, field=field,
+                                       label=self.engine)
 
 
 OWN_STEP = 1e-6

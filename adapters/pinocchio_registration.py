@@ -1,15 +1,19 @@
-"""Pinocchio's registrations (:mod:`.pinocchio_`, :mod:`.pinocchio_model`): importable without
-Pinocchio; stepped by MuJoCo's integrators' definitions."""
+"""Pinocchio's registrations (:mod:`.pinocchio_model`, which also serves ``dyncheck run``):
+importable without Pinocchio; stepped by MuJoCo's integrators' definitions
+(:mod:`.pinocchio_simulation`). ``pinocchio`` reads a book case as stated (the case's gravity,
+its point masses exact, as a model built in code holds them); ``pinocchio-mjcf`` reads the
+very MJCF file MuJoCo loads as Pinocchio's MJCF parser does."""
 
 from __future__ import annotations
 
+from dyncheck.adapters.model_files import Format
 from dyncheck.adapters.mujoco_registration import MUJOCO_C
 from dyncheck.adapters.registration import A, Needs, Registration
 
 REGISTRATIONS: dict[str, Registration] = {
     "pinocchio": Registration(
-        module=A + "pinocchio_", cls="PinocchioAdapter", package="pin", integrators=MUJOCO_C,
-        model=A + "pinocchio_model:PinocchioModel", label="pinocchio",
+        package="pin", integrators=MUJOCO_C, model=A + "pinocchio_model:PinocchioModel",
+        label="pinocchio", run=Format.MJCF, as_stated=True,
         releases=("3.4.0", "3.7.0", "3.9.0", "4.0.0", "4.1.0"),
         released_with=("libpinocchio", "cmeel", "coal", "libcoal", "eigenpy",
                        "jrl-cmakemodules"),
@@ -24,7 +28,7 @@ REGISTRATIONS: dict[str, Registration] = {
         ),
     ),
     "pinocchio-mjcf": Registration(
-        module=A + "pinocchio_", cls="PinocchioMJCFAdapter", package="pin",
-        integrators=MUJOCO_C,
+        package="pin", integrators=MUJOCO_C, model=A + "pinocchio_model:PinocchioModel",
+        run=Format.MJCF, checks_files=False,
     ),
 }

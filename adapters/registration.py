@@ -87,3 +87,11 @@ class Registration:
     """An engine without a run adapter of its own (``module``): the format a book case is
     written in for its file loader (``model``), which then serves ``dyncheck run`` too
     (:mod:`.model_adapter`); a loader given URDF takes the case's ``gravity=``."""
+    as_stated: bool = False
+    """Its run reads a book case as stated, not as the file approximates it: its loader is
+    given the case's gravity and each point mass's exact inertia (``gravity=``,
+    ``inertias=``): Pinocchio's model as built in code, beside its MJCF parser's."""
+    checks_files: bool = True
+    """Whether ``dyncheck check`` reads users' files with its loader (``model``); False: a
+    second run of that loader under another name, reading the case otherwise
+    (``pinocchio-mjcf``, the file as Pinocchio's parser reads it)."""

@@ -63,9 +63,11 @@ MULTI_JOINT_CASES = sorted(
 fuses them into a D6 that applies the slides first: read as that chain, explained)."""
 LOADER_LIMITS: dict[str, tuple[tuple[str, ...], str]] = {}
 """A file loader's limit on the book's cases, and the word its refusal names it by."""
-FLOORED = ("mujoco", "pinocchio-mjcf", "drake", *PORTS, *FILE_LOADERS)
+FLOORED = ("mujoco", *PORTS,
+           *(n for n in FILE_LOADERS if not adapters.REGISTRY[n].as_stated))
 """Engines given the case as a file (MJCF, or URDF for PyBullet), whose point masses carry
-the file's small isotropic inertia (``Multibody.mjcf_point_inertia``)."""
+the file's small isotropic inertia (``Multibody.mjcf_point_inertia``); ``pinocchio`` reads
+the case as stated (its loader given the exact point masses)."""
 COUPLINGS_ONLY_ENGINES = ("mujoco-stiff",)
 """Engines that exist only for cases with couplings."""
 ENGINES = [e for e in ALL_ENGINES if e not in COUPLINGS_ONLY_ENGINES]

@@ -4,12 +4,13 @@ quaternion order, the velocity frames of ball and free joints, degrees against r
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from dyncheck.adapters import get_adapter
-from dyncheck.adapters.model_tree import Orientation, StateLayout
+from dyncheck.adapters.model_tree import ModelTree, Orientation
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.comparison import compare_instantaneous
@@ -21,15 +22,18 @@ from dyncheck.vocabulary import Verdict
 
 
 def worst(case_name: str, engine: str, cmap=None,
-          state_layout: StateLayout | None = None) -> float:
+          reading: Callable[[ModelTree], ModelTree] | None = None) -> float:
     """Largest relative error of ``engine`` against the reference over the instantaneous
     quantities, with the case's map replaced by ``cmap`` or the engine's storage conventions
-    by ``state_layout`` (the other kept)."""
+    by ``reading`` (of its loader's tree, whose layouts the run's map feeds)."""
     case = get_case(case_name)
     impl = make_implementation(engine, case)
-    if cmap is not None or state_layout is not None:
+    if cmap is not None:
         assert isinstance(impl, EngineImplementation)
-        impl.map = NativeMap.of(case, engine, cmap, state_layout)
+        impl.map = NativeMap.of(case, engine, cmap)
+    if reading is not None:
+        adapter: Any = impl.adapter  # a loader's run adapter
+        adapter.tree = reading(adapter.tree)
     impls = {"reference": make_implementation("reference", case), engine: impl}
     rows = compare_instantaneous(case, impls, case.sample_states())
     errors = [r.max_rel_err for r in rows if r.verdict != Verdict.EXPLAINED or cmap is not None]
@@ -91,9 +95,13 @@ def coordinate_order() -> Entry:
 def quaternion_order() -> Entry:
     case = "spherical_pendulum"
     correct = worst(case, "pinocchio")
-    declared = get_adapter("pinocchio").state_layout
-    mujocos = dataclasses.replace(declared.ball, quat=Orientation.WXYZ)
-    naive = worst(case, "pinocchio", state_layout=dataclasses.replace(declared, ball=mujocos))
+
+    def mujocos(tree: ModelTree) -> ModelTree:  # its ball joint read as (w, x, y, z)
+        return dataclasses.replace(tree, joints=tuple(dataclasses.replace(
+            j, layout=dataclasses.replace(j.layout, quat=Orientation.WXYZ))
+            for j in tree.joints))
+
+    naive = worst(case, "pinocchio", reading=mujocos)
     return Entry(
         "quaternion-storage-order",
         "A ball joint's orientation is a unit quaternion; engines store it in different orders.",

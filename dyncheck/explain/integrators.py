@@ -125,24 +125,18 @@ def group_rk4() -> Entry:
 
     case = get_case("rigid_body_ball")
     impl = make_implementation("pinocchio", case)
-    adapter: Any = impl.adapter  # Pinocchio's: its state in MuJoCo's layout, its v̇ there
-    q0, v0 = adapter.to_mujoco(*impl.engine_start())  # type: ignore[attr-defined]
+    assert isinstance(impl, EngineImplementation)
+    adapter: Any = impl.adapter  # Pinocchio's loader: its v̇ in MuJoCo's layout
+    stepping = adapter.engine.stepping
+    q0, v0 = impl.engine_start()  # the run's canonical start: MuJoCo's layout
     duration = case.trajectory.duration
     dts = case.trajectory.steps[Integrator.RK4][1:]
 
     def order(naive: bool) -> float:
         ends = []
         for dt in dts:
-            qs, _ = integrate(
-                adapter.mujoco_acceleration,
-                q0,
-                v0,
-                dt,
-                round(duration / dt),
-                Integrator.RK4,
-                layout=adapter.layout,
-                naive_group=naive,
-            )
+            qs, _ = integrate(stepping.acceleration(None), q0, v0, dt, round(duration / dt),
+                              Integrator.RK4, layout=stepping.layout, naive_group=naive)
             ends.append(qs[-1])
         return self_convergence(ends)
 

@@ -7,9 +7,9 @@ from typing import Any
 
 
 def pin_mjcf(xml: str):
-    from dyncheck.adapters.pinocchio_ import load_mjcf
+    from dyncheck.adapters.pinocchio_model import parse_xml
 
-    return load_mjcf(xml)
+    return parse_xml(xml)
 
 
 def beside_mujoco(mjcf: str, other: Any, states: int) -> tuple[Any, Any, Any, Any]:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dyncheck.adapters import get_adapter
+from dyncheck.adapters import REGISTRY, get_adapter
 from dyncheck.cases import get_case
 from dyncheck.errors import EngineNotInstalled, Unsupported
 from dyncheck.implementations import general_method, make_implementation
@@ -35,15 +35,18 @@ def test_the_bodies_read_back_are_the_cases(case, engine):
     spec = get_case(case).multibody()
     adapter = _adapter_class(engine)(spec)
     for body, loaded in zip(spec.bodies, adapter.loaded_bodies(), strict=True):
-        stated = spec.mjcf_point_inertia * np.eye(3) if body.is_point_mass else \
-            np.asarray(body.inertia, float)
+        stated = np.asarray(body.inertia, float)
+        if body.is_point_mass:  # the file's floor, or the case as stated (exact)
+            stated = spec.body_inertia(body) if REGISTRY[engine].as_stated else \
+                spec.mjcf_point_inertia * np.eye(3)
         com = np.asarray(body.com, float)
         scale = max(float(np.abs(stated).max()), body.mass * float(com @ com))
         assert loaded.mass == body.mass
         assert np.abs(loaded.inertia - stated).max() <= 64 * adapter.eps * scale
-    # Newton's MJCF importer keeps its default gravity whatever <option gravity> says (the
-    # convention "MJCF gravity option not read", explained on kepler's rows)
-    if engine == "newton":  # (float32: its −9.81 rounded)
+    # Newton's MJCF importer and Pinocchio's MJCF parser keep their default gravity whatever
+    # <option gravity> says (the convention "MJCF gravity option not read", explained on
+    # kepler's rows); ``pinocchio`` is given the case's (its loader's ``gravity=``)
+    if engine in ("newton", "pinocchio-mjcf"):  # (Newton's float32: its −9.81 rounded)
         assert np.allclose(adapter.loaded_gravity(), [0.0, 0.0, -9.81], rtol=1e-7, atol=0)
     else:
         assert np.array_equal(adapter.loaded_gravity(), np.asarray(spec.gravity, float))
@@ -91,11 +94,13 @@ def test_a_declared_defect_explains_only_the_rows_it_predicts(monkeypatch):
     assert set(failed.quantity) == set(by_defect.quantity)
 
 
-@pytest.mark.parametrize("engine", FILE_LOADERS)
+@pytest.mark.parametrize("engine", [e for e in FILE_LOADERS if not REGISTRY[e].as_stated])
 def test_the_engines_own_step_is_mujocos_euler(engine):
     """Newton's Featherstone solver and PyBullet's stepSimulation (motors off, damping 0) are
-    semi-implicit Euler on hinges: the same run as MuJoCo's ``euler`` (another engine, the
-    expected values), to the accumulated round-off of the less precise (ε per step)."""
+    semi-implicit Euler on hinges, and Pinocchio is stepped by MuJoCo's definition: the same
+    run as MuJoCo's ``euler`` (another engine, the expected values), to the accumulated
+    round-off of the less precise (ε per step). (``pinocchio`` holds the point masses exactly,
+    another model than the file's: its runs are compared by the run's predicted rows.)"""
     cls = _adapter_class(engine)
     case = get_case("compound_pendulum")
     spec = case.multibody()

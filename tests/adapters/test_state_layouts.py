@@ -55,24 +55,26 @@ def _mujoco():
 def _pinocchio(name: str):
     import pinocchio as pin
 
-    case = get_case("spherical_pendulum")
-    impl = make_implementation(name, case)
-    m, d = impl.adapter.model, impl.adapter.data
-    q = to_engine(name, case.multibody(), ROT[None])[0]
+    adapter, q = _loaded(name, "spherical_pendulum", ROT)
+    m, d = adapter.engine.model, adapter.engine.data
     pin.forwardKinematics(m, d, q, OMEGA)
-    j = impl.adapter._joint_ids[0]
+    j = m.frames[m.getFrameId("bob", pin.FrameType.BODY)].parentJoint
     world = pin.getVelocity(m, d, j, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).angular
     return d.oMi[j].rotation, world
 
 
 @pytest.mark.parametrize("engine", ["mujoco", "pinocchio", "pinocchio-mjcf"])
 def test_quaternion_order_and_velocity_frame(engine):
-    """Feeding the quaternion in the order the table states must give the rotation it means;
+    """Feeding the quaternion in the order the layout states must give the rotation it means;
     the angular velocity seen in the world is R ω (ω in the body frame)."""
     R, omega_world = _mujoco() if engine == "mujoco" else _pinocchio(engine)
     assert_allclose(R, quat_to_matrix(ROT[None])[0], atol=1e-14)
     assert_allclose(omega_world, R @ OMEGA, atol=1e-14)
-    assert get_adapter(engine).state_layout.ball.angular_axes is Axes.LOCAL
+    if engine == "mujoco":
+        assert get_adapter(engine).state_layout.ball.angular_axes is Axes.LOCAL
+    else:  # a loader's layout is its tree's
+        ball = make_implementation(engine, get_case("spherical_pendulum")).adapter.tree.joints[0]
+        assert ball.layout.angular_axes is Axes.LOCAL
 
 
 @pytest.mark.parametrize("engine", ALL_ENGINES)  # every engine declares a layout
@@ -82,20 +84,39 @@ def test_native_order_round_trip(engine):
     assert_allclose(from_engine(engine, spec, q), ROT[None])
 
 
-def test_pinocchio_native_order_is_xyzw():
-    spec = get_case("spherical_pendulum").multibody()
-    assert_allclose(
-        to_engine("pinocchio", spec, ROT[None])[0], [ROT[1], ROT[2], ROT[3], ROT[0]]
-    )
+@pytest.mark.parametrize("name", ["pinocchio", "pinocchio-mjcf"])
+def test_pinocchio_native_order_is_xyzw(name):
+    """The loader's map puts the canonical (w, x, y, z) in Pinocchio's (x, y, z, w)."""
+    assert_allclose(_loaded(name, "spherical_pendulum", ROT)[1], [ROT[1], ROT[2], ROT[3], ROT[0]])
 
 
-@pytest.mark.parametrize(("engine", "wrong"), [("mujoco", "xyzw"), ("pinocchio", "wxyz")])
-def test_wrong_quaternion_order_is_caught(engine, wrong, monkeypatch):
-    """The same engine with the other storage order assumed: its rows fail."""
-    adapter = get_adapter(engine)
-    ball = dataclasses.replace(adapter.state_layout.ball, quat=Orientation(wrong))
+def test_wrong_quaternion_order_is_caught(monkeypatch):
+    """MuJoCo with the other storage order assumed: its rows fail."""
+    adapter = get_adapter("mujoco")
+    ball = dataclasses.replace(adapter.state_layout.ball, quat=Orientation("xyzw"))
     monkeypatch.setattr(adapter, "state_layout",
                         dataclasses.replace(adapter.state_layout, ball=ball))
+    _fails_on_the_ball("mujoco")
+
+
+def test_a_loader_read_in_the_wrong_quaternion_order_is_caught(monkeypatch):
+    """Pinocchio's loader with its tree saying (w, x, y, z): the run's map feeds it the
+    quaternion in the wrong order, and its rows fail."""
+    from dyncheck.adapters.pinocchio_model import PinocchioModel
+
+    tree_of = PinocchioModel._tree
+
+    def wrong(self, notes):
+        tree = tree_of(self, notes)
+        joints = tuple(dataclasses.replace(j, layout=dataclasses.replace(
+            j.layout, quat=Orientation.WXYZ)) for j in tree.joints)
+        return dataclasses.replace(tree, joints=joints)
+
+    monkeypatch.setattr(PinocchioModel, "_tree", wrong)
+    _fails_on_the_ball("pinocchio")
+
+
+def _fails_on_the_ball(engine: str) -> None:
     case = get_case("spherical_pendulum")
     impls = {
         "reference": make_implementation("reference", case),
@@ -176,13 +197,9 @@ def test_pinocchio_free_flyer_velocity_is_body_frame(name):
     its v̇[:3] is not zero but −ω × v_b (the derivative of body-frame components)."""
     import pinocchio as pin
 
-    case = get_case("rigid_body_free")
-    impl = make_implementation(name, case)
-    m, d = impl.adapter.model, impl.adapter.data
+    adapter, q = _loaded(name, "rigid_body_free", np.concatenate([[0.1, 0.2, 0.3], ROT]))
+    m, d = adapter.engine.model, adapter.engine.data
     m.gravity.linear[:] = 0
-    q = to_engine(name, case.multibody(), np.concatenate([[0.1, 0.2, 0.3], ROT])[None])[
-        0
-    ]
     v = np.concatenate([V_LIN, OMEGA])
     pin.forwardKinematics(m, d, q, v)
     R = d.oMi[1].rotation
@@ -192,17 +209,21 @@ def test_pinocchio_free_flyer_velocity_is_body_frame(name):
     assert_allclose(world.angular, R @ OMEGA, atol=1e-14)
     a = pin.aba(m, d, q, v, np.zeros(6))
     assert_allclose(a[:3], -np.cross(OMEGA, V_LIN), atol=1e-12)
-    assert get_adapter(name).state_layout.free.linear_axes is Axes.LOCAL
+    assert adapter.tree.joints[0].layout.linear_axes is Axes.LOCAL
+
+
+def _loaded(name: str, case_name: str, canonical: np.ndarray):
+    """An engine's loader of the case's MJCF, and the canonical configuration in the
+    engine's q as its run maps it (:func:`~dyncheck.adapters.layout_batch.engine_states`)."""
+    from dyncheck.adapters.layout_batch import engine_states
+
+    adapter = make_implementation(name, get_case(case_name)).adapter
+    zero = np.zeros((1, adapter.canon.nv))
+    return adapter, engine_states(adapter.canon, adapter.tree, canonical[None], zero, zero)[1][0]
 
 
 def _drake(case_name: str, canonical: np.ndarray):
-    """Drake's loader of the case's MJCF, and the canonical configuration in Drake's q as
-    its run maps it (:func:`~dyncheck.adapters.layout_batch.engine_states`)."""
-    from dyncheck.adapters.layout_batch import engine_states
-
-    adapter = make_implementation("drake", get_case(case_name)).adapter
-    zero = np.zeros((1, adapter.canon.nv))
-    return adapter, engine_states(adapter.canon, adapter.tree, canonical[None], zero, zero)[1][0]
+    return _loaded("drake", case_name, canonical)
 
 
 def test_drake_ball_joint_is_rpy_with_world_angular_velocity():
