@@ -18,13 +18,13 @@ import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from enum import StrEnum
 from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
 from dyncheck.adapters.actuators import Actuation, InputJacobian
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, ModelTree, StateLayout, Transition
+from dyncheck.adapters.offers import Field, Offer
 from dyncheck.cases.multibody import Coupling, Multibody
 from dyncheck.errors import EngineError, Unsupported
 from dyncheck.vocabulary import Quantity
@@ -312,51 +312,6 @@ class Adapter(ABC):
         return None
 
 
-class Offer(StrEnum):
-    """What an engine computes beyond its dynamics (:attr:`ModelEngine.offers`)."""
-
-    DERIVATIVES = "derivatives"
-    """``derivatives(q, v, a)``: ∂v̇/∂(q, v, τ) and ∂τ/∂(q, v), its own (analytic, automatic
-    or finite differences)."""
-    TRANSITION = "transition"
-    """``transition(q, v, a)``: the Jacobians of one step of each of its integrators."""
-    FORWARD = "forward"
-    """``forward(q, v, τ)``: its own forward dynamics at τ (Pinocchio's ABA), which a run
-    compares, rather than M⁻¹ (τ − h) from its M and h."""
-    STEPPING = "simulate"
-    """``simulate(q0, v0, dt, steps, integrator=)``: trajectories by its own stepping, with
-    each of its registration's integrators."""
-    SOLVING = "solve"
-    """``solve(q0, v0, t_eval, rtol=)``: a trajectory by scipy's error-controlled DOP853 on its
-    own forward dynamics (an engine with no integrator of its own)."""
-    CONTROLLED_STEPPING = "simulate_controlled"
-    """``simulate_controlled(q0, v0, period, samples, accuracy=)``: a trajectory by its own
-    error-controlled integrator at a target accuracy, and its step counts."""
-    ACTUATION = "actuation"
-    """``actuation(q, v, u)``: the generalized force of its actuators at controls u and its
-    forward dynamics with it (its tree's ``actuators`` say what it read)."""
-    CONTROL_DERIVATIVES = "control_derivatives"
-    """``control_derivatives(q, v, u)``: ∂v̇/∂u of its forward dynamics with its actuators,
-    its own (automatic differentiation)."""
-    INPUT_JACOBIAN = "input_jacobians"
-    """``input_jacobians(q, v, u)``: the Jacobians of one step of its integrators in the
-    controls, ∂x₊/∂u."""
-    COUPLINGS = "couplings"
-    """``couple(couplings)``: a book case's couplings (linear equalities between joints) as
-    the engine's own constraints, which its forward dynamics and stepping then hold, and
-    ``constraint_forces(q, v, τ)`` their multipliers."""
-    BODY_FORCES = "body_forces"
-    """``body_forces(q, v, field)``: the generalized force of forces at bodies' centres of
-    mass (a :data:`Field`), its own (its Jacobians or its solver's sum); and
-    ``simulate(..., field=)`` applying them at every step through its stepping API."""
-
-
-Field = Callable[[dict[str, np.ndarray]], dict[str, np.ndarray]]
-"""Forces on bodies: each body's centre of mass in world axes, by the body's name, to the
-force (world axes, at that centre) on it — a book case's external field, evaluated at the
-positions the engine itself computes."""
-
-
 Answer = tuple[Any, float] | Exception
 """A request's answer: (its value, the engine's seconds), or the exception it raised."""
 
@@ -392,6 +347,14 @@ class ModelEngine(ABC):
     coordinates (roll-pitch-yaw angles, a quaternion's four components: q₊ = q + h N(q) v),
     not along the rotation group as MuJoCo's Euler does (its runs then differ from another
     engine's by O(h) on a rotating body)."""
+    gyroscopic_implicit: bool = False
+    """A class fact: its ``implicitfast`` differentiates a free body's gyroscopic force
+    (MuJoCo ≥ 3.11: no longer semi-implicit Euler on a free joint)."""
+    rk4_group_order: int = 4
+    """A class fact: RK4's order on a rotating joint as its stepping defines the stages (2
+    where it sums stage velocities across tangent spaces: MuJoCo before 4.0)."""
+    couplings_with_field: bool = False
+    """A class fact: it holds couplings and a field in one model (MuJoCo's)."""
     definitions: ClassVar[Mapping[str, str]] = {}
     """A class fact: its integrators whose run is another's here (name → the definition it
     runs: Pinocchio's ``implicitfast`` is ``euler``, nothing damped); one run serves both."""
@@ -436,6 +399,10 @@ class ModelEngine(ABC):
               field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
         """q, v at ``t_eval``: scipy's DOP853, rtol = atol = ``rtol`` (:attr:`Offer.SOLVING`)."""
         raise Unsupported(f"{self.engine} offers no error-controlled integration")
+
+    def softness(self) -> tuple[float, ...] | None:
+        """Its couplings' soft-constraint model (MuJoCo's solref and solimp); None: exact."""
+        return None
 
     def couple(self, couplings: Sequence[Coupling]) -> None:
         """Hold ``couplings`` from now on (:attr:`Offer.COUPLINGS`)."""

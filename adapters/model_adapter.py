@@ -73,10 +73,16 @@ class ModelAdapter(Adapter):
     loader: ClassVar[type]
     as_stated: ClassVar[bool] = False
     """The registration's :attr:`~.registration.Registration.as_stated`."""
+    loader_options: ClassVar[dict[str, Any]] = {}
+    """The registration's :attr:`~.registration.Registration.loader_options`."""
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
-        offers = cast(type[ModelEngine], self.loader).offers  # (a loader is a ModelEngine)
+        loader = cast(type[ModelEngine], self.loader)  # (a loader is a ModelEngine)
+        if self.requires_couplings and not model.couplings:
+            raise Unsupported(f"{self.name} differs from {loader.engine} only on couplings; "
+                              "none here")
+        offers = loader.offers
         if model.couplings and Offer.COUPLINGS not in offers:
             raise Unsupported(f"{self.name}: its model holds no coupling between joints (the "
                               "equality constraints of the book's cords)")
@@ -90,8 +96,9 @@ class ModelAdapter(Adapter):
             path = Path(folder) / f"{model.name}.{'urdf' if urdf else 'xml'}"
             path.write_text(text, encoding="utf-8")
             source = read(path, floating=urdf and root_is_free(model))
-            options: dict[str, Any] = {"gravity": np.asarray(model.gravity, float)} \
-                if urdf or self.as_stated else {}
+            options: dict[str, Any] = dict(self.loader_options)
+            if urdf or self.as_stated:
+                options["gravity"] = np.asarray(model.gravity, float)
             if self.as_stated:
                 options["inertias"] = {body.name: model.body_inertia(body)
                                        for body in model.bodies if body.is_point_mass}
@@ -195,6 +202,10 @@ class ModelAdapter(Adapter):
     @property
     def _offers(self) -> frozenset[Offer]:
         return cast(type[ModelEngine], self.loader).offers
+
+    def softness(self) -> tuple[float, ...] | None:
+        """Its loader's couplings' soft-constraint model (:meth:`~.base.ModelEngine.softness`)."""
+        return self.engine.softness()
 
     def definition(self, integrator: str) -> str:
         """Its loader's :attr:`~.base.ModelEngine.definitions`."""
@@ -397,6 +408,11 @@ def for_engine(name: str, registration: Registration) -> type[Adapter]:
              "run_format": registration.run, "as_stated": registration.as_stated,
              "dtype": np.float32 if registration.float32 else np.float64,
              "integrators": registration.integrators,
+             "loader_options": dict(registration.loader_options),
+             "requires_couplings": registration.couplings_only,
+             "gyroscopic_implicit": loader.gyroscopic_implicit,
+             "rk4_group_order": loader.rk4_group_order,
+             "couplings_with_field": loader.couplings_with_field,
              "error_controlled": Offer.CONTROLLED_STEPPING in loader.offers,
              "adaptive": Offer.SOLVING in loader.offers, "__module__": __name__}
     return type(f"{cls}Adapter", (ModelAdapter,), attrs)

@@ -1,4 +1,6 @@
-"""MuJoCo behind the canonical form, from the MJCF that :mod:`.mjcf` writes.
+"""MuJoCo C from the MJCF that :mod:`.mjcf` writes, as MuJoCo's ports (:mod:`.mujoco_port`:
+MJX, MuJoCo Warp) compile it and compare with it. ``dyncheck run`` reaches MuJoCo C itself
+through its file loader (:mod:`.mujoco_model`, :mod:`.mujoco_simulation`).
 
 MuJoCo's names: M from ``mj_fullM``; h = ``qfrc_bias`` (Coriolis, centrifugal and gravity);
 forward dynamics ``qacc`` after ``mj_forward`` with ``qfrc_applied`` = τ; inverse dynamics
@@ -14,8 +16,7 @@ simulation, a force written to ``xfrc_applied`` before ``mj_step`` is held over 
 
 Couplings are tendon equalities, MuJoCo's *soft* constraints: their force is ``efc_force`` of
 the equality rows (``qfrc_constraint = efc_Jᵀ efc_force``), their model the loaded
-``eq_solref`` and ``eq_solimp``. ``mujoco-stiff`` is the same model with the impedance at
-MuJoCo's ceiling (solimp d = 0.9999 everywhere).
+``eq_solref`` and ``eq_solimp``.
 """
 
 from __future__ import annotations
@@ -32,9 +33,9 @@ from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.mujoco_api import INTEGRATORS, full_inertia
 from dyncheck.adapters.mujoco_dynamics import Around, evaluate
-from dyncheck.adapters.mujoco_registration import REGISTRATIONS
+from dyncheck.adapters.mujoco_registration import MUJOCO, REGISTRATIONS
 from dyncheck.cases.multibody import Multibody
-from dyncheck.errors import EngineError, Unsupported
+from dyncheck.errors import EngineError
 from dyncheck.vocabulary import Integrator
 
 _DIVERGED = (
@@ -46,9 +47,9 @@ _DIVERGED = (
 
 
 class MuJoCoAdapter(Adapter):
-    name: ClassVar[str] = "mujoco"
-    package: ClassVar[str] = "mujoco"
-    integrators: ClassVar[tuple[str, ...]] = REGISTRATIONS["mujoco"].integrators
+    name: ClassVar[str] = MUJOCO
+    package: ClassVar[str] = REGISTRATIONS[MUJOCO].package
+    integrators: ClassVar[tuple[str, ...]] = REGISTRATIONS[MUJOCO].integrators
     couplings_with_field: ClassVar[bool] = True
     """Tendon equalities and xfrc_applied coexist in one MuJoCo model."""
     gyroscopic_implicit: ClassVar[bool] = mujoco_api.GYROSCOPIC_IMPLICIT
@@ -58,14 +59,9 @@ class MuJoCoAdapter(Adapter):
     rk4_group_order: ClassVar[int] = 4 if mujoco_api.RK4_ON_GROUP else 2
     """RK4's order on ball and free joints (2 before MuJoCo 4.0: stages summed naively)."""
 
-    solimp: ClassVar[tuple[float, ...] | None] = None
-    """The equalities' solimp written to the MJCF (None: MuJoCo's default)."""
-
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
-        if self.requires_couplings and not model.couplings:
-            raise Unsupported(f"{self.name} differs from mujoco only on couplings; none here")
-        self.xml = to_mjcf(model, solimp=self.solimp)
+        self.xml = to_mjcf(model)
         self.model = mujoco.MjModel.from_xml_string(self.xml)
         self.data = mujoco.MjData(self.model)
         self._body_ids = [self.model.body(b.name).id for b in model.bodies]
@@ -283,18 +279,3 @@ class MuJoCoAdapter(Adapter):
                 mujoco.mj_inverse(m, d)
 
         return loop
-
-
-
-class MuJoCoStiffAdapter(MuJoCoAdapter):
-    """MuJoCo with the equalities' impedance at its ceiling mjMAXIMP = 0.9999 (solimp
-    dmin = dmax): the stiffest soft constraint MuJoCo offers. Only for models with couplings."""
-
-    name: ClassVar[str] = "mujoco-stiff"
-    requires_couplings: ClassVar[bool] = True
-    solimp: ClassVar[tuple[float, ...] | None] = (0.9999, 0.9999, 0.001, 0.5, 2.0)
-
-    def raw_calls(self, qe: np.ndarray, ve: np.ndarray, te: np.ndarray,
-                  ae: np.ndarray) -> Callable[[], None] | None:
-        return None  # MuJoCo's own calls, timed under its name
-

@@ -49,6 +49,7 @@ from dyncheck.adapters.mujoco_api import (
 )
 from dyncheck.adapters.mujoco_dynamics import evaluate
 from dyncheck.adapters.mujoco_meshes import TEXT_MESHES, mesh_rounding
+from dyncheck.adapters.mujoco_simulation import MujocoRun
 from dyncheck.errors import EngineError
 from dyncheck.vocabulary import Integrator
 
@@ -192,17 +193,25 @@ def _total_mass_hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
     return tuple(("model", f, why) for f in ("mass", "inertia", "com"))
 
 
-class MujocoModel(MujocoActuation, ModelEngine):
-    """A compiled model and its neutral tree."""
+class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
+    """A compiled model and its neutral tree; in a run, its couplings, a field and its
+    stepping (:mod:`.mujoco_simulation`; ``solimp=`` sets every equality's)."""
 
     engine = ENGINE
     fd_step = FD_STEP
     offers = frozenset({Offer.DERIVATIVES, Offer.TRANSITION, Offer.ACTUATION,
-                        Offer.INPUT_JACOBIAN})
+                        Offer.INPUT_JACOBIAN, Offer.FORWARD, Offer.STEPPING, Offer.COUPLINGS,
+                        Offer.BODY_FORCES})
+    gyroscopic_implicit = GYROSCOPIC_IMPLICIT
+    rk4_group_order = 4 if RK4_ON_GROUP else 2
+    couplings_with_field = True  # tendon equalities and a field in one model
 
-    def __init__(self, source: ModelFile, *, exact_meshes: bool = False) -> None:
+    def __init__(self, source: ModelFile, *, exact_meshes: bool = False,
+                 solimp: tuple[float, ...] | None = None) -> None:
         self.model, notes, self._inertias = _compile(source, exact_meshes=exact_meshes)
         m = self.model
+        if solimp is not None:
+            m.eq_solimp[:] = solimp
         self._gravity = m.opt.gravity.copy()
         if m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_GRAVITY:
             self._gravity[:] = 0.0

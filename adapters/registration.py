@@ -91,6 +91,9 @@ class Registration:
     """Its run reads a book case as stated, not as the file approximates it: its loader is
     given the case's gravity and each point mass's exact inertia (``gravity=``,
     ``inertias=``): Pinocchio's model as built in code, beside its MJCF parser's."""
+    loader_options: tuple[tuple[str, object], ...] = ()
+    """Keywords its loader is given in the run (``mujoco-stiff``: ``solimp``, its equalities'
+    impedance at MuJoCo's ceiling)."""
     checks_files: bool = True
     """Whether ``dyncheck check`` reads users' files with its loader (``model``); False: a
     second run of that loader under another name, reading the case otherwise

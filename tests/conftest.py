@@ -53,7 +53,7 @@ NO_COUPLINGS: tuple[str, ...] = ()
 """Engines dyncheck does not run with couplings (skipped, with the reason)."""
 PORTS = ("mjx", "mjx-f64", "mujoco-warp")
 """MuJoCo's ports: no passive-force callback, so no external field evaluated per stage."""
-FILE_LOADERS = tuple(n for n, r in adapters.REGISTRY.items() if r.run)
+FILE_LOADERS = tuple(n for n, r in adapters.REGISTRY.items() if r.run and not r.couplings_only)
 """Engines whose book cases go through their loader of a user's file (couplings where the
 engine has constraints for them: PyBullet's gears, of two joints)."""
 MULTI_JOINT_CASES = sorted(

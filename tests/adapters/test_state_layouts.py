@@ -41,10 +41,9 @@ def from_engine(engine, spec, q):
 def _mujoco():
     import mujoco
 
-    case = get_case("spherical_pendulum")
-    impl = make_implementation("mujoco", case)
-    m, d = impl.adapter.model, impl.adapter.data
-    d.qpos[:] = to_engine("mujoco", case.multibody(), ROT[None])[0]
+    adapter, q = _loaded("mujoco", "spherical_pendulum", ROT)
+    m, d = adapter.engine.model, adapter.engine.data
+    d.qpos[:] = q
     d.qvel[:] = OMEGA
     mujoco.mj_forward(m, d)
     vel = np.zeros(6)
@@ -70,11 +69,8 @@ def test_quaternion_order_and_velocity_frame(engine):
     R, omega_world = _mujoco() if engine == "mujoco" else _pinocchio(engine)
     assert_allclose(R, quat_to_matrix(ROT[None])[0], atol=1e-14)
     assert_allclose(omega_world, R @ OMEGA, atol=1e-14)
-    if engine == "mujoco":
-        assert get_adapter(engine).state_layout.ball.angular_axes is Axes.LOCAL
-    else:  # a loader's layout is its tree's
-        ball = make_implementation(engine, get_case("spherical_pendulum")).adapter.tree.joints[0]
-        assert ball.layout.angular_axes is Axes.LOCAL
+    ball = make_implementation(engine, get_case("spherical_pendulum")).adapter.tree.joints[0]
+    assert ball.layout.angular_axes is Axes.LOCAL  # (a loader's layout is its tree's)
 
 
 @pytest.mark.parametrize("engine", ALL_ENGINES)  # every engine declares a layout
@@ -90,30 +86,24 @@ def test_pinocchio_native_order_is_xyzw(name):
     assert_allclose(_loaded(name, "spherical_pendulum", ROT)[1], [ROT[1], ROT[2], ROT[3], ROT[0]])
 
 
-def test_wrong_quaternion_order_is_caught(monkeypatch):
-    """MuJoCo with the other storage order assumed: its rows fail."""
-    adapter = get_adapter("mujoco")
-    ball = dataclasses.replace(adapter.state_layout.ball, quat=Orientation("xyzw"))
-    monkeypatch.setattr(adapter, "state_layout",
-                        dataclasses.replace(adapter.state_layout, ball=ball))
-    _fails_on_the_ball("mujoco")
-
-
-def test_a_loader_read_in_the_wrong_quaternion_order_is_caught(monkeypatch):
-    """Pinocchio's loader with its tree saying (w, x, y, z): the run's map feeds it the
-    quaternion in the wrong order, and its rows fail."""
+@pytest.mark.parametrize(("engine", "wrong"), [("mujoco", "xyzw"), ("pinocchio", "wxyz")])
+def test_a_loader_read_in_the_wrong_quaternion_order_is_caught(engine, wrong, monkeypatch):
+    """An engine's loader with its tree saying the other storage order: the run's map feeds
+    it the quaternion in the wrong order, and its rows fail."""
+    from dyncheck.adapters.mujoco_model import MujocoModel
     from dyncheck.adapters.pinocchio_model import PinocchioModel
 
-    tree_of = PinocchioModel._tree
+    loader = {"mujoco": MujocoModel, "pinocchio": PinocchioModel}[engine]
+    tree_of = loader._tree
 
-    def wrong(self, notes):
+    def misread(self, notes):
         tree = tree_of(self, notes)
         joints = tuple(dataclasses.replace(j, layout=dataclasses.replace(
-            j.layout, quat=Orientation.WXYZ)) for j in tree.joints)
+            j.layout, quat=Orientation(wrong))) for j in tree.joints)
         return dataclasses.replace(tree, joints=joints)
 
-    monkeypatch.setattr(PinocchioModel, "_tree", wrong)
-    _fails_on_the_ball("pinocchio")
+    monkeypatch.setattr(loader, "_tree", misread)
+    _fails_on_the_ball(engine)
 
 
 def _fails_on_the_ball(engine: str) -> None:
@@ -175,9 +165,8 @@ def test_mujoco_free_joint_linear_velocity_is_world_frame():
     angular velocity in body axes; with no force the linear qacc is zero (p̈ = 0)."""
     import mujoco
 
-    case = get_case("rigid_body_free")
-    impl = make_implementation("mujoco", case)
-    m, d = impl.adapter.model, impl.adapter.data
+    adapter, _ = _loaded("mujoco", "rigid_body_free", np.concatenate([[0.1, 0.2, 0.3], ROT]))
+    m, d = adapter.engine.model, adapter.engine.data
     m.opt.gravity[:] = 0
     d.qpos[:] = np.concatenate([[0.1, 0.2, 0.3], ROT])
     d.qvel[:] = np.concatenate([V_LIN, OMEGA])
@@ -188,7 +177,7 @@ def test_mujoco_free_joint_linear_velocity_is_world_frame():
     assert_allclose(vel[3:], V_LIN, atol=1e-14)
     assert_allclose(vel[:3], R @ OMEGA, atol=1e-14)
     assert_allclose(d.qacc[:3], 0, atol=1e-12)
-    assert get_adapter("mujoco").state_layout.free.linear_axes is Axes.WORLD
+    assert adapter.tree.joints[0].layout.linear_axes is Axes.WORLD
 
 
 @pytest.mark.parametrize("name", ["pinocchio", "pinocchio-mjcf"])
