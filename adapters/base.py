@@ -413,6 +413,12 @@ class ModelEngine(ABC):
         sign of M v̇ + h = τ + Cᵀ f (:attr:`Offer.COUPLINGS`)."""
         raise Unsupported(f"{self.engine}: its model holds no coupling between joints")
 
+    def constrained(self, q: np.ndarray, v: np.ndarray,
+                    tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """v̇ and the multipliers at τ of one solve (:attr:`Offer.COUPLINGS`); by default
+        :meth:`forward` and :meth:`constraint_forces`, each its own."""
+        return self.forward(q, v, tau), self.constraint_forces(q, v, tau)
+
     def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
         """The generalized force (n, nv, its layout) of ``field`` at each state
         (:attr:`Offer.BODY_FORCES`)."""

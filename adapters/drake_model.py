@@ -333,24 +333,26 @@ class DrakeModel(ModelEngine):
             self.plant.SetVelocities(self.context, v[i])
             yield i
 
-    def _closed(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, which: int) -> np.ndarray:
-        """v̇ (``which`` 0) or the multipliers (1) of the couplings' KKT solve per state."""
-        assert self._rows is not None
-        out = np.empty((len(q), self.plant.num_velocities() if which == 0 else len(self._rows)))
+    def constrained(self, q: np.ndarray, v: np.ndarray,
+                    tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """v̇ and the multipliers of the couplings' KKT solve, state by state."""
+        if self._rows is None:
+            raise Unsupported("drake: its model holds no coupling between joints")
+        vdot = np.empty((len(q), self.plant.num_velocities()))
+        forces = np.empty((len(q), len(self._rows)))
         for i in self._at(q, v):
-            out[i] = drake_simulation.closed(self.plant, self.context, tau[i], self._rows)[which]
-        return out
+            vdot[i], forces[i] = drake_simulation.closed(self.plant, self.context, tau[i],
+                                                         self._rows)
+        return vdot, forces
 
     def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """v̇ at τ: with couplings, their KKT solve; else M⁻¹ (τ − h)."""
         if self._rows is None:
             return super().forward(q, v, tau)
-        return self._closed(q, v, tau, 0)
+        return self.constrained(q, v, tau)[0]
 
     def constraint_forces(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        if self._rows is None:
-            return super().constraint_forces(q, v, tau)
-        return self._closed(q, v, tau, 1)
+        return self.constrained(q, v, tau)[1]
 
     def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
         """Σ Jᵀ F of the field at each state (Drake's translational Jacobians)."""

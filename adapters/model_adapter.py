@@ -270,10 +270,11 @@ class ModelAdapter(Adapter):
             t = np.array([m.t for m in maps])  # (mapped: v̇_e = T v̇ + Ṫ v)
             tdot_v = np.array([m.tdot_v for m in maps])
             tau_e = np.linalg.solve(np.swapaxes(t, 1, 2), tau[..., None])[..., 0]
-            forward = np.linalg.solve(t, (self.engine.forward(qe, ve, tau_e)
-                                          - tdot_v)[..., None])[..., 0]
-            if self.spec.couplings:  # its constraints' multipliers in that same step
-                constraint = self.engine.constraint_forces(qe, ve, tau_e)
+            if self.spec.couplings:  # its constraints' multipliers in that same solve
+                forward_e, constraint = self.engine.constrained(qe, ve, tau_e)
+            else:
+                forward_e = self.engine.forward(qe, ve, tau_e)
+            forward = np.linalg.solve(t, (forward_e - tdot_v)[..., None])[..., 0]
         else:
             forward = np.linalg.solve(d.mass_matrix, (tau - d.bias)[..., None])[..., 0]
         return self._outputs(d.mass_matrix, d.bias, forward, d.inverse, d.kinetic,

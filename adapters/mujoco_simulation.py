@@ -110,12 +110,18 @@ class MujocoRun:
 
     def constraint_forces(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """``efc_force`` of the equality rows at τ, in equality order."""
+        return self.constrained(q, v, tau)[1]
+
+    def constrained(self, q: np.ndarray, v: np.ndarray,
+                    tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``qacc`` and the equality rows' ``efc_force`` of one ``mj_forward`` per state."""
         d = self.data
-        out = np.empty((len(q), self.model.neq))
+        vdot, forces = np.empty((len(q), self.model.nv)), np.empty((len(q), self.model.neq))
         for k in self._forwards(q, v, tau):
+            vdot[k] = d.qacc
             rows = np.flatnonzero(d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
-            out[k] = d.efc_force[rows[np.argsort(d.efc_id[rows], kind="stable")]]
-        return out
+            forces[k] = d.efc_force[rows[np.argsort(d.efc_id[rows], kind="stable")]]
+        return vdot, forces
 
     def _pushed(self, field: Field, out: np.ndarray) -> np.ndarray:
         """out += Σ Jᵀ F of ``field`` at the bodies' centres of mass (kinematics done)."""

@@ -361,13 +361,18 @@ class PinocchioModel(ModelEngine):
 
     def constraint_forces(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """``data.lambda_c`` of the constrained forward dynamics at τ."""
+        return self.constrained(q, v, tau)[1]
+
+    def constrained(self, q: np.ndarray, v: np.ndarray,
+                    tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """v̇ and ``data.lambda_c`` of one constrained forward dynamics per state."""
         if self._rows is None:
             raise Unsupported("pinocchio: its model holds no coupling between joints")
-        out = np.empty((len(q), len(self._rows)))
+        vdot, forces = np.empty((len(q), self.model.nv)), np.empty((len(q), len(self._rows)))
         for i in range(len(q)):
-            self.stepping.accelerate(q[i], v[i], tau[i])
-            out[i] = self.data.lambda_c
-        return out
+            vdot[i] = self.stepping.accelerate(q[i], v[i], tau[i])
+            forces[i] = self.data.lambda_c
+        return vdot, forces
 
     def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
         """Σ Jᵀ F of the field as Pinocchio's external forces give it: ``rnea`` without them

@@ -368,6 +368,11 @@ class PybulletModel(PybulletState, ModelEngine):
         """Its gears' multipliers in the step that gives :meth:`forward`."""
         return self._steps(q, v, tau)[1]
 
+    def constrained(self, q: np.ndarray, v: np.ndarray,
+                    tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """v̇ and its gears' multipliers of the same steps (:meth:`_steps`)."""
+        return self._steps(q, v, tau)
+
     def _steps(self, q: np.ndarray, v: np.ndarray,
                tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         out, forces = np.zeros_like(v), np.zeros((len(q), len(self._gears)))
