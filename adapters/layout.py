@@ -24,7 +24,7 @@ and reads the result back):
 
 - MuJoCo: ball-joint qpos (w, x, y, z), qvel ω in body axes; a free joint's qpos (p, w, x, y,
   z), qvel (v, ω), v of the body origin in *world* axes, ω in body axes (the canonical).
-- Pinocchio (``JointModelSpherical``, programmatic or from MJCF): q (x, y, z, w), v ω in the
+- Pinocchio (``JointModelSpherical``, from MJCF or URDF): q (x, y, z, w), v ω in the
   joint's local frame; its free-flyer q (p, x, y, z, w), v (v, ω) *both* in body axes: v_b =
   Rᵀ v_w, so T = diag(Rᵀ, 1) and Ṫ v = (−ω × v_b, 0) — the engine's v̇ is the derivative of
   body-frame components (the "spatial" acceleration Rᵀ p̈ − ω × v_b), not the body's

@@ -7,17 +7,21 @@ dynamics mapped from the engine's layout to the canonical one (MuJoCo's, the lay
 run's coordinate maps start from) by :mod:`.layout` — the same loader, tree and map
 ``dyncheck check`` uses, so that one engine object serves both commands.
 
-Forward dynamics at τ is M⁻¹(τ − h) from the engine's M and h mapped to the canonical layout
-(these loaders offer M and h; the engine's own forward dynamics is M⁻¹(−h) likewise);
-T = ½ vᵀ M v and V as the loader computes them. A URDF states no gravity: the case's is
-given to the loader (``gravity=``), as its user would set it. An external field (a force
-on a body at its centre of mass) enters through the engine's own means where its class
-offers them (:attr:`~.base.Offer.BODY_FORCES`: its Jacobians or its solver's sum for the
-generalized force, its stepping API at every step); couplings (constraints) are refused
-before any work (a skipped row naming it). Its ``integrators`` are the registration's: the
-engine's own stepping, named by the definition it is (Newton's Featherstone solver and
-PyBullet's ``stepSimulation`` are semi-implicit Euler, MuJoCo's ``euler``; measured by the
-order studies against the reference's discrete map of that definition).
+Forward dynamics at τ is the engine's own where its class offers it (:attr:`~.base.Offer.
+FORWARD`: Pinocchio's ABA, MuJoCo's ``qacc``), else M⁻¹(τ − h) from the engine's M and h
+mapped to the canonical layout; T = ½ vᵀ M v and V as the loader computes them. A URDF
+states no gravity: the case's is given to the loader (``gravity=``), as its user would set
+it; a registration that reads the case as stated (``as_stated``) gives it the case's gravity
+and point masses (``inertias=``) whatever the file says. An external field (a force on a
+body at its centre of mass) enters through the engine's own means where its class offers
+them (:attr:`~.base.Offer.BODY_FORCES`: its Jacobians or its solver's sum for the
+generalized force, its stepping API at every step); couplings through its constraints
+(:attr:`~.base.Offer.COUPLINGS`: v̇ and the multipliers of one solve); either is refused
+before any work where its class does not offer it (a skipped row naming it). Its
+``integrators`` are the registration's: the engine's own stepping, named by the definition
+it is (Newton's Featherstone solver and PyBullet's ``stepSimulation`` are semi-implicit
+Euler, MuJoCo's ``euler``; Pinocchio has none, and is stepped by MuJoCo's definitions;
+measured by the order studies against the reference's discrete map of that definition).
 """
 
 from __future__ import annotations
@@ -78,7 +82,7 @@ class ModelAdapter(Adapter):
 
     def __init__(self, model: Multibody) -> None:
         super().__init__(model)
-        loader = cast(type[ModelEngine], self.loader)  # (a loader is a ModelEngine)
+        loader = self._loader()
         if self.requires_couplings and not model.couplings:
             raise Unsupported(f"{self.name} differs from {loader.engine} only on couplings; "
                               "none here")
@@ -199,9 +203,13 @@ class ModelAdapter(Adapter):
         return [(k, j) for k, j in enumerate(self.tree.joint(n) for n in self.canon.names)
                 if j.type is JointType.FREE and j.gravity_frame is GravityFrame.RPY_REVERSED]
 
+    @classmethod
+    def _loader(cls) -> type[ModelEngine]:
+        return cast(type[ModelEngine], cls.loader)  # (a loader is a ModelEngine)
+
     @property
     def _offers(self) -> frozenset[Offer]:
-        return cast(type[ModelEngine], self.loader).offers
+        return self._loader().offers
 
     def softness(self) -> tuple[float, ...] | None:
         """Its loader's couplings' soft-constraint model (:meth:`~.base.ModelEngine.softness`)."""
@@ -209,13 +217,13 @@ class ModelAdapter(Adapter):
 
     def definition(self, integrator: str) -> str:
         """Its loader's :attr:`~.base.ModelEngine.definitions`."""
-        return cast(type[ModelEngine], self.loader).definitions.get(integrator, integrator)
+        return self._loader().definitions.get(integrator, integrator)
 
     @classmethod
     def steps_in_a_chart(cls) -> bool:
         """Its loader's stepping fact (:attr:`~.base.ModelEngine.steps_in_a_chart`): the
         run's states are in the canonical layout, the engine's stepping is its own."""
-        return cast(type[ModelEngine], cls.loader).steps_in_a_chart
+        return cls._loader().steps_in_a_chart
 
     @classmethod
     def version(cls) -> str:

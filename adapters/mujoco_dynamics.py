@@ -1,13 +1,12 @@
-"""MuJoCo's smooth dynamics at a batch of states, written once for the run's adapter
-(:mod:`.mujoco_`) and the file loader (:mod:`.mujoco_model`): per state one ``mj_forward``
-with ``qfrc_applied`` = τ — M from ``mj_fullM`` (armature included), h = ``qfrc_bias``,
-v̇ = ``qacc``, the energies (V, T) = ``data.energy`` — and one ``mj_inverse`` at v̇ = a,
-``qfrc_inverse``. ``mjData``'s arrays are bound once (a small model's state costs ~6 µs: the
-attribute reads around the two engine calls were a fifth of it)."""
+"""MuJoCo's smooth dynamics at a batch of states, for its loader (:mod:`.mujoco_model`, which
+serves the run and the check): per state one ``mj_forward`` with ``qfrc_applied`` = τ — M from
+``mj_fullM`` (armature included), h = ``qfrc_bias``, v̇ = ``qacc``, the energies (V, T) =
+``data.energy`` — and one ``mj_inverse`` at v̇ = a, ``qfrc_inverse``. ``mjData``'s arrays are
+bound once (a small model's state costs ~6 µs: the attribute reads around the two engine calls
+were a fifth of it)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
@@ -28,23 +27,9 @@ class Evaluated:
     potential: np.ndarray
 
 
-@dataclass(frozen=True, kw_only=True)
-class Around:
-    """What a caller adds around the two calls of each state (the run's external field and
-    its couplings' forces); each optional."""
-
-    before: Callable[[mujoco.MjData], None] | None = None
-    """After the state is written, before ``mj_forward`` (the field's ``xfrc_applied``)."""
-    after_forward: Callable[[int, mujoco.MjData], None] | None = None
-    """After ``mj_forward``, with the state's index (the equality rows' forces)."""
-    taken_from_inverse: Callable[[mujoco.MjData], np.ndarray] | None = None
-    """A generalized force subtracted from ``qfrc_inverse`` (the field's Jᵀ F)."""
-
-
 def evaluate(m: mujoco.MjModel, d: mujoco.MjData, *, q: np.ndarray, v: np.ndarray,
-             tau: np.ndarray, a: np.ndarray, around: Around | None = None) -> Evaluated:
+             tau: np.ndarray, a: np.ndarray) -> Evaluated:
     """M, h, v̇ at τ, the energies and τ at v̇ = a at every state of the batch (rows)."""
-    around = around or Around()
     n, nv = v.shape
     mass = np.empty((n, nv, nv))
     bias, fwd, inv = np.empty((n, nv)), np.empty((n, nv)), np.empty((n, nv))
@@ -54,17 +39,11 @@ def evaluate(m: mujoco.MjModel, d: mujoco.MjData, *, q: np.ndarray, v: np.ndarra
     forward, inverse = mujoco.mj_forward, mujoco.mj_inverse
     for k in range(n):
         qpos[:], qvel[:], qfrc[:] = q[k], v[k], tau[k]
-        if around.before is not None:
-            around.before(d)
         forward(m, d)
         full_inertia(m, d, mass[k])
         bias[k], fwd[k], energy[k] = qbias, qacc, en
-        if around.after_forward is not None:
-            around.after_forward(k, d)
         qacc[:] = a[k]
         inverse(m, d)
         inv[k] = qinv
-        if around.taken_from_inverse is not None:
-            inv[k] -= around.taken_from_inverse(d)
     return Evaluated(mass=mass, bias=bias, forward=fwd, inverse=inv, kinetic=energy[:, 1],
                      potential=energy[:, 0])

@@ -1,8 +1,8 @@
 """What MuJoCo's ports (MJX, MuJoCo Warp) share: the C engine's MJCF and ``MjModel``, put on
 the port; every quantity then computed by the port, batched over states.
 
-The C model is loaded exactly as :class:`~dyncheck.adapters.mujoco_.MuJoCoAdapter` loads it
-(one MJCF for all three), then handed to the port (``mjx.put_model``,
+The C model is compiled by MuJoCo from the MJCF that :mod:`.mjcf` writes, the file MuJoCo's
+own loader reads in the run (one MJCF for all three), then handed to the port (``mjx.put_model``,
 ``mujoco_warp.put_model``). Nothing below calls the C engine's dynamics: masses, inertias,
 gravity and constraint parameters are read back from the port's own copy, and M, h, v̇, τ are
 the port's. The ports compute no energies (MJX has no ``energy`` flag; MuJoCo Warp's
@@ -24,8 +24,8 @@ from typing import ClassVar
 import mujoco
 import numpy as np
 
-from dyncheck.adapters.base import LoadedBody, Trajectory
-from dyncheck.adapters.mujoco_ import MuJoCoAdapter
+from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import EngineError, Unsupported
 from dyncheck.vocabulary import Quantity
@@ -38,7 +38,7 @@ STEPS = 200
 """Steps per compiled stretch of a simulation (the last stretch run whole, its tail dropped)."""
 
 
-class PortAdapter(MuJoCoAdapter):
+class PortAdapter(Adapter):
     """A port of MuJoCo behind the canonical form; subclasses provide :meth:`_batch` and
     :meth:`_run`."""
 
@@ -55,6 +55,9 @@ class PortAdapter(MuJoCoAdapter):
                 "mjcb_passive callback, which the port does not offer"
             )
         super().__init__(model)
+        self.xml = to_mjcf(model)
+        self.model = mujoco.MjModel.from_xml_string(self.xml)
+        self._body_ids = [self.model.body(b.name).id for b in model.bodies]
 
     @classmethod
     def on_model(cls, model: mujoco.MjModel) -> PortAdapter:

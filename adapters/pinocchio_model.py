@@ -9,8 +9,13 @@ dynamics ``aba`` at τ = 0, inverse ``rnea``, ``computeKineticEnergy``,
 joint's ``joint_v``, which ``JointModelRevoluteUnaligned`` leaves at zero. A composite joint
 (the MJCF parser's for a body with several joints) is read back component by component.
 Pinocchio applies no damping: its ``model.damping`` is read back as a field only. State
-layout: quaternions (x, y, z, w); a free
-joint v = (linear, angular), both in local axes; an unbounded revolute joint q = (cos θ, sin θ).
+layout: quaternions (x, y, z, w); a free joint v = (linear, angular), both in local axes; an
+unbounded revolute joint q = (cos θ, sin θ).
+
+In a book case's run (``dyncheck run``) the same loader answers forward dynamics at τ
+(``aba``), the cords (constrained ``forwardDynamics`` with their constant Jacobian), a field
+(Pinocchio's external forces) and trajectories (:mod:`.pinocchio_simulation`: MuJoCo's
+integrators' definitions and scipy's DOP853 on its forward dynamics).
 """
 
 from __future__ import annotations
@@ -153,7 +158,7 @@ def _held_bodies(m: pin.Model) -> dict[str, int]:
     return {name: j for j, name in out.items()}
 
 
-def _state_inertias(m: pin.Model, inertias: Mapping[str, np.ndarray]) -> None:
+def _stated_inertias(m: pin.Model, inertias: Mapping[str, np.ndarray]) -> None:
     """Each named body's rotational inertia about its centre of mass set as given (body axes),
     its mass and centre kept: what a format floors (MJCF's point masses) held exactly."""
     frames = [f for f in m.frames if f.type == pin.FrameType.BODY]
@@ -173,7 +178,7 @@ class PinocchioModel(ModelEngine):
     """A Pinocchio model and its neutral tree. Options (the run's, :mod:`.model_adapter`):
     ``gravity`` as the model's (its MJCF parser reads none), ``inertias`` (body name → its
     rotational inertia about its centre of mass, body axes) in place of the file's: the
-    book's point masses exact, as a model built in code holds them.
+    book's point masses exact.
 
     It has no time integrator: :mod:`.pinocchio_simulation` steps its forward dynamics by
     MuJoCo's integrators' definitions and scipy's DOP853."""
@@ -190,7 +195,7 @@ class PinocchioModel(ModelEngine):
         self.model = _load(source)
         if gravity is not None:
             self.model.gravity = pin.Motion(np.asarray(gravity, float), np.zeros(3))
-        _state_inertias(self.model, inertias or {})
+        _stated_inertias(self.model, inertias or {})
         self.data = self.model.createData()
         self._rows: np.ndarray | None = None
         notes: tuple[str, ...] = ()

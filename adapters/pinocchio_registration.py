@@ -1,7 +1,7 @@
 """Pinocchio's registrations (:mod:`.pinocchio_model`, which also serves ``dyncheck run``):
 importable without Pinocchio; stepped by MuJoCo's integrators' definitions
 (:mod:`.pinocchio_simulation`). ``pinocchio`` reads a book case as stated (the case's gravity,
-its point masses exact, as a model built in code holds them); ``pinocchio-mjcf`` reads the
+its point masses exact); ``pinocchio-mjcf`` reads the
 very MJCF file MuJoCo loads as Pinocchio's MJCF parser does."""
 
 from __future__ import annotations

@@ -90,7 +90,7 @@ class Registration:
     as_stated: bool = False
     """Its run reads a book case as stated, not as the file approximates it: its loader is
     given the case's gravity and each point mass's exact inertia (``gravity=``,
-    ``inertias=``): Pinocchio's model as built in code, beside its MJCF parser's."""
+    ``inertias=``): ``pinocchio``, beside ``pinocchio-mjcf``, its MJCF parser's reading."""
     loader_options: tuple[tuple[str, object], ...] = ()
     """Keywords its loader is given in the run (``mujoco-stiff``: ``solimp``, its equalities'
     impedance at MuJoCo's ceiling)."""

@@ -144,8 +144,8 @@ def point_mass_floor() -> Entry:
         f"'{refused}'; its floor is mjMINVAL = 1e-15), so the MJCF gives each point mass "
         f"an isotropic {floor:g} kg m². The reference predicts its effect exactly "
         "(½ I |ω|²); `dyncheck run` reports it as explained rows.",
-        "MuJoCo, Drake and pinocchio-mjcf read the floor; Pinocchio built in code holds "
-        "exact point masses (except on a ball joint, where the spin needs inertia).",
+        "MuJoCo, Drake and pinocchio-mjcf read the floor; Pinocchio given the case as stated "
+        "holds exact point masses (except on a ball joint, where the spin needs inertia).",
         "the floor ignored",
         floor / (point + floor),
         0.0,

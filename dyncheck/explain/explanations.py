@@ -62,11 +62,11 @@ EXPLANATIONS: dict[str, Explanation] = {
         text="MuJoCo's compiler rejects a moving body whose mass or inertia is below mjMINVAL "
         "(1e-15), so the MJCF gives each of the book's point masses a small isotropic inertia "
         "(`Multibody.mjcf_point_inertia`). MuJoCo and `pinocchio-mjcf` read it; `pinocchio` "
-        "(built programmatically) holds exact point masses. The reference predicts the "
-        "difference exactly: the general method with ½ I |ω|² added per body (from (2.2.40); "
-        "ω = θ̇ for a pendulum bob with θ absolute, the rotation of the coordinate triad for a "
-        "particle carried by coordinate joints). A row is `explained` only when observed − "
-        "predicted is within round-off.",
+        "(the case as stated: its loader given the exact inertias) holds exact point masses. "
+        "The reference predicts the difference exactly: the general method with ½ I |ω|² added "
+        "per body (from (2.2.40); ω = θ̇ for a pendulum bob with θ absolute, the rotation of "
+        "the coordinate triad for a particle carried by coordinate joints). A row is "
+        "`explained` only when observed − predicted is within round-off.",
     ),
     DEFECT: Explanation(
         origin=Origin.ENGINE,

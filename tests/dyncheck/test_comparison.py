@@ -136,7 +136,7 @@ def test_every_instantaneous_pair_is_passed_or_explained(full_run):
     assert (inst.verdict != "skipped").sum() == measured  # no row beyond the pairs
 
 
-def test_programmatic_pinocchio_needs_no_explanation(full_run):
+def test_pinocchio_as_stated_needs_no_explanation(full_run):
     """pinocchio holds exact point masses and the case's gravity: it must pass against book
     and reference outright (except the deliberate held-force RK4, a finding, and the
     derivatives of a composite joint, its declared defect)."""
