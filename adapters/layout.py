@@ -228,11 +228,9 @@ def state_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray,
     return mapper(canon, tree)(q_c, v_c)
 
 
-def canonical_states(canon: Canonical, tree: ModelTree, q_e: np.ndarray,
-                     v_e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Engine states (n, tree.nq), (n, tree.nv) back to canonical ones: :func:`state_map`
-    inverted joint by joint (a free joint's placement and offset undone, quaternions
-    renormalized), and v_c = T⁻¹ v_e with T at the canonical q found."""
+def canonical_positions(canon: Canonical, tree: ModelTree, q_e: np.ndarray) -> np.ndarray:
+    """Engine positions (n, tree.nq) back to canonical ones: :func:`state_map` inverted joint
+    by joint (a free joint's placement and offset undone, quaternions renormalized)."""
     joints = [tree.joint(name) for name in canon.names]
     q_c = np.zeros((len(q_e), canon.nq))
     for joint, kind, qs, zero in zip(joints, canon.types, canon.q_start, canon.zeros,
@@ -247,11 +245,7 @@ def canonical_states(canon: Canonical, tree: ModelTree, q_e: np.ndarray,
                 _unit(chunk[:, np.argsort(quat_order(lay.quat))])
         else:
             q_c[:, qs : qs + 7] = [_free_back(lay, row) for row in chunk]
-    to = mapper(canon, tree)
-    v_c = np.array([np.linalg.solve(to(q, np.zeros(canon.nv)).t, v)
-                    for q, v in zip(q_c, v_e, strict=True)]) if len(q_c) else \
-        np.zeros((0, canon.nv))
-    return q_c, v_c
+    return q_c
 
 
 def _free_back(lay: Layout, q_e: np.ndarray) -> np.ndarray:

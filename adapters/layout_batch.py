@@ -8,7 +8,14 @@ from __future__ import annotations
 import numpy as np
 
 from dyncheck.adapters.integrators import quat_mul
-from dyncheck.adapters.layout import IDENTITY, Canonical, StateMap, mapper, quat_order
+from dyncheck.adapters.layout import (
+    IDENTITY,
+    Canonical,
+    StateMap,
+    canonical_positions,
+    mapper,
+    quat_order,
+)
 from dyncheck.adapters.model_tree import Axes, Dynamics, JointType, Layout, ModelTree, Orientation
 from dyncheck.cases.coordinate_maps import quat_from_matrix, quat_to_matrix
 
@@ -47,6 +54,18 @@ def batch_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray,
             q_e[:, qe : qe + 7], t[:, ve : ve + 6, vs : vs + 6], tdot_v[:, ve : ve + 6] = \
                 free_batch(lay, place, q_c[:, qs : qs + 7], v_c[:, vs : vs + 6])
     return q_e, t, tdot_v
+
+
+def canonical_states(canon: Canonical, tree: ModelTree, q_e: np.ndarray,
+                     v_e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Engine states (n, tree.nq), (n, tree.nv) back to canonical ones: the positions by
+    :func:`~.layout.canonical_positions`, and v_c = T⁻¹ v_e with T at the canonical q found,
+    every state at once (:func:`batch_map`)."""
+    q_c = canonical_positions(canon, tree, q_e)
+    if not len(q_c):
+        return q_c, np.zeros((0, canon.nv))
+    _, t, _ = batch_map(canon, tree, q_c, np.zeros((len(q_c), canon.nv)))
+    return q_c, np.linalg.solve(t, np.asarray(v_e, float)[..., None])[..., 0]
 
 
 def rpy_batch(rot: np.ndarray) -> np.ndarray:

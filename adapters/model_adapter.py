@@ -47,8 +47,8 @@ from dyncheck.adapters.base import (
     Trajectory,
 )
 from dyncheck.adapters.c_output import c_output_dropped
-from dyncheck.adapters.layout import Canonical, StateMap, canonical_states
-from dyncheck.adapters.layout_batch import engine_states, to_canonical
+from dyncheck.adapters.layout import Canonical, StateMap
+from dyncheck.adapters.layout_batch import canonical_states, engine_states, to_canonical
 from dyncheck.adapters.mjcf import to_mjcf
 from dyncheck.adapters.model_files import Format, read
 from dyncheck.adapters.model_tree import (

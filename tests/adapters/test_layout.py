@@ -163,7 +163,8 @@ def test_engine_states_map_back_to_the_canonical_ones(free, ball):
     canonical one."""
     from dataclasses import replace
 
-    from dyncheck.adapters.layout import Canonical, canonical_states, state_map
+    from dyncheck.adapters.layout import Canonical, state_map
+    from dyncheck.adapters.layout_batch import canonical_states
     from dyncheck.adapters.model_tree import JointType, ModelTree
 
     free = replace(free, q_start=0, v_start=0, placement=PLACEMENT)

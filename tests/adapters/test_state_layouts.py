@@ -218,7 +218,7 @@ def _drake(case_name: str, canonical: np.ndarray):
 def test_drake_ball_joint_is_rpy_with_world_angular_velocity():
     """Drake's BallRpyJoint: q = (r, p, y) with R = R_z(y) R_y(p) R_x(r); v = ω in world
     axes. Checked on the plant Drake's parser builds from the spherical pendulum's MJCF."""
-    from dyncheck.adapters.layout import canonical_states
+    from dyncheck.adapters.layout_batch import canonical_states
 
     adapter, q = _drake("spherical_pendulum", ROT)
     plant, ctx = adapter.engine.plant, adapter.engine.context
