@@ -14,22 +14,22 @@ Adapters never see the book's coordinates: the comparison layer maps them.
 
 from __future__ import annotations
 
+import importlib.metadata
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, ClassVar, TypeVar
+from typing import Any, ClassVar
 
 import numpy as np
 
 from dyncheck.adapters.actuators import Actuation, InputJacobian
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, ModelTree, StateLayout, Transition
 from dyncheck.adapters.offers import Field, Offer
+from dyncheck.adapters.symbolic import Symbolic
 from dyncheck.cases.multibody import Coupling, Multibody
 from dyncheck.errors import EngineError, Unsupported
 from dyncheck.vocabulary import Quantity
-
-_T = TypeVar("_T")
 
 DIVERGED = 1e12
 """A coordinate beyond this (rad or m) means a run has blown up: no case here comes near it."""
@@ -61,33 +61,6 @@ class LoadedBody:
     name: str
     mass: float
     inertia: np.ndarray
-
-
-def _computed(kind: str, inputs: object, compute: Callable[[], _T]) -> _T:
-    return compute()
-
-
-def _lambdified(args: Sequence[Any], exprs: Any, modules: str) -> Callable[..., Any]:
-    import sympy as sp
-
-    return sp.lambdify(args, exprs, modules=modules, cse=True)
-
-
-@dataclass(frozen=True, kw_only=True)
-class Symbolic:
-    """How an adapter that derives its equations symbolically keeps them — ``derive(kind,
-    inputs, compute)``: ``compute()``'s result, keyed by ``kind`` and ``inputs`` — and makes
-    numeric functions of them — ``lambdify(args, exprs, modules)``, as ``sympy.lambdify``
-    with ``cse=True``. The default computes both afresh; the comparison layer, which may see
-    the reference, hands in the reference's disk caches (``dyncheck.implementations.CACHED``):
-    adapters never import the reference, and nothing is patched in at import."""
-
-    derive: Callable[[str, object, Callable[[], Any]], Any] = _computed
-    lambdify: Callable[[Sequence[Any], Any, str], Callable[..., Any]] = _lambdified
-
-
-AFRESH = Symbolic()
-"""Equations derived and compiled afresh (no cache)."""
 
 
 class Adapter(ABC):
@@ -355,6 +328,19 @@ class ModelEngine(ABC):
     where it sums stage velocities across tangent spaces: MuJoCo before 4.0)."""
     couplings_with_field: bool = False
     """A class fact: it holds couplings and a field in one model (MuJoCo's)."""
+    no_body_forces: ClassVar[str] = "its model takes no force on a body (an external field)"
+    """A class fact: why it takes no field, where it does not offer
+    :attr:`Offer.BODY_FORCES` (its limit, in a sentence)."""
+    batches_steps: ClassVar[bool] = False
+    """A class fact: :meth:`simulate_many` runs its step sizes at once (MuJoCo Warp's
+    worlds), not one after another."""
+    per_state_calls: ClassVar[bool] = True
+    """A class fact: :meth:`dynamics` is a loop of its own per-state calls, what ``dyncheck
+    bench`` times a run against; False: one compiled batch (a port)."""
+    max_steps: int | None = None
+    """The longest fixed-step run it makes here (None: no limit)."""
+    device: str = "cpu"
+    """Where it computes (a port: from ``--device``)."""
     definitions: ClassVar[Mapping[str, str]] = {}
     """A class fact: its integrators whose run is another's here (name → the definition it
     runs: Pinocchio's ``implicitfast`` is ``euler``, nothing damped); one run serves both."""
@@ -385,6 +371,23 @@ class ModelEngine(ABC):
         """``steps`` steps of ``dt`` by ``integrator`` (one of its registration's), q and v at
         every step, the start included (:attr:`Offer.STEPPING`)."""
         raise Unsupported(f"{self.engine} offers no stepping of its own")
+
+    def simulate_many(self, q0: np.ndarray, v0: np.ndarray, dts: Sequence[float],
+                      steps: Sequence[int], *, integrator: str,
+                      field: Field | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
+        """:meth:`simulate` at each step size, ``steps[i]`` steps of ``dts[i]``."""
+        return [self.simulate(q0, v0, dt, n, integrator=integrator, field=field)
+                for dt, n in zip(dts, steps, strict=True)]
+
+    @classmethod
+    def version(cls, package: str) -> str:
+        """Its version: its ``package``'s, unless it says more (a port: its device)."""
+        return importlib.metadata.version(package)
+
+    @classmethod
+    def release_compiled(cls) -> None:
+        """Free what it compiled for the models built so far (a port's programs)."""
+        return None
 
     def simulate_controlled(self, q0: np.ndarray, v0: np.ndarray, period: float, samples: int,
                             *, accuracy: float, scheme: str | None = None, caching: bool = True,

@@ -230,7 +230,9 @@ def state_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray,
 
 def canonical_positions(canon: Canonical, tree: ModelTree, q_e: np.ndarray) -> np.ndarray:
     """Engine positions (n, tree.nq) back to canonical ones: :func:`state_map` inverted joint
-    by joint (a free joint's placement and offset undone, quaternions renormalized)."""
+    by joint (a free joint's placement and offset undone, a quaternion renormalized where its
+    norm drifted beyond the rounding of the engine's arithmetic, ``tree.eps``:
+    :func:`_unit`)."""
     joints = [tree.joint(name) for name in canon.names]
     q_c = np.zeros((len(q_e), canon.nq))
     for joint, kind, qs, zero in zip(joints, canon.types, canon.q_start, canon.zeros,
@@ -242,17 +244,17 @@ def canonical_positions(canon: Canonical, tree: ModelTree, q_e: np.ndarray) -> n
             q_c[:, qs] = value - lay.zero + zero
         elif kind is JointType.BALL:
             q_c[:, qs : qs + 4] = _quat_of_rpy(chunk) if lay.quat is Orientation.RPY else \
-                _unit(chunk[:, np.argsort(quat_order(lay.quat))])
+                _unit(chunk[:, np.argsort(quat_order(lay.quat))], tree.eps)
         else:
-            q_c[:, qs : qs + 7] = [_free_back(lay, row) for row in chunk]
+            q_c[:, qs : qs + 7] = [_free_back(lay, row, tree.eps) for row in chunk]
     return q_c
 
 
-def _free_back(lay: Layout, q_e: np.ndarray) -> np.ndarray:
+def _free_back(lay: Layout, q_e: np.ndarray, eps: float = 0.0) -> np.ndarray:
     """A free joint's canonical (p, quat) from its q in the engine's layout (:func:`_free`
     inverted: quat_e = P⁻¹ ⊗ quat ⊗ q(R_o), p_e = P_r⁻¹ (p + R o − P_p))."""
     quat_e, p_e = (q_e[:4], q_e[4:]) if lay.quat_first else (q_e[3:], q_e[:3])
-    quat_e = _unit(quat_e[None, np.argsort(quat_order(lay.quat))])[0]
+    quat_e = _unit(quat_e[None, np.argsort(quat_order(lay.quat))], eps)[0]
     place_r, place_p = lay.placement[:3, :3], lay.placement[:3, 3]
     turned = quat_mul(quat_from_matrix(place_r[None])[0], quat_e)
     quat_w = quat_mul(turned, quat_conj(quat_from_matrix(lay.offset[None, :3, :3])[0]))
@@ -300,9 +302,19 @@ def _quat_of_rpy(rpy: np.ndarray) -> np.ndarray:
     )
 
 
-def _unit(quat: np.ndarray) -> np.ndarray:
-    """Engines that integrate quaternion components (Drake) let the norm drift: renormalize."""
-    return quat / np.linalg.norm(quat, axis=-1, keepdims=True)
+UNIT_ROUNDING = 8
+"""|‖q‖ − 1| of a quaternion an engine normalized in its own arithmetic is at most a few ε
+(its norm's four products, three sums and square root, then the division): within this many
+of its ε it is left as the engine gave it."""
+
+
+def _unit(quat: np.ndarray, eps: float = 0.0) -> np.ndarray:
+    """Engines that integrate quaternion components (Drake) let the norm drift: renormalize
+    where it drifted beyond :data:`UNIT_ROUNDING` ε of the engine's arithmetic (``eps``; 0:
+    always). A quaternion the engine normalized is its own: a float32 port's, whose norm is
+    1 to ε₃₂, carries its round-off into the comparison as the engine computed it."""
+    norm = np.linalg.norm(quat, axis=-1, keepdims=True)
+    return np.where(np.abs(norm - 1.0) <= UNIT_ROUNDING * eps, quat, quat / norm)
 
 
 def to_engine(layouts: Sequence[Layout], kinds: Sequence[JointType],

@@ -1,10 +1,11 @@
-"""MJX (MuJoCo in JAX) behind the canonical form: ``mjx`` in float32 (JAX's default) and
-``mjx-f64`` with JAX's 64-bit mode, both from the MJCF and ``MjModel`` of ``mujoco``.
+"""MJX (MuJoCo in JAX) as a port of MuJoCo's compiled model (:class:`~.mujoco_port.Port`, used
+by :class:`~.port_models.MjxModel`): ``mjx`` in float32 (JAX's default) and ``mjx-f64`` with
+JAX's 64-bit mode.
 
 MJX's names: ``mjx.forward`` (``qfrc_bias``, ``qacc`` with ``qfrc_applied`` = τ), M from
 ``mjx.full_m``, ``mjx.inverse`` (``qfrc_inverse``), the equality rows' ``efc_force``; all
 ``jax.vmap``-ed over a chunk of states and compiled once per model. A simulation is
-``mjx.step`` under ``jax.lax.scan``. 64-bit mode is scoped to this adapter's calls
+``mjx.step`` under ``jax.lax.scan``. 64-bit mode is scoped to this port's calls
 (``jax.enable_x64``), so the two precisions coexist in one process and neither changes JAX's
 global default.
 
@@ -34,10 +35,8 @@ import mujoco
 import numpy as np
 from mujoco import mjx
 
-from dyncheck.adapters.mjx_registration import REGISTRATIONS
 from dyncheck.adapters.mujoco_api import INTEGRATORS
-from dyncheck.adapters.mujoco_port import STEPS, PortAdapter
-from dyncheck.cases.multibody import Multibody
+from dyncheck.adapters.mujoco_port import STEPS, Port
 from dyncheck.settings import current
 
 
@@ -228,23 +227,15 @@ _ACTUATE = jax.jit(jax.vmap(_actuate, in_axes=(None, 0, 0, 0)))
 _INPUT_JACOBIAN = jax.jit(jax.vmap(_input_jacobian, in_axes=(None, 0, 0, 0)))
 _STRETCH = jax.jit(_stretch)
 _DERIVATIVES = jax.jit(jax.vmap(_derivatives, in_axes=(None, 0, 0, 0)))
-"""Compiled once per model structure and precision, shared by every adapter: the model is an
-argument, so a second adapter of the same structure (other masses, other step) reuses it."""
+"""Compiled once per model structure and precision, shared by every port: the model is an
+argument, so a second port of the same structure (other masses, other step) reuses it."""
 
 
-class MJXAdapter(PortAdapter):
+class MjxPort(Port):
     """MJX in float32."""
 
     name: ClassVar[str] = "mjx"
-    package: ClassVar[str] = "mujoco-mjx"
-    integrators: ClassVar[tuple[str, ...]] = REGISTRATIONS["mjx"].integrators
-    rk4_group_order: ClassVar[int] = 2
-    gyroscopic_implicit: ClassVar[bool] = False
     dtype: ClassVar[type[np.floating]] = np.float32
-
-    def __init__(self, model: Multibody) -> None:
-        super().__init__(model)
-        self._put()
 
     def _put(self) -> None:
         _compile_cache()
@@ -273,7 +264,7 @@ class MJXAdapter(PortAdapter):
         )
 
     def _precision(self) -> AbstractContextManager[Any]:
-        """JAX's 64-bit mode on or off for this adapter's calls. JAX 0.10 cannot lower a
+        """JAX's 64-bit mode on or off for this port's calls. JAX 0.10 cannot lower a
         function that calls an inner ``jit`` on a NumPy constant (MJX's RK4 tableau through
         ``jnp.tril``) in one mode once another function has done so in the other mode (a
         minimal reproducer: ``jnp.tril`` of a NumPy array in two jitted functions, one under
@@ -286,7 +277,7 @@ class MJXAdapter(PortAdapter):
         return jax.enable_x64(x64)
 
     def _cast(self, tree: Any) -> Any:
-        """Every floating array of a model or data in the adapter's precision."""
+        """Every floating array of a model or data in the port's precision."""
         return jax.tree_util.tree_map(
             lambda x: (
                 x.astype(self.dtype)
@@ -333,13 +324,13 @@ class MJXAdapter(PortAdapter):
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, np.ndarray]:
         """The port's own derivatives at a batch of states (:func:`_derivatives`: JAX's
         ``jacfwd`` through ``mjx.forward`` and ``mjx.inverse``), in MuJoCo's layout and
-        chart, computed in the adapter's precision."""
+        chart, computed in the port's precision."""
         with self._precision():
             args = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, a))
             out = _DERIVATIVES(self.mx, *args)
             return {k: np.asarray(x, dtype=float) for k, x in out.items()}
 
-    def _run(
+    def run(
         self, q0: np.ndarray, v0: np.ndarray, steps: int, dt: float, integrator: str
     ) -> tuple[np.ndarray, np.ndarray]:
         with self._precision():
@@ -365,7 +356,7 @@ class MJXAdapter(PortAdapter):
         return np.concatenate(qs)[: steps + 1], np.concatenate(vs)[: steps + 1]
 
 
-class MJXF64Adapter(MJXAdapter):
+class MjxF64Port(MjxPort):
     """MJX with JAX's 64-bit mode: the same code in float64, which must agree with MuJoCo C
     to round-off."""
 

@@ -1,8 +1,9 @@
-"""MJX's registrations (:mod:`.mjx_`, :mod:`.port_models`), float32 and float64: importable without
-JAX."""
+"""MJX's registrations (:mod:`.port_models` on :mod:`.mjx_`), float32 and float64: importable
+without JAX."""
 
 from __future__ import annotations
 
+from dyncheck.adapters.model_files import Format
 from dyncheck.adapters.mujoco_registration import MUJOCO
 from dyncheck.adapters.registration import A, Registration
 from dyncheck.vocabulary import Integrator
@@ -12,14 +13,12 @@ PORTS = (Integrator.EULER, Integrator.IMPLICITFAST, Integrator.RK4)
 
 REGISTRATIONS: dict[str, Registration] = {
     "mjx-f64": Registration(
-        module=A + "mjx_", cls="MJXF64Adapter", package="mujoco-mjx", extra="mjx", ports=MUJOCO,
-        integrators=PORTS,
+        package="mujoco-mjx", extra="mjx", ports=MUJOCO, integrators=PORTS, run=Format.MJCF,
         model=A + "port_models:MjxF64Model", on_request=True, accelerator=True,
     ),
     "mjx": Registration(
-        module=A + "mjx_",
-        cls="MJXAdapter",
         package="mujoco-mjx",
+        run=Format.MJCF,
         extra="mjx",
         ports=MUJOCO,
         float32=True,

@@ -27,9 +27,8 @@ measured by the order studies against the reference's discrete map of that defin
 from __future__ import annotations
 
 import importlib
-import importlib.metadata
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
@@ -91,8 +90,7 @@ class ModelAdapter(Adapter):
             raise Unsupported(f"{self.name}: its model holds no coupling between joints (the "
                               "equality constraints of the book's cords)")
         if model.central_mu and Offer.BODY_FORCES not in offers:
-            raise Unsupported(f"{self.name}: its model takes no force on a body (an external "
-                              "field)")
+            raise Unsupported(f"{self.name}: {loader.no_body_forces}")
         self.field: Field | None = _field(model) if model.central_mu else None
         urdf = self.run_format is Format.URDF
         text = to_urdf(model) if urdf else to_mjcf(model)
@@ -111,6 +109,7 @@ class ModelAdapter(Adapter):
         if model.couplings:
             self.engine.couple(model.couplings)  # (refused, in its words, where it cannot)
         self.tree: ModelTree = self.engine.tree
+        self.max_steps, self.device = self.engine.max_steps, self.engine.device
         self.parser_warnings = self.engine.parser_warnings
         self.inertia_rounded = self.tree.inertia_accuracy > 0.0
         self.canon, self._carriers = self._canonical(model)
@@ -227,7 +226,11 @@ class ModelAdapter(Adapter):
 
     @classmethod
     def version(cls) -> str:
-        return importlib.metadata.version(cls.package)
+        return cls._loader().version(cls.package)
+
+    @classmethod
+    def release_compiled(cls) -> None:
+        cls._loader().release_compiled()
 
     def _held(self, loaded: np.ndarray, stated: np.ndarray) -> np.ndarray:
         """The loaded value, or the stated one where they agree to the engine's rounding
@@ -330,11 +333,29 @@ class ModelAdapter(Adapter):
     ) -> Trajectory:
         """The loader's own stepping (``simulate(q0, v0, dt, steps)`` in its layout), its
         states mapped back to the canonical layout (:func:`~.layout.canonical_states`)."""
+        return self._runs(q0, v0, duration=duration, dts=[dt], integrator=integrator,
+                          batched=False)[0]
+
+    def simulate_many(self, q0: np.ndarray, v0: np.ndarray, duration: float,
+                      dts: Sequence[float], integrator: str) -> list[Trajectory]:
+        """The loader's runs at each step size, at once (its
+        :attr:`~.base.ModelEngine.batches_steps`), mapped back as :meth:`simulate`'s."""
+        return self._runs(q0, v0, duration=duration, dts=dts, integrator=integrator,
+                          batched=True)
+
+    def _runs(self, q0: np.ndarray, v0: np.ndarray, *, duration: float, dts: Sequence[float],
+              integrator: str, batched: bool) -> list[Trajectory]:
+        """Its runs at each of ``dts`` (``batched``: in one call to the loader), mapped back."""
         if integrator not in self.integrators:
             raise Unsupported(f"{self.name} offers no integrator {integrator!r}")
-        q_e, v_e = self.engine.simulate(*self._engine_start(q0, v0), dt, round(duration / dt),
-                                        integrator=integrator, field=self.field)
-        return self._trajectory(q_e, v_e, np.arange(len(q_e)) * dt)
+        steps = [round(duration / dt) for dt in dts]
+        start = self._engine_start(q0, v0)
+        runs = self.engine.simulate_many(*start, dts, steps, integrator=integrator,
+                                         field=self.field) if batched else \
+            [self.engine.simulate(*start, dts[0], steps[0], integrator=integrator,
+                                  field=self.field)]
+        return [self._trajectory(q_e, v_e, np.arange(len(q_e)) * dt)
+                for (q_e, v_e), dt in zip(runs, dts, strict=True)]
 
     def simulate_controlled(self, q0: np.ndarray, v0: np.ndarray, duration: float,
                             grid: float, accuracy: float, scheme: str | None = None,
@@ -393,7 +414,10 @@ class ModelAdapter(Adapter):
     def raw_calls(self, qe: np.ndarray, ve: np.ndarray, te: np.ndarray,
                   ae: np.ndarray) -> Callable[[], None] | None:
         """The loader's own per-state engine calls on states already in its layout (the map
-        to it is dyncheck's, timed in the adapter's row)."""
+        to it is dyncheck's, timed in the adapter's row); None where its dynamics is one
+        compiled batch (a port: timed by its batch, first call apart)."""
+        if not self._loader().per_state_calls:
+            return None
         _, q, v, a = engine_states(self.canon, self.tree, qe, ve, ae)
         return partial(self.engine.dynamics, q, v, a)
 
@@ -422,6 +446,7 @@ def for_engine(name: str, registration: Registration) -> type[Adapter]:
              "gyroscopic_implicit": loader.gyroscopic_implicit,
              "rk4_group_order": loader.rk4_group_order,
              "couplings_with_field": loader.couplings_with_field,
+             "batches_steps": loader.batches_steps,
              "error_controlled": Offer.CONTROLLED_STEPPING in loader.offers,
              "adaptive": Offer.SOLVING in loader.offers, "__module__": __name__}
     return type(f"{cls}Adapter", (ModelAdapter,), attrs)

@@ -62,10 +62,24 @@ def tendon_couplings(m: mujoco.MjModel) -> list[dict[str, float]]:
     return out
 
 
+def soft_model(m: mujoco.MjModel, solref: np.ndarray, solimp: np.ndarray,
+               engine: str) -> tuple[float, ...] | None:
+    """(timeconst, dampratio, dmin, dmax, width, mid, power) shared by every equality of
+    ``m`` as ``engine`` holds them (``solref``, ``solimp``: MuJoCo C's arrays or a port's
+    copies); None where ``m`` has no equality or its constraints are off."""
+    if not m.neq or m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_CONSTRAINT:
+        return None
+    params = {(*map(float, r), *map(float, i)) for r, i in zip(solref, solimp, strict=True)}
+    if len(params) > 1:
+        raise EngineError(f"{engine}: equalities with different solref/solimp")
+    return params.pop()
+
+
 class MujocoRun:
     """The run's offers of MuJoCo's loader (see the module); ``model`` and ``data`` are the
     loader's."""
 
+    engine: str
     model: mujoco.MjModel
     data: mujoco.MjData
 
@@ -84,14 +98,7 @@ class MujocoRun:
     def softness(self) -> tuple[float, ...] | None:
         """(timeconst, dampratio, dmin, dmax, width, mid, power) of its equalities (None
         without)."""
-        m = self.model
-        if not m.neq or m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_CONSTRAINT:
-            return None
-        params = {(*map(float, m.eq_solref[i]), *map(float, m.eq_solimp[i]))
-                  for i in range(m.neq)}
-        if len(params) > 1:
-            raise EngineError("mujoco: equalities with different solref/solimp")
-        return params.pop()
+        return soft_model(self.model, self.model.eq_solref, self.model.eq_solimp, self.engine)
 
     def _forwards(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> Iterator[int]:
         """Each state's index, after ``mj_forward`` with ``qfrc_applied`` = τ."""

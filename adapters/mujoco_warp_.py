@@ -1,5 +1,6 @@
-"""MuJoCo Warp (NVIDIA Warp) behind the canonical form, float32, from the MJCF and ``MjModel``
-of ``mujoco``; a chunk of states is a batch of Warp "worlds" (``nworld``).
+"""MuJoCo Warp (NVIDIA Warp) as a port of MuJoCo's compiled model (:class:`~.mujoco_port.Port`,
+used by :class:`~.port_models.MujocoWarpModel`), float32; a chunk of states is a batch of Warp
+"worlds" (``nworld``).
 
 MuJoCo Warp's names: ``mujoco_warp.forward`` (``qfrc_bias``, ``qacc`` with ``qfrc_applied`` =
 τ), ``mujoco_warp.inverse`` (``qfrc_inverse``), M column by column from ``mul_m`` (M eⱼ; the
@@ -31,20 +32,17 @@ import mujoco_warp as mjw
 import numpy as np
 import warp as wp
 
-from dyncheck.adapters.base import Trajectory
 from dyncheck.adapters.mujoco_api import INTEGRATORS
-from dyncheck.adapters.mujoco_port import CHUNK, PortAdapter
-from dyncheck.adapters.mujoco_warp_registration import REGISTRATIONS
-from dyncheck.cases.multibody import Multibody
+from dyncheck.adapters.mujoco_port import CHUNK, Port
 from dyncheck.errors import Unsupported
 from dyncheck.settings import current
 
 CPU_STEPS = 400
-"""The longest run the adapter makes on Warp's CPU device (~16 s of RK4 steps)."""
+"""The longest run the port makes on Warp's CPU device (~16 s of RK4 steps)."""
 
 
 def _init_quietly() -> None:
-    """Warp started when the adapter first uses it (never by importing this module): its log
+    """Warp started when the port first uses it (never by importing this module): its log
     at errors only (no banner, no line per kernel module loaded — Warp's setting, for the
     process), and ``wp.init()`` with its native library's stderr held back: on a machine
     without a CUDA driver it prints a warning line on every start, which says nothing here
@@ -82,19 +80,11 @@ def device() -> str:
     return current().device or "cpu"
 
 
-class MuJoCoWarpAdapter(PortAdapter):
+class MujocoWarpPort(Port):
     """MuJoCo Warp in float32 (Warp's ``float``)."""
 
     name: ClassVar[str] = "mujoco-warp"
-    package: ClassVar[str] = "mujoco-warp"
-    integrators: ClassVar[tuple[str, ...]] = REGISTRATIONS["mujoco-warp"].integrators
-    rk4_group_order: ClassVar[int] = 4
-    gyroscopic_implicit: ClassVar[bool] = True
     dtype: ClassVar[type[np.floating]] = np.float32
-
-    def __init__(self, model: Multibody) -> None:
-        super().__init__(model)
-        self._put()
 
     def _put(self) -> None:
         _init_quietly()  # wp.init() returns at once when Warp has started
@@ -185,22 +175,14 @@ class MuJoCoWarpAdapter(PortAdapter):
     (MuJoCo Warp reads the timestep per world): a step of every world costs one step's kernel
     launches, which dominate on a CPU."""
 
-    def simulate_many(
-        self, q0: np.ndarray, v0: np.ndarray, duration: float, dts: Sequence[float],
-        integrator: str,
-    ) -> list[Trajectory]:
-        self._require(integrator)
-        steps = [round(duration / dt) for dt in dts]
-        runs = self._run_many(np.asarray(q0), np.asarray(v0), steps, list(dts), integrator)
-        return [self._trajectory(qs, vs, dt) for (qs, vs), dt in zip(runs, dts, strict=True)]
-
-    def _run(
+    def run(
         self, q0: np.ndarray, v0: np.ndarray, steps: int, dt: float, integrator: str
     ) -> tuple[np.ndarray, np.ndarray]:
-        return self._run_many(q0, v0, [steps], [dt], integrator)[0]
+        return self.run_many(q0, v0, [steps], [dt], integrator)[0]
 
-    def _run_many(
-        self, q0: np.ndarray, v0: np.ndarray, steps: list[int], dts: list[float], integrator: str
+    def run_many(
+        self, q0: np.ndarray, v0: np.ndarray, steps: Sequence[int], dts: Sequence[float],
+        integrator: str,
     ) -> list[tuple[np.ndarray, np.ndarray]]:
         """World i steps ``dts[i]`` and is read for its first ``steps[i]`` steps; the worlds
         do not interact (each world's arithmetic is that of a run of its own)."""

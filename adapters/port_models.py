@@ -1,41 +1,66 @@
-"""A user's model on MuJoCo's ports — MJX in float32 and in float64, MuJoCo Warp — for
-``dyncheck check --impl mjx …``: the question of a user moving a model to a port.
+"""A model on MuJoCo's ports — MJX in float32 and in float64, MuJoCo Warp — for ``dyncheck
+check --impl mjx …`` (the question of a user moving a model to a port) and for ``dyncheck
+run`` (a book case written as MJCF, :mod:`.model_adapter`): one engine interface for both.
 
 A port reads no file: the file is compiled by MuJoCo's parser exactly as
 :class:`~dyncheck.adapters.mujoco_model.MujocoModel` compiles it (the same tree, the same
-smooth-dynamics flags), then handed to the port (``on_model``). M, h, forward and inverse
-dynamics are the port's; the ports compute no energies, so T = ½ vᵀ M v from the port's M and
-V = −Σ mᵢ g·xᵢ from the port's centres of mass — MuJoCo's own definitions (``mj_energyVel``,
-``mj_energyPos``) on the port's numbers. A float32 port's tree declares ε₃₂: its round-off
-bounds are the same formula with that ε.
+smooth-dynamics flags), then handed to the port (:class:`~.mujoco_port.Port`). M, h, forward
+and inverse dynamics are the port's; the ports compute no energies, so T = ½ vᵀ M v from the
+port's M and V = −Σ mᵢ g·xᵢ from the port's centres of mass — MuJoCo's own definitions
+(``mj_energyVel``, ``mj_energyPos``) on the port's numbers. A float32 port's tree declares
+ε₃₂: its round-off bounds are the same formula with that ε. The tree is MuJoCo's reading with
+the masses, inertias and gravity the port holds, where they differ from MuJoCo's by more than
+the port's rounding.
+
+In a run: the port's own v̇ at τ (``qacc``), its stepping (``mjx.step``, ``mujoco_warp.step``
+with MuJoCo's integrators as each port defines them), and the couplings as the file's tendon
+equalities (MuJoCo's soft constraints, the model re-put on the port with them on, their
+multipliers the equality rows' ``efc_force``). No field: a force evaluated at every stage
+needs MuJoCo C's ``mjcb_passive`` callback, which neither port has.
 """
 
 from __future__ import annotations
 
 import copy
 import importlib
+from collections.abc import Sequence
 from dataclasses import replace
+from functools import cache
 from typing import Any, ClassVar
 
 import mujoco
 import numpy as np
 
 from dyncheck.adapters.actuators import EULER_DAMPING, Actuation, InputJacobian
-from dyncheck.adapters.base import Offer
+from dyncheck.adapters.base import Field, Offer
 from dyncheck.adapters.model_files import ModelFile
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, derivatives
 from dyncheck.adapters.mujoco_actuators import STEPS, activations, with_actuation
 from dyncheck.adapters.mujoco_model import MujocoModel
+from dyncheck.adapters.mujoco_port import Port
+from dyncheck.adapters.mujoco_simulation import soft_model
+from dyncheck.cases.multibody import Coupling
 from dyncheck.errors import Unsupported
+
+_RUN = frozenset({Offer.FORWARD, Offer.STEPPING, Offer.COUPLINGS})
+"""What every port offers a run (see the module)."""
+
+_HELD = ("body_mass", "body_inertia", "body_iquat")
+"""The model arrays a port holds that the tree reads (its gravity apart)."""
 
 
 class PortModel(MujocoModel):
     """MuJoCo's reading of the file, computed on a port."""
 
     engine = ""
-    offers = frozenset({Offer.ACTUATION})  # its own derivatives where it has them (MJX's)
-    port: ClassVar[str] = ""
-    """``module:class`` of the port's adapter (imported here only: JAX and Warp cost seconds)."""
+    offers = _RUN | {Offer.ACTUATION}
+    """Its own derivatives where it has them (MJX's); never a field (see the module)."""
+    no_body_forces = ("an external field evaluated at every stage needs MuJoCo's mjcb_passive "
+                      "callback, which the port does not offer")
+    couplings_with_field = False
+    port_class: ClassVar[str] = ""
+    """``module:class`` of its :class:`~.mujoco_port.Port` (imported only when a model is put
+    on it: JAX and Warp cost seconds)."""
     _actuated_port: Any = None
     euler_damps_when_disabled: ClassVar[bool] = False
     """Whether the port's Euler step applies the joints' damping implicitly, (M + h D),
@@ -44,23 +69,52 @@ class PortModel(MujocoModel):
     3.17.0: its B is h/(M + h d) with or without ``<flag damper="disable">``, where MuJoCo C
     gives h/M)."""
 
-    def __init__(self, source: ModelFile) -> None:
-        super().__init__(source)
-        module, cls = self.port.split(":")
-        adapter = getattr(importlib.import_module(module), cls)
+    def __init__(self, source: ModelFile, **options: Any) -> None:
+        super().__init__(source, **options)
+        kind = self._port_type()
         colliding = int(np.count_nonzero(self.model.geom_contype | self.model.geom_conaffinity))
-        self.adapter = adapter.on_model(_collisionless(self.model))
-        eps = float(np.finfo(adapter.dtype).eps)
+        self.port = kind.on_model(_collisionless(self.model))
+        self.max_steps, self.device = self.port.max_steps, self.port.device
+        self._as_held()
+        eps = float(np.finfo(kind.dtype).eps)
         self.tree = replace(self.tree, engine=self.engine, eps=eps, notes=(
             *self.tree.notes,
             *([f"{self.engine}: given the model with its {colliding} colliding geoms' contype "
                "and conaffinity set to 0 (MJX 3.17.0 refuses a geom pair it cannot collide, "
                "(ellipsoid, box), with contacts disabled too; the smooth dynamics use no "
                "collision)"] if colliding else []),
-            f"{self.engine}: MuJoCo's compiled model put on the port ({adapter.version()}), "
-            f"computing in {np.dtype(adapter.dtype).name} (round-off bounds with eps "
+            f"{self.engine}: MuJoCo's compiled model put on the port ({kind.version()}), "
+            f"computing in {np.dtype(kind.dtype).name} (round-off bounds with eps "
             f"{eps:.3g}); energies from the port's M and centres of mass",
-        ), hints=(*self.tree.hints, *self._euler_damping(adapter.version())))
+        ), hints=(*self.tree.hints, *self._euler_damping(kind.version())))
+
+    @classmethod
+    def _port_type(cls) -> type[Port]:
+        return _imported(cls.port_class)
+
+    @classmethod
+    def version(cls, package: str) -> str:
+        """The port's version and device (its package's version, its backend's, its device)."""
+        return cls._port_type().version()
+
+    @classmethod
+    def release_compiled(cls) -> None:
+        cls._port_type().release_compiled()
+
+    def _as_held(self) -> None:
+        """MuJoCo's tree read again from the masses, inertias and gravity the port holds,
+        where one differs from MuJoCo's by more than the port's rounding (a port that changed
+        a parameter: a different model, not round-off); nothing where none does."""
+        changed = False
+        for field in _HELD:
+            held, c = self.port.held(field), getattr(self.model, field)
+            if not np.array_equal(held.reshape(c.shape), c):
+                c[...], changed = held.reshape(c.shape), True
+        gravity = self.port.held("opt.gravity").reshape(3)
+        if np.any(self._gravity) and not np.array_equal(gravity, self._gravity):
+            self._gravity, changed = gravity, True
+        if changed:
+            self.tree = replace(self._tree(self.tree.notes), exact_meshes=self.tree.exact_meshes)
 
     def _euler_damping(self, version: str) -> tuple[tuple[str, str, str], ...]:
         """The hint :data:`~.actuators.EULER_DAMPING` where its premise holds on the model:
@@ -76,9 +130,9 @@ class PortModel(MujocoModel):
             "set <flag eulerdamp=\"disable\"/> to step as MuJoCo C does without damping")),)
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
-        raw = self.adapter.raw(q, v, np.zeros_like(v), a)
-        masses = self.adapter.model_array("body_mass")[1:]
-        gravity = self.adapter.model_array("opt.gravity") if np.any(self._gravity) else \
+        raw = self.port.raw(q, v, np.zeros_like(v), a)
+        masses = self.port.model_array("body_mass")[1:]
+        gravity = self.port.model_array("opt.gravity") if np.any(self._gravity) else \
             self._gravity  # <flag gravity="disable">: none, as in MuJoCo's reading
         potential = -np.einsum("b,nb->n", masses, raw["xipos"][:, 1:] @ gravity)
         return Dynamics.at(v, mass_matrix=raw["M"], bias=raw["bias"], forward=raw["qacc"],
@@ -114,7 +168,7 @@ class PortModel(MujocoModel):
     def _actuation_port(self) -> Any:
         """The port holding a copy of the model with actuation on (made once)."""
         if self._actuated_port is None:
-            self._actuated_port = type(self.adapter).on_model(
+            self._actuated_port = type(self.port).on_model(
                 _collisionless(with_actuation(self.model)))
         return self._actuated_port
 
@@ -127,12 +181,63 @@ class PortModel(MujocoModel):
             raise Unsupported(f"{self.engine} offers no derivatives of its dynamics (its "
                               "kernels are not differentiated; MuJoCo C's are on MuJoCo's "
                               "rows)")
-        own = self.adapter.derivatives(q, v, a)
+        own = self.port.derivatives(q, v, a)
         return derivatives(own, method=f"automatic differentiation (JAX jacfwd, "
-                           f"{np.dtype(self.adapter.dtype).name})")
+                           f"{np.dtype(self.port.dtype).name})")
 
     def transition(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> tuple:
         raise Unsupported(f"{self.engine}: the port's step Jacobian is not checked yet")
+
+
+    # --- in a run ---------------------------------------------------------------------
+
+    def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """The port's ``qacc`` at τ."""
+        return self.port.raw(q, v, tau, np.zeros_like(v))["qacc"]
+
+    def couple(self, couplings: Sequence[Coupling]) -> None:
+        """MuJoCo's couplings (the file's tendon equalities, checked to be ``couplings``,
+        enabled alone of its constraints), the model then put on the port again."""
+        super().couple(couplings)
+        self.port = self._port_type().on_model(_collisionless(self.model))
+
+    def softness(self) -> tuple[float, ...] | None:
+        return soft_model(self.model, self.port.held("eq_solref"), self.port.held("eq_solimp"),
+                          self.engine)
+
+    def constraint_forces(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        return self.constrained(q, v, tau)[1]
+
+    def constrained(self, q: np.ndarray, v: np.ndarray,
+                    tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The port's ``qacc`` and its equality rows' ``efc_force`` at τ, of one solve."""
+        raw = self.port.raw(q, v, tau, np.zeros_like(v))
+        return raw["qacc"], raw["efc_force"]
+
+    def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
+        raise Unsupported(f"{self.engine}: {self.no_body_forces}")
+
+    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
+                 integrator: str, field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The port's own step (see the module), its numbers as float64."""
+        return self.simulate_many(q0, v0, [dt], [steps], integrator=integrator, field=field)[0]
+
+    def simulate_many(self, q0: np.ndarray, v0: np.ndarray, dts: Sequence[float],
+                      steps: Sequence[int], *, integrator: str,
+                      field: Field | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
+        """One run per step size (MuJoCo Warp: worlds of one batch, :attr:`batches_steps`)."""
+        if field is not None:
+            raise Unsupported(f"{self.engine}: {self.no_body_forces}")
+        runs = self.port.run_many(np.asarray(q0), np.asarray(v0), steps, dts, integrator)
+        return [(q.astype(float), v.astype(float)) for q, v in runs]
+
+
+@cache
+def _imported(where: str) -> type[Port]:
+    """The port class at ``module:class``."""
+    module, cls = where.split(":")
+    kind: type[Port] = getattr(importlib.import_module(module), cls)
+    return kind
 
 
 def _collisionless(m: mujoco.MjModel) -> mujoco.MjModel:
@@ -147,18 +252,21 @@ def _collisionless(m: mujoco.MjModel) -> mujoco.MjModel:
 
 class MjxModel(PortModel):
     engine = "mjx"
+    rk4_group_order = 2  # (its RK4 sums stage velocities in one tangent space: the module's)
+    gyroscopic_implicit = False  # (its implicitfast: actuator and damping derivatives only)
     euler_damps_when_disabled = True
-    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION, Offer.INPUT_JACOBIAN})
-    port = "dyncheck.adapters.mjx_:MJXAdapter"
+    offers = _RUN | {Offer.DERIVATIVES, Offer.ACTUATION, Offer.INPUT_JACOBIAN}
+    port_class = "dyncheck.adapters.mjx_:MjxPort"
 
 
-class MjxF64Model(PortModel):
+class MjxF64Model(MjxModel):
     engine = "mjx-f64"
-    euler_damps_when_disabled = True
-    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION, Offer.INPUT_JACOBIAN})
-    port = "dyncheck.adapters.mjx_:MJXF64Adapter"
+    port_class = "dyncheck.adapters.mjx_:MjxF64Port"
 
 
 class MujocoWarpModel(PortModel):
     engine = "mujoco-warp"
-    port = "dyncheck.adapters.mujoco_warp_:MuJoCoWarpAdapter"
+    rk4_group_order = 4  # (MuJoCo C 4.0's RK4 on the group, read in mujoco_warp/_src)
+    gyroscopic_implicit = True  # (implicit_free_body)
+    batches_steps = True
+    port_class = "dyncheck.adapters.mujoco_warp_:MujocoWarpPort"

@@ -28,16 +28,11 @@ import numpy as np
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from dyncheck.adapters.base import (
-    AFRESH,
-    Adapter,
-    LoadedBody,
-    Symbolic,
-    Trajectory,
-)
+from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.integrators import integrate
 from dyncheck.adapters.linalg import solve
 from dyncheck.adapters.model_tree import Axes, Layout, Orientation, StateLayout
+from dyncheck.adapters.symbolic import AFRESH, Symbolic
 from dyncheck.adapters.sympy_registration import REGISTRATIONS
 from dyncheck.cases.multibody import ROTATING, Multibody
 from dyncheck.vocabulary import Integrator

@@ -36,10 +36,9 @@ def _states(case, n: int):
 
 
 def _raw_c(adapter, qe, ve, te, ae) -> float:
-    """Seconds per state of the loop ``dyncheck bench`` times for MuJoCo C."""
-    from dyncheck.bench.engines import _raw_mujoco
-
-    loop = _raw_mujoco(adapter, qe, ve, te, ae)
+    """Seconds per state of the loop ``dyncheck bench`` times for MuJoCo C (its loader's
+    per-state calls, ``raw_calls``)."""
+    loop = adapter.raw_calls(qe, ve, te, ae)
     t0 = time.perf_counter()
     loop()
     return (time.perf_counter() - t0) / len(qe)
@@ -79,7 +78,7 @@ def main() -> None:
             for batch in args.batches if port != "mujoco-warp" else [256]:
                 adapter = ADAPTERS[port](mb)
                 if port != "mujoco-warp":
-                    adapter.chunk = batch
+                    adapter.engine.port.chunk = batch  # the port's states per batched call
                 x = _states(case, batch)
                 t0 = time.perf_counter()
                 adapter.evaluate_all(*x)

@@ -27,9 +27,9 @@ from dyncheck.adapters import (
     Trajectory,
     get_adapter,
 )
-from dyncheck.adapters.base import Symbolic
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
+from dyncheck.adapters.symbolic import Symbolic
 from dyncheck.cases import Case, StateSample
 from dyncheck.coordinates import NativeMap
 from dyncheck.errors import UnknownName

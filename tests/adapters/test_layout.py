@@ -193,3 +193,29 @@ def test_engine_states_map_back_to_the_canonical_ones(free, ball):
     np.testing.assert_allclose(back_q[:, :3], q_c[:, :3], atol=1e-12)
     np.testing.assert_allclose(np.angle(np.exp(1j * (back_q[:, 7] - q_c[:, 7]))), 0, atol=1e-12)
     np.testing.assert_allclose(back_v, v_c, atol=1e-12)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_a_quaternion_normalized_by_the_engine_comes_back_as_it_gave_it(dtype):
+    """A run's quaternion comes back (``canonical_positions``) as the engine computed it where
+    the engine normalized it in its own arithmetic, and renormalized where its norm drifted.
+    Expected values, independent of the code: a quaternion normalized in ``dtype`` has
+    |‖q‖ − 1| of a few ε of ``dtype`` (its round-off, which a float32 port's rows must carry:
+    the bit pattern is unchanged); one drifted by 1e-6 (Drake's components integrated) comes
+    back with norm 1 to float64 round-off."""
+    from dyncheck.adapters.layout import Canonical, canonical_positions
+    from dyncheck.adapters.model_tree import JointType, ModelTree
+
+    ball = Layout.ball(quat=Orientation.WXYZ, angular_axes=Axes.LOCAL)
+    tree = ModelTree(engine="toy", joints=(_joint("wrist", "ball", ball),), gravity=np.zeros(3),
+                     nq=4, nv=3, eps=float(np.finfo(dtype).eps))
+    canon = Canonical(names=("wrist",), types=(JointType.BALL,), q_start=(0,), v_start=(0,),
+                      nq=4, nv=3, zeros=(0.0,))
+    raw = Rotation.random(64, random_state=7).as_quat()[:, [3, 0, 1, 2]].astype(dtype)
+    normalized = (raw / np.linalg.norm(raw, axis=1, keepdims=True)).astype(float)
+    assert np.abs(np.linalg.norm(normalized, axis=1) - 1).max() > 0  # not unit in float64
+    np.testing.assert_array_equal(canonical_positions(canon, tree, normalized), normalized)
+    drifted = normalized * (1 + 1e-6)
+    back = canonical_positions(canon, tree, drifted)
+    np.testing.assert_allclose(np.linalg.norm(back, axis=1), 1.0, atol=4e-16)
+    np.testing.assert_allclose(back, normalized, rtol=0, atol=8 * np.finfo(dtype).eps)

@@ -181,7 +181,7 @@ def test_a_file_in_another_encoding_is_copied_as_utf8_with_its_paths_kept(tmp_pa
 def test_every_engine_reads_a_file_in_another_encoding_as_its_utf8_twin(tmp_path, engine):
     """Expected: the engine's own reading of the same model saved as UTF-8 — the same joints
     (accented names included) and the same dynamics, bit for bit. MuJoCo's ports read the file
-    through MuJoCo C (:mod:`adapters.mujoco_port`)."""
+    through MuJoCo C (:mod:`adapters.port_models`)."""
     twin, utf8 = _twins(tmp_path, "ISO-8859-1", include=False)
     read_twin, read_utf8 = (load(engine, read(path)) for path in (twin, utf8))
     if isinstance(read_utf8, NotLoaded):

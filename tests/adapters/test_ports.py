@@ -85,14 +85,14 @@ def _plant_mass_defect(impl: EngineImplementation, factor: float) -> None:
     reports (its loaded bodies) stays the book's: a defect inside the port's dynamics, which
     only the tolerance can catch."""
     adapter = impl.adapter
-    i = adapter._body_ids[0]
+    port = adapter.engine.port  # the port's own copy of MuJoCo's compiled model
+    i = port.model.body(adapter.spec.bodies[0].name).id
     if impl.name.startswith("mjx"):
-        mass = adapter.mx.body_mass.at[i].multiply(factor)
-        adapter.mx = adapter.mx.replace(body_mass=mass)
+        port.mx = port.mx.replace(body_mass=port.mx.body_mass.at[i].multiply(factor))
     else:
-        values = adapter.mw.body_mass.numpy()
+        values = port.mw.body_mass.numpy()
         values[..., i] *= factor
-        adapter.mw.body_mass.assign(values)
+        port.mw.body_mass.assign(values)
     honest = adapter.loaded_bodies()
     adapter.loaded_bodies = lambda: honest  # the port claims the book's mass
 

@@ -54,7 +54,7 @@ def test_a_port_never_passes_off_mujoco_cs_derivatives_as_its_own():
     from dyncheck.errors import Unsupported
 
     port = object.__new__(MujocoWarpModel)  # no port needed: the refusal comes before any work
-    port.adapter = SimpleNamespace()  # an adapter without derivatives of its own
+    port.port = SimpleNamespace()  # a port without derivatives of its own
     with pytest.raises(Unsupported, match="mujoco-warp offers no derivatives"):
         port.derivatives(None, None, None)
     with pytest.raises(Unsupported, match="mjx: the port's step Jacobian"):
@@ -245,3 +245,36 @@ def test_a_model_with_a_pair_mjx_cannot_collide_is_computed_on_mjx(tmp_path):
                        & (result.rows["impl_b"] == "mjx-f64")]
     assert len(rows) == 12 and (rows["verdict"] == "passed").all(), rows[["subject", "note"]]
     assert any("colliding geoms' contype" in n for n in result.notes)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("factor", "held"), [(1.0 + 1e-9, False), (1.0 + 1e-4, True)])
+def test_the_tree_reads_the_masses_the_port_holds(monkeypatch, factor, held):
+    """A port that changed a mass by more than its rounding holds another model: its tree
+    (what the check and the run compare) reads the port's mass, not MuJoCo C's; a change
+    within float32's rounding is round-off, and the tree keeps MuJoCo C's value. Expected
+    values: MuJoCo C's own reading of the file, times the planted factor (to float32's
+    rounding, in which the port holds it)."""
+    if not _installed("mjx"):
+        pytest.skip("needs the extra that installs mjx")
+    import numpy as np
+
+    from dyncheck.adapters.mjx_ import MjxPort
+    from dyncheck.adapters.model_files import read
+    from dyncheck.adapters.mujoco_model import MujocoModel
+    from dyncheck.adapters.port_models import MjxModel
+
+    loaded = MjxPort._loaded
+
+    def scaled(port: MjxPort, field: str) -> np.ndarray:
+        value = loaded(port, field)
+        return value * factor if field == "body_mass" else value
+
+    monkeypatch.setattr(MjxPort, "_loaded", scaled)
+    source = read(MODELS / "mixed.xml")
+    c = {j.name: j.mass for j in MujocoModel(source).tree.joints}
+    port = {j.name: j.mass for j in MjxModel(source).tree.joints}
+    for name, mass in c.items():  # (the port's own value: rounded to float32 as it holds it)
+        want, rel = (mass * factor, float(np.finfo(np.float32).eps)) if held else (mass, 0.0)
+        assert port[name] == pytest.approx(want, rel=rel, abs=0), name
+    assert held == any(port[n] != c[n] for n in c if c[n] > 0)

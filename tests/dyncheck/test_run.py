@@ -31,7 +31,7 @@ def test_moving_to_the_next_case_frees_the_compiled_programs_of_the_last():
         mjx.simulate(case.trajectory.steps["euler"][0], "euler")
 
     _release()
-    mjx_.MJXAdapter.release_compiled()
+    mjx_.MjxPort.release_compiled()
     use("simple_pendulum")
     alone = programs()
     _release()
