@@ -54,10 +54,6 @@ class Port(ABC):
         port._put()
         return port
 
-    @property
-    def eps(self) -> float:
-        return float(np.finfo(self.dtype).eps)
-
     @staticmethod
     @abstractmethod
     def version() -> str:
@@ -105,7 +101,8 @@ class Port(ABC):
         bound, not a different model (a mass changed by 1e-4 in the port is)."""
         port = self._loaded(field)
         c = np.asarray(attrgetter(field)(self.model), dtype=float).reshape(port.shape)
-        return np.where(np.abs(port - c) <= self.eps * np.abs(c), c, port)
+        eps = float(np.finfo(self.dtype).eps)
+        return np.where(np.abs(port - c) <= eps * np.abs(c), c, port)
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict[str, np.ndarray]:
         """Its own derivatives of its dynamics (MJX's, by JAX), where it has them."""
