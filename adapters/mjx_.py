@@ -234,7 +234,6 @@ argument, so a second port of the same structure (other masses, other step) reus
 class MjxPort(Port):
     """MJX in float32."""
 
-    name: ClassVar[str] = "mjx"
     dtype: ClassVar[type[np.floating]] = np.float32
 
     def _put(self) -> None:
@@ -254,12 +253,12 @@ class MjxPort(Port):
             cast(Any, jitted).clear_cache()  # a method of jit's wrapper its stubs do not declare
 
     @staticmethod
-    def version() -> str:
+    def version(package: str) -> str:
         from importlib.metadata import version
 
         device = jax.devices()[0]
         return (
-            f"{version('mujoco-mjx')} (jax {jax.__version__}, "
+            f"{version(package)} (jax {jax.__version__}, "
             f"device {device.platform}: {device.device_kind})"
         )
 
@@ -360,5 +359,4 @@ class MjxF64Port(MjxPort):
     """MJX with JAX's 64-bit mode: the same code in float64, which must agree with MuJoCo C
     to round-off."""
 
-    name: ClassVar[str] = "mjx-f64"
     dtype: ClassVar[type[np.floating]] = np.float64

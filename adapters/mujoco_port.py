@@ -34,7 +34,8 @@ class Port(ABC):
     """MuJoCo's compiled model on a port (:meth:`on_model`); subclasses put it there and
     compute a chunk of states (:meth:`_batch`) and a run (:meth:`run`)."""
 
-    name: ClassVar[str]
+    name: str
+    """The engine's name, as its loader gives it (:meth:`on_model`)."""
     dtype: ClassVar[type[np.floating]] = np.float32
     chunk: int = CHUNK
     """States per batched call (a GPU wants more: ``benchmarks/ports.py`` sets it)."""
@@ -47,17 +48,17 @@ class Port(ABC):
     model: mujoco.MjModel
 
     @classmethod
-    def on_model(cls, model: mujoco.MjModel) -> Port:
-        """The port holding the compiled C model ``model``."""
+    def on_model(cls, model: mujoco.MjModel, *, name: str) -> Port:
+        """The port holding the compiled C model ``model``, for the engine ``name``."""
         port = cls()
-        port.model = model
+        port.name, port.model = name, model
         port._put()
         return port
 
     @staticmethod
     @abstractmethod
-    def version() -> str:
-        """The port's version and its device."""
+    def version(package: str) -> str:
+        """The port's version (its ``package``'s) and its device."""
 
     @classmethod
     def release_compiled(cls) -> None:

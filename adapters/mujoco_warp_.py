@@ -83,7 +83,6 @@ def device() -> str:
 class MujocoWarpPort(Port):
     """MuJoCo Warp in float32 (Warp's ``float``)."""
 
-    name: ClassVar[str] = "mujoco-warp"
     dtype: ClassVar[type[np.floating]] = np.float32
 
     def _put(self) -> None:
@@ -96,11 +95,11 @@ class MujocoWarpPort(Port):
             self.dw = mjw.make_data(self.model, nworld=CHUNK)
 
     @staticmethod
-    def version() -> str:
+    def version(package: str) -> str:
         _init_quietly()
         where = wp.get_device(device())
         warp = f"warp-lang {wp.__version__}"
-        return f"{_version('mujoco-warp')} ({warp}, device {where.alias}: {where.name})"
+        return f"{_version(package)} ({warp}, device {where.alias}: {where.name})"
 
     def _loaded(self, field: str) -> np.ndarray:
         obj = attrgetter(field)(self.mw)

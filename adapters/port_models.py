@@ -61,6 +61,8 @@ class PortModel(MujocoModel):
     port_class: ClassVar[str] = ""
     """``module:class`` of its :class:`~.mujoco_port.Port` (imported only when a model is put
     on it: JAX and Warp cost seconds)."""
+    package: ClassVar[str] = ""
+    """The port's package (its version is in the run's and the check's provenance)."""
     _actuated_port: Any = None
     euler_damps_when_disabled: ClassVar[bool] = False
     """Whether the port's Euler step applies the joints' damping implicitly, (M + h D),
@@ -73,20 +75,20 @@ class PortModel(MujocoModel):
         super().__init__(source, **options)
         kind = self._port_type()
         colliding = int(np.count_nonzero(self.model.geom_contype | self.model.geom_conaffinity))
-        self.port = kind.on_model(_collisionless(self.model))
+        self.port = kind.on_model(_collisionless(self.model), name=self.engine)
         self.max_steps, self.device = self.port.max_steps, self.port.device
         self._as_held()
-        eps = float(np.finfo(kind.dtype).eps)
+        eps, version = float(np.finfo(kind.dtype).eps), self.version(self.package)
         self.tree = replace(self.tree, engine=self.engine, eps=eps, notes=(
             *self.tree.notes,
             *([f"{self.engine}: given the model with its {colliding} colliding geoms' contype "
                "and conaffinity set to 0 (MJX 3.17.0 refuses a geom pair it cannot collide, "
                "(ellipsoid, box), with contacts disabled too; the smooth dynamics use no "
                "collision)"] if colliding else []),
-            f"{self.engine}: MuJoCo's compiled model put on the port ({kind.version()}), "
+            f"{self.engine}: MuJoCo's compiled model put on the port ({version}), "
             f"computing in {np.dtype(kind.dtype).name} (round-off bounds with eps "
             f"{eps:.3g}); energies from the port's M and centres of mass",
-        ), hints=(*self.tree.hints, *self._euler_damping(kind.version())))
+        ), hints=(*self.tree.hints, *self._euler_damping(version)))
 
     @classmethod
     def _port_type(cls) -> type[Port]:
@@ -95,7 +97,7 @@ class PortModel(MujocoModel):
     @classmethod
     def version(cls, package: str) -> str:
         """The port's version and device (its package's version, its backend's, its device)."""
-        return cls._port_type().version()
+        return cls._port_type().version(package)
 
     @classmethod
     def release_compiled(cls) -> None:
@@ -169,7 +171,7 @@ class PortModel(MujocoModel):
         """The port holding a copy of the model with actuation on (made once)."""
         if self._actuated_port is None:
             self._actuated_port = type(self.port).on_model(
-                _collisionless(with_actuation(self.model)))
+                _collisionless(with_actuation(self.model)), name=self.engine)
         return self._actuated_port
 
     def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
@@ -199,7 +201,7 @@ class PortModel(MujocoModel):
         """MuJoCo's couplings (the file's tendon equalities, checked to be ``couplings``,
         enabled alone of its constraints), the model then put on the port again."""
         super().couple(couplings)
-        self.port = self._port_type().on_model(_collisionless(self.model))
+        self.port = self._port_type().on_model(_collisionless(self.model), name=self.engine)
 
     def softness(self) -> tuple[float, ...] | None:
         return soft_model(self.model, self.port.held("eq_solref"), self.port.held("eq_solimp"),
@@ -252,6 +254,7 @@ def _collisionless(m: mujoco.MjModel) -> mujoco.MjModel:
 
 class MjxModel(PortModel):
     engine = "mjx"
+    package = "mujoco-mjx"
     rk4_group_order = 2  # (its RK4 sums stage velocities in one tangent space: the module's)
     gyroscopic_implicit = False  # (its implicitfast: actuator and damping derivatives only)
     euler_damps_when_disabled = True
@@ -266,6 +269,7 @@ class MjxF64Model(MjxModel):
 
 class MujocoWarpModel(PortModel):
     engine = "mujoco-warp"
+    package = "mujoco-warp"
     rk4_group_order = 4  # (MuJoCo C 4.0's RK4 on the group, read in mujoco_warp/_src)
     gyroscopic_implicit = True  # (implicit_free_body)
     batches_steps = True
