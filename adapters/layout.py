@@ -246,21 +246,24 @@ def canonical_positions(canon: Canonical, tree: ModelTree, q_e: np.ndarray) -> n
             q_c[:, qs : qs + 4] = _quat_of_rpy(chunk) if lay.quat is Orientation.RPY else \
                 _unit(chunk[:, np.argsort(quat_order(lay.quat))], tree.eps)
         else:
-            q_c[:, qs : qs + 7] = [_free_back(lay, row, tree.eps) for row in chunk]
+            q_c[:, qs : qs + 7] = _free_back(lay, chunk, tree.eps)
     return q_c
 
 
 def _free_back(lay: Layout, q_e: np.ndarray, eps: float = 0.0) -> np.ndarray:
-    """A free joint's canonical (p, quat) from its q in the engine's layout (:func:`_free`
-    inverted: quat_e = P⁻¹ ⊗ quat ⊗ q(R_o), p_e = P_r⁻¹ (p + R o − P_p))."""
-    quat_e, p_e = (q_e[:4], q_e[4:]) if lay.quat_first else (q_e[3:], q_e[:3])
-    quat_e = _unit(quat_e[None, np.argsort(quat_order(lay.quat))], eps)[0]
+    """A free joint's canonical (p, quat) (n, 7) from its q (n, 7) in the engine's layout
+    (:func:`_free` inverted: quat_e = P⁻¹ ⊗ quat ⊗ q(R_o), p_e = P_r⁻¹ (p + R o − P_p)),
+    every state at once: the placement's and offset's quaternions are the joint's."""
+    quat_e, p_e = (q_e[:, :4], q_e[:, 4:]) if lay.quat_first else (q_e[:, 3:], q_e[:, :3])
+    quat_e = _unit(quat_e[:, np.argsort(quat_order(lay.quat))], eps)
     place_r, place_p = lay.placement[:3, :3], lay.placement[:3, 3]
-    turned = quat_mul(quat_from_matrix(place_r[None])[0], quat_e)
-    quat_w = quat_mul(turned, quat_conj(quat_from_matrix(lay.offset[None, :3, :3])[0]))
-    rot = quat_to_matrix(quat_w[None])[0]
-    p_w = place_r @ p_e + place_p - rot @ lay.offset[:3, 3]
-    return np.concatenate([p_w, quat_w])
+    turned = quat_mul(quat_from_matrix(place_r[None])[0][:, None], quat_e.T)
+    undo = quat_conj(quat_from_matrix(lay.offset[None, :3, :3])[0])[:, None]
+    quat_w = quat_mul(turned, undo).T
+    p_w = np.einsum("ij,nj->ni", place_r, p_e) + place_p
+    if np.any(lay.offset[:3, 3]):  # (a case's free body has none: no rotation needed)
+        p_w = p_w - np.einsum("nij,j->ni", quat_to_matrix(quat_w), lay.offset[:3, 3])
+    return np.concatenate([p_w, quat_w], axis=1)
 
 
 # Batched maps for the run's cases: canonical states (n, nq) and (n, nv) in the canonical
