@@ -329,9 +329,8 @@ class MjxPort(Port):
             out = _DERIVATIVES(self.mx, *args)
             return {k: np.asarray(x, dtype=float) for k, x in out.items()}
 
-    def run(
-        self, q0: np.ndarray, v0: np.ndarray, steps: int, dt: float, integrator: str
-    ) -> tuple[np.ndarray, np.ndarray]:
+    def run(self, q0: np.ndarray, v0: np.ndarray, *, dt: float, steps: int,
+            integrator: str) -> tuple[np.ndarray, np.ndarray]:
         with self._precision():
             opt = self.mx.opt.replace(
                 integrator=mjx.IntegratorType(int(INTEGRATORS[integrator])),

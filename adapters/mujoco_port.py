@@ -113,10 +113,12 @@ class Port(ABC):
         """A model array as the port holds it, float64 (see :meth:`_loaded`)."""
         return self._loaded(field)
 
-    def run_many(self, q0: np.ndarray, v0: np.ndarray, steps: Sequence[int],
-                 dts: Sequence[float], integrator: str) -> list[tuple[np.ndarray, np.ndarray]]:
-        """:meth:`run` at each step size (a port that batches them overrides it)."""
-        return [self.run(q0, v0, n, dt, integrator) for n, dt in zip(steps, dts, strict=True)]
+    def run_many(self, q0: np.ndarray, v0: np.ndarray, *, dts: Sequence[float],
+                 steps: Sequence[int], integrator: str) -> list[tuple[np.ndarray, np.ndarray]]:
+        """:meth:`run` at each step size, ``steps[i]`` steps of ``dts[i]`` (a port that
+        batches them overrides it)."""
+        return [self.run(q0, v0, dt=dt, steps=n, integrator=integrator)
+                for dt, n in zip(dts, steps, strict=True)]
 
     # --- what each port provides ----------------------------------------------------------
 
@@ -137,8 +139,7 @@ class Port(ABC):
         ``qfrc_inverse`` (n, nv), ``xipos`` (n, nbody, 3), ``efc_force`` (n, neq)."""
 
     @abstractmethod
-    def run(
-        self, q0: np.ndarray, v0: np.ndarray, steps: int, dt: float, integrator: str
-    ) -> tuple[np.ndarray, np.ndarray]:
+    def run(self, q0: np.ndarray, v0: np.ndarray, *, dt: float, steps: int,
+            integrator: str) -> tuple[np.ndarray, np.ndarray]:
         """The port's own integrator: qpos (steps + 1, nq) and qvel (steps + 1, nv), in the
         port's numbers."""

@@ -174,15 +174,12 @@ class MujocoWarpPort(Port):
     (MuJoCo Warp reads the timestep per world): a step of every world costs one step's kernel
     launches, which dominate on a CPU."""
 
-    def run(
-        self, q0: np.ndarray, v0: np.ndarray, steps: int, dt: float, integrator: str
-    ) -> tuple[np.ndarray, np.ndarray]:
-        return self.run_many(q0, v0, [steps], [dt], integrator)[0]
+    def run(self, q0: np.ndarray, v0: np.ndarray, *, dt: float, steps: int,
+            integrator: str) -> tuple[np.ndarray, np.ndarray]:
+        return self.run_many(q0, v0, dts=[dt], steps=[steps], integrator=integrator)[0]
 
-    def run_many(
-        self, q0: np.ndarray, v0: np.ndarray, steps: Sequence[int], dts: Sequence[float],
-        integrator: str,
-    ) -> list[tuple[np.ndarray, np.ndarray]]:
+    def run_many(self, q0: np.ndarray, v0: np.ndarray, *, dts: Sequence[float],
+                 steps: Sequence[int], integrator: str) -> list[tuple[np.ndarray, np.ndarray]]:
         """World i steps ``dts[i]`` and is read for its first ``steps[i]`` steps; the worlds
         do not interact (each world's arithmetic is that of a run of its own)."""
         longest, worlds = max(steps), len(dts)

@@ -230,7 +230,8 @@ class PortModel(MujocoModel):
         """One run per step size (MuJoCo Warp: worlds of one batch, :attr:`batches_steps`)."""
         if field is not None:
             raise Unsupported(f"{self.engine}: {self.no_body_forces}")
-        runs = self.port.run_many(np.asarray(q0), np.asarray(v0), steps, dts, integrator)
+        runs = self.port.run_many(np.asarray(q0), np.asarray(v0), dts=dts, steps=steps,
+                                  integrator=integrator)
         return [(q.astype(float), v.astype(float)) for q, v in runs]
 
 
