@@ -332,7 +332,7 @@ class ModelAdapter(Adapter):
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:
         """The loader's own stepping (``simulate(q0, v0, dt, steps)`` in its layout), its
-        states mapped back to the canonical layout (:func:`~.layout.canonical_states`)."""
+        states mapped back to the canonical layout (:func:`~.layout_batch.canonical_states`)."""
         return self._runs(q0, v0, duration=duration, dts=[dt], integrator=integrator,
                           batched=False)[0]
 
@@ -383,7 +383,7 @@ class ModelAdapter(Adapter):
 
     def _trajectory(self, q_e: np.ndarray, v_e: np.ndarray, t: np.ndarray) -> Trajectory:
         """The engine's states at times ``t``, finite (:meth:`_finite`), in the canonical
-        layout (:func:`~.layout.canonical_states`)."""
+        layout (:func:`~.layout_batch.canonical_states`)."""
         self._finite(q_e, v_e, t)
         q, v = canonical_states(self.canon, self.tree, q_e, v_e)
         return Trajectory(t, self._check("simulate", q), v)
