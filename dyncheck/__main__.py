@@ -59,11 +59,15 @@ def _parser() -> argparse.ArgumentParser:
     p = _Parser(
         prog="dyncheck",
         description="A textbook's tensor dynamics (its general method and printed equations) "
-        "against MuJoCo, Pinocchio and Drake: every discrepancy measured and explained.",
+        "against MuJoCo (with MJX and MuJoCo Warp), Pinocchio, Drake, Newton, PyBullet and "
+        "sympy.physics.mechanics: every discrepancy measured and explained.",
         epilog="exit status: 0 nothing failed unexplained; 1 a check failed, regressed or "
         "moved; 2 bad usage or input (one line naming the argument and value). "
         "`dyncheck COMMAND --help` shows an example of each command.",
     )
+    from dyncheck.provenance import dyncheck_version
+
+    p.add_argument("--version", action="version", version=f"dyncheck {dyncheck_version()}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for command in COMMANDS.values():
         one = sub.add_parser(command.name, help=command.help,
@@ -110,6 +114,7 @@ def _main(argv: Sequence[str] | None) -> int:
     except SystemExit as exc:  # --help (0) or a one-line usage error (2), already printed
         return int(exc.code or 0)
     from dyncheck.cache.compiled import held
+    from dyncheck.ci_outputs import json_on_stdout
     from dyncheck.commands.options import settings_of
     from dyncheck.workers import settled
 
@@ -117,7 +122,7 @@ def _main(argv: Sequence[str] | None) -> int:
         _address_space(args)
         # handed to every unit of work (dyncheck.settings), with the compiled-code folder
         # checked before any engine runs and signed when the command ends
-        with held(settings_of(args)) as settings, settled(settings):
+        with held(settings_of(args)) as settings, settled(settings), json_on_stdout(args):
             return COMMANDS[args.command].handler(args)
     except DyncheckError as exc:
         print(f"dyncheck: error: {one_line(str(exc))}", file=sys.stderr)

@@ -1,16 +1,24 @@
 """Results a CI system reads: JUnit XML (``--junit FILE``: one test suite per case or model,
 one test case per group of rows — a quantity of one pair of implementations — failed with its
-numbers, skipped with its reason) and a JSON summary (``--json FILE``: the counts, each
-suite's counts and every row), for ``run`` and ``check`` alike. Written with ``junitparser``
-(a maintained JUnit library) and ``json``; each file whole, then renamed.
+two values and its cause, an explained row's cause in the test case's system-out, skipped with
+its reason, each suite and test case with the seconds its engines took where the command
+measured them) and a JSON summary (``--json FILE``, ``--json -`` for standard output: the
+counts, each suite's counts and every row, in the format :data:`SCHEMA` describes), for
+``run`` and ``check`` alike. Written with ``junitparser`` (a maintained JUnit library) and
+``json``; each file whole, then renamed.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
+from typing import TextIO
 
 import pandas as pd
 from junitparser import Failure, JUnitXml, Skipped, TestCase, TestSuite
@@ -27,12 +35,19 @@ class Columns:
     error: str
     tolerance: str
     detail: tuple[str, ...]
+    values: tuple[str, str] | None = None
+    """The two compared values, where the rows keep them (a reading: "1.45 vs 1.51")."""
 
 
 RUN = Columns(suite="case", group=("quantity", "impl_a", "impl_b", "integrator", "dt"),
               error="max_rel_err", tolerance="tolerance", detail=("tolerance_basis", "note"))
 CHECK = Columns(suite="model", group=("section", "subject", "impl_a", "impl_b"),
-                error="error", tolerance="tolerance", detail=("field", "basis", "note"))
+                error="error", tolerance="tolerance", detail=("field", "basis", "note"),
+                values=("value_a", "value_b"))
+
+SCHEMA = "results.schema.json"
+"""The JSON Schema of ``--json`` (in this package; ``schema_version`` names its version)."""
+SCHEMA_VERSION = 1
 
 
 def _text(value: object) -> str:
@@ -48,17 +63,34 @@ def _name(keys: tuple[object, ...], columns: tuple[str, ...]) -> str:
     return f"{rest} ({pair})" if pair else rest
 
 
-def _case(name: str, suite: str, rows: pd.DataFrame, columns: Columns) -> TestCase:
-    case = TestCase(name, classname=f"dyncheck.{suite}")
+def _failure(values: dict[str, object], columns: Columns) -> str:
+    """A failed row in one line that leads with what a reader compares: the two values
+    where the row has them ("1.45 vs 1.51"), else the error against its tolerance; then the
+    field, basis and cause."""
+    detail = "; ".join(_text(values.get(c)) for c in columns.detail if _text(values.get(c)))
+    error, tolerance = _text(values.get(columns.error)), _text(values.get(columns.tolerance))
+    pair = [_text(values.get(c)) for c in columns.values or ()]
+    if pair and all(pair):
+        head = f"{pair[0]} vs {pair[1]}"
+        if error and error != "0.0":
+            head += f" (error {error}, tolerance {tolerance})"
+    else:
+        head = f"error {error} > tolerance {tolerance}"
+    return head + (f": {detail}" if detail else "")
+
+
+def _case(name: str, suite: str, rows: pd.DataFrame, columns: Columns,
+          seconds: float | None = None) -> TestCase:
+    case = TestCase(name, classname=f"dyncheck.{suite}", time=seconds)
     failed = rows[rows["verdict"] == Verdict.FAILED.value]
+    explained = rows[rows["verdict"] == Verdict.EXPLAINED.value]
+    if not explained.empty:
+        case.system_out = "\n".join(
+            "explained: " + "; ".join(_text(v) for c in columns.detail
+                                      if _text(v := row._asdict().get(c)))
+            for row in explained.itertuples(index=False))
     if not failed.empty:
-        lines = []
-        for row in failed.itertuples(index=False):
-            values = row._asdict()
-            detail = "; ".join(_text(values.get(c)) for c in columns.detail if _text(values.get(c)))
-            lines.append(f"error {_text(values.get(columns.error))} > tolerance "
-                         f"{_text(values.get(columns.tolerance))}" + (f" ({detail})" if detail
-                                                                          else ""))
+        lines = [_failure(row._asdict(), columns) for row in failed.itertuples(index=False)]
         case.result = [Failure(lines[0], "dyncheck")]
         case.result[0].text = "\n".join(lines)
     elif (rows["verdict"] == Verdict.SKIPPED.value).all():
@@ -67,10 +99,25 @@ def _case(name: str, suite: str, rows: pd.DataFrame, columns: Columns) -> TestCa
     return case
 
 
+def _seconds(keys: tuple[object, ...], columns: Columns,
+             took: dict[str, float] | None) -> float | None:
+    """The seconds of the engines a group compares (each engine's time on the model, as the
+    command measured it; shared by that engine's groups), or None where not measured."""
+    if not took:
+        return None
+    parts = dict(zip(columns.group, keys, strict=True))
+    spent = [took[i] for i in (_text(parts.get("impl_a")), _text(parts.get("impl_b")))
+             if i in took]
+    return round(sum(spent), 6) if spent else None
+
+
 def junit(tables: dict[str, pd.DataFrame], columns: Columns,
-          refused: dict[str, str] | None = None) -> JUnitXml:
+          refused: dict[str, str] | None = None,
+          seconds: dict[str, dict[str, float]] | None = None) -> JUnitXml:
     """One suite per table (a case, a model), one test case per group of rows; a refused
-    model (bad input: no rows) one suite of one failed test case, its reason the message."""
+    model (bad input: no rows) one suite of one failed test case, its reason the message.
+    ``seconds``: per suite, the seconds each engine (and step) took, where measured — the
+    suite's time is their sum, a test case's that of the engines it compares."""
     xml = JUnitXml("dyncheck")
     for name, why in (refused or {}).items():
         if name in tables:
@@ -83,10 +130,13 @@ def junit(tables: dict[str, pd.DataFrame], columns: Columns,
         xml.add_testsuite(suite)
     for suite_name, rows in tables.items():
         suite = TestSuite(suite_name)
+        took = (seconds or {}).get(suite_name)
         for keys, group in rows.groupby(list(columns.group), sort=False, dropna=False):
             suite.add_testcase(_case(_name(tuple(keys), columns.group), suite_name, group,
-                                     columns))
+                                     columns, _seconds(tuple(keys), columns, took)))
         suite.update_statistics()
+        if took:
+            suite.time = round(sum(took.values()), 6)
         xml.add_testsuite(suite)
     xml.update_statistics()
     return xml
@@ -98,28 +148,76 @@ def split(rows: pd.DataFrame, columns: Columns) -> dict[str, pd.DataFrame]:
 
 
 def write_junit(path: Path, tables: dict[str, pd.DataFrame], columns: Columns,
-                refused: dict[str, str] | None = None) -> None:
-    text = junit(tables, columns, refused).tostring()
+                refused: dict[str, str] | None = None,
+                seconds: dict[str, dict[str, float]] | None = None) -> None:
+    text = junit(tables, columns, refused, seconds).tostring()
     write_atomic(path, text.decode() if isinstance(text, bytes) else text)
 
 
 def summary(tables: dict[str, pd.DataFrame], versions: dict[str, str],
-            refused: dict[str, str] | None = None) -> dict[str, object]:
-    """The counts overall and per suite, refusals with their reason, the versions and every
-    row (NaN as null)."""
+            refused: dict[str, str] | None = None, *, command: str = "",
+            seconds: dict[str, dict[str, float]] | None = None) -> dict[str, object]:
+    """The counts overall and per suite, refusals with their reason, the versions, each
+    suite's seconds where measured and every row (NaN as null), under :data:`SCHEMA`'s
+    version and dyncheck's."""
+    from dyncheck.provenance import dyncheck_version
+
     every = pd.concat(list(tables.values())) if tables else pd.DataFrame({"verdict": []})
 
     def counts(rows: pd.DataFrame) -> dict[str, int]:
         return {v.value: int((rows["verdict"] == v.value).sum()) for v in Verdict}
 
     rows = json.loads(every.to_json(orient="records")) if len(every) else []
-    return {"counts": counts(every),
+    return {"schema_version": SCHEMA_VERSION,
+            "dyncheck": dyncheck_version(),
+            "command": command,
+            "counts": counts(every),
             "suites": {name: counts(t) for name, t in tables.items()},
+            "seconds": {name: round(sum(t.values()), 6) for name, t in (seconds or {}).items()
+                        if name in tables},
             "refused": refused or {},
             "versions": versions,
             "rows": rows}
 
 
+def schema() -> dict[str, object]:
+    """The JSON Schema of :func:`summary`'s output (draft 2020-12)."""
+    text = resources.files("dyncheck").joinpath(SCHEMA).read_text(encoding="utf-8")
+    loaded: dict[str, object] = json.loads(text)
+    return loaded
+
+
+STDOUT = Path("-")
+"""``--json -``: the summary to standard output (the command's other lines go to stderr)."""
+
+_STDOUT: list[TextIO] = []
+"""Standard output as the command found it, while :func:`json_on_stdout` holds it."""
+
+
+@contextmanager
+def json_on_stdout(args: object) -> Iterator[None]:
+    """With ``--json -``, standard output kept for the JSON alone while the block runs:
+    everything else the command prints goes to standard error (a pipe into ``jq`` reads one
+    document)."""
+    if getattr(args, "json", None) != STDOUT:
+        yield
+        return
+    _STDOUT.append(sys.stdout)
+    sys.stdout = sys.stderr
+    try:
+        yield
+    finally:
+        sys.stdout = _STDOUT.pop()
+
+
 def write_json(path: Path, tables: dict[str, pd.DataFrame], versions: dict[str, str],
-               refused: dict[str, str] | None = None) -> None:
-    write_atomic(path, json.dumps(summary(tables, versions, refused), indent=1) + "\n")
+               refused: dict[str, str] | None = None, *, command: str = "",
+               seconds: dict[str, dict[str, float]] | None = None) -> None:
+    text = json.dumps(summary(tables, versions, refused, command=command, seconds=seconds),
+                      indent=1) + "\n"
+    if path == STDOUT:
+        stream = _STDOUT[-1] if _STDOUT else sys.stdout
+        stream.write(text)
+        stream.flush()
+    else:
+        write_atomic(path, text)

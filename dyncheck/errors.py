@@ -57,8 +57,10 @@ class EngineNotInstalled(DyncheckError, ImportError):
         self, implementation: str, package: str, reason: str, extra: str | None = None
     ) -> None:
         self.implementation, self.package, self.extra = implementation, package, extra
+        from dyncheck.installation import install_hint
+
         self.hint = (
-            f"pip install 'dyncheck[{extra}]' (the extra {extra!r})"
+            f"{install_hint(extra)} (the extra {extra!r})"
             if extra
             else f"pip install {package}"
         )

@@ -101,3 +101,17 @@ def markdown_table(frame: pd.DataFrame, *, escaped: tuple[str, ...] = (),
             shown[column] = shown[column].map(lambda v: markdown(v) if isinstance(v, str) else v)
     shown.columns = [markdown(c) for c in shown.columns]
     return shown.to_markdown(index=False, **options)
+
+
+MAX_NAME = 200
+"""Bytes of a page name at most, as UTF-8 (a file name's limit is 255 bytes; the suffix and
+the numbering need the rest)."""
+
+
+def file_name(text: str) -> str:
+    """``text`` as one safe file name in an output folder: shown as dyncheck shows names
+    (:func:`~dyncheck.escaping.shown`), with no path separator, no leading dot (no hidden
+    file, no ``..``), never empty, at most :data:`MAX_NAME` bytes."""
+    name = shown(text).replace("/", "__")
+    name = name.lstrip(".").strip() or "model"
+    return name.encode()[:MAX_NAME].decode(errors="ignore")

@@ -15,6 +15,16 @@ from dyncheck.errors import EngineNotInstalled
 NOT_USED = "not used in this run"
 
 
+def dyncheck_version() -> str:
+    """dyncheck's own version, as installed (``dyncheck --version``)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("dyncheck")
+    except PackageNotFoundError:  # (imported from a source tree that was never installed)
+        return "unknown (not installed)"
+
+
 def engine_versions(names: Iterable[str]) -> dict[str, str]:
     """The versions of the engines behind the implementations ``names`` (provenance name →
     version, "not installed" for an engine that is not), each implementation standing for
@@ -53,7 +63,7 @@ def versions(engines: Mapping[str, str] | None = None) -> dict[str, str]:
     used = engine_versions(RUN) if engines is None else engines
     out |= {label: used.get(label, NOT_USED) for name, label in LABELS.items()
             if name in RUN or label in used}
-    out["dyncheck"] = version("dyncheck")
+    out["dyncheck"] = dyncheck_version()
     try:
         commit = subprocess.run(
             ["git", "rev-parse", "--short", "HEAD"],

@@ -127,6 +127,25 @@ def table(records: Iterable[Any], record_type: type, key: list[str]) -> pd.DataF
     return frame.sort_values(key, kind="stable").reset_index(drop=True)
 
 
+def _as_umask_gives(fd: int) -> None:
+    """A temporary file (``mkstemp`` makes it 0600) given the mode a plainly created file
+    would have: 0666 less the process's umask, so that CI artifacts and shared report folders
+    are readable as the user set them up."""
+    mask = os.umask(0o022)  # (read by setting: Python 3.11 has no os.get_umask)
+    os.umask(mask)
+    os.fchmod(fd, 0o666 & ~mask)
+
+
+def within(out: Path, name: str) -> Path:
+    """``out / name``, checked to be a file directly in ``out`` whatever ``name`` holds (an
+    absolute name, a separator or ``..`` would leave the output folder: refused)."""
+    path = out / name
+    if path.parent != out or name in ("", ".", "..") or os.path.isabs(name):
+        raise OSError(errno.EPERM, "an output name that leaves the output folder: not "
+                      "written", str(path))
+    return path
+
+
 def write_atomic(path: Path, content: str | bytes) -> None:
     """Write to a temporary file in the same folder, then rename over ``path``; where the
     write fails, the temporary file and any folder made for it are removed again."""
@@ -138,6 +157,7 @@ def write_atomic(path: Path, content: str | bytes) -> None:
     mode = "wb" if isinstance(content, bytes) else "w"
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
+        _as_umask_gives(fd)
         with os.fdopen(fd, mode) as f:
             f.write(content)
         os.replace(tmp, path)
@@ -174,6 +194,7 @@ def write_together(files: dict[Path, str | bytes]) -> None:
             fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
             staged.append((tmp, path))
             try:
+                _as_umask_gives(fd)
                 with os.fdopen(fd, "wb" if isinstance(content, bytes) else "w") as f:
                     f.write(content)
             except OSError as exc:

@@ -11,9 +11,9 @@ from pathlib import Path
 from typing import Any
 
 from dyncheck.errors import DyncheckError, EngineNotInstalled, UnknownName
+from dyncheck.installation import ROOT, needs_checkout
 from dyncheck.results import write_atomic
 
-ROOT = Path(__file__).resolve().parents[1]
 FOLDER = ROOT / "tutorials"
 TIMEOUT_S = 600
 """Per cell: the slowest (a model check of 200 states) takes seconds; a hang must end."""
@@ -24,7 +24,9 @@ class TutorialFailed(DyncheckError):
 
 
 def available() -> dict[str, Path]:
-    """Tutorial name (file stem) → path, in reading order."""
+    """Tutorial name (file stem) → path, in reading order (the sources are a checkout's:
+    :class:`~dyncheck.installation.NeedsCheckout` from an installed package)."""
+    needs_checkout("dyncheck tutorials (the tutorials' sources and the models they read)")
     return {p.stem: p for p in sorted(FOLDER.glob("[0-9][0-9]_*.py"))}
 
 

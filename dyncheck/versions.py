@@ -35,11 +35,11 @@ from dyncheck import diff, reproduced
 from dyncheck.adapters import REGISTRY, Needs
 from dyncheck.cache.store import cache_root
 from dyncheck.errors import DyncheckError, InvalidInput, UnknownName
+from dyncheck.installation import ROOT
 from dyncheck.progress import Progress
 from dyncheck.settings import current
 from dyncheck.vocabulary import Verdict
 
-ROOT = Path(__file__).resolve().parents[1]
 CORE = tuple(re.match(r"[A-Za-z0-9_.-]+", r)[0]  # type: ignore[index]
              for r in importlib.metadata.requires("dyncheck") or () if ";" not in r)
 """What every environment installs: dyncheck's own dependencies (pyproject.toml's, read from

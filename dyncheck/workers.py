@@ -90,8 +90,10 @@ def executor(jobs: int = 1, dask: str | None = None) -> Iterator[Executor | None
     try:
         from distributed import Client, LocalCluster
     except ImportError:
+        from dyncheck.installation import install_hint
+
         raise InvalidInput(
-            "--dask", dask, "used with the extra 'dask' installed (pip install 'dyncheck[dask]')"
+            "--dask", dask, "used with the extra 'dask' installed (" + install_hint("dask") + ")"
         ) from None
     with _quiet_distributed():
         yield from _dask_executor(jobs, dask, Client, LocalCluster)

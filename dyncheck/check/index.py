@@ -16,7 +16,7 @@ from dyncheck.check.page import counts
 from dyncheck.check.rows import CheckResult
 from dyncheck.check.verdicts import Agreement, EngineVerdict, Reading, per_engine
 from dyncheck.errors import InvalidInput
-from dyncheck.escaping import markdown, markdown_link, markdown_table, shown
+from dyncheck.escaping import file_name, markdown, markdown_link, markdown_table
 from dyncheck.results import to_csv, write_atomic
 from dyncheck.vocabulary import Verdict
 
@@ -60,40 +60,64 @@ def in_folder(folder: Path) -> list[Path]:
     return [p for p, _ in candidates if p.resolve() not in included]
 
 
-def page_names(paths: list[Path]) -> list[str]:
-    """One page name per file: its stem; where stems collide, the fewest enclosing folders
-    that tell the files apart (``suite__hopper``), else the suffix (``a-urdf``), else both;
-    the same file given twice gets ``-2``."""
-    names = [shown(p.stem) for p in paths]
+RESERVED = (INDEX,)
+"""Page names a model never gets: the index's own files (a model named ``index.xml`` in a
+folder would lose its page and CSV to the index)."""
+
+
+def page_names(paths: list[Path], given: list[str | None] | None = None) -> list[str]:
+    """One page name per file: its stem (or the name ``given`` for it, such as a robot's);
+    where stems collide, the fewest enclosing folders that tell the files apart
+    (``suite__hopper``), else the suffix (``a-urdf``), else both; names still alike — the same
+    file given twice, or names that differ only in what :func:`file_name` erases — get
+    ``-2``, ``-3``. Every name is one file name (:func:`file_name`), none is a
+    :data:`RESERVED` one, and no two are alike even on a file system that ignores case."""
+    given = given if given is not None else [None] * len(paths)
+    names = [file_name(g) if g else file_name(p.stem) for p, g in zip(paths, given,
+                                                                       strict=True)]
     groups: dict[str, list[int]] = {}
     for i, name in enumerate(names):
-        groups.setdefault(name, []).append(i)
-    for stem, members in groups.items():
-        if len(members) < 2:
-            continue
+        if not given[i]:
+            groups.setdefault(name.casefold(), []).append(i)
+    for members in groups.values():
         distinct = len({paths[i].resolve() for i in members})
-        if distinct < 2:
-            continue
-        parents = [paths[i].resolve().parent.parts for i in members]
-        suffixes = [paths[i].suffix.lstrip(".") for i in members]
-        for depth in range(0, max(len(p) for p in parents) + 1):
-            folders = ["__".join(p[len(p) - depth:]) if depth else "" for p in parents]
-            for with_suffix in (False, True):
-                tried = [shown((f"{f}__" if f else "") + stem + (f"-{x}" if with_suffix
-                                                                  else ""))
-                         for f, x in zip(folders, suffixes, strict=True)]
-                if len(set(tried)) == distinct:
-                    break
-            if len(set(tried)) == distinct:
-                break
-        for i, name in zip(members, tried, strict=True):
-            names[i] = name
-    seen: dict[str, int] = {}
-    for i, name in enumerate(names):  # still alike: the same file named twice
-        seen[name] = seen.get(name, 0) + 1
-        if seen[name] > 1:
-            names[i] = f"{name}-{seen[name]}"
-    return names
+        if distinct > 1:
+            for i, name in zip(members, _told_apart([paths[i] for i in members], distinct),
+                               strict=True):
+                names[i] = name
+    return _numbered(names)
+
+
+def _told_apart(paths: list[Path], distinct: int) -> list[str]:
+    """The names of same-stem files: with the fewest enclosing folders (never the file
+    system's root) and the suffix that make them ``distinct``; the plain stems where none
+    does (the numbering then tells them apart)."""
+    parents = [p.resolve().parent.parts[1:] for p in paths]  # (parts[0]: the root, '/')
+    suffixes = [p.suffix.lstrip(".") for p in paths]
+    for depth in range(0, max(len(p) for p in parents) + 1):
+        folders = ["__".join(p[len(p) - depth:]) if depth else "" for p in parents]
+        for with_suffix in (False, True):
+            tried = [file_name((f"{f}__" if f else "") + p.stem
+                               + (f"-{x}" if with_suffix else ""))
+                     for f, x, p in zip(folders, suffixes, paths, strict=True)]
+            if len({t.casefold() for t in tried}) == distinct:
+                return tried
+    return [file_name(p.stem) for p in paths]
+
+
+def _numbered(names: list[str]) -> list[str]:
+    """``names`` made unique (case ignored) and kept off :data:`RESERVED`: a later alike
+    name gets ``-2``, ``-3`` … (the first free one)."""
+    taken = {r.casefold() for r in RESERVED}
+    out = []
+    for name in names:
+        chosen, n = name, 1
+        while chosen.casefold() in taken:
+            n += 1
+            chosen = f"{name}-{n}"
+        taken.add(chosen.casefold())
+        out.append(chosen)
+    return out
 
 
 @dataclass(frozen=True, kw_only=True)

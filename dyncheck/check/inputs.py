@@ -178,8 +178,10 @@ def robots() -> dict[str, Path]:
 def robot(name: str) -> Path:
     available = robots()
     if not available:
+        from dyncheck.installation import install_hint
+
         raise InvalidInput(
-            "--robot", name, "a robot of example-robot-data: pip install 'dyncheck[robots]'"
+            "--robot", name, "a robot of example-robot-data: " + install_hint("robots")
         )
     if name not in available:
         raise UnknownName("robot", name, available)

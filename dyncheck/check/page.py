@@ -11,8 +11,15 @@ import pandas as pd
 
 from dyncheck.check.rows import CheckResult, Section
 from dyncheck.check.verdicts import per_engine
-from dyncheck.escaping import markdown, markdown_code, markdown_table
-from dyncheck.results import PROVENANCE, Verdict, provenance_json, to_csv, write_together
+from dyncheck.escaping import file_name, markdown, markdown_code, markdown_table
+from dyncheck.results import (
+    PROVENANCE,
+    Verdict,
+    provenance_json,
+    to_csv,
+    within,
+    write_together,
+)
 
 TITLES = {
     Section.LOAD: "Loading",
@@ -140,9 +147,9 @@ def write(result: CheckResult, out: Path, *, name: str | None = None) -> list[Pa
     """The page, its CSV and the provenance, written as one (:func:`write_together`: never
     one model's page beside another's CSV; ``name``: the files' name, by default the
     model's)."""
-    name = name or result.model.replace("/", "__")
+    name = name or file_name(result.model)
     result = without_paths(result)
-    csv_path, md_path = out / f"{name}.csv", out / f"{name}.md"
+    csv_path, md_path = within(out, f"{name}.csv"), within(out, f"{name}.md")
     versions = _versions(result)
     write_together({csv_path: to_csv(result.rows), md_path: page(result, versions),
                     out / PROVENANCE: provenance_json(versions)})

@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from dyncheck.commands import flags
 from dyncheck.commands.flags import Command
 from dyncheck.commands.options import (
     BENCH_MAX,
+    OUT,
     check_out,
     claim_out,
     path_arg,
@@ -22,6 +22,9 @@ def bench_command(args: argparse.Namespace) -> int:
 
     check_out(args.out)
     if args.suite:
+        from dyncheck.installation import needs_checkout
+
+        needs_checkout("dyncheck bench --suite (it times the README's commands in the checkout)")
         claim_out(args.out)
         from dyncheck.bench import suite as bench_suite
 
@@ -51,7 +54,9 @@ def _arguments(p: argparse.ArgumentParser) -> None:
         metavar="N",
         help="sweep sizes whose peak memory is measured in fresh processes",
     )
-    p.add_argument("--out", type=path_arg, default=Path("reports"), help="report folder")
+    p.add_argument("--out", type=path_arg, default=OUT,
+                   help=f"report folder (default: {OUT}; the committed benchmark: --out "
+                   "reports)")
     p.add_argument("--jobs", type=int, default=1, metavar="N",
                    help="also time the sweep in slices on N processes against this one "
                    "(the same rows, checked)")

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 from dyncheck.commands import flags
 from dyncheck.commands.flags import Command
-from dyncheck.commands.options import path_arg
+from dyncheck.commands.options import OUT, path_arg
 from dyncheck.errors import DyncheckError, InvalidInput
 
 if TYPE_CHECKING:
@@ -122,8 +122,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     from dyncheck.progress import Progress
     from dyncheck.workers import each_unit
 
-    names = [robot.replace("/", "__") if robot else name for (_, robot), name in
-             zip(targets, index.page_names([p for p, _ in targets]), strict=True)]
+    names = index.page_names([p for p, _ in targets], [robot for _, robot in targets])
     several = len(targets) > 1
     base = index.common_folder([p for p, _ in targets])
     files = {name: f"robot {robot}" if robot else f"book case {p.stem}" if p.parent == cases
@@ -158,6 +157,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     engines = tuple(i for i in implementations(tuple(args.impl) or None) if i != "reference")
     failed, refusals = False, len(entries)
     tables: dict[str, pd.DataFrame] = {}
+    seconds: dict[str, dict[str, float]] = {}
     refused: dict[str, str] = {}
     progress = Progress("check", len(units) if several else None, quiet=args.quiet or not several)
     for name, result in each_unit(units, jobs=args.jobs, dask=args.dask):
@@ -175,6 +175,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
             print(f"{summary_line(result)} -> {written[1]}")
             entries.append(index.entry(result, name, files[name]))
             tables[name] = result.rows
+            seconds[name] = dict(result.seconds)
             if not result.ok:
                 failed = True
                 print(result.failures())
@@ -189,7 +190,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
         from dyncheck.ci_outputs import CHECK
 
         write_ci(args, tables, CHECK, engine_versions_of(implementations(
-            tuple(args.impl) or None)), refused)
+            tuple(args.impl) or None)), refused, seconds)
     return 2 if refusals else 1 if failed else 0
 
 
@@ -220,7 +221,8 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    "step Jacobian in the controls are compared)")
     p.add_argument("--against", type=path_arg, default=None, metavar="PATH",
                    help="also compare what MuJoCo reads with this other file (a previous version)")
-    p.add_argument("--out", type=path_arg, default=Path("reports/check"), help="output folder")
+    p.add_argument("--out", type=path_arg, default=OUT / "check",
+                   help=f"output folder (default: {OUT / 'check'})")
     flags.jobs(p, "models checked")
     flags.dask(p)
     flags.ci(p)

@@ -82,7 +82,9 @@ def ci(p: argparse.ArgumentParser) -> None:
                    "one test case per quantity and pair) for a CI system to show")
     p.add_argument("--json", type=path_arg, default=None, metavar="FILE",
                    help="also write a JSON summary: the counts, each case's or model's, every "
-                   "row")
+                   "row, in the format of the JSON Schema dyncheck ships (results.schema.json, "
+                   "its schema_version in the file); '-': to standard output, the command's "
+                   "other lines to standard error")
 
 
 def dask(p: argparse.ArgumentParser) -> None:

@@ -6,6 +6,7 @@ import argparse
 
 from dyncheck.commands.flags import Command
 from dyncheck.errors import EngineNotInstalled
+from dyncheck.installation import install_hint
 
 
 def installed_version(package: str) -> str | None:
@@ -56,7 +57,7 @@ def list_command(*, integrators: bool = False) -> int:
         elif (version := installed_version(ENGINE_PACKAGES[name])) is not None:
             what = f"{ENGINE_PACKAGES[name]} {version}"
         elif name in ENGINE_EXTRAS:
-            what = f"not installed: pip install 'dyncheck[{ENGINE_EXTRAS[name]}]'"
+            what = f"not installed: {install_hint(ENGINE_EXTRAS[name])}"
         else:
             what = f"not installed: pip install {ENGINE_PACKAGES[name]}"
         print(f"  {name:24s} {what}")
@@ -70,7 +71,7 @@ def list_command(*, integrators: bool = False) -> int:
         for name, path in found.items():
             print(f"  {name:32s} {path.name}")
     else:
-        print("robots: the 'robots' extra is not installed (pip install 'dyncheck[robots]')")
+        print(f"robots: the 'robots' extra is not installed ({install_hint('robots')})")
     return 0
 
 

@@ -21,6 +21,13 @@ if TYPE_CHECKING:
     from dyncheck.ci_outputs import Columns
 
 
+OUT = Path("dyncheck-report")
+"""Where ``run``, ``check``, ``bench`` and ``tutorials`` write by default: a folder of the
+current directory, never a checkout's committed ``reports/`` (a newcomer's first command
+leaves ``git status`` clean; the maintainers regenerate the committed report with
+``--out reports``)."""
+
+
 def path_arg(text: str) -> Path:
     """A path argument; an empty one is refused (it would silently mean this folder)."""
     if not text.strip():
@@ -35,9 +42,11 @@ def path_arg(text: str) -> Path:
 
 def ci_files(args: argparse.Namespace, inputs: Sequence[Path] = ()) -> None:
     """The ``--junit`` and ``--json`` files writable and none of the command's ``inputs``,
-    checked before any work."""
+    checked before any work (``--json -``: standard output)."""
+    from dyncheck.ci_outputs import STDOUT
+
     for flag, path in (("--junit", args.junit), ("--json", args.json)):
-        if path is not None:
+        if path is not None and not (flag == "--json" and path == STDOUT):
             check_out_file(flag, path, inputs)
             out = getattr(args, "out", None)
             if out is not None and path.resolve() == Path(out).resolve():
@@ -49,13 +58,17 @@ def ci_files(args: argparse.Namespace, inputs: Sequence[Path] = ()) -> None:
 
 
 def write_ci(args: argparse.Namespace, tables: dict[str, pd.DataFrame], columns: Columns,
-              versions: dict[str, str], refused: dict[str, str] | None = None) -> None:
+             versions: dict[str, str], refused: dict[str, str] | None = None,
+             seconds: dict[str, dict[str, float]] | None = None) -> None:
+    """The ``--junit`` and ``--json`` files of a command's tables (``seconds``: per table,
+    what each engine took, where the command measured it)."""
     from dyncheck import ci_outputs
 
     if args.junit is not None:
-        ci_outputs.write_junit(args.junit, tables, columns, refused)
+        ci_outputs.write_junit(args.junit, tables, columns, refused, seconds)
     if args.json is not None:
-        ci_outputs.write_json(args.json, tables, versions, refused)
+        ci_outputs.write_json(args.json, tables, versions, refused, command=args.command,
+                              seconds=seconds)
 
 
 def check_out(out: Path, flag: str = "--out") -> None:

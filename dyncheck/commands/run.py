@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from dyncheck.commands import flags
 from dyncheck.commands.flags import Command
 from dyncheck.commands.options import (
     MAX_STATES,
+    OUT,
     check_out,
     ci_files,
     claim_out,
@@ -83,7 +83,8 @@ def run_command(args: argparse.Namespace) -> int:
 
 def _arguments(p: argparse.ArgumentParser) -> None:
     flags.selection(p)
-    p.add_argument("--out", type=path_arg, default=Path("reports"), help="report folder")
+    p.add_argument("--out", type=path_arg, default=OUT,
+                   help=f"report folder (default: {OUT}; the committed report: --out reports)")
     p.add_argument("--device", choices=("cpu", "cuda"), default=None,
                    help="where MuJoCo's ports (MJX, MuJoCo Warp) compute (default: the CPU "
                    "for Warp, JAX's default device for MJX); named in the provenance")

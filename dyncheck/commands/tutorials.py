@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from dyncheck.commands import flags
 from dyncheck.commands.flags import Command
-from dyncheck.commands.options import check_out, claim_out, path_arg
+from dyncheck.commands.options import OUT, check_out, claim_out, path_arg
 from dyncheck.errors import UnknownName
 from dyncheck.progress import Progress
 
@@ -44,8 +43,9 @@ def tutorials_command(args: argparse.Namespace) -> int:
 
 def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("names", nargs="*", metavar="NAME", help="tutorials (default: all)")
-    p.add_argument("--out", type=path_arg, default=Path("reports/tutorials"),
-                   help="output folder")
+    p.add_argument("--out", type=path_arg, default=OUT / "tutorials",
+                   help=f"output folder (default: {OUT / 'tutorials'}; the committed pages: "
+                   "--out reports/tutorials)")
     flags.quiet(p)
 
 

@@ -148,8 +148,10 @@ def _run(name: str) -> Entry:
         except (EngineNotInstalled, importlib.metadata.PackageNotFoundError):
             why = f"{engine} is not installed (pip install {ENGINE_PACKAGES[engine]})"
             if engine in ENGINE_EXTRAS:
+                from dyncheck.installation import install_hint
+
                 extra = ENGINE_EXTRAS[engine]
-                why = f"{engine} is not installed (pip install 'dyncheck[{extra}]')"
+                why = f"{engine} is not installed ({install_hint(extra)})"
             return _skipped(name, why)
     demo, origin = DEMOS[name]
     try:

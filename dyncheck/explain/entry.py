@@ -47,6 +47,16 @@ TUTORIALS: dict[str, str] = {
 """The executed tutorial (``reports/tutorials/NAME.md``) that teaches an entry step by step."""
 
 
+def tutorial_where(name: str) -> str:
+    """Where a reader finds tutorial ``name``: its rendered page in a checkout; installed,
+    the command that renders it in one (the package holds no reports)."""
+    from dyncheck.installation import checkout
+
+    if checkout() is not None:
+        return f"reports/tutorials/{name}.md"
+    return f"{name} (reports/tutorials/{name}.md in a checkout of dyncheck)"
+
+
 def render(entries: list[Entry]) -> str:
     lines = []
     for e in entries:
@@ -72,6 +82,6 @@ def render(entries: list[Entry]) -> str:
             f"- Correct mapping: {e.unit} {e.correct_error:.3g}",
         ]
         if e.name in TUTORIALS:
-            lines.append(f"- Tutorial: reports/tutorials/{TUTORIALS[e.name]}.md")
+            lines.append(f"- Tutorial: {tutorial_where(TUTORIALS[e.name])}")
         lines.append("")
     return "\n".join(lines)

@@ -120,3 +120,76 @@ def test_page_names_from_odd_file_names_are_shown_safely(tmp_path):
     assert names == ["bad\ufffd", "ctl\\x1b[31mred"]
     for name in names:
         name.encode("utf-8")  # writable as UTF-8
+
+
+def _written(root: Path) -> set[Path]:
+    return {p for p in root.rglob("*") if p.is_file()}
+
+
+@pytest.mark.parametrize("names", [
+    (b"r\xff.urdf", "r\ufffd.urdf".encode()),  # a byte that is not UTF-8 against U+FFFD
+    (b"r\n.urdf", b"r\\x0a.urdf"),  # a newline against its escaped spelling
+], ids=["not-utf8-vs-ufffd", "newline-vs-escaped"])
+def test_look_alike_file_names_get_two_pages_inside_the_output_folder(tmp_path, names):
+    """#81: two files whose names differ only in what the page name's escaping erases. The
+    old naming widened the folder prefix up to the file system's root ('/'), and ``out /
+    '/__tmp__…'`` dropped ``out``: the pages went to the root. Expected: each file its own
+    page (two distinct names), every file written inside --out, nothing new at '/'."""
+    folder = tmp_path / "m"
+    folder.mkdir()
+    for raw in names:
+        Path(os.fsdecode(os.path.join(os.fsencode(folder), raw))).write_text(
+            URDF.format(n="r").replace('izz="0.002"', 'izz="0.002" ixy="0" ixz="0" iyz="0"'))
+    before = set(Path("/").iterdir())
+    out = tmp_path / "out"
+    code = main(["check", str(folder), "--states", "2", "--impl", "reference", "--impl",
+                 "mujoco", "--out", str(out)])
+    assert code == 0
+    assert set(Path("/").iterdir()) == before
+    pages = {p.name for p in out.glob("*.md")} - {"index.md"}
+    assert len(pages) == 2, pages
+    assert all(p.resolve().parent == out.resolve() for p in _written(out))
+    assert _written(tmp_path) - _written(out) == _written(folder)
+
+
+def test_a_model_named_index_keeps_its_page(tmp_path):
+    """#81: ``index.xml`` beside another model lost its page and CSV to the check's index.
+    Expected: its own page (``index-2``), linked from the index, and the index intact."""
+    folder = tmp_path / "m"
+    folder.mkdir()
+    (folder / "index.xml").write_text(CHAIN.format(n="index"))
+    (folder / "other.xml").write_text(CHAIN.format(n="other"))
+    out = tmp_path / "out"
+    assert main(["check", str(folder), "--states", "2", "--impl", "reference", "--impl",
+                 "mujoco", "--out", str(out)]) == 0
+    assert {p.name for p in out.glob("*.md")} == {"index.md", "index-2.md", "other.md"}
+    assert "(index-2.md)" in (out / "index.md").read_text()
+    assert (out / "index-2.csv").read_text().startswith("model,")
+
+
+@pytest.mark.parametrize("stem", ["..", ".hidden", "a/b", "", " ", "x" * 300, "é" * 200])
+def test_a_page_name_is_one_file_name_in_the_folder(stem):
+    """Whatever a robot's or file's name holds: no separator, no leading dot, not empty,
+    at most 255 bytes with its suffix (the file system's limit for one name)."""
+    from dyncheck.escaping import file_name
+    from dyncheck.results import within
+
+    name = file_name(stem)
+    assert name and "/" not in name and not name.startswith(".")
+    assert len(f"{name}-99.csv".encode()) <= 255
+    assert within(Path("/tmp/out"), f"{name}.md").parent == Path("/tmp/out")
+
+
+@pytest.mark.parametrize("name", ["../x.md", "/etc/x.md", "a/b.md", "..", ""])
+def test_an_output_name_that_leaves_the_folder_is_refused(name):
+    from dyncheck.results import within
+
+    with pytest.raises(OSError, match="leaves the output folder"):
+        within(Path("/tmp/out"), name)
+
+
+def test_robot_names_and_file_names_never_share_a_page():
+    """A robot named like a file's stem (and an index) gets a page of its own."""
+    paths = [Path("/m/go1.urdf"), Path("/r/go1.urdf"), Path("/m/index.xml")]
+    names = index.page_names(paths, [None, "go1", None])
+    assert len({n.casefold() for n in names}) == 3 and "index" not in names

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import io
+import os
+import stat
 import warnings
 
 import numpy as np
@@ -95,3 +97,26 @@ def test_a_report_is_replaced_as_a_whole_or_not_at_all(tmp_path, monkeypatch):
     write_together(new)
     assert (tmp_path / "README.md").read_text() == "new readme"
     assert (tmp_path / "figures" / "f.png").read_bytes() == b"png"
+
+
+@pytest.mark.parametrize("umask", [0o022, 0o002, 0o077])
+@pytest.mark.parametrize("together", [False, True])
+def test_a_written_file_has_the_mode_the_umask_gives(tmp_path, umask, together):
+    """#80: every file was 0600 (mkstemp's mode survived the rename), so CI artifacts and
+    shared report folders were unreadable to others. Expected: 0666 less the umask, as
+    ``open()`` would create it (the same rule the kernel applies: an independent file made
+    with ``open`` under the same umask is the oracle)."""
+    from dyncheck.results import write_atomic, write_together
+
+    old = os.umask(umask)
+    try:
+        (tmp_path / "plain").write_text("x")
+        target = tmp_path / "sub" / "page.md"
+        if together:
+            write_together({target: "x", tmp_path / "other.csv": b"y"})
+        else:
+            write_atomic(target, "x")
+    finally:
+        os.umask(old)
+    expected = stat.S_IMODE((tmp_path / "plain").stat().st_mode)
+    assert stat.S_IMODE(target.stat().st_mode) == expected == 0o666 & ~umask
