@@ -99,16 +99,17 @@ def _case(name: str, suite: str, rows: pd.DataFrame, columns: Columns,
     return case
 
 
-def _seconds(keys: tuple[object, ...], columns: Columns,
-             took: dict[str, float] | None) -> float | None:
-    """The seconds of the engines a group compares (each engine's time on the model, as the
-    command measured it; shared by that engine's groups), or None where not measured."""
+def _shares(keys: list[tuple[object, ...]], columns: Columns,
+            took: dict[str, float] | None) -> list[float | None]:
+    """Each group's share of the measured seconds: every engine's time on the model split
+    equally among the groups that compare it, so that a suite's test cases add up to the time
+    its engines took (None where the command measured none)."""
     if not took:
-        return None
-    parts = dict(zip(columns.group, keys, strict=True))
-    spent = [took[i] for i in (_text(parts.get("impl_a")), _text(parts.get("impl_b")))
-             if i in took]
-    return round(sum(spent), 6) if spent else None
+        return [None] * len(keys)
+    pairs = [[i for i in (_text(dict(zip(columns.group, k, strict=True)).get(c))
+                          for c in ("impl_a", "impl_b")) if i in took] for k in keys]
+    groups = {e: sum(e in p for p in pairs) for e in took}
+    return [round(sum(took[e] / groups[e] for e in p), 6) if p else None for p in pairs]
 
 
 def junit(tables: dict[str, pd.DataFrame], columns: Columns,
@@ -116,8 +117,9 @@ def junit(tables: dict[str, pd.DataFrame], columns: Columns,
           seconds: dict[str, dict[str, float]] | None = None) -> JUnitXml:
     """One suite per table (a case, a model), one test case per group of rows; a refused
     model (bad input: no rows) one suite of one failed test case, its reason the message.
-    ``seconds``: per suite, the seconds each engine (and step) took, where measured — the
-    suite's time is their sum, a test case's that of the engines it compares."""
+    ``seconds``: per suite, the seconds each engine (and step) took, where measured — a test
+    case's time is its share of its engines' (:func:`_shares`), a suite's the sum of its test
+    cases' (the JSON summary has each suite's whole time)."""
     xml = JUnitXml("dyncheck")
     for name, why in (refused or {}).items():
         if name in tables:
@@ -130,13 +132,13 @@ def junit(tables: dict[str, pd.DataFrame], columns: Columns,
         xml.add_testsuite(suite)
     for suite_name, rows in tables.items():
         suite = TestSuite(suite_name)
-        took = (seconds or {}).get(suite_name)
-        for keys, group in rows.groupby(list(columns.group), sort=False, dropna=False):
-            suite.add_testcase(_case(_name(tuple(keys), columns.group), suite_name, group,
-                                     columns, _seconds(tuple(keys), columns, took)))
+        groups = [(tuple(k), g) for k, g in rows.groupby(list(columns.group), sort=False,
+                                                          dropna=False)]
+        shares = _shares([k for k, _ in groups], columns, (seconds or {}).get(suite_name))
+        for (keys, group), share in zip(groups, shares, strict=True):
+            suite.add_testcase(_case(_name(keys, columns.group), suite_name, group, columns,
+                                     share))
         suite.update_statistics()
-        if took:
-            suite.time = round(sum(took.values()), 6)
         xml.add_testsuite(suite)
     xml.update_statistics()
     return xml

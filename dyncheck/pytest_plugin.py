@@ -3,9 +3,11 @@ a user's own test suite checks their models without copied code:
 
     pytest --dyncheck-model robots/arm.xml --dyncheck-model robots/dog.urdf --dyncheck-floating
 
-adds one test per model, ``dyncheck[robots/arm.xml]``, that fails with the check's failed rows
-(every row passed or explained: it passes). In a test, the fixture ``dyncheck_model`` checks a
-model and asserts the same::
+adds one test per model, ``robots/arm.xml::dyncheck``, that fails with the check's failed rows
+(every row passed or explained: it passes). The tests are collected as pytest collects its own
+(a collector per model file, reported before ``-k``, ``-m`` and ``--collect-only`` see them),
+so ``-k arm`` selects and counts them as any test. In a test, the fixture ``dyncheck_model``
+checks a model and asserts the same::
 
     def test_my_arm(dyncheck_model):
         result = dyncheck_model("robots/arm.xml", states=100)   # a CheckResult
@@ -69,10 +71,31 @@ class ModelItem(pytest.Item):
         return self.path, None, f"dyncheck[{self.model}]"
 
 
+class ModelFile(pytest.File):
+    """A model file named by ``--dyncheck-model``: collects its one :class:`ModelItem`
+    (node id ``PATH::dyncheck``)."""
+
+    def __init__(self, *, model: str, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.model = model
+
+    def collect(self) -> list[pytest.Item]:
+        return [ModelItem.from_parent(self, name="dyncheck", model=self.model)]
+
+
+@pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(session: pytest.Session, config: pytest.Config,
                                   items: list[pytest.Item]) -> None:
+    """The models' tests, collected and reported as pytest's own are — before any other
+    plugin's hook, so that ``-k`` and ``-m`` deselect among them and the terminal counts
+    them (they were appended after the count: ``-k`` said "-1 selected")."""
+    from pathlib import Path
+
     for model in config.getoption("dyncheck_model"):
-        items.append(ModelItem.from_parent(session, name=f"dyncheck[{model}]", model=model))
+        collector = ModelFile.from_parent(session, path=Path(model).absolute(), model=model)
+        report = session.ihook.pytest_make_collect_report(collector=collector)
+        session.ihook.pytest_collectreport(report=report)
+        items.extend(i for i in report.result if isinstance(i, pytest.Item))
 
 
 @pytest.fixture

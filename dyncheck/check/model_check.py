@@ -46,6 +46,8 @@ from dyncheck.check.dynamics import (
     tie_row,
 )
 from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
+from dyncheck.check.given_states import GivenStates
+from dyncheck.check.given_states import given as given_states_of
 from dyncheck.check.referee import ReferenceModel, standing_of
 from dyncheck.check.rows import COLUMNS, CheckResult, CheckRow, Section
 from dyncheck.check.sampling import sample, sampled_note
@@ -113,6 +115,7 @@ def check_model(
     derivatives: bool = False,
     actuators: bool = True,
     say: Callable[[str], None] | None = None,
+    given_states: object = None,
 ) -> CheckResult:
     """Check one model file (see the module's docstring); bad input raises
     :class:`~dyncheck.errors.InvalidInput` before any engine runs. With ``isolate`` (the
@@ -121,8 +124,14 @@ def check_model(
     (:mod:`dyncheck.check.engines`). ``derivatives`` adds the derivatives' rows
     (:mod:`dyncheck.check.derivatives`), ``actuators`` the actuation section where the model has
     actuators (:mod:`dyncheck.check.actuation`), ``say`` hears the estimate of a derivative check
-    that will take a while (the command's progress)."""
+    that will take a while (the command's progress). ``given_states``: the states to check at
+    instead of sampled ones — a pair ``(q, v)`` of arrays (n, nq) and (n, nv), or the path of a
+    ``.npz`` (arrays ``q``, ``v``) or ``.npy`` (n, nq + nv) file — in the canonical layout the
+    page names (MuJoCo's ``qpos``/``qvel`` order for a file MuJoCo loads;
+    :mod:`dyncheck.check.given_states`)."""
     source_path = inputs.model_path(str(path))
+    given = None if given_states is None else given_states_of(given_states,
+                                                               most=inputs.MAX_STATES)
     against_path = inputs.model_path(str(against)) if against is not None else None
     inputs.states(states)
     chosen = implementations(impls)
@@ -143,7 +152,7 @@ def check_model(
             return _check(model, source_path, source, engines=engines, chosen=chosen,
                           states=states, seed=seed, floating=floating,
                           against_path=against_path, load_seconds=time.perf_counter() - t0,
-                          derivatives=derivatives, actuators=actuators, say=say)
+                          derivatives=derivatives, actuators=actuators, say=say, given=given)
     finally:
         engine_processes.stop(engines)
 
@@ -152,7 +161,8 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
            engines: dict[str, ModelEngine | NotLoaded], chosen: tuple[str, ...],
            states: int, seed: int, floating: bool, against_path: Path | None,
            load_seconds: float, derivatives: bool = False, actuators: bool = True,
-           say: Callable[[str], None] | None = None) -> CheckResult:
+           say: Callable[[str], None] | None = None,
+           given: GivenStates | None = None) -> CheckResult:
     """The check's steps in order: what loaded, what each engine read and whether it is
     physically possible, the dynamics at the same states, every pair compared, and the
     derivatives where asked for."""
@@ -174,8 +184,12 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
         rows.extend(_against(model, canonical_tree, read(against_path, floating=floating)))
     canon = layout.canonical(canonical_tree)
     parts, unmatched = _parts(canon, canonical_tree, loaded, notes)
-    batch = sample(canon, canonical_tree, states, seed)
-    notes.append(sampled_note(canon, canonical_tree))
+    if given is None:
+        batch = sample(canon, canonical_tree, states, seed)
+        notes.append(sampled_note(canon, canonical_tree))
+    else:
+        batch, states = given.states(canon, seed), given.n
+        notes.append(given.note())
     own: dict[str, readings.Reading] = {}
     results = _dynamics(model, canon, canonical_tree, batch, loaded, parts, unmatched,
                         with_referee=REFEREE in chosen, rows=rows, seconds=seconds, own=own)

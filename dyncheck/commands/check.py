@@ -108,7 +108,8 @@ def _options(args: argparse.Namespace) -> dict[str, Any]:
     return {"impls": tuple(args.impl) or None, "states": args.states, "seed": args.seed,
             "floating": args.floating, "against": args.against, "isolate": not args.in_process,
             "limits": _limits(args), "derivatives": args.derivatives,
-            "actuators": not args.no_actuators, "say": None if args.quiet else say}
+            "actuators": not args.no_actuators, "say": None if args.quiet else say,
+            "given_states": args.states_file}
 
 
 def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
@@ -143,11 +144,15 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     if args.against is not None:
         inputs.model_path(str(args.against))
     inputs.states(args.states)
+    if args.states_file is not None:  # what the file alone can say, before any engine
+        from dyncheck.check.given_states import given
+
+        given(args.states_file, most=inputs.MAX_STATES)
     if args.seed < 0:
         raise InvalidInput("--seed", args.seed, "a non-negative integer")
     check_out(args.out)
-    read = [p for p, _ in targets] + (
-        [args.against] if args.against is not None else [])
+    read = [p for p, _ in targets] + [f for f in (args.against, args.states_file)
+                                       if f is not None]
     ci_files(args, read)
     positive("--jobs", args.jobs)
     claim_out(args.out)  # every option checked: the folder held for this command
@@ -209,6 +214,11 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    "mujoco-warp, and newton, pybullet (repeatable; default: the first four; the "
                    "others only when named)")
     p.add_argument("--states", type=int, default=100, metavar="N", help="sampled states")
+    p.add_argument("--states-file", type=path_arg, default=None, metavar="FILE",
+                   help="check at these states instead of sampled ones: a .npz with arrays q "
+                   "(n, nq) and v (n, nv), or a .npy of q then v per row, in the canonical "
+                   "layout the page names (MuJoCo's qpos and qvel order for a file MuJoCo "
+                   "loads); accelerations drawn with --seed")
     p.add_argument("--seed", type=int, default=0, metavar="S")
     p.add_argument("--floating", action="store_true",
                    help="a URDF's root link is a free body (a free joint in every engine)")

@@ -10,6 +10,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pandas as pd
+import pytest
 
 from dyncheck.__main__ import main
 
@@ -36,7 +37,16 @@ def test_check_writes_junit_and_json_that_agree_with_its_csv(tmp_path):
     suites = {s.get("name"): s for s in root.iter("testsuite")}
     assert set(suites) == {"heavy", "mixed"}
     failures = suites["heavy"].findall("testcase/failure")
-    assert failures and all("> tolerance" in f.get("message", "") for f in failures)
+    assert failures
+    rows = pd.read_csv(out / "heavy.csv", keep_default_na=False)
+    failed = rows[rows["verdict"] == "failed"]
+    for f in failures:  # each leads with the values it compares (#80), or the error
+        message = f.get("message", "")
+        assert any(message.startswith(f"{r.value_a} vs {r.value_b}") for r in
+                   failed.itertuples() if r.value_a != "" and r.value_b != "") \
+            or message.startswith("error "), message
+    reading = failed[(failed["value_a"] != "") & (failed["value_b"] != "")]
+    assert len(reading) >= 1  # the mass × 1.01: the two masses on the row
     assert int(root.get("failures")) == len(root.findall(".//failure")) >= 1
     rows = pd.concat([pd.read_csv(out / "heavy.csv"), pd.read_csv(out / "mixed.csv")])
     data = json.loads(summary.read_text())
@@ -70,6 +80,13 @@ def test_run_writes_junit_per_case(tmp_path):
     rows = pd.read_csv(out / "discrepancies.csv")
     assert int(root.get("tests")) == len(rows.groupby(
         ["quantity", "impl_a", "impl_b", "integrator", "dt"], dropna=False))
+    # #80: an explained row was a plain pass; its cause (the row's note in the CSV the same
+    # command wrote) is now in its test case's system-out
+    explained = rows[rows["verdict"] == "explained"]
+    assert len(explained) >= 1
+    said = "\n".join(e.text or "" for e in root.iter("system-out"))
+    for note in explained["note"]:
+        assert note in said
 
 
 def test_a_refused_model_is_a_failed_test_case(tmp_path):
@@ -90,3 +107,53 @@ def test_a_refused_model_is_a_failed_test_case(tmp_path):
     failure = suites["broken"].find("testcase/failure")
     assert failure is not None and "broken.xml" in failure.get("message", "")
     assert int(root.get("failures")) >= 1
+
+
+def _full_urdf() -> str:
+    return (MODELS / "branches.urdf").read_text()
+
+
+def test_json_to_standard_output_follows_the_schema(tmp_path, capsys):
+    """#80: ``--json -`` writes the summary alone on standard output (the command's lines on
+    stderr), and the summary validates against the JSON Schema dyncheck ships — checked by
+    ``jsonschema`` (an independent validator), on check and run output alike; a summary
+    without its version field does not validate."""
+    import jsonschema
+
+    from dyncheck.ci_outputs import schema
+
+    model = tmp_path / "m.urdf"
+    model.write_text(_full_urdf())
+    code = main(["check", str(model), "--states", "3", "--impl", "reference", "--impl",
+                 "mujoco", "--out", str(tmp_path / "o"), "--json", "-"])
+    assert code == 0
+    captured = capsys.readouterr()
+    data = json.loads(captured.out)
+    assert "-> " in captured.err  # the summary line went to stderr
+    jsonschema.Draft202012Validator.check_schema(schema())
+    jsonschema.validate(data, schema())
+    assert data["schema_version"] == 1 and data["command"] == "check"
+    assert data["seconds"]["m"] > 0
+    main(["run", "simple_pendulum", "--impl", "reference", "--impl", "mujoco", "--out",
+          str(tmp_path / "r"), "--json", str(tmp_path / "r.json")])
+    jsonschema.validate(json.loads((tmp_path / "r.json").read_text()), schema())
+    del data["schema_version"]
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(data, schema())
+
+
+def test_check_test_cases_carry_their_engines_time(tmp_path):
+    """#80: test cases had no time. Each test case now carries its share of the seconds its
+    engines took (each engine's time split among the groups comparing it): positive, adding
+    up to the suite's time, which is at most the model's whole measured time (the JSON's,
+    which also counts loading and the referee)."""
+    model = tmp_path / "m.urdf"
+    model.write_text(_full_urdf())
+    junit, summary = tmp_path / "r.xml", tmp_path / "r.json"
+    main(["check", str(model), "--states", "3", "--impl", "reference", "--impl", "mujoco",
+          "--out", str(tmp_path / "o"), "--junit", str(junit), "--json", str(summary)])
+    suite = ET.parse(junit).getroot().find("testsuite")
+    times = [float(c.get("time")) for c in suite.iter("testcase") if c.get("time")]
+    assert times and all(t > 0 for t in times)
+    assert sum(times) == pytest.approx(float(suite.get("time")), abs=1e-3)
+    assert float(suite.get("time")) <= json.loads(summary.read_text())["seconds"]["m"] + 1e-3

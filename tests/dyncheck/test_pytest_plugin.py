@@ -41,5 +41,25 @@ def test_the_plugin_checks_models_named_on_the_command_line(tmp_path):
     assert "2 passed" in good.stdout  # the fixture's test and the model's
     bad = _pytest(project, "--dyncheck-model", "robots/heavy.urdf", "--dyncheck-states", "5")
     assert bad.returncode == 1, bad.stdout + bad.stderr
-    assert "dyncheck[robots/heavy.urdf]" in bad.stdout
+    assert "robots/heavy.urdf::dyncheck" in bad.stdout
     assert "differences found" in bad.stdout and "mass" in bad.stdout
+
+
+def test_the_plugin_s_tests_are_selected_and_counted_as_pytest_s_own(tmp_path):
+    """#80: the items were added after pytest had counted and filtered: ``-k`` said "-1
+    selected" and their node ids had no file part. Expected (pytest's own counting, read
+    from its output): with two models and one test function, ``-k good`` selects the good
+    model and the test function whose name says good (2 of 3); ``--collect-only`` lists
+    each model as ``PATH::dyncheck``; the JUnit XML pytest writes names the file."""
+    project = _project(tmp_path)
+    models = ("--dyncheck-model", "robots/good.urdf", "--dyncheck-model", "robots/heavy.urdf",
+              "--dyncheck-floating", "--dyncheck-states", "5")
+    listed = _pytest(project, *models, "--collect-only")
+    assert "robots/good.urdf::dyncheck" in listed.stdout
+    assert "robots/heavy.urdf::dyncheck" in listed.stdout
+    assert "3 tests collected" in listed.stdout, listed.stdout
+    chosen = _pytest(project, *models, "-k", "good", "--junitxml", "out.xml")
+    assert chosen.returncode == 0, chosen.stdout + chosen.stderr
+    assert "2 passed, 1 deselected" in chosen.stdout, chosen.stdout
+    junit = (project / "out.xml").read_text()
+    assert 'name="dyncheck"' in junit and "good.urdf" in junit
