@@ -120,7 +120,7 @@ def test_the_readmes_counts_are_the_committed_reports():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     counts = r"(\d+) passed, (\d+) explained, (\d+) failed, (\d+) skipped"
     first = re.search(r"\$ dyncheck run\n.*\n\s+" + counts, text)
-    second = re.search(r"\$ dyncheck run --accelerators\n\s+" + counts, text)
+    second = re.search(r"\$ dyncheck run --accelerators --out reports\n\s+" + counts, text)
     assert first and second
     rows = pd.read_csv(ROOT / "reports" / "discrepancies.csv")
     ports = rows.impl_a.isin(ACCELERATORS) | rows.impl_b.isin(ACCELERATORS)
@@ -140,8 +140,8 @@ def test_the_readmes_timings_are_the_command_timings_page():
 
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     timed = pd.read_csv(ROOT / "reports" / "benchmark-suite.csv").set_index("command")
-    first = re.search(r"(\d+) s on two cores, the install included", text)
-    second = re.search(r"(\d+) s on two CPU cores, where they compile", text)
+    first = re.search(r"(\d+) s on two cores, the install\s+included", text)
+    second = re.search(r"(\d+) s on two CPU cores,\s+where they compile", text)
     assert first and second
     main = timed.loc[f"{MAIN} in all (install and run), empty caches", "seconds"]
     second_run = next(c for c in timed.index if c.startswith(f"{SECOND}: its run"))
@@ -262,7 +262,42 @@ def test_the_readmes_main_command_installs_the_extras_the_suite_times():
                      if "pip install" in line][:2]
     for line, extras, command in ((first, MAIN_EXTRAS, "dyncheck run"),
                                   (second, (*MAIN_EXTRAS, *ACCELERATOR_EXTRAS),
-                                   "dyncheck run --accelerators")):
+                                   "dyncheck run --accelerators --out reports")):
         found = re.search(r'-e "\.\[([a-z,]+)\]"', line)
         assert found is not None and line.endswith(command)
         assert tuple(found.group(1).split(",")) == extras
+
+
+PENDULUM = ('<mujoco model="arm"><worldbody><body name="b" pos="0 0 1"><joint name="j" '
+            'type="hinge" axis="0 1 0"/><inertial pos="0 0 -0.2" mass="1" '
+            'diaginertia="0.02 0.02 0.002"/></body></worldbody></mujoco>')
+
+
+def test_the_readme_s_python_example_runs(tmp_path, monkeypatch):
+    """#80: the Python API's example in the README, executed as written (on an ``arm.xml``
+    written here: a one-hinge pendulum, nq = nv = 1 as the example says)."""
+    text = (ROOT / "README.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)
+    example = next(b for b in blocks if "from dyncheck import check_model" in b)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "arm.xml").write_text(PENDULUM)
+    with contextlib.redirect_stdout(io.StringIO()) as out:
+        exec(compile(example, "README.md", "exec"), {})
+    assert out.getvalue().startswith("True ")
+
+
+def test_the_default_output_folder_is_git_ignored_and_not_the_committed_report():
+    """#80: the README's first command rewrote the committed reports/ (60 tracked files
+    changed). Its default folder is now one that git ignores (git itself says so)."""
+    import subprocess
+
+    from dyncheck.commands.options import OUT
+
+    assert OUT.parts[0] != "reports"
+    for command in ("run", "check", "bench", "tutorials"):
+        args = _parser().parse_args([command] + (["m.xml"] if command == "check" else []))
+        assert Path(args.out).parts[0] == OUT.parts[0], command
+    done = subprocess.run(["git", "check-ignore", "-q", f"{OUT}/README.md"], cwd=ROOT)
+    if done.returncode == 128:
+        pytest.skip("not a git checkout")
+    assert done.returncode == 0

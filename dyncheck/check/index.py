@@ -54,10 +54,25 @@ def in_folder(folder: Path) -> list[Path]:
             if len(candidates) > MAX_MODELS:
                 raise InvalidInput("PATH", str(folder), f"a folder of at most {MAX_MODELS} "
                                    "model files")
-    included = {(path.parent / i.get("file", "")).resolve() for path, root in candidates
-                if root is not None and root.tag == ROOT_TAG[Format.MJCF]
-                for i in root.iter("include")}
-    return [p for p, _ in candidates if p.resolve() not in included]
+    found = included(candidates)
+    return [p for p, _ in candidates if p.resolve() not in found]
+
+
+def included(candidates: list[tuple[Path, ET.Element | None]]) -> set[Path]:
+    """The files the MJCF files among ``candidates`` (path, parsed root) ``<include>``."""
+    return {(path.parent / i.get("file", "")).resolve() for path, root in candidates
+            if root is not None and root.tag == ROOT_TAG[Format.MJCF]
+            for i in root.iter("include")}
+
+
+def without_fragments(paths: list[Path]) -> list[Path]:
+    """``paths`` less the files that another model file beside one of them (in its folder)
+    or among them includes — MJCF fragments (materials, assets, shared bodies) a pre-commit
+    hook is handed when they change, which are no model of their own."""
+    beside = {f for p in paths if p.parent.is_dir() for f in p.parent.iterdir()
+              if f.suffix.lower() in MODEL_SUFFIXES and f.is_file() and not f.is_symlink()}
+    found = included([(f, _root(f)) for f in sorted(beside | set(paths))])
+    return [p for p in paths if p.resolve() not in found]
 
 
 RESERVED = (INDEX,)

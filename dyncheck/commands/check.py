@@ -62,6 +62,11 @@ def _check_targets(args: argparse.Namespace, cases: Path) -> list[tuple[Path, st
             targets += [(p, None) for p in found]
         else:
             targets.append((path, None))
+    if args.skip_included:
+        kept = set(index.without_fragments([p for p, _ in targets]))
+        targets = [(p, r) for p, r in targets if p in kept]
+        if not targets and not args.robot and not args.case:
+            return []
     robots = list(inputs.robots()) if "all" in args.robot else args.robot
     targets += [(inputs.robot(name), name) for name in robots]
     targets += _case_files(args.case, cases)
@@ -100,7 +105,11 @@ def _without(message: str, path: Path) -> str:
 
 def check_command(args: argparse.Namespace) -> int:
     with tempfile.TemporaryDirectory(prefix="dyncheck-cases-") as cases:
-        return _check_all(args, _check_targets(args, Path(cases)), Path(cases))
+        targets = _check_targets(args, Path(cases))
+        if not targets:  # --skip-included, and every file given is a fragment
+            print("no model to check: every file given is included by another model file")
+            return 0
+        return _check_all(args, targets, Path(cases))
 
 
 def _options(args: argparse.Namespace) -> dict[str, Any]:
@@ -214,6 +223,9 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    "mujoco-warp, and newton, pybullet (repeatable; default: the first four; the "
                    "others only when named)")
     p.add_argument("--states", type=int, default=100, metavar="N", help="sampled states")
+    p.add_argument("--skip-included", action="store_true",
+                   help="leave out a file given that another model file beside it includes "
+                   "(an MJCF fragment: what a pre-commit hook is handed when it changes)")
     p.add_argument("--states-file", type=path_arg, default=None, metavar="FILE",
                    help="check at these states instead of sampled ones: a .npz with arrays q "
                    "(n, nq) and v (n, nv), or a .npy of q then v per row, in the canonical "
