@@ -401,6 +401,12 @@ def close_all() -> None:
             proxy.close(hung=True)
 
 
+IN_PROCESS_NOTE = (
+    "The engines ran in the checking process, not each in its own: a daemonic worker (a dask "
+    "worker's default) cannot start processes, so an engine crashing on this file would take "
+    "the worker with it (start the workers with distributed.worker.daemon set to False)."
+)
+
 
 def can_isolate() -> bool:
     """Whether this process may start engine processes: a daemonic process (a worker of a

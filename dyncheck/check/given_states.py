@@ -13,6 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from dyncheck.adapters.layout import Canonical
+from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.check.sampling import sample, sampled_note
 from dyncheck.check.states import States
 from dyncheck.errors import InvalidInput
 from dyncheck.vocabulary import JointType
@@ -80,11 +82,13 @@ def _unit_quaternions(q: np.ndarray, canon: Canonical) -> None:
                                f"{UNIT:g}) in columns {at}..{at + 3}")
 
 
-def given(value: object, *, most: int) -> GivenStates:
+def given(value: object, *, most: int) -> GivenStates | None:
     """``value`` — a :class:`GivenStates`, a pair ``(q, v)`` of arrays, or the path of a
     ``.npz`` file holding arrays ``q`` and ``v`` or a ``.npy`` file of one (n, nq + nv)
     array — read and checked for what it can say alone: finite, 2-D, at most ``most``
-    states."""
+    states (None: none given)."""
+    if value is None:
+        return None
     if isinstance(value, GivenStates):
         found = value
     elif isinstance(value, tuple) and len(value) == 2:
@@ -137,3 +141,12 @@ def _read(path: Path) -> GivenStates:
         raise InvalidInput(FLAG, f"arrays {sorted(arrays)}", "a .npz holding arrays 'q' and "
                            "'v' alone")
     return GivenStates(q=_array("q", arrays["q"]), v=_array("v", arrays["v"]), source=source)
+
+
+def check_states(given: GivenStates | None, canon: Canonical, tree: ModelTree, n: int,
+                 seed: int) -> tuple[States, int, str]:
+    """The check's states — those ``given``, else ``n`` sampled — their count and the page's
+    note on them."""
+    if given is None:
+        return sample(canon, tree, n, seed), n, sampled_note(canon, tree)
+    return given.states(canon, seed), given.n, given.note()

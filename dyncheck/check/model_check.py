@@ -46,11 +46,10 @@ from dyncheck.check.dynamics import (
     tie_row,
 )
 from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
-from dyncheck.check.given_states import GivenStates
+from dyncheck.check.given_states import GivenStates, check_states
 from dyncheck.check.given_states import given as given_states_of
 from dyncheck.check.referee import ReferenceModel, standing_of
 from dyncheck.check.rows import COLUMNS, CheckResult, CheckRow, Section
-from dyncheck.check.sampling import sample, sampled_note
 from dyncheck.check.states import States, condition
 from dyncheck.errors import InvalidInput, UnknownName
 from dyncheck.escaping import shown
@@ -74,12 +73,6 @@ SMOOTH_NOTE = (
 
 SAY_AFTER_S = 10.0
 """A derivative check expected to take longer than this is announced with its estimate."""
-
-IN_PROCESS_NOTE = (
-    "The engines ran in the checking process, not each in its own: a daemonic worker (a dask "
-    "worker's default) cannot start processes, so an engine crashing on this file would take "
-    "the worker with it (start the workers with distributed.worker.daemon set to False)."
-)
 
 
 def implementations(impls: tuple[str, ...] | None) -> tuple[str, ...]:
@@ -124,14 +117,10 @@ def check_model(
     (:mod:`dyncheck.check.engines`). ``derivatives`` adds the derivatives' rows
     (:mod:`dyncheck.check.derivatives`), ``actuators`` the actuation section where the model has
     actuators (:mod:`dyncheck.check.actuation`), ``say`` hears the estimate of a derivative check
-    that will take a while (the command's progress). ``given_states``: the states to check at
-    instead of sampled ones — a pair ``(q, v)`` of arrays (n, nq) and (n, nv), or the path of a
-    ``.npz`` (arrays ``q``, ``v``) or ``.npy`` (n, nq + nv) file — in the canonical layout the
-    page names (MuJoCo's ``qpos``/``qvel`` order for a file MuJoCo loads;
-    :mod:`dyncheck.check.given_states`)."""
+    that will take a while (the command's progress), ``given_states`` the states to check at
+    instead of sampled ones (:func:`~dyncheck.check.given_states.given`)."""
     source_path = inputs.model_path(str(path))
-    given = None if given_states is None else given_states_of(given_states,
-                                                               most=inputs.MAX_STATES)
+    given = given_states_of(given_states, most=inputs.MAX_STATES)
     against_path = inputs.model_path(str(against)) if against is not None else None
     inputs.states(states)
     chosen = implementations(impls)
@@ -143,7 +132,7 @@ def check_model(
     inputs.massive(source_path, source)
     if isolate and not engine_processes.can_isolate():
         isolate = False
-        source = replace(source, notes=(*source.notes, IN_PROCESS_NOTE))
+        source = replace(source, notes=(*source.notes, engine_processes.IN_PROCESS_NOTE))
     t0 = time.perf_counter()
     engines = engine_processes.start([i for i in chosen if i in ENGINES], source,
                                      isolate=isolate, limits=limits)
@@ -184,12 +173,8 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
         rows.extend(_against(model, canonical_tree, read(against_path, floating=floating)))
     canon = layout.canonical(canonical_tree)
     parts, unmatched = _parts(canon, canonical_tree, loaded, notes)
-    if given is None:
-        batch = sample(canon, canonical_tree, states, seed)
-        notes.append(sampled_note(canon, canonical_tree))
-    else:
-        batch, states = given.states(canon, seed), given.n
-        notes.append(given.note())
+    batch, states, said = check_states(given, canon, canonical_tree, states, seed)
+    notes.append(said)
     own: dict[str, readings.Reading] = {}
     results = _dynamics(model, canon, canonical_tree, batch, loaded, parts, unmatched,
                         with_referee=REFEREE in chosen, rows=rows, seconds=seconds, own=own)

@@ -253,7 +253,7 @@ def test_a_daemonic_worker_checks_in_process_and_says_so():
     notes say that a crash would not be contained."""
     import multiprocessing as mp
 
-    from dyncheck.check.model_check import IN_PROCESS_NOTE
+    from dyncheck.check.engines import IN_PROCESS_NOTE
 
     isolated = check_model(MODELS / "mixed.xml", states=10, impls=("reference", "mujoco"))
     here = mp.current_process()
