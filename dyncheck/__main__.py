@@ -122,7 +122,8 @@ def _main(argv: Sequence[str] | None) -> int:
         _address_space(args)
         # handed to every unit of work (dyncheck.settings), with the compiled-code folder
         # checked before any engine runs and signed when the command ends
-        with held(settings_of(args)) as settings, settled(settings), json_on_stdout(args):
+        with held(settings_of(args)) as settings, settled(settings), \
+                json_on_stdout(vars(args).get("json")):
             return COMMANDS[args.command].handler(args)
     except DyncheckError as exc:
         print(f"dyncheck: error: {one_line(str(exc))}", file=sys.stderr)

@@ -79,7 +79,7 @@ def _failure(values: dict[str, object], columns: Columns) -> str:
     return head + (f": {detail}" if detail else "")
 
 
-def _case(name: str, suite: str, rows: pd.DataFrame, columns: Columns,
+def _case(name: str, suite: str, rows: pd.DataFrame, columns: Columns, *,
           seconds: float | None = None) -> TestCase:
     case = TestCase(name, classname=f"dyncheck.{suite}", time=seconds)
     failed = rows[rows["verdict"] == Verdict.FAILED.value]
@@ -113,7 +113,7 @@ def _shares(keys: list[tuple[object, ...]], columns: Columns,
 
 
 def junit(tables: dict[str, pd.DataFrame], columns: Columns,
-          refused: dict[str, str] | None = None,
+          refused: dict[str, str] | None = None, *,
           seconds: dict[str, dict[str, float]] | None = None) -> JUnitXml:
     """One suite per table (a case, a model), one test case per group of rows; a refused
     model (bad input: no rows) one suite of one failed test case, its reason the message.
@@ -137,7 +137,7 @@ def junit(tables: dict[str, pd.DataFrame], columns: Columns,
         shares = _shares([k for k, _ in groups], columns, (seconds or {}).get(suite_name))
         for (keys, group), share in zip(groups, shares, strict=True):
             suite.add_testcase(_case(_name(keys, columns.group), suite_name, group, columns,
-                                     share))
+                                     seconds=share))
         suite.update_statistics()
         xml.add_testsuite(suite)
     xml.update_statistics()
@@ -149,10 +149,10 @@ def split(rows: pd.DataFrame, columns: Columns) -> dict[str, pd.DataFrame]:
     return {str(k): g for k, g in rows.groupby(columns.suite, sort=False)}
 
 
-def write_junit(path: Path, tables: dict[str, pd.DataFrame], columns: Columns,
+def write_junit(path: Path, tables: dict[str, pd.DataFrame], columns: Columns, *,
                 refused: dict[str, str] | None = None,
                 seconds: dict[str, dict[str, float]] | None = None) -> None:
-    text = junit(tables, columns, refused, seconds).tostring()
+    text = junit(tables, columns, refused, seconds=seconds).tostring()
     write_atomic(path, text.decode() if isinstance(text, bytes) else text)
 
 
@@ -197,11 +197,11 @@ _STDOUT: list[TextIO] = []
 
 
 @contextmanager
-def json_on_stdout(args: object) -> Iterator[None]:
+def json_on_stdout(path: Path | None) -> Iterator[None]:
     """With ``--json -``, standard output kept for the JSON alone while the block runs:
     everything else the command prints goes to standard error (a pipe into ``jq`` reads one
     document)."""
-    if getattr(args, "json", None) != STDOUT:
+    if path != STDOUT:
         yield
         return
     _STDOUT.append(sys.stdout)
@@ -212,8 +212,8 @@ def json_on_stdout(args: object) -> Iterator[None]:
         sys.stdout = _STDOUT.pop()
 
 
-def write_json(path: Path, tables: dict[str, pd.DataFrame], versions: dict[str, str],
-               refused: dict[str, str] | None = None, *, command: str = "",
+def write_json(path: Path, tables: dict[str, pd.DataFrame], versions: dict[str, str], *,
+               refused: dict[str, str] | None = None, command: str = "",
                seconds: dict[str, dict[str, float]] | None = None) -> None:
     text = json.dumps(summary(tables, versions, refused, command=command, seconds=seconds),
                       indent=1) + "\n"

@@ -10,8 +10,7 @@ import re
 from pathlib import Path
 from typing import Any
 
-from dyncheck.errors import DyncheckError, EngineNotInstalled, UnknownName
-from dyncheck.installation import ROOT, needs_checkout
+from dyncheck.errors import ROOT, DyncheckError, EngineNotInstalled, NeedsCheckout, UnknownName
 from dyncheck.results import write_atomic
 
 FOLDER = ROOT / "tutorials"
@@ -25,8 +24,9 @@ class TutorialFailed(DyncheckError):
 
 def available() -> dict[str, Path]:
     """Tutorial name (file stem) → path, in reading order (the sources are a checkout's:
-    :class:`~dyncheck.installation.NeedsCheckout` from an installed package)."""
-    needs_checkout("dyncheck tutorials (the tutorials' sources and the models they read)")
+    :class:`~dyncheck.errors.NeedsCheckout` from an installed package)."""
+    NeedsCheckout.unless_checkout("dyncheck tutorials (the tutorials' sources and the models "
+                                  "they read)")
     return {p.stem: p for p in sorted(FOLDER.glob("[0-9][0-9]_*.py"))}
 
 

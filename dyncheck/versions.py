@@ -34,8 +34,7 @@ import pandas as pd
 from dyncheck import diff, reproduced
 from dyncheck.adapters import REGISTRY, Needs
 from dyncheck.cache.store import cache_root
-from dyncheck.errors import DyncheckError, InvalidInput, UnknownName
-from dyncheck.installation import ROOT
+from dyncheck.errors import ROOT, DyncheckError, InvalidInput, UnknownName
 from dyncheck.progress import Progress
 from dyncheck.settings import current
 from dyncheck.vocabulary import Verdict

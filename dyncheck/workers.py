@@ -90,7 +90,7 @@ def executor(jobs: int = 1, dask: str | None = None) -> Iterator[Executor | None
     try:
         from distributed import Client, LocalCluster
     except ImportError:
-        from dyncheck.installation import install_hint
+        from dyncheck.errors import install_hint
 
         raise InvalidInput(
             "--dask", dask, "used with the extra 'dask' installed (" + install_hint("dask") + ")"

@@ -143,7 +143,7 @@ def _read(path: Path) -> GivenStates:
     return GivenStates(q=_array("q", arrays["q"]), v=_array("v", arrays["v"]), source=source)
 
 
-def check_states(given: GivenStates | None, canon: Canonical, tree: ModelTree, n: int,
+def check_states(given: GivenStates | None, canon: Canonical, tree: ModelTree, *, n: int,
                  seed: int) -> tuple[States, int, str]:
     """The check's states — those ``given``, else ``n`` sampled — their count and the page's
     note on them."""

@@ -178,7 +178,7 @@ def robots() -> dict[str, Path]:
 def robot(name: str) -> Path:
     available = robots()
     if not available:
-        from dyncheck.installation import install_hint
+        from dyncheck.errors import install_hint
 
         raise InvalidInput(
             "--robot", name, "a robot of example-robot-data: " + install_hint("robots")

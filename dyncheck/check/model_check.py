@@ -173,8 +173,8 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
         rows.extend(_against(model, canonical_tree, read(against_path, floating=floating)))
     canon = layout.canonical(canonical_tree)
     parts, unmatched = _parts(canon, canonical_tree, loaded, notes)
-    batch, states, said = check_states(given, canon, canonical_tree, states, seed)
-    notes.append(said)
+    batch, states, drawn = check_states(given, canon, canonical_tree, n=states, seed=seed)
+    notes.append(drawn)
     own: dict[str, readings.Reading] = {}
     results = _dynamics(model, canon, canonical_tree, batch, loaded, parts, unmatched,
                         with_referee=REFEREE in chosen, rows=rows, seconds=seconds, own=own)

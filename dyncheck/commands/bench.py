@@ -22,9 +22,10 @@ def bench_command(args: argparse.Namespace) -> int:
 
     check_out(args.out)
     if args.suite:
-        from dyncheck.installation import needs_checkout
+        from dyncheck.errors import NeedsCheckout
 
-        needs_checkout("dyncheck bench --suite (it times the README's commands in the checkout)")
+        NeedsCheckout.unless_checkout("dyncheck bench --suite (it times the README's commands "
+                                      "in the checkout)")
         claim_out(args.out)
         from dyncheck.bench import suite as bench_suite
 

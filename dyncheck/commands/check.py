@@ -121,6 +121,22 @@ def _options(args: argparse.Namespace) -> dict[str, Any]:
             "given_states": args.states_file}
 
 
+def _named(targets: list[tuple[Path, str | None]], cases: Path
+           ) -> tuple[list[str], dict[str, str]]:
+    """Each target's page name (:func:`~dyncheck.check.index.page_names`) and what the index
+    calls its file: a robot's name, a book case's, or the path below the files' common
+    folder."""
+    from dyncheck.check import index
+    from dyncheck.escaping import shown
+
+    names = index.page_names([p for p, _ in targets], [robot for _, robot in targets])
+    base = index.common_folder([p for p, _ in targets])
+    files = {name: f"robot {robot}" if robot else f"book case {p.stem}" if p.parent == cases
+             else shown(str(p.resolve().relative_to(base)))
+             for (p, robot), name in zip(targets, names, strict=True)}
+    return names, files
+
+
 def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
                cases: Path) -> int:
     from functools import partial
@@ -128,16 +144,11 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     from dyncheck.check import index, inputs
     from dyncheck.check.model_check import check_model, implementations
     from dyncheck.check.page import summary_line, write
-    from dyncheck.escaping import shown
     from dyncheck.progress import Progress
     from dyncheck.workers import each_unit
 
-    names = index.page_names([p for p, _ in targets], [robot for _, robot in targets])
+    names, files = _named(targets, cases)
     several = len(targets) > 1
-    base = index.common_folder([p for p, _ in targets])
-    files = {name: f"robot {robot}" if robot else f"book case {p.stem}" if p.parent == cases
-             else shown(str(p.resolve().relative_to(base)))
-             for (p, robot), name in zip(targets, names, strict=True)}
     entries: list[index.Entry] = []
     valid = []
     for (path, robot), name in zip(targets, names, strict=True):  # all before any engine runs
@@ -204,7 +215,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
         from dyncheck.ci_outputs import CHECK
 
         write_ci(args, tables, CHECK, engine_versions_of(implementations(
-            tuple(args.impl) or None)), refused, seconds)
+            tuple(args.impl) or None)), refused=refused, seconds=seconds)
     return 2 if refusals else 1 if failed else 0
 
 

@@ -5,8 +5,7 @@ from __future__ import annotations
 import argparse
 
 from dyncheck.commands.flags import Command
-from dyncheck.errors import EngineNotInstalled
-from dyncheck.installation import install_hint
+from dyncheck.errors import EngineNotInstalled, install_hint
 
 
 def installed_version(package: str) -> str | None:

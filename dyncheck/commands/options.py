@@ -58,17 +58,17 @@ def ci_files(args: argparse.Namespace, inputs: Sequence[Path] = ()) -> None:
 
 
 def write_ci(args: argparse.Namespace, tables: dict[str, pd.DataFrame], columns: Columns,
-             versions: dict[str, str], refused: dict[str, str] | None = None,
+             versions: dict[str, str], *, refused: dict[str, str] | None = None,
              seconds: dict[str, dict[str, float]] | None = None) -> None:
     """The ``--junit`` and ``--json`` files of a command's tables (``seconds``: per table,
     what each engine took, where the command measured it)."""
     from dyncheck import ci_outputs
 
     if args.junit is not None:
-        ci_outputs.write_junit(args.junit, tables, columns, refused, seconds)
+        ci_outputs.write_junit(args.junit, tables, columns, refused=refused, seconds=seconds)
     if args.json is not None:
-        ci_outputs.write_json(args.json, tables, versions, refused, command=args.command,
-                              seconds=seconds)
+        ci_outputs.write_json(args.json, tables, versions, refused=refused,
+                              command=args.command, seconds=seconds)
 
 
 def check_out(out: Path, flag: str = "--out") -> None:

@@ -16,12 +16,12 @@ def versions_command(args: argparse.Namespace) -> int:
     """Exit 0 (the matrix reports moves; it does not judge them)."""
     from dyncheck import versions
     from dyncheck.cases import get_case
+    from dyncheck.errors import NeedsCheckout
     from dyncheck.explain.releases import EXPLANATIONS
-    from dyncheck.installation import needs_checkout
     from dyncheck.results import write_atomic
 
-    needs_checkout("dyncheck versions (each release is installed beside the checkout's code, "
-                   "pinned by its constraints.txt)")
+    NeedsCheckout.unless_checkout("dyncheck versions (each release is installed beside the "
+                                  "checkout's code, pinned by its constraints.txt)")
     positive("--jobs", args.jobs)
     for name in args.case:
         get_case(name)

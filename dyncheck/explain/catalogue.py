@@ -148,7 +148,7 @@ def _run(name: str) -> Entry:
         except (EngineNotInstalled, importlib.metadata.PackageNotFoundError):
             why = f"{engine} is not installed (pip install {ENGINE_PACKAGES[engine]})"
             if engine in ENGINE_EXTRAS:
-                from dyncheck.installation import install_hint
+                from dyncheck.errors import install_hint
 
                 extra = ENGINE_EXTRAS[engine]
                 why = f"{engine} is not installed ({install_hint(extra)})"

@@ -50,7 +50,7 @@ TUTORIALS: dict[str, str] = {
 def tutorial_where(name: str) -> str:
     """Where a reader finds tutorial ``name``: its rendered page in a checkout; installed,
     the command that renders it in one (the package holds no reports)."""
-    from dyncheck.installation import checkout
+    from dyncheck.errors import checkout
 
     if checkout() is not None:
         return f"reports/tutorials/{name}.md"

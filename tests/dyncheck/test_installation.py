@@ -1,5 +1,5 @@
 """Where dyncheck runs from and how an extra is installed there
-(:mod:`dyncheck.installation`). Expected values: the extras' requirements as
+(:func:`dyncheck.errors.checkout`, :func:`~dyncheck.errors.install_hint`). Expected values: the extras' requirements as
 ``pyproject.toml`` states them (read here with ``tomllib``, not through the installed
 metadata the code reads), and the commands' own exit codes."""
 
@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from dyncheck import installation
+from dyncheck import errors as installation
 from dyncheck.__main__ import main
 
 ROOT = Path(__file__).resolve().parents[2]
