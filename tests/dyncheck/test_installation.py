@@ -1,7 +1,7 @@
 """Where dyncheck runs from and how an extra is installed there
-(:func:`dyncheck.errors.checkout`, :func:`~dyncheck.errors.install_hint`). Expected values: the extras' requirements as
-``pyproject.toml`` states them (read here with ``tomllib``, not through the installed
-metadata the code reads), and the commands' own exit codes."""
+(:func:`dyncheck.errors.checkout`, :func:`~dyncheck.errors.install_hint`). Expected values:
+the extras' requirements as ``pyproject.toml`` states them (read here with ``tomllib``, not
+through the installed metadata the code reads), and the commands' own exit codes."""
 
 from __future__ import annotations
 
