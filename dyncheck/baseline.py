@@ -36,7 +36,11 @@ def write(discrepancies: pd.DataFrame, path: Path, versions: dict[str, str] | No
     """The baseline CSV under a header line naming its row count (a file cut short at a line
     end is still found truncated) and the versions that made it (so that a later mismatch
     says whether the code or an engine changed)."""
-    table = baseline_table(discrepancies)
+    write_table(baseline_table(discrepancies), path, versions)
+
+
+def write_table(table: pd.DataFrame, path: Path, versions: dict[str, str] | None) -> None:
+    """Any baseline table (a run's, a check's) under its header line, written whole."""
     items = {"rows": str(len(table)), **(versions or {})}
     head = HEADER + " " + " ".join(f"{_word(k)}={_word(v)}" for k, v in items.items())
     write_atomic(path, head + "\n" + to_csv(table))
@@ -46,7 +50,9 @@ def _word(text: str) -> str:
     return text.replace(" ", "_")
 
 
-def _header(path: Path) -> dict[str, str]:
+def header(path: Path) -> dict[str, str]:
+    """The items of a baseline's header line (``rows`` and the versions; empty without
+    one)."""
     with path.open(encoding="utf-8", errors="replace") as f:
         first = f.readline()
     if not first.startswith(HEADER):
@@ -56,7 +62,7 @@ def _header(path: Path) -> dict[str, str]:
 
 def versions_of(path: Path) -> dict[str, str]:
     """The versions a baseline was made with (empty when its header names none)."""
-    return {k: v for k, v in _header(path).items() if k != "rows"}
+    return {k: v for k, v in header(path).items() if k != "rows"}
 
 
 def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
@@ -89,7 +95,7 @@ def load(path: Path, flag: str = "--baseline") -> pd.DataFrame:
             str(path),
             f"a finite max_rel_err on every passed or explained row (data row {row})",
         )
-    expected = _header(path).get("rows")
+    expected = header(path).get("rows")
     if expected is not None and expected != str(len(frame)):
         raise InvalidInput(
             flag, str(path), f"{expected} rows as its header says ({len(frame)} found: truncated?)"

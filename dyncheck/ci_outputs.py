@@ -45,6 +45,16 @@ CHECK = Columns(suite="model", group=("section", "subject", "impl_a", "impl_b"),
                 error="error", tolerance="tolerance", detail=("field", "basis", "note"),
                 values=("value_a", "value_b"))
 
+@dataclass(frozen=True, kw_only=True)
+class Moves:
+    """A check against a stored baseline: its file, the versions that changed since, and
+    the rows that moved (:func:`dyncheck.check.baseline.compare`'s table)."""
+
+    file: str
+    versions_changed: tuple[str, ...]
+    rows: pd.DataFrame
+
+
 SCHEMA = "results.schema.json"
 """The JSON Schema of ``--json`` (in this package; ``schema_version`` names its version)."""
 SCHEMA_VERSION = 1
@@ -82,13 +92,17 @@ def _failure(values: dict[str, object], columns: Columns) -> str:
 def _case(name: str, suite: str, rows: pd.DataFrame, columns: Columns, *,
           seconds: float | None = None) -> TestCase:
     case = TestCase(name, classname=f"dyncheck.{suite}", time=seconds)
-    failed = rows[rows["verdict"] == Verdict.FAILED.value]
+    accepted = rows["accepted"].fillna("").astype(str).ne("") if "accepted" in rows \
+        else pd.Series(False, index=rows.index)
+    failed = rows[(rows["verdict"] == Verdict.FAILED.value) & ~accepted]
     explained = rows[rows["verdict"] == Verdict.EXPLAINED.value]
-    if not explained.empty:
-        case.system_out = "\n".join(
-            "explained: " + "; ".join(_text(v) for c in columns.detail
+    said = ["explained: " + "; ".join(_text(v) for c in columns.detail
                                       if _text(v := row._asdict().get(c)))
-            for row in explained.itertuples(index=False))
+            for row in explained.itertuples(index=False)]
+    said += [f"accepted: {_failure(row._asdict(), columns)} — {row.accepted}"
+             for row in rows[accepted].itertuples(index=False)]
+    if said:
+        case.system_out = "\n".join(said)
     if not failed.empty:
         lines = [_failure(row._asdict(), columns) for row in failed.itertuples(index=False)]
         case.result = [Failure(lines[0], "dyncheck")]
@@ -112,9 +126,25 @@ def _shares(keys: list[tuple[object, ...]], columns: Columns,
     return [round(sum(took[e] / groups[e] for e in p), 6) if p else None for p in pairs]
 
 
+def _baseline_suite(moves: Moves) -> TestSuite:
+    """One failed test case per row that moved against the baseline (one passed test case
+    where nothing moved)."""
+    suite = TestSuite("baseline")
+    for row in moves.rows.itertuples(index=False):
+        case = TestCase(f"{row.model}: {row.row}", classname="dyncheck.baseline")
+        case.result = [Failure(f"{row.move}: {row.note}", "moved")]
+        suite.add_testcase(case)
+    if moves.rows.empty:
+        suite.add_testcase(TestCase(f"nothing moved against {moves.file}",
+                                    classname="dyncheck.baseline"))
+    suite.update_statistics()
+    return suite
+
+
 def junit(tables: dict[str, pd.DataFrame], columns: Columns,
           refused: dict[str, str] | None = None, *,
-          seconds: dict[str, dict[str, float]] | None = None) -> JUnitXml:
+          seconds: dict[str, dict[str, float]] | None = None,
+          moves: Moves | None = None) -> JUnitXml:
     """One suite per table (a case, a model), one test case per group of rows; a refused
     model (bad input: no rows) one suite of one failed test case, its reason the message.
     ``seconds``: per suite, the seconds each engine (and step) took, where measured — a test
@@ -140,6 +170,8 @@ def junit(tables: dict[str, pd.DataFrame], columns: Columns,
                                      seconds=share))
         suite.update_statistics()
         xml.add_testsuite(suite)
+    if moves is not None:
+        xml.add_testsuite(_baseline_suite(moves))
     xml.update_statistics()
     return xml
 
@@ -151,25 +183,36 @@ def split(rows: pd.DataFrame, columns: Columns) -> dict[str, pd.DataFrame]:
 
 def write_junit(path: Path, tables: dict[str, pd.DataFrame], columns: Columns, *,
                 refused: dict[str, str] | None = None,
-                seconds: dict[str, dict[str, float]] | None = None) -> None:
-    text = junit(tables, columns, refused, seconds=seconds).tostring()
+                seconds: dict[str, dict[str, float]] | None = None,
+                moves: Moves | None = None) -> None:
+    text = junit(tables, columns, refused, seconds=seconds, moves=moves).tostring()
     write_atomic(path, text.decode() if isinstance(text, bytes) else text)
 
 
 def summary(tables: dict[str, pd.DataFrame], versions: dict[str, str],
             refused: dict[str, str] | None = None, *, command: str = "",
-            seconds: dict[str, dict[str, float]] | None = None) -> dict[str, object]:
+            seconds: dict[str, dict[str, float]] | None = None,
+            moves: Moves | None = None) -> dict[str, object]:
     """The counts overall and per suite, refusals with their reason, the versions, each
     suite's seconds where measured and every row (NaN as null), under :data:`SCHEMA`'s
-    version and dyncheck's."""
+    version and dyncheck's; against a baseline, what moved (``baseline``)."""
     from dyncheck.provenance import dyncheck_version
 
     every = pd.concat(list(tables.values())) if tables else pd.DataFrame({"verdict": []})
 
     def counts(rows: pd.DataFrame) -> dict[str, int]:
-        return {v.value: int((rows["verdict"] == v.value).sum()) for v in Verdict}
+        out = {v.value: int((rows["verdict"] == v.value).sum()) for v in Verdict}
+        if "accepted" in rows:
+            accepted = int(rows["accepted"].fillna("").astype(str).ne("").sum())
+            if accepted:
+                out[Verdict.FAILED.value] -= accepted
+                out["accepted"] = accepted
+        return out
 
     rows = json.loads(every.to_json(orient="records")) if len(every) else []
+    extra: dict[str, object] = {} if moves is None else {"baseline": {
+        "file": moves.file, "versions_changed": list(moves.versions_changed),
+        "moved": json.loads(moves.rows.to_json(orient="records"))}}
     return {"schema_version": SCHEMA_VERSION,
             "dyncheck": dyncheck_version(),
             "command": command,
@@ -179,7 +222,8 @@ def summary(tables: dict[str, pd.DataFrame], versions: dict[str, str],
                         if name in tables},
             "refused": refused or {},
             "versions": versions,
-            "rows": rows}
+            "rows": rows,
+            **extra}
 
 
 def schema() -> dict[str, object]:
@@ -214,9 +258,10 @@ def json_on_stdout(path: Path | None) -> Iterator[None]:
 
 def write_json(path: Path, tables: dict[str, pd.DataFrame], versions: dict[str, str], *,
                refused: dict[str, str] | None = None, command: str = "",
-               seconds: dict[str, dict[str, float]] | None = None) -> None:
-    text = json.dumps(summary(tables, versions, refused, command=command, seconds=seconds),
-                      indent=1) + "\n"
+               seconds: dict[str, dict[str, float]] | None = None,
+               moves: Moves | None = None) -> None:
+    text = json.dumps(summary(tables, versions, refused, command=command, seconds=seconds,
+                              moves=moves), indent=1) + "\n"
     if path == STDOUT:
         stream = _STDOUT[-1] if _STDOUT else sys.stdout
         stream.write(text)

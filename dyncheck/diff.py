@@ -56,6 +56,8 @@ class Move(StrEnum):
     IMPROVED = "improved"
     REGRESSED = "regressed"
     DEFINITION_CHANGED = "definition changed"
+    VALUE_CHANGED = "value changed"
+    """A reading's value changed, its verdict and error did not (a check baseline)."""
     APPEARED = "appeared"
     VANISHED = "vanished"
 

@@ -11,6 +11,13 @@ checks a model and asserts the same::
 
     def test_my_arm(dyncheck_model):
         result = dyncheck_model("robots/arm.xml", states=100)   # a CheckResult
+
+and ``dyncheck_baseline`` holds a model's rows to a baseline stored beside the test, as
+pytest-regressions' ``data_regression`` holds data (``--dyncheck-update-baseline`` accepts the
+new values)::
+
+    def test_my_arm_has_not_moved(dyncheck_baseline):
+        dyncheck_baseline("robots/arm.xml")   # tests/test_arm/test_my_arm_has_not_moved.csv
 """
 
 from __future__ import annotations
@@ -35,6 +42,9 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                     help="a URDF's root link is a free body")
     group.addoption("--dyncheck-states", type=int, default=DEFAULT_STATES, metavar="N",
                     help=f"sampled states per model (default {DEFAULT_STATES})")
+    group.addoption("--dyncheck-update-baseline", action="store_true",
+                    help="dyncheck_baseline writes each test's baseline from this run "
+                    "(accepting what moved) instead of comparing with it")
 
 
 def _check(path: str, **options: Any) -> Any:
@@ -103,3 +113,58 @@ def dyncheck_model() -> Callable[..., Any]:
     """``check(path, **options)``: :func:`~dyncheck.check.model_check.check_model` that fails
     the test with the failed rows, and returns the result otherwise."""
     return _check
+
+
+class BaselineMoved(AssertionError):
+    """A model whose rows moved against its stored baseline: the message names each row."""
+
+
+def baseline_file(node_path: Any, test_name: str) -> Any:
+    """Where a test's baseline lives: ``<test module's folder>/<module name>/<test>.csv``
+    (the test's name made one file name)."""
+    from dyncheck.escaping import file_name
+
+    return node_path.parent / node_path.stem / f"{file_name(test_name)}.csv"
+
+
+def _held(path: str, stored: Any, update: bool, **options: Any) -> Any:
+    """Check ``path`` and hold its rows to the baseline ``stored``: write it where it is
+    absent (and fail: a first baseline is to be looked at and committed) or ``update``; else
+    fail naming every row that moved."""
+    from dyncheck import baseline
+    from dyncheck.check import baseline as check_baseline
+    from dyncheck.check.model_check import check_model
+    from dyncheck.check.page import engine_versions_of
+    from dyncheck.provenance import dyncheck_version
+
+    __tracebackhide__ = True  # pytest shows the test's line and the message, not dyncheck
+    result = check_model(path, **options)
+    tables = {result.model: result.rows}
+    versions = {"dyncheck": dyncheck_version(), **engine_versions_of(result.impls)}
+    if update or not stored.exists():
+        stored.parent.mkdir(parents=True, exist_ok=True)
+        check_baseline.write(tables, stored, versions)
+        if not update:
+            raise BaselineMoved(f"no baseline for {path}: written to {stored} (look at it, "
+                                "commit it, and run again)")
+        return result
+    moved = check_baseline.compare(check_baseline.table(tables), check_baseline.load(stored))
+    if len(moved):
+        changed = baseline.version_changes(stored, versions)
+        lines = [f"{r.row}: {r.move}: {r.note}" for r in moved.itertuples(index=False)]
+        raise BaselineMoved(
+            f"dyncheck check {path}: {len(moved)} rows moved against {stored}"
+            + (f" (versions changed: {', '.join(changed)})" if changed else "")
+            + "\n" + "\n".join(lines) + "\n(--dyncheck-update-baseline accepts them)")
+    return result
+
+
+@pytest.fixture
+def dyncheck_baseline(request: pytest.FixtureRequest) -> Callable[..., Any]:
+    """``check(path, **options)``: :func:`~dyncheck.check.model_check.check_model`, its rows
+    held to the test's stored baseline (:func:`baseline_file`); returns the result."""
+    from functools import partial
+
+    stored = baseline_file(request.node.path, request.node.name)
+    update = bool(request.config.getoption("dyncheck_update_baseline"))
+    return partial(_held, stored=stored, update=update)

@@ -12,6 +12,7 @@ from pathlib import Path
 import pandas as pd
 
 from dyncheck.adapters.model_files import ROOT_TAG, Format
+from dyncheck.check import baseline
 from dyncheck.check.page import counts
 from dyncheck.check.rows import CheckResult
 from dyncheck.check.verdicts import Agreement, EngineVerdict, Reading, per_engine
@@ -75,9 +76,9 @@ def without_fragments(paths: list[Path]) -> list[Path]:
     return [p for p in paths if p.resolve() not in found]
 
 
-RESERVED = (INDEX,)
-"""Page names a model never gets: the index's own files (a model named ``index.xml`` in a
-folder would lose its page and CSV to the index)."""
+RESERVED = (INDEX, baseline.PAGE)
+"""Page names a model never gets: the index's own files and the baseline's page (a model
+named ``index.xml`` in a folder would lose its page and CSV to the index)."""
 
 
 def page_names(paths: list[Path], given: list[str | None] | None = None) -> list[str]:
@@ -150,7 +151,9 @@ class Entry:
     def outcome(self) -> str:
         if self.refused:
             return "refused"
-        return "differences found" if self.counts.get(Verdict.FAILED, 0) else "engines agree"
+        if self.counts.get(Verdict.FAILED, 0):
+            return "differences found"
+        return "known findings accepted" if self.counts.get("accepted", 0) else "engines agree"
 
 
 def entry(result: CheckResult, page: str, file: str) -> Entry:

@@ -56,14 +56,34 @@ def engine_versions_of(impls: tuple[str, ...]) -> dict[str, str]:
     return versions(used)
 
 
+ACCEPTED = "accepted"
+"""The count of failed rows an ``--accept`` entry accepts (named only where there are any)."""
+
+
 def counts(result: CheckResult) -> dict[str, int]:
+    """Rows per verdict, the one rule of a page's first lines and the index: ``failed``
+    counts the failed rows nothing accepts, ``accepted`` (where nonzero) the others."""
     verdicts = result.rows["verdict"]
-    return {v.value: int((verdicts == v.value).sum()) for v in Verdict}
+    out = {v.value: int((verdicts == v.value).sum()) for v in Verdict}
+    still = len(result.open_failures)
+    if still != out[Verdict.FAILED]:
+        out[ACCEPTED] = out[Verdict.FAILED] - still
+        out[Verdict.FAILED] = still
+    return out
 
 
 def summary_line(result: CheckResult) -> str:
     c = counts(result)
     return f"{result.model}: " + ", ".join(f"{n} {v}" for v, n in c.items())
+
+
+def _outcome(result: CheckResult, c: dict[str, int]) -> str:
+    if not result.ok:
+        return "differences found** (failed rows below)."
+    if c.get(ACCEPTED):
+        return (f"no new difference** ({c[ACCEPTED]} known findings accepted: the rows marked "
+                "accepted below, with their reasons).")
+    return "the engines agree** (every row passed or is explained)."
 
 
 def _table(frame: pd.DataFrame, columns: list[str]) -> str:
@@ -87,8 +107,7 @@ def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
         f"File: {markdown_code(result.path.name)} · {result.states} sampled states · "
         + " · ".join(f"**{n} {v}**" for v, n in c.items()),
         "",
-        "**Outcome: " + ("the engines agree** (every row passed or is explained)."
-                         if result.ok else "differences found** (failed rows below)."),
+        "**Outcome: " + _outcome(result, c),
         "",
         "## Per engine",
         "",
@@ -105,7 +124,7 @@ def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
         "",
         "## Findings (failed and explained rows)",
         "",
-        _table(rows[rows["verdict"].isin([Verdict.FAILED, Verdict.EXPLAINED])],
+        _table(_marked(rows[rows["verdict"].isin([Verdict.FAILED, Verdict.EXPLAINED])]),
                ["section", "subject", "field", "impl_a", "impl_b", "value_a", "value_b",
                 "error", "verdict", "note"]),
         "",
@@ -115,14 +134,25 @@ def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
         if section in (Section.DERIVATIVES, Section.ACTUATION) and not len(part):
             continue  # not asked for (--derivatives): no section that reads "none"
         lines += [f"## {TITLES[section]}", "",
-                  _table(part, ["subject", "field", "impl_a", "impl_b", "error", "tolerance",
-                                "verdict", "note"]), ""]
+                  _table(_marked(part), ["subject", "field", "impl_a", "impl_b", "error",
+                                         "tolerance", "verdict", "note"]), ""]
     lines += ["## Time (seconds on this machine, loading and evaluating)", "",
               pd.DataFrame([result.seconds]).to_markdown(index=False, floatfmt=".3f"), "",
               "## Versions", ""]
     lines += [f"- {markdown(k)}: {markdown(v)}" for k, v in versions.items()]
     lines += [f"- machine: {platform.processor() or platform.machine()}", ""]
     return "\n".join(lines)
+
+
+def _marked(rows: pd.DataFrame) -> pd.DataFrame:
+    """Rows as shown: an accepted failed row's verdict reads ``failed (accepted: REASON)``."""
+    if "accepted" not in rows or not rows["accepted"].fillna("").astype(str).ne("").any():
+        return rows
+    shown = rows.copy()
+    reason = shown["accepted"].fillna("").astype(str)
+    shown["verdict"] = shown["verdict"].where(reason.eq(""),
+                                              shown["verdict"] + " (accepted: " + reason + ")")
+    return shown
 
 
 def without_paths(result: CheckResult) -> CheckResult:

@@ -43,6 +43,8 @@ class CheckRow:
     verdict: Verdict
     note: str
     worst_state: int = -1
+    accepted: str = ""
+    """A failed row's acceptance (``--accept``): the known finding's reason; empty otherwise."""
 
 
 COMPUTED = "max rel error"
@@ -51,7 +53,7 @@ states (an actuation row's other fields compare readings)."""
 
 COLUMNS = [
     "model", "section", "subject", "field", "impl_a", "impl_b", "value_a", "value_b", "error",
-    "tolerance", "basis", "verdict", "note", "worst_state",
+    "tolerance", "basis", "verdict", "note", "worst_state", "accepted",
 ]
 
 
@@ -69,11 +71,20 @@ class CheckResult:
     """The implementations asked for (their versions are the page's provenance)."""
 
     @property
+    def open_failures(self) -> pd.DataFrame:
+        """The failed rows no ``--accept`` entry accepts (an accepted one stays failed: its
+        verdict is the engines', the acceptance the user's)."""
+        rows = self.rows
+        accepted = rows["accepted"].fillna("").astype(str).ne("") if "accepted" in rows \
+            else pd.Series(False, index=rows.index)
+        return rows[(rows["verdict"] == Verdict.FAILED) & ~accepted]
+
+    @property
     def ok(self) -> bool:
-        return not (self.rows["verdict"] == Verdict.FAILED).any()
+        return self.open_failures.empty
 
     def failures(self) -> str:
-        failed = self.rows[self.rows["verdict"] == Verdict.FAILED]
+        failed = self.open_failures
         return "\n".join(
             f"{r.section} {r.subject} {r.field} {r.impl_a}/{r.impl_b}: {r.value_a} vs "
             f"{r.value_b} (error {r.error:.3g}) {r.note}"

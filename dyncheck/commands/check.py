@@ -5,25 +5,31 @@ from __future__ import annotations
 import argparse
 import sys
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from dyncheck.commands import flags
 from dyncheck.commands.flags import Command
-from dyncheck.commands.options import OUT, path_arg
+from dyncheck.commands.options import (
+    OUT,
+    check_out,
+    check_out_file,
+    ci_files,
+    claim_out,
+    path_arg,
+    positive,
+    write_ci,
+)
 from dyncheck.errors import DyncheckError, InvalidInput
 
 if TYPE_CHECKING:
     import pandas as pd
 
+    from dyncheck.check import index
+    from dyncheck.check.acceptance import Acceptance
     from dyncheck.check.engines import Limits
-from dyncheck.commands.options import (
-    check_out,
-    ci_files,
-    claim_out,
-    positive,
-    write_ci,
-)
+    from dyncheck.ci_outputs import Moves
 
 
 def say(message: str) -> None:
@@ -137,21 +143,17 @@ def _named(targets: list[tuple[Path, str | None]], cases: Path
     return names, files
 
 
-def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
-               cases: Path) -> int:
-    from functools import partial
-
+def _validated(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
+               names: list[str], files: dict[str, str]
+               ) -> tuple[list[index.Entry], list[tuple[Path, str | None, str]], Gates]:
+    """Every input checked before any engine runs: the model files (one refused among
+    several is an index entry), the options, the output files; then the folder claimed."""
     from dyncheck.check import index, inputs
-    from dyncheck.check.model_check import check_model, implementations
-    from dyncheck.check.page import summary_line, write
-    from dyncheck.progress import Progress
-    from dyncheck.workers import each_unit
 
-    names, files = _named(targets, cases)
     several = len(targets) > 1
     entries: list[index.Entry] = []
     valid = []
-    for (path, robot), name in zip(targets, names, strict=True):  # all before any engine runs
+    for (path, robot), name in zip(targets, names, strict=True):
         try:
             inputs.model_path(str(path))
         except DyncheckError as exc:
@@ -171,19 +173,38 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     if args.seed < 0:
         raise InvalidInput("--seed", args.seed, "a non-negative integer")
     check_out(args.out)
-    read = [p for p, _ in targets] + [f for f in (args.against, args.states_file)
+    read = [p for p, _ in targets] + [f for f in (args.against, args.states_file, args.accept)
                                        if f is not None]
     ci_files(args, read)
+    gates = _gates(args, read)
     positive("--jobs", args.jobs)
     claim_out(args.out)  # every option checked: the folder held for this command
+    return entries, valid, gates
+
+
+def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
+               cases: Path) -> int:
+    import datetime as dt
+    from functools import partial
+
+    from dyncheck.check import acceptance, index
+    from dyncheck.check.model_check import check_model, implementations
+    from dyncheck.check.page import engine_versions_of, summary_line, write
+    from dyncheck.progress import Progress
+    from dyncheck.workers import each_unit
+
+    names, files = _named(targets, cases)
+    several = len(targets) > 1
+    entries, valid, gates = _validated(args, targets, names, files)
     options = _options(args)
     units = [(name, partial(check_model, **options, name=robot or (name if several else None)),
               (str(path),)) for path, robot, name in valid]
     engines = tuple(i for i in implementations(tuple(args.impl) or None) if i != "reference")
-    failed, refusals = False, len(entries)
+    failed, refusals, today = False, len(entries), dt.date.today()
     tables: dict[str, pd.DataFrame] = {}
     seconds: dict[str, dict[str, float]] = {}
     refused: dict[str, str] = {}
+    checked, used = [], set()
     progress = Progress("check", len(units) if several else None, quiet=args.quiet or not several)
     for name, result in each_unit(units, jobs=args.jobs, dask=args.dask):
         progress.done(name)
@@ -196,11 +217,13 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
             refused[name] = _without(str(result), path)
             refusals += 1
         else:
+            result, accepted = acceptance.apply(result, gates.accepted, today)
+            used |= accepted
+            checked.append(result)
             written = write(result, args.out, name=name)
             print(f"{summary_line(result)} -> {written[1]}")
             entries.append(index.entry(result, name, files[name]))
-            tables[name] = result.rows
-            seconds[name] = dict(result.seconds)
+            tables[name], seconds[name] = result.rows, dict(result.seconds)
             if not result.ok:
                 failed = True
                 print(result.failures())
@@ -209,14 +232,84 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
     progress.close()
     if several:
         print(f"{len(entries)} models: index -> {args.out / (index.INDEX + '.md')}")
+    for line in acceptance.unused(gates.accepted, checked, used, today):
+        print(f"dyncheck check: {line}")
+    versions = engine_versions_of(implementations(tuple(args.impl) or None))
+    moves = _held(args, gates, tables, versions)
     refused |= {e.model: e.refused for e in entries if e.refused}
     if args.junit is not None or args.json is not None:
-        from dyncheck.check.page import engine_versions_of
         from dyncheck.ci_outputs import CHECK
 
-        write_ci(args, tables, CHECK, engine_versions_of(implementations(
-            tuple(args.impl) or None)), refused=refused, seconds=seconds)
-    return 2 if refusals else 1 if failed else 0
+        write_ci(args, tables, CHECK, versions, refused=refused, seconds=seconds, moves=moves)
+    if refusals:
+        return 2
+    if moves is not None:  # held to the baseline: a failed row it holds is a known one
+        return 1 if len(moves.rows) else 0
+    return 1 if failed else 0
+
+
+@dataclass(frozen=True, kw_only=True)
+class Gates:
+    """What a check is held to besides its verdicts, read before any work: the known findings
+    it accepts (``--accept``) and the stored baseline (``--baseline``; None without one, or
+    none yet where ``--update-baseline`` writes the first)."""
+
+    accepted: tuple[Acceptance, ...] = ()
+    stored: pd.DataFrame | None = None
+
+
+def _gates(args: argparse.Namespace, read: list[Path]) -> Gates:
+    from dyncheck.check import acceptance
+    from dyncheck.check import baseline as check_baseline
+
+    accepted = acceptance.load(args.accept) if args.accept is not None else ()
+    if args.update_baseline and args.baseline is None:
+        raise InvalidInput("--update-baseline", True, "given with --baseline FILE (the file "
+                           "to write)")
+    stored = None
+    if args.baseline is not None:
+        if args.update_baseline:
+            check_out_file("--baseline", args.baseline, read)
+            if args.baseline.exists():  # what it will replace: a baseline, not another file
+                stored = check_baseline.load(args.baseline)
+        else:
+            stored = check_baseline.load(args.baseline)
+    return Gates(accepted=accepted, stored=stored)
+
+
+def _held(args: argparse.Namespace, gates: Gates, tables: dict[str, pd.DataFrame],
+          versions: dict[str, str]) -> Moves | None:
+    """The check against its baseline: what moved, on ``baseline.md`` and the terminal
+    (None without ``--baseline``, and after ``--update-baseline`` wrote it)."""
+    from dyncheck import baseline as stored_versions
+    from dyncheck.check import baseline as check_baseline
+    from dyncheck.ci_outputs import Moves
+    from dyncheck.provenance import dyncheck_version
+    from dyncheck.results import write_atomic
+
+    if args.baseline is None:
+        return None
+    versions = {"dyncheck": dyncheck_version(), **versions}
+    current = check_baseline.table(tables)
+    moved = (check_baseline.compare(current, gates.stored) if gates.stored is not None
+             else None)
+    if args.update_baseline:
+        check_baseline.write(tables, args.baseline, versions)
+        before = f"; {len(moved)} rows moved since the previous one" if moved is not None \
+            else ""
+        print(f"baseline written to {args.baseline} ({len(current)} rows{before})")
+        return None
+    assert moved is not None  # loaded by _gates
+    changed = tuple(stored_versions.version_changes(args.baseline, versions))
+    page = check_baseline.page(moved, args.baseline, list(changed), len(current))
+    write_atomic(args.out / f"{check_baseline.PAGE}.md", page)
+    if changed:
+        print("versions changed since the baseline: " + ", ".join(changed))
+    print(f"{len(moved)} rows moved against {args.baseline}" if len(moved)
+          else f"nothing moved against {args.baseline}")
+    for row in moved.itertuples(index=False):
+        print(f"  {row.model}: {row.row}: {row.move}: {row.note}")
+    return Moves(file=str(args.baseline), versions_changed=changed, rows=moved)
 
 
 def _arguments(p: argparse.ArgumentParser) -> None:
@@ -254,6 +347,18 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    "step Jacobian in the controls are compared)")
     p.add_argument("--against", type=path_arg, default=None, metavar="PATH",
                    help="also compare what MuJoCo reads with this other file (a previous version)")
+    p.add_argument("--baseline", type=path_arg, default=None, metavar="FILE",
+                   help="hold every row to this stored baseline of the same models: exit 1 "
+                   "when a row moved (its verdict, its error by more than its tolerance, a "
+                   "reading), appeared or vanished, each named on baseline.md (a failed row "
+                   "the baseline holds is a known one)")
+    p.add_argument("--update-baseline", action="store_true",
+                   help="write --baseline FILE from this check instead (accepting what moved)")
+    p.add_argument("--accept", type=path_arg, default=None, metavar="FILE",
+                   help="a TOML file of known findings ([[accept]]: model, engine, label, "
+                   "reason, optional expires): a failed row one matches stays on the page "
+                   "marked accepted and no longer fails the command; an entry that accepts "
+                   "nothing is named")
     p.add_argument("--out", type=path_arg, default=OUT / "check",
                    help=f"output folder (default: {OUT / 'check'})")
     flags.jobs(p, "models checked")

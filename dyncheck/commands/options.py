@@ -18,7 +18,7 @@ from dyncheck.settings import Settings, from_environment
 if TYPE_CHECKING:
     import pandas as pd
 
-    from dyncheck.ci_outputs import Columns
+    from dyncheck.ci_outputs import Columns, Moves
 
 
 OUT = Path("dyncheck-report")
@@ -59,16 +59,19 @@ def ci_files(args: argparse.Namespace, inputs: Sequence[Path] = ()) -> None:
 
 def write_ci(args: argparse.Namespace, tables: dict[str, pd.DataFrame], columns: Columns,
              versions: dict[str, str], *, refused: dict[str, str] | None = None,
-             seconds: dict[str, dict[str, float]] | None = None) -> None:
+             seconds: dict[str, dict[str, float]] | None = None,
+             moves: Moves | None = None) -> None:
     """The ``--junit`` and ``--json`` files of a command's tables (``seconds``: per table,
-    what each engine took, where the command measured it)."""
+    what each engine took, where the command measured it; ``moves``: what moved against a
+    baseline)."""
     from dyncheck import ci_outputs
 
     if args.junit is not None:
-        ci_outputs.write_junit(args.junit, tables, columns, refused=refused, seconds=seconds)
+        ci_outputs.write_junit(args.junit, tables, columns, refused=refused, seconds=seconds,
+                               moves=moves)
     if args.json is not None:
         ci_outputs.write_json(args.json, tables, versions, refused=refused,
-                              command=args.command, seconds=seconds)
+                              command=args.command, seconds=seconds, moves=moves)
 
 
 def check_out(out: Path, flag: str = "--out") -> None:

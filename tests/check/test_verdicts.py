@@ -18,7 +18,7 @@ IMPLS = ("reference", "mujoco", "pinocchio", "drake")
 
 def _row(section, a, b, verdict, subject="mass_matrix", error=0.0, tolerance=1e-12, note=""):
     return dict(zip(COLUMNS, ["m", section.value, subject, "all", a, b, "", "", error,
-                              tolerance, "", verdict.value, note, -1], strict=True))
+                              tolerance, "", verdict.value, note, -1, ""], strict=True))
 
 
 def _frame(*rows):

@@ -6,6 +6,7 @@ corrupted mass × 1.01 fails, see ``tests/check/test_model_check.py``)."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -63,3 +64,45 @@ def test_the_plugin_s_tests_are_selected_and_counted_as_pytest_s_own(tmp_path):
     assert "2 passed, 1 deselected" in chosen.stdout, chosen.stdout
     junit = (project / "out.xml").read_text()
     assert 'name="dyncheck"' in junit and "good.urdf" in junit
+
+
+def test_the_baseline_fixture_writes_holds_and_accepts(tmp_path):
+    """``dyncheck_baseline`` as pytest-regressions' users know it, run by pytest itself: the
+    first run writes the baseline beside the test and fails (a first baseline is looked at and
+    committed), the second passes, a change of 1e-6 planted in Pinocchio's kinetic energy (in
+    the test's process: the check runs in process here) fails naming the row, and
+    ``--dyncheck-update-baseline`` accepts it. Expected: the planted change is 1e-6 relative,
+    far beyond the row's round-off tolerance."""
+    project = _project(tmp_path)
+    (project / "conftest.py").write_text(
+        "import os\n"
+        "from dyncheck.adapters.pinocchio_model import PinocchioModel\n"
+        "if os.environ.get('PLANT'):\n"
+        "    real = PinocchioModel.dynamics\n"
+        "    def dynamics(self, q, v, a):\n"
+        "        d = real(self, q, v, a)\n"
+        "        return type(d)(**{**vars(d), 'kinetic': d.kinetic * (1 + 1e-6)})\n"
+        "    PinocchioModel.dynamics = dynamics\n")
+    (project / "test_robots.py").write_text(
+        "def test_arm_has_not_moved(dyncheck_baseline):\n"
+        "    dyncheck_baseline('robots/good.urdf', states=5, floating=True, isolate=False,\n"
+        "                      impls=('reference', 'mujoco', 'pinocchio'))\n")
+    stored = project / "test_robots" / "test_arm_has_not_moved.csv"
+    first = _pytest(project)
+    assert first.returncode == 1 and "no baseline" in first.stdout and stored.is_file()
+    again = _pytest(project)
+    assert again.returncode == 0, again.stdout
+    env = {**os.environ, "PLANT": "1"}
+    moved = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                            "-p", "no:randomly"], cwd=project, capture_output=True, text=True,
+                           timeout=300, env=env)
+    assert moved.returncode == 1
+    assert "dynamics kinetic_energy max rel error reference/pinocchio" in moved.stdout
+    update = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                             "-p", "no:randomly", "--dyncheck-update-baseline"], cwd=project,
+                            capture_output=True, text=True, timeout=300, env=env)
+    assert update.returncode == 0, update.stdout
+    held = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                           "-p", "no:randomly"], cwd=project, capture_output=True, text=True,
+                          timeout=300, env=env)
+    assert held.returncode == 0, held.stdout
