@@ -25,9 +25,11 @@ import itertools
 import re
 import subprocess
 import sys
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol
 
 import pandas as pd
 
@@ -104,7 +106,7 @@ SOURCES = ("reference", "adapters", "cases", "dyncheck", ":(exclude)dyncheck/ver
 """The code whose content keys the cached runs (the matrix's own code and pages left out)."""
 
 
-def _code_key() -> str:
+def code_key() -> str:
     """A hash of the committed content of :data:`SOURCES`, ``+dirty`` when the working tree
     differs from it (runs are then not reused)."""
 
@@ -130,22 +132,36 @@ def environment(eng: Engine, release: str, *, log: Log) -> Path:
         _install_checkout(python, folder)
         return python
     log(f"creating {folder} ({eng.package}=={release})")
+    started = time.perf_counter()
     subprocess.run([sys.executable, "-m", "venv", "--clear", str(folder)], check=True)
     pins = folder / "constraints.txt"
     pins.write_text(constraints(eng, (ROOT / "constraints.txt").read_text(), release))
     wanted = [p for p in (*CORE, *eng.extra) if p != eng.package]
     wanted += [r for n in eng.needs_of(release) for r in n.require]
     pip = [str(python), "-m", "pip", "install", "--disable-pip-version-check"]  # not -q: the
-    # resolver explains a conflict only when not quiet (read by _last_line)
+    # resolver explains a conflict only when not quiet (read by last_line)
     result = subprocess.run(
         [*pip, "-c", str(pins), *wanted, f"{eng.package}=={release}"],
         capture_output=True, text=True, check=False,
     )
     if result.returncode != 0:
-        raise ReleaseUnavailable(eng.name, release, _last_line(result.stderr))
+        raise ReleaseUnavailable(eng.name, release, last_line(result.stderr))
     _install_checkout(python, folder)
-    done.write_text(release + "\n")
+    done.write_text(f"{release}\n{time.perf_counter() - started:.1f}\n")  # the seconds it took
     return python
+
+
+def environment_made(eng: Engine, release: str) -> tuple[float | None, int]:
+    """The seconds the release's environment took to make (None where not recorded) and the
+    bytes it holds now (0 where there is none)."""
+    folder = cache_root() / "venvs" / f"{eng.name}-{release}"
+    done = folder / ".installed"
+    if not done.exists():
+        return None, 0
+    lines = done.read_text().split()
+    seconds = float(lines[1]) if len(lines) > 1 else None
+    size = sum(f.lstat().st_size for f in folder.rglob("*") if f.is_file() and not f.is_symlink())
+    return seconds, size
 
 
 def _install_checkout(python: Path, folder: Path) -> None:
@@ -167,7 +183,7 @@ class ReleaseUnavailable(DyncheckError):
         super().__init__(f"{engine} {release} cannot be installed: {reason}")
 
 
-def _last_line(text: str) -> str:
+def last_line(text: str) -> str:
     """pip's reason in one line: the dependency that conflicts with a pinned version, else
     its last line."""
     lines = [ln.strip() for ln in text.splitlines() if ln.strip() and "WARNING" not in ln]
@@ -199,7 +215,7 @@ def run_release(
         )
         if cached:
             return cached[-1].parent
-    key = _code_key()
+    key = code_key()
     out = cache_root() / "runs" / key / f"{eng.name}-{release}{subset}"
     if (out / "discrepancies.csv").exists() and not key.endswith("+dirty"):
         if not (out / reproduced.FILE).exists():
@@ -214,7 +230,7 @@ def run_release(
         capture_output=True, text=True, check=False,
     )
     if result.returncode not in (0, 1) or not (out / "discrepancies.csv").exists():
-        raise ReleaseFailed(eng.name, release, _last_line(result.stderr))
+        raise ReleaseFailed(eng.name, release, last_line(result.stderr))
     missing = _not_importable(out / "discrepancies.csv", eng.impls)
     if missing:
         raise ReleaseFailed(eng.name, release, f"the engine does not import there: {missing}")
@@ -331,7 +347,7 @@ def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None
                 + f" — {n.reason}." for n in needs]
             lines += [""]
         for s in (s for s in steps if s.engine == name):
-            lines += [f"### {s.old} → {s.new}", "", *_defect_lines(s)]
+            lines += [f"### {s.old} → {s.new}", "", *defect_lines(s)]
             if s.table is None:
                 lines += [f"_not compared_: {s.problem}", ""]
                 continue
@@ -348,7 +364,21 @@ def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None
     return "\n".join(lines)
 
 
-def _defect_lines(step: Step) -> list[str]:
+class Stepped(Protocol):
+    """Two consecutive releases and the defects fixed and back between them (read-only: a
+    frozen :class:`Step` or :class:`~dyncheck.model_versions.ModelStep`)."""
+
+    @property
+    def old(self) -> str: ...
+    @property
+    def new(self) -> str: ...
+    @property
+    def fixed(self) -> tuple[str, ...]: ...
+    @property
+    def back(self) -> tuple[str, ...]: ...
+
+
+def defect_lines(step: Stepped) -> list[str]:
     """The engine defects a step fixed or brought back, each by its catalogue name (its
     reproducer: ``dyncheck explain NAME --reproducer FILE``)."""
     lines = []
@@ -381,6 +411,20 @@ def bisect(
     """The first release after ``good`` whose run differs from ``good``'s (``bad`` must), and
     what moved there. ``releases``: the candidates in order (default: ``pip index``)."""
     eng = engine(name)
+
+    def load(release: str) -> diff.RunTables:
+        return diff.load(run_release(eng, release, cases=cases, jobs=jobs, log=log), release)
+
+    return first_moved(eng, good, bad, log=log, releases=releases,
+                       moves=lambda a, b: diff.moved(diff.diff(load(a), load(b))))
+
+
+def first_moved(eng: Engine, good: str, bad: str, *, log: Log,
+                releases: Sequence[str] | None,
+                moves: Callable[[str, str], pd.DataFrame]) -> tuple[str, pd.DataFrame]:
+    """Bisection over the releases between ``good`` and ``bad`` (``moves(a, b)``: the rows
+    that moved from release a to b; ``bad`` must move from ``good``): the first release that
+    moved, and what moved from the release before it."""
     ordered = list(releases) if releases is not None else published(eng)
     for r in (good, bad):
         if r not in ordered:
@@ -388,26 +432,17 @@ def bisect(
     lo, hi = ordered.index(good), ordered.index(bad)
     if lo >= hi:
         raise InvalidInput("--bisect", f"{good} {bad}", "GOOD older than BAD")
-
-    def load(release: str) -> diff.RunTables:
-        return diff.load(run_release(eng, release, cases=cases, jobs=jobs, log=log), release)
-
-    reference = load(good)
-
-    def moves(release: str) -> pd.DataFrame:
-        return diff.moved(diff.diff(reference, load(release)))
-
-    if moves(bad).empty:
+    if moves(good, bad).empty:
         raise InvalidInput("--bisect", f"{good} {bad}", "two releases whose runs differ")
     while hi - lo > 1:
         mid = (lo + hi) // 2
         log(f"bisect: {ordered[lo]} .. {ordered[mid]} .. {ordered[hi]}")
-        if moves(ordered[mid]).empty:
+        if moves(good, ordered[mid]).empty:
             lo = mid
         else:
             hi = mid
     first = ordered[hi]
-    return first, diff.moved(diff.diff(load(ordered[lo]), load(first)))
+    return first, moves(ordered[lo], first)
 
 
 def published(eng: Engine) -> list[str]:
@@ -421,7 +456,7 @@ def published(eng: Engine) -> list[str]:
         if line.startswith("Available versions:"):
             found = [v.strip() for v in line.split(":", 1)[1].split(",")]
             return sorted(found, key=_release_key)
-    raise ReleaseUnavailable(eng.name, "*", _last_line(result.stderr or result.stdout))
+    raise ReleaseUnavailable(eng.name, "*", last_line(result.stderr or result.stdout))
 
 
 def _release_key(text: str) -> tuple[int, ...]:

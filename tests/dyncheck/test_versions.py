@@ -55,7 +55,7 @@ def test_pip_conflict_is_named_in_one_line():
         "    The user requested (constraint) numpy==2.4.6\n"
         "ERROR: ResolutionImpossible: for help visit https://pip.pypa.io\n"
     )
-    assert versions._last_line(stderr) == (
+    assert versions.last_line(stderr) == (
         "cmeel-boost 1.89.0 depends on numpy<2.4 and >=2.3, but constraints.txt pins numpy==2.4.6"
     )
 
@@ -141,7 +141,7 @@ def test_a_run_of_some_cases_is_cached_apart_from_the_run_of_all(tmp_path, monke
     the run of every case."""
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
     monkeypatch.setattr(versions, "environment", lambda eng, release, log: Path("python"))
-    monkeypatch.setattr(versions, "_code_key", lambda: "k")
+    monkeypatch.setattr(versions, "code_key", lambda: "k")
 
     def fake_run(cmd, **kw):
         out = Path(cmd[cmd.index("--out") + 1])
