@@ -176,16 +176,9 @@ def page(steps: Sequence[ModelStep], outcomes: dict[str, dict[str, str]], models
              "releases are compared row by row as a check is held to its baseline (a verdict "
              "changed, an error moved by more than its row's tolerance, a reading changed, a "
              "row appeared or vanished).", ""]
-    if seconds is not None:
-        lines += [f"This page took {seconds:.0f} s on this machine, making the environments not "
-                  "made before included.", ""]
-    if environments:
-        lines += ["Each release's environment (made once, reused; `dyncheck versions "
-                  "--remove-environments` deletes them):", ""]
-        lines += [f"- {r}: {size / 2**30:.2f} GiB"
-                  + (f", made in {made:.0f} s" if made is not None else "")
-                  for r, (made, size) in environments.items()]
-        lines += [""]
+    lines += versions.environment_lines(
+        seconds, {(steps[0].engine if steps else "", r): m
+                  for r, m in (environments or {}).items()})
     for s in steps:
         lines += [f"## {s.engine} {s.old} → {s.new}", "", *versions.defect_lines(s)]
         if s.moved is None:

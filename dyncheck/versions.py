@@ -321,10 +321,14 @@ def matrix(
     return steps
 
 
-def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None = None) -> str:
+def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None = None,
+         seconds: float | None = None,
+         environments: dict[tuple[str, str], tuple[float | None, int]] | None = None) -> str:
     """``reports/versions.md``: per engine, per consecutive pair, the counts of each move and
     every moved row grouped by (case, quantity, pair, integrator), with its largest ratio.
-    ``notes`` (engine, old, new) → the explanation found for that step."""
+    ``notes`` (engine, old, new) → the explanation found for that step; ``seconds`` the time
+    the matrix took, ``environments`` (engine, release) → the seconds each environment took
+    to make (None: made before) and its size."""
     notes = notes or {}
     lines = [
         "# Engine versions: what moved between releases",
@@ -336,6 +340,7 @@ def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None
         "changed` when the change vanishes with the step like dt^p).",
         "",
     ]
+    lines += environment_lines(seconds, environments or {})
     for name in dict.fromkeys(s.engine for s in steps):
         lines += [f"## {name}", ""]
         needs = ENGINES[name].needs if name in ENGINES else ()
@@ -376,6 +381,24 @@ class Stepped(Protocol):
     def fixed(self) -> tuple[str, ...]: ...
     @property
     def back(self) -> tuple[str, ...]: ...
+
+
+def environment_lines(seconds: float | None,
+                      environments: dict[tuple[str, str], tuple[float | None, int]]) -> list[str]:
+    """What the matrix cost on this machine: its time, each environment's size and making."""
+    lines = []
+    if seconds is not None:
+        lines += [f"This page took {seconds / 60:.1f} min on this machine, making the "
+                  "environments not made before included.", ""]
+    if environments:
+        total = sum(size for _, size in environments.values())
+        lines += [f"The environments (made once, reused; `dyncheck versions "
+                  f"--remove-environments` deletes them) hold {total / 2**30:.1f} GiB:", ""]
+        lines += [f"- {e} {r}: {size / 2**30:.2f} GiB"
+                  + (f", made in {made:.0f} s" if made is not None else "")
+                  for (e, r), (made, size) in environments.items()]
+        lines += [""]
+    return lines
 
 
 def defect_lines(step: Stepped) -> list[str]:

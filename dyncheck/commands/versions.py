@@ -15,6 +15,8 @@ from dyncheck.workers import default_jobs
 
 def versions_command(args: argparse.Namespace) -> int:
     """Exit 0 (the matrix reports moves; it does not judge them)."""
+    import time
+
     from dyncheck import versions
     from dyncheck.cases import get_case
     from dyncheck.errors import NeedsCheckout
@@ -46,10 +48,14 @@ def versions_command(args: argparse.Namespace) -> int:
     out = args.out or Path("reports/versions.md")
     check_out_file("--out", out)
     releases = sum(len(versions.engine(name).releases) for name in names)
+    t0 = time.perf_counter()
     with Progress("versions", releases, quiet=args.quiet) as progress:
         steps = versions.matrix(names, cases=args.case, jobs=args.jobs, log=log,
                               reuse=args.reuse, progress=progress)
-    write_atomic(out, versions.page(steps, notes=EXPLANATIONS))
+    made = {(n, r): versions.environment_made(versions.engine(n), r) for n in names
+            for r in versions.engine(n).releases}
+    write_atomic(out, versions.page(steps, notes=EXPLANATIONS, seconds=time.perf_counter() - t0,
+                                    environments={k: m for k, m in made.items() if m[1]}))
     print(f"version matrix written to {out}")
     return 0
 
