@@ -140,8 +140,10 @@ fig.tight_layout()
 #
 # The committed [`reports/versions-models.md`](../versions-models.md) is the first command's
 # page. The second bisects over the published releases to the first one whose check of the
-# model moved. The book's rigid bodies, whose inertia MuJoCo reads the same way, moved at
-# 3.14.0 ([`reports/versions.md`](../versions.md)).
+# model moved. On this machine it named **3.14.0** (8 rows, the ones above) in 2 min 36 s,
+# making the environments of 3.10.0, 3.12.0, 3.13.0 and 3.14.0 on the way. The book's rigid
+# bodies, whose inertia MuJoCo reads the same way, moved at the same release
+# ([`reports/versions.md`](../versions.md)).
 
 # %% [markdown]
 # ## 5 · The decision
