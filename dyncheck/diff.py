@@ -118,11 +118,17 @@ def tables(
     return RunTables(path=path, kind=kind, rows=normal, versions=versions or {})
 
 
+TEXTS = {"value_a": str, "value_b": str}
+"""Columns read as text whatever they hold (a reading "2" stays "2", never 2.0)."""
+
+
 def read_csv(path: Path, flag: str) -> pd.DataFrame:
-    """A CSV table of dyncheck's (``#`` lines are comments, empty cells NaN); a one-line
-    InvalidInput naming ``flag`` and the path when it cannot be read or parsed."""
+    """A CSV table of dyncheck's (``#`` lines are comments, empty cells NaN, :data:`TEXTS`
+    as text); a one-line InvalidInput naming ``flag`` and the path when it cannot be read or
+    parsed."""
     try:
-        return pd.read_csv(path, keep_default_na=False, na_values=[""], comment="#")
+        return pd.read_csv(path, keep_default_na=False, na_values=[""], comment="#",
+                           dtype=TEXTS)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise InvalidInput(flag, str(path), f"a CSV file ({reason})") from None

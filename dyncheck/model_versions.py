@@ -24,7 +24,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from dyncheck import reproduced, versions
+from dyncheck import diff, reproduced, versions
 from dyncheck.cache.store import cache_root
 from dyncheck.check import baseline as check_baseline
 from dyncheck.check.engines import ENGINES as CHECKED
@@ -101,11 +101,8 @@ def rows_of(folder: Path) -> pd.DataFrame:
         if folder.is_dir() else []
     if not files:
         return pd.DataFrame(columns=check_baseline.COLUMNS)
-    frames = [pd.read_csv(f, keep_default_na=False, na_values=[""]) for f in files]
-    rows = pd.concat(frames, ignore_index=True)
-    for col in ("value_a", "value_b", "impl_b"):
-        rows[col] = rows[col].fillna("").astype(str)
-    return rows
+    frames = [diff.read_csv(f, "--engine") for f in files]
+    return check_baseline.texts(pd.concat(frames, ignore_index=True))
 
 
 def moved(old: Path, new: Path) -> pd.DataFrame:

@@ -57,8 +57,15 @@ def load(path: Path) -> pd.DataFrame:
     if expected is not None and expected != str(len(frame)):
         raise InvalidInput(FLAG, str(path),
                            f"{expected} rows as its header says ({len(frame)} found: truncated?)")
+    return texts(frame)
+
+
+def texts(frame: pd.DataFrame) -> pd.DataFrame:
+    """``frame`` with its pair's second engine and its two values as text, an empty cell
+    as "" (a row of one implementation, a row without readings)."""
+    frame = frame.copy()
     for col in ("value_a", "value_b", "impl_b"):
-        frame[col] = frame[col].fillna("").astype(str)
+        frame[col] = frame[col].map(lambda x: "" if pd.isna(x) else str(x))
     return frame
 
 
@@ -101,9 +108,7 @@ def _move(old: pd.Series, new: pd.Series) -> tuple[diff.Move, str]:
 def compare(current: pd.DataFrame, stored: pd.DataFrame) -> pd.DataFrame:
     """Every row that moved against the baseline: its model, ``row`` (its label and pair),
     ``move``, ``note``, and each side's verdict and error (``baseline``, ``current``)."""
-    now = current[COLUMNS].copy()
-    for col in ("value_a", "value_b", "impl_b"):
-        now[col] = now[col].fillna("").astype(str)
+    now = texts(current[COLUMNS])
     old, new = stored[COLUMNS].set_axis(diff.keys(stored, KEY)), now.set_axis(diff.keys(now, KEY))
     p = diff.paired(old, new)
     moves = [(k, diff.Move.VANISHED, f"row gone (was {old.loc[k, 'verdict']})")

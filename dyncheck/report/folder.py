@@ -8,7 +8,14 @@ from pathlib import Path
 
 from dyncheck.provenance import versions
 from dyncheck.report.figures import figures
-from dyncheck.report.pages import case_page, conventions_page, errata, index_page
+from dyncheck.report.pages import (
+    PAGES,
+    case_page,
+    conventions_page,
+    errata,
+    index_page,
+    page_link,
+)
 from dyncheck.report.tables import (
     conservation_table,
     md,
@@ -37,8 +44,11 @@ def render(
             case, result.figures[case.name], result.convergence)
         for kind, png in pngs.items():
             files[out / "figures" / f"{case.name}_{kind}.png"] = png
-    files[out / "README.md"] = index_page(result, date=date)
     files[out / "conventions.md"] = conventions_page(result.conventions)
+    written = {out / "conventions.md", out / "printed-equations.md", out / "README.md"}
+    present = frozenset(link for _, link, _ in PAGES
+                        if (out / link).is_file() or out / link in files or out / link in written)
+    files[out / "README.md"] = index_page(result, date=date, present=present)
     files[out / PROVENANCE] = provenance_json(
         {"date (UTC)": date, **versions(result.engines), RAN: ", ".join(result.ran)})
     lead, table = errata(result.discrepancies)
@@ -47,7 +57,8 @@ def render(
             "# The book's printed equations of motion against the general method",
             "",
             "The errata of §2.2, formula by formula (every derivation step, identity and "
-            "exercise), are in [errata.md](errata.md); this page is the numeric check of the "
+            "exercise), are in " + page_link("errata.md", "errata.md", present)
+            + "; this page is the numeric check of the "
             "equations of motion the cases implement.",
             "",
             "Each printed equation of motion (and its T and V) is evaluated as `book` and compared "

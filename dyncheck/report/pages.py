@@ -208,14 +208,22 @@ def errata(d: pd.DataFrame) -> tuple[str, pd.DataFrame]:
     return lead, table
 
 
-def index_page(result: RunResult, *, date: str) -> str:
+def index_page(result: RunResult, *, date: str, present: frozenset[str] = frozenset()) -> str:
     """``reports/README.md``: how to read the rows, the provenance, the matrices of verdicts
-    and the rows that failed or were skipped, and the conventions that explain differences."""
-    return "\n".join([*_opening(result), *_provenance(result, date=date), *_matrices(result),
-                      *_closing(result)])
+    and the rows that failed or were skipped, and the conventions that explain differences.
+    ``present``: the other pages (:data:`PAGES`) the folder holds — only those are linked (a
+    fresh ``--out`` folder holds none of them: no link on its page leads nowhere)."""
+    return "\n".join([*_opening(result, present), *_provenance(result, date=date),
+                      *_matrices(result), *_closing(result, present)])
 
 
-def _opening(result: RunResult) -> list[str]:
+def page_link(title: str, target: str, present: frozenset[str]) -> str:
+    """A Markdown link to ``target`` where the folder holds it, else the title with the
+    command that writes it (its :data:`PAGES` description names it)."""
+    return f"[{title}]({target})" if target in present else f"{title} (not in this folder)"
+
+
+def _opening(result: RunResult, present: frozenset[str]) -> list[str]:
     """The index's title, contents and how to read a row."""
     return [
         "# dyncheck verification report",
@@ -231,7 +239,7 @@ def _opening(result: RunResult) -> list[str]:
         "",
         "Case pages: " + ", ".join(f"[{c.name}]({c.name}.md)" for c in result.cases) + ".",
         "",
-        *[f"- [{title}]({link}): {what}" for title, link, what in PAGES],
+        *[f"- {page_link(title, link, present)}: {what}" for title, link, what in PAGES],
         "",
         "### How to read a row",
         "",
@@ -308,7 +316,7 @@ def _matrices(result: RunResult) -> list[str]:
     ]
 
 
-def _closing(result: RunResult) -> list[str]:
+def _closing(result: RunResult, present: frozenset[str]) -> list[str]:
     """The printed equations' check, the failed or skipped rows, what the parsers ignore,
     the conventions that explain differences and the case pages."""
     d = result.discrepancies
@@ -319,7 +327,7 @@ def _closing(result: RunResult) -> list[str]:
         "### The book's printed equations of motion against the general method",
         "",
         "(The errata of §2.2 formula by formula, derivation steps and exercises included: "
-        "[errata.md](errata.md).)",
+        + page_link("errata.md", "errata.md", present) + ".)",
         "",
         errata(d)[0],
         "",

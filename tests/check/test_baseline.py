@@ -168,3 +168,11 @@ def test_the_numbers_compared_are_the_stored_ones():
     """A value written and read back compares equal: no move from formatting alone."""
     t = _table({"error": float(np.nextafter(1e-16, 1))})
     assert baseline.compare(t, t).empty
+
+
+def test_a_numeric_reading_read_back_from_the_file_is_the_same_text(tmp_path):
+    """A column of readings that are all numbers (or empty) was read back as floats: "2"
+    became "2.0" and every such row 'changed'. Written and loaded, nothing moved."""
+    table = _table()  # the gear row reads "2" and "1"; the other row has no reading
+    baseline.write({"arm": table}, tmp_path / "b.csv", {})
+    assert baseline.compare(table, baseline.load(tmp_path / "b.csv")).empty
