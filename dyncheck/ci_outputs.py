@@ -73,6 +73,15 @@ def _name(keys: tuple[object, ...], columns: tuple[str, ...]) -> str:
     return f"{rest} ({pair})" if pair else rest
 
 
+def _nonzero(value: object) -> bool:
+    """An error worth printing beside two values: a number other than zero (a reading's
+    rows carry 0: the values are the finding)."""
+    try:
+        return float(str(value)) != 0.0
+    except (TypeError, ValueError):
+        return bool(_text(value))
+
+
 def _failure(values: dict[str, object], columns: Columns) -> str:
     """A failed row in one line that leads with what a reader compares: the two values
     where the row has them ("1.45 vs 1.51"), else the error against its tolerance; then the
@@ -82,7 +91,7 @@ def _failure(values: dict[str, object], columns: Columns) -> str:
     pair = [_text(values.get(c)) for c in columns.values or ()]
     if pair and all(pair):
         head = f"{pair[0]} vs {pair[1]}"
-        if error and error != "0.0":
+        if _nonzero(values.get(columns.error)):
             head += f" (error {error}, tolerance {tolerance})"
     else:
         head = f"error {error} > tolerance {tolerance}"
