@@ -40,7 +40,8 @@ def intervals(canon: Canonical, tree: ModelTree) -> list[Interval]:
     """Per hinge and slide, the interval drawn: its range where the canonical engine holds a
     finite one of positive width, else the default (:data:`DEFAULT_INTERVAL`) — a range of no
     width (a URDF ``<limit>`` without lower and upper, read as (0, 0)) would hold the joint at
-    one value in every state, and is replaced, said."""
+    one value in every state, and one whose width is not a finite number (±inf, ±1e308: the
+    width overflows) cannot be drawn from; each is replaced, said."""
     out = []
     for name, kind in zip(canon.names, canon.types, strict=True):
         if kind not in DEFAULT_INTERVAL:
@@ -49,12 +50,16 @@ def intervals(canon: Canonical, tree: ModelTree) -> list[Interval]:
         low, high = DEFAULT_INTERVAL[kind]
         if found is None:
             out.append(Interval(joint=name, low=low, high=high, why="unlimited"))
-        elif np.all(np.isfinite(found)) and found[1] > found[0]:
-            out.append(Interval(joint=name, low=float(found[0]), high=float(found[1]),
-                                why="range"))
-        else:
+        elif not found[1] > found[0]:
             out.append(Interval(joint=name, low=low, high=high, why=(
                 f"its range ({found[0]:.4g}, {found[1]:.4g}) has no width: the default drawn")))
+        elif not np.isfinite(float(found[1]) - float(found[0])):  # ±inf, or ±1e308: overflows
+            out.append(Interval(joint=name, low=low, high=high, why=(
+                f"its range ({found[0]:.4g}, {found[1]:.4g}) has no finite width: the default "
+                "drawn")))
+        else:
+            out.append(Interval(joint=name, low=float(found[0]), high=float(found[1]),
+                                why="range"))
     return out
 
 

@@ -6,6 +6,7 @@ definition of a unit quaternion."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from dyncheck.adapters import layout
 from dyncheck.adapters.model_files import read
@@ -66,3 +67,18 @@ def test_a_range_of_no_width_is_replaced_by_the_default_and_said(tmp_path):
     result = check_model(path, states=30, impls=("reference", "mujoco"))  # MuJoCo: unlimited
     note = next(n for n in result.notes if n.startswith("sampled configurations"))
     assert note.endswith("j [-3.142, 3.142]")
+
+
+@pytest.mark.parametrize("bound", ["1e308", "1.7e308"])
+def test_a_range_whose_width_overflows_is_replaced_by_the_default_and_said(tmp_path, bound):
+    """#81: a slide's range of ±1e308 is finite, but its width (2e308) is not: numpy's
+    uniform raised OverflowError (a traceback). The width, not only the bounds, must be a
+    finite number; else the slide's default [-1, 1] m is drawn, said on the page."""
+    path = tmp_path / "huge.xml"
+    path.write_text(f'<mujoco><worldbody><body pos="0 0 1"><joint name="j" type="slide" '
+                    f'axis="1 0 0" range="-{bound} {bound}" limited="true"/>'
+                    '<geom size="0.1" mass="1"/></body></worldbody></mujoco>')
+    result = check_model(path, states=5, impls=("reference", "mujoco"), isolate=False)
+    note = next(n for n in result.notes if n.startswith("sampled configurations"))
+    assert "j [-1, 1] (its range" in note and "has no finite width" in note
+    assert result.ok
