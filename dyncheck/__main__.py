@@ -153,16 +153,38 @@ def console() -> int:
     from dyncheck.workers import exit_without_collecting
 
     exit_without_collecting()
+    _open_standard_streams()
     sys.stdout = _LeavingReader(sys.stdout)
+    sys.stderr = _LeavingReader(sys.stderr)
     return main()
 
 
+def _open_standard_streams() -> None:
+    """A standard stream the command was started without (``dyncheck check m.xml >&-``, as
+    some CI runners and daemons start commands) is opened on /dev/null: Python gave it as
+    None, every engine process died flushing it (a good model reported as one no engine
+    could load), and the next file dyncheck opened would have taken its descriptor (a page
+    written where output goes)."""
+    for fd, name, mode in ((0, "stdin", os.O_RDONLY), (1, "stdout", os.O_WRONLY),
+                           (2, "stderr", os.O_WRONLY)):
+        try:
+            os.fstat(fd)
+        except OSError:
+            null = os.open(os.devnull, mode)
+            if null != fd:
+                os.dup2(null, fd)
+                os.close(null)
+            setattr(sys, name, open(fd, "r" if fd == 0 else "w", closefd=False,
+                                    encoding="utf-8", errors="replace"))
+
+
 class _LeavingReader:
-    """``sys.stdout`` for a reader that may go away — ``dyncheck check FOLDER | head``: a
-    write to the closed pipe raised ``BrokenPipeError``, which ended the check after the
-    first model ('cannot write output: Broken pipe', exit 2, the other pages never
-    written). Now the rest of the output goes to /dev/null and the command finishes with
-    its own exit status."""
+    """``sys.stdout`` (and ``sys.stderr``) for a reader that may go away — ``dyncheck check
+    FOLDER | head``: a write to the closed pipe raised ``BrokenPipeError``, which ended the
+    check after the first model ('cannot write output: Broken pipe', exit 2, the other pages
+    never written); a full one (``> /dev/full``) raised ``OSError`` (no space) the same way.
+    Now the rest of that stream's output goes to /dev/null and the command finishes with its
+    own exit status: what it writes into ``--out`` does not depend on who reads its lines."""
 
     def __init__(self, stream: TextIO) -> None:
         self._stream = stream
@@ -170,14 +192,14 @@ class _LeavingReader:
     def write(self, text: str) -> int:
         try:
             return self._stream.write(text)
-        except BrokenPipeError:
+        except OSError:  # a closed pipe, a full device, an I/O error: the reader is gone
             self._drop()
             return len(text)
 
     def flush(self) -> None:
         try:
             self._stream.flush()
-        except BrokenPipeError:
+        except OSError:
             self._drop()
 
     def _drop(self) -> None:
@@ -186,6 +208,10 @@ class _LeavingReader:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, self._stream.fileno())
         os.close(devnull)
+        try:  # what the stream still buffers goes to /dev/null now
+            self._stream.flush()
+        except OSError:
+            pass
 
     def __getattr__(self, name: str) -> object:
         return getattr(self._stream, name)

@@ -229,6 +229,41 @@ def test_a_reader_that_leaves_costs_no_page_and_no_error(tmp_path):
     assert "error" not in err and "Traceback" not in err
 
 
+STREAMS = {
+    "stdout closed": "exec 1>&-",
+    "stderr closed": "exec 2>&-",
+    "stdin closed": "exec 0<&-",
+    "stdout full": "exec 1>/dev/full",
+    "stderr full": "exec 2>/dev/full",
+}
+
+
+@pytest.mark.parametrize("stream", sorted(STREAMS))
+def test_a_closed_or_full_standard_stream_fails_no_model(tmp_path, stream):
+    """#81: with standard output closed (``dyncheck check m.xml >&-``) every engine process
+    died flushing it: "no engine could load it", a false refusal of a good model, three
+    tracebacks and exit 120; a full one (/dev/full) ended the command with exit 2 after the
+    first line. Expected: the command's own result on the same files with its streams open
+    (exit 0 and both pages: mujoco agrees with the referee on these models, see
+    tests/check/test_model_check.py), no traceback where stderr can be read."""
+    import shlex
+    from pathlib import Path
+
+    models = Path(__file__).resolve().parents[1] / "check" / "models"
+    out = tmp_path / "out"
+    command = shlex.join([sys.executable, "-m", "dyncheck", "check", str(models / "mixed.xml"),
+                          str(models / "branches.urdf"), "--states", "3", "--impl",
+                          "reference", "--impl", "mujoco", "--out", str(out)])
+    err = tmp_path / "err"
+    redirect = "" if "stderr" in stream else f" 2>{shlex.quote(str(err))}"
+    done = subprocess.run(["bash", "-c", f"{STREAMS[stream]}; {command}{redirect}"],
+                          timeout=300, capture_output="stdout" not in stream)
+    assert done.returncode == 0, err.read_text() if err.exists() else done.returncode
+    assert (out / "mixed.md").is_file() and (out / "branches.md").is_file()
+    if err.exists():
+        assert "Traceback" not in err.read_text() and "Exception ignored" not in err.read_text()
+
+
 def test_an_out_folder_in_use_by_another_dyncheck_is_refused_naming_it(tmp_path):
     """#60: two commands writing one --out interleaved their pages and CSVs. A second
     dyncheck is refused at once (exit 2, one line naming the process that holds the folder,
