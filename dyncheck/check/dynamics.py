@@ -202,8 +202,9 @@ def tie_row(tie: Tie, model: str) -> CheckRow:
     number on the page)."""
     served = ("the recursive algorithm gave the referee's M, h and dynamics at every "
               "state and its derivatives" if tie.agrees else
-              "the referee's two methods disagree: the general method gave every "
-              "number on this page; the referee's derivatives are not to be trusted")
+              "the referee's two methods disagree on this model (a defect of the referee, not "
+              "of an engine): no engine's dynamics are judged against it, the engines are "
+              "compared with each other only; the referee's derivatives are not to be trusted")
     return CheckRow(
         model=model, section=Section.DYNAMICS, subject="referee",
         field="recursive Newton-Euler against the general method (M, h)",

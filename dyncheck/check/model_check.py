@@ -317,9 +317,11 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
         on_canonical = referee.dynamics(batch.q, batch.v, batch.a)
         assert referee.tie is not None
         if with_referee:
-            results[REFEREE] = on_canonical
             rows.append(tie_row(referee.tie, model))
-        readings.own_readings(canonical_tree, batch, loaded, parts, on_canonical, own)
+        if referee.tie.agrees:  # a referee that disagrees with itself judges no engine
+            if with_referee:
+                results[REFEREE] = on_canonical
+            readings.own_readings(canonical_tree, batch, loaded, parts, on_canonical, own)
     except Exception as exc:  # the referee failing on a tree costs its own rows too
         rows.append(_row(model, Section.DYNAMICS, REFEREE, Verdict.FAILED,
                          f"{type(exc).__name__}: {exc}", field="dynamics"))

@@ -118,6 +118,13 @@ def _reading(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Reading, 
                            if not explained.empty else "")
 
 
+def _referee_split(rows: pd.DataFrame) -> bool:
+    """Whether the referee's two methods disagreed on the model (its row failed): it then
+    judged no engine."""
+    tie = rows[(rows["section"] == Section.DYNAMICS) & (rows["subject"] == "referee")]
+    return bool((tie["verdict"] == Verdict.FAILED).any())
+
+
 def _agreement(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Agreement, str]:
     """Judged against the referee (MuJoCo where the referee was not run): a difference
     between two engines belongs to the one that differs from the judge. One rule, in this
@@ -134,7 +141,9 @@ def _agreement(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Agreeme
     compared = dynamics[dynamics["verdict"] != Verdict.SKIPPED]
     if compared.empty:
         skipped = dynamics[dynamics["verdict"] == Verdict.SKIPPED]
-        why = _first_notes(skipped, 1) if not skipped.empty else "no other engine to compare"
+        why = _first_notes(skipped, 1) if not skipped.empty else (
+            "the referee's two methods disagree on this model, and no other engine to "
+            "compare" if _referee_split(rows) else "no other engine to compare")
         return Agreement.NOT_COMPARED, why
     failed = compared[compared["verdict"] == Verdict.FAILED]
     if not failed.empty:

@@ -37,10 +37,12 @@ def test_a_mutated_recursion_fails_the_tie(monkeypatch, model):
     tie = rows[rows["subject"] == "referee"]
     assert set(tie["verdict"]) == {"failed"}, tie
     assert (tie["error"] > tie["tolerance"]).all()
-    assert "general method gave every number" in tie["note"].iloc[0]
-    # the general method served the dynamics: the referee still agrees with MuJoCo there
+    assert "the referee's two methods disagree on this model" in tie["note"].iloc[0]
+    # #81: a referee that disagrees with itself judges no engine (it served MuJoCo's rows
+    # before, from its general method alone)
     dynamics = rows[(rows["section"] == "dynamics") & (rows["subject"] != "referee")]
-    assert set(dynamics["verdict"]) == {"passed"}, dynamics
+    assert not ((dynamics["impl_a"] == "reference") | (dynamics["impl_b"] == "reference")
+                ).any(), dynamics
     # and its derivatives are not a side of any row
     derivative = rows[rows["section"] == "derivatives"]
     assert not ((derivative["impl_a"] == "reference") & (derivative["subject"] != "referee")
@@ -60,3 +62,35 @@ def test_the_unmutated_recursion_passes_the_tie(model):
     assert float(tie["error"].iloc[0]) < 0.1 * float(tie["tolerance"].iloc[0])
     derivative = rows[rows["section"] == "derivatives"]
     assert (derivative["impl_a"] == "reference").any()
+
+
+FLOATING_BELOW = """<robot name="fb">
+  <link name="base"><inertial><mass value="1"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="arm"><inertial><origin xyz="0 0 -0.2"/><mass value="1.2"/>
+    <inertia ixx="0.02" iyy="0.03" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="free"><inertial><origin xyz="0.1 0 0"/><mass value="0.5"/>
+    <inertia ixx="0.01" iyy="0.012" izz="0.008" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="hinge" type="revolute"><parent link="base"/><child link="arm"/>
+    <axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="10" velocity="10"/></joint>
+  <joint name="float" type="floating"><parent link="arm"/><child link="free"/>
+    <origin xyz="0 0 -0.4"/></joint>
+</robot>"""
+
+
+def test_a_referee_that_disagrees_with_itself_judges_no_engine(tmp_path):
+    """#81: a URDF floating joint below a moving link — the referee's two methods disagree
+    (M by 0.87, h by 0.61, measured), yet Pinocchio's rows failed "cause unknown" against it.
+    Now the referee's own row fails and names itself, and no engine is judged against it
+    (the engines are compared with each other only)."""
+    path = tmp_path / "floating_below.urdf"
+    path.write_text(FLOATING_BELOW)
+    result = check_model(path, states=10, impls=("reference", "pinocchio"), isolate=False)
+    rows = result.rows[result.rows["section"] == "dynamics"]
+    tie = rows[rows["subject"] == "referee"]
+    assert list(tie["verdict"]) == ["failed"]
+    assert "the referee's two methods disagree on this model" in tie["note"].iloc[0]
+    judged = rows[(rows["subject"] != "referee") & ((rows["impl_a"] == "reference")
+                                                   | (rows["impl_b"] == "reference"))]
+    assert judged.empty
+    assert "cause unknown" not in " ".join(result.rows["note"])
