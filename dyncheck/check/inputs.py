@@ -4,6 +4,7 @@ naming the file (and the element, line or engine where known)."""
 from __future__ import annotations
 
 import importlib.metadata
+import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -146,6 +147,34 @@ def states(value: int) -> int:
     if not 1 <= value <= MAX_STATES:
         raise InvalidInput("--states", value, f"an integer in [1, {MAX_STATES}]")
     return value
+
+
+MEMORY_SHARE = 0.5
+"""The share of this machine's memory a check's arrays may take."""
+
+
+def machine_memory() -> int:
+    """Bytes of physical memory (0 where the system does not say)."""
+    try:
+        return int(os.sysconf("SC_PHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return 0
+
+
+def fits_in_memory(*, count: int, nv: int, arrays: int, flag: str = "--states") -> None:
+    """Refuse, before the work, a check whose ``arrays`` arrays of ``count`` states × nv²
+    doubles (the mass matrices every implementation returns, and the referee's on every
+    engine's reading) would take more than :data:`MEMORY_SHARE` of this machine's memory: a
+    100 000-state check of a 100-joint chain died with numpy's ArrayMemoryError after the
+    engines had run."""
+    total = machine_memory()
+    need = count * nv * nv * 8 * arrays
+    if total and need > MEMORY_SHARE * total:
+        most = max(1, int(MEMORY_SHARE * total // (nv * nv * 8 * arrays)))
+        raise InvalidInput(flag, count, (
+            f"at most {most} states for this model: {nv} degrees of freedom at {count} states "
+            f"need {need / 2**30:.1f} GiB for {arrays} arrays of states × nv² doubles, more "
+            f"than {MEMORY_SHARE:.0%} of this machine's {total / 2**30:.1f} GiB"))
 
 
 def robots_folder() -> Path | None:

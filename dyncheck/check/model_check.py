@@ -172,6 +172,8 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     if against_path is not None:
         rows.extend(_against(model, canonical_tree, read(against_path, floating=floating)))
     canon = layout.canonical(canonical_tree)
+    inputs.fits_in_memory(count=states if given is None else given.n, nv=canon.nv,
+                          arrays=2 + 3 * len(loaded))  # referee, engines, their readings, pairs
     parts, unmatched = _parts(canon, canonical_tree, loaded, notes)
     batch, states, drawn = check_states(given, canon, canonical_tree, n=states, seed=seed)
     notes.append(drawn)

@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from dyncheck.__main__ import main
+from dyncheck.errors import InvalidInput
 
 MODELS = Path(__file__).parent / "models"
 URDF = (MODELS / "branches.urdf").read_text()
@@ -47,3 +48,26 @@ def test_failed_model_exits_1(tmp_path):
     args = ["check", str(corrupted), "--against", str(MODELS / "branches.urdf"),
             "--states", "5", "--out", str(tmp_path / "o")]
     assert main(args) == 1
+
+
+def test_states_that_would_not_fit_in_memory_are_refused_before_the_dynamics(tmp_path,
+                                                                             monkeypatch):
+    """#81: 100 000 states of a 100-joint chain died with numpy's ArrayMemoryError (7.45 GiB
+    for one array) after the engines had run. Expected: the arrays' size by hand — 8 arrays
+    (referee, 2 engines with the referee's reading of each, pairs: 2 + 3 × 2) of states × 100²
+    doubles — against half of a machine given 8 GiB: at most ⌊4 GiB / (100² × 8 × 8)⌋ = 6710
+    states, named in one line before any dynamics."""
+    from dyncheck.check import inputs as module
+    from dyncheck.check.model_check import check_model
+
+    body = '<geom size="0.05" mass="1"/>'
+    chain = "".join(f'<body pos="0 0 -0.1"><joint name="j{i}" type="hinge" axis="0 1 0"/>'
+                    f"{body}" for i in range(100))
+    path = tmp_path / "chain.xml"
+    path.write_text(f"<mujoco><worldbody>{chain}{'</body>' * 100}</worldbody></mujoco>")
+    monkeypatch.setattr(module, "machine_memory", lambda: 8 * 2**30)
+    with pytest.raises(InvalidInput) as caught:
+        check_model(path, states=100_000, impls=("reference", "mujoco", "pinocchio"),
+                    isolate=False, actuators=False)
+    message = str(caught.value)
+    assert "--states" in message and "at most 6710 states" in message and "\n" not in message
