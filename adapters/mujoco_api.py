@@ -29,6 +29,18 @@ INTEGRATORS: dict[str, mujoco.mjtIntegrator] = {
 }
 """dyncheck's integrator names → MuJoCo's (the C engine and its ports alike)."""
 
+_DISABLE = mujoco.mjtDisableBit.__members__
+SPRINGS_APART = "mjDSBL_SPRING" in _DISABLE
+"""MuJoCo 3.3 split the flag that disables passive forces, ``mjDSBL_PASSIVE``, into
+``mjDSBL_SPRING`` and ``mjDSBL_DAMPER`` (3.2.7 has the one flag only: measured)."""
+PASSIVE_OFF = (int(_DISABLE["mjDSBL_SPRING"]) | int(_DISABLE["mjDSBL_DAMPER"]) if SPRINGS_APART
+               else int(_DISABLE["mjDSBL_PASSIVE"]))
+"""The flags that disable springs and dampers, in every release."""
+SPRINGS_OFF = int(_DISABLE["mjDSBL_SPRING"] if SPRINGS_APART else _DISABLE["mjDSBL_PASSIVE"])
+"""The flag whose clearing enables spring forces (and ``mjcb_passive``); before 3.3 it
+enables dampers too."""
+
+
 FULLM_READS_DATA = RELEASE >= (3, 10, 0)
 """MuJoCo 3.10.0 changed ``mj_fullM(m, dst, M)`` (M: ``d.qM``) to ``mj_fullM(m, d, dst)``
 (changelog 3.10.0, item 14, commit 7b9b8806)."""

@@ -43,6 +43,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.mujoco_actuators import MujocoActuation
 from dyncheck.adapters.mujoco_api import (
     GYROSCOPIC_IMPLICIT,
+    PASSIVE_OFF,
     RK4_ON_GROUP,
     full_inertia,
     mujoco_warnings,
@@ -63,8 +64,7 @@ _TYPES = {
 _SMOOTH_ONLY = (
     mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
     | mujoco.mjtDisableBit.mjDSBL_ACTUATION
-    | mujoco.mjtDisableBit.mjDSBL_SPRING
-    | mujoco.mjtDisableBit.mjDSBL_DAMPER
+    | PASSIVE_OFF
     | mujoco.mjtDisableBit.mjDSBL_SENSOR
 )
 GRAVITY_OFF = (

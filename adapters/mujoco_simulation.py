@@ -28,7 +28,7 @@ import mujoco
 import numpy as np
 
 from dyncheck.adapters.base import Field
-from dyncheck.adapters.mujoco_api import INTEGRATORS
+from dyncheck.adapters.mujoco_api import INTEGRATORS, SPRINGS_APART, SPRINGS_OFF
 from dyncheck.cases.multibody import Coupling
 from dyncheck.errors import EngineError, Unsupported
 from dyncheck.vocabulary import Integrator
@@ -199,11 +199,13 @@ class MujocoRun:
         """The field added at every stage: ``mjcb_passive``, called where spring forces are
         enabled (refused where the model has springs or other passive forces)."""
         m = self.model
-        if np.any(m.jnt_stiffness) or np.any(m.tendon_stiffness) or \
+        dampers = not SPRINGS_APART and (np.any(m.dof_damping)
+                                                    or np.any(m.tendon_damping))
+        if np.any(m.jnt_stiffness) or np.any(m.tendon_stiffness) or dampers or \
                 np.any(m.body_gravcomp) or m.opt.density or m.opt.viscosity:
             raise Unsupported("mujoco: a field at every stage rides on the passive-force "
                               "callback; the model has passive forces of its own")
-        m.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_SPRING)
+        m.opt.disableflags &= ~SPRINGS_OFF
         model = m
 
         def passive(m: mujoco.MjModel, d: mujoco.MjData) -> None:
