@@ -186,12 +186,7 @@ def page(steps: Sequence[ModelStep], outcomes: dict[str, dict[str, str]], models
         lines += [f"**{len(s.moved)} of {s.rows} rows moved** ({each}).", ""]
         if len(s.moved):
             lines += [markdown_table(s.moved), ""]
-    if outcomes:
-        table = pd.DataFrame(outcomes).rename_axis("reproducer").reset_index()
-        lines += ["## The engine's defect reproducers under each release", "",
-                  "A reproducer exits 1 while its defect stands (`dyncheck explain NAME "
-                  "--reproducer FILE`).", "",
-                  markdown_table(table) if len(table) else "_none for this engine_", ""]
+    lines += versions.reproducer_lines(outcomes)
     return "\n".join(lines)
 
 

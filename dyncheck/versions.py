@@ -280,6 +280,8 @@ class Step:
     fixed under ``new``: ``new`` is the release that fixed them."""
     back: tuple[str, ...] = ()
     """Engine defects fixed under ``old`` that stand again under ``new``."""
+    outcomes: tuple[dict[str, str], dict[str, str]] = ({}, {})
+    """The engine's reproducers' outcomes under ``old`` and under ``new`` (name → outcome)."""
 
 
 def matrix(
@@ -306,9 +308,10 @@ def matrix(
             was, now = reproduced.load(a), reproduced.load(b)
             fixed = reproduced.changed(was, now, to=reproduced.Outcome.FIXED)
             back = reproduced.changed(was, now, to=reproduced.Outcome.STANDS)
+            outcomes = ({k: str(v) for k, v in was.items()}, {k: str(v) for k, v in now.items()})
             if a is None or b is None:
                 steps.append(Step(engine=name, old=old, new=new, table=None,
-                                  problem=pa or pb, fixed=fixed, back=back))
+                                  problem=pa or pb, fixed=fixed, back=back, outcomes=outcomes))
                 continue
             ta, tb = diff.load(a, "RUN_A"), diff.load(b, "RUN_B")
             made_by = " and ".join(dict.fromkeys(
@@ -317,7 +320,8 @@ def matrix(
             also = tuple(c for c in diff.version_changes(ta.versions, tb.versions)
                          if c.split()[0].replace("_", " ") not in own)
             steps.append(Step(engine=name, old=old, new=new, table=diff.diff(ta, tb),
-                              made_by=made_by, also_changed=also, fixed=fixed, back=back))
+                              made_by=made_by, also_changed=also, fixed=fixed, back=back,
+                              outcomes=outcomes))
     return steps
 
 
@@ -366,7 +370,21 @@ def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None
                 lines += [f"**Explanation.** {notes[(name, s.old, s.new)]}", ""]
             grouped = _grouped(diff.moved(s.table))
             lines += [grouped.to_markdown(index=False) if len(grouped) else "_nothing moved_", ""]
+        lines += reproducer_lines({r: o for s in steps if s.engine == name
+                                   for r, o in ((s.old, s.outcomes[0]), (s.new, s.outcomes[1]))})
     return "\n".join(lines)
+
+
+def reproducer_lines(outcomes: dict[str, dict[str, str]]) -> list[str]:
+    """A table of each reproducer's outcome under each release (release → name → outcome;
+    none where the engine has no reproducer or no release ran one)."""
+    if not any(outcomes.values()):
+        return []
+    table = pd.DataFrame(outcomes).rename_axis("reproducer").reset_index().fillna("not run")
+    return ["#### The engine's defect reproducers under each release", "",
+            "A reproducer exits 1 while its defect stands (`dyncheck explain NAME --reproducer "
+            "FILE`); `does not run`: the script fails by itself under that release (an API it "
+            "calls is missing).", "", table.to_markdown(index=False), ""]
 
 
 class Stepped(Protocol):
