@@ -423,6 +423,22 @@ TEXTURE_FILES = ("file", "fileright", "fileleft", "fileup", "filedown", "filefro
 """The attributes that name a file on an asset (a cube texture names one per face)."""
 
 
+def asset_files(root: ET.Element, folder: Path) -> list[tuple[str, Path]]:
+    """Every file the (inlined) model's assets name — meshes, skins, height fields, textures
+    (each face of a cube), attached models — as ``(<element attribute>, absolute path)``,
+    resolved as MuJoCo resolves them (the compiler's asset folders)."""
+    out = []
+    for element in root.iter():
+        if element.tag not in (*ASSET_DIRS, "model"):
+            continue
+        base = _compiler(root, ASSET_DIRS.get(element.tag, "assetdir"),
+                         _compiler(root, "assetdir", ""))
+        for key in TEXTURE_FILES:
+            if file := element.get(key):
+                out.append((f"<{element.tag} {key}>", (folder / base / file).resolve()))
+    return out
+
+
 def _standalone(root: ET.Element, folder: Path) -> str:
     """The (inlined) model as text whose asset files are absolute paths, so that it reads the
     same from anywhere: the compiler's asset folders folded into them."""

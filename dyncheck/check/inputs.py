@@ -8,7 +8,7 @@ import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from dyncheck.adapters.mjcf_copy import inline
+from dyncheck.adapters.mjcf_copy import asset_files, inline
 from dyncheck.adapters.model_files import (
     INERTIA_KEYS,
     ROOT_TAG,
@@ -69,6 +69,10 @@ def model_path(text: str) -> Path:
             inlined = inline(path)
         except EngineError as exc:
             raise ModelFileError(path, str(exc).removeprefix(f"{path.resolve()}: ")) from None
+        for where, asset in asset_files(inlined, path.resolve().parent):
+            if asset.exists() and not asset.is_file():  # a FIFO never ends; a device neither
+                raise ModelFileError(path, f"{where} names {asset.name!r}, which is not a "
+                                     f"regular file ({_kind(asset)}): no engine may open it")
         deepest = nesting(inlined)
         if deepest > MAX_NESTING:
             raise ModelFileError(path, f"bodies nested {deepest} deep (the check walks "
@@ -77,6 +81,19 @@ def model_path(text: str) -> Path:
         raise ModelFileError(path, f"links chained {deepest} deep (the check walks trees "
                              f"at most {MAX_NESTING} deep; split the model)")
     return path
+
+
+def _kind(path: Path) -> str:
+    """What a path that is not a regular file is, in a word."""
+    import stat
+
+    mode = path.stat().st_mode
+    for test, word in ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISSOCK, "a socket"),
+                       (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                       (stat.S_ISDIR, "a folder")):
+        if test(mode):
+            return word
+    return "a special file"
 
 
 MAX_NESTING = 2000

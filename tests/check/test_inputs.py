@@ -71,3 +71,35 @@ def test_states_that_would_not_fit_in_memory_are_refused_before_the_dynamics(tmp
                     isolate=False, actuators=False)
     message = str(caught.value)
     assert "--states" in message and "at most 6710 states" in message and "\n" not in message
+
+
+SPECIAL_ASSETS = {
+    "FIFO mesh": ('<asset><mesh name="m" file="pipe.stl"/></asset>', "a FIFO"),
+    "device texture": ('<asset><texture name="t" type="2d" file="/dev/zero"/></asset>',
+                       "a character device"),
+}
+
+
+@pytest.mark.parametrize("where", ["model", "--against"])
+@pytest.mark.parametrize("kind", sorted(SPECIAL_ASSETS))
+def test_an_asset_that_is_not_a_regular_file_is_refused_before_any_engine(tmp_path, kind,
+                                                                           where):
+    """#81: a mesh that is a FIFO hung the command until killed (an engine's parser waits for
+    the FIFO's end, which never comes), from the model or from an --against model. Expected:
+    exit 2, one line naming the element, the file and its kind, within seconds."""
+    import subprocess
+    import sys
+
+    os.mkfifo(tmp_path / "pipe.stl")
+    asset, said = SPECIAL_ASSETS[kind]
+    special = tmp_path / "special.xml"
+    special.write_text(f"<mujoco>{asset}<worldbody><body><joint type='hinge'/>"
+                       "<geom size='0.1' mass='1'/></body></worldbody></mujoco>")
+    plain = tmp_path / "plain.xml"
+    plain.write_text("<mujoco><worldbody><body><joint type='hinge'/><geom size='0.1' "
+                     "mass='1'/></body></worldbody></mujoco>")
+    argv = [str(special)] if where == "model" else [str(plain), "--against", str(special)]
+    done = subprocess.run([sys.executable, "-m", "dyncheck", "check", *argv, "--out",
+                           str(tmp_path / "out")], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and said in done.stderr and "special.xml" in done.stderr
