@@ -423,33 +423,32 @@ TEXTURE_FILES = ("file", "fileright", "fileleft", "fileup", "filedown", "filefro
 """The attributes that name a file on an asset (a cube texture names one per face)."""
 
 
-def asset_files(root: ET.Element, folder: Path) -> list[tuple[str, Path]]:
-    """Every file the (inlined) model's assets name — meshes, skins, height fields, textures
-    (each face of a cube), attached models — as ``(<element attribute>, absolute path)``,
-    resolved as MuJoCo resolves them (the compiler's asset folders)."""
+def _asset_attributes(root: ET.Element, folder: Path
+                      ) -> list[tuple[ET.Element, str, Path]]:
+    """Every file attribute of the (inlined) model's assets — meshes, skins, height fields,
+    textures (each face of a cube), attached models — with the absolute path MuJoCo resolves
+    it to (the compiler's asset folders)."""
     out = []
     for element in root.iter():
         if element.tag not in (*ASSET_DIRS, "model"):
             continue
         base = _compiler(root, ASSET_DIRS.get(element.tag, "assetdir"),
                          _compiler(root, "assetdir", ""))
-        for key in TEXTURE_FILES:
-            if file := element.get(key):
-                out.append((f"<{element.tag} {key}>", (folder / base / file).resolve()))
+        out += [(element, key, (folder / base / file).resolve()) for key in TEXTURE_FILES
+                if (file := element.get(key))]
     return out
+
+
+def asset_files(root: ET.Element, folder: Path) -> list[tuple[str, Path]]:
+    """Every file the model's assets name, as ``(<element attribute>, absolute path)``."""
+    return [(f"<{e.tag} {key}>", path) for e, key, path in _asset_attributes(root, folder)]
 
 
 def _standalone(root: ET.Element, folder: Path) -> str:
     """The (inlined) model as text whose asset files are absolute paths, so that it reads the
     same from anywhere: the compiler's asset folders folded into them."""
-    for element in root.iter():
-        if element.tag not in (*ASSET_DIRS, "model"):
-            continue
-        base = _compiler(root, ASSET_DIRS.get(element.tag, "assetdir"),
-                         _compiler(root, "assetdir", ""))
-        for key in TEXTURE_FILES:
-            if file := element.get(key):
-                element.set(key, str((folder / base / file).resolve()))
+    for element, key, path in _asset_attributes(root, folder):
+        element.set(key, str(path))
     for compiler in root.iter("compiler"):
         for key in ("meshdir", "texturedir", "assetdir"):
             compiler.attrib.pop(key, None)
