@@ -111,6 +111,10 @@ def test_a_planted_change_fails_named_within_tolerance_passes_update_accepts(tmp
     planted(1e-6)
     code, summary = _check(tmp_path)
     assert code == 1
+    jsonschema = pytest.importorskip("jsonschema", reason="jsonschema (extra 'test')")
+    from dyncheck.ci_outputs import schema
+
+    jsonschema.validate(summary, schema())  # the baseline's entries in the shipped schema
     moved = summary["baseline"]["moved"]
     assert "dynamics kinetic_energy max rel error reference/pinocchio" in {m["row"]
                                                                            for m in moved}
