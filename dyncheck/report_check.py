@@ -92,6 +92,7 @@ PAGES_NOT_COMPARED = (
     "benchmark-check.md",
     "versions.md",
     "versions-newton-pybullet.md",
+    "versions-models.md",
     "reliability.md",
     "errata.md",
 )

@@ -46,6 +46,8 @@ PAGES = (
      "releases (`dyncheck versions`)"),
     ("Newton and PyBullet versions", "versions-newton-pybullet.md", "the same for Newton and "
      "PyBullet"),
+    ("Your models across versions", "versions-models.md", "two example models under two "
+     "MuJoCo releases (`dyncheck versions MODEL ...`)"),
     ("Reliability", "reliability.md", "every kind of bad input and fault and the answer given"),
     ("Benchmark", "benchmark.md", "speed against the engines (`dyncheck bench`)"),
     ("Command timings", "benchmark-suite.md", "how long each command takes "
