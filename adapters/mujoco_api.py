@@ -41,6 +41,10 @@ SPRINGS_OFF = int(_DISABLE["mjDSBL_SPRING"] if SPRINGS_APART else _DISABLE["mjDS
 enables dampers too."""
 
 
+HAS_TENDON_ARMATURE = "tendon_armature" in dir(mujoco.MjModel)
+"""Tendon armature (``<tendon armature>``) came after 3.2.7, whose model has no such field
+(measured: the version matrix's 3.2.7 run failed every tendon case on it)."""
+
 FULLM_READS_DATA = RELEASE >= (3, 10, 0)
 """MuJoCo 3.10.0 changed ``mj_fullM(m, dst, M)`` (M: ``d.qM``) to ``mj_fullM(m, d, dst)``
 (changelog 3.10.0, item 14, commit 7b9b8806)."""

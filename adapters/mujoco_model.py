@@ -43,6 +43,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.mujoco_actuators import MujocoActuation
 from dyncheck.adapters.mujoco_api import (
     GYROSCOPIC_IMPLICIT,
+    HAS_TENDON_ARMATURE,
     PASSIVE_OFF,
     RK4_ON_GROUP,
     full_inertia,
@@ -226,7 +227,7 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
         self.data = mujoco.MjData(m)
         if np.any(m.body_gravcomp != 0):
             notes += ("mujoco: gravity compensation (gravcomp) left out of the dynamics",)
-        if m.ntendon and np.any(m.tendon_armature != 0):
+        if HAS_TENDON_ARMATURE and m.ntendon and np.any(m.tendon_armature != 0):
             armed = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_TENDON, i) or f"tendon {i}"
                      for i in np.flatnonzero(m.tendon_armature)]
             notes += (TENDON_ARMATURE.format(tendons=", ".join(repr(t) for t in armed[:4])
