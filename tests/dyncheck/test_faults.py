@@ -1681,7 +1681,7 @@ ROUND3 = (  # #59 and #60: readings measured, refusals named, folders held
           answer=r"^dyncheck: error: ulimit -v must be at least 4096 MiB for `dyncheck run`"),
 )
 
-def _files(**named: str) -> Callable[[Path], Path]:
+def _several(**named: str) -> Callable[[Path], Path]:
     """Several files written into the test's folder (a model and the file an option reads;
     a name with a double underscore is written with a dot there: ``a__xml`` → ``a.xml``)."""
     def make(tmp: Path) -> Path:
@@ -1689,6 +1689,14 @@ def _files(**named: str) -> Callable[[Path], Path]:
             (tmp / name.replace("__", ".")).write_text(content)
         return tmp
     return make
+
+
+def _memory(size: int) -> Callable[[pytest.MonkeyPatch, Path], None]:
+    """The machine's memory as ``size`` bytes (the answer then names the same bound on every
+    machine)."""
+    def patch(monkeypatch: pytest.MonkeyPatch, _tmp: Path) -> None:
+        monkeypatch.setattr("dyncheck.check.inputs.machine_memory", lambda: size)
+    return patch
 
 
 def _fifo_mesh(tmp: Path) -> Path:
@@ -1705,55 +1713,55 @@ CHAIN_100 = "<mujoco><worldbody>" + "".join(
     "</worldbody></mujoco>"
 CHECK_COLUMNS = "model,section,subject,field,impl_a,impl_b,value_a,value_b,error,tolerance,verdict"
 ROUND4 = (  # #79 and #81: the CI gate's files, special files, sizes, versions on models
-    Fault(kind="check --accept missing", area="check", prepare=_files(a__xml=SMALL_MJCF),
+    Fault(kind="check --accept missing", area="check", prepare=_several(a__xml=SMALL_MJCF),
           argv=("check", "{tmp}/a.xml", "--accept", "{tmp}/none.toml", "--out", OUT),
           answer=r"--accept must be an existing TOML file of \[\[accept\]\] entries"),
     Fault(kind="check --accept not TOML", area="check",
-          prepare=_files(a__xml=SMALL_MJCF, k__toml="[[accept]\n"),
+          prepare=_several(a__xml=SMALL_MJCF, k__toml="[[accept]\n"),
           argv=("check", "{tmp}/a.xml", "--accept", "{tmp}/k.toml", "--out", OUT),
           answer=r"--accept must be a TOML file \("),
     Fault(kind="check --accept entry without a reason", area="check",
-          prepare=_files(a__xml=SMALL_MJCF,
+          prepare=_several(a__xml=SMALL_MJCF,
                          k__toml='[[accept]]\nmodel="a"\nengine="b"\nlabel="c"\n'),
           argv=("check", "{tmp}/a.xml", "--accept", "{tmp}/k.toml", "--out", OUT),
           answer=r"accept\[1\]\.reason must be a non-empty string, got None"),
     Fault(kind="check --accept entry with an unknown field", area="check",
-          prepare=_files(a__xml=SMALL_MJCF, k__toml='[[accept]]\nmodel="a"\nengine="b"\n'
+          prepare=_several(a__xml=SMALL_MJCF, k__toml='[[accept]]\nmodel="a"\nengine="b"\n'
                          'label="c"\nreason="r"\nuntil=1\n'),
           argv=("check", "{tmp}/a.xml", "--accept", "{tmp}/k.toml", "--out", OUT),
           answer=r"accept\[1\]\.until must be absent"),
     Fault(kind="check --accept expiry not a date", area="check",
-          prepare=_files(a__xml=SMALL_MJCF, k__toml='[[accept]]\nmodel="a"\nengine="b"\n'
+          prepare=_several(a__xml=SMALL_MJCF, k__toml='[[accept]]\nmodel="a"\nengine="b"\n'
                          'label="c"\nreason="r"\nexpires="soon"\n'),
           argv=("check", "{tmp}/a.xml", "--accept", "{tmp}/k.toml", "--out", OUT),
           answer=r"accept\[1\]\.expires must be a date, YYYY-MM-DD, got 'soon'"),
     Fault(kind="check --accept a key other than accept", area="check",
-          prepare=_files(a__xml=SMALL_MJCF, k__toml="ignore = true\n"),
+          prepare=_several(a__xml=SMALL_MJCF, k__toml="ignore = true\n"),
           argv=("check", "{tmp}/a.xml", "--accept", "{tmp}/k.toml", "--out", OUT),
           answer=r"must be an \[\[accept\]\] table \(the only key\), got 'ignore'"),
-    Fault(kind="check --baseline missing", area="check", prepare=_files(a__xml=SMALL_MJCF),
+    Fault(kind="check --baseline missing", area="check", prepare=_several(a__xml=SMALL_MJCF),
           argv=("check", "{tmp}/a.xml", "--baseline", "{tmp}/none.csv", "--out", OUT),
           answer=r"--baseline must be an existing check baseline CSV \(write one with "
           r"--update-baseline\)"),
-    Fault(kind="check --baseline a folder", area="check", prepare=_files(a__xml=SMALL_MJCF),
+    Fault(kind="check --baseline a folder", area="check", prepare=_several(a__xml=SMALL_MJCF),
           argv=("check", "{tmp}/a.xml", "--baseline", "{tmp}", "--out", OUT),
           answer=r"--baseline must be an existing check baseline CSV"),
     Fault(kind="check --baseline of run, not of check", area="check",
-          prepare=_files(a__xml=SMALL_MJCF, b__csv="case,quantity,impl_a,impl_b,integrator,"
+          prepare=_several(a__xml=SMALL_MJCF, b__csv="case,quantity,impl_a,impl_b,integrator,"
                          "dt,max_rel_err,tolerance,verdict\n"),
           argv=("check", "{tmp}/a.xml", "--baseline", "{tmp}/b.csv", "--out", OUT),
           answer=r"--baseline must be a check baseline \(missing \["),
     Fault(kind="check --baseline truncated (header says 9 rows)", area="check",
-          prepare=_files(a__xml=SMALL_MJCF, b__csv="# dyncheck baseline rows=9\n"
+          prepare=_several(a__xml=SMALL_MJCF, b__csv="# dyncheck baseline rows=9\n"
                          + CHECK_COLUMNS + "\n"),
           argv=("check", "{tmp}/a.xml", "--baseline", "{tmp}/b.csv", "--out", OUT),
           answer=r"9 rows as its header says \(0 found: truncated\?\)"),
     Fault(kind="check --update-baseline without --baseline", area="check",
-          prepare=_files(a__xml=SMALL_MJCF),
+          prepare=_several(a__xml=SMALL_MJCF),
           argv=("check", "{tmp}/a.xml", "--update-baseline", "--out", OUT),
           answer=r"--update-baseline must be given with --baseline FILE"),
     Fault(kind="check --update-baseline onto the model itself", area="check",
-          prepare=_files(a__xml=SMALL_MJCF),
+          prepare=_several(a__xml=SMALL_MJCF),
           argv=("check", "{tmp}/a.xml", "--baseline", "{tmp}/a.xml", "--update-baseline",
                 "--out", OUT),
           answer=r"--baseline"),
@@ -1767,26 +1775,29 @@ ROUND4 = (  # #79 and #81: the CI gate's files, special files, sizes, versions o
         "<mujoco><asset><texture name='t' type='2d' file='/dev/zero'/></asset><worldbody>"
         "<body><joint type='hinge'/><geom size='0.1' mass='1'/></body></worldbody></mujoco>",
         answer=r"names 'zero', which is not a regular file \(a character device\)"),
-    chk("100 000 states of a 100-joint chain (82 GiB of arrays)", "a.xml", CHAIN_100,
-        "--states", "100000", "--impl", "reference", "--impl", "mujoco",
-        answer=r"--states must be at most \d+ states for this model: 100 degrees of freedom"),
+    Fault(kind="100 000 states of a 100-joint chain (37 GiB of arrays; a machine of 8 GiB)",
+          area="check", prepare=_file("a.xml", CHAIN_100), patch=_memory(8 * 2**30),
+          argv=("check", "{tmp}/a.xml", "--states", "100000", "--impl", "reference", "--impl",
+                "mujoco", "--out", OUT),
+          answer=r"--states must be at most 10737 states for this model: 100 degrees of "
+          r"freedom at 100000 states need 37\.3 GiB"),
     chk("slide range of ±1e308 (its width overflows)", "a.xml",
         "<mujoco><worldbody><body><joint type='slide' range='-1e308 1e308' limited='true'/>"
         "<geom size='0.1' mass='1'/></body></worldbody></mujoco>", "--impl", "reference",
         "--impl", "mujoco", exit=0, answer=AGREE),
     Fault(kind="versions on models with two engines", area="versions",
-          prepare=_files(a__xml=SMALL_MJCF),
+          prepare=_several(a__xml=SMALL_MJCF),
           argv=("versions", "{tmp}/a.xml", "--engine", "mujoco", "--engine", "drake"),
           answer=r"--engine must be one engine with model files"),
     Fault(kind="versions on models with --case", area="versions",
-          prepare=_files(a__xml=SMALL_MJCF),
+          prepare=_several(a__xml=SMALL_MJCF),
           argv=("versions", "{tmp}/a.xml", "--engine", "mujoco", "--case", "atwood"),
           answer=r"--case must be absent with model files"),
     Fault(kind="versions --release without models", area="versions",
           argv=("versions", "--release", "3.3.7"),
           answer=r"--release must be given with model files"),
     Fault(kind="versions --bisect of another engine than --engine", area="versions",
-          prepare=_files(a__xml=SMALL_MJCF),
+          prepare=_several(a__xml=SMALL_MJCF),
           argv=("versions", "{tmp}/a.xml", "--engine", "mujoco", "--bisect", "drake", "1.40.0",
                 "1.51.1"),
           answer=r"--bisect must be the engine of --engine \(mujoco\)"),
