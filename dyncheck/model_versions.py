@@ -29,6 +29,7 @@ from dyncheck.cache.store import cache_root
 from dyncheck.check import baseline as check_baseline
 from dyncheck.check.engines import ENGINES as CHECKED
 from dyncheck.escaping import markdown, markdown_code, markdown_table
+from dyncheck.matrix_lines import defect_lines, environment_lines, reproducer_lines
 from dyncheck.versions import Engine, Log, ReleaseFailed, ReleaseUnavailable
 
 FOLDER = "checks"
@@ -173,11 +174,11 @@ def page(steps: Sequence[ModelStep], outcomes: dict[str, dict[str, str]], models
              "releases are compared row by row as a check is held to its baseline (a verdict "
              "changed, an error moved by more than its row's tolerance, a reading changed, a "
              "row appeared or vanished).", ""]
-    lines += versions.environment_lines(
+    lines += environment_lines(
         seconds, {(steps[0].engine if steps else "", r): m
                   for r, m in (environments or {}).items()})
     for s in steps:
-        lines += [f"## {s.engine} {s.old} → {s.new}", "", *versions.defect_lines(s)]
+        lines += [f"## {s.engine} {s.old} → {s.new}", "", *defect_lines(s)]
         if s.moved is None:
             lines += [f"_not compared_: {markdown(s.problem)}", ""]
             continue
@@ -186,7 +187,7 @@ def page(steps: Sequence[ModelStep], outcomes: dict[str, dict[str, str]], models
         lines += [f"**{len(s.moved)} of {s.rows} rows moved** ({each}).", ""]
         if len(s.moved):
             lines += [markdown_table(s.moved), ""]
-    lines += versions.reproducer_lines(outcomes)
+    lines += reproducer_lines(outcomes)
     return "\n".join(lines)
 
 
