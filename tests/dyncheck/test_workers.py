@@ -316,6 +316,26 @@ with workers.on_sigterm():
 """
 
 
+def _wait_for_children(pid: int, count: int, limit: float = 60.0) -> None:
+    """Until process ``pid`` has ``count`` children (/proc), at most ``limit`` seconds: on a
+    loaded machine a pool's workers took longer than the fixed 2 s this test slept, and the
+    signal then came while the pool was being started — another moment than the one this
+    test is about (a signal during the pool's start is #81's open item)."""
+    from pathlib import Path
+
+    end = time.monotonic() + limit
+    while time.monotonic() < end:
+        found = 0
+        for task in Path(f"/proc/{pid}/task").glob("*"):
+            children = task / "children"
+            if children.exists():
+                found += len(children.read_text().split())
+        if found >= count:
+            return
+        time.sleep(0.1)
+    pytest.fail(f"the pool's {count} workers did not start within {limit:g} s")
+
+
 @pytest.mark.parametrize(("signum", "code"), [(2, 130), (15, 143)], ids=["SIGINT", "SIGTERM"])
 def test_a_signal_ends_a_pool_at_once_not_after_its_queue(signum, code):
     """Eight one-minute units on two workers: Ctrl-C or SIGTERM ends the process at once with
@@ -327,7 +347,8 @@ def test_a_signal_ends_a_pool_at_once_not_after_its_queue(signum, code):
     child = subprocess.Popen([sys.executable, "-c", SLOW_POOL], stdout=subprocess.PIPE,
                              text=True)
     assert child.stdout is not None and child.stdout.readline().strip() == "started"
-    time.sleep(2.0)  # the workers are up and sleeping in their first units
+    _wait_for_children(child.pid, 2)  # the workers are up and sleeping in their first units
+    time.sleep(0.5)
     sent = time.monotonic()
     child.send_signal(signum)
     try:
