@@ -300,7 +300,10 @@ def test_a_scheduler_that_dies_mid_run_is_one_line_naming_dask_not_a_failed_chec
 
 
 SLOW_POOL = """
-import sys, time
+import signal, sys, time
+signal.signal(signal.SIGINT, signal.default_int_handler)  # as a shell starts it: an ignored
+# SIGINT is inherited across exec, and a test before this one in the same pytest worker
+# can leave it ignored there (the child then outlived the signal: twice in CI, never alone)
 from dyncheck import workers
 from dyncheck.errors import Terminated
 units = [(f"u{i}", time.sleep, (60,)) for i in range(8)]
