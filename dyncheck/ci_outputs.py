@@ -23,6 +23,7 @@ from typing import TextIO
 import pandas as pd
 from junitparser import Failure, JUnitXml, Skipped, TestCase, TestSuite
 
+from dyncheck.check.rows import accepted as accepted_rows
 from dyncheck.results import Verdict, write_atomic
 
 
@@ -101,8 +102,7 @@ def _failure(values: dict[str, object], columns: Columns) -> str:
 def _case(name: str, suite: str, rows: pd.DataFrame, columns: Columns, *,
           seconds: float | None = None) -> TestCase:
     case = TestCase(name, classname=f"dyncheck.{suite}", time=seconds)
-    accepted = rows["accepted"].fillna("").astype(str).ne("") if "accepted" in rows \
-        else pd.Series(False, index=rows.index)
+    accepted = accepted_rows(rows)
     failed = rows[(rows["verdict"] == Verdict.FAILED.value) & ~accepted]
     explained = rows[rows["verdict"] == Verdict.EXPLAINED.value]
     said = ["explained: " + "; ".join(_text(v) for c in columns.detail
@@ -212,7 +212,7 @@ def summary(tables: dict[str, pd.DataFrame], versions: dict[str, str],
     def counts(rows: pd.DataFrame) -> dict[str, int]:
         out = {v.value: int((rows["verdict"] == v.value).sum()) for v in Verdict}
         if "accepted" in rows:
-            accepted = int(rows["accepted"].fillna("").astype(str).ne("").sum())
+            accepted = int(accepted_rows(rows).sum())
             if accepted:
                 out[Verdict.FAILED.value] -= accepted
                 out["accepted"] = accepted

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from dyncheck.check.rows import CheckResult, Section
+from dyncheck.check.rows import CheckResult, Section, accepted
 from dyncheck.check.verdicts import per_engine
 from dyncheck.escaping import file_name, markdown, markdown_code, markdown_table
 from dyncheck.results import (
@@ -146,7 +146,7 @@ def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
 
 def _marked(rows: pd.DataFrame) -> pd.DataFrame:
     """Rows as shown: an accepted failed row's verdict reads ``failed (accepted: REASON)``."""
-    if "accepted" not in rows or not rows["accepted"].fillna("").astype(str).ne("").any():
+    if not accepted(rows).any():
         return rows
     shown = rows.copy()
     reason = shown["accepted"].fillna("").astype(str)

@@ -57,6 +57,13 @@ COLUMNS = [
 ]
 
 
+def accepted(rows: pd.DataFrame) -> pd.Series:
+    """Which rows an ``--accept`` entry accepts (a table without the column: none)."""
+    if "accepted" not in rows:
+        return pd.Series(False, index=rows.index)
+    return rows["accepted"].fillna("").astype(str).ne("")
+
+
 @dataclass(frozen=True, kw_only=True)
 class CheckResult:
     """The rows of one model's check (a DataFrame, :data:`~dyncheck.check.rows.COLUMNS`)."""
@@ -75,9 +82,7 @@ class CheckResult:
         """The failed rows no ``--accept`` entry accepts (an accepted one stays failed: its
         verdict is the engines', the acceptance the user's)."""
         rows = self.rows
-        accepted = rows["accepted"].fillna("").astype(str).ne("") if "accepted" in rows \
-            else pd.Series(False, index=rows.index)
-        return rows[(rows["verdict"] == Verdict.FAILED) & ~accepted]
+        return rows[(rows["verdict"] == Verdict.FAILED) & ~accepted(rows)]
 
     @property
     def ok(self) -> bool:
