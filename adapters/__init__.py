@@ -1,5 +1,7 @@
-"""Engine adapters, one module per engine; each engine's registration is in its own module
-(``<engine>_registration.py``, importable without the engine), gathered here.
+"""Engine adapters, a folder per engine (``adapters/<engine>/``): its ``__init__`` holds its
+registrations (importable without the engine), ``model.py`` its loader of a model file, the
+rest named for what they hold. The registrations are gathered here; MJCF and URDF handling
+shared by every engine is in :mod:`.formats`, what the engines share beside the folders.
 
 ``REGISTRY`` names each implementation's module and class; modules are imported on first use.
 ``ADAPTERS`` maps implementation name → adapter class for the engines that are installed;
@@ -15,24 +17,23 @@ import importlib.metadata
 from typing import Any
 
 from dyncheck.adapters import (
-    drake_registration,
-    mjx_registration,
-    mujoco_registration,
-    mujoco_warp_registration,
-    newton_registration,
-    pinocchio_registration,
-    pybullet_registration,
-    sympy_registration,
+    drake,
+    mjx,
+    mujoco,
+    mujoco_warp,
+    newton,
+    pinocchio,
+    pybullet,
+    sympy_mechanics,
 )
 from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
 from dyncheck.adapters.registration import Needs, Registration
 from dyncheck.errors import EngineNotInstalled, UnknownName
 
-BUILT_IN = (sympy_registration, pinocchio_registration, drake_registration,
-            mujoco_registration, mjx_registration, mujoco_warp_registration,
-            newton_registration, pybullet_registration)
-"""The built-in engines' registration modules, each beside its engine's code and importable
-without it, in the order of trust the report lists them (after the reference and the book)."""
+BUILT_IN = (sympy_mechanics, pinocchio, drake, mujoco, mjx, mujoco_warp, newton, pybullet)
+"""The built-in engines' folders, whose ``__init__`` holds the engine's registrations and
+nothing else (importable without the engine and without any other engine's folder), in the
+order of trust the report lists them (after the reference and the book)."""
 
 REGISTRY: dict[str, Registration] = {
     name: registration for module in BUILT_IN

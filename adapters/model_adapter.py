@@ -1,8 +1,9 @@
 """A book case through an engine's loader of a user's file: a book case is a model in a file.
 
 An engine registered with ``run=`` (a file format) has no adapter of its own: the case's
-model is written in that format (:func:`.mjcf.to_mjcf` or :func:`.urdf.to_urdf`), read as a
-user's file is (:func:`.model_files.read`), loaded by the engine's ``model=`` class, and its
+model is written in that format (:func:`~dyncheck.adapters.formats.mjcf.to_mjcf` or
+:func:`~dyncheck.adapters.formats.urdf.to_urdf`), read as a user's file is
+(:func:`~dyncheck.adapters.formats.files.read`), loaded by the engine's ``model=`` class, and its
 dynamics mapped from the engine's layout to the canonical one (MuJoCo's, the layout the
 run's coordinate maps start from) by :mod:`.layout` — the same loader, tree and map
 ``dyncheck check`` uses, so that one engine object serves both commands.
@@ -46,10 +47,11 @@ from dyncheck.adapters.base import (
     Trajectory,
 )
 from dyncheck.adapters.c_output import c_output_dropped
+from dyncheck.adapters.formats.files import read
+from dyncheck.adapters.formats.mjcf import to_mjcf
+from dyncheck.adapters.formats.urdf import root_is_free, to_urdf
 from dyncheck.adapters.layout import Canonical, StateMap
 from dyncheck.adapters.layout_batch import canonical_states, engine_states, to_canonical
-from dyncheck.adapters.mjcf import to_mjcf
-from dyncheck.adapters.model_files import Format, read
 from dyncheck.adapters.model_tree import (
     NQ,
     NV,
@@ -61,8 +63,7 @@ from dyncheck.adapters.model_tree import (
     TreeJoint,
     reversed_rpy,
 )
-from dyncheck.adapters.registration import Registration
-from dyncheck.adapters.urdf import root_is_free, to_urdf
+from dyncheck.adapters.registration import Format, Registration
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.cases.multibody import Multibody
 from dyncheck.errors import Unsupported

@@ -68,9 +68,9 @@ def scale(folder: Path, repeats: int) -> tuple[pd.DataFrame, dict[str, float]]:
     exponents (per family and kind of work)."""
     import numpy as np
 
+    from dyncheck.adapters.formats.files import read
     from dyncheck.adapters.layout import canonical
-    from dyncheck.adapters.model_files import read
-    from dyncheck.adapters.mujoco_model import MujocoModel
+    from dyncheck.adapters.mujoco.model import MujocoModel
     from dyncheck.check.derivative_referee import referee
     from dyncheck.check.referee import ReferenceModel
     from dyncheck.check.sampling import sample

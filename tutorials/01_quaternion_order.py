@@ -12,7 +12,7 @@
 # motion (2.2.24) — gyroscopic and gravity terms — depend on the orientation q; an offset
 # bob on a ball joint makes that dependence strong, so a wrong orientation cannot hide.
 #
-# The code of the convention in dyncheck: [`adapters/pinocchio_model.py`](../../adapters/pinocchio_model.py) (`PinocchioModel._tree`: each joint's `Layout`, the order each engine's loader declares), applied by [`adapters/layout.py`](../../adapters/layout.py)
+# The code of the convention in dyncheck: [`adapters/pinocchio/model.py`](../../adapters/pinocchio/model.py) (`PinocchioModel._tree`: each joint's `Layout`, the order each engine's loader declares), applied by [`adapters/layout.py`](../../adapters/layout.py)
 # and [`cases/coordinate_maps.py`](../../cases/coordinate_maps.py) (`quat_from_matrix`, `quat_to_matrix`).
 
 # %%

@@ -26,7 +26,7 @@ import numpy as np
 import pinocchio as pin
 from scipy.spatial.transform import Rotation
 
-from dyncheck.adapters.mujoco_api import full_inertia
+from dyncheck.adapters.mujoco.api import full_inertia
 
 XML = """
 <mujoco>

@@ -19,7 +19,7 @@ import matplotlib.pyplot as plt
 import mujoco
 import numpy as np
 
-from dyncheck.adapters.mujoco_api import full_inertia
+from dyncheck.adapters.mujoco.api import full_inertia
 
 m1, m2, L1, L2 = 1.0, 0.7, 1.2, 0.9
 POINT = 1e-12  # the bobs' rotational inertia (kg m²): MuJoCo needs one, the book has none

@@ -19,7 +19,7 @@
 # unviolated, a_ref = 0, so for one cord the mass-1 acceleration is
 # a₁ = −g + d · 2 g m₂ / (m₁ + m₂) (derived in the cell below): exact only as d → 1.
 #
-# The code in dyncheck: `mujoco-stiff` in [`adapters/mujoco_registration.py`](../../adapters/mujoco_registration.py) and
+# The code in dyncheck: `mujoco-stiff` in [`adapters/mujoco/__init__.py`](../../adapters/mujoco/__init__.py) and
 # `dyncheck explain soft-vs-exact-constraints`.
 
 # %%

@@ -19,7 +19,7 @@ import matplotlib.pyplot as plt
 import mujoco
 import numpy as np
 
-from dyncheck.adapters.mujoco_api import full_inertia
+from dyncheck.adapters.mujoco.api import full_inertia
 
 eps32 = np.finfo(np.float32).eps
 

@@ -26,9 +26,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from dyncheck.adapters import layout, layout_batch
-from dyncheck.adapters.model_files import read
-from dyncheck.adapters.mujoco_model import MujocoModel
-from dyncheck.adapters.pinocchio_model import PinocchioModel
+from dyncheck.adapters.formats.files import read
+from dyncheck.adapters.mujoco.model import MujocoModel
+from dyncheck.adapters.pinocchio.model import PinocchioModel
 from dyncheck.check import derivatives
 from dyncheck.check.sampling import sample
 from dyncheck.explain.charts import FALLING

@@ -11,7 +11,7 @@
 # τ ≠ 0; damping a velocity-dependent τ. Semi-implicit Euler, v₊ = v + h q̈, q₊ = q + h v₊,
 # is then one map, whichever engine steps it.
 #
-# The code in dyncheck: [`adapters/pybullet_model.py`](../../adapters/pybullet_model.py)
+# The code in dyncheck: [`adapters/pybullet/model.py`](../../adapters/pybullet/model.py)
 # (the flags stated), `dyncheck explain pybullet-inertia-source` and
 # `dyncheck explain pybullet-default-motors`.
 
@@ -25,8 +25,8 @@ import numpy as np
 import pinocchio as pin
 
 from dyncheck.adapters.c_output import c_output_dropped
-from dyncheck.adapters.mjcf import to_mjcf
-from dyncheck.adapters.urdf import to_urdf
+from dyncheck.adapters.formats.mjcf import to_mjcf
+from dyncheck.adapters.formats.urdf import to_urdf
 from dyncheck.cases import get_case
 from dyncheck.explain.moving import ARM
 

@@ -13,7 +13,7 @@
 # z = z — the slide r along the *turned* x axis). Round-off of M q̈ = −h (2.2.24) in
 # precision ε: ‖δq̈‖/‖q̈‖ ≲ c n ε κ(M) (tutorial 08).
 #
-# The code in dyncheck: [`adapters/newton_model.py`](../../adapters/newton_model.py) and
+# The code in dyncheck: [`adapters/newton/model.py`](../../adapters/newton/model.py) and
 # `dyncheck explain newton-several-joints-on-a-body`.
 
 # %%

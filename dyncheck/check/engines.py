@@ -35,7 +35,7 @@ import numpy as np
 from dyncheck.adapters import MODELS, Registration
 from dyncheck.adapters.actuators import Actuation, InputJacobian
 from dyncheck.adapters.base import Answer, ModelEngine
-from dyncheck.adapters.model_files import ModelFile
+from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, Transition
 from dyncheck.confinement import confine
 from dyncheck.errors import DyncheckError, EngineError, Unsupported

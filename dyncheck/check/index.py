@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from dyncheck.adapters.model_files import ROOT_TAG, Format
+from dyncheck.adapters.formats.files import ROOT_TAG
+from dyncheck.adapters.registration import Format
 from dyncheck.check import baseline
 from dyncheck.check.page import counts
 from dyncheck.check.rows import CheckResult

@@ -8,15 +8,15 @@ import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from dyncheck.adapters.mjcf_copy import asset_files, inline
-from dyncheck.adapters.model_files import (
+from dyncheck.adapters.formats.files import (
     INERTIA_KEYS,
     ROOT_TAG,
-    Format,
     ModelFile,
     urdf_inertials,
     urdf_welded,
 )
+from dyncheck.adapters.formats.mjcf_copy import asset_files, inline
+from dyncheck.adapters.registration import Format
 from dyncheck.errors import EngineError, InvalidInput, UnknownName
 
 URDF_JOINTS = ("revolute", "continuous", "prismatic", "fixed", "floating", "spherical")

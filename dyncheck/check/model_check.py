@@ -23,7 +23,7 @@ import pandas as pd
 
 from dyncheck.adapters import REGISTRY, layout, layout_batch
 from dyncheck.adapters.base import ModelEngine
-from dyncheck.adapters.model_files import ModelFile, read, urdf_inertials, urdf_welded
+from dyncheck.adapters.formats.files import ModelFile, read, urdf_inertials, urdf_welded
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import (
     actuation,
@@ -492,7 +492,7 @@ def _reading_effect(canonical_tree: ModelTree, a: str, b: str, own: dict[str, re
 def _against(model: str, mine: ModelTree, other: ModelFile) -> list[CheckRow]:
     """The description diff against another file (the previous version of the model), both
     read by the same engine."""
-    from dyncheck.adapters.mujoco_model import MujocoModel
+    from dyncheck.adapters.mujoco.model import MujocoModel
 
     theirs = MujocoModel(other).tree
     label = f"against:{other.path.name}"

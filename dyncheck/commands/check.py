@@ -39,9 +39,9 @@ def say(message: str) -> None:
 
 
 def _case_files(names: list[str], folder: Path) -> list[tuple[Path, str | None]]:
-    """Each book case's MJCF (:func:`~dyncheck.adapters.mjcf.to_mjcf`, what ``run`` gives
+    """Each book case's MJCF (:func:`~dyncheck.adapters.formats.mjcf.to_mjcf`, what ``run`` gives
     MuJoCo) written into ``folder``."""
-    from dyncheck.adapters.mjcf import to_mjcf
+    from dyncheck.adapters.formats.mjcf import to_mjcf
     from dyncheck.cases import CASES, get_case
 
     chosen = list(CASES) if "all" in names else names

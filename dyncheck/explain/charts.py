@@ -23,7 +23,7 @@ def free_body_derivatives(states: int = 10) -> tuple[dict[str, float], dict[str,
     from Pinocchio's mapped ones."""
     from dyncheck.adapters import layout_batch
     from dyncheck.adapters.model_tree import Derivatives
-    from dyncheck.adapters.pinocchio_model import PinocchioModel
+    from dyncheck.adapters.pinocchio.model import PinocchioModel
     from dyncheck.check import derivative_charts, derivative_referee
 
     mine, other, canon, batch = beside_mujoco(FALLING, PinocchioModel, states)

@@ -63,7 +63,7 @@ def pinocchio_equality() -> Entry:
     import os
     import tempfile
 
-    from dyncheck.adapters.pinocchio_api import CONSTRAINTS_CALL, mjcf_constraints
+    from dyncheck.adapters.pinocchio.api import CONSTRAINTS_CALL, mjcf_constraints
 
     body = (
         "<body name='{n}' pos='{x} 0 -1'><joint name='{n}' type='slide' axis='0 0 -1'/>"
@@ -104,7 +104,7 @@ def drake_equality() -> Entry:
     from pydrake.multibody.plant import DiscreteContactApproximation, MultibodyPlant
     from pydrake.systems.analysis import Simulator
 
-    from dyncheck.adapters.drake_model import parse_xml
+    from dyncheck.adapters.drake.model import parse_xml
 
     (m1, m2, g), h = ATWOOD, 1e-3
     book = (m1 - m2) * g / (m1 + m2)  # Example 6

@@ -35,7 +35,7 @@ def mujoco_defaults() -> Entry:
 def energy_after_step() -> Entry:
     import mujoco
 
-    from dyncheck.adapters.mjcf import to_mjcf
+    from dyncheck.adapters.formats.mjcf import to_mjcf
 
     case = get_case("simple_pendulum")
     m = mujoco.MjModel.from_xml_string(to_mjcf(case.multibody()))
@@ -98,7 +98,7 @@ def passive_damping() -> Entry:
 def geometry_inertia() -> Entry:
     import mujoco
 
-    from dyncheck.adapters.mujoco_api import full_inertia
+    from dyncheck.adapters.mujoco.api import full_inertia
 
     xml = (
         "<mujoco><worldbody><body name='b'><joint type='hinge' axis='0 1 0'/>"
@@ -127,7 +127,7 @@ def geometry_inertia() -> Entry:
 def point_mass_floor() -> Entry:
     import mujoco
 
-    from dyncheck.adapters.mjcf import to_mjcf
+    from dyncheck.adapters.formats.mjcf import to_mjcf
 
     case = get_case("simple_pendulum")
     xml = to_mjcf(case.multibody())

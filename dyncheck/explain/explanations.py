@@ -89,7 +89,7 @@ EXPLANATIONS: dict[str, Explanation] = {
         "its effect (PyBullet 3.2.7's floating-base dynamics resolve gravity in the base "
         "frame through Rx(r) Ry(p) Rz(y) of the orientation's roll, pitch, yaw — the "
         "state's Rz(y) Ry(p) Rx(r) in reverse order; measured against a closed form in "
-        "tests/adapters/test_pybullet_model.py): its h and inverse dynamics are those of "
+        "tests/adapters/pybullet/test_model.py): its h and inverse dynamics are those of "
         "g′ = R R′ᵀ g, predicted per state as G(g′) − G(g), and its forward dynamics by −M⁻¹ "
         "that. A row is `explained` only when observed − predicted is within round-off; "
         "it stays a finding about the engine, named on the page.",

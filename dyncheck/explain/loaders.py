@@ -7,7 +7,7 @@ from typing import Any
 
 
 def pin_mjcf(xml: str):
-    from dyncheck.adapters.pinocchio_model import parse_xml
+    from dyncheck.adapters.pinocchio.model import parse_xml
 
     return parse_xml(xml)
 
@@ -20,8 +20,8 @@ def beside_mujoco(mjcf: str, other: Any, states: int) -> tuple[Any, Any, Any, An
     from pathlib import Path
 
     from dyncheck.adapters import layout
-    from dyncheck.adapters.model_files import read
-    from dyncheck.adapters.mujoco_model import MujocoModel
+    from dyncheck.adapters.formats.files import read
+    from dyncheck.adapters.mujoco.model import MujocoModel
     from dyncheck.check.sampling import sample
 
     with tempfile.TemporaryDirectory(prefix="dyncheck-explain-") as folder:

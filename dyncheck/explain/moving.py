@@ -90,7 +90,7 @@ def newton_free_velocity() -> Entry:
     declared in its tree), against the referee on MuJoCo's reading: the worst relative error
     over M, h, forward and inverse dynamics at 20 sampled states."""
     from dyncheck.adapters import layout_batch
-    from dyncheck.adapters.newton_model import NewtonModel
+    from dyncheck.adapters.newton.model import NewtonModel
     from dyncheck.check.referee import ReferenceModel
 
     mine, newton, canon, states = beside_mujoco(FREE, NewtonModel, 20)
@@ -126,8 +126,8 @@ def pybullet_default_motors() -> Entry:
     import mujoco
 
     from dyncheck.adapters.c_output import c_output_dropped
-    from dyncheck.adapters.mjcf import to_mjcf
-    from dyncheck.adapters.urdf import to_urdf
+    from dyncheck.adapters.formats.mjcf import to_mjcf
+    from dyncheck.adapters.formats.urdf import to_urdf
     from dyncheck.cases import get_case
 
     with c_output_dropped():  # its import prints a line of its own (on stderr)

@@ -26,7 +26,7 @@ EXPLANATIONS: dict[tuple[str, str, str], str] = {
     "two releases' errors shrinks as dt² — `diff` classifies it `definition changed`. MuJoCo "
     "4.0.0 combines RK4's stages on the rotation group (Runge-Kutta-Munthe-Kaas, dexp⁻¹): "
     "order 4; before, the stages' angular velocities were summed as vectors: order 2 "
-    "(declared by the adapter, `adapters/mujoco_api.py` `RK4_ON_GROUP`; tutorial 07). The "
+    "(declared by the adapter, `adapters/mujoco/api.py` `RK4_ON_GROUP`; tutorial 07). The "
     "runs of the earlier releases predate that declaration: their rk4 rows on these cases "
     "show `failed` (observed order 2.000); with it they are `explained`.",
 }

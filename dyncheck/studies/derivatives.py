@@ -19,7 +19,7 @@ from pathlib import Path
 from dyncheck import coordinates as co
 from dyncheck.adapters import MODELS, RUN, get_adapter
 from dyncheck.adapters.base import ModelEngine, Offer
-from dyncheck.adapters.mjcf import to_mjcf
+from dyncheck.adapters.formats.mjcf import to_mjcf
 from dyncheck.cases import Case
 from dyncheck.coordinates import NativeMap
 from dyncheck.errors import EngineNotInstalled
@@ -50,7 +50,7 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
     """The case's derivative rows for the implementations of ``impl_names`` that load a file
     (:data:`~dyncheck.adapters.MODELS`) and the referee (where ``reference`` is named)."""
     from dyncheck.adapters import layout
-    from dyncheck.adapters.model_files import read
+    from dyncheck.adapters.formats.files import read
     from dyncheck.check import derivatives, engines
     from dyncheck.check.alignment import align_by_body
     from dyncheck.check.derivative_pairs import label

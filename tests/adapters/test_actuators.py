@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from dyncheck.adapters.actuators import Activation, Transmission
-from dyncheck.adapters.model_files import read
+from dyncheck.adapters.formats.files import read
 
 MJCF = """<mujoco model="one">
   <worldbody>
@@ -83,7 +83,7 @@ def _state(kind: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 @pytest.mark.parametrize("kind", list(KINDS))
 def test_mujoco_reads_each_kind_as_worked_out(kind, files):
-    from dyncheck.adapters.mujoco_model import MujocoModel
+    from dyncheck.adapters.mujoco.model import MujocoModel
 
     engine = MujocoModel(read(files[kind]))
     (actuator,) = engine.tree.actuators
@@ -97,7 +97,7 @@ def test_mujoco_reads_each_kind_as_worked_out(kind, files):
 @pytest.mark.parametrize("kind", list(KINDS))
 def test_drake_reads_each_kind_as_worked_out(kind, files):
     pytest.importorskip("pydrake", reason="the drake extra is not installed")
-    from dyncheck.adapters.drake_model import DrakeModel
+    from dyncheck.adapters.drake.model import DrakeModel
 
     engine = DrakeModel(read(files[kind]))
     expected = KINDS[kind][4]
@@ -123,7 +123,7 @@ NEWTON = {  # kind: (fields by hand, τ by hand), None where its Featherstone so
 @pytest.mark.parametrize("kind", list(KINDS))
 def test_newton_reads_each_kind_as_worked_out(kind, files):
     pytest.importorskip("newton", reason="the newton extra is not installed")
-    from dyncheck.adapters.newton_model import NewtonModel
+    from dyncheck.adapters.newton.model import NewtonModel
 
     engine = NewtonModel(read(files[kind]))
     if kind not in NEWTON:  # a <motor> or <general>: kept for its MuJoCo solver only
@@ -142,8 +142,8 @@ def test_the_forward_dynamics_carry_the_force(files):
     """MuJoCo's and Drake's v̇ with a motor's control differ from v̇ at τ = 0 by M⁻¹ τ (their
     own M): the engines apply the force they report."""
     pytest.importorskip("pydrake", reason="the drake extra is not installed")
-    from dyncheck.adapters.drake_model import DrakeModel
-    from dyncheck.adapters.mujoco_model import MujocoModel
+    from dyncheck.adapters.drake.model import DrakeModel
+    from dyncheck.adapters.mujoco.model import MujocoModel
 
     for cls in (MujocoModel, DrakeModel):
         engine = cls(read(files["motor with gear"]))
@@ -157,7 +157,7 @@ def test_the_forward_dynamics_carry_the_force(files):
 def test_mujoco_reads_a_joints_actuator_force_range(tmp_path):
     """A joint's actuatorfrcrange (what MuJoCo's URDF compiler makes of <limit effort>) holds
     the sum of its actuators: a motor of gear 3 at u = 1 makes 3, held at 2."""
-    from dyncheck.adapters.mujoco_model import MujocoModel
+    from dyncheck.adapters.mujoco.model import MujocoModel
 
     path = tmp_path / "held.xml"
     path.write_text(MJCF.replace('type="hinge"', 'type="hinge" actuatorfrcrange="-2 2"')

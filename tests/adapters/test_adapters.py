@@ -16,7 +16,7 @@ from numpy.testing import assert_allclose
 
 from dyncheck import adapters
 from dyncheck.adapters import REGISTRY, get_adapter
-from dyncheck.adapters.mjcf import to_mjcf
+from dyncheck.adapters.formats.mjcf import to_mjcf
 from dyncheck.cases import get_case
 from dyncheck.errors import UnknownName
 
@@ -280,7 +280,7 @@ def test_drake_parser_ignores_the_tendon_equality():
     """Measured: Drake's MJCF parser warns that it ignores <tendon> and the tendon equality,
     and loads no constraint — why Drake's loader closes the cords itself (a KKT solve with
     Drake's M and h)."""
-    from dyncheck.adapters.drake_model import parse_xml
+    from dyncheck.adapters.drake.model import parse_xml
 
     plant, warnings = parse_xml(to_mjcf(get_case("atwood").multibody()))
     assert plant.num_velocities() == 2 and plant.num_constraints() == 0
@@ -310,7 +310,7 @@ def test_registered_integrators_are_those_the_engine_maps(engine):
     if entry.module is None:  # a file loader's run adapter: its own schemes (Drake's scheme
         # names), or one stepping whose definition is the reference's (semi-implicit Euler)
         assert get_adapter(engine).integrators == entry.integrators
-        own = {"drake": "dyncheck.adapters.drake_simulation"}.get(engine)
+        own = {"drake": "dyncheck.adapters.drake.simulation"}.get(engine)
         mapped = importlib.import_module(own).INTEGRATORS if own else STEPPERS
         assert set(entry.integrators) <= set(mapped), set(entry.integrators) - set(mapped)
         return

@@ -24,7 +24,7 @@ from dataclasses import replace
 
 from dyncheck.adapters import Registration
 from dyncheck.adapters.base import ModelEngine
-from dyncheck.adapters.model_files import Format
+from dyncheck.adapters.registration import Format
 
 REGISTRATION = Registration(package="toy-engine", model="toy_engine:ToyModel",
                             run=Format.MJCF, label="toy", releases=("0.1.0", "0.2.0"))
@@ -34,7 +34,7 @@ class ToyModel(ModelEngine):
     engine = "toy"
 
     def __init__(self, source, **options):
-        from dyncheck.adapters.mujoco_model import MujocoModel
+        from dyncheck.adapters.mujoco.model import MujocoModel
         from dyncheck.check.referee import ReferenceModel
 
         self.tree = replace(MujocoModel(source).tree, engine="toy")

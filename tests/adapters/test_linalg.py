@@ -28,7 +28,7 @@ def test_solve_is_numpys_solve_within_round_off(n):
 
 def test_a_kkt_matrix_needs_pivoting_and_is_solved():
     """A mass matrix bordered by a constraint row has a zero on its diagonal: only a pivoting
-    LU solves it (Drake's cords, adapters/drake_simulation.py)."""
+    LU solves it (Drake's cords, adapters/drake/simulation.py)."""
     m = np.diag([2.0, 3.0])
     c = np.array([[1.0, -1.0]])
     k = np.block([[m, -c.T], [c, np.zeros((1, 1))]])

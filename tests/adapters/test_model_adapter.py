@@ -1,7 +1,7 @@
 """Book cases through an engine's file loader (``Registration.run``): the bodies it reads back,
 the held-inertia variant the reference predicts from, and the evidence a failed row cites.
 Expected values: the case's own parameters, the reference's general method (on the tensor
-PyBullet holds), and the gravity defect measured in tests/adapters/test_pybullet_model.py."""
+PyBullet holds), and the gravity defect measured in tests/adapters/pybullet/test_model.py."""
 
 from __future__ import annotations
 

@@ -20,7 +20,7 @@ PACKAGE = ("dyncheck", "adapters", "cases", "reference")
 TEACHING = ("dyncheck/explain/",)
 """The conventions catalogue and its demonstrations name the engines they teach about (and
 the engines a demonstration needs): not a second home of a registration."""
-FORMATS = ("adapters/model_files.py",)
+FORMATS = ("adapters/formats/files.py",)
 """The file formats' module: MJCF's root element is ``<mujoco>``, a format's word, not an
 engine's name."""
 LEGACY: dict[str, int] = {}
@@ -31,11 +31,19 @@ own)."""
 
 
 def _own(name: str) -> set[str]:
-    """The engine's modules: its adapter's, its loader's and its registration's."""
+    """The engine's modules: its folder's (registration, loader and the rest), its adapter's
+    and loader's where they live elsewhere (an installed engine's), and the registrations of
+    its ports, which name the engine they port (``Registration.ports``)."""
     reg = REGISTRY[name]
     modules = {m for m in (reg.module, (reg.model or "").split(":")[0]) if m}
-    modules |= {m.__name__ for m in BUILT_IN if name in m.REGISTRATIONS}
-    return {m.removeprefix("dyncheck.").replace(".", "/") + ".py" for m in modules}
+    files = {m.removeprefix("dyncheck.").replace(".", "/") + ".py" for m in modules}
+    for module in BUILT_IN:
+        folder = Path(module.__file__ or "").parent.relative_to(ROOT).as_posix()
+        if name in module.REGISTRATIONS:
+            files |= {p.relative_to(ROOT).as_posix() for p in (ROOT / folder).rglob("*.py")}
+        elif any(r.ports == name for r in module.REGISTRATIONS.values()):
+            files.add(f"{folder}/__init__.py")
+    return files
 
 
 def _literals(name: str, root: Path = ROOT) -> list[str]:
@@ -63,5 +71,6 @@ def test_the_rule_catches_a_name_written_elsewhere(tmp_path):
     for folder in PACKAGE:
         (tmp_path / folder).mkdir()
     (tmp_path / "dyncheck" / "leak.py").write_text('ENGINE = "newton"\n')
-    (tmp_path / "adapters" / "newton_model.py").write_text('ENGINE = "newton"\n')
+    (tmp_path / "adapters" / "newton").mkdir()
+    (tmp_path / "adapters" / "newton" / "model.py").write_text('ENGINE = "newton"\n')
     assert _literals("newton", tmp_path) == ["dyncheck/leak.py"]

@@ -90,8 +90,8 @@ def test_pinocchio_native_order_is_xyzw(name):
 def test_a_loader_read_in_the_wrong_quaternion_order_is_caught(engine, wrong, monkeypatch):
     """An engine's loader with its tree saying the other storage order: the run's map feeds
     it the quaternion in the wrong order, and its rows fail."""
-    from dyncheck.adapters.mujoco_model import MujocoModel
-    from dyncheck.adapters.pinocchio_model import PinocchioModel
+    from dyncheck.adapters.mujoco.model import MujocoModel
+    from dyncheck.adapters.pinocchio.model import PinocchioModel
 
     loader = {"mujoco": MujocoModel, "pinocchio": PinocchioModel}[engine]
     tree_of = loader._tree

@@ -7,7 +7,7 @@ from __future__ import annotations
 import ctypes
 import time
 
-from dyncheck.adapters.mujoco_model import MujocoModel
+from dyncheck.adapters.mujoco.model import MujocoModel
 
 
 def _segfault() -> None:

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from dyncheck.adapters import mujoco_actuators
+from dyncheck.adapters.mujoco import actuators as mujoco_actuators
 from dyncheck.check.model_check import check_model
 from dyncheck.check.verdicts import Controls, per_engine
 

@@ -75,7 +75,7 @@ ARM = ('<mujoco model="arm"><worldbody><body name="a" pos="0 0 1">'
 @pytest.fixture
 def planted(monkeypatch):
     """Plant a relative change in Pinocchio's kinetic energy (this process's engines)."""
-    from dyncheck.adapters.pinocchio_model import PinocchioModel
+    from dyncheck.adapters.pinocchio.model import PinocchioModel
 
     real = PinocchioModel.dynamics
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from dyncheck.adapters import pinocchio_model
+from dyncheck.adapters.pinocchio import model as pinocchio_model
 from dyncheck.check.model_check import check_model
 from dyncheck.check.verdicts import Agreement, Reading, per_engine
 
@@ -68,8 +68,8 @@ def test_the_pendulum_derivatives_are_the_books_closed_form(tmp_path):
     path = tmp_path / "pendulum.urdf"
     path.write_text(PENDULUM.format(m=m, l=length))
     from dyncheck.adapters import layout, layout_batch
-    from dyncheck.adapters.model_files import read
-    from dyncheck.adapters.pinocchio_model import PinocchioModel
+    from dyncheck.adapters.formats.files import read
+    from dyncheck.adapters.pinocchio.model import PinocchioModel
     from dyncheck.check import derivative_charts, derivative_referee
     from dyncheck.check.sampling import sample
 

@@ -593,7 +593,7 @@ def test_tendon_armature_is_left_out_and_said(tmp_path):
     import mujoco
     import numpy as np
 
-    from dyncheck.adapters.mujoco_api import full_inertia
+    from dyncheck.adapters.mujoco.api import full_inertia
 
     body = ('<site name="s0" pos="1 0 1"/><body name="b"><joint name="z" type="slide" '
             'axis="0 0 1"/><joint name="y" type="hinge" axis="0 1 0"/><geom type="box" '

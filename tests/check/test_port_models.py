@@ -50,7 +50,8 @@ def test_a_port_never_passes_off_mujoco_cs_derivatives_as_its_own():
     has no derivatives, in the controls too."""
     from types import SimpleNamespace
 
-    from dyncheck.adapters.port_models import MjxModel, MujocoWarpModel
+    from dyncheck.adapters.mjx.model import MjxModel
+    from dyncheck.adapters.mujoco_warp.model import MujocoWarpModel
     from dyncheck.errors import Unsupported
 
     port = object.__new__(MujocoWarpModel)  # no port needed: the refusal comes before any work
@@ -139,7 +140,7 @@ def test_a_quaternion_column_mapped_without_its_factor_two_fails(monkeypatch):
     float64 row: the comparison sees the ball's and the free body's rows."""
     if not _installed("mjx-f64"):
         pytest.skip("needs the extra that installs mjx-f64")
-    from dyncheck.adapters import mjx_
+    from dyncheck.adapters.mjx import port as mjx_
 
     tangent = mjx_._tangent
 
@@ -189,7 +190,7 @@ def test_mjxs_euler_damping_is_explained_by_its_predicted_size(tmp_path, monkeyp
     assert row["verdict"] == "explained" and "eulerdamp" in row["note"]
     assert row["error"] == pytest.approx(by_hand, rel=1e-6)
     assert f"predicted {by_hand:.3g}" in row["note"]
-    from dyncheck.adapters.port_models import MjxF64Model
+    from dyncheck.adapters.mjx.model import MjxF64Model
 
     monkeypatch.setattr(MjxF64Model, "euler_damps_when_disabled", False)
     row = euler_row(check_model(path, impls=("reference", "mujoco", "mjx-f64"), states=4,
@@ -259,10 +260,10 @@ def test_the_tree_reads_the_masses_the_port_holds(monkeypatch, factor, held):
         pytest.skip("needs the extra that installs mjx")
     import numpy as np
 
-    from dyncheck.adapters.mjx_ import MjxPort
-    from dyncheck.adapters.model_files import read
-    from dyncheck.adapters.mujoco_model import MujocoModel
-    from dyncheck.adapters.port_models import MjxModel
+    from dyncheck.adapters.formats.files import read
+    from dyncheck.adapters.mjx.model import MjxModel
+    from dyncheck.adapters.mjx.port import MjxPort
+    from dyncheck.adapters.mujoco.model import MujocoModel
 
     loaded = MjxPort._loaded
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from dyncheck.adapters import layout
-from dyncheck.adapters.model_files import read
+from dyncheck.adapters.formats.files import read
 from dyncheck.check.dynamics import Prediction, _candidates
 from dyncheck.check.engines import load
 from dyncheck.check.predicted import rotor_energy

@@ -12,8 +12,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from dyncheck.adapters.model_files import read
-from dyncheck.adapters.mujoco_model import MujocoModel
+from dyncheck.adapters.formats.files import read
+from dyncheck.adapters.mujoco.model import MujocoModel
 from dyncheck.check import predicted
 from dyncheck.check.model_check import check_model
 from dyncheck.check.readings import effect, own_tree

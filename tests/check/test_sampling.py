@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from dyncheck.adapters import layout
-from dyncheck.adapters.model_files import read
+from dyncheck.adapters.formats.files import read
 from dyncheck.check.engines import load
 from dyncheck.check.model_check import check_model
 from dyncheck.check.sampling import sample

@@ -58,7 +58,7 @@ def test_implicitfast_is_eulers_step_without_a_free_joint(tmp_path):
 
 
 def _pendulum(tmp_path, case: str = "compound_pendulum") -> Path:
-    from dyncheck.adapters.mjcf import to_mjcf
+    from dyncheck.adapters.formats.mjcf import to_mjcf
     from dyncheck.cases import get_case
 
     path = tmp_path / f"{case}.xml"
@@ -74,7 +74,7 @@ def test_rk4_step_jacobian_is_the_chain_rule_through_its_four_stages(tmp_path, c
     integrators apart: MuJoCo's Euler and RK4 Jacobians at the same states (expected: the
     engine's own two steps) differ by more than the RK4 row allows, so a step differentiated
     as Euler's would fail it."""
-    from dyncheck.adapters.model_files import read
+    from dyncheck.adapters.formats.files import read
     from dyncheck.check.engines import load
 
     path = _pendulum(tmp_path, case)
@@ -98,7 +98,7 @@ def test_a_step_jacobian_off_by_one_part_in_ten_thousand_fails(monkeypatch, tmp_
     ball joint; RK4's on a double pendulum, whose stages the referee follows)."""
     from dataclasses import replace
 
-    from dyncheck.adapters import mujoco_model
+    from dyncheck.adapters.mujoco import model as mujoco_model
 
     original = mujoco_model.MujocoModel.transition
 
@@ -149,8 +149,8 @@ def test_the_rk4_chain_rule_on_rotations_is_the_derivative_of_the_step_itself():
     differences of the same step written from its definition (Richardson-extrapolated,
     steps 1e-4 and 5e-5, in the canonical chart): they agree to 1e-7 — and leaving dexp⁻¹'s
     derivatives out (D = 1, E = 0) is off by far more, so the test sees them."""
+    from dyncheck.adapters.formats.files import read
     from dyncheck.adapters.layout import canonical
-    from dyncheck.adapters.model_files import read
     from dyncheck.check.derivative_charts import perturb
     from dyncheck.check.derivative_referee import referee
     from dyncheck.check.engines import load

@@ -319,7 +319,7 @@ def test_free_body_velocity_frame_ignored_is_caught(monkeypatch):
     import dataclasses
 
     from dyncheck.adapters.model_tree import Axes
-    from dyncheck.adapters.pinocchio_model import PinocchioModel
+    from dyncheck.adapters.pinocchio.model import PinocchioModel
 
     case = get_case("rigid_body_free")
     assert all(r.verdict == "passed" for r in _compare_with(case, "pinocchio"))

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from dyncheck.adapters import get_adapter
-from dyncheck.adapters import sympy_mechanics as sm
+from dyncheck.adapters.sympy_mechanics import model as sm
 from dyncheck.cases import get_case
 from dyncheck.implementations import CACHED
 

@@ -27,7 +27,7 @@ ARM = ('<mujoco model="arm"><worldbody><body name="a" pos="0 0 1">'
 @pytest.fixture(scope="module")
 def releases(tmp_path_factory):
     """Check folders per release, made by ``dyncheck check`` in this process."""
-    from dyncheck.adapters.pinocchio_model import PinocchioModel
+    from dyncheck.adapters.pinocchio.model import PinocchioModel
 
     root = tmp_path_factory.mktemp("releases")
     model = root / "arm.xml"

@@ -76,7 +76,7 @@ def test_the_baseline_fixture_writes_holds_and_accepts(tmp_path):
     project = _project(tmp_path)
     (project / "conftest.py").write_text(
         "import os\n"
-        "from dyncheck.adapters.pinocchio_model import PinocchioModel\n"
+        "from dyncheck.adapters.pinocchio.model import PinocchioModel\n"
         "if os.environ.get('PLANT'):\n"
         "    real = PinocchioModel.dynamics\n"
         "    def dynamics(self, q, v, a):\n"

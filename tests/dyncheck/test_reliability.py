@@ -44,7 +44,7 @@ def test_divergence_is_an_error_not_a_hang(engine):
 def test_a_crashing_simulation_becomes_failed_rows(monkeypatch):
     """One engine raising inside simulate: its trajectory rows fail with the message; every
     other row is still computed."""
-    from dyncheck.adapters.pinocchio_model import PinocchioModel
+    from dyncheck.adapters.pinocchio.model import PinocchioModel
 
     def boom(self, *args, **kwargs):
         raise FloatingPointError("boom")

@@ -19,7 +19,7 @@ def test_moving_to_the_next_case_frees_the_compiled_programs_of_the_last():
     implementations are built as a run builds them (:func:`~dyncheck.slices.built`, which releases
     the last case's) and compile both programs: a batch of states and a stepped run."""
     pytest.importorskip("mujoco.mjx", reason="the extra 'mjx' (pip install 'dyncheck[mjx]')")
-    from dyncheck.adapters import mjx_
+    from dyncheck.adapters.mjx import port as mjx_
 
     def programs() -> int:
         return mjx_._EVALUATE._cache_size() + mjx_._STRETCH._cache_size()

@@ -21,7 +21,7 @@ SYSTEMS = {"spherical_coordinates": spherical, "cylindrical_coordinates": cylind
 @pytest.mark.parametrize(("case_name", "engine"), [
     (c, e) for c in sorted(SYSTEMS) for e in ENGINES if supported(c, e)
     # Newton applies a body's slides before its hinges (its D6): another model, whose M is
-    # the referee's on that order (tests/adapters/test_newton_model.py)
+    # the referee's on that order (tests/adapters/newton/test_model.py)
     and e != "newton"])
 def test_engine_mass_matrix_is_metric_and_bias_is_christoffel(case_name, engine):
     case = get_case(case_name)

@@ -123,7 +123,7 @@ def test_full_inertia_calls_the_signature_of_the_installed_release(monkeypatch):
     """MuJoCo 3.10.0 changed mj_fullM(m, dst, qM) to mj_fullM(m, d, dst): both branches."""
     import mujoco
 
-    from dyncheck.adapters import mujoco_api
+    from dyncheck.adapters.mujoco import api as mujoco_api
 
     calls = []
     monkeypatch.setattr(mujoco, "mj_fullM", lambda *args: calls.append(args))

@@ -168,7 +168,7 @@ def test_swapped_jax_entries_are_compiled_again_not_run(tmp_path):
 AFTER_COMMAND = """
 import jax, jax.numpy as jnp
 from dyncheck.cache import compiled as compiled_caches
-from dyncheck.adapters import mjx_
+from dyncheck.adapters.mjx import port as mjx_
 from dyncheck.settings import Settings
 from dyncheck.workers import settled
 

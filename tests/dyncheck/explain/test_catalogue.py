@@ -150,7 +150,7 @@ def test_pinocchio_3x_branch_reads_the_constraints_under_a_free_root(monkeypatch
     version matrix)."""
     import pinocchio as pin
 
-    from dyncheck.adapters import pinocchio_api
+    from dyncheck.adapters.pinocchio import api as pinocchio_api
 
     calls = []
 

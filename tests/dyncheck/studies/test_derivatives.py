@@ -42,7 +42,7 @@ def test_a_derivative_off_by_one_part_in_a_million_fails_naming_engine_case_and_
     against the referee and MuJoCo fail, naming Pinocchio and the entry; nothing else."""
     from dataclasses import replace
 
-    from dyncheck.adapters import pinocchio_model
+    from dyncheck.adapters.pinocchio import model as pinocchio_model
 
     original = pinocchio_model.PinocchioModel.derivatives
 

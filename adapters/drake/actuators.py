@@ -1,0 +1,174 @@
+"""Drake's joint actuators: read back into the neutral form (:mod:`dyncheck.adapters.actuators`)
+as they act, their generalized force and the forward dynamics at a control, and why they
+differ from the file's where Drake is known to read them otherwise (each premise checked on
+the plant or the file).
+
+A Drake joint actuator's input is its joint's effort itself: τ = clamp(u, ±effort limit),
+its gear ratio only scaling the rotor inertia it reflects (M's armature). One with PD gains
+(what Drake's MJCF parser makes of ``<position>``) adds −kp (q − q_d) − kd (v − v_d) to its
+input before the clamp, q_d and v_d from the plant's desired-state port. The control of the
+file's actuator is mapped as the parser means it: a motor's control is Drake's input, a
+position servo's control is its target q_d (v_d = 0, no feed-forward).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from dyncheck.adapters.actuators import Actuation, Actuator, Transmission
+from dyncheck.adapters.formats.files import ModelFile
+from dyncheck.adapters.registration import Format
+
+GEAR = (
+    "Drake applies a joint actuator's input to its joint as it is: its gear ratio ({gear:g}, "
+    "read from the file) scales only the rotor inertia it reflects, where MuJoCo "
+    "multiplies the actuator's force by its gear (fix: scale the control by the gear in "
+    "Drake, or write gear 1 and fold the gear into the gains and ranges)"
+)
+DAMPING = (
+    "Drake's MJCF parser reads a <position> servo's damping from an attribute 'kd', which "
+    "MJCF does not have, so the file's kv is lost (its PD gains hold d = {d:g}) (fix: after "
+    "parsing, JointActuator.set_controller_gains(PdControllerGains(p=kp, d=kv)))"
+)
+EFFORT = (
+    "Drake's MJCF parser makes one symmetric effort limit of a <motor>'s or <position>'s "
+    "ctrlrange and forcerange (the smaller of their largest magnitudes, here {limit:g}): on "
+    "a position servo, whose ctrlrange bounds the target position, that bounds its torque "
+    "(fix: set the effort limit after parsing, JointActuator.set_effort_limit)"
+)
+PD_DROPPED = (
+    "Drake's scalar conversion to AutoDiffXd (MultibodyPlant.ToAutoDiffXd) drops the PD "
+    "gains of its joint actuators ({count} of {total} servos have none in the converted "
+    "plant, measured), so its derivatives in a servo's target are 0 (fix: set the gains on "
+    "the converted plant, JointActuator.set_controller_gains; dyncheck explain "
+    "drake-autodiff-pd-gains)"
+)
+IGNORED = (
+    "Drake's MJCF parser reads only <motor> and <position> actuators and ignores {tags} with "
+    "a warning (fix: write them as <motor> or <position>, or add the actuator in Drake)"
+)
+
+
+def read(plant: Any) -> tuple[Actuator, ...]:
+    """Every joint actuator of ``plant`` in the neutral form, as it acts (gear 1)."""
+    out = []
+    for index in plant.GetJointActuatorIndices():
+        actuator = plant.get_joint_actuator(index)
+        limit = float(actuator.effort_limit())
+        kp = kd = 0.0
+        if actuator.has_controller():
+            gains = actuator.get_controller_gains()
+            kp, kd = float(gains.p), float(gains.d)
+        servo = actuator.has_controller()
+        out.append(Actuator(
+            name=actuator.name(), joint=actuator.joint().name(),
+            transmission=Transmission.JOINT if actuator.joint().num_velocities() == 1
+            else Transmission.OTHER,
+            gear=1.0, gain=(kp, 0.0, 0.0) if servo else (1.0, 0.0, 0.0),
+            bias=(0.0, -kp, -kd) if servo else (0.0, 0.0, 0.0), ctrl_range=None,
+            force_range=(-limit, limit) if np.isfinite(limit) else None,
+            what=f"JointActuator {actuator.name()!r}"
+            + (f" with PD gains p={kp:g}, d={kd:g}" if servo else "")
+            + f", gear ratio {actuator.default_gear_ratio():g}"))
+    return tuple(out)
+
+
+def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
+        tuple[str, str, str], ...]:
+    """(actuator, field, why) for what Drake is known to read otherwise, each premise
+    checked on the plant (``tags``: the file's actuator elements per joint); actuator
+    ``model``: of the file's actuators Drake holds none of, and what its automatic
+    differentiation drops (measured on the plant converted)."""
+    out = []
+    servos = [i for i in plant.GetJointActuatorIndices()
+              if plant.get_joint_actuator(i).has_controller()]
+    if servos:
+        converted = plant.ToAutoDiffXd()
+        dropped = sum(not converted.get_joint_actuator(i).has_controller() for i in servos)
+        if dropped:
+            out.append(("model", "control derivatives",
+                        PD_DROPPED.format(count=dropped, total=len(servos))))
+    for index in plant.GetJointActuatorIndices():
+        actuator = plant.get_joint_actuator(index)
+        name, gear = actuator.name(), float(actuator.default_gear_ratio())
+        if gear != 1.0:
+            out.append((name, "gear", GEAR.format(gear=gear)))
+        if actuator.has_controller() and source.format is Format.MJCF:
+            out.append((name, "bias", DAMPING.format(d=actuator.get_controller_gains().d)))
+        if np.isfinite(actuator.effort_limit()) and source.format is Format.MJCF:
+            out.append((name, "limits", EFFORT.format(limit=actuator.effort_limit())))
+    ignored = sorted({t.split(" ")[0] for found in tags.values() for t in found
+                      if not t.startswith(("<motor>", "<position>"))})
+    if ignored:
+        out.append(("model", "actuator", IGNORED.format(tags=", ".join(ignored))))
+    return tuple(out)
+
+
+def actuation(plant: Any, context: Any, *, q: np.ndarray, v: np.ndarray,
+              u: np.ndarray) -> Actuation:
+    """In a ``context`` of its own (its fixed desired state arms the PD controllers, which
+    the smooth dynamics' context leaves unconnected, so off): Drake's generalized actuator
+    force B · (its net actuation output) and its generalized acceleration at each state and
+    control (:func:`read`'s order): a motor's control its
+    input, a servo's its target position (see the module's docstring)."""
+    indices = list(plant.GetJointActuatorIndices())
+    servo = np.array([plant.get_joint_actuator(i).has_controller() for i in indices], bool)
+    matrix = plant.MakeActuationMatrix()
+    port = plant.get_actuation_input_port()
+    desired = _desired_ports(plant, indices)
+    net = plant.get_net_actuation_output_port()
+    acc = plant.get_generalized_acceleration_output_port()
+    n, nv = len(q), plant.num_velocities()
+    tau, forward = np.empty((n, nv)), np.empty((n, nv))
+    for s in range(n):
+        plant.SetPositions(context, q[s])
+        plant.SetVelocities(context, v[s])
+        port.FixValue(context, np.where(servo, 0.0, u[s]))
+        for instance_port, members in desired.values():
+            target = np.zeros(2 * len(members))
+            target[: len(members)] = u[s, members]
+            instance_port.FixValue(context, target)
+        tau[s] = matrix @ net.Eval(context)
+        forward[s] = acc.Eval(context)
+    return Actuation(tau=tau, forward=forward)
+
+
+def control_derivatives(plant: Any, ad: Any, context: Any, *, q: np.ndarray, v: np.ndarray,
+                        u: np.ndarray) -> np.ndarray:
+    """∂v̇/∂u (n, nv, nu) by Drake's forward-mode automatic differentiation of its
+    generalized acceleration, the controls seeded (``ad``: ``plant`` as ``AutoDiffXd``, in a
+    ``context`` of its own, see :func:`actuation`; which actuator is a servo, whose control
+    is its target, is ``plant``'s fact: :data:`PD_DROPPED`)."""
+    from pydrake.autodiffutils import AutoDiffXd, ExtractGradient, InitializeAutoDiff
+
+    indices = list(ad.GetJointActuatorIndices())
+    servo = np.array([plant.get_joint_actuator(i).has_controller() for i in indices], bool)
+    port, desired = ad.get_actuation_input_port(), _desired_ports(ad, indices)
+    acc = ad.get_generalized_acceleration_output_port()
+    out = np.empty((len(q), ad.num_velocities(), len(indices)))
+    for s in range(len(q)):
+        seeded = InitializeAutoDiff(np.asarray(u[s], float))[:, 0]  # type: ignore[arg-type]
+        zero = AutoDiffXd(0.0, np.zeros(len(indices)))  # type: ignore[arg-type]  # (its stub)
+        ad.SetPositions(context, [AutoDiffXd(x) for x in q[s]])
+        ad.SetVelocities(context, [AutoDiffXd(x) for x in v[s]])
+        port.FixValue(context, [zero if pd else seeded[k] for k, pd in enumerate(servo)])
+        for instance_port, members in desired.values():
+            target = [seeded[k] for k in members] + [zero] * len(members)
+            instance_port.FixValue(context, target)
+        out[s] = ExtractGradient(acc.Eval(context))
+    return out
+
+
+def _desired_ports(plant: Any, indices: list[Any]) -> dict[int, tuple[Any, list[int]]]:
+    """Model instance → its desired-state port and the places (in ``indices``) of its
+    actuators, in actuator order (the port's order: q_d of each, then v_d of each)."""
+    out: dict[int, tuple[Any, list[int]]] = {}
+    for place, index in enumerate(indices):
+        instance = plant.get_joint_actuator(index).model_instance()
+        key = int(instance)
+        if key not in out:
+            out[key] = (plant.get_desired_state_input_port(instance), [])
+        out[key][1].append(place)
+    return out

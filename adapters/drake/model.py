@@ -1,0 +1,471 @@
+"""A user's model in Drake (optional extra ``drake``), through Drake's own parsers, in a
+continuous-time ``MultibodyPlant``.
+
+Drake keeps a URDF's fixed links as welded bodies (lumped here into the moving body they are
+welded to) and leaves a URDF's root link floating unless welded: the root is welded to the
+world, or with ``--floating`` given a ``QuaternionFloatingJoint`` named ``root_joint``. Drake
+names the floating joint of an MJCF ``<freejoint>`` after its body. Joint damping is read back
+as a field, then zeroed before ``Finalize`` (Drake applies it in every dynamics call; the check
+compares damping-free dynamics in every engine). Drake has no joint armature: rotor inertia
+belongs to its actuators, and its MJCF parser turns a joint's ``armature`` into the reflected
+inertia (rotor inertia × gear²) of the actuator on that joint — read back here as the joint's
+armature; a joint without an actuator keeps none (a hint names the fix).
+M = ``CalcMassMatrix``, h = ``CalcBiasTerm`` −
+``CalcGravityGeneralizedForces``, forward dynamics the plant's generalized-acceleration
+output, inverse ``CalcInverseDynamics`` with gravity from ``CalcForceElementsContribution``.
+State layout: a floating joint q = (w, x, y, z, p), v = (ω, v), both in world axes. A ball
+joint is a ``BallRpyJoint``: q = (roll, pitch, yaw) of the child frame M in the parent-side
+frame F, v = ω_FM in F (measured: the body's world angular velocity equals v when F is the
+world).
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+import tempfile
+import xml.etree.ElementTree as ET
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pydrake.autodiffutils import AutoDiffXd
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import (
+    BodyIndex,
+    MultibodyForces,
+    MultibodyForces_,
+    QuaternionFloatingJoint,
+)
+
+from dyncheck.adapters.actuators import Actuation
+from dyncheck.adapters.base import Field, ModelEngine, Offer, Steps
+from dyncheck.adapters.drake import actuators as drake_actuators
+from dyncheck.adapters.drake import simulation as drake_simulation
+from dyncheck.adapters.drake.hints import actuators, armature_hint, file_hints, ignored_frames
+from dyncheck.adapters.formats.files import ModelFile
+from dyncheck.adapters.formats.mjcf_copy import for_parser
+from dyncheck.adapters.model_tree import (
+    Axes,
+    DerivativeChart,
+    Derivatives,
+    Dynamics,
+    JointType,
+    Layout,
+    ModelTree,
+    Orientation,
+    TreeJoint,
+    lump,
+)
+from dyncheck.adapters.model_tree import (
+    derivatives as _derivatives,
+)
+from dyncheck.adapters.registration import Format
+from dyncheck.cases.multibody import Coupling
+from dyncheck.errors import DyncheckError, EngineError, Unsupported
+
+ENGINE = "drake"
+MESH_FORMATS = (".obj",)
+"""The mesh files Drake's MJCF parser reads (others: the geoms dropped where they carry no
+inertia, see :mod:`dyncheck.adapters.formats.mjcf_copy`)."""
+_TYPES = {
+    "revolute": JointType.HINGE,
+    "prismatic": JointType.SLIDE,
+    "quaternion_floating": JointType.FREE,
+    "ball_rpy": JointType.BALL,
+}
+class _Capture(logging.Handler):
+    def __init__(self) -> None:
+        super().__init__()
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.messages.append(record.getMessage().split("warning: ", 1)[-1])
+
+
+@contextmanager
+def parser_warnings() -> Iterator[list[str]]:
+    """Drake's log messages while the block runs (its parser's warnings: what it ignores or
+    changes), kept in the yielded list instead of printed."""
+    capture = _Capture()
+    log = logging.getLogger("drake")
+    log.addHandler(capture)
+    propagate, log.propagate = log.propagate, False
+    try:
+        yield capture.messages
+    finally:
+        log.removeHandler(capture)
+        log.propagate = propagate
+
+
+def parse_xml(xml: str, time_step: float = 0.0) -> tuple[MultibodyPlant, list[str]]:
+    """Drake's MJCF parser on ``xml`` as it is (no copy made for it), and its warnings: the
+    parser itself, as the catalogue's demonstrations measure it."""
+    plant = MultibodyPlant(time_step)
+    with parser_warnings() as warnings:
+        Parser(plant).AddModelsFromString(xml, "xml")
+    plant.Finalize()
+    return plant, warnings
+
+
+def _plant(source: ModelFile) -> tuple[MultibodyPlant, list[str], tuple[str, ...],
+                                       dict[str, tuple]]:
+    """The finalized plant, its parser's warnings, the notes on the reading, and each
+    joint's damping (zeroed in the plant)."""
+    plant = MultibodyPlant(0.0)
+    notes: list[str] = []
+    with parser_warnings() as warnings, tempfile.TemporaryDirectory() as meshes:
+        try:
+            if source.format is Format.MJCF and (copy := for_parser(
+                    source.path, ENGINE, MESH_FORMATS, massless_aborts=True,
+                    constraints_refused=True, convert_into=Path(meshes))).text:
+                Parser(plant).AddModelsFromString(copy.text, "xml")
+                notes.extend(copy.notes)
+            elif source.format is Format.MJCF:
+                Parser(plant).AddModels(str(source.path))
+            else:
+                Parser(plant).AddModelsFromString(source.text, "urdf")
+        except DyncheckError:
+            raise
+        except Exception as exc:
+            raise EngineError(
+                f"drake refused {source.path}: {' '.join(str(exc).split())}"
+            ) from None
+    notes.extend(_summary(warnings))
+    if source.format is Format.URDF:
+        notes.extend(_floating_joints(plant, source.text))
+        root = _urdf_root(plant)
+        if root is None:
+            notes.append("drake: the URDF's root link is 'world' (already welded)")
+        elif source.floating:
+            plant.AddJoint(QuaternionFloatingJoint("root_joint", plant.world_frame(),
+                                                   root.body_frame()))
+            notes.append("drake: QuaternionFloatingJoint 'root_joint' at the URDF root")
+        else:
+            plant.WeldFrames(plant.world_frame(), root.body_frame())
+    damping = {}
+    for index in plant.GetJointIndices():
+        joint = plant.get_joint(index)
+        if joint.num_velocities() > 0:
+            damping[joint.name()] = tuple(float(x) for x in joint.default_damping_vector())
+            joint.set_default_damping_vector(np.zeros(joint.num_velocities()))
+    plant.Finalize()
+    return plant, warnings, tuple(notes), damping
+
+
+def _summary(warnings: list[str]) -> list[str]:
+    """Drake's parser warnings for the report, in Drake's own words: each distinct one once
+    with its count, messages that differ only in their numbers (an inertia warning's matrix)
+    counted as one and shown by the first in full (whitespace collapsed; capped at
+    :data:`MESSAGE_CHARS` against a hostile file's flood)."""
+    first: dict[str, str] = {}
+    counts: dict[str, int] = {}
+    for message in warnings:
+        text = " ".join(message.split())
+        key = re.sub(r"[-+]?\d[\d.eE+-]*", "#", text).replace(" ", "")
+        first.setdefault(key, text)
+        counts[key] = counts.get(key, 0) + 1
+    out = []
+    for key, text in first.items():
+        shown = text if len(text) <= MESSAGE_CHARS else text[:MESSAGE_CHARS] + " […]"
+        n = counts[key]
+        out.append(f"drake parser warning ({n}x{', the first' if n > 1 else ''}): {shown}")
+    return out
+
+
+MESSAGE_CHARS = 1000
+"""The longest engine message a page quotes whole."""
+
+
+def _floating_joints(plant: MultibodyPlant, text: str) -> list[str]:
+    """A URDF ``floating`` joint from the world: Drake's parser leaves its child a free body
+    without a joint (its warning says so); it is given the ``QuaternionFloatingJoint`` of that
+    name that MuJoCo's and Pinocchio's parsers make of it (measured: both read a free joint).
+    One below another link: Drake holds no joint there, an engine's limit (skipped, said)."""
+    notes = []
+    for joint in ET.fromstring(text).findall("joint"):
+        parent, child = joint.find("parent"), joint.find("child")
+        if joint.get("type") != "floating" or parent is None or child is None:
+            continue
+        if parent.get("link") != "world":
+            raise Unsupported(
+                f"drake: the URDF's floating joint {joint.get('name')!r} is below link "
+                f"{parent.get('link')!r}: Drake's parser leaves its link a free body that no "
+                "joint holds (MuJoCo's and Pinocchio's read a free joint there)")
+        if not plant.HasBodyNamed(child.get("link", "")):
+            continue
+        body = plant.GetBodyByName(child.get("link", ""))
+        plant.AddJoint(QuaternionFloatingJoint(joint.get("name", ""), plant.world_frame(),
+                                               body.body_frame()))
+        notes.append(f"drake: the URDF's floating joint {joint.get('name')!r} given as a "
+                     "QuaternionFloatingJoint (Drake's parser leaves its link a free body)")
+    return notes
+
+
+def _urdf_root(plant: MultibodyPlant):
+    """The link no joint points to (URDF: one, or none when a link named ``world`` welds the
+    model to Drake's world)."""
+    children = {plant.get_joint(i).child_body().index() for i in plant.GetJointIndices()}
+    candidates = [
+        plant.get_body(BodyIndex(b)) for b in range(1, plant.num_bodies())
+        if BodyIndex(b) not in children
+    ]
+    if len(candidates) > 1:
+        raise EngineError(f"drake: expected one URDF root link, found {len(candidates)}")
+    return candidates[0] if candidates else None
+
+
+class DrakeModel(ModelEngine):
+    """A Drake plant and its neutral tree."""
+
+    engine = ENGINE
+    offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION, Offer.CONTROL_DERIVATIVES,
+                        Offer.STEPPING, Offer.CONTROLLED_STEPPING, Offer.COUPLINGS,
+                        Offer.BODY_FORCES})
+    steps_in_a_chart = True  # its integrators advance q = (roll, pitch, yaw) and (w, x, y, z, p)
+
+    def __init__(self, source: ModelFile) -> None:
+        self.plant, said, notes, self._damping = _plant(source)
+        self.parser_warnings = tuple(dict.fromkeys(said))
+        self._source = source
+        self.context = self.plant.CreateDefaultContext()
+        actuation = self.plant.get_actuation_input_port()
+        if self.plant.num_actuated_dofs() > 0:
+            actuation.FixValue(self.context, np.zeros(self.plant.num_actuated_dofs()))
+        self._acc = self.plant.get_generalized_acceleration_output_port()
+        self._ad: Any = None  # the AutoDiffXd plant, made on the first derivatives asked for
+        self._actuated: Any = None  # the context of actuation (its PD controllers armed)
+        self._rows: np.ndarray | None = None  # the couplings C v = 0 it holds (Drake's order)
+        self._ad_actuated: Any = None  # the same for the AutoDiffXd plant
+        self.tree = self._tree(notes)
+
+    def _tree(self, notes: tuple[str, ...]) -> ModelTree:
+        plant, ctx = self.plant, self.context
+        q0 = plant.GetPositions(ctx).copy()
+        moving = [plant.get_joint(i) for i in plant.GetJointIndices()
+                  if plant.get_joint(i).num_velocities() > 0]
+        for joint in moving:
+            if joint.type_name() not in _TYPES:
+                raise Unsupported(
+                    f"drake holds joint {joint.name()!r} as a {joint.type_name()} joint, which "
+                    "the model check does not map"
+                )
+        for joint in moving:  # free bodies at the reference pose: the origin, unrotated
+            if _TYPES[joint.type_name()] is JointType.FREE:
+                q0[joint.position_start() : joint.position_start() + 7] = (1, 0, 0, 0, 0, 0, 0)
+        plant.SetPositions(ctx, q0)
+        owner_of = {}  # body index → the moving joint whose child group holds it
+        for joint in moving:
+            for body in plant.GetBodiesWeldedTo(joint.child_body()):
+                owner_of[body.index()] = joint
+        joints = []
+        reflected = self._reflected
+        for joint in moving:
+            kind = _TYPES[joint.type_name()]
+            group = plant.GetBodiesWeldedTo(joint.child_body())
+            masses, coms, inertias = [], [], []
+            for body in group:
+                m = body.default_mass()
+                p = np.asarray(body.default_com())  # from the body origin, body axes
+                pose = body.EvalPoseInWorld(ctx)
+                rot = pose.rotation().matrix()
+                i_origin = body.default_rotational_inertia().CopyToFullMatrix3()  # about Bo
+                i_com = i_origin - m * (p @ p * np.eye(3) - np.outer(p, p))  # parallel axis
+                masses.append(m)
+                coms.append(pose.translation() + rot @ p)
+                inertias.append(rot @ i_com @ rot.T)
+            mass, com, inertia = lump(masses, coms, inertias)
+            parent_joint = owner_of.get(joint.parent_body().index())
+            child_pose = joint.frame_on_child().CalcPoseInWorld(ctx)
+            if kind is JointType.HINGE:
+                axis = joint.frame_on_parent().CalcPoseInWorld(ctx).rotation().matrix() @ \
+                    joint.revolute_axis()
+            elif kind is JointType.SLIDE:
+                axis = joint.frame_on_parent().CalcPoseInWorld(ctx).rotation().matrix() @ \
+                    joint.translation_axis()
+            else:
+                axis = np.zeros(3)
+            lower, upper = joint.position_lower_limits(), joint.position_upper_limits()
+            limited = kind is not JointType.FREE and np.isfinite(lower[0]) and \
+                np.isfinite(upper[0])
+            nv = joint.num_velocities()
+            joints.append(
+                TreeJoint(
+                    name=joint.name(), type=kind,
+                    parent=None if parent_joint is None else parent_joint.name(),
+                    body=joint.child_body().name(), axis=np.asarray(axis, float),
+                    anchor=np.asarray(child_pose.translation(), float),
+                    frame=child_pose.rotation().matrix(), mass=mass, com=com, inertia=inertia,
+                    armature=(reflected.get(joint.name(), 0.0),) if nv == 1 else (0.0,) * nv,
+                    damping=self._damping.get(joint.name(), (0.0,) * nv),
+                    range=(float(lower[0]), float(upper[0])) if limited else None,
+                    layout=Layout(
+                        q_start=joint.position_start(), v_start=joint.velocity_start(),
+                        nq=joint.num_positions(), nv=nv,
+                        quat=Orientation.RPY if kind is JointType.BALL else Orientation.WXYZ,
+                        quat_first=True,
+                        angular_first=True, linear_axes=Axes.WORLD,
+                        angular_axes=Axes.PARENT if kind is JointType.BALL else Axes.WORLD,
+                        zero=float(q0[joint.position_start()]) if nv == 1 else 0.0,
+                    ),
+                )
+            )
+        gravity = np.asarray(plant.gravity_field().gravity_vector(), float)
+        driven = actuators(self._source) if self._source.format is Format.MJCF else {}
+        hints = tuple((j.name, "armature", armature_hint(j, driven.get(j.name, [])))
+                      for j in joints if j.name not in reflected and self._source.format is
+                      Format.MJCF) + ignored_frames(notes) + file_hints(self._source) + \
+            drake_actuators.hints(plant, self._source, driven)
+        return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
+                         nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,
+                         hints=hints, actuators=drake_actuators.read(plant))
+
+    def couple(self, couplings: Sequence[Coupling]) -> None:
+        """The couplings closed with Drake's M and h (:mod:`.simulation`: Drake's
+        continuous plant enforces no constraint)."""
+        self._rows = drake_simulation.coupling_matrix(self.plant, couplings)
+
+    def _at(self, q: np.ndarray, v: np.ndarray) -> Iterator[int]:
+        """Each state's index, its plant context set to that state."""
+        for i in range(len(q)):
+            self.plant.SetPositions(self.context, q[i])
+            self.plant.SetVelocities(self.context, v[i])
+            yield i
+
+    def constrained(self, q: np.ndarray, v: np.ndarray,
+                    tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """v̇ and the multipliers of the couplings' KKT solve, state by state."""
+        if self._rows is None:
+            raise Unsupported("drake: its model holds no coupling between joints")
+        vdot = np.empty((len(q), self.plant.num_velocities()))
+        forces = np.empty((len(q), len(self._rows)))
+        for i in self._at(q, v):
+            vdot[i], forces[i] = drake_simulation.closed(self.plant, self.context, tau[i],
+                                                         self._rows)
+        return vdot, forces
+
+    def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """v̇ at τ: with couplings, their KKT solve; else M⁻¹ (τ − h)."""
+        if self._rows is None:
+            return super().forward(q, v, tau)
+        return self.constrained(q, v, tau)[0]
+
+    def constraint_forces(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        return self.constrained(q, v, tau)[1]
+
+    def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
+        """Σ Jᵀ F of the field at each state (Drake's translational Jacobians)."""
+        held = drake_simulation.bodies(self.plant)
+        out = np.empty((len(q), self.plant.num_velocities()))
+        for i in self._at(q, v):
+            out[i] = drake_simulation.generalized(self.plant, self.context, field, held)
+        return out
+
+    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
+                 integrator: str, field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Drake's own fixed-step integrator (:data:`.simulation.INTEGRATORS`)."""
+        q, v, _ = drake_simulation.simulate(
+            self.plant, q0, v0, samples=steps, period=dt,
+            scheme=drake_simulation.INTEGRATORS[integrator], dt=dt, field=field,
+            rows=self._rows)
+        return q, v
+
+    def simulate_controlled(self, q0: np.ndarray, v0: np.ndarray, period: float, samples: int,
+                            *, accuracy: float, scheme: str | None = None, caching: bool = True,
+                            field: Field | None = None) -> tuple[np.ndarray, np.ndarray, Steps]:
+        """Drake's error-controlled integration (default ``runge_kutta3``, the Simulator's)."""
+        return drake_simulation.simulate(
+            self.plant, q0, v0, samples=samples, period=period,
+            scheme=scheme or drake_simulation.CONTROLLED, dt=None, accuracy=accuracy,
+            caching=caching, field=field, rows=self._rows)
+
+    def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
+        """Drake's actuator force and forward dynamics at controls u
+        (:func:`drake_actuators.actuation`)."""
+        if self._actuated is None:
+            self._actuated = self.plant.CreateDefaultContext()
+        return drake_actuators.actuation(self.plant, self._actuated, q=q, v=v, u=u)
+
+    def control_derivatives(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """Drake's ∂v̇/∂u by automatic differentiation (:mod:`.actuators`)."""
+        if self._ad is None:
+            self._ad = self.plant.ToAutoDiffXd()
+            self._ad_context = self._ad.CreateDefaultContext()
+        if self._ad_actuated is None:
+            self._ad_actuated = self._ad.CreateDefaultContext()
+        return drake_actuators.control_derivatives(self.plant, self._ad, self._ad_actuated, q=q,
+                                                   v=v, u=u)
+
+    @property
+    def _reflected(self) -> dict[str, float]:
+        """Each actuated joint's armature as Drake holds it: the sum of its actuators'
+        reflected inertia, rotor inertia × gear ratio²."""
+        out: dict[str, float] = {}
+        for index in self.plant.GetJointActuatorIndices():
+            actuator = self.plant.get_joint_actuator(index)
+            name = actuator.joint().name()
+            out[name] = out.get(name, 0.0) + float(actuator.default_reflected_inertia())
+        return out
+
+    def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
+        plant, ctx = self.plant, self.context
+        n, nv = len(q), plant.num_velocities()
+        mass = np.empty((n, nv, nv))
+        bias, forward, inverse = (np.empty((n, nv)) for _ in range(3))
+        kinetic, potential = np.empty(n), np.empty(n)
+        forces = MultibodyForces(plant)
+        for i in self._at(q, v):
+            mass[i] = plant.CalcMassMatrix(ctx)
+            bias[i] = plant.CalcBiasTerm(ctx) - plant.CalcGravityGeneralizedForces(ctx)
+            forward[i] = self._acc.Eval(ctx)
+            forces.SetZero()
+            plant.CalcForceElementsContribution(ctx, forces)
+            inverse[i] = plant.CalcInverseDynamics(ctx, a[i], forces)
+            kinetic[i] = plant.CalcKineticEnergy(ctx)
+            potential[i] = plant.CalcPotentialEnergy(ctx)
+        return Dynamics(mass_matrix=mass, bias=bias, forward=forward, inverse=inverse,
+                          kinetic=kinetic, potential=potential)
+
+    def derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Derivatives:
+        """Forward-mode automatic differentiation (``ToAutoDiffXd``, q and v seeded) of
+        ``CalcInverseDynamics`` with gravity (``CalcForceElementsContribution``) at v̇ = a
+        for ∂τ/∂q, ∂τ/∂v, and at v̇ = its forward acceleration for the forward derivatives
+        through ∂v̇/∂x = −M⁻¹ ∂τ/∂x; ∂v̇/∂τ = M⁻¹ of ``CalcMassMatrix``. With respect to
+        Drake's q itself (a quaternion's four entries, roll-pitch-yaw: the chart
+        :attr:`DerivativeChart.COORDINATES`)."""
+        from pydrake.autodiffutils import ExtractGradient, InitializeAutoDiff
+
+        plant = self.plant
+        if self._ad is None:
+            self._ad = plant.ToAutoDiffXd()
+            self._ad_context = self._ad.CreateDefaultContext()
+        ad, ctx = self._ad, self._ad_context
+        n, nq, nv = len(q), plant.num_positions(), plant.num_velocities()
+        out = {k: np.empty((n, nv, nq if k.endswith("_q") else nv)) for k in
+               ("forward_q", "forward_v", "forward_tau", "inverse_q", "inverse_v")}
+        forces = MultibodyForces_[AutoDiffXd](ad)
+        dynamics = self.dynamics(q, v, np.asarray(a))
+        for i in range(n):
+            state = np.concatenate([q[i], v[i]]).astype(float)
+            seeded = InitializeAutoDiff(state)  # type: ignore[arg-type]  # pydrake's stub
+            ad.SetPositions(ctx, seeded[:nq, 0])
+            ad.SetVelocities(ctx, seeded[nq:, 0])
+            inverse_mass = np.linalg.inv(dynamics.mass_matrix[i])
+            for acceleration, key in ((dynamics.forward[i], "forward"), (a[i], "inverse")):
+                forces.SetZero()
+                ad.CalcForceElementsContribution(ctx, forces)
+                tau = ad.CalcInverseDynamics(ctx, np.array([AutoDiffXd(x) for x in
+                                                            acceleration]), forces)
+                gradient = ExtractGradient(tau)
+                d_q, d_v = gradient[:, :nq], gradient[:, nq:]
+                if key == "inverse":
+                    out["inverse_q"][i], out["inverse_v"][i] = d_q, d_v
+                else:
+                    out["forward_q"][i] = -inverse_mass @ d_q
+                    out["forward_v"][i] = -inverse_mass @ d_v
+            out["forward_tau"][i] = inverse_mass
+        return _derivatives(out, method="automatic differentiation (AutoDiffXd)",
+                            chart=DerivativeChart.COORDINATES)
