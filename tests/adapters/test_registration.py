@@ -74,3 +74,67 @@ def test_the_rule_catches_a_name_written_elsewhere(tmp_path):
     (tmp_path / "adapters" / "newton").mkdir()
     (tmp_path / "adapters" / "newton" / "model.py").write_text('ENGINE = "newton"\n')
     assert _literals("newton", tmp_path) == ["dyncheck/leak.py"]
+
+
+ENGINE_PACKAGES = ("mujoco", "mujoco_warp", "pinocchio", "pydrake", "jax", "warp", "newton",
+                   "pybullet", "sympy")
+"""The engines' import packages (sympy's too: sympy.physics.mechanics is an engine here)."""
+
+BLOCKED_IMPORT = """
+import importlib.abc, sys
+BLOCKED = {blocked!r}
+class Block(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path, target=None):
+        if name in BLOCKED or name.startswith(tuple(b + "." for b in BLOCKED)):
+            raise ImportError("blocked: " + name)
+sys.meta_path.insert(0, Block())
+import dyncheck.adapters as a
+print(" ".join(sorted(a.REGISTRY)))
+"""
+
+
+@pytest.mark.parametrize("blocked", [ENGINE_PACKAGES, ("dyncheck.adapters.formats",),
+                                     (*ENGINE_PACKAGES, "dyncheck.adapters.formats")],
+                         ids=["engines", "formats", "both"])
+def test_every_registration_imports_with_no_engine_and_no_model_format(blocked):
+    """#76: the registrations (the facts needed before any engine) import with every engine
+    package and the MJCF/URDF toolkit refused at import: the registry is then whole."""
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", BLOCKED_IMPORT.format(blocked=blocked)],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == sorted(REGISTRY)
+
+
+def _imports(path: Path) -> set[str]:
+    import ast
+
+    found: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom):
+            found.add("." * node.level + (node.module or ""))
+        elif isinstance(node, ast.Import):
+            found |= {a.name for a in node.names}
+    return found
+
+
+REGISTRATION_NEEDS = {"__future__", "dyncheck.adapters.registration", "dyncheck.vocabulary"}
+"""All a registration module may import: the record, the vocabulary of integrators."""
+
+
+@pytest.mark.parametrize("module", BUILT_IN, ids=lambda m: m.__name__.rsplit(".", 1)[-1])
+def test_a_registration_imports_no_other_engine_folder(module):
+    """#76: an engine folder's ``__init__`` holds its registrations and imports only the
+    record (read from its source: importing it would already have imported the others)."""
+    assert module.__file__ is not None and module.__file__.endswith("__init__.py")
+    assert _imports(Path(module.__file__)) <= REGISTRATION_NEEDS
+
+
+def test_the_registration_rule_catches_an_import_of_another_engine(tmp_path):
+    """The rule can fail: a registration importing MuJoCo's folder is found."""
+    (tmp_path / "__init__.py").write_text(
+        "from dyncheck.adapters.mujoco import MUJOCO\n"
+        "from dyncheck.adapters.registration import A\n")
+    assert not _imports(tmp_path / "__init__.py") <= REGISTRATION_NEEDS
