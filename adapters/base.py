@@ -331,6 +331,12 @@ class ModelEngine(ABC):
     no_body_forces: ClassVar[str] = "its model takes no force on a body (an external field)"
     """A class fact: why it takes no field, where it does not offer
     :attr:`Offer.BODY_FORCES` (its limit, in a sentence)."""
+    coupled_joints: ClassVar[int | None] = None
+    """A class fact, where it offers :attr:`Offer.COUPLINGS`: the most joints one coupling may
+    tie (PyBullet's gear constraint: 2); None, any number."""
+    no_bias_with_ball: ClassVar[str] = ""
+    """A class fact: why it computes no h and no inverse dynamics on a model with a ball
+    joint, where it cannot (its limit, in a sentence); empty: it computes them."""
     batches_steps: ClassVar[bool] = False
     """A class fact: :meth:`simulate_many` runs its step sizes at once (MuJoCo Warp's
     worlds), not one after another."""

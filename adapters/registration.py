@@ -1,8 +1,9 @@
 """An engine's registration: the facts about an engine implementation that are needed before
 (or without) importing it — where its adapter and loader are, its package and extra, its
-integrators, its releases. Each engine declares its own in its folder's ``adapters/<engine>/__init__.py``,
-beside its code (importable without the engine); an installed package adds one through the
-``dyncheck.engines`` entry points (:data:`dyncheck.adapters.ENTRY_POINTS`)."""
+integrators, its releases. Each engine declares its own in its folder's
+``adapters/<engine>/__init__.py``, beside its code (importable without the engine); an
+installed package adds one through the ``dyncheck.engines`` entry points
+(:data:`dyncheck.adapters.ENTRY_POINTS`)."""
 
 from __future__ import annotations
 

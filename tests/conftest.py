@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import os
 import pickle
 import re
@@ -15,10 +16,12 @@ from hypothesis import settings
 
 from dyncheck import adapters
 from dyncheck.adapters import RUN
+from dyncheck.adapters.offers import Offer
 from dyncheck.cases import CASES, get_case
 from dyncheck.workers import exit_without_collecting
 
 if TYPE_CHECKING:
+    from dyncheck.adapters.base import ModelEngine
     from dyncheck.run_result import RunResult
 
 exit_without_collecting()  # each test process (xdist's workers too): ~3 s with every engine loaded
@@ -51,8 +54,16 @@ COUPLED_CASES = sorted(n for n in CASES if get_case(n).multibody().couplings)
 """Cases whose masses are held by cords (couplings between joints)."""
 NO_COUPLINGS: tuple[str, ...] = ()
 """Engines dyncheck does not run with couplings (skipped, with the reason)."""
-PORTS = ("mjx", "mjx-f64", "mujoco-warp")
-"""MuJoCo's ports: no passive-force callback, so no external field evaluated per stage."""
+PORTS = tuple(adapters.ENGINE_PORTS)
+"""Ports of another engine (MuJoCo's: MJX, MuJoCo Warp), from their registrations."""
+
+
+def loader(engine: str) -> type[ModelEngine]:
+    """The engine's loader class (its registration's ``model``): its class facts are what
+    the suites select by — never a hand-kept table of engine names."""
+    module, cls = (adapters.REGISTRY[engine].model or ":").split(":")
+    found: type[ModelEngine] = getattr(importlib.import_module(module), cls)
+    return found
 FILE_LOADERS = tuple(n for n, r in adapters.REGISTRY.items() if r.run and not r.couplings_only)
 """Engines whose book cases go through their loader of a user's file (couplings where the
 engine has constraints for them: PyBullet's gears, of two joints)."""
@@ -68,14 +79,12 @@ FLOORED = ("mujoco", *PORTS,
 """Engines given the case as a file (MJCF, or URDF for PyBullet), whose point masses carry
 the file's small isotropic inertia (``Multibody.mjcf_point_inertia``); ``pinocchio`` reads
 the case as stated (its loader given the exact point masses)."""
-COUPLINGS_ONLY_ENGINES = ("mujoco-stiff",)
-"""Engines that exist only for cases with couplings."""
+COUPLINGS_ONLY_ENGINES = tuple(sorted(adapters.COUPLINGS_ONLY))
+"""Engines that exist only for cases with couplings (their registrations say so)."""
 ENGINES = [e for e in ALL_ENGINES if e not in COUPLINGS_ONLY_ENGINES]
 """The engines every case runs in (where supported)."""
 
 
-NO_INVERSE = "calculateInverseDynamics does not take a multibody with a spherical joint"
-"""PyBullet's stated limit on a ball-joint case: its h and inverse dynamics (skipped rows)."""
 SPHERICAL_CASES = sorted(
     n for n in CASES if any(j.type == "ball" for j in get_case(n).multibody().joints))
 """Cases with a ball joint (a spherical joint in PyBullet; a free joint is its moving base)."""
@@ -84,9 +93,9 @@ SPHERICAL_CASES = sorted(
 def quantity_limit(case: str, engine: str, quantity: str) -> str | None:
     """The words a skipped row of ``quantity`` must contain where ``engine`` does not compute
     it on ``case`` (its stated limit), or None."""
-    if engine == "pybullet" and case in SPHERICAL_CASES and quantity in ("bias_forces",
-                                                                          "inverse_dynamics"):
-        return NO_INVERSE
+    if (case in SPHERICAL_CASES and quantity in ("bias_forces", "inverse_dynamics")
+            and engine in FILE_LOADERS and (limit := loader(engine).no_bias_with_ball)):
+        return limit.split(" (")[0]
     return None
 
 
@@ -118,8 +127,9 @@ FIELD_CASES = sorted(n for n in CASES if get_case(n).multibody().central_mu)
 
 def unsupported_reason(case: str, engine: str) -> str | None:
     """The words the Unsupported message must contain, or None when supported."""
-    if case in FIELD_CASES and engine in PORTS:
-        return "mjcb_passive"
+    if case in FIELD_CASES and engine in FILE_LOADERS + PORTS \
+            and Offer.BODY_FORCES not in loader(engine).offers:
+        return loader(engine).no_body_forces
     if case in POINT_BALL_CASES and engine in NO_BALL:
         return "point mass on a ball joint"
     if case in COUPLED_CASES and engine in NO_COUPLINGS:
@@ -128,10 +138,11 @@ def unsupported_reason(case: str, engine: str) -> str | None:
         return "couplings"
     if engine in FILE_LOADERS and case in COUPLED_CASES:
         widest = max(len(c.coefs) for c in get_case(case).multibody().couplings)
-        if engine == "newton":  # (its Featherstone solver has no equality constraints)
+        held = loader(engine)
+        if Offer.COUPLINGS not in held.offers:  # (Newton's Featherstone solver: none)
             return "no coupling between joints"
-        if widest > 2 and engine == "pybullet":  # (its gear constraint couples two joints;
-            return "couples"  # Drake's loader closes any coupling by a KKT solve)
+        if held.coupled_joints is not None and widest > held.coupled_joints:
+            return "couples"  # (PyBullet's gear: two joints; Drake's KKT solve: any)
     cases, word = LOADER_LIMITS.get(engine, ((), ""))
     if case in cases:
         return word

@@ -301,3 +301,16 @@ def test_the_default_output_folder_is_git_ignored_and_not_the_committed_report()
     if done.returncode == 128:
         pytest.skip("not a git checkout")
     assert done.returncode == 0
+
+
+def test_the_guide_lists_every_field_of_a_registration():
+    """CONTRIBUTING's recipe names a ``Registration``'s fields in the record's order: the
+    record itself (its dataclass fields) is the expected list."""
+    import dataclasses
+
+    from dyncheck.adapters import Registration
+
+    text = " ".join((ROOT / "CONTRIBUTING.md").read_text(encoding="utf-8").split())
+    found = re.search(r"`Registration\(\*, ([a-z0-9_, ]+)\)`", text)
+    assert found, "CONTRIBUTING.md no longer spells Registration(*, ...)"
+    assert found.group(1).split(", ") == [f.name for f in dataclasses.fields(Registration)]

@@ -24,7 +24,6 @@ from __future__ import annotations
 import logging
 import re
 import tempfile
-import xml.etree.ElementTree as ET
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -46,6 +45,7 @@ from dyncheck.adapters.base import Field, ModelEngine, Offer, Steps
 from dyncheck.adapters.drake import actuators as drake_actuators
 from dyncheck.adapters.drake import simulation as drake_simulation
 from dyncheck.adapters.drake.hints import actuators, armature_hint, file_hints, ignored_frames
+from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.mjcf_copy import for_parser
 from dyncheck.adapters.model_tree import (
@@ -186,7 +186,7 @@ def _floating_joints(plant: MultibodyPlant, text: str) -> list[str]:
     name that MuJoCo's and Pinocchio's parsers make of it (measured: both read a free joint).
     One below another link: Drake holds no joint there, an engine's limit (skipped, said)."""
     notes = []
-    for joint in ET.fromstring(text).findall("joint"):
+    for joint in parsing.root(text).findall("joint"):
         parent, child = joint.find("parent"), joint.find("child")
         if joint.get("type") != "floating" or parent is None or child is None:
             continue

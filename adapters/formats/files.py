@@ -8,6 +8,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
+from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.mjcf_copy import encoding, transcoded
 from dyncheck.adapters.registration import Format
 
@@ -55,7 +56,7 @@ class ModelFile:
 
 def read(path: Path, *, floating: bool = False) -> ModelFile:
     """Read ``path``; the caller has validated it (exists, parses, known root element)."""
-    tree = ET.parse(path)
+    tree = parsing.parse(path)
     root = tree.getroot()
     if root.tag == "robot":
         missing = missing_meshes(path, root)
@@ -136,7 +137,7 @@ def urdf_welded(source: ModelFile) -> set[str]:
     base" idiom leaves such a link massless)."""
     if source.format is not Format.URDF:
         return set()
-    robot = ET.fromstring(source.text)
+    robot = parsing.root(source.text)
     root = urdf_root_link(robot)
     if root is None or source.floating:
         return set()
@@ -159,7 +160,7 @@ def urdf_inertials(source: ModelFile) -> list[Inertial]:
     if source.format is not Format.URDF:
         return []
     out = []
-    for link in ET.fromstring(source.text).findall("link"):
+    for link in parsing.root(source.text).findall("link"):
         inertial = link.find("inertial")
         if inertial is None:
             continue

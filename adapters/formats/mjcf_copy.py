@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
 
+from dyncheck.adapters.formats import parsing
 from dyncheck.errors import EngineError, Unsupported
 
 
@@ -69,7 +70,7 @@ def _read(path: Path, including: Path) -> ET.Element:
                               f"{MAX_INCLUDE_BYTES // 2**20} MiB")
         raw = handle.read()
     try:
-        return ET.fromstring(raw)
+        return parsing.root(raw)
     except ET.ParseError as exc:
         raise EngineError(f"{path}: not XML ({exc})") from None
 

@@ -11,7 +11,6 @@ dynamics is evaluated with its activation state equal to its control.
 from __future__ import annotations
 
 import copy
-import xml.etree.ElementTree as ET
 
 import mujoco
 import numpy as np
@@ -23,6 +22,7 @@ from dyncheck.adapters.actuators import (
     InputJacobian,
     Transmission,
 )
+from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.registration import Format
 from dyncheck.vocabulary import Integrator
@@ -112,7 +112,7 @@ def file_hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
     file)."""
     if source.format is not Format.URDF:
         return ()
-    count = len(ET.fromstring(source.text).findall("transmission"))
+    count = len(parsing.root(source.text).findall("transmission"))
     return (("model", "actuator", UNREAD_TRANSMISSIONS.format(count=count)),) if count else ()
 
 

@@ -27,6 +27,7 @@ import numpy as np
 
 from dyncheck.adapters.actuators import Actuation
 from dyncheck.adapters.base import Field, ModelEngine, Offer
+from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
 from dyncheck.adapters.model_tree import (
@@ -288,12 +289,11 @@ class NewtonModel(ModelEngine):
         written order (``jcalc_transform``: translate, then rotate by the angular axes
         composed intrinsically) — named from its label (the written names joined by "_"),
         their kinds from the file."""
-        import xml.etree.ElementTree as ET
 
         n_lin, n_ang = (int(x) for x in self.model.joint_dof_dim.numpy()[j])
         names = self._name(j).split("_")
         written = {e.get("name"): e.get("type", "hinge")
-                   for e in ET.fromstring(self._text).iter("joint")} if self._text else {}
+                   for e in parsing.root(self._text).iter("joint")} if self._text else {}
         slides = [n for n in names if written.get(n) == "slide"]
         hinges = [n for n in names if written.get(n) == "hinge"]
         if len(names) != n_lin + n_ang or len(slides) != n_lin or len(hinges) != n_ang:

@@ -30,13 +30,17 @@ class Gear:
     body: int
 
 
+GEARED = 2
+"""The joints one gear constraint (``JOINT_GEAR``) ties."""
+
+
 def gears(client: int, joints: dict[str, tuple[int, int]],
           couplings: Sequence[Coupling]) -> list[Gear]:
     """Each coupling as a gear constraint between its two joints (``joints``: name → (body,
     joint index)); refused where a coupling is not two joints of one multibody."""
     out = []
     for coupling in couplings:
-        if len(coupling.coefs) != 2:
+        if len(coupling.coefs) != GEARED:
             raise Unsupported(
                 f"pybullet: its gear constraint (JOINT_GEAR) couples two joints; "
                 f"{coupling.name!r} couples {len(coupling.coefs)}")

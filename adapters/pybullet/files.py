@@ -5,13 +5,13 @@ the hints a page gives where its reading is known to differ (:mod:`.model`)."""
 from __future__ import annotations
 
 import tempfile
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pybullet as pb
 
+from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile, urdf_inertials
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
 from dyncheck.adapters.registration import Format
@@ -65,7 +65,7 @@ def mjcf_hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
     a class's is not resolved here: no hint, cause unknown). Named on the body's joints."""
     if source.format is not Format.MJCF:
         return ()
-    root = ET.fromstring(source.text)
+    root = parsing.root(source.text)
     default = root.find("default/geom")
     fallback = default.get("density") if default is not None else None
     out: list[tuple[str, str, str]] = []
@@ -163,7 +163,7 @@ def defaulted(source: ModelFile, links: list[Link]) -> tuple[tuple[str, str, str
     """Why a joint's mass reads 1 kg more: a URDF link it carries has no ``<inertial>``."""
     if source.format is not Format.URDF:
         return ()
-    bare = {link.get("name", "") for link in ET.fromstring(source.text).findall("link")
+    bare = {link.get("name", "") for link in parsing.root(source.text).findall("link")
             if link.find("inertial") is None}
     by_key = {(link.body, link.index): link for link in links}
     out: dict[str, list[str]] = {}

@@ -56,7 +56,7 @@ from dyncheck.adapters.model_tree import (
     lump,
 )
 from dyncheck.adapters.pybullet.base import base_state, place_base, world_linear
-from dyncheck.adapters.pybullet.couplings import Gear, gears, multipliers
+from dyncheck.adapters.pybullet.couplings import GEARED, Gear, gears, multipliers
 from dyncheck.adapters.pybullet.files import (
     ACCURACY_HINT,
     ARMATURE_HINT,
@@ -101,6 +101,8 @@ class PybulletModel(PybulletState, ModelEngine):
 
     engine = ENGINE
     offers = frozenset({Offer.STEPPING, Offer.BODY_FORCES, Offer.COUPLINGS})
+    coupled_joints = GEARED
+    no_bias_with_ball = NO_INVERSE
     no_actuation = ("pybullet holds no actuator model (no control law of a file's actuators "
                     "or transmissions): a script drives each joint with "
                     "setJointMotorControl2 (TORQUE_CONTROL applies the torque it is given; "

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ROOT_TAG
 from dyncheck.adapters.registration import Format
 from dyncheck.check import baseline
@@ -36,7 +37,7 @@ AGREEMENT = {Agreement.AGREE: "computes what it read",
 
 def _root(path: Path) -> ET.Element | None:
     try:
-        return ET.parse(path).getroot()
+        return parsing.parse(path).getroot()
     except (ET.ParseError, OSError):
         return None
 

@@ -8,6 +8,7 @@ import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import (
     INERTIA_KEYS,
     ROOT_TAG,
@@ -49,7 +50,7 @@ def model_path(text: str) -> Path:
     except OSError as exc:
         raise ModelFileError(path, f"cannot be read ({exc.strerror})") from None
     try:
-        root = ET.fromstring(raw)
+        root = parsing.root(raw)
     except ET.ParseError as exc:
         line, column = exc.position
         raise ModelFileError(path, f"not XML (line {line}, column {column})") from None
@@ -240,7 +241,7 @@ def massive(path: Path, source: ModelFile) -> None:
     if source.format.value != "urdf":
         return
     welded = urdf_welded(source)
-    links = {link.get("name") for link in ET.fromstring(source.text).findall("link")}
+    links = {link.get("name") for link in parsing.root(source.text).findall("link")}
     if links <= welded:  # nothing moves: the check's own refusal says so
         return
     if not any(i.mass > 0 for i in urdf_inertials(source) if i.link not in welded):

@@ -323,9 +323,7 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="a book case's MJCF, the file `run` gives MuJoCo (repeatable; 'all': "
                    "every case)")
     p.add_argument("--impl", action="append", default=[], metavar="NAME",
-                   help="reference, mujoco, pinocchio, drake, MuJoCo's ports mjx, mjx-f64, "
-                   "mujoco-warp, and newton, pybullet (repeatable; default: the first four; the "
-                   "others only when named)")
+                   help=flags.impl_help())
     p.add_argument("--states", type=int, default=100, metavar="N", help="sampled states")
     p.add_argument("--skip-included", action="store_true",
                    help="leave out a file given that another model file beside it includes "

@@ -41,14 +41,33 @@ def selection(p: argparse.ArgumentParser) -> None:
         action="append",
         default=[],
         metavar="NAME",
-        help="implementation to include (repeatable; default: every one but the engines "
-        "built for accelerators); the catalogue's entries that need an engine left out say "
-        "so",
+        help=f"implementation to include: {', '.join(_run_names())} (repeatable; default: "
+        "every one but the engines built for accelerators); the catalogue's entries that need "
+        "an engine left out say so",
     )
     accelerators(p)
     jobs(p, "cases")
     dask(p)
     no_cache(p)
+
+
+def _run_names() -> tuple[str, ...]:
+    """What ``run --impl`` takes: the book's solutions, the referee, each registered engine."""
+    from dyncheck.roster import IMPLEMENTATIONS
+
+    return IMPLEMENTATIONS
+
+
+def impl_help() -> str:
+    """``check --impl``'s help, from the registry: the engines that load a user's file, and
+    which of them are checked only when named (:attr:`Registration.on_request`)."""
+    from dyncheck.adapters import MODELS
+    from dyncheck.roster import REFEREE
+
+    named = [n for n, r in MODELS.items() if r.on_request]
+    default = [REFEREE, *(n for n in MODELS if n not in named)]
+    return (f"{', '.join([REFEREE, *MODELS])} (repeatable; default: {', '.join(default)}; "
+            f"{', '.join(named)} only when named)")
 
 
 def accelerators(p: argparse.ArgumentParser) -> None:

@@ -23,6 +23,8 @@ from pathlib import Path
 import pytest
 
 from dyncheck.__main__ import main
+from dyncheck.adapters import MODELS as LOADERS
+from dyncheck.adapters import REGISTRY
 from dyncheck.cases import get_case
 from dyncheck.cases.multibody import Body, Joint
 from dyncheck.errors import DyncheckError
@@ -33,6 +35,11 @@ PAGE = REPORTS / "reliability.md"
 MODELS = ROOT / "tests" / "check" / "models"
 URDF = (MODELS / "branches.urdf").read_text()
 Y = (0.0, 1.0, 0.0)
+
+CHECKED = ", ".join(sorted(["reference", *LOADERS]))
+"""``check --impl``'s valid names, from the registry: the referee and every file loader."""
+VERSIONED = ", ".join(sorted(n for n, r in REGISTRY.items() if r.releases))
+"""``versions --engine``'s valid names: the registrations that list releases."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -423,8 +430,7 @@ FAULTS: tuple[Fault, ...] = (
           answer=r"--engine-seconds must be a number of seconds"),
     Fault(kind="unknown implementation", area="check",
           argv=("check", BRANCHES, "--impl", "bulet", "--out", OUT),
-          answer=r"unknown implementation 'bulet'; valid: drake, mjx, mjx-f64, mujoco, "
-                 r"mujoco-warp, newton, pinocchio, pybullet, reference$"),
+          answer=r"unknown implementation 'bulet'; valid: " + re.escape(CHECKED) + "$"),
     Fault(kind="only the referee chosen", area="check",
           argv=("check", BRANCHES, "--impl", "reference", "--out", OUT),
           answer=r"--impl must be at least one engine"),
@@ -457,7 +463,7 @@ FAULTS: tuple[Fault, ...] = (
           argv=("diff", "{tmp}/a", str(REPORTS)), answer=r"RUN_A .*<tmp>/a"),
     # --- versions
     Fault(kind="unknown engine", area="versions", argv=("versions", "--engine", "bullet"),
-          answer=r"unknown engine 'bullet'; valid: drake, mujoco, newton, pinocchio, pybullet$"),
+          answer=r"unknown engine 'bullet'; valid: " + re.escape(VERSIONED) + "$"),
     Fault(kind="unknown case", area="versions", argv=("versions", "--case", "nope"),
           answer=r"unknown case 'nope'"),
     Fault(kind="--jobs 0", area="versions", argv=("versions", "--jobs", "0"),
