@@ -283,7 +283,8 @@ def _converted(root: ET.Element, files: dict[str, Path | None], unreadable: set[
             continue
         for element in root.iter("mesh"):
             if _mesh_name(element) == name and element.get("file"):
-                element.set("file", str(target))
+                element.set("name", name)  # (a nameless mesh is named by its file's stem:
+                element.set("file", str(target))  # the converted file's would lose it)
         unreadable.discard(name)
         done.append(f"{name!r} ({file.name})")
     if not done:

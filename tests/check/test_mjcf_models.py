@@ -729,15 +729,19 @@ STL_BODY = """<mujoco model="stl"><asset><mesh name="box" file="box.stl"/></asse
 @pytest.mark.skipif(importlib.util.find_spec("trimesh") is None
                     or importlib.util.find_spec("pydrake") is None,
                     reason="needs trimesh and drake (extra drake)")
-def test_drake_is_given_an_stl_mesh_converted_and_compared(tmp_path):
+@pytest.mark.parametrize("asset", ['<mesh name="box" file="box.stl"/>', '<mesh file="box.stl"/>'],
+                         ids=["named", "nameless"])
+def test_drake_is_given_an_stl_mesh_converted_and_compared(tmp_path, asset):
     """#59: a body whose inertia comes from an STL mesh, which Drake's MJCF parser cannot
     read: Drake is given the mesh converted to OBJ by trimesh (every float32 vertex written
     exactly) and reads mass, centre and inertia as MuJoCo does — expected: MuJoCo's own
     reading of the same triangles (a 0.2 × 0.1 × 0.4 m box of density 1000). Without
-    trimesh: the test above."""
+    trimesh: the test above. #77: a nameless mesh is named by its file's stem (MuJoCo's
+    rule, read by Drake too): the converted copy keeps that name, or Drake drops the geom
+    and reads the body massless."""
     _binary_stl(tmp_path / "box.stl", (-0.07, -0.05, -0.19), (0.13, 0.05, 0.21))
     path = tmp_path / "m.xml"
-    path.write_text(STL_BODY)
+    path.write_text(STL_BODY.replace('<mesh name="box" file="box.stl"/>', asset))
     result = check_model(path, states=5, impls=("reference", "mujoco", "drake"))
     rows = result.rows
     load = rows[(rows["section"] == "load") & (rows["impl_a"] == "drake")].iloc[0]
