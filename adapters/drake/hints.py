@@ -10,7 +10,8 @@ import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.mjcf_copy import inline, joints
+from dyncheck.adapters.formats.includes import inline
+from dyncheck.adapters.formats.mjcf_copy import joints
 from dyncheck.adapters.formats.mjcf_unread import springdampers
 from dyncheck.adapters.model_tree import JointType, TreeJoint
 from dyncheck.adapters.registration import Format

@@ -56,8 +56,7 @@ class ModelFile:
 
 def read(path: Path, *, floating: bool = False) -> ModelFile:
     """Read ``path``; the caller has validated it (exists, parses, known root element)."""
-    tree = parsing.parse(path)
-    root = tree.getroot()
+    root = parsing.root(path.read_bytes())
     if root.tag == "robot":
         missing = missing_meshes(path, root)
         for link in root.iter("link"):

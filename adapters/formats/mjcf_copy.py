@@ -13,9 +13,7 @@ the mesh, and the copy is refused naming the mesh and the conversion that would 
 
 from __future__ import annotations
 
-import os
 import re
-import stat
 import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Iterator
@@ -24,8 +22,8 @@ from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
 
-from dyncheck.adapters.formats import parsing
-from dyncheck.errors import EngineError, Unsupported
+from dyncheck.adapters.formats.includes import ASSET_DIRS, asset_file, compiler, inline
+from dyncheck.errors import Unsupported
 
 
 class Owner(Enum):
@@ -35,8 +33,6 @@ class Owner(Enum):
     STATES_INERTIA = "a moving body with an <inertial>"
     PLAIN = "a moving body without one"
 
-MAX_INCLUDE_BYTES = 64 * 2**20
-MAX_INCLUDE_DEPTH = 32
 GEOM_INERTIA_KEYS = ("type", "mesh", "mass", "density", "group", "contype", "conaffinity")
 """The geom attributes (from defaults too) that decide whether, and how, a geom carries
 inertia (in MuJoCo; ``contype``/``conaffinity`` in Pinocchio's MJCF parser)."""
@@ -50,71 +46,6 @@ class Copy:
 
     text: str
     notes: tuple[str, ...]
-
-
-def _read(path: Path, including: Path) -> ET.Element:
-    """An included file's root, read only if it is a regular file (a FIFO or a device would
-    block or never end)."""
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
-    except OSError as exc:
-        raise EngineError(f"{including}: <include file={path.name!r}>: cannot be read "
-                          f"({exc.strerror})") from None
-    info = os.fstat(fd)  # before fdopen, which refuses a folder with its fd for a name
-    if not stat.S_ISREG(info.st_mode):
-        os.close(fd)
-        raise EngineError(f"{including}: <include file={path.name!r}>: not a regular file")
-    with os.fdopen(fd, "rb") as handle:
-        if info.st_size > MAX_INCLUDE_BYTES:
-            raise EngineError(f"{including}: <include file={path.name!r}>: larger than "
-                              f"{MAX_INCLUDE_BYTES // 2**20} MiB")
-        raw = handle.read()
-    try:
-        return parsing.root(raw)
-    except ET.ParseError as exc:
-        raise EngineError(f"{path}: not XML ({exc})") from None
-
-
-def inline(path: Path) -> ET.Element:
-    """The model's root with every ``<include>`` replaced by the included file's children
-    (paths relative to the main file's folder, as MuJoCo resolves them, else to the including
-    file's)."""
-    main = path.resolve()
-
-    def expand(start: ET.Element, origin: tuple[Path, ...]) -> None:
-        pending = [(start, origin)]  # (elements without recursion: trees 1000 bodies deep)
-        while pending:
-            element, chain = pending.pop()
-            _expand_one(element, chain, pending)
-
-    def _expand_one(element: ET.Element, chain: tuple[Path, ...],
-                    pending: list[tuple[ET.Element, tuple[Path, ...]]]) -> None:
-        children = list(element)
-        for index, child in reversed(list(enumerate(children))):
-            if child.tag != "include":
-                pending.append((child, chain))
-                continue
-            name = child.get("file", "")
-            if not name.strip():
-                raise EngineError(f"{chain[-1]}: <include> has no file attribute")
-            target = (main.parent / name).resolve()
-            if not target.exists():  # older files: relative to the including file
-                target = (chain[-1].parent / name).resolve()
-            if target in chain:
-                raise EngineError(f"{chain[-1]}: <include file={name!r}> includes itself "
-                                  "(an include cycle)")
-            if len(chain) > MAX_INCLUDE_DEPTH:
-                raise EngineError(f"{chain[-1]}: includes nested deeper than "
-                                  f"{MAX_INCLUDE_DEPTH}")
-            included = _read(target, chain[-1])
-            expand(included, (*chain, target))  # (recursion only per include: at most 32)
-            element.remove(child)
-            for offset, part in enumerate(included):
-                element.insert(index + offset, part)
-
-    root = _read(main, main)
-    expand(root, (main,))
-    return root
 
 
 def class_defaults(root: ET.Element, tag: str,
@@ -206,34 +137,13 @@ def joints(root: ET.Element) -> list[Placed]:
     return placed(root, "joint", JOINT_KEYS)
 
 
-def _compiler(root: ET.Element, key: str, default: str) -> str:
-    value = default
-    for compiler in root.iter("compiler"):
-        value = compiler.get(key, value)
-    return value
-
-
-ASSET_DIRS = {"mesh": "meshdir", "skin": "meshdir", "hfield": "meshdir",
-              "texture": "texturedir"}
-"""The compiler attribute each asset's file is relative to (``assetdir`` where it is absent)."""
-
-
-def _asset_file(root: ET.Element, folder: Path, element: ET.Element) -> Path | None:
-    file = element.get("file")
-    if not file:
-        return None
-    base = _compiler(root, ASSET_DIRS.get(element.tag, "assetdir"),
-                     _compiler(root, "assetdir", ""))
-    return (folder / base / file).resolve()
-
-
 def _mesh_name(mesh: ET.Element) -> str:
     return mesh.get("name") or Path(mesh.get("file", "")).stem
 
 
 def _mesh_files(root: ET.Element, folder: Path) -> dict[str, Path | None]:
     """Every ``<mesh>`` asset by name: its file (absolute), None for a mesh without one."""
-    return {_mesh_name(m): _asset_file(root, folder, m) for m in root.iter("mesh")
+    return {_mesh_name(m): asset_file(root, folder, m) for m in root.iter("mesh")
             if m.get("file") or m.get("name")}
 
 
@@ -315,9 +225,9 @@ def for_parser(path: Path, engine: str, readable: tuple[str, ...], *,
     unreadable = {name for name, file in files.items()
                   if file is None or file.suffix.lower() not in readable}
     if unreadable:
-        mode = _compiler(root, "inertiafromgeom", "auto")
+        mode = compiler(root, "inertiafromgeom", "auto")
         low, high = (int(float(x)) for x in
-                     _compiler(root, "inertiagrouprange", "0 5").split()[:2])
+                     compiler(root, "inertiagrouprange", "0 5").split()[:2])
         needed = {found.attrs.get("mesh") for found in geoms(root)
                   if found.attrs.get("mesh") in unreadable
                   and _carries_inertia(found.attrs, found.owner, mode, (low, high))}
@@ -434,8 +344,8 @@ def _asset_attributes(root: ET.Element, folder: Path
     for element in root.iter():
         if element.tag not in (*ASSET_DIRS, "model"):
             continue
-        base = _compiler(root, ASSET_DIRS.get(element.tag, "assetdir"),
-                         _compiler(root, "assetdir", ""))
+        base = compiler(root, ASSET_DIRS.get(element.tag, "assetdir"),
+                         compiler(root, "assetdir", ""))
         out += [(element, key, (folder / base / file).resolve()) for key in TEXTURE_FILES
                 if (file := element.get(key))]
     return out
@@ -451,9 +361,9 @@ def _standalone(root: ET.Element, folder: Path) -> str:
     same from anywhere: the compiler's asset folders folded into them."""
     for element, key, path in _asset_attributes(root, folder):
         element.set(key, str(path))
-    for compiler in root.iter("compiler"):
+    for settings in root.iter("compiler"):
         for key in ("meshdir", "texturedir", "assetdir"):
-            compiler.attrib.pop(key, None)
+            settings.attrib.pop(key, None)
     return ET.tostring(root, encoding="unicode")
 
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
-from pathlib import Path
 from pyexpat import errors
 
 UNDECLARED = "urn:dyncheck:undeclared:"
@@ -41,8 +40,3 @@ def root(raw: bytes | str) -> ET.Element:
             ET.register_namespace(prefix.decode(), UNDECLARED + prefix.decode())
     added = b"".join(b' xmlns:%s="%s%s"' % (p, UNDECLARED.encode(), p) for p in prefixes)
     return ET.fromstring(data[:start.end()] + added + data[start.end():])
-
-
-def parse(path: Path | str) -> ET.ElementTree:
-    """:func:`root` of a file, as ``ET.parse`` gives it."""
-    return ET.ElementTree(root(Path(path).read_bytes()))

@@ -21,7 +21,8 @@ import numpy as np
 
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.mjcf_copy import inline, utf8_file
+from dyncheck.adapters.formats.includes import inline
+from dyncheck.adapters.formats.mjcf_copy import utf8_file
 from dyncheck.adapters.model_tree import (
     NQ,
     NV,

@@ -15,7 +15,8 @@ from collections.abc import Iterable
 import numpy as np
 
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.mjcf_copy import Placed, children, geoms, inline, joints
+from dyncheck.adapters.formats.includes import inline
+from dyncheck.adapters.formats.mjcf_copy import Placed, children, geoms, joints
 from dyncheck.adapters.formats.mjcf_unread import springdampers
 from dyncheck.adapters.registration import Format
 

@@ -31,7 +31,8 @@ import pinocchio as pin
 
 from dyncheck.adapters.base import Field, ModelEngine, Offer
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.mjcf_copy import inline, utf8_file
+from dyncheck.adapters.formats.includes import inline
+from dyncheck.adapters.formats.mjcf_copy import utf8_file
 from dyncheck.adapters.model_tree import (
     Axes,
     Derivatives,

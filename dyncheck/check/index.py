@@ -37,7 +37,7 @@ AGREEMENT = {Agreement.AGREE: "computes what it read",
 
 def _root(path: Path) -> ET.Element | None:
     try:
-        return parsing.parse(path).getroot()
+        return parsing.root(path.read_bytes())
     except (ET.ParseError, OSError):
         return None
 

@@ -1,0 +1,112 @@
+"""An MJCF file's ``<include>``s, inlined as MuJoCo's parser inlines them — a cycle, a missing
+or special file (a FIFO, a device) found here, never handed to a parser that can loop or block
+on it — and the files its assets name, resolved as MuJoCo resolves them (the compiler's
+``meshdir``, ``texturedir``, ``assetdir``; an included file's asset beside the included file
+where the main file's folder has none)."""
+
+from __future__ import annotations
+
+import os
+import stat
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from dyncheck.adapters.formats import parsing
+from dyncheck.errors import EngineError
+
+MAX_INCLUDE_BYTES = 64 * 2**20
+MAX_INCLUDE_DEPTH = 32
+
+
+def compiler(root: ET.Element, key: str, default: str) -> str:
+    """The compiler's ``key`` (the last ``<compiler>`` that states it), else ``default``."""
+    value = default
+    for element in root.iter("compiler"):
+        value = element.get(key, value)
+    return value
+
+
+ASSET_DIRS = {"mesh": "meshdir", "skin": "meshdir", "hfield": "meshdir",
+              "texture": "texturedir"}
+"""The compiler attribute each asset's file is relative to (``assetdir`` where it is absent)."""
+
+
+def asset_file(root: ET.Element, folder: Path, element: ET.Element) -> Path | None:
+    file = element.get("file")
+    if not file:
+        return None
+    base = compiler(root, ASSET_DIRS.get(element.tag, "assetdir"),
+                    compiler(root, "assetdir", ""))
+    return (folder / base / file).resolve()
+
+
+def _read(path: Path, including: Path) -> ET.Element:
+    """An included file's root, read only if it is a regular file (a FIFO or a device would
+    block or never end)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError as exc:
+        raise EngineError(f"{including}: <include file={path.name!r}>: cannot be read "
+                          f"({exc.strerror})") from None
+    info = os.fstat(fd)  # before fdopen, which refuses a folder with its fd for a name
+    if not stat.S_ISREG(info.st_mode):
+        os.close(fd)
+        raise EngineError(f"{including}: <include file={path.name!r}>: not a regular file")
+    with os.fdopen(fd, "rb") as handle:
+        if info.st_size > MAX_INCLUDE_BYTES:
+            raise EngineError(f"{including}: <include file={path.name!r}>: larger than "
+                              f"{MAX_INCLUDE_BYTES // 2**20} MiB")
+        raw = handle.read()
+    try:
+        return parsing.root(raw)
+    except ET.ParseError as exc:
+        raise EngineError(f"{path}: not XML ({exc})") from None
+
+
+def inline(path: Path) -> ET.Element:
+    """The model's root with every ``<include>`` replaced by the included file's children
+    (paths relative to the main file's folder, as MuJoCo resolves them, else to the including
+    file's)."""
+    main = path.resolve()
+
+    def expand(start: ET.Element, origin: tuple[Path, ...]) -> None:
+        pending = [(start, origin)]  # (elements without recursion: trees 1000 bodies deep)
+        while pending:
+            element, chain = pending.pop()
+            _expand_one(element, chain, pending)
+
+    def _expand_one(element: ET.Element, chain: tuple[Path, ...],
+                    pending: list[tuple[ET.Element, tuple[Path, ...]]]) -> None:
+        children = list(element)
+        for index, child in reversed(list(enumerate(children))):
+            if child.tag != "include":
+                pending.append((child, chain))
+                continue
+            name = child.get("file", "")
+            if not name.strip():
+                raise EngineError(f"{chain[-1]}: <include> has no file attribute")
+            target = (main.parent / name).resolve()
+            if not target.exists():  # older files: relative to the including file
+                target = (chain[-1].parent / name).resolve()
+            if target in chain:
+                raise EngineError(f"{chain[-1]}: <include file={name!r}> includes itself "
+                                  "(an include cycle)")
+            if len(chain) > MAX_INCLUDE_DEPTH:
+                raise EngineError(f"{chain[-1]}: includes nested deeper than "
+                                  f"{MAX_INCLUDE_DEPTH}")
+            included = _read(target, chain[-1])
+            origins.extend((e, target.parent) for e in included.iter() if e.tag in ASSET_DIRS)
+            expand(included, (*chain, target))  # (recursion only per include: at most 32)
+            element.remove(child)
+            for offset, part in enumerate(included):
+                element.insert(index + offset, part)
+
+    origins: list[tuple[ET.Element, Path]] = []
+    root = _read(main, main)
+    expand(root, (main,))
+    for element, folder in origins:  # MuJoCo (4.0, measured): the main file's folder first,
+        found = asset_file(root, main.parent, element)  # else the included file's
+        beside = asset_file(root, folder, element)
+        if found is not None and beside is not None and not found.exists() and beside.exists():
+            element.set("file", str(beside))
+    return root
