@@ -98,6 +98,11 @@ LATER_DEFAULTS = (
 )
 
 
+CLASS_LOOKUP_FAILED = "unordered_map::at"
+"""Pinocchio's MJCF parser's own words when a class it looks up is unknown to it (measured:
+``std::unordered_map::at``'s exception): the one refusal :data:`LATER_DEFAULTS` explains."""
+
+
 def later_defaults(root: ET.Element) -> str | None:
     """Why Pinocchio fails on a file with several top-level ``<default>`` blocks whose later
     blocks define a class the file uses (:data:`LATER_DEFAULTS`); None where that premise does

@@ -30,6 +30,7 @@ import numpy as np
 import pinocchio as pin
 
 from dyncheck.adapters.base import Field, ModelEngine, Offer
+from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
@@ -46,7 +47,13 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
-from dyncheck.adapters.pinocchio.mjcf import BARE_BODY, bare_bodies, hints, later_defaults
+from dyncheck.adapters.pinocchio.mjcf import (
+    BARE_BODY,
+    CLASS_LOOKUP_FAILED,
+    bare_bodies,
+    hints,
+    later_defaults,
+)
 from dyncheck.adapters.pinocchio.simulation import Stepping
 from dyncheck.adapters.registration import Format
 from dyncheck.cases.multibody import Coupling
@@ -99,7 +106,10 @@ def _load(source: ModelFile) -> pin.Model:
             root = inline(source.path)
             if (count := bare_bodies(root)):
                 message += f" ({BARE_BODY.format(count=count)})"
-            if (why := later_defaults(root)):
+            # a cause is stated only where the engine's own words are its symptom (#77), on
+            # the file as Pinocchio reads it: its own text, no <include> followed
+            if CLASS_LOOKUP_FAILED in message and (why := later_defaults(
+                    parsing.root(source.text))):
                 message += f" ({why})"
         raise EngineError(f"pinocchio refused {source.path}: {message}") from None
 

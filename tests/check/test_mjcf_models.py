@@ -753,3 +753,23 @@ def test_drake_is_given_an_stl_mesh_converted_and_compared(tmp_path, asset):
     assert set(read["verdict"]) == {"passed"}, read
     masses = rows[(rows["section"] == "validity") & (rows["impl_a"] == "mujoco")]
     assert not masses.empty
+
+
+def test_a_refusal_names_the_defaults_cause_only_where_pinocchio_s_words_are_its_symptom(
+        tmp_path):
+    """#77: a file with two top-level <default> blocks (class 'b' of the second used) and an
+    <hfield>: Pinocchio refuses it for the height field ("hfields are not supported yet", its
+    own words, measured), not for a class lookup; the defaults' cause, whose symptom is the
+    lookup's "unordered_map::at", is not written beside it."""
+    a = '<default class="a"><joint damping="0.1"/></default>'
+    b = '<default class="b"><joint damping="0.3"/></default>'
+    text = TWO_DEFAULTS.format(defaults=f"<default>{a}</default><default>{b}</default>")
+    text = text.replace("<worldbody>", '<asset><hfield name="h" nrow="2" ncol="2" '
+                        'size="1 1 0.1 0.1"/></asset><worldbody><geom type="hfield" '
+                        'hfield="h"/>')
+    path = tmp_path / "hf.xml"
+    path.write_text(text)
+    rows = check_model(path, states=5, impls=("reference", "mujoco", "pinocchio")).rows
+    load = rows[(rows["section"] == "load") & (rows["impl_a"] == "pinocchio")].iloc[0]
+    assert "hfields are not supported" in load["note"]
+    assert "top-level <default>" not in load["note"]
