@@ -211,6 +211,24 @@ def empty_cache(monkeypatch, tmp_path):
     clear()
 
 @pytest.fixture(autouse=True)
+def signals_kept(request: pytest.FixtureRequest):
+    """A test leaves the process's SIGINT and SIGTERM handlers as it found them: a handler
+    left behind (SIGINT ignored, which every later child process inherits across exec)
+    changed a later test's outcome in CI (#81). The handler is put back, and the leak named in
+    the warnings summary with the test that left it."""
+    import signal
+    import warnings
+
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    yield
+    for sig, handler in before.items():
+        if (left := signal.getsignal(sig)) is not handler:
+            signal.signal(sig, handler)
+            warnings.warn(f"{request.node.nodeid} left {sig.name}'s handler {left!r} "
+                          f"(was {handler!r})", stacklevel=1)
+
+
+@pytest.fixture(autouse=True)
 def cache_on():
     """Every test under the command line's default settings (the disk cache read and
     written, the reference handed its store), as ``dyncheck`` runs: tests call the library
