@@ -46,6 +46,8 @@ class Controls(StrEnum):
     STEPS_AS_EXPLAINED = "reads the controls alike; its step differs only as explained"
     """A computed row explained by a known property of the engine (MJX's Euler damping)."""
     DIFFER = "computes a control's force differently from what it read"
+    DISAGREES = "a control's force differs from another engine's (cause unknown)"
+    """A failed actuation row between two engines that no rule above places on either."""
     NOT_COMPARED = "controls not compared"
     NONE = "holds no actuators"
     """It holds none where another engine holds some (its reading rows say why)."""
@@ -171,9 +173,10 @@ def _agreement(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Agreeme
 def _controls(engine: str, rows: pd.DataFrame) -> tuple[Controls, str]:
     """One rule, in this order: no actuation row of the engine → absent; its actuators read
     differently from the canonical engine's (a failed reading row) → differently; its force
-    or step Jacobian failing against the referee on its own reading → differ; a skipped row
-    (no actuator model) → not compared; read differently as explained → explained; its
-    computed rows explained (a known property of its step) → steps as explained; else alike.
+    or step Jacobian failing against the referee on its own reading → differ; any other
+    failed row of the engine (one between two engines) → disagrees; a skipped row (no
+    actuator model) → not compared; read differently as explained → explained; its computed
+    rows explained (a known property of its step) → steps as explained; else alike.
     An engine holding none where another holds some (its only row) → none."""
     part = rows[(rows["section"] == Section.ACTUATION)
                 & ((rows["impl_a"] == engine) | (rows["impl_b"] == engine))]
@@ -191,6 +194,8 @@ def _controls(engine: str, rows: pd.DataFrame) -> tuple[Controls, str]:
     computed = failed[(failed["impl_a"] == REFEREE) & (failed["field"] == COMPUTED)]
     if not computed.empty:
         return Controls.DIFFER, _first_notes(computed, 1)
+    if not failed.empty:  # (every failed row changes its engines' lines: #77)
+        return Controls.DISAGREES, _first_notes(failed, 1)
     if (part["verdict"] == Verdict.SKIPPED).all():
         return Controls.NOT_COMPARED, _first_notes(part, 1)
     explained = part[(part["verdict"] == Verdict.EXPLAINED) & (part["impl_b"] == engine)]

@@ -154,3 +154,20 @@ def test_an_explained_step_is_not_a_reading_of_the_controls(rows, expected):
     verdict = _by_engine(frame, ("reference", "mujoco", "mjx"))["mjx"]
     assert verdict.controls is expected
 
+
+
+@pytest.mark.parametrize("engine", ["mujoco", "drake"])
+def test_a_failed_row_between_two_engines_changes_both_lines(engine):
+    """#77: a failed actuation row between MuJoCo and Drake (their actuator forces compared
+    with each other, no referee row failing) left both first lines saying "reads the
+    controls alike". Every failed row changes its engines' lines: the rule cannot tell
+    which engine is at fault, so it says the forces differ, cause unknown."""
+    loads = [_row(Section.LOAD, e, "", Verdict.PASSED, subject="model") for e in
+             ("mujoco", "drake")]
+    cross = _row(Section.ACTUATION, "mujoco", "drake", Verdict.FAILED, subject="a1")
+    cross["field"] = COMPUTED
+    frame = _frame(*loads, _actuation(Verdict.PASSED, COMPUTED, "mujoco"),
+                   _actuation(Verdict.PASSED, COMPUTED, "drake"), cross)
+    verdict = _by_engine(frame, ("reference", "mujoco", "drake"))[engine]
+    assert verdict.controls is Controls.DISAGREES
+    assert not verdict.ok
