@@ -19,6 +19,7 @@ import numpy as np
 
 from dyncheck.adapters.actuators import Actuation, Actuator, Transmission
 from dyncheck.adapters.formats.files import ModelFile
+from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.registration import Format
 
 GEAR = (
@@ -90,12 +91,13 @@ def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
         if dropped:
             out.append(("model", "control derivatives",
                         PD_DROPPED.format(count=dropped, total=len(servos))))
+    stated_kv = source.format is Format.MJCF and _states_kv(source)
     for index in plant.GetJointActuatorIndices():
         actuator = plant.get_joint_actuator(index)
         name, gear = actuator.name(), float(actuator.default_gear_ratio())
         if gear != 1.0:
             out.append((name, "gear", GEAR.format(gear=gear)))
-        if actuator.has_controller() and source.format is Format.MJCF:
+        if actuator.has_controller() and stated_kv:  # (its premise: a kv to lose, #77)
             out.append((name, "bias", DAMPING.format(d=actuator.get_controller_gains().d)))
         if np.isfinite(actuator.effort_limit()) and source.format is Format.MJCF:
             out.append((name, "limits", EFFORT.format(limit=actuator.effort_limit())))
@@ -104,6 +106,13 @@ def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
     if ignored:
         out.append(("model", "actuator", IGNORED.format(tags=", ".join(ignored))))
     return tuple(out)
+
+
+def _states_kv(source: ModelFile) -> bool:
+    """Whether the file (its includes inlined) gives any ``<position>`` a nonzero ``kv``,
+    directly or through a default class: the premise of :data:`DAMPING`."""
+    return any(float(e.get("kv", "0") or 0) != 0.0
+               for e in inline(source.path).iter("position"))
 
 
 def actuation(plant: Any, context: Any, *, q: np.ndarray, v: np.ndarray,

@@ -174,7 +174,8 @@ def _controls(engine: str, rows: pd.DataFrame) -> tuple[Controls, str]:
     """One rule, in this order: no actuation row of the engine → absent; its actuators read
     differently from the canonical engine's (a failed reading row) → differently; its force
     or step Jacobian failing against the referee on its own reading → differ; any other
-    failed row of the engine (one between two engines) → disagrees; a skipped row (no
+    failed row of the engine (one between two engines, unless the other engine's failed
+    reading rows place it there) → disagrees; a skipped row (no
     actuator model) → not compared; read differently as explained → explained; its computed
     rows explained (a known property of its step) → steps as explained; else alike.
     An engine holding none where another holds some (its only row) → none."""
@@ -194,8 +195,12 @@ def _controls(engine: str, rows: pd.DataFrame) -> tuple[Controls, str]:
     computed = failed[(failed["impl_a"] == REFEREE) & (failed["field"] == COMPUTED)]
     if not computed.empty:
         return Controls.DIFFER, _first_notes(computed, 1)
-    if not failed.empty:  # (every failed row changes its engines' lines: #77)
-        return Controls.DISAGREES, _first_notes(failed, 1)
+    misread = set(rows[(rows["section"] == Section.ACTUATION)
+                       & (rows["verdict"] == Verdict.FAILED) & (rows["field"] != COMPUTED)
+                       ]["impl_b"])  # (engines a failed reading row places a pair's gap on)
+    unplaced = failed[~((failed["impl_a"] == engine) & failed["impl_b"].isin(misread))]
+    if not unplaced.empty:  # (every other failed row changes its engines' lines: #77)
+        return Controls.DISAGREES, _first_notes(unplaced, 1)
     if (part["verdict"] == Verdict.SKIPPED).all():
         return Controls.NOT_COMPARED, _first_notes(part, 1)
     explained = part[(part["verdict"] == Verdict.EXPLAINED) & (part["impl_b"] == engine)]

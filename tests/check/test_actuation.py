@@ -8,6 +8,7 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
+import mujoco
 import pytest
 
 from dyncheck.adapters.mujoco import actuators as mujoco_actuators
@@ -221,3 +222,28 @@ def test_a_tendons_actuator_is_named_once_not_failed_per_engine(tmp_path):
     assert "t" not in set(rows["subject"])
     assert list(rows[rows["subject"] == "m0"]["verdict"]) == ["passed"]
     assert sum("outside the neutral form" in n and "'t'" in n for n in result.notes) == 1
+
+
+KP_IN_A_PARENT_CLASS = """<mujoco model="kp">
+  <default><default class="arm"><position kp="5" ctrlrange="-1 1"/>
+    <default class="link"><joint damping="0.1"/></default></default></default>
+  <worldbody><body name="a" pos="0 0 1"><joint name="j" class="link" type="hinge" axis="0 1 0"/>
+    <inertial pos="0 0 -0.3" mass="1.5" diaginertia="0.02 0.03 0.01"/></body></worldbody>
+  <actuator><position name="servo" joint="j" class="link"/></actuator></mujoco>"""
+
+
+def test_a_cause_whose_premise_the_file_lacks_is_not_written(tmp_path):
+    """#77: a servo whose kp comes from a parent default class (MuJoCo reads kp = 5, measured
+    by MuJoCo's own biasprm; Drake reads 1) and which states no kv anywhere: Drake's reading
+    of the bias differs, but "the file's kv is lost" is not its cause — the file has none
+    to lose. The row stays failed, without that cause."""
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    path = tmp_path / "kp.xml"
+    path.write_text(KP_IN_A_PARENT_CLASS)
+    assert mujoco.MjModel.from_xml_path(str(path)).actuator_biasprm[0, 1] == -5.0
+    result = check_model(path, impls=("mujoco", "drake", "reference"), states=8)
+    bias = _rows(result, impl_b="drake", verdict="failed")
+    bias = bias[bias["field"] == "bias"]
+    assert len(bias) == 1 and "'kd'" not in bias["note"].iloc[0]
+    drake = next(v for v in per_engine(result.rows, result.impls) if v.engine == "drake")
+    assert drake.controls is Controls.DIFFERENTLY and "'kd'" not in drake.line()

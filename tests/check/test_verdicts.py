@@ -171,3 +171,20 @@ def test_a_failed_row_between_two_engines_changes_both_lines(engine):
     verdict = _by_engine(frame, ("reference", "mujoco", "drake"))[engine]
     assert verdict.controls is Controls.DISAGREES
     assert not verdict.ok
+
+
+def test_a_pair_s_gap_placed_by_a_reading_row_is_not_the_canonical_engine_s():
+    """The same failed pair row, where Drake's reading of the servo's gain failed (a reading
+    row): the gap is Drake's reading, so MuJoCo's line keeps "reads the controls alike" and
+    Drake's says it reads them differently."""
+    loads = [_row(Section.LOAD, e, "", Verdict.PASSED, subject="model") for e in
+             ("mujoco", "drake")]
+    cross = _row(Section.ACTUATION, "mujoco", "drake", Verdict.FAILED, subject="a1")
+    cross["field"] = COMPUTED
+    read = _row(Section.ACTUATION, "mujoco", "drake", Verdict.FAILED, subject="a1")
+    read["field"] = "gain"
+    frame = _frame(*loads, _actuation(Verdict.PASSED, COMPUTED, "mujoco"),
+                   _actuation(Verdict.PASSED, COMPUTED, "drake"), cross, read)
+    verdicts = _by_engine(frame, ("reference", "mujoco", "drake"))
+    assert verdicts["mujoco"].controls is Controls.ALIKE
+    assert verdicts["drake"].controls is Controls.DIFFERENTLY
