@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from dyncheck.adapters.actuators import Actuation, Actuator, Transmission
+from dyncheck.adapters.drake.defaults import class_gain_hints
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.registration import Format
@@ -105,7 +106,7 @@ def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
                       if not t.startswith(("<motor>", "<position>"))})
     if ignored:
         out.append(("model", "actuator", IGNORED.format(tags=", ".join(ignored))))
-    return tuple(out)
+    return (*out, *class_gain_hints(plant, source))
 
 
 def _states_kv(source: ModelFile) -> bool:

@@ -268,7 +268,7 @@ def for_parser(path: Path, engine: str, readable: tuple[str, ...], *,
                      f"given the copy the name {path.stem!r}")
     if not notes and encoding(path) is None:  # a UTF-8 copy is said once, by model_files
         return Copy(text="", notes=())
-    return Copy(text=_standalone(root, folder), notes=tuple(notes))
+    return Copy(text=standalone(root, folder), notes=tuple(notes))
 
 
 def _without_equalities(root: ET.Element, engine: str) -> list[str]:
@@ -356,7 +356,7 @@ def asset_files(root: ET.Element, folder: Path) -> list[tuple[str, Path]]:
     return [(f"<{e.tag} {key}>", path) for e, key, path in _asset_attributes(root, folder)]
 
 
-def _standalone(root: ET.Element, folder: Path) -> str:
+def standalone(root: ET.Element, folder: Path) -> str:
     """The (inlined) model as text whose asset files are absolute paths, so that it reads the
     same from anywhere: the compiler's asset folders folded into them."""
     for element, key, path in _asset_attributes(root, folder):
@@ -392,12 +392,12 @@ def transcoded(declared: str) -> str:
 @contextmanager
 def utf8_file(path: Path) -> Iterator[Path]:
     """The file a parser should be given: the file itself where it is UTF-8; else a UTF-8
-    copy (:func:`_standalone`) in a private temporary folder, removed once the parser is
+    copy (:func:`standalone`) in a private temporary folder, removed once the parser is
     done."""
     if encoding(path) is None:
         yield path
         return
-    text = _standalone(inline(path), path.resolve().parent)
+    text = standalone(inline(path), path.resolve().parent)
     with tempfile.TemporaryDirectory(prefix="dyncheck-mjcf-") as folder:
         copy = Path(folder) / path.name
         copy.write_text(text, encoding="utf-8")

@@ -245,5 +245,23 @@ def test_a_cause_whose_premise_the_file_lacks_is_not_written(tmp_path):
     bias = _rows(result, impl_b="drake", verdict="failed")
     bias = bias[bias["field"] == "bias"]
     assert len(bias) == 1 and "'kd'" not in bias["note"].iloc[0]
+    assert "fix verified: with it, Drake reads kp = 5" in bias["note"].iloc[0]
     drake = next(v for v in per_engine(result.rows, result.impls) if v.engine == "drake")
     assert drake.controls is Controls.DIFFERENTLY and "'kd'" not in drake.line()
+
+
+def test_a_fix_that_does_not_close_the_gap_writes_no_cause(tmp_path, monkeypatch):
+    """The verifier can fail: Drake's parse of the fixed copy replaced by one that still
+    holds kp = 1 (a fix that does not work) — the cause is not written, the row says
+    "cause unknown"."""
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    from dyncheck.adapters.drake import defaults
+
+    monkeypatch.setattr(defaults, "_fixed_gains", lambda *_: {"servo": 1.0})
+    path = tmp_path / "kp.xml"
+    path.write_text(KP_IN_A_PARENT_CLASS)
+    result = check_model(path, impls=("mujoco", "drake", "reference"), states=8,
+                         isolate=False)
+    bias = _rows(result, impl_b="drake", verdict="failed")
+    note = bias[bias["field"] == "bias"]["note"].iloc[0]
+    assert note == "cause unknown"
