@@ -13,6 +13,7 @@ position servo's control is its target q_d (v_d = 0, no feed-forward).
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from typing import Any
 
 import numpy as np
@@ -92,7 +93,8 @@ def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
         if dropped:
             out.append(("model", "control derivatives",
                         PD_DROPPED.format(count=dropped, total=len(servos))))
-    stated_kv = source.format is Format.MJCF and _states_kv(source)
+    root = inline(source.path) if source.format is Format.MJCF else None
+    stated_kv = root is not None and _states_kv(root)
     for index in plant.GetJointActuatorIndices():
         actuator = plant.get_joint_actuator(index)
         name, gear = actuator.name(), float(actuator.default_gear_ratio())
@@ -106,14 +108,13 @@ def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
                       if not t.startswith(("<motor>", "<position>"))})
     if ignored:
         out.append(("model", "actuator", IGNORED.format(tags=", ".join(ignored))))
-    return (*out, *class_gain_hints(plant, source))
+    return (*out, *(class_gain_hints(plant, source, root) if root is not None else ()))
 
 
-def _states_kv(source: ModelFile) -> bool:
-    """Whether the file (its includes inlined) gives any ``<position>`` a nonzero ``kv``,
-    directly or through a default class: the premise of :data:`DAMPING`."""
-    return any(float(e.get("kv", "0") or 0) != 0.0
-               for e in inline(source.path).iter("position"))
+def _states_kv(root: ET.Element) -> bool:
+    """Whether the file (``root``: its includes inlined) gives any ``<position>`` a nonzero
+    ``kv``, directly or through a default class: the premise of :data:`DAMPING`."""
+    return any(float(e.get("kv", "0") or 0) != 0.0 for e in root.iter("position"))
 
 
 def actuation(plant: Any, context: Any, *, q: np.ndarray, v: np.ndarray,

@@ -14,9 +14,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import standalone
-from dyncheck.adapters.registration import Format
 
 CLASS_GAINS = (
     "Drake's MJCF parser takes a <position>'s defaults only from a class with a <position> "
@@ -83,14 +81,12 @@ def _fixed_gains(source: ModelFile, root: ET.Element, found: list[Orphan]) -> di
     return out
 
 
-def class_gain_hints(plant: Any, source: ModelFile) -> tuple[tuple[str, str, str], ...]:
-    """(actuator, field, why) for each :func:`orphans` actuator whose kp Drake holds
-    otherwise, where the fix, applied to a copy and parsed by Drake, gives MuJoCo's kp; none
-    where the copy fails to load or the fix does not close the gap (cause unknown), or the
-    file is not an MJCF."""
-    if source.format is not Format.MJCF:
-        return ()
-    root = inline(source.path)
+def class_gain_hints(plant: Any, source: ModelFile,
+                     root: ET.Element) -> tuple[tuple[str, str, str], ...]:
+    """(actuator, field, why) for each :func:`orphans` actuator of the MJCF ``source``
+    (``root``: its includes inlined) whose kp Drake holds otherwise, where the fix, applied to
+    a copy and parsed by Drake, gives MuJoCo's kp; none where the copy fails to load or the
+    fix does not close the gap (cause unknown)."""
     found = orphans(root)
     held = {plant.get_joint_actuator(i).name(): plant.get_joint_actuator(i)
             for i in plant.GetJointActuatorIndices()}

@@ -29,10 +29,17 @@ def compiler(root: ET.Element, key: str, default: str) -> str:
 ASSET_DIRS = {"mesh": "meshdir", "skin": "meshdir", "hfield": "meshdir",
               "texture": "texturedir"}
 """The compiler attribute each asset's file is relative to (``assetdir`` where it is absent)."""
+ASSET_TAGS = (*ASSET_DIRS, "model")
+"""The elements that name a file: the assets, and a model to attach."""
+FILE_KEYS = ("file", "fileright", "fileleft", "fileup", "filedown", "filefront", "fileback")
+"""The attributes that name a file on an asset (a cube texture names one per face)."""
 
 
-def asset_file(root: ET.Element, folder: Path, element: ET.Element) -> Path | None:
-    file = element.get("file")
+def asset_file(root: ET.Element, folder: Path, element: ET.Element,
+               key: str = "file") -> Path | None:
+    """The absolute path of the file ``element``'s ``key`` names, relative to ``folder`` and
+    the compiler's asset folders; None where it names none."""
+    file = element.get(key)
     if not file:
         return None
     base = compiler(root, ASSET_DIRS.get(element.tag, "assetdir"),

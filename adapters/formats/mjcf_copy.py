@@ -22,7 +22,13 @@ from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
 
-from dyncheck.adapters.formats.includes import ASSET_DIRS, asset_file, compiler, inline
+from dyncheck.adapters.formats.includes import (
+    ASSET_TAGS,
+    FILE_KEYS,
+    asset_file,
+    compiler,
+    inline,
+)
 from dyncheck.errors import Unsupported
 
 
@@ -330,25 +336,13 @@ def _without_massless(root: ET.Element, engine: str) -> list[str]:
             "unchanged"]
 
 
-TEXTURE_FILES = ("file", "fileright", "fileleft", "fileup", "filedown", "filefront",
-                 "fileback")
-"""The attributes that name a file on an asset (a cube texture names one per face)."""
-
-
 def _asset_attributes(root: ET.Element, folder: Path
                       ) -> list[tuple[ET.Element, str, Path]]:
     """Every file attribute of the (inlined) model's assets — meshes, skins, height fields,
     textures (each face of a cube), attached models — with the absolute path MuJoCo resolves
     it to (the compiler's asset folders)."""
-    out = []
-    for element in root.iter():
-        if element.tag not in (*ASSET_DIRS, "model"):
-            continue
-        base = compiler(root, ASSET_DIRS.get(element.tag, "assetdir"),
-                         compiler(root, "assetdir", ""))
-        out += [(element, key, (folder / base / file).resolve()) for key in TEXTURE_FILES
-                if (file := element.get(key))]
-    return out
+    return [(element, key, path) for element in root.iter() if element.tag in ASSET_TAGS
+            for key in FILE_KEYS if (path := asset_file(root, folder, element, key))]
 
 
 def asset_files(root: ET.Element, folder: Path) -> list[tuple[str, Path]]:
