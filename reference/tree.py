@@ -131,6 +131,8 @@ class Tree:
         ]
 
 
+_Pose = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+"""A body on its rows: R, t, Ω, V (see :meth:`TreeDynamics._walk`)."""
 _Column = tuple[slice, np.ndarray, "np.ndarray | None"]
 """A joint's velocity columns on each row: their span in v, the columns (angular or linear),
 and the pivot of angular ones (None: linear)."""
@@ -150,6 +152,22 @@ class _Sums:
     linear0: np.ndarray
     momentum: np.ndarray
     spin_sum: np.ndarray
+
+
+@dataclass(frozen=True, kw_only=True)
+class PointMotion:
+    """A body point at S states: its position x (S, 3); the rows J_x = ∂ẋ/∂v and J_ω = ∂ω/∂v
+    (S, 3, nv) of its velocity and of its body's angular velocity (world axes); and their
+    accelerations at v̇ = 0, J̇_x v and J̇_ω v (S, 3) — exact: the velocity along the path
+    q ⊕ s v (v held, which keeps v̇ = 0 on every chart) differentiated by the complex step."""
+
+    position: np.ndarray
+    rotation: np.ndarray
+    """A_b (S, 3, 3): the body's rotation from the reference configuration."""
+    linear: np.ndarray
+    angular: np.ndarray
+    linear_bias: np.ndarray
+    angular_bias: np.ndarray
 
 
 class TreeDynamics(Tree):
@@ -178,6 +196,43 @@ class TreeDynamics(Tree):
             return np.empty((0, nv, nv)), np.empty((0, nv)), np.empty(0), np.empty(0)
         mass, h, kinetic, potential = (np.concatenate(x) for x in zip(*parts, strict=True))
         return mass, h, kinetic, potential
+
+    def point_motion(self, q: np.ndarray, v: np.ndarray, *, body: int,
+                     point: np.ndarray) -> PointMotion:
+        """A point fixed on joint ``body``'s body (world coordinates at the reference
+        configuration; −1: fixed in the world) at S states: where it is, and its and the
+        body's rows of velocity and of acceleration at v̇ = 0 (what the closures of
+        :mod:`.closure` are made of)."""
+        q, v = np.atleast_2d(np.asarray(q, float)), np.atleast_2d(np.asarray(v, float))
+        ns, nv = len(q), self.nv
+        zeros = np.zeros((ns, 3, nv))
+        if body < 0:
+            fixed = np.broadcast_to(np.asarray(point, float), (ns, 3)).copy()
+            return PointMotion(position=fixed, rotation=np.tile(np.eye(3), (ns, 1, 1)),
+                               linear=zeros, angular=zeros.copy(),
+                               linear_bias=np.zeros((ns, 3)), angular_bias=np.zeros((ns, 3)))
+        poses, columns_of = self._walk(q, v)
+        rot, trans, omega, vel = poses[body]
+        n = len(self.ancestor_columns[body])
+        x = np.einsum("srij,j->sri", rot, np.asarray(point, float)) + trans
+        x0 = x[:, -1].real
+        linear, angular = zeros, zeros.copy()
+        chain = [body]
+        while self.bodies[chain[-1]].parent >= 0:
+            chain.append(self.bodies[chain[-1]].parent)
+        for j in chain:
+            for part, w, pivot in columns_of[j]:
+                w0 = w[:, -1].real
+                if pivot is None:
+                    linear[..., part] = w0
+                else:
+                    angular[..., part] = w0
+                    linear[..., part] = np.cross(w0, (x0 - pivot[:, -1].real)[..., None],
+                                                 axis=1)
+        moving = vel[:, n] + np.cross(omega[:, n], x[:, n])  # ẋ along q ⊕ iη v
+        return PointMotion(position=x0, rotation=rot[:, -1].real.copy(), linear=linear,
+                           angular=angular,
+                           linear_bias=moving.imag / STEP, angular_bias=omega[:, n].imag / STEP)
 
     def _rows(self) -> None:
         """Each body's rows of complex steps: one per ancestor column (that column stepped),
@@ -236,6 +291,41 @@ class TreeDynamics(Tree):
                        (slice(vs + 3, vs + 6), world @ jr, position)]
         return rot, trans, columns
 
+    def _walk(self, q: np.ndarray, v: np.ndarray
+              ) -> tuple[list[_Pose], list[list[_Column]]]:
+        """Each joint's body on its rows (:meth:`_rows`): its pose (R, t), its twist (Ω, V:
+        the angular velocity and the velocity of the body point at the world origin), and
+        its joint's velocity columns, from the root outward."""
+        ns = len(q)
+        step = 1j * STEP
+        poses: list[_Pose] = []
+        columns_of: list[list[_Column]] = []
+        for j, body in enumerate(self.bodies):
+            n, own = len(self.ancestor_columns[j]), NV[body.kind]
+            qs, vs = int(self.q_start[j]), int(self.v_start[j])
+            xj = np.zeros((ns, n + 2, own), complex)  # this joint's chart coordinates
+            xj[:, np.arange(n - own, n), np.arange(own)] = step
+            xj[:, n, :] = step * v[:, vs : vs + own]
+            if body.parent >= 0:
+                up = self.rows_of[j][body.parent]
+                rp, tp, omega, vel = (x[:, up] for x in poses[body.parent])
+            else:
+                rp = np.broadcast_to(np.eye(3), (ns, n + 2, 3, 3))
+                tp = np.zeros((ns, n + 2, 3))
+                omega = vel = np.zeros((ns, n + 2, 3), complex)
+            rot, trans, columns = self._moved(body, q, xj, parent=(rp, tp), qs=qs, vs=vs,
+                                              own=own)
+            for part, w, point in columns:  # the twist: the parent's plus this joint's
+                turn = np.einsum("srik,sk->sri", w, v[:, part])
+                if point is None:
+                    vel = vel + turn
+                else:
+                    omega = omega + turn
+                    vel = vel + np.cross(point, turn)
+            poses.append((rot, trans, omega, vel))
+            columns_of.append(columns)
+        return poses, columns_of
+
     def _at_chunk(
         self, q: np.ndarray, v: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -262,44 +352,22 @@ class TreeDynamics(Tree):
             linear0=np.zeros((ns, 3, nv)),
             momentum=np.zeros((nb, ns, 3), complex),  # P of the subtree, at the v row
             spin_sum=np.zeros((nb, ns, 3), complex))  # L about the origin, at the v row
-        step = 1j * STEP
-        poses: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []  # R t Ω V
-        # per joint, at its v row (complex) and its unperturbed row (real): columns as
-        # (angular (S, 3, k), pivot (S, 3)) or (linear (S, 3, k), None), with their span
+        poses, columns_of = self._walk(q, v)
+        # per joint, at its v row (complex): columns as (angular (S, 3, k), pivot (S, 3)) or
+        # (linear (S, 3, k), None), with their span
         at_v: list[list[tuple[slice, np.ndarray, np.ndarray | None]]] = []
-        for j, body in enumerate(self.bodies):
-            cols = self.ancestor_columns[j]
-            n, own = len(cols), NV[body.kind]
-            qs, vs = int(self.q_start[j]), int(self.v_start[j])
-            vj = v[:, vs : vs + own]
-            xj = np.zeros((ns, n + 2, own), complex)  # this joint's chart coordinates
-            xj[:, np.arange(n - own, n), np.arange(own)] = step
-            xj[:, n, :] = step * vj
-            if body.parent >= 0:
-                up = self.rows_of[j][body.parent]
-                rp, tp, omega, vel = (x[:, up] for x in poses[body.parent])
-            else:
-                rp = np.broadcast_to(np.eye(3), (ns, n + 2, 3, 3))
-                tp = np.zeros((ns, n + 2, 3))
-                omega = vel = np.zeros((ns, n + 2, 3), complex)
-            rot, trans, columns = self._moved(body, q, xj, parent=(rp, tp), qs=qs, vs=vs,
-                                              own=own)
-            for part, w, point in columns:  # the twist: the parent's plus this joint's
-                turn = np.einsum("srik,sk->sri", w, v[:, part])
-                if point is None:
-                    vel = vel + turn
-                else:
-                    omega = omega + turn
-                    vel = vel + np.cross(point, turn)
+        for j, columns in enumerate(columns_of):
+            n = len(self.ancestor_columns[j])
+            for part, w, point in columns:  # the joints' real columns (unperturbed row)
                 sums.angular0[..., part] = w[:, -1].real if point is not None else 0.0
                 sums.linear0[..., part] = w[:, -1].real if point is None else 0.0
                 if point is not None:
                     sums.pivot0[..., part] = point[:, -1, :, None].real
             at_v.append([(part, w[:, n], None if point is None else point[:, n])
                          for part, w, point in columns])
-            poses.append((rot, trans, omega, vel))
+        for j, body in enumerate(self.bodies):
             if body.mass != 0.0 or np.any(body.inertia):
-                self._add_body(j, body, sums, pose=(rot, trans, omega, vel), n=n)
+                self._add_body(j, body, sums, pose=poses[j], n=len(self.ancestor_columns[j]))
         self._inward(sums, at_v)
         kinetic = 0.5 * np.einsum("si,sij,sj->s", v, sums.mass, v)
         return sums.mass, sums.h, kinetic, sums.potential
