@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from dyncheck.adapters.actuators import Actuator
+from dyncheck.adapters.closures import Closure
 from dyncheck.vocabulary import JointType, Quantity
 
 
@@ -220,6 +221,9 @@ class ModelTree:
     """Its actuators (:mod:`dyncheck.adapters.actuators`), in the order of its control
     vector; none where it holds none, or holds no actuator model at all (its class does not
     offer :attr:`~dyncheck.adapters.base.Offer.ACTUATION`)."""
+    closures: tuple[Closure, ...] = ()
+    """The constraints that close its tree, as it holds them
+    (:mod:`dyncheck.adapters.closures`); none where it holds none or states none."""
     exact_meshes: ModelTree | None = None
     """The engine's reading with every mesh's volume and inertia computed exactly (MuJoCo:
     ``inertia="exact"`` instead of its default ``"legacy"``, which overcounts a non-convex

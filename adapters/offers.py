@@ -42,6 +42,9 @@ class Offer(StrEnum):
     """``couple(couplings)``: a book case's couplings (linear equalities between joints) as
     the engine's own constraints, which its forward dynamics and stepping then hold, and
     ``constraint_forces(q, v, τ)`` their multipliers."""
+    CLOSURES = "closed"
+    """``closed(q, v, τ)``: its own rows and constrained forward dynamics on the constraints
+    its tree's ``closures`` hold (:class:`~.closures.ClosedReading`)."""
     BODY_FORCES = "body_forces"
     """``body_forces(q, v, field)``: the generalized force of forces at bodies' centres of
     mass (a :data:`Field`), its own (its Jacobians or its solver's sum); and

@@ -164,3 +164,70 @@ def forward(tree: TreeDynamics, closures: list[Closure] | tuple[Closure, ...], q
     held = rows(tree, closures, q, v)
     return [way(mass[s], bias[s], tau[s], J=held.jacobian[s], jdot_v=held.bias[s])
             for s in range(len(q))]
+
+
+def _quat_step(quat: np.ndarray, xi: np.ndarray) -> np.ndarray:
+    """quat ⊗ exp(ξ/2) (w, x, y, z): the rotation R exp(ξ̂), ξ in the body's axes."""
+    angle = np.linalg.norm(xi)
+    half = np.concatenate([[np.cos(angle / 2)],
+                           xi * (np.sinc(angle / (2 * np.pi)) / 2)])  # sin(θ/2)/θ · ξ
+    w1, v1, w2, v2 = quat[0], quat[1:], half[0], half[1:]
+    out = np.concatenate([[w1 * w2 - v1 @ v2], w1 * v2 + w2 * v1 + np.cross(v1, v2)])
+    return out / np.linalg.norm(out)
+
+
+def retract(tree: TreeDynamics, q: np.ndarray, dv: np.ndarray) -> np.ndarray:
+    """q ⊕ dv on the tree's charts: hinges and slides add, a ball turns by exp(dξ) in its
+    axes, a free body moves by its world displacement and turns likewise (MuJoCo's layout)."""
+    out = np.array(q, float)
+    for j, body in enumerate(tree.bodies):
+        qs, vs = int(tree.q_start[j]), int(tree.v_start[j])
+        if body.kind in ("hinge", "slide"):
+            out[qs] += dv[vs]
+        elif body.kind == "ball":
+            out[qs : qs + 4] = _quat_step(out[qs : qs + 4], dv[vs : vs + 3])
+        else:
+            out[qs : qs + 3] += dv[vs : vs + 3]
+            out[qs + 3 : qs + 7] = _quat_step(out[qs + 3 : qs + 7], dv[vs + 3 : vs + 6])
+    return out
+
+
+@dataclass(frozen=True, kw_only=True)
+class Projected:
+    """A state moved onto the constraints: q with C(q) = 0 and v in J's null space, how
+    far it is from them (|C|, |J v|, largest entries), and whether Newton's method
+    converged."""
+
+    q: np.ndarray
+    v: np.ndarray
+    residual: float
+    rate: float
+    converged: bool
+
+
+PROJECTION_STEPS = 50
+"""Newton's iterations before a draw is dropped (quadratic convergence: a draw that takes
+more is near a singular configuration, or off every solution)."""
+
+
+def project(tree: TreeDynamics, closures: list[Closure] | tuple[Closure, ...], q: np.ndarray,
+            v: np.ndarray, *, tol: float) -> Projected:
+    """Newton's method on C(q) = 0 from the draw q (the least-norm step −J⁺ C on the charts,
+    :func:`retract`), then v projected on J's null space: the admissible state nearest the
+    draw's velocity. ``tol``: the largest |C| accepted (lengths in the file's units)."""
+    q, v = np.array(q, float), np.array(v, float)
+    last = np.inf
+    for _ in range(PROJECTION_STEPS):
+        held = rows(tree, closures, q[None], v[None])
+        value, jac = held.value[0], held.jacobian[0]
+        size = float(np.abs(value).max(initial=0.0))
+        if size <= tol and size >= last / 2:  # (within tol and no longer shrinking)
+            break
+        last = size
+        q = retract(tree, q, -np.linalg.lstsq(jac, value, rcond=None)[0])
+    held = rows(tree, closures, q[None], v[None])
+    jac = held.jacobian[0]
+    v = v - np.linalg.pinv(jac) @ (jac @ v) if jac.size else v
+    residual = float(np.abs(held.value[0]).max(initial=0.0))
+    rate = float(np.abs(jac @ v).max(initial=0.0))
+    return Projected(q=q, v=v, residual=residual, rate=rate, converged=residual <= tol)

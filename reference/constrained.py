@@ -86,3 +86,21 @@ def inconsistent(J: np.ndarray, jdot_v: np.ndarray, *, atol: float) -> list[int]
     u, _, _, rank = _svd(J)
     outside = jdot_v - u[:, :rank] @ (u[:, :rank].T @ jdot_v)
     return [int(i) for i in np.flatnonzero(np.abs(outside) > atol)]
+
+
+def soft(M: np.ndarray, h: np.ndarray, tau: np.ndarray, *, J: np.ndarray, a_ref: np.ndarray,
+         regularizer: np.ndarray) -> Closed:
+    """MuJoCo's documented soft constraints (Computation chapter, "Soft constraints"; the
+    parameters of :class:`~.constraints.Softness`): with a₀ = M⁻¹ (τ − h) and A = J M⁻¹ Jᵀ,
+
+        f = −(A + R)⁻¹ (J a₀ − a_ref),   v̇ = a₀ + M⁻¹ Jᵀ f,
+
+    i.e. J v̇ = a_ref − R f: the rows' acceleration is J v̇ — no J̇ v — pulled toward a_ref
+    and yielding by R f. ``regularizer`` R's diagonal (m,)."""
+    a0 = np.linalg.solve(M, tau - h)
+    minv_jt = np.linalg.solve(M, J.T)
+    f = -np.linalg.solve(J @ minv_jt + np.diag(regularizer), J @ a0 - a_ref) if J.size else \
+        np.zeros(0)
+    vdot = a0 + minv_jt @ f
+    return Closed(vdot=vdot, force=J.T @ f, rank=_svd(J)[3] if J.size else 0,
+                  residual=float(np.abs(J @ vdot - a_ref + regularizer * f).max(initial=0.0)))

@@ -70,6 +70,27 @@ velocities were summed as if in one tangent space: order 2 there (measured by th
 matrix, ``reports/versions.md``)."""
 
 
+def _jdotv_in_reference() -> bool:
+    """Probe: a point 1 m out on a hinge turning at 1 rad/s, held by a connect where it is:
+    MuJoCo's ``efc_aref`` of the radial row is −J̇ v = ω² r = 1 where the term is held, 0
+    where not (the row's position and velocity are 0)."""
+    xml = """<mujoco><worldbody><body name="arm"><joint type="hinge" axis="0 0 1"/>
+<geom size=".1" mass="1"/></body></worldbody>
+<equality><connect body1="arm" anchor="1 0 0"/></equality></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    d.qvel[:] = 1.0
+    mujoco.mj_forward(m, d)
+    return bool(d.efc_aref[0] > 0.5)
+
+
+JDOTV_IN_REFERENCE = _jdotv_in_reference()
+"""MuJoCo's reference acceleration of a connect's and a weld's rows holds −J̇ v (commit
+412cee2, "Added the centripetal/Coriolis acceleration term J̇v to the constraint solver bias
+for connect and weld", in 4.0.0; a joint's or tendon's coupling still omits it); before, no
+row held it — probed, not read from the version."""
+
+
 @contextmanager
 def mujoco_warnings() -> Iterator[list[str]]:
     """MuJoCo's warnings while the block runs, kept in the yielded list (whitespace

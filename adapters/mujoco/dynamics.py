@@ -47,3 +47,35 @@ def evaluate(m: mujoco.MjModel, d: mujoco.MjData, *, q: np.ndarray, v: np.ndarra
         inv[k] = qinv
     return Evaluated(mass=mass, bias=bias, forward=fwd, inverse=inv, kinetic=energy[:, 1],
                      potential=energy[:, 0])
+
+
+def step_differences(m: mujoco.MjModel, d: mujoco.MjData, q: np.ndarray, v: np.ndarray,
+                      step: float) -> np.ndarray:
+    """∂x₊/∂x of one ``mj_step`` from (q, v) by centered differences of ``step`` in MuJoCo's
+    chart — q nudged by ``mj_integratePos``, q₊ compared by ``mj_differentiatePos`` —, the
+    scheme of ``mjd_transitionFD`` (``engine_derivative_fd.c``), for a step it refuses."""
+    nv = m.nv
+
+    def stepped(nudge: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        d.qpos[:] = q
+        mujoco.mj_integratePos(m, d.qpos, nudge[:nv], 1.0)
+        d.qvel[:] = v + nudge[nv:]
+        d.qfrc_applied[:] = 0.0
+        d.ctrl[:] = 0.0
+        d.time = 0.0
+        mujoco.mj_step(m, d)
+        return d.qpos.copy(), d.qvel.copy()
+
+    centre, _ = stepped(np.zeros(2 * nv))
+    out = np.zeros((2 * nv, 2 * nv))
+    tangent = np.zeros(nv)
+    for k in range(2 * nv):
+        nudge = np.zeros(2 * nv)
+        nudge[k] = step
+        ends = []
+        for sign in (1.0, -1.0):
+            q_next, v_next = stepped(sign * nudge)
+            mujoco.mj_differentiatePos(m, tangent, 1.0, centre, q_next)
+            ends.append(np.concatenate([tangent, v_next]))
+        out[:, k] = (ends[0] - ends[1]) / (2 * step)
+    return out

@@ -20,6 +20,7 @@ import mujoco
 import numpy as np
 
 from dyncheck.adapters.base import ModelEngine, Offer
+from dyncheck.adapters.closures import ClosedReading
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
@@ -40,7 +41,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
-from dyncheck.adapters.mujoco import actuators
+from dyncheck.adapters.mujoco import actuators, closures
 from dyncheck.adapters.mujoco.actuators import MujocoActuation
 from dyncheck.adapters.mujoco.api import (
     GYROSCOPIC_IMPLICIT,
@@ -50,7 +51,7 @@ from dyncheck.adapters.mujoco.api import (
     full_inertia,
     mujoco_warnings,
 )
-from dyncheck.adapters.mujoco.dynamics import evaluate
+from dyncheck.adapters.mujoco.dynamics import evaluate, step_differences
 from dyncheck.adapters.mujoco.meshes import TEXT_MESHES, mesh_rounding
 from dyncheck.adapters.mujoco.simulation import MujocoRun
 from dyncheck.adapters.registration import Format
@@ -204,7 +205,7 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
     fd_step = FD_STEP
     offers = frozenset({Offer.DERIVATIVES, Offer.TRANSITION, Offer.ACTUATION,
                         Offer.INPUT_JACOBIAN, Offer.FORWARD, Offer.STEPPING, Offer.COUPLINGS,
-                        Offer.BODY_FORCES})
+                        Offer.BODY_FORCES, Offer.CLOSURES})
     gyroscopic_implicit = GYROSCOPIC_IMPLICIT
     rk4_group_order = 4 if RK4_ON_GROUP else 2
     couplings_with_field = True  # tendon equalities and a field in one model
@@ -308,18 +309,24 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
                     layout=layouts[j],
                 )
             )
+        held, unheld = closures.read(m, d, [_joint_name(m, j) for j in range(m.njnt)])
         rounding = mesh_rounding(m, self._inertias.from_geoms, self._inertias.text_meshes)
         by_joint = {j.name: max(rounding.get(b, 0.0) for b in groups[int(m.jnt_bodyid[k])])
                     for k, j in enumerate(joints)}
         return ModelTree(
             engine=ENGINE, joints=tuple(joints), gravity=self._gravity.copy(),
-            nq=m.nq, nv=m.nv, notes=notes, hints=self._hints,
+            nq=m.nq, nv=m.nv, notes=notes + unheld, hints=self._hints, closures=held,
             actuators=actuators.read(m, [_joint_name(m, j) for j in range(m.njnt)]),
             mesh_rounding={name: bound for name, bound in by_joint.items() if bound > 0},
         )
 
     def reference_q(self) -> np.ndarray:
         return self.model.qpos0.copy()
+
+    def closed(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> ClosedReading:
+        """Its equalities' rows and its forward dynamics with them on (:func:`.closures.
+        closed`)."""
+        return closures.closed(self.model, q, v, tau)
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
         e = evaluate(self.model, self.data, q=q, v=v, tau=np.zeros_like(v), a=a)
@@ -374,7 +381,7 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
         step at the file's time step, at steps :data:`FD_STEP` and twice that, for the
         semi-implicit Euler and implicitfast integrators, and the same differences of RK4's
         step, which ``mjd_transitionFD`` refuses ("RK4 integrator is not supported", MuJoCo
-        4.0): :func:`_step_differences` (the smooth dynamics only, as everywhere in the
+        4.0): :func:`.dynamics.step_differences` (the smooth dynamics only, as everywhere in the
         check: no damping, no actuation, so implicitfast's implicit term (M − h ∂f/∂v with
         f's passive and actuator forces) is M, and its step Euler's — but on a standalone
         free body, whose block holds the bias's derivative: ``Transition.implicit_bias``)."""
@@ -399,7 +406,7 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
                         d.qfrc_applied[:] = 0.0
                         d.ctrl[:] = 0.0
                         if name is Integrator.RK4:
-                            found[i] = _step_differences(m, d, q[i], v[i], step)
+                            found[i] = step_differences(m, d, q[i], v[i], step)
                             continue
                         mujoco.mj_forward(m, d)
                         mujoco.mjd_transitionFD(m, d, step, True, matrix, None, None, None)
@@ -451,38 +458,6 @@ def _standalone_free(m: mujoco.MjModel) -> tuple[str, ...]:
                 and m.body_subtreemass[body] == m.body_mass[body]):
             out.append(_joint_name(m, j))
     return tuple(out)
-
-
-def _step_differences(m: mujoco.MjModel, d: mujoco.MjData, q: np.ndarray, v: np.ndarray,
-                      step: float) -> np.ndarray:
-    """∂x₊/∂x of one ``mj_step`` from (q, v) by centered differences of ``step`` in MuJoCo's
-    chart — q nudged by ``mj_integratePos``, q₊ compared by ``mj_differentiatePos`` —, the
-    scheme of ``mjd_transitionFD`` (``engine_derivative_fd.c``), for a step it refuses."""
-    nv = m.nv
-
-    def stepped(nudge: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        d.qpos[:] = q
-        mujoco.mj_integratePos(m, d.qpos, nudge[:nv], 1.0)
-        d.qvel[:] = v + nudge[nv:]
-        d.qfrc_applied[:] = 0.0
-        d.ctrl[:] = 0.0
-        d.time = 0.0
-        mujoco.mj_step(m, d)
-        return d.qpos.copy(), d.qvel.copy()
-
-    centre, _ = stepped(np.zeros(2 * nv))
-    out = np.zeros((2 * nv, 2 * nv))
-    tangent = np.zeros(nv)
-    for k in range(2 * nv):
-        nudge = np.zeros(2 * nv)
-        nudge[k] = step
-        ends = []
-        for sign in (1.0, -1.0):
-            q_next, v_next = stepped(sign * nudge)
-            mujoco.mj_differentiatePos(m, tangent, 1.0, centre, q_next)
-            ends.append(np.concatenate([tangent, v_next]))
-        out[:, k] = (ends[0] - ends[1]) / (2 * step)
-    return out
 
 
 def _joint_name(m: mujoco.MjModel, j: int) -> str:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dyncheck.reference.closure import Connect, Coupling, Weld, forward, rows
+from dyncheck.reference.closure import Connect, Coupling, Weld, forward, project, rows
 from dyncheck.reference.constrained import multipliers, reduced
 from dyncheck.reference.tree import Body, TreeDynamics
 
@@ -182,3 +182,33 @@ def test_the_two_ways_agree_on_a_four_bar_anywhere(seed):
     two = forward(tree, held, q, v, tau=tau, way=multipliers)[0]
     np.testing.assert_allclose(one.vdot, two.vdot, atol=1e-11)
     np.testing.assert_allclose(one.force, two.force, atol=1e-11)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_draw_projected_onto_the_four_bar_closes_it(seed):
+    """From a random draw of the three angles, Newton's method reaches C = 0 (|C| ≤ 1e-12
+    m) with v in J's null space, and the state is one of the parallelogram's: by hand, the
+    crank and rocker then turn alike and the coupler's hinge by the opposite angle
+    (q = (φ, −φ, φ), v = (φ̇, −φ̇, φ̇)), unless the draw fell in the crossed branch."""
+    tree, held = _four_bar(0.5, 0.8, (1.2, 0.9, 0.7))
+    rng = np.random.default_rng(seed)
+    q, v = rng.uniform(-0.6, 0.6, 3), rng.normal(size=3)
+    out = project(tree, held, q, v, tol=1e-12)
+    assert out.converged and out.residual <= 1e-12 and out.rate <= 1e-12
+    np.testing.assert_allclose(out.q[1], -out.q[0], atol=1e-10)
+    np.testing.assert_allclose(out.q[2], out.q[0], atol=1e-10)
+    np.testing.assert_allclose(out.v, out.v[0] * np.array([1, -1, 1]), atol=1e-10)
+
+
+def test_a_free_body_projected_onto_a_weld_lands_on_its_pose():
+    """A free body welded to the world at its reference pose: from a draw moved and turned,
+    the projection returns the reference pose (the weld's only solution near it), v = 0."""
+    tree = TreeDynamics([_body("free", -1)], np.array([0.0, 0.0, -G]))
+    point = np.zeros(3)
+    held = [Weld(body1=0, body2=-1, point1=point, point2=point, held=np.eye(3))]
+    turned = np.array([0.9, 0.2, -0.3, 0.1])
+    q = np.array([0.1, -0.05, 0.2, *(turned / np.linalg.norm(turned))])
+    out = project(tree, held, q, np.ones(6), tol=1e-12)
+    assert out.converged
+    np.testing.assert_allclose(out.q, [0, 0, 0, 1, 0, 0, 0], atol=1e-10)
+    np.testing.assert_allclose(out.v, 0.0, atol=1e-12)

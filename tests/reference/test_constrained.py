@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dyncheck.reference.constrained import inconsistent, multipliers, reduced
+from dyncheck.reference.constrained import inconsistent, multipliers, reduced, soft
 
 WAYS = [reduced, multipliers]
 G = 9.81
@@ -90,3 +90,18 @@ def test_the_two_ways_agree_on_any_tree(seed):
     np.testing.assert_allclose(a.force, b.force, atol=bound * np.abs(M).max())
     assert a.residual < bound and b.residual < bound
     assert a.rank == b.rank == k
+
+
+def test_the_soft_model_is_the_rigid_one_as_r_vanishes_and_mixes_with_the_free_one():
+    """The Atwood machine at rest (J̇ v = 0, a_ref = 0): by hand, with A = 1/m₁ + 1/m₂ and
+    R = (1 − d)/d · A (MuJoCo's regularizer at impedance d), f = −d (J a₀)/A, so
+    v̇ = a_rigid + (1 − d)(a₀ − a_rigid), a₀ = (g, g) the free fall; d = 1 is the rigid."""
+    m1, m2 = 3.0, 1.0
+    M, h, J = np.diag([m1, m2]), -G * np.array([m1, m2]), np.array([[1.0, 1.0]])
+    rigid = multipliers(M, h, np.zeros(2), J=J, jdot_v=np.zeros(1)).vdot
+    a = 1 / m1 + 1 / m2
+    for d in (0.9, 0.99, 1.0):
+        found = soft(M, h, np.zeros(2), J=J, a_ref=np.zeros(1),
+                     regularizer=np.array([(1 - d) / d * a]))
+        np.testing.assert_allclose(found.vdot, rigid + (1 - d) * (np.full(2, G) - rigid),
+                                   atol=1e-13)

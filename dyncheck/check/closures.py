@@ -1,0 +1,266 @@
+"""A model's closures checked (#78): the constraints that close its tree, as the canonical
+engine reads them, put to the referee — the tree's Lagrange equations with constraints,
+(2.2.23)–(2.2.26), two ways (:mod:`dyncheck.reference.constrained`) — at states moved onto
+the constraints (:func:`~dyncheck.reference.closure.project`), and an engine's own answer
+on them measured against it:
+
+- its rows: C and J of each constraint against the referee's (a connect's, a coupling's and
+  a weld's position rows are the same functions; a weld's rotation rows are ½ · scale ·
+  (ω₁ − ω₂) in body 1's axes in MuJoCo, so their row space is compared);
+- its accelerations against the referee's soft model (MuJoCo's documented equations, its
+  :func:`~dyncheck.reference.constrained.soft`, with the file's solref and solimp and the
+  engine's approximation of A's diagonal), and against the rigid answer: their distance is
+  what the soft model predicts (a share 1 − d of the free motion, and no J̇ v in its rows).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from dyncheck.adapters.closures import ClosedReading, ClosureKind
+from dyncheck.adapters.closures import Closure as Held
+from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.check.computed import bodies
+from dyncheck.precision import EPS, ROUNDOFF_FACTOR
+from dyncheck.reference.closure import (
+    Closure,
+    Connect,
+    Coupling,
+    Projected,
+    Rows,
+    Weld,
+    project,
+    rows,
+)
+from dyncheck.reference.constrained import multipliers, reduced, soft
+from dyncheck.reference.constraints import Softness
+from dyncheck.reference.tree import TreeDynamics
+
+PROJECTION_TOL = 1e-12
+"""|C| accepted of a state moved onto the constraints, relative to the model's reach (a few
+ε of the positions Newton's last step rounds)."""
+
+
+def referee_closures(tree: ModelTree) -> list[Closure]:
+    """The tree's closures as the referee takes them (joints by their place in
+    ``tree.joints``, the order :func:`~.computed.bodies` gives the general method)."""
+    index = {j.name: i for i, j in enumerate(tree.joints)}
+
+    def at(name: str | None) -> int:
+        return -1 if name is None else index[name]
+
+    out: list[Closure] = []
+    for c in tree.closures:
+        if c.kind is ClosureKind.CONNECT or (c.kind is ClosureKind.WELD
+                                             and c.rotation_scale == 0.0):
+            out.append(Connect(body1=at(c.joint1), body2=at(c.joint2), point1=c.point1,
+                               point2=c.point2))
+        elif c.kind is ClosureKind.WELD:
+            out.append(Weld(body1=at(c.joint1), body2=at(c.joint2), point1=c.point1,
+                            point2=c.point2, held=c.held))
+        else:
+            out.append(Coupling(first=tuple((index[n], k) for n, k in c.first),
+                                second=tuple((index[n], k) for n, k in c.second),
+                                reference1=c.reference1, reference2=c.reference2,
+                                polycoef=c.polycoef))
+    return out
+
+
+def row_sizes(tree: ModelTree) -> list[int]:
+    """Each closure's rows in the referee (a weld whose rotation is free: a connect's 3)."""
+    return [3 if c.kind is ClosureKind.WELD and c.rotation_scale == 0.0 else c.rows
+            for c in tree.closures]
+
+
+def engine_rows(tree: ModelTree) -> np.ndarray:
+    """Where the referee's rows sit among the engine's (a weld whose rotation is free keeps
+    its three zero rotation rows in MuJoCo: left out)."""
+    out: list[int] = []
+    start = 0
+    for c, size in zip(tree.closures, row_sizes(tree), strict=True):
+        out += range(start, start + size)
+        start += c.rows
+    return np.array(out, int)
+
+
+def rotation_rows(tree: ModelTree) -> np.ndarray:
+    """Which of the referee's rows are a weld's rotation rows (bool, one per row)."""
+    out: list[bool] = []
+    for size in row_sizes(tree):
+        out += [False] * 3 + [True] * 3 if size == 6 else [False] * size
+    return np.array(out, bool)
+
+
+def softness(c: Held) -> Softness:
+    """A closure's soft model (MuJoCo's solref, solimp)."""
+    return Softness(*c.solref[:2], *c.solimp[:5])
+
+
+@dataclass(frozen=True, kw_only=True)
+class ClosedStates:
+    """States on the constraints: the draws kept (q, v), how many were drawn, and the
+    largest |C| and |J v| of the kept."""
+
+    q: np.ndarray
+    v: np.ndarray
+    drawn: int
+    residual: float
+    rate: float
+
+
+def on_constraints(tree: ModelTree, q: np.ndarray, v: np.ndarray, *,
+                   reach: float) -> ClosedStates:
+    """The draws (q, v) moved onto the tree's closures; a draw whose Newton iteration does
+    not converge is dropped and counted."""
+    solver = TreeDynamics(bodies(tree), tree.gravity)
+    held = referee_closures(tree)
+    kept: list[Projected] = []
+    for qk, vk in zip(q, v, strict=True):
+        moved = project(solver, held, qk, vk, tol=PROJECTION_TOL * max(reach, 1.0))
+        if moved.converged:
+            kept.append(moved)
+    nq, nv = q.shape[1], v.shape[1]
+    return ClosedStates(
+        q=np.array([k.q for k in kept]).reshape(-1, nq),
+        v=np.array([k.v for k in kept]).reshape(-1, nv), drawn=len(q),
+        residual=max((k.residual for k in kept), default=0.0),
+        rate=max((k.rate for k in kept), default=0.0))
+
+
+@dataclass(frozen=True, kw_only=True)
+class RefereeAnswer:
+    """The referee at S states: its rows, and v̇ (S, nv) rigid (both ways) and soft."""
+
+    rows: Rows
+    reduced: np.ndarray
+    multipliers: np.ndarray
+    soft: np.ndarray
+
+
+def regularizer(tree: ModelTree, *, diagonal: np.ndarray, value: np.ndarray) -> np.ndarray:
+    """R's diagonal on the referee's rows at one state: (1 − d)/d times the engine's
+    approximation of A's diagonal (``diagonal``, on its rows), a weld's rotation rows by
+    4/scale² (the engine's rows are ½ · scale times a rotation of the referee's: the same
+    soft solve needs R scaled by the inverse square)."""
+    per_row: list[Softness] = []
+    scale: list[float] = []
+    for c, size in zip(tree.closures, row_sizes(tree), strict=True):
+        per_row += [softness(c)] * size
+        scale += [1.0] * 3 + [4.0 / c.rotation_scale**2] * 3 if size == 6 else [1.0] * size
+    d = np.array([s.impedance(np.array([r]))[0] for s, r in zip(per_row, value, strict=True)])
+    return (1 - d) / d * diagonal * np.array(scale)
+
+
+def reference_row(tree: ModelTree, *, value: np.ndarray, rate: np.ndarray,
+                  jdot_v: np.ndarray) -> np.ndarray:
+    """a_ref = −b ṙ − k d(r) r of every row (MuJoCo's documented reference acceleration),
+    less J̇ v on the rows of a closure whose engine takes it in
+    (:attr:`~dyncheck.adapters.closures.Closure.bias_in_reference`)."""
+    out: list[float] = []
+    k = 0
+    for c, size in zip(tree.closures, row_sizes(tree), strict=True):
+        s = softness(c)
+        for _ in range(size):
+            d = float(s.impedance(np.array([value[k]]))[0])
+            out.append(-s.damping * rate[k] - s.stiffness * d * value[k]
+                       - (jdot_v[k] if c.bias_in_reference else 0.0))
+            k += 1
+    return np.array(out)
+
+
+def referee(tree: ModelTree, q: np.ndarray, v: np.ndarray, *, tau: np.ndarray,
+            diagonal: np.ndarray) -> RefereeAnswer:
+    """The referee on ``tree``'s closures at the states (canonical layout), the soft model
+    with the engine's ``diagonal`` (S, m)."""
+    solver = TreeDynamics(bodies(tree), tree.gravity)
+    held = rows(solver, referee_closures(tree), q, v)
+    mass, bias, _, _ = solver.at_states(q, v)
+    out: dict[str, list[np.ndarray]] = {"reduced": [], "multipliers": [], "soft": []}
+    for s in range(len(q)):
+        jac, jdot_v = held.jacobian[s], held.bias[s]
+        args = (mass[s], bias[s], tau[s])
+        out["reduced"].append(reduced(*args, J=jac, jdot_v=jdot_v).vdot)
+        out["multipliers"].append(multipliers(*args, J=jac, jdot_v=jdot_v).vdot)
+        a_ref = reference_row(tree, value=held.value[s], rate=jac @ v[s], jdot_v=jdot_v)
+        out["soft"].append(soft(*args, J=jac, a_ref=a_ref, regularizer=regularizer(
+            tree, diagonal=diagonal[s], value=held.value[s])).vdot)
+    nv = v.shape[1]
+    return RefereeAnswer(rows=held, **{k: np.array(x).reshape(-1, nv)
+                                       for k, x in out.items()})
+
+
+def row_space_gap(engine: np.ndarray, referee_rows: np.ndarray) -> float:
+    """How far two sets of rows span different spaces: the largest |(I − P) x| over the
+    engine's unit rows x, P the projector on the referee's row space (0: the same space)."""
+    if not engine.size:
+        return 0.0
+    basis = np.linalg.svd(referee_rows, full_matrices=False)[2]
+    unit = engine / np.maximum(np.linalg.norm(engine, axis=1, keepdims=True), 1e-300)
+    return float(np.abs(unit - (unit @ basis.T) @ basis).max())
+
+
+@dataclass(frozen=True, kw_only=True)
+class Measured:
+    """An engine's answer on its closures against the referee's, at states on them; every
+    gap the largest over the states, with the round-off bound it is held to."""
+
+    residual: float
+    """max |C| of the engine's rows at the referee's states (lengths; 0: the same set)."""
+    jacobian: float
+    """max |J − J_ref| of the rows both state alike, relative to max |J_ref|."""
+    row_space: float
+    """A weld's rotation rows: how far the engine's leave the referee's row space."""
+    ways: float
+    """The referee's two ways (independent coordinates, multipliers), apart."""
+    soft: float
+    """The engine's v̇ against the referee's soft model of it."""
+    rigid: float
+    """The engine's v̇ against the rigid answer."""
+    predicted: float
+    """The soft model's distance from the rigid answer: what the engine's should be."""
+    scale: float
+    """The accelerations' scale: the largest |v̇| of the free tree and of the answers."""
+    bound: float
+    """The round-off bound of the accelerations: 64 ε κ(M) κ(A + R), relative to ``scale``."""
+    rows_bound: float
+    """The round-off bound of the rows: 64 ε relative to the model's reach and |J|."""
+
+
+def measure(tree: ModelTree, reading: ClosedReading, states: ClosedStates, *,
+            tau: np.ndarray, reach: float) -> Measured:
+    """The engine's ``reading`` at ``states`` (on ``tree``'s closures) against the referee."""
+    pick, rot = engine_rows(tree), rotation_rows(tree)
+    q, v = states.q, states.v
+    ref = referee(tree, q, v, tau=tau, diagonal=reading.diagonal[:, pick])
+    jac = reading.jacobian[:, pick]
+    solver = TreeDynamics(bodies(tree), tree.gravity)
+    mass, bias, _, _ = solver.at_states(q, v)
+    free = np.linalg.solve(mass, (tau - bias)[..., None])[..., 0]
+    kappa = max((float(np.linalg.cond(mass[s])) * _soft_condition(
+        mass[s], ref.rows.jacobian[s], regularizer(tree, diagonal=reading.diagonal[s, pick],
+                                                   value=ref.rows.value[s]))
+                 for s in range(len(q))), default=1.0)
+    scale = max(float(np.abs(free).max(initial=0.0)), float(np.abs(ref.soft).max(initial=0.0)),
+                float(np.abs(ref.multipliers).max(initial=0.0)), 1e-300)
+    norm = max(float(np.abs(ref.rows.jacobian).max(initial=0.0)), 1e-300)
+    return Measured(
+        residual=float(np.abs(reading.value[:, pick]).max(initial=0.0)),
+        jacobian=float(np.abs(jac[:, ~rot] - ref.rows.jacobian[:, ~rot]).max(initial=0.0))
+        / norm,
+        row_space=max((row_space_gap(jac[s][rot], ref.rows.jacobian[s][rot])
+                       for s in range(len(q))), default=0.0) if rot.any() else 0.0,
+        ways=float(np.abs(ref.reduced - ref.multipliers).max(initial=0.0)) / scale,
+        soft=float(np.abs(reading.vdot - ref.soft).max(initial=0.0)) / scale,
+        rigid=float(np.abs(reading.vdot - ref.multipliers).max(initial=0.0)) / scale,
+        predicted=float(np.abs(ref.soft - ref.multipliers).max(initial=0.0)) / scale,
+        scale=scale, bound=ROUNDOFF_FACTOR * EPS * kappa,
+        rows_bound=ROUNDOFF_FACTOR * EPS * max(reach, 1.0))
+
+
+def _soft_condition(mass: np.ndarray, jac: np.ndarray, reg: np.ndarray) -> float:
+    """κ(A + R), A = J M⁻¹ Jᵀ (1 without rows)."""
+    if not jac.size:
+        return 1.0
+    return float(np.linalg.cond(jac @ np.linalg.solve(mass, jac.T) + np.diag(reg)))

@@ -1,0 +1,162 @@
+"""Closed chains checked (:mod:`dyncheck.check.closures`, #78), on models written here: a
+planar four-bar (connect), two fingers coupled by a joint polynomial, a tendon coupling, a free
+box welded to the world, and a loop through a ball joint. Each engine that offers its own
+constrained dynamics is measured against the referee (the book's constrained method, whose
+closed forms tests/reference/test_closure.py checks): its rows hold at the referee's states,
+its accelerations are the referee's soft model of it, and its distance from the rigid answer
+is the one that model predicts. Mutations of its reading (an anchor moved by 1 mm, a slope
+changed by 1 %, one constraint's impedance taken from another) must be found."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dyncheck import adapters
+from dyncheck.adapters.formats.files import read
+from dyncheck.adapters.offers import Offer
+from dyncheck.check import closures as checked
+from tests.conftest import loader
+
+CLOSING = sorted(n for n, r in adapters.REGISTRY.items()
+                 if r.model and Offer.CLOSURES in loader(n).offers)
+"""Engines whose loader computes with the constraints of a user's file."""
+
+FOUR_BAR = """<mujoco><option gravity="0 0 -9.81"/><worldbody>
+ <body name="crank"><joint name="crank" axis="0 1 0"/>
+  <geom type="capsule" fromto="0 0 0 0 0 0.5" size=".02" mass="1.2"/>
+  <body name="coupler" pos="0 0 0.5"><joint name="coupler" axis="0 1 0"/>
+   <geom type="capsule" fromto="0 0 0 0.9 0 0" size=".02" mass="0.9"/></body></body>
+ <body name="rocker" pos="1.0 0 0"><joint name="rocker" axis="0 1 0"/>
+  <geom type="capsule" fromto="0 0 0 -0.1 0 0.5" size=".02" mass="0.7"/></body>
+</worldbody><equality><connect body1="coupler" body2="rocker" anchor="0.9 0 0"/></equality>
+</mujoco>"""
+FINGERS = """<mujoco><option gravity="0 0 -9.81"/><worldbody><body name="palm">
+ <geom size=".05" mass="1"/>
+ <body name="left"><joint name="left" type="slide" axis="1 0 0"/><geom size=".02" mass="0.1"/>
+ </body>
+ <body name="right"><joint name="right" type="slide" axis="-1 0 1"/>
+  <geom size=".02" mass="0.15"/></body></body></worldbody>
+<equality><joint joint1="right" joint2="left" polycoef="0 1.5 -0.4 0 0"/></equality></mujoco>"""
+TENDON = """<mujoco><option gravity="0 0 -9.81"/><worldbody>
+ <body><joint name="a" axis="0 1 0"/><geom type="capsule" fromto="0 0 0 0.3 0 0" size=".02"
+  mass="1"/><body pos="0.3 0 0"><joint name="b" axis="0 1 0"/>
+  <geom type="capsule" fromto="0 0 0 0.3 0 0" size=".02" mass="1"/></body></body></worldbody>
+<tendon><fixed name="t1"><joint joint="a" coef="1"/><joint joint="b" coef="-0.5"/></fixed>
+ <fixed name="t2"><joint joint="b" coef="1"/></fixed></tendon>
+<equality><tendon tendon1="t1" tendon2="t2" polycoef="0 0.7 0 0 0"/></equality></mujoco>"""
+WELD = """<mujoco><option gravity="0 0 -9.81"/><worldbody>
+ <body name="arm"><joint name="arm" axis="0 1 0"/>
+  <geom type="capsule" fromto="0 0 0 0.4 0 0" size=".02" mass="1"/></body>
+ <body name="box" pos="0.4 0 0" euler="10 20 30"><freejoint name="box"/>
+  <geom type="box" size=".1 .2 .3" mass="2"/></body></worldbody>
+<equality><weld body1="arm" body2="box" torquescale="0.5"/></equality></mujoco>"""
+BALL_LOOP = """<mujoco><option gravity="0 0 -9.81"/><worldbody>
+ <body name="arm"><joint name="shoulder" type="ball"/>
+  <geom type="capsule" fromto="0 0 0 0.4 0 0" size=".02" mass="1"/>
+  <body name="forearm" pos="0.4 0 0"><joint name="elbow" axis="0 1 0"/>
+   <geom type="capsule" fromto="0 0 0 0 0 -0.4" size=".02" mass="0.8"/></body></body>
+ <body name="post" pos="0.4 0 -0.7"><joint name="post" type="slide" axis="0 0 1"/>
+  <geom size=".03" mass="0.5"/></body></worldbody>
+<equality><connect body1="forearm" body2="post" anchor="0 0 -0.4"
+  solimp="0.8 0.9 0.001 0.5 2"/></equality></mujoco>"""
+MODELS = {"four_bar": FOUR_BAR, "fingers": FINGERS, "tendon": TENDON, "weld": WELD,
+          "ball_loop": BALL_LOOP}
+DRAWS = 12
+
+
+def _load(engine: str, name: str, tmp_path: Path):
+    path = tmp_path / f"{name}.xml"
+    path.write_text(MODELS[name])
+    return loader(engine)(read(path))
+
+
+def _draws(model, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Random states about the reference: hinges and slides ±0.3, quaternions turned."""
+    tree, rng = model.tree, np.random.default_rng(seed)
+    q = np.tile(model.reference_q(), (DRAWS, 1))
+    for j in tree.joints:
+        at, n = j.layout.q_start, j.layout.nq
+        if n == 1:
+            q[:, at] += rng.uniform(-0.3, 0.3, DRAWS)
+        else:
+            quat = q[:, at + n - 4 : at + n] + rng.normal(size=(DRAWS, 4)) * 0.2
+            q[:, at + n - 4 : at + n] = quat / np.linalg.norm(quat, axis=1)[:, None]
+    return q, rng.normal(size=(DRAWS, tree.nv))
+
+
+def _measured(model, tree=None):
+    tree = tree or model.tree
+    q, v = _draws(model)
+    states = checked.on_constraints(tree, q, v, reach=1.0)
+    tau = np.zeros_like(states.v)
+    return states, checked.measure(tree, model.closed(states.q, states.v, tau), states,
+                                   tau=tau, reach=1.0)
+
+
+@pytest.mark.parametrize("engine", CLOSING)
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_an_engine_on_its_closures_is_the_referees_soft_model(engine, name, tmp_path):
+    """Every draw reaches the constraints (|C|, |J v| ≤ 1e-12); there the engine's own rows
+    vanish and equal the referee's; its accelerations are the referee's soft model of it to
+    round-off (64 ε κ(M) κ(A + R)); and the referee's two ways agree."""
+    model = _load(engine, name, tmp_path)
+    assert model.tree.closures, "the file's constraint was not read"
+    states, found = _measured(model)
+    assert len(states.q) == states.drawn
+    assert states.residual <= 1e-12 and states.rate <= 1e-12
+    assert found.residual <= found.rows_bound
+    assert found.jacobian <= found.rows_bound and found.row_space <= found.rows_bound
+    assert found.ways <= found.bound
+    assert found.soft <= found.bound, (found.soft, found.bound)
+
+
+@pytest.mark.parametrize("engine", CLOSING)
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_the_distance_from_the_rigid_answer_is_the_one_predicted(engine, name, tmp_path):
+    """The engine's constraints are soft: it is not the rigid answer (by more than round-off,
+    on every model here: its impedance below 1 leaves a share of the free motion), and its
+    distance from it is the referee's soft model's, to round-off."""
+    model = _load(engine, name, tmp_path)
+    _, found = _measured(model)
+    assert found.rigid > 100 * found.bound
+    assert abs(found.rigid - found.predicted) <= 2 * found.bound
+
+
+def _moved(model, **change):
+    """The engine's tree with its first closure changed: a reading mutated."""
+    tree = model.tree
+    return replace(tree, closures=(replace(tree.closures[0], **change), *tree.closures[1:]))
+
+
+@pytest.mark.parametrize("engine", CLOSING)
+def test_an_anchor_moved_by_a_millimetre_is_found(engine, tmp_path):
+    """The four-bar's coupler anchor moved 1 mm along x in the reading the referee is given:
+    the engine's own rows, at the referee's states, are off by about that."""
+    model = _load(engine, "four_bar", tmp_path)
+    held = model.tree.closures[0]
+    _, found = _measured(model, _moved(model, point1=held.point1 + np.array([1e-3, 0, 0])))
+    assert found.residual > 1e-4 > found.rows_bound
+
+
+@pytest.mark.parametrize("engine", CLOSING)
+def test_a_slope_changed_by_one_percent_is_found(engine, tmp_path):
+    """The fingers' coupling slope 1.5 read as 1.515: the engine's row at the referee's states
+    is off by 1 % of the left finger's travel (draws of ±0.3)."""
+    model = _load(engine, "fingers", tmp_path)
+    coef = model.tree.closures[0].polycoef
+    _, found = _measured(model, _moved(model, polycoef=(coef[0], coef[1] * 1.01, *coef[2:])))
+    assert found.residual > 1e-4
+
+
+@pytest.mark.parametrize("engine", CLOSING)
+def test_an_impedance_from_the_wrong_constraint_is_found(engine, tmp_path):
+    """The ball loop's connect holds solimp (0.8, 0.9, …); given MuJoCo's default (0.9,
+    0.95, …) of another constraint instead, the soft model moves by far more than
+    round-off: the engine's accelerations no longer match it."""
+    model = _load(engine, "ball_loop", tmp_path)
+    _, found = _measured(model, _moved(model, solimp=(0.9, 0.95, 0.001, 0.5, 2.0)))
+    assert found.soft > 100 * found.bound
