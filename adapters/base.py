@@ -24,6 +24,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from dyncheck.adapters.actuators import Actuation, InputJacobian
+from dyncheck.adapters.closures import ClosedReading
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, ModelTree, StateLayout, Transition
 from dyncheck.adapters.offers import Field, Offer
 from dyncheck.adapters.symbolic import Symbolic
@@ -447,14 +448,19 @@ class ModelEngine(ABC):
         """∂v̇/∂u (n, nv, its actuators) at each state and control, its layout."""
         raise Unsupported(f"{self.engine} offers no derivative in its controls")
 
+    def closed(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> ClosedReading:
+        """Its own rows and forward dynamics on its tree's closures (:attr:`Offer.CLOSURES`)."""
+        raise Unsupported(f"{self.engine} offers no dynamics with the file's constraints")
+
     def request(self, kind: str, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Answer:
         """One request of ``kind`` (``dynamics``, ``derivatives``, ``transition``,
-        ``actuation`` or ``input_jacobians``, whose ``a`` is the controls) answered here,
+        ``actuation`` or ``input_jacobians``, whose ``a`` is the controls, or ``closed``,
+        whose ``a`` is τ) answered here,
         timed; its exception handed back, not raised."""
         method = {"dynamics": self.dynamics, "derivatives": self.derivatives,
                   "transition": self.transition, "actuation": self.actuation,
                   "input_jacobians": self.input_jacobians,
-                  "control_derivatives": self.control_derivatives}[kind]
+                  "control_derivatives": self.control_derivatives, "closed": self.closed}[kind]
         t0 = time.perf_counter()
         try:
             return method(q, v, a), time.perf_counter() - t0

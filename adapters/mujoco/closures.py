@@ -100,8 +100,9 @@ def read(m: mujoco.MjModel, d: mujoco.MjData,
     out: list[Closure] = []
     notes: list[str] = []
     for i in range(m.neq):
-        name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_EQUALITY, i) or f"equality {i}"
         kind = mujoco.mjtEq(int(m.eq_type[i]))
+        name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_EQUALITY, i) or \
+            f"{kind.name.removeprefix('mjEQ_').lower()} {i}"
         soft: dict[str, Any] = dict(solref=_solref(m, m.eq_solref[i]),
                                     solimp=tuple(float(x) for x in m.eq_solimp[i]))
         if not m.eq_active0[i]:

@@ -35,6 +35,7 @@ import numpy as np
 from dyncheck.adapters import MODELS, Registration
 from dyncheck.adapters.actuators import Actuation, InputJacobian
 from dyncheck.adapters.base import Answer, ModelEngine
+from dyncheck.adapters.closures import ClosedReading
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, Transition
 from dyncheck.confinement import confine
@@ -358,6 +359,11 @@ class Isolated(ModelEngine):
     def control_derivatives(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> np.ndarray:
         """The engine's ∂v̇/∂u (:class:`Unsupported` where it offers none)."""
         return self._ask("control_derivatives", q, v, u)
+
+    def closed(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> ClosedReading:
+        """The engine's rows and dynamics on its closures (:class:`Unsupported` where it
+        offers none)."""
+        return self._ask("closed", q, v, tau)
 
     def collect(self) -> tuple[Any, float]:
         """The submitted batch's answer (dynamics or derivatives) and the seconds the engine

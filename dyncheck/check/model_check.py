@@ -27,6 +27,7 @@ from dyncheck.adapters.formats.files import ModelFile, read, urdf_inertials, urd
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import (
     actuation,
+    closure_rows,
     describe,
     inputs,
     partial,
@@ -41,7 +42,6 @@ from dyncheck.check.derivatives import expected_seconds
 from dyncheck.check.derivatives import rows as derivative_rows
 from dyncheck.check.dynamics import (
     QUANTITIES,
-    Prediction,
     compare,
     tie_row,
 )
@@ -67,7 +67,8 @@ DERIVATIVES_NOTE = (
 SMOOTH_NOTE = (
     "smooth dynamics only: contacts, joint limits, equality constraints, actuators and passive "
     "forces (springs, damping) are left out of M, h, forward and inverse dynamics; damping and "
-    "armature are compared as fields of the model, actuators in their own section"
+    "armature are compared as fields of the model, actuators and equality constraints in their "
+    "own sections"
 )
 
 
@@ -183,6 +184,7 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     seconds = {k: seconds[k] for k in ("load", REFEREE, *loaded) if k in seconds}
     rows.extend(_pairs(model, canon, canonical_tree, batch, loaded, parts, results, differing,
                        own))
+    rows.extend(closure_rows.rows(model, canonical_tree, loaded, batch))
     if actuators and any(m.tree.actuators for m in loaded.values()):
         t0 = time.perf_counter()
         computed = {e: m for e, m in loaded.items() if e in results}  # (a failed one: its row)
@@ -459,7 +461,7 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
                     mesh = 0.0  # the same inertias: b's own
                 explanations = predicted.differences(canon, canonical_tree, tree_a,
                                                      trees[b], batch, dyn_a)
-                reading = {} if a == REFEREE else _reading_effect(
+                reading = {} if a == REFEREE else readings.pair_effect(
                     canonical_tree, a, b, own, batch, differing)
                 if a != REFEREE and a not in kappas:
                     kappas[a] = condition(results[a].mass_matrix)
@@ -474,19 +476,6 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
                 parts=parts, loaded=loaded, own=own, differing=differing, eps=eps,
                 vertices=mesh, standing=factor))
     return rows
-
-
-def _reading_effect(canonical_tree: ModelTree, a: str, b: str, own: dict[str, readings.Reading],
-                    batch: States, differing: dict[str, list[str]]) -> dict[str, Prediction]:
-    """Quantity → the measured effect of a and b reading the model differently (the
-    referee on b's reading minus on a's, with each differing field's share by substitution);
-    empty where one of them holds no whole reading or they read every field alike."""
-    groups = list(dict.fromkeys(f for e in (a, b) for f in differing.get(e, ())))
-    if not groups or a not in own or b not in own or own[a].dynamics is own[b].dynamics:
-        return {}
-    found = readings.effect(canonical_tree, a, own[a].tree, own[a].dynamics, b, own[b].tree,
-                            own[b].dynamics, batch, groups)
-    return {q: p for q in QUANTITIES if (p := found.prediction(q)) is not None}
 
 
 def _against(model: str, mine: ModelTree, other: ModelFile) -> list[CheckRow]:

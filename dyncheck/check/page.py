@@ -26,6 +26,8 @@ TITLES = {
     Section.DESCRIPTION: "Model reading (each engine's tree against MuJoCo's)",
     Section.VALIDITY: "Physical validity",
     Section.DYNAMICS: "Dynamics",
+    Section.CLOSURES: "Closures (the dynamics with the file's constraints, against the referee's "
+                      "constrained method at states on them)",
     Section.ACTUATION: "Actuation (each engine's actuators against the first reading of them; "
                        "their force and step Jacobian in the controls against the referee)",
     Section.DERIVATIVES: "Derivatives (canonical chart; MuJoCo's by its own finite differences)",

@@ -188,3 +188,16 @@ def own_readings(canonical_tree: ModelTree, batch: States,
         with np.errstate(all="ignore"):
             own[engine] = Reading(tree=tree, dynamics=ReferenceModel(tree).dynamics(
                 batch.q, batch.v, batch.a))
+
+
+def pair_effect(canonical_tree: ModelTree, a: str, b: str, own: dict[str, Reading],
+                    batch: States, differing: dict[str, list[str]]) -> dict[str, Prediction]:
+    """Quantity → the measured effect of a and b reading the model differently (the
+    referee on b's reading minus on a's, with each differing field's share by substitution);
+    empty where one of them holds no whole reading or they read every field alike."""
+    groups = list(dict.fromkeys(f for e in (a, b) for f in differing.get(e, ())))
+    if not groups or a not in own or b not in own or own[a].dynamics is own[b].dynamics:
+        return {}
+    found = effect(canonical_tree, a, own[a].tree, own[a].dynamics, b, own[b].tree,
+                            own[b].dynamics, batch, groups)
+    return {q: p for q in QUANTITIES if (p := found.prediction(q)) is not None}

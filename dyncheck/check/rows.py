@@ -19,6 +19,7 @@ class Section(StrEnum):
     DESCRIPTION = "description"
     VALIDITY = "validity"
     DYNAMICS = "dynamics"
+    CLOSURES = "closures"
     ACTUATION = "actuation"
     DERIVATIVES = "derivatives"
 

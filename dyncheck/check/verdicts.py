@@ -133,7 +133,7 @@ def _agreement(engine: str, rows: pd.DataFrame, canonical: str) -> tuple[Agreeme
     order: a failed row → differ; else an explained row → differ only as explained (the
     quantities named); else every compared row passed → agree; nothing compared → not
     compared. "Agree" never stands beside a failed or explained row of that engine."""
-    dynamics = rows[rows["section"].isin((Section.DYNAMICS, Section.DERIVATIVES))
+    dynamics = rows[rows["section"].isin((Section.DYNAMICS, Section.CLOSURES, Section.DERIVATIVES))
                     & ((rows["impl_a"] == engine) | (rows["impl_b"] == engine))]
     for judge in (REFEREE, canonical):  # the referee judges; without it, the canonical engine
         against = dynamics[(dynamics["impl_a"] == judge) | (dynamics["impl_b"] == judge)]

@@ -1,0 +1,87 @@
+"""The closures section of a model's check (:mod:`dyncheck.check.closure_rows`, #78) and how
+its rows reach the page's per-engine lines, on the four-bar of tests/check/test_closures.py
+(whose measures are tested there against the referee's closed forms)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import pytest
+
+from dyncheck.adapters.offers import Offer
+from dyncheck.check.engines import DEFAULT, ENGINES
+from dyncheck.check.model_check import check_model
+from dyncheck.check.verdicts import Agreement, per_engine
+from tests.check.test_closures import FOUR_BAR
+from tests.conftest import loader
+
+CLOSING = [e for e in ENGINES if Offer.CLOSURES in loader(e).offers]
+"""The engines a check loads whose loader computes with the file's constraints."""
+NOT_CLOSING = [e for e in DEFAULT if e in ENGINES and Offer.CLOSURES not in loader(e).offers]
+"""The engines a check runs by default whose loader offers no constrained dynamics."""
+STATES = 8
+
+
+def _section(result, engine: str | None = None):
+    rows = result.rows[result.rows["section"] == "closures"]
+    return rows if engine is None else rows[rows["impl_b"] == engine]
+
+
+@pytest.fixture
+def four_bar(tmp_path):
+    path = tmp_path / "four_bar.xml"
+    path.write_text(FOUR_BAR)
+    return path
+
+
+@pytest.mark.parametrize("engine", CLOSING)
+def test_an_engine_on_the_four_bar_is_soft_as_its_file_says(engine, four_bar):
+    """Every state reaches the loop; the engine's rows and soft model pass; its distance from
+    the rigid answer is explained by the soft model, and its page line says so."""
+    result = check_model(four_bar, impls=(engine, "reference"), states=STATES, isolate=False)
+    states = _section(result)[lambda d: d["subject"] == "states"]
+    assert states["verdict"].tolist() == ["passed"]
+    assert f"{STATES} of {STATES} sampled states" in states["note"].iloc[0]
+    mine = _section(result, engine).set_index("subject")
+    assert mine.loc["model", "verdict"] == "passed"
+    assert mine.loc["forward (soft)", "verdict"] == "passed"
+    assert mine.loc["forward (rigid)", "verdict"] == "explained"
+    line = next(v for v in per_engine(result.rows, result.impls) if v.engine == engine)
+    assert line.agreement is Agreement.EXPLAINED and "forward (rigid)" in line.agreement_why
+
+
+@pytest.mark.parametrize("engine", CLOSING)
+def test_an_engine_off_its_soft_model_differs_on_its_line(engine, four_bar, monkeypatch):
+    """Its accelerations moved by 1e-6 (far beyond round-off, far below the soft model's
+    distance from the rigid answer): the soft row fails, the rigid row is no longer
+    explained, and the page line says the engine differs."""
+    cls = loader(engine)
+    honest = cls.closed
+
+    def off(self, q, v, tau):
+        found = honest(self, q, v, tau)
+        return replace(found, vdot=found.vdot + 1e-6)
+
+    monkeypatch.setattr(cls, "closed", off)
+    result = check_model(four_bar, impls=(engine, "reference"), states=STATES, isolate=False)
+    mine = _section(result, engine).set_index("subject")
+    assert mine.loc["forward (soft)", "verdict"] == "failed"
+    assert mine.loc["forward (rigid)", "verdict"] == "failed"
+    line = next(v for v in per_engine(result.rows, result.impls) if v.engine == engine)
+    assert line.agreement is Agreement.DIFFER
+
+
+@pytest.mark.parametrize("engine", NOT_CLOSING)
+def test_an_engine_without_constrained_dynamics_has_one_skipped_row(engine, four_bar):
+    result = check_model(four_bar, impls=(*CLOSING[:1], engine, "reference"), states=STATES,
+                         isolate=False)
+    rows = _section(result, engine)
+    assert rows["verdict"].tolist() == ["skipped"]
+    assert "not compared" in rows["note"].iloc[0]
+
+
+def test_a_model_without_constraints_has_no_closures_section(tmp_path):
+    path = tmp_path / "open.xml"
+    path.write_text(FOUR_BAR.split("<equality>")[0] + "</mujoco>")
+    result = check_model(path, impls=(*CLOSING[:1], "reference"), states=STATES, isolate=False)
+    assert _section(result).empty
