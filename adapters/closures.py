@@ -65,6 +65,11 @@ class Closure:
     solimp: tuple[float, ...] = ()
 
     @property
+    def soft(self) -> bool:
+        """Whether the engine holds it softly (a soft model: MuJoCo's solref and solimp)."""
+        return bool(self.solref)
+
+    @property
     def rows(self) -> int:
         """How many constraint rows it gives (a weld 6, a connect 3, a coupling 1)."""
         return {ClosureKind.CONNECT: 3, ClosureKind.WELD: 6}.get(self.kind, 1)
@@ -83,3 +88,6 @@ class ClosedReading:
     vdot: np.ndarray
     force: np.ndarray
     diagonal: np.ndarray
+    accuracy: float = 0.0
+    """How far its solver may leave its answer from its own equations, |J v̇ + J̇ v| (an
+    iterative solver's stopping accuracy, acceleration units; 0: a direct solve)."""

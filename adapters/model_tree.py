@@ -224,6 +224,10 @@ class ModelTree:
     closures: tuple[Closure, ...] = ()
     """The constraints that close its tree, as it holds them
     (:mod:`dyncheck.adapters.closures`); none where it holds none or states none."""
+    closures_read: bool = False
+    """Whether its loader reads the file's constraints into :attr:`closures` (False: none
+    are read, whatever the file holds: its notes say why where it was given a copy
+    without them)."""
     exact_meshes: ModelTree | None = None
     """The engine's reading with every mesh's volume and inertia computed exactly (MuJoCo:
     ``inertia="exact"`` instead of its default ``"legacy"``, which overcounts a non-convex

@@ -316,6 +316,7 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
         return ModelTree(
             engine=ENGINE, joints=tuple(joints), gravity=self._gravity.copy(),
             nq=m.nq, nv=m.nv, notes=notes + unheld, hints=self._hints, closures=held,
+            closures_read=True,
             actuators=actuators.read(m, [_joint_name(m, j) for j in range(m.njnt)]),
             mesh_rounding={name: bound for name, bound in by_joint.items() if bound > 0},
         )

@@ -30,6 +30,7 @@ import numpy as np
 import pinocchio as pin
 
 from dyncheck.adapters.base import Field, ModelEngine, Offer
+from dyncheck.adapters.closures import ClosedReading
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
@@ -47,6 +48,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
+from dyncheck.adapters.pinocchio import closures
 from dyncheck.adapters.pinocchio.mjcf import (
     BARE_BODY,
     CLASS_LOOKUP_FAILED,
@@ -87,6 +89,14 @@ def parse_xml(xml: str) -> pin.Model:
         path = Path(folder) / "model.xml"
         path.write_text(xml, encoding="utf-8")
         return pin.buildModelFromMJCF(str(path))
+
+
+def _constraints(source: ModelFile, model: pin.Model) -> list:
+    """The MJCF file's constraint models as Pinocchio parses them (:mod:`.closures`)."""
+    if source.format is not Format.MJCF or "<equality" not in source.text:
+        return []
+    with utf8_file(source.path) as file:
+        return closures.load(file, model)
 
 
 def _load(source: ModelFile) -> pin.Model:
@@ -197,7 +207,7 @@ class PinocchioModel(ModelEngine):
 
     engine = ENGINE
     offers = frozenset({Offer.DERIVATIVES, Offer.FORWARD, Offer.STEPPING, Offer.SOLVING,
-                        Offer.COUPLINGS, Offer.BODY_FORCES})
+                        Offer.COUPLINGS, Offer.BODY_FORCES, Offer.CLOSURES})
     definitions: ClassVar[Mapping[str, str]] = {Integrator.IMPLICITFAST: Integrator.EULER}
     """Its ``implicitfast`` is ``euler``: it applies no damping and has no actuators (D = 0,
     :mod:`.integrators`)."""
@@ -205,6 +215,8 @@ class PinocchioModel(ModelEngine):
     def __init__(self, source: ModelFile, *, gravity: np.ndarray | None = None,
                  inertias: Mapping[str, np.ndarray] | None = None) -> None:
         self.model = _load(source)
+        self._held = _constraints(source, self.model)
+        self._closures_read = source.format is Format.MJCF  # (its URDF parser: no mimic read)
         if gravity is not None:
             self.model.gravity = pin.Motion(np.asarray(gravity, float), np.zeros(3))
         _stated_inertias(self.model, inertias or {})
@@ -300,6 +312,8 @@ class PinocchioModel(ModelEngine):
         return ModelTree(
             engine=ENGINE, joints=tuple(joints), gravity=np.asarray(m.gravity.linear, float),
             nq=m.nq, nv=m.nv, notes=notes, hints=self._hints,
+            closures=closures.read(self._held, d, {i: n for i, n in last_name.items() if n}),
+            closures_read=self._closures_read,
         )
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
@@ -361,6 +375,10 @@ class PinocchioModel(ModelEngine):
         for i in range(len(q)):
             out[i] = self.stepping.accelerate(q[i], v[i], tau[i])
         return out
+
+    def closed(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> ClosedReading:
+        """Its constrained dynamics on the file's constraints (:func:`.closures.closed`)."""
+        return closures.closed(self.model, self._held, q, v, tau=tau)
 
     def couple(self, couplings: Sequence[Coupling]) -> None:
         """The couplings as the constant Jacobian C of Pinocchio's constrained forward

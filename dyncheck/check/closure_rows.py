@@ -6,12 +6,18 @@ row saying so."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
+from dyncheck.adapters import layout, layout_batch
 from dyncheck.adapters.base import ModelEngine
+from dyncheck.adapters.closures import ClosedReading
+from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.adapters.offers import Offer
-from dyncheck.check import closures
+from dyncheck.check import closure_readings, closures
+from dyncheck.check.computed import canonical_reading
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.check.states import States
 from dyncheck.errors import EngineError, Unsupported
@@ -36,12 +42,35 @@ def _without(name: str) -> str:
             f"constraint solver of {name}'s yet")
 
 
+def _unread(name: str, tree: ModelTree) -> str:
+    """Why an engine's constraints are not compared: the note of the copy it was given
+    without them, or that its loader reads none."""
+    given = next((n for n in tree.notes if "without its equality constraints" in n), "")
+    return (f"{name}'s constraints are not compared: " + (given.split(": ", 1)[-1] if given
+            else "dyncheck reads none of its constraint models yet"))
+
+
 def reach(tree: ModelTree) -> float:
     """The model's size in its lengths: the farthest anchor or closure point from the
     origin (1 at least)."""
     points = [j.anchor for j in tree.joints] + [p for c in tree.closures
                                                  for p in (c.point1, c.point2)]
     return max([1.0, *(float(np.linalg.norm(p)) for p in points)])
+
+
+def in_canonical(canon: Canonical, engine: ModelEngine, states: closures.ClosedStates,
+                 tau: np.ndarray) -> tuple[ModelTree, ClosedReading]:
+    """The engine's reading put in the canonical layout, and its answer at the states (given
+    canonical, handed to it in its own layout): v̇ = T⁻¹ (v̇ₑ − Ṫ v), J = Jₑ T."""
+    tree = canonical_reading(canon, engine.tree)
+    maps, q_e, v_e, _ = layout_batch.engine_states(canon, engine.tree, states.q, states.v,
+                                                   np.zeros_like(states.v))
+    t = np.array([m.t for m in maps])
+    tdot_v = np.array([m.tdot_v for m in maps])
+    tau_e = np.linalg.solve(np.swapaxes(t, 1, 2), tau[..., None])[..., 0]  # τ·v invariant
+    found = engine.closed(q_e, v_e, tau_e)
+    return tree, replace(found, jacobian=found.jacobian @ t,
+                         vdot=np.linalg.solve(t, (found.vdot - tdot_v)[..., None])[..., 0])
 
 
 def rows(model: str, canonical_tree: ModelTree, loaded: dict[str, ModelEngine],
@@ -66,45 +95,61 @@ def rows(model: str, canonical_tree: ModelTree, loaded: dict[str, ModelEngine],
     if not kept:
         return out
     for name, engine in loaded.items():
+        if not engine.tree.closures_read:
+            out.append(_row(model, subject="model", field="closures", engine=name,
+                            verdict=Verdict.SKIPPED, note=_unread(name, engine.tree)))
+            continue
+        out += closure_readings.rows(model, canonical_tree, engine.tree, reach=size)
         if Offer.CLOSURES not in engine.offers:
             out.append(_row(model, subject="model", field="closed dynamics", engine=name,
                             verdict=Verdict.SKIPPED,
                             note=_without(name)))
             continue
-        out += _engine_rows(model, name, engine, states, size)
+        out += _engine_rows(model, name, engine, states, size=size,
+                            canonical_tree=canonical_tree)
     return out
 
 
 def _engine_rows(model: str, name: str, engine: ModelEngine, states: closures.ClosedStates,
-                 size: float) -> list[CheckRow]:
-    """One engine's rows: its constraint rows, its soft model, the rigid answer."""
+                 *, size: float, canonical_tree: ModelTree) -> list[CheckRow]:
+    """One engine's rows: its constraint rows, its soft model where it holds one, the rigid
+    answer — each judged on its own reading of the closures."""
+    if {j.name for j in engine.tree.joints} != {j.name for j in canonical_tree.joints}:
+        return [_row(model, subject="model", field="closed dynamics", engine=name,
+                     verdict=Verdict.SKIPPED, note=f"{name} holds part of the model (its "
+                     "reading rows): its closed dynamics are compared only on the whole")]
+    if not engine.tree.closures:
+        return []  # (its reading rows say it holds none)
     tau = np.zeros_like(states.v)
     try:
-        reading = engine.closed(states.q, states.v, tau)
+        tree, reading = in_canonical(layout.canonical(canonical_tree), engine, states, tau)
     except (EngineError, Unsupported) as exc:
         return [_row(model, subject="model", field="closed dynamics", engine=name,
                      verdict=Verdict.FAILED, note=f"{name} failed: {exc}")]
-    found = closures.measure(engine.tree, reading, states, tau=tau, reach=size)
+    found = closures.measure(tree, reading, states, tau=tau, reach=size)
     shape = max(found.residual / size, found.jacobian, found.row_space)
     out = [_row(model, subject="model", field="constraint rows", engine=name,
                 verdict=Verdict.PASSED if shape <= found.rows_bound else Verdict.FAILED,
                 error=shape, tolerance=found.rows_bound, basis=ROWS_BASIS,
                 note="C and J of its constraints at the referee's states" if
                 shape <= found.rows_bound else "cause unknown: its constraints are not the "
-                "referee's reading of them at the same states"),
-           _row(model, subject="forward (soft)", field="max rel error", engine=name,
-                verdict=Verdict.PASSED if found.soft <= found.bound else Verdict.FAILED,
-                error=found.soft, tolerance=found.bound, basis=SOFT_BASIS,
-                note="against the referee's soft model with the file's solref and solimp"
-                if found.soft <= found.bound else "cause unknown: not the soft model its "
-                "file states")]
+                "referee's reading of them at the same states")]
+    soft = any(c.soft for c in tree.closures)
+    if soft:
+        out.append(_row(model, subject="forward (soft)", field="max rel error", engine=name,
+                        verdict=Verdict.PASSED if found.soft <= found.bound else Verdict.FAILED,
+                        error=found.soft, tolerance=found.bound, basis=SOFT_BASIS,
+                        note="against the referee's soft model with the file's solref and "
+                             "solimp" if found.soft <= found.bound else "cause unknown: not "
+                             "the soft model its file states"))
     rigid = Verdict.PASSED if found.rigid <= found.bound else (
-        Verdict.EXPLAINED if abs(found.rigid - found.predicted) <= 2 * found.bound
+        Verdict.EXPLAINED if soft and abs(found.rigid - found.predicted) <= 2 * found.bound
         else Verdict.FAILED)
     why = {Verdict.PASSED: "the rigid answer, to round-off",
            Verdict.EXPLAINED: f"its constraints are soft (solref, solimp): the soft model "
                               f"predicts {found.predicted:.3g} from the rigid answer",
-           Verdict.FAILED: f"cause unknown: the soft model predicts {found.predicted:.3g}"}
+           Verdict.FAILED: f"cause unknown: the soft model predicts {found.predicted:.3g}"
+           if soft else "cause unknown: it holds its constraints rigidly"}
     out.append(_row(model, subject="forward (rigid)", field="max rel error", engine=name,
                     verdict=rigid, error=found.rigid, tolerance=found.bound,
                     basis=SOFT_BASIS, note=why[rigid]))

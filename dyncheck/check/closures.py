@@ -34,7 +34,7 @@ from dyncheck.reference.closure import (
     project,
     rows,
 )
-from dyncheck.reference.constrained import multipliers, reduced, soft
+from dyncheck.reference.constrained import RANK_RTOL, multipliers, reduced, soft
 from dyncheck.reference.constraints import Softness
 from dyncheck.reference.tree import TreeDynamics
 
@@ -173,16 +173,21 @@ def reference_row(tree: ModelTree, *, value: np.ndarray, rate: np.ndarray,
 def referee(tree: ModelTree, q: np.ndarray, v: np.ndarray, *, tau: np.ndarray,
             diagonal: np.ndarray) -> RefereeAnswer:
     """The referee on ``tree``'s closures at the states (canonical layout), the soft model
-    with the engine's ``diagonal`` (S, m)."""
+    with the engine's ``diagonal`` (S, m); where the engine holds its closures rigidly, the
+    soft model is the rigid answer."""
     solver = TreeDynamics(bodies(tree), tree.gravity)
     held = rows(solver, referee_closures(tree), q, v)
     mass, bias, _, _ = solver.at_states(q, v)
+    soft_held = any(c.soft for c in tree.closures)
     out: dict[str, list[np.ndarray]] = {"reduced": [], "multipliers": [], "soft": []}
     for s in range(len(q)):
         jac, jdot_v = held.jacobian[s], held.bias[s]
         args = (mass[s], bias[s], tau[s])
         out["reduced"].append(reduced(*args, J=jac, jdot_v=jdot_v).vdot)
         out["multipliers"].append(multipliers(*args, J=jac, jdot_v=jdot_v).vdot)
+        if not soft_held:
+            out["soft"].append(out["multipliers"][-1])
+            continue
         a_ref = reference_row(tree, value=held.value[s], rate=jac @ v[s], jdot_v=jdot_v)
         out["soft"].append(soft(*args, J=jac, a_ref=a_ref, regularizer=regularizer(
             tree, diagonal=diagonal[s], value=held.value[s])).vdot)
@@ -223,7 +228,8 @@ class Measured:
     scale: float
     """The accelerations' scale: the largest |v̇| of the free tree and of the answers."""
     bound: float
-    """The round-off bound of the accelerations: 64 ε κ(M) κ(A + R), relative to ``scale``."""
+    """The round-off bound of the accelerations, relative to ``scale``: 64 ε κ(M) κ(A + R),
+    plus an iterative solver's accuracy (its residual in the rows) times that κ."""
     rows_bound: float
     """The round-off bound of the rows: 64 ε relative to the model's reach and |J|."""
 
@@ -238,10 +244,11 @@ def measure(tree: ModelTree, reading: ClosedReading, states: ClosedStates, *,
     solver = TreeDynamics(bodies(tree), tree.gravity)
     mass, bias, _, _ = solver.at_states(q, v)
     free = np.linalg.solve(mass, (tau - bias)[..., None])[..., 0]
+    soft_held = any(c.soft for c in tree.closures)
     kappa = max((float(np.linalg.cond(mass[s])) * _soft_condition(
         mass[s], ref.rows.jacobian[s], regularizer(tree, diagonal=reading.diagonal[s, pick],
-                                                   value=ref.rows.value[s]))
-                 for s in range(len(q))), default=1.0)
+                                                   value=ref.rows.value[s])
+        if soft_held else np.zeros(len(pick))) for s in range(len(q))), default=1.0)
     scale = max(float(np.abs(free).max(initial=0.0)), float(np.abs(ref.soft).max(initial=0.0)),
                 float(np.abs(ref.multipliers).max(initial=0.0)), 1e-300)
     norm = max(float(np.abs(ref.rows.jacobian).max(initial=0.0)), 1e-300)
@@ -255,12 +262,15 @@ def measure(tree: ModelTree, reading: ClosedReading, states: ClosedStates, *,
         soft=float(np.abs(reading.vdot - ref.soft).max(initial=0.0)) / scale,
         rigid=float(np.abs(reading.vdot - ref.multipliers).max(initial=0.0)) / scale,
         predicted=float(np.abs(ref.soft - ref.multipliers).max(initial=0.0)) / scale,
-        scale=scale, bound=ROUNDOFF_FACTOR * EPS * kappa,
+        scale=scale, bound=ROUNDOFF_FACTOR * EPS * kappa + reading.accuracy * kappa / scale,
         rows_bound=ROUNDOFF_FACTOR * EPS * max(reach, 1.0))
 
 
 def _soft_condition(mass: np.ndarray, jac: np.ndarray, reg: np.ndarray) -> float:
-    """κ(A + R), A = J M⁻¹ Jᵀ (1 without rows)."""
+    """κ(A + R), A = J M⁻¹ Jᵀ, on its range (a redundant row of a rigid constraint adds a
+    zero singular value that no solve meets; 1 without rows)."""
     if not jac.size:
         return 1.0
-    return float(np.linalg.cond(jac @ np.linalg.solve(mass, jac.T) + np.diag(reg)))
+    values = np.linalg.svd(jac @ np.linalg.solve(mass, jac.T) + np.diag(reg), compute_uv=False)
+    kept = values[values > RANK_RTOL * values[0]] if values[0] > 0 else values[:1]
+    return float(kept[0] / kept[-1]) if kept.size and kept[-1] > 0 else 1.0
