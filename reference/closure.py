@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.reference.constrained import Closed
-from dyncheck.reference.tree import PointMotion, TreeDynamics
+from dyncheck.reference.tree import TreeDynamics
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -119,23 +119,19 @@ def _coupling(c: Coupling, tree: TreeDynamics, q: np.ndarray,
     return value[:, None], jac[:, None], bias[:, None]
 
 
-def _pair(tree: TreeDynamics, q: np.ndarray, v: np.ndarray, *, body1: int, body2: int,
-          point1: np.ndarray, point2: np.ndarray) -> tuple[PointMotion, PointMotion]:
-    return (tree.point_motion(q, v, body=body1, point=point1),
-            tree.point_motion(q, v, body=body2, point=point2))
-
-
 def rows(tree: TreeDynamics, closures: list[Closure] | tuple[Closure, ...], q: np.ndarray,
          v: np.ndarray) -> Rows:
     """Every closure's rows at S states (q (S, nq), v (S, nv), the tree's layout)."""
     q, v = np.atleast_2d(np.asarray(q, float)), np.atleast_2d(np.asarray(v, float))
     parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    posed = [c for c in closures if not isinstance(c, Coupling)]
+    motions = iter(tree.points_motion(q, v, [x for c in posed for x in (
+        (c.body1, c.point1), (c.body2, c.point2))]))
     for c in closures:
         if isinstance(c, Coupling):
             parts.append(_coupling(c, tree, q, v))
             continue
-        one, two = _pair(tree, q, v, body1=c.body1, body2=c.body2, point1=c.point1,
-                         point2=c.point2)
+        one, two = next(motions), next(motions)
         value = one.position - two.position
         jac = one.linear - two.linear
         bias = one.linear_bias - two.linear_bias
@@ -167,42 +163,44 @@ def forward(tree: TreeDynamics, closures: list[Closure] | tuple[Closure, ...], q
 
 
 def _quat_step(quat: np.ndarray, xi: np.ndarray) -> np.ndarray:
-    """quat ⊗ exp(ξ/2) (w, x, y, z): the rotation R exp(ξ̂), ξ in the body's axes."""
-    angle = np.linalg.norm(xi)
-    half = np.concatenate([[np.cos(angle / 2)],
-                           xi * (np.sinc(angle / (2 * np.pi)) / 2)])  # sin(θ/2)/θ · ξ
-    w1, v1, w2, v2 = quat[0], quat[1:], half[0], half[1:]
-    out = np.concatenate([[w1 * w2 - v1 @ v2], w1 * v2 + w2 * v1 + np.cross(v1, v2)])
-    return out / np.linalg.norm(out)
+    """quat ⊗ exp(ξ/2) (w, x, y, z; S rows): the rotation R exp(ξ̂), ξ in the body's axes."""
+    angle = np.linalg.norm(xi, axis=-1, keepdims=True)
+    half = np.concatenate([np.cos(angle / 2),
+                           xi * (np.sinc(angle / (2 * np.pi)) / 2)], -1)  # sin(θ/2)/θ · ξ
+    w1, v1, w2, v2 = quat[..., :1], quat[..., 1:], half[..., :1], half[..., 1:]
+    out = np.concatenate([w1 * w2 - np.sum(v1 * v2, -1, keepdims=True),
+                          w1 * v2 + w2 * v1 + np.cross(v1, v2)], -1)
+    return out / np.linalg.norm(out, axis=-1, keepdims=True)
 
 
 def retract(tree: TreeDynamics, q: np.ndarray, dv: np.ndarray) -> np.ndarray:
-    """q ⊕ dv on the tree's charts: hinges and slides add, a ball turns by exp(dξ) in its
-    axes, a free body moves by its world displacement and turns likewise (MuJoCo's layout)."""
+    """q ⊕ dv on the tree's charts, S states at once: hinges and slides add, a ball turns
+    by exp(dξ) in its axes, a free body moves by its world displacement and turns likewise
+    (MuJoCo's layout)."""
     out = np.array(q, float)
     for j, body in enumerate(tree.bodies):
         qs, vs = int(tree.q_start[j]), int(tree.v_start[j])
         if body.kind in ("hinge", "slide"):
-            out[qs] += dv[vs]
+            out[..., qs] += dv[..., vs]
         elif body.kind == "ball":
-            out[qs : qs + 4] = _quat_step(out[qs : qs + 4], dv[vs : vs + 3])
+            out[..., qs : qs + 4] = _quat_step(out[..., qs : qs + 4], dv[..., vs : vs + 3])
         else:
-            out[qs : qs + 3] += dv[vs : vs + 3]
-            out[qs + 3 : qs + 7] = _quat_step(out[qs + 3 : qs + 7], dv[vs + 3 : vs + 6])
+            out[..., qs : qs + 3] += dv[..., vs : vs + 3]
+            out[..., qs + 3 : qs + 7] = _quat_step(out[..., qs + 3 : qs + 7],
+                                                   dv[..., vs + 3 : vs + 6])
     return out
 
 
 @dataclass(frozen=True, kw_only=True)
 class Projected:
-    """A state moved onto the constraints: q with C(q) = 0 and v in J's null space, how
-    far it is from them (|C|, |J v|, largest entries), and whether Newton's method
-    converged."""
+    """S states moved onto the constraints: q with C(q) = 0 and v in J's null space, how far
+    each is from them (|C|, |J v|, largest entries), and whether Newton's method converged."""
 
     q: np.ndarray
     v: np.ndarray
-    residual: float
-    rate: float
-    converged: bool
+    residual: np.ndarray
+    rate: np.ndarray
+    converged: np.ndarray
 
 
 PROJECTION_STEPS = 50
@@ -210,24 +208,40 @@ PROJECTION_STEPS = 50
 more is near a singular configuration, or off every solution)."""
 
 
+def _least_norm(jac: np.ndarray, value: np.ndarray) -> np.ndarray:
+    """J⁺ C of each state (S, m, nv), (S, m): the least-norm step (rank-deficient rows
+    allowed)."""
+    return np.einsum("sij,sj->si", np.linalg.pinv(jac, rcond=1e-12), value)
+
+
 def project(tree: TreeDynamics, closures: list[Closure] | tuple[Closure, ...], q: np.ndarray,
             v: np.ndarray, *, tol: float) -> Projected:
-    """Newton's method on C(q) = 0 from the draw q (the least-norm step −J⁺ C on the charts,
-    :func:`retract`), then v projected on J's null space: the admissible state nearest the
-    draw's velocity. ``tol``: the largest |C| accepted (lengths in the file's units)."""
-    q, v = np.array(q, float), np.array(v, float)
-    last = np.inf
+    """Newton's method on C(q) = 0 from the draws q (S, nq) — the least-norm step −J⁺ C on
+    the charts (:func:`retract`), every state at once, each stopping once within ``tol``
+    and no longer shrinking — then v projected on J's null space: the admissible state
+    nearest the draw's velocity. ``tol``: the largest |C| accepted (the file's lengths)."""
+    q, v = np.atleast_2d(np.array(q, float)), np.atleast_2d(np.array(v, float))
+    moving = np.ones(len(q), bool)
+    last = np.full(len(q), np.inf)
     for _ in range(PROJECTION_STEPS):
-        held = rows(tree, closures, q[None], v[None])
-        value, jac = held.value[0], held.jacobian[0]
-        size = float(np.abs(value).max(initial=0.0))
-        if size <= tol and size >= last / 2:  # (within tol and no longer shrinking)
+        if not moving.any():
             break
-        last = size
-        q = retract(tree, q, -np.linalg.lstsq(jac, value, rcond=None)[0])
-    held = rows(tree, closures, q[None], v[None])
-    jac = held.jacobian[0]
-    v = v - np.linalg.pinv(jac) @ (jac @ v) if jac.size else v
-    residual = float(np.abs(held.value[0]).max(initial=0.0))
-    rate = float(np.abs(jac @ v).max(initial=0.0))
+        held = rows(tree, closures, q[moving], v[moving])
+        size = np.abs(held.value).max(axis=1, initial=0.0)
+        done = (size <= tol) & (size >= last[moving] / 2)
+        last[moving] = size
+        step = moving.copy()
+        step[moving] = ~done
+        if step.any():
+            keep = ~done
+            q[step] = retract(tree, q[step], -_least_norm(held.jacobian[keep],
+                                                          held.value[keep]))
+        moving = step
+    held = rows(tree, closures, q, v)
+    jac = held.jacobian
+    if jac.shape[1]:
+        v = v - np.einsum("sij,sj->si", np.linalg.pinv(jac, rcond=1e-12),
+                          np.einsum("sij,sj->si", jac, v))
+    residual = np.abs(held.value).max(axis=1, initial=0.0)
+    rate = np.abs(np.einsum("sij,sj->si", jac, v)).max(axis=1, initial=0.0)
     return Projected(q=q, v=v, residual=residual, rate=rate, converged=residual <= tol)

@@ -202,19 +202,31 @@ class TreeDynamics(Tree):
         """A point fixed on joint ``body``'s body (world coordinates at the reference
         configuration; −1: fixed in the world) at S states: where it is, and its and the
         body's rows of velocity and of acceleration at v̇ = 0 (what the closures of
-        :mod:`.closure` are made of)."""
+        :mod:`.closure` are made of); :meth:`points_motion` for several, one walk."""
+        return self.points_motion(q, v, [(body, point)])[0]
+
+    def points_motion(self, q: np.ndarray, v: np.ndarray,
+                      points: list[tuple[int, np.ndarray]]) -> list[PointMotion]:
+        """:meth:`point_motion` of each (body, point), the tree walked once."""
         q, v = np.atleast_2d(np.asarray(q, float)), np.atleast_2d(np.asarray(v, float))
-        ns, nv = len(q), self.nv
-        zeros = np.zeros((ns, 3, nv))
-        if body < 0:
-            fixed = np.broadcast_to(np.asarray(point, float), (ns, 3)).copy()
+        walked = self._walk(q, v) if any(b >= 0 for b, _ in points) else None
+        return [self._point(walked, len(q), body=b, point=np.asarray(p, float))
+                for b, p in points]
+
+    def _point(self, walked: tuple[list[_Pose], list[list[_Column]]] | None, ns: int, *,
+               body: int, point: np.ndarray) -> PointMotion:
+        """One point's motion from the tree's walk (None: no body moves; see
+        :meth:`point_motion`)."""
+        zeros = np.zeros((ns, 3, self.nv))
+        if body < 0 or walked is None:
+            fixed = np.broadcast_to(point, (ns, 3)).copy()
             return PointMotion(position=fixed, rotation=np.tile(np.eye(3), (ns, 1, 1)),
                                linear=zeros, angular=zeros.copy(),
                                linear_bias=np.zeros((ns, 3)), angular_bias=np.zeros((ns, 3)))
-        poses, columns_of = self._walk(q, v)
+        poses, columns_of = walked
         rot, trans, omega, vel = poses[body]
         n = len(self.ancestor_columns[body])
-        x = np.einsum("srij,j->sri", rot, np.asarray(point, float)) + trans
+        x = np.einsum("srij,j->sri", rot, point) + trans
         x0 = x[:, -1].real
         linear, angular = zeros, zeros.copy()
         chain = [body]

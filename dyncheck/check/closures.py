@@ -28,7 +28,6 @@ from dyncheck.reference.closure import (
     Closure,
     Connect,
     Coupling,
-    Projected,
     Rows,
     Weld,
     project,
@@ -115,18 +114,11 @@ def on_constraints(tree: ModelTree, q: np.ndarray, v: np.ndarray, *,
     """The draws (q, v) moved onto the tree's closures; a draw whose Newton iteration does
     not converge is dropped and counted."""
     solver = TreeDynamics(bodies(tree), tree.gravity)
-    held = referee_closures(tree)
-    kept: list[Projected] = []
-    for qk, vk in zip(q, v, strict=True):
-        moved = project(solver, held, qk, vk, tol=PROJECTION_TOL * max(reach, 1.0))
-        if moved.converged:
-            kept.append(moved)
-    nq, nv = q.shape[1], v.shape[1]
-    return ClosedStates(
-        q=np.array([k.q for k in kept]).reshape(-1, nq),
-        v=np.array([k.v for k in kept]).reshape(-1, nv), drawn=len(q),
-        residual=max((k.residual for k in kept), default=0.0),
-        rate=max((k.rate for k in kept), default=0.0))
+    moved = project(solver, referee_closures(tree), q, v, tol=PROJECTION_TOL * max(reach, 1.0))
+    kept = moved.converged
+    return ClosedStates(q=moved.q[kept], v=moved.v[kept], drawn=len(q),
+                        residual=float(moved.residual[kept].max(initial=0.0)),
+                        rate=float(moved.rate[kept].max(initial=0.0)))
 
 
 @dataclass(frozen=True, kw_only=True)
