@@ -7,10 +7,11 @@ per-implementation seconds: the referee against the slowest engine).
 Models: a 29-joint floating humanoid (example-robot-data's ``g1_29dof_rev_1_0``, extra
 ``robots``) at 1000 states; a chain of 200 hinges (written here) at 10 states; every book
 case's MJCF at 100 states (``--case all``); the humanoid with ``--derivatives`` at 100 states;
-the chain with ``--derivatives`` at 10 states. Targets from the issues: the humanoid's whole
-command ≤ 2 s, its referee ≤ 5× the slowest engine; the chain ≤ 10 s; with derivatives ≤ 5 s,
-the referee's derivatives ≤ 3× the slowest engine's own (#58); the chain with derivatives
-≤ 10 s (#58).
+the chain with ``--derivatives`` at 10 states; a ladder of 66 hinges closed by 5 connects
+(written here) and the same ladder open, at 100 states. Targets from the issues: the
+humanoid's whole command ≤ 2 s, its referee ≤ 5× the slowest engine; the chain ≤ 10 s; with
+derivatives ≤ 5 s, the referee's derivatives ≤ 3× the slowest engine's own (#58); the chain
+with derivatives ≤ 10 s (#58); the closed ladder ≤ 2× the open one (#78).
 
 Then the referee's scale, in this process: its derivatives (:func:`dyncheck.check.derivatives.
 referee`, the recursive algorithm differentiated by a complex step, with the curvatures
@@ -40,6 +41,23 @@ def chain(n: int) -> str:
             '<inertial pos="0 0 -0.05" mass="0.1" diaginertia="1e-3 1e-3 1e-4"/>')
     body = "".join(link.format(i=i, z=-0.1 if i else 0) for i in range(n)) + "</body>" * n
     return f'<mujoco model="chain{n}"><worldbody>{body}</worldbody></mujoco>'
+
+
+def ladder(n: int, loops: int, *, closed: bool = True) -> str:
+    """A planar ladder: ``loops`` + 1 hanging chains of ``n`` hinges side by side, each chain's
+    last link held to the next one's by a ``<connect>`` (``closed``; without: the same tree
+    open, the check as it was before closures were checked)."""
+    def chain(k: int) -> str:
+        links = "".join(
+            f'<body name="b{k}_{i}" pos="{0.3 * k if i == 0 else 0} 0 {0 if i == 0 else -0.2}">'
+            f'<joint name="b{k}_{i}" axis="0 1 0"/><geom type="capsule" fromto="0 0 0 0 0 -0.2"'
+            ' size=".02" mass="0.3"/>' for i in range(n))
+        return links + "</body>" * n
+    held = "".join(f'<connect body1="b{k}_{n - 1}" body2="b{k + 1}_{n - 1}" '
+                   'anchor="0.15 0 -0.2"/>' for k in range(loops))
+    return ('<mujoco model="ladder"><worldbody><body name="ground">'
+            + "".join(chain(k) for k in range(loops + 1)) + "</body></worldbody>"
+            + (f"<equality>{held}</equality>" if closed else "") + "</mujoco>")
 
 
 def floating(n: int) -> str:
@@ -119,6 +137,8 @@ def measure(repeats: int) -> pd.DataFrame:
     rows = []
     with tempfile.TemporaryDirectory(prefix="dyncheck-check-speed-") as tmp:
         (Path(tmp) / "chain200.xml").write_text(chain(200))
+        (Path(tmp) / "ladder.xml").write_text(ladder(10, 5))
+        (Path(tmp) / "ladder_open.xml").write_text(ladder(10, 5, closed=False))
         commands = {
             "29-joint floating humanoid, 1000 states": (
                 ["--robot", "g1_29dof_rev_1_0", "--floating", "--states", "1000"],
@@ -131,6 +151,10 @@ def measure(repeats: int) -> pd.DataFrame:
                  "--derivatives"], "g1_29dof_rev_1_0", 5.0),
             "200-hinge chain with --derivatives, 10 states": (
                 [f"{tmp}/chain200.xml", "--states", "10", "--derivatives"], "chain200", 10.0),
+            "66-hinge ladder without its 5 connects, 100 states": (
+                [f"{tmp}/ladder_open.xml"], "", 0.0),
+            "66-hinge ladder closed by 5 connects (#78: ≤ 2× open), 100 states": (
+                [f"{tmp}/ladder.xml"], "", 0.0),
         }
         for what, (args, page, target) in commands.items():
             seconds = []
@@ -158,7 +182,12 @@ def measure(repeats: int) -> pd.DataFrame:
                             "d_referee_over_engine": round(parts["d reference"] / max(own),
                                                            1)}
             rows.append(row)
-    return pd.DataFrame(rows)
+    frame = pd.DataFrame(rows)
+    is_open = frame["command"].str.contains("without its 5 connects")
+    closed = frame["command"].str.contains("closed by 5 connects")
+    frame.loc[closed, "target_s"] = 2 * float(frame.loc[is_open, "seconds"].iloc[0])
+    frame.loc[is_open, "target_s"] = None
+    return frame
 
 
 def main() -> None:
