@@ -21,7 +21,8 @@ GEOMETRY_NOTE = (
 )
 MIMIC_NOTE = (
     "URDF <mimic> couplings removed before loading: they are constraints, left out of the "
-    "smooth dynamics in every engine (Drake's continuous plant refuses them outright)"
+    "smooth dynamics in every engine (Drake's continuous plant refuses them outright); an "
+    "engine that reads them computes with them in the closures section"
 )
 
 
@@ -52,6 +53,9 @@ class ModelFile:
     text: str
     floating: bool
     notes: tuple[str, ...]
+    closed_text: str = ""
+    """The text with the constraints :attr:`text` leaves out (a URDF's ``<mimic>``), for an
+    engine's dynamics with them (the closures section); empty where nothing was left out."""
 
 
 def read(path: Path, *, floating: bool = False) -> ModelFile:
@@ -68,6 +72,7 @@ def read(path: Path, *, floating: bool = False) -> ModelFile:
             notes.append(f"{len(missing)} mesh files the URDF names were not found (first: "
                          f"{missing[0]!r}); no mesh is read, so the check does not need them")
         mimics = [(j, m) for j in root.findall("joint") for m in j.findall("mimic")]
+        closed = ET.tostring(root, encoding="unicode") if mimics else ""
         for joint, mimic in mimics:
             joint.remove(mimic)
         if mimics:
@@ -76,9 +81,8 @@ def read(path: Path, *, floating: bool = False) -> ModelFile:
             floating = False
             notes.append(WELDED_NOTE)
         text = ET.tostring(root, encoding="unicode")
-        return ModelFile(
-            path=path, format=Format.URDF, text=text, floating=floating, notes=tuple(notes)
-        )
+        return ModelFile(path=path, format=Format.URDF, text=text, floating=floating,
+                         notes=tuple(notes), closed_text=closed)
     said: tuple[str, ...] = (FLOATING_MJCF,) if floating else ()
     # the text as the file declares it is encoded: the file's own where it is UTF-8,
     # else the parsed document written out again

@@ -214,8 +214,11 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
                  solimp: tuple[float, ...] | None = None) -> None:
         self.model, notes, self._inertias = _compile(source, exact_meshes=exact_meshes)
         m = self.model
+        self._closed = _compile(replace(source, text=source.closed_text))[0] \
+            if source.closed_text else m  # (a URDF's <mimic>: MuJoCo's joint equalities)
         if solimp is not None:
             m.eq_solimp[:] = solimp
+            self._closed.eq_solimp[:] = solimp
         self._gravity = m.opt.gravity.copy()
         if m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_GRAVITY:
             self._gravity[:] = 0.0
@@ -309,7 +312,7 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
                     layout=layouts[j],
                 )
             )
-        held, unheld = closures.read(m, d, [_joint_name(m, j) for j in range(m.njnt)])
+        held, unheld = closures.read(self._closed, d, [_joint_name(m, j) for j in range(m.njnt)])
         rounding = mesh_rounding(m, self._inertias.from_geoms, self._inertias.text_meshes)
         by_joint = {j.name: max(rounding.get(b, 0.0) for b in groups[int(m.jnt_bodyid[k])])
                     for k, j in enumerate(joints)}
@@ -327,7 +330,7 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
     def closed(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> ClosedReading:
         """Its equalities' rows and its forward dynamics with them on (:func:`.closures.
         closed`)."""
-        return closures.closed(self.model, q, v, tau)
+        return closures.closed(self._closed, q, v, tau)
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
         e = evaluate(self.model, self.data, q=q, v=v, tau=np.zeros_like(v), a=a)

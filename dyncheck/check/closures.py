@@ -37,6 +37,9 @@ from dyncheck.reference.constrained import RANK_RTOL, multipliers, reduced, soft
 from dyncheck.reference.constraints import Softness
 from dyncheck.reference.tree import TreeDynamics
 
+ACCELERATION_FLOOR = 1.0
+"""The smallest scale of accelerations (m/s²): where the free and constrained motions are
+slower (a mechanism moving across gravity, at rest), errors are held absolutely at it."""
 PROJECTION_TOL = 1e-12
 """|C| accepted of a state moved onto the constraints, relative to the model's reach (a few
 ε of the positions Newton's last step rounds)."""
@@ -218,10 +221,12 @@ class Measured:
     predicted: float
     """The soft model's distance from the rigid answer: what the engine's should be."""
     scale: float
-    """The accelerations' scale: the largest |v̇| of the free tree and of the answers."""
+    """The accelerations' scale: the largest |v̇| of the free tree and of the answers, at
+    least :data:`ACCELERATION_FLOOR`."""
     bound: float
     """The round-off bound of the accelerations, relative to ``scale``: 64 ε κ(M) κ(A + R),
-    plus an iterative solver's accuracy (its residual in the rows) times that κ."""
+    plus an iterative solver's accuracy (its residual in the rows) times that κ, plus what
+    the soft model makes of the states' leftover |C| and |J v| (:func:`_reference_spread`)."""
     rows_bound: float
     """The round-off bound of the rows: 64 ε relative to the model's reach and |J|."""
 
@@ -233,16 +238,13 @@ def measure(tree: ModelTree, reading: ClosedReading, states: ClosedStates, *,
     q, v = states.q, states.v
     ref = referee(tree, q, v, tau=tau, diagonal=reading.diagonal[:, pick])
     jac = reading.jacobian[:, pick]
-    solver = TreeDynamics(bodies(tree), tree.gravity)
-    mass, bias, _, _ = solver.at_states(q, v)
+    mass, bias, _, _ = TreeDynamics(bodies(tree), tree.gravity).at_states(q, v)
     free = np.linalg.solve(mass, (tau - bias)[..., None])[..., 0]
-    soft_held = any(c.soft for c in tree.closures)
-    kappa = max((float(np.linalg.cond(mass[s])) * _soft_condition(
-        mass[s], ref.rows.jacobian[s], regularizer(tree, diagonal=reading.diagonal[s, pick],
-                                                   value=ref.rows.value[s])
-        if soft_held else np.zeros(len(pick))) for s in range(len(q))), default=1.0)
+    kappa, gain = _conditioning(tree, mass, ref.rows, diagonal=reading.diagonal[:, pick])
     scale = max(float(np.abs(free).max(initial=0.0)), float(np.abs(ref.soft).max(initial=0.0)),
-                float(np.abs(ref.multipliers).max(initial=0.0)), 1e-300)
+                float(np.abs(ref.multipliers).max(initial=0.0)), ACCELERATION_FLOOR)
+    leftover = gain * _reference_spread(tree, states, reach=reach,
+                                        rows=float(np.abs(ref.rows.jacobian).max(initial=0.0)))
     norm = max(float(np.abs(ref.rows.jacobian).max(initial=0.0)), 1e-300)
     return Measured(
         residual=float(np.abs(reading.value[:, pick]).max(initial=0.0)),
@@ -254,8 +256,41 @@ def measure(tree: ModelTree, reading: ClosedReading, states: ClosedStates, *,
         soft=float(np.abs(reading.vdot - ref.soft).max(initial=0.0)) / scale,
         rigid=float(np.abs(reading.vdot - ref.multipliers).max(initial=0.0)) / scale,
         predicted=float(np.abs(ref.soft - ref.multipliers).max(initial=0.0)) / scale,
-        scale=scale, bound=ROUNDOFF_FACTOR * EPS * kappa + reading.accuracy * kappa / scale,
+        scale=scale, bound=ROUNDOFF_FACTOR * EPS * kappa
+        + (reading.accuracy * kappa + leftover) / scale,
         rows_bound=ROUNDOFF_FACTOR * EPS * max(reach, 1.0))
+
+
+def _conditioning(tree: ModelTree, mass: np.ndarray, held: Rows, *,
+                  diagonal: np.ndarray) -> tuple[float, float]:
+    """κ(M) κ(A + R), the largest over the states, and the largest ‖M⁻¹ Jᵀ (A + R)⁻¹‖₂: how
+    much a change of the rows' reference acceleration moves v̇ (0 for a rigid reading)."""
+    soft_held = any(c.soft for c in tree.closures)
+    kappa, gain = 1.0, 0.0
+    for s in range(len(mass)):
+        jac = held.jacobian[s]
+        reg = regularizer(tree, diagonal=diagonal[s], value=held.value[s]) if soft_held else \
+            np.zeros(len(jac))
+        kappa = max(kappa, float(np.linalg.cond(mass[s])) * _soft_condition(mass[s], jac, reg))
+        if soft_held and jac.size:
+            minv_jt = np.linalg.solve(mass[s], jac.T)
+            gain = max(gain, float(np.linalg.norm(
+                minv_jt @ np.linalg.inv(jac @ minv_jt + np.diag(reg)), 2)))
+    return kappa, gain
+
+
+def _reference_spread(tree: ModelTree, states: ClosedStates, *, reach: float,
+                      rows: float) -> float:
+    """How far two implementations' reference accelerations a_ref = −b ṙ − k d r may lie
+    apart at the states: each rounds the leftover r (≤ |C| + 64 ε reach) and ṙ (≤ |J v| +
+    64 ε |J| |v|) its own way (0 where no closure is soft)."""
+    soft = [softness(c) for c in tree.closures if c.soft]
+    if not soft:
+        return 0.0
+    speed = float(np.abs(states.v).max(initial=0.0))
+    rate = states.rate + ROUNDOFF_FACTOR * EPS * rows * speed
+    residual = states.residual + ROUNDOFF_FACTOR * EPS * max(reach, 1.0)
+    return max(s.damping for s in soft) * rate + max(s.stiffness for s in soft) * residual
 
 
 def _soft_condition(mass: np.ndarray, jac: np.ndarray, reg: np.ndarray) -> float:
