@@ -48,7 +48,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
-from dyncheck.adapters.pinocchio import closures
+from dyncheck.adapters.pinocchio import closures, mimic
 from dyncheck.adapters.pinocchio.mjcf import (
     BARE_BODY,
     CLASS_LOOKUP_FAILED,
@@ -216,7 +216,8 @@ class PinocchioModel(ModelEngine):
                  inertias: Mapping[str, np.ndarray] | None = None) -> None:
         self.model = _load(source)
         self._held = _constraints(source, self.model)
-        self._closures_read = source.format is Format.MJCF  # (its URDF parser: no mimic read)
+        self._mimics = mimic.load(source.closed_text, self.model, floating=source.floating) \
+            if source.closed_text else None  # (a URDF's <mimic>: its mimic joints)
         if gravity is not None:
             self.model.gravity = pin.Motion(np.asarray(gravity, float), np.zeros(3))
         _stated_inertias(self.model, inertias or {})
@@ -312,8 +313,8 @@ class PinocchioModel(ModelEngine):
         return ModelTree(
             engine=ENGINE, joints=tuple(joints), gravity=np.asarray(m.gravity.linear, float),
             nq=m.nq, nv=m.nv, notes=notes, hints=self._hints,
-            closures=closures.read(self._held, d, {i: n for i, n in last_name.items() if n}),
-            closures_read=self._closures_read,
+            closures=closures.read(self._held, d, {i: n for i, n in last_name.items() if n})
+            + mimic.read(self._mimics), closures_read=True,
         )
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
@@ -378,6 +379,8 @@ class PinocchioModel(ModelEngine):
 
     def closed(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> ClosedReading:
         """Its constrained dynamics on the file's constraints (:func:`.closures.closed`)."""
+        if self._mimics is not None:
+            return mimic.closed(self._mimics, self.model.nv, q, v, tau=tau)
         return closures.closed(self.model, self._held, q, v, tau=tau)
 
     def couple(self, couplings: Sequence[Coupling]) -> None:

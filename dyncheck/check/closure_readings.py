@@ -37,15 +37,16 @@ def _gap(mine: Closure, theirs: Closure, *, reach: float) -> tuple[float, str]:
                          held=theirs.held.T, rotation_scale=theirs.rotation_scale)
     size = max(len(mine.polycoef), len(theirs.polycoef))
     gaps = {
-        "anchor": max(float(np.abs(mine.point1 - theirs.point1).max()),
-                      float(np.abs(mine.point2 - theirs.point2).max())) / reach,
-        "rotation": float(np.abs(mine.held - theirs.held).max()),
         "polycoef": float(np.abs(np.pad(mine.polycoef, (0, size - len(mine.polycoef)))
                                  - np.pad(theirs.polycoef, (0, size - len(theirs.polycoef))))
                           .max(initial=0.0)),
         "lengths": 0.0 if (dict(mine.first), dict(mine.second)) == (dict(theirs.first),
                                                                     dict(theirs.second))
         else float("inf"),
+    } if mine.first else {
+        "anchor": max(float(np.abs(mine.point1 - theirs.point1).max()),
+                      float(np.abs(mine.point2 - theirs.point2).max())) / reach,
+        "rotation": float(np.abs(mine.held - theirs.held).max()),
     }
     field = max(gaps, key=lambda k: gaps[k])
     return gaps[field], field
