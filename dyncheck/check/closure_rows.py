@@ -42,6 +42,15 @@ def _without(name: str) -> str:
             f"constraint solver of {name}'s yet")
 
 
+def _dropped(states: closures.ClosedStates) -> str:
+    """The dropped draws' farthest constraint, as words (empty: none dropped)."""
+    if states.unmet is None:
+        return ""
+    name, far = states.unmet
+    return (f"; {states.drawn - len(states.q)} dropped, none closer to meeting {name!r} than "
+            f"|C| = {far:.2g}")
+
+
 def _unread(name: str, tree: ModelTree) -> str:
     """Why an engine's constraints are not compared: the note of the copy it was given
     without them, or that its loader reads none."""
@@ -87,11 +96,12 @@ def rows(model: str, canonical_tree: ModelTree, loaded: dict[str, ModelEngine],
                 value_a=f"{kept} of {states.drawn} kept",
                 value_b=f"|C| <= {states.residual:.1e}, |J v| <= {states.rate:.1e}",
                 note=f"{kept} of {states.drawn} sampled states moved onto {names} by "
-                     "Newton's method on C(q) = 0 (a draw that does not converge is dropped), "
-                     f"velocities onto J's null space: |C| <= {states.residual:.1e}, "
-                     f"|J v| <= {states.rate:.1e}" if kept else
-                     f"no sampled state could be moved onto {names}: the constraints cannot "
-                     "be met near the sampled configurations")]
+                     "Newton's method on C(q) = 0 (a draw that does not converge is dropped"
+                     f"{_dropped(states)}), velocities onto J's null space: |C| <= "
+                     f"{states.residual:.1e}, |J v| <= {states.rate:.1e}" if kept else
+                     f"no sampled state could be moved onto {names}{_dropped(states)}: the "
+                     "constraints cannot all be met near the sampled configurations (they "
+                     "conflict, or a loop cannot close with the file's lengths)")]
     if not kept:
         return out
     for name, engine in loaded.items():

@@ -15,6 +15,7 @@ on them measured against it:
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -110,6 +111,9 @@ class ClosedStates:
     drawn: int
     residual: float
     rate: float
+    unmet: tuple[str, float] | None = None
+    """Of the dropped draws: the closure none of them came close to meeting, and the
+    smallest |C| they left it at (None: none dropped)."""
 
 
 def on_constraints(tree: ModelTree, q: np.ndarray, v: np.ndarray, *,
@@ -117,11 +121,20 @@ def on_constraints(tree: ModelTree, q: np.ndarray, v: np.ndarray, *,
     """The draws (q, v) moved onto the tree's closures; a draw whose Newton iteration does
     not converge is dropped and counted."""
     solver = TreeDynamics(bodies(tree), tree.gravity)
-    moved = project(solver, referee_closures(tree), q, v, tol=PROJECTION_TOL * max(reach, 1.0))
+    held = referee_closures(tree)
+    moved = project(solver, held, q, v, tol=PROJECTION_TOL * max(reach, 1.0))
     kept = moved.converged
+    unmet = None
+    if not kept.all():  # the constraint the dropped draws came least close to meeting
+        left = np.abs(rows(solver, held, moved.q[~kept], moved.v[~kept]).value)
+        ends = np.cumsum([0, *row_sizes(tree)])
+        far = [float(left[:, a:b].max(axis=1, initial=0.0).min())
+               for a, b in itertools.pairwise(ends)]
+        worst = int(np.argmax(far))
+        unmet = (tree.closures[worst].name, far[worst])
     return ClosedStates(q=moved.q[kept], v=moved.v[kept], drawn=len(q),
                         residual=float(moved.residual[kept].max(initial=0.0)),
-                        rate=float(moved.rate[kept].max(initial=0.0)))
+                        rate=float(moved.rate[kept].max(initial=0.0)), unmet=unmet)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -207,7 +220,9 @@ class Measured:
     gap the largest over the states, with the round-off bound it is held to."""
 
     residual: float
-    """max |C| of the engine's rows at the referee's states (lengths; 0: the same set)."""
+    """max |C − C_ref| of the engine's rows at the referee's states (lengths; 0: the same
+    constraint; a weld's rotation rows compared only where both vanish, as every state here
+    is on the constraints)."""
     jacobian: float
     """max |J − J_ref| of the rows both state alike, relative to max |J_ref|."""
     row_space: float
@@ -247,7 +262,7 @@ def measure(tree: ModelTree, reading: ClosedReading, states: ClosedStates, *,
                                         rows=float(np.abs(ref.rows.jacobian).max(initial=0.0)))
     norm = max(float(np.abs(ref.rows.jacobian).max(initial=0.0)), 1e-300)
     return Measured(
-        residual=float(np.abs(reading.value[:, pick]).max(initial=0.0)),
+        residual=float(np.abs(reading.value[:, pick] - ref.rows.value).max(initial=0.0)),
         jacobian=float(np.abs(jac[:, ~rot] - ref.rows.jacobian[:, ~rot]).max(initial=0.0))
         / norm,
         row_space=max((row_space_gap(jac[s][rot], ref.rows.jacobian[s][rot])

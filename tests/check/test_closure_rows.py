@@ -97,3 +97,24 @@ def test_a_model_without_constraints_has_no_closures_section(tmp_path):
     path.write_text(FOUR_BAR.split("<equality>")[0] + "</mujoco>")
     result = check_model(path, impls=(*CLOSING[:1], "reference"), states=STATES, isolate=False)
     assert _section(result).empty
+
+
+def test_a_loop_that_cannot_close_is_named_with_its_gap(tmp_path):
+    """Two 0.3 m bars on hinges 1.0 m apart whose tips a site connect holds together: by
+    hand the tips come no closer than 1.0 − 2 × 0.3 = 0.4 m, so no draw reaches the
+    constraint; the states row fails, naming the connect and a gap of at least 0.4 m."""
+    path = tmp_path / "open_loop.xml"
+    path.write_text("""<mujoco><worldbody><body name="ground">
+ <body name="left"><joint name="left" axis="0 1 0"/>
+  <geom type="capsule" fromto="0 0 0 0 0 0.3" size=".02" mass="1"/><site name="a" pos="0 0 0.3"/>
+ </body><body name="right" pos="1 0 0"><joint name="right" axis="0 1 0"/>
+  <geom type="capsule" fromto="0 0 0 0 0 0.3" size=".02" mass="1"/><site name="b" pos="0 0 0.3"/>
+ </body></body></worldbody>
+<equality><connect name="tips" site1="a" site2="b"/></equality></mujoco>""")
+    result = check_model(path, impls=(*CLOSING[:1], "reference"), states=STATES, isolate=False)
+    rows = _section(result)
+    assert rows["verdict"].tolist() == ["failed"]
+    note = rows["note"].iloc[0]
+    assert "'tips'" in note
+    gap = float(note.split("than |C| = ")[1].split(":")[0])
+    assert gap >= 0.4 - 1e-9
