@@ -122,13 +122,21 @@ def _case(name: str, suite: str, rows: pd.DataFrame, columns: Columns, *,
     return case
 
 
+WHOLE = "*"
+"""The key of a suite's seconds measured as a whole (a run's case: its units of work), which
+its test cases share equally."""
+
+
 def _shares(keys: list[tuple[object, ...]], columns: Columns,
             took: dict[str, float] | None) -> list[float | None]:
     """Each group's share of the measured seconds: every engine's time on the model split
     equally among the groups that compare it, so that a suite's test cases add up to the time
-    its engines took (None where the command measured none)."""
+    its engines took (None where the command measured none); a suite measured as a whole
+    (:data:`WHOLE`) split equally among its groups."""
     if not took:
         return [None] * len(keys)
+    if WHOLE in took:
+        return [round(took[WHOLE] / len(keys), 6)] * len(keys)
     pairs = [[i for i in (_text(dict(zip(columns.group, k, strict=True)).get(c))
                           for c in ("impl_a", "impl_b")) if i in took] for k in keys]
     groups = {e: sum(e in p for p in pairs) for e in took}

@@ -115,7 +115,9 @@ def run(
                               (case, list(impl_names), n, start, stop)))
     first_convention = len(units)
     units += conventions or ()
-    done = run_units(units, jobs=jobs, dask=dask, progress=progress)
+    took: list[float] = []
+    done = run_units(units, jobs=jobs, dask=dask, progress=progress, took=took)
+    seconds: dict[str, float] = {}
     rows: list[Discrepancy] = []
     points: list[ConvergencePoint] = []
     figures: dict[str, TrajectoryFigures] = {}
@@ -129,6 +131,7 @@ def run(
             engines |= out[1]
         elif fn is not sweep_slice:  # a case; its slices' sweeps merged in order
             r, p, f, said, drawn, used = out
+            seconds[what] = took[i] + sum(took[k] for k in slices.get(what, ()))
             engines |= used
             if what in slices:
                 r = rows_of(reduce(Sweep.merge, (done[i] for i in slices[what]))) + r
@@ -149,4 +152,5 @@ def run(
         pngs,
         engines,
         tuple(impl_names),
+        seconds,
     )

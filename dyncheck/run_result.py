@@ -34,6 +34,9 @@ class RunResult:
     ran: tuple[str, ...] = IMPLEMENTATIONS
     """The implementations the run was asked for (the others have no rows: one line says
     which, :func:`dyncheck.roster.not_run`)."""
+    seconds: dict[str, float] = field(default_factory=dict)
+    """Per case, the seconds its units of work took where they ran (its whole unit and its
+    slices of states): the JUnit's and the JSON's times."""
 
     @property
     def failed(self) -> bool:

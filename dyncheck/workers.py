@@ -325,30 +325,36 @@ def run_units(
     jobs: int = 1,
     dask: str | None = None,
     progress: Progress | None = None,
+    took: list[float] | None = None,
 ) -> list[Any]:
     """The units' results in submission order, run here, on ``jobs`` processes or on a dask
     cluster (see :func:`executor`); ``progress`` hears of each unit as it finishes, with the
-    time it took."""
+    time it took; ``took``, where given, receives each unit's seconds in submission order
+    (its own time where it ran, not the wait for a worker)."""
     if progress is not None:
         progress.begin(len(units))
+    seconds_of: dict[int, float] = {}
     with executor(max(1, min(jobs, len(units))), dask) as pool:
-        done = []
+        results: dict[int, Any] = {}
         if pool is None:
-            for what, fn, args in units:
-                done.append(fn(*args))
+            for i, (what, fn, args) in enumerate(units):
+                start = time.perf_counter()
+                results[i] = fn(*args)
+                seconds_of[i] = time.perf_counter() - start
                 if progress is not None:
                     progress.done(what)
-            return done
-        settings = current()
-        futures = {pool.submit(_timed, settings, fn, *args): i
-                   for i, (_what, fn, args) in enumerate(units)}
-        results: dict[int, Any] = {}
-        for future in as_completed(futures):  # progress as units finish, not in order
-            i = futures[future]
-            seconds, results[i] = _result(future, units[i][0], dask)
-            if progress is not None:
-                progress.done(units[i][0], seconds=seconds)
-        return [results[i] for i in range(len(units))]
+        else:
+            settings = current()
+            futures = {pool.submit(_timed, settings, fn, *args): i
+                       for i, (_what, fn, args) in enumerate(units)}
+            for future in as_completed(futures):  # progress as units finish, not in order
+                i = futures[future]
+                seconds_of[i], results[i] = _result(future, units[i][0], dask)
+                if progress is not None:
+                    progress.done(units[i][0], seconds=seconds_of[i])
+    if took is not None:
+        took[:] = [seconds_of[i] for i in range(len(units))]
+    return [results[i] for i in range(len(units))]
 
 
 def _result(future: Any, what: str, dask: str | None) -> Any:

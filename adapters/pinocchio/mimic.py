@@ -49,7 +49,9 @@ def load(text: str, full: pin.Model, *, floating: bool) -> Mimics | None:
     if not mimicking:
         return None
     full_ids = {full.names[i]: i for i in range(1, full.njoints)}
-    q_of, v_of, couplings = [], [], []
+    q_of: list[int] = []
+    v_of: list[int] = []
+    couplings: list[Coupled] = []
     for i in range(1, model.njoints):
         name = model.names[i]
         if name not in full_ids:

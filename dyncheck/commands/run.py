@@ -49,9 +49,10 @@ def run_command(args: argparse.Namespace) -> int:
                      conventions=None if args.cases else catalogue.units(impls),
                      progress=progress, render=draw_figures)
     report.write(result, args.out)
-    from dyncheck.ci_outputs import RUN, split
+    from dyncheck.ci_outputs import RUN, WHOLE, split
 
-    write_ci(args, split(result.discrepancies, RUN), RUN, versions(result.engines))
+    write_ci(args, split(result.discrepancies, RUN), RUN, versions(result.engines),
+             seconds={case: {WHOLE: t} for case, t in result.seconds.items()})
     counts = result.discrepancies["verdict"].value_counts()
     left_out = None if args.impl else not_run(impls)  # (what --impl names is chosen)
     if left_out is not None:

@@ -87,6 +87,11 @@ def test_run_writes_junit_per_case(tmp_path):
     said = "\n".join(e.text or "" for e in root.iter("system-out"))
     for note in explained["note"]:
         assert note in said
+    # #80: a run's test cases had no time; each now carries its share of its case's seconds
+    suite = root.find("testsuite")
+    times = [float(c.get("time")) for c in suite.iter("testcase")]
+    assert all(t > 0 for t in times)
+    assert sum(times) == pytest.approx(float(suite.get("time")), abs=1e-3)
 
 
 def test_a_refused_model_is_a_failed_test_case(tmp_path):
@@ -157,3 +162,20 @@ def test_check_test_cases_carry_their_engines_time(tmp_path):
     assert times and all(t > 0 for t in times)
     assert sum(times) == pytest.approx(float(suite.get("time")), abs=1e-3)
     assert float(suite.get("time")) <= json.loads(summary.read_text())["seconds"]["m"] + 1e-3
+
+
+def test_a_suite_timed_as_a_whole_shares_its_seconds_among_its_test_cases():
+    """A run's case is timed as a whole (its units of work), not per engine: its 2 s are
+    split equally among its three groups — each test case 2/3 s, the suite 2 s."""
+    from dyncheck.ci_outputs import RUN, WHOLE, junit
+
+    rows = pd.DataFrame({"case": ["c"] * 3, "quantity": ["mass_matrix", "bias", "forward"],
+                         "impl_a": ["reference"] * 3, "impl_b": ["mujoco"] * 3,
+                         "integrator": [None] * 3, "dt": [None] * 3,
+                         "max_rel_err": [0.0] * 3, "tolerance": [1e-14] * 3,
+                         "tolerance_basis": [""] * 3, "note": [""] * 3,
+                         "verdict": ["passed"] * 3})
+    root = ET.fromstring(junit({"c": rows}, RUN, seconds={"c": {WHOLE: 2.0}}).tostring())
+    times = [float(c.get("time")) for c in root.iter("testcase")]
+    assert times == pytest.approx([2 / 3] * 3)
+    assert float(root.find("testsuite").get("time")) == pytest.approx(2.0)
