@@ -16,6 +16,7 @@ from dyncheck.cache.measured import reused
 from dyncheck.cases import Case
 from dyncheck.reference.derivations import value_bytes
 from dyncheck.results import to_csv
+from dyncheck.roster import IMPLEMENTATIONS
 from dyncheck.studies.order import TrajectoryFigures
 from dyncheck.vocabulary import Integrator
 
@@ -129,6 +130,18 @@ def _styles(n: int) -> list[tuple[str, str]]:
     return [(f"C{k % 10}", MARKERS[(k // 10) % len(MARKERS)]) for k in range(n)]
 
 
+STYLES = dict(zip(IMPLEMENTATIONS, _styles(len(IMPLEMENTATIONS)), strict=True))
+"""Each implementation's one colour and marker, in every figure: its place in the roster."""
+
+
+def styled(impls: list[str]) -> dict[str, tuple[str, str]]:
+    """The style of each of ``impls`` (:data:`STYLES`; a name the roster lacks takes the
+    styles after the roster's, in name order)."""
+    extra = sorted(i for i in set(impls) if i not in STYLES)
+    more = _styles(len(STYLES) + len(extra))[len(STYLES):]
+    return {i: STYLES[i] if i in STYLES else more[extra.index(i)] for i in impls}
+
+
 K = TypeVar("K")
 
 PER_PANEL = 5
@@ -155,7 +168,7 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     plt.rcParams.update({"font.family": "DejaVu Sans", "font.size": 9})
     out = {}
     rk4 = [(impl, q) for (impl, integ), q in sorted(data.runs.items()) if integ == Integrator.RK4]
-    styles = dict(zip([impl for impl, _ in rk4], _styles(len(rk4)), strict=True))
+    styles = styled([impl for impl, _ in rk4])
     panels = [(i, label, part) for i in range(case.ndof)
               for label, part in _panels([(case.coordinates[i], rk4)])]
     fig, axes = plt.subplots(len(panels), 1, figsize=(8.5, 2.2 * len(panels)), squeeze=False,
@@ -182,7 +195,7 @@ def figures(case: Case, data: TrajectoryFigures, conv: pd.DataFrame) -> dict[str
     c = conv[conv["case"] == case.name]
     integrators = sorted(c["integrator"].unique()) or [""]
     impls = sorted(c["impl"].unique())
-    styles = dict(zip(impls, _styles(len(impls)), strict=True))
+    styles = styled(impls)
     # an integrator's implementations with different nominal orders (RK4 summed across
     # tangent spaces: 2) get panels and slopes of their own
     groups: list[tuple[str, list[str]]] = []
@@ -232,7 +245,7 @@ def _per_integrator(plt: ModuleType, t: np.ndarray, series: dict[tuple[str, str]
     values at ``t``), each implementation its own colour and marker, the legend outside."""
     integrators = sorted({integ for _, integ in series}) or [""]
     impls = sorted({impl for impl, _ in series})
-    styles = dict(zip(impls, _styles(len(impls)), strict=True))
+    styles = styled(impls)
     panels = _panels([(integ, sorted(k for k in series if k[1] == integ))
                       for integ in integrators])
     fig, axes = plt.subplots(len(panels), 1, figsize=(8.5, 2.2 * len(panels)),

@@ -154,3 +154,18 @@ def test_no_panel_holds_more_than_six_series_and_an_engine_keeps_its_style(monke
     assert set(styles) == set(impls)  # every series drawn somewhere
     assert all(len(s) == 1 for s in styles.values()), styles
     assert len({next(iter(s)) for s in styles.values()}) == len(impls)  # none alike
+
+
+def test_an_implementation_has_one_style_in_every_figure():
+    """#80: styles were dealt by a figure's own order, so an engine's colour changed from
+    figure to figure. Each now keeps its roster's style whatever else a figure draws, no two
+    implementations of the roster alike, and a name the roster lacks takes one no roster
+    implementation has."""
+    from dyncheck.roster import IMPLEMENTATIONS
+
+    alone = module.styled(["drake"])["drake"]
+    assert module.styled(["reference", "mujoco", "drake"])["drake"] == alone
+    assert module.styled(sorted(IMPLEMENTATIONS))["drake"] == alone
+    everyone = module.styled(list(IMPLEMENTATIONS))
+    assert len(set(everyone.values())) == len(IMPLEMENTATIONS)
+    assert module.styled(["someone-new"])["someone-new"] not in everyone.values()
