@@ -18,6 +18,7 @@ from dyncheck.report.tables import (
     md,
     order_matrix,
     order_table,
+    per_engine,
     summary,
 )
 from dyncheck.results import MEANINGS
@@ -237,6 +238,13 @@ def _opening(result: RunResult, present: frozenset[str]) -> list[str]:
         "",
         *([f"**{left_out[0].upper()}{left_out[1:]}**", ""]
           if (left_out := not_run(result.ran)) else []),
+        "### Per engine",
+        "",
+        "Each engine's rows (those naming it on either side), by verdict; an explained "
+        "row's convention and a failed row's quantity in brackets:",
+        "",
+        *per_engine(result.discrepancies, result.ran),
+        "",
         "### Contents",
         "",
         "Case pages: " + ", ".join(f"[{c.name}]({c.name}.md)" for c in result.cases) + ".",

@@ -8,6 +8,7 @@ import pandas as pd
 
 from dyncheck.escaping import markdown_table
 from dyncheck.results import SEVERITY
+from dyncheck.roster import BOOK_SIDE
 from dyncheck.run_result import RunResult
 from dyncheck.studies.order import CONTROLLED, CONTROLLED_ACCURACIES, finest_pair
 from dyncheck.vocabulary import ALONG_RUNS, Quantity, Verdict
@@ -175,3 +176,27 @@ def summary(d: pd.DataFrame) -> pd.DataFrame:
         if v not in counts:
             counts[v] = 0
     return counts[list(Verdict)].reset_index()
+
+
+def per_engine(rows: pd.DataFrame, ran: tuple[str, ...]) -> list[str]:
+    """One line per engine the run was asked for (the book's side, the judge, left out):
+    its rows — those naming it on either side — counted by verdict, with the conventions
+    that explain its explained rows (the most frequent three) and the quantities of its
+    failed ones. The report's first lines, from its rows by this one rule."""
+    out = []
+    for engine in ran:
+        if engine in BOOK_SIDE:
+            continue
+        mine = rows[(rows["impl_a"] == engine) | (rows["impl_b"] == engine)]
+        counts = mine["verdict"].value_counts()
+        parts = [f"{int(counts.get(v, 0))} {v}" for v in Verdict]
+        explained = mine[mine["verdict"] == Verdict.EXPLAINED]
+        labels = explained["convention"].fillna("").astype(str)
+        common = labels[labels != ""].value_counts().head(3)
+        if len(common):
+            parts[1] += " (" + ", ".join(f"{label} ×{n}" for label, n in common.items()) + ")"
+        failed = mine[mine["verdict"] == Verdict.FAILED]
+        if len(failed):
+            parts[2] += " (" + ", ".join(dict.fromkeys(failed["quantity"].astype(str))) + ")"
+        out.append(f"- **{engine}** — {len(mine)} rows: " + ", ".join(parts))
+    return out

@@ -137,3 +137,26 @@ def test_a_case_without_instantaneous_rows_has_an_empty_matrix_not_an_error():
     only_runs = INSTANT[INSTANT["quantity"] == "trajectory"]
     assert instantaneous_matrix(only_runs, "a").empty
     assert family_matrix(only_runs, trajectories=False).empty
+
+
+def test_the_per_engine_lines_count_each_engines_rows_by_verdict():
+    """#80: the report opens with one line per engine. Five rows written here: mujoco is on
+    four (two passed, one explained by convention "c", one failed on forward), pinocchio on
+    two (one shared with mujoco, one skipped); the book's side is the judge, not a line."""
+    from dyncheck.report.tables import per_engine
+
+    rows = pd.DataFrame({
+        "impl_a": ["reference", "reference", "mujoco", "reference", "book"],
+        "impl_b": ["mujoco", "mujoco", "pinocchio", "pinocchio", "reference"],
+        "verdict": ["passed", "explained", "passed", "skipped", "passed"],
+        "convention": [None, "c", None, None, None],
+        "quantity": ["mass_matrix", "bias", "forward", "forward", "forward"],
+    })
+    rows = pd.concat([rows, pd.DataFrame({"impl_a": ["reference"], "impl_b": ["mujoco"],
+                                          "verdict": ["failed"], "convention": [None],
+                                          "quantity": ["forward"]})], ignore_index=True)
+    lines = per_engine(rows, ("reference", "book", "pinocchio", "mujoco"))
+    assert lines == [
+        "- **pinocchio** — 2 rows: 1 passed, 0 explained, 0 failed, 1 skipped",
+        "- **mujoco** — 4 rows: 2 passed, 1 explained (c ×1), 1 failed (forward), 0 skipped",
+    ]
