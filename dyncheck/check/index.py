@@ -15,7 +15,7 @@ from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ROOT_TAG
 from dyncheck.adapters.registration import Format
 from dyncheck.check import baseline
-from dyncheck.check.page import counts
+from dyncheck.check.page import INDEX, counts
 from dyncheck.check.rows import CheckResult
 from dyncheck.check.verdicts import Agreement, EngineVerdict, Reading, per_engine
 from dyncheck.errors import InvalidInput
@@ -26,7 +26,6 @@ from dyncheck.vocabulary import Verdict
 MODEL_SUFFIXES = (".xml", ".urdf", ".mjcf")
 MAX_MODELS = 10_000
 """Most files one ``check`` takes from folders (a folder of more is refused, named)."""
-INDEX = "index"
 
 READING = {Reading.ALIKE: "read alike", Reading.DIFFERENTLY: "read differently",
            Reading.PART: "holds part", Reading.REFUSED: "refused", Reading.SKIPPED: "not run"}

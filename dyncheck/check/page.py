@@ -21,6 +21,10 @@ from dyncheck.results import (
     write_together,
 )
 
+INDEX = "index"
+"""The name of the index of several models checked together (:mod:`.index`), beside their
+pages."""
+
 TITLES = {
     Section.LOAD: "Loading",
     Section.DESCRIPTION: "Model reading (each engine's tree against MuJoCo's)",
@@ -98,14 +102,17 @@ def _table(frame: pd.DataFrame, columns: list[str]) -> str:
     return markdown_table(shown)
 
 
-def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
-    """The Markdown page (``versions``: the provenance, read now when not given)."""
+def page(result: CheckResult, versions: dict[str, str] | None = None, *,
+         indexed: bool = False) -> str:
+    """The Markdown page (``versions``: the provenance, read now when not given;
+    ``indexed``: written beside the index of several models, which it links to)."""
     versions = _versions(result) if versions is None else versions
     rows = result.rows
     c = counts(result)
     lines = [
         f"# Model check: {markdown_code(result.model)}",
         "",
+        *([f"[All models checked together]({INDEX}.md)", ""] if indexed else []),
         f"File: {markdown_code(result.path.name)} · {result.states} sampled states · "
         + " · ".join(f"**{n} {v}**" for v, n in c.items()),
         "",
@@ -133,8 +140,9 @@ def page(result: CheckResult, versions: dict[str, str] | None = None) -> str:
     ]
     for section in Section:
         part = rows[rows["section"] == section.value]
-        if section in (Section.DERIVATIVES, Section.ACTUATION) and not len(part):
-            continue  # not asked for (--derivatives): no section that reads "none"
+        if section in (Section.DERIVATIVES, Section.ACTUATION, Section.CLOSURES) and \
+                not len(part):
+            continue  # not asked for, or nothing to check: no section that reads "none"
         lines += [f"## {TITLES[section]}", "",
                   _table(_marked(part), ["subject", "field", "impl_a", "impl_b", "error",
                                          "tolerance", "verdict", "note"]), ""]
@@ -175,14 +183,15 @@ def without_paths(result: CheckResult) -> CheckResult:
     return replace(result, rows=rows, notes=tuple(str(cut(n)) for n in result.notes))
 
 
-def write(result: CheckResult, out: Path, *, name: str | None = None) -> list[Path]:
+def write(result: CheckResult, out: Path, *, name: str | None = None,
+          indexed: bool = False) -> list[Path]:
     """The page, its CSV and the provenance, written as one (:func:`write_together`: never
     one model's page beside another's CSV; ``name``: the files' name, by default the
-    model's)."""
+    model's; ``indexed``: the page links to the index of the models checked with it)."""
     name = name or file_name(result.model)
     result = without_paths(result)
     csv_path, md_path = within(out, f"{name}.csv"), within(out, f"{name}.md")
     versions = _versions(result)
-    write_together({csv_path: to_csv(result.rows), md_path: page(result, versions),
+    write_together({csv_path: to_csv(result.rows), md_path: page(result, versions, indexed=indexed),
                     out / PROVENANCE: provenance_json(versions)})
     return [csv_path, md_path, out / PROVENANCE]

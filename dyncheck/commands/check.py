@@ -220,7 +220,7 @@ def _check_all(args: argparse.Namespace, targets: list[tuple[Path, str | None]],
             result, accepted = acceptance.apply(result, gates.accepted, today)
             used |= accepted
             checked.append(result)
-            written = write(result, args.out, name=name)
+            written = write(result, args.out, name=name, indexed=several)
             print(f"{summary_line(result)} -> {written[1]}")
             entries.append(index.entry(result, name, files[name]))
             tables[name], seconds[name] = result.rows, dict(result.seconds)

@@ -73,6 +73,18 @@ def test_several_models_each_get_a_page_and_one_line_of_the_index(tmp_path, caps
     assert html.count("<tr>") == 1 + 4  # the header and one line per model
     assert "refused" in html and "bad.xml" in html and str(tmp_path) not in html
     assert "good: " in capsys.readouterr().out
+    # #80: a page of several models checked together links to their index
+    page = MarkdownIt("commonmark").render((out / "good.md").read_text())
+    assert 'href="index.md"' in page
+
+
+def test_a_model_checked_alone_links_to_no_index(tmp_path):
+    """One model writes no index (its page is the whole report): no link to one."""
+    (tmp_path / "good.xml").write_text(CHAIN.format(n="good"))
+    out = tmp_path / "out"
+    assert main(["check", str(tmp_path / "good.xml"), "--states", "3", "--out", str(out)]) == 0
+    assert not (out / "index.md").exists()
+    assert "index.md" not in (out / "good.md").read_text()
 
 
 def test_a_hostile_file_name_cannot_break_the_index(tmp_path):
