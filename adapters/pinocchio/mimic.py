@@ -12,6 +12,7 @@ import numpy as np
 import pinocchio as pin
 
 from dyncheck.adapters.closures import ClosedReading, Closure, ClosureKind
+from dyncheck.errors import Unsupported
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -42,9 +43,14 @@ class Mimics:
 
 def load(text: str, full: pin.Model, *, floating: bool) -> Mimics | None:
     """Pinocchio's mimic model of the URDF ``text`` (None where it holds no mimic joint, or
-    its joints are not the full model's)."""
-    model = pin.buildModelFromXML(text, pin.JointModelFreeFlyer(), mimic=True) if floating \
-        else pin.buildModelFromXML(text, mimic=True)
+    its joints are not the full model's); its parser's refusal raised as
+    :class:`Unsupported`, in its words."""
+    try:
+        model = pin.buildModelFromXML(text, pin.JointModelFreeFlyer(), mimic=True) \
+            if floating else pin.buildModelFromXML(text, mimic=True)
+    except Exception as exc:  # (its parser's ValueError or RuntimeError: its words)
+        raise Unsupported(f"pinocchio's URDF parser refuses its <mimic> joints: "
+                          f"{' '.join(str(exc).split())}") from None
     mimicking = [int(i) for i in model.mimicking_joints]
     if not mimicking:
         return None

@@ -215,9 +215,9 @@ class PinocchioModel(ModelEngine):
     def __init__(self, source: ModelFile, *, gravity: np.ndarray | None = None,
                  inertias: Mapping[str, np.ndarray] | None = None) -> None:
         self.model = _load(source)
+        self._closures_read = True
         self._held = _constraints(source, self.model)
-        self._mimics = mimic.load(source.closed_text, self.model, floating=source.floating) \
-            if source.closed_text else None  # (a URDF's <mimic>: its mimic joints)
+        self._mimics, unread = self._mimic_joints(source)
         if gravity is not None:
             self.model.gravity = pin.Motion(np.asarray(gravity, float), np.zeros(3))
         _stated_inertias(self.model, inertias or {})
@@ -228,8 +228,20 @@ class PinocchioModel(ModelEngine):
             f.name for f in self.model.frames if f.type == pin.FrameType.BODY))
         if source.floating and source.format is Format.URDF:
             notes = ("pinocchio: JointModelFreeFlyer 'root_joint' at the URDF root",)
+        notes += unread
         self.tree = self._tree(notes)
         self.stepping = self._stepper()  # its v̇ in MuJoCo's layout, and its runs there
+
+    def _mimic_joints(self, source: ModelFile) -> tuple[mimic.Mimics | None, tuple[str, ...]]:
+        """A URDF's ``<mimic>`` joints as Pinocchio's parser builds them (:mod:`.mimic`), or
+        the note of its refusal (its constraints then not read)."""
+        if not source.closed_text:
+            return None, ()
+        try:
+            return mimic.load(source.closed_text, self.model, floating=source.floating), ()
+        except Unsupported as exc:
+            self._closures_read = False
+            return None, (f"{exc}; its constraints are not read",)
 
     def _stepper(self) -> Stepping:
         """Its stepping in MuJoCo's layout (:mod:`.simulation`)."""
@@ -314,7 +326,7 @@ class PinocchioModel(ModelEngine):
             engine=ENGINE, joints=tuple(joints), gravity=np.asarray(m.gravity.linear, float),
             nq=m.nq, nv=m.nv, notes=notes, hints=self._hints,
             closures=closures.read(self._held, d, {i: n for i, n in last_name.items() if n})
-            + mimic.read(self._mimics), closures_read=True,
+            + mimic.read(self._mimics), closures_read=self._closures_read,
         )
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:

@@ -12,10 +12,11 @@ from typing import Any
 
 import numpy as np
 
-from dyncheck.adapters.layout import Canonical
+from dyncheck.adapters.layout import Canonical, canonical
 from dyncheck.adapters.model_tree import (
     Dynamics,
     JointType,
+    Layout,
     ModelTree,
     StateLayout,
     TreeJoint,
@@ -57,6 +58,29 @@ def canonical_reading(canon: Canonical, tree: ModelTree) -> ModelTree:
                       armature=canonical_armature(tree.joint(name)))
               for name, place in zip(canon.names, places, strict=True)]
     return replace(tree, joints=parents_first(joints), nq=canon.nq, nv=canon.nv)
+
+
+def _key(lay: Layout) -> tuple[object, ...]:
+    """What places a joint's coordinates: where they start, and their conventions."""
+    return (lay.q_start, lay.v_start, lay.quat, lay.quat_first, lay.angular_first,
+            lay.linear_axes, lay.angular_axes, lay.cos_sin)
+
+
+def canonical_of(tree: ModelTree) -> ModelTree:
+    """The first engine's reading as the canonical one: itself where it holds the canonical
+    layout (MuJoCo's) parents first, else put in it (:func:`canonical_reading`: Drake's,
+    where MuJoCo and Pinocchio refuse the file, lists a child before its parent and holds a
+    free joint's velocities otherwise; taken as it was, the referee crashed on it, or judged
+    it on the wrong columns)."""
+    places = StateLayout().joints([j.type for j in tree.joints])
+    if parents_first(list(tree.joints)) == tree.joints and all(
+            _key(j.layout) == _key(p) for j, p in zip(tree.joints, places, strict=True)):
+        return tree
+    ordered = replace(tree, joints=parents_first(list(tree.joints)))
+    placed = canonical_reading(canonical(ordered), ordered)
+    zero = {j.name: j.layout.zero for j in tree.joints}  # (a hinge's reference angle kept)
+    return replace(placed, joints=tuple(replace(j, layout=replace(j.layout, zero=zero[j.name]))
+                                        for j in placed.joints))
 
 
 def parents_first(joints: list[TreeJoint]) -> tuple[TreeJoint, ...]:

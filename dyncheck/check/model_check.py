@@ -38,6 +38,7 @@ from dyncheck.check import (
 )
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.alignment import align_by_body
+from dyncheck.check.computed import canonical_of
 from dyncheck.check.derivatives import expected_seconds
 from dyncheck.check.derivatives import rows as derivative_rows
 from dyncheck.check.dynamics import (
@@ -161,7 +162,7 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     seconds: dict[str, float] = {"load": load_seconds}
     loaded = _loaded(model, source_path, source, engines, rows, notes)
     first = next(iter(loaded.values()))
-    canonical_tree: ModelTree = first.tree
+    canonical_tree = canonical_of(first.tree)
     if canonical_tree.nv == 0:
         raise inputs.ModelFileError(source_path, "has no degrees of freedom (nothing moves)")
     notes.append(
