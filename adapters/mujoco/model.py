@@ -230,6 +230,7 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
         self._hints += _total_mass_hints(source) + actuators.file_hints(source)
         m.opt.disableflags |= int(_SMOOTH_ONLY)
         m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
+        self._closed.opt.disableflags = m.opt.disableflags  # (the same smooth dynamics)
         self.data = mujoco.MjData(m)
         if np.any(m.body_gravcomp != 0):
             notes += ("mujoco: gravity compensation (gravcomp) left out of the dynamics",)
@@ -239,6 +240,7 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
             notes += (TENDON_ARMATURE.format(tendons=", ".join(repr(t) for t in armed[:4])
                                              + (" …" if len(armed) > 4 else "")),)
             m.tendon_armature[:] = 0.0
+            self._closed.tendon_armature[:] = 0.0
         self.tree = self._tree(notes)
         if not exact_meshes and self._inertias.meshes_weigh(m, self._inertias.inexact_meshes):
             self.tree = replace(self.tree, exact_meshes=self._exact_meshes(source))

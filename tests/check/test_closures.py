@@ -1,7 +1,8 @@
 """Closed chains checked (:mod:`dyncheck.check.closures`, #78), on models written here: a
 planar four-bar (connect), two fingers coupled by a joint polynomial, a tendon coupling, a free
 box welded to the world, a loop through a ball joint, and a URDF gripper whose fingers are
-coupled by a ``<mimic>`` joint. Each engine that offers its own
+coupled by a ``<mimic>`` joint (one finger damped: the smooth dynamics leave damping out,
+and so must an engine's closed dynamics). Each engine that offers its own
 constrained dynamics is measured against the referee (the book's constrained method, whose
 closed forms tests/reference/test_closure.py checks): its rows hold at the referee's states,
 its accelerations are the referee's soft model of it, and its distance from the rigid answer
@@ -82,7 +83,7 @@ MIMIC = """<robot name="gripper">
   <axis xyz="0.6 0 0.8"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
  <joint name="right" type="prismatic"><parent link="palm"/><child link="right"/>
   <axis xyz="-0.6 0 0.8"/><limit lower="-1" upper="1" effort="1" velocity="1"/>
-  <mimic joint="left" multiplier="1.5" offset="0.01"/></joint>
+  <dynamics damping="0.5"/><mimic joint="left" multiplier="1.5" offset="0.01"/></joint>
 </robot>"""
 MODELS = {"four_bar": FOUR_BAR, "fingers": FINGERS, "tendon": TENDON, "weld": WELD,
           "ball_loop": BALL_LOOP, "mimic": MIMIC}
