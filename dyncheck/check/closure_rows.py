@@ -54,8 +54,10 @@ def _dropped(states: closures.ClosedStates) -> str:
 def _unread(name: str, tree: ModelTree) -> str:
     """Why an engine's constraints are not compared: the note of the copy it was given
     without them, or that its loader reads none."""
-    given = next((n for n in tree.notes if "without its equality constraints" in n
-                  or n.endswith("its constraints are not read")), "")
+    refused = next((n for n in tree.notes if n.endswith("its constraints are not read")), "")
+    if refused:
+        return refused
+    given = next((n for n in tree.notes if "without its equality constraints" in n), "")
     return (f"{name}'s constraints are not compared: " + (given.split(": ", 1)[-1] if given
             else "dyncheck reads none of its constraint models yet"))
 
