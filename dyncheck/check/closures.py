@@ -10,7 +10,9 @@ on them measured against it:
 - its accelerations against the referee's soft model (MuJoCo's documented equations, its
   :func:`~dyncheck.reference.constrained.soft`, with the file's solref and solimp and the
   engine's approximation of A's diagonal), and against the rigid answer: their distance is
-  what the soft model predicts (a share 1 − d of the free motion, and no J̇ v in its rows).
+  what the soft model predicts (R's share of the free motion, and J̇ v on the rows whose
+  reference acceleration leaves it out: a joint or tendon coupling in MuJoCo 4, every row
+  before it).
 """
 
 from __future__ import annotations
@@ -42,8 +44,10 @@ ACCELERATION_FLOOR = 1.0
 """The smallest scale of accelerations (m/s²): where the free and constrained motions are
 slower (a mechanism moving across gravity, at rest), errors are held absolutely at it."""
 PROJECTION_TOL = 1e-12
-"""|C| accepted of a state moved onto the constraints, relative to the model's reach (a few
-ε of the positions Newton's last step rounds)."""
+"""|C| accepted of a state moved onto the constraints, relative to the model's reach. Newton's
+method goes on while |C| still halves, so a regular mechanism's states end at round-off
+(~1e-16 here) and a singular one's, converging linearly, nearer 1e-14; a draw above this
+after its iterations is dropped."""
 
 
 def referee_closures(tree: ModelTree) -> list[Closure]:
