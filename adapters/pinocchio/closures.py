@@ -16,6 +16,7 @@ import numpy as np
 import pinocchio as pin
 
 from dyncheck.adapters.closures import ClosedReading, Closure, ClosureKind
+from dyncheck.errors import Unsupported
 
 ACCURACY = 1e-13
 """The proximal solver's stopping accuracy (|J v̇ + J̇ v| of its answer, m/s²)."""
@@ -27,14 +28,16 @@ ITERATIONS = 200
 
 def load(path: Path, model: pin.Model) -> list:
     """The file's constraint models as Pinocchio's MJCF parser returns them (none where it
-    parses a model other than ``model``, or refuses a constraint: one on a body outside the
-    first tree, which it does not read)."""
+    parses a model other than ``model``); its refusal (a constraint on a body outside the
+    first tree, which it does not read, or on ``world``) raised as :class:`Unsupported`, in
+    its words."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
         try:
             found = pin.buildModelAndLegacyConstraintsFromMJCF(str(path))
-        except Exception:  # (a constraint on a body its parser left out: its tree says so)
-            return []
+        except Exception as exc:  # (its parser's words: a body it does not hold, "world")
+            raise Unsupported("pinocchio's MJCF parser refuses its constraints: "
+                              f"{' '.join(str(exc).split())}") from None
     again, held = found[0], list(found[1])
     if again.njoints != model.njoints or list(again.names) != list(model.names):
         return []

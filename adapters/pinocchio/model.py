@@ -216,8 +216,12 @@ class PinocchioModel(ModelEngine):
                  inertias: Mapping[str, np.ndarray] | None = None) -> None:
         self.model = _load(source)
         self._closures_read = True
-        self._held = _constraints(source, self.model)
         self._mimics, unread = self._mimic_joints(source)
+        try:
+            self._held = _constraints(source, self.model)
+        except Unsupported as exc:
+            self._held, self._closures_read = [], False
+            unread += (f"{exc}; its constraints are not read",)
         if gravity is not None:
             self.model.gravity = pin.Motion(np.asarray(gravity, float), np.zeros(3))
         _stated_inertias(self.model, inertias or {})
