@@ -143,9 +143,12 @@ def on_constraints(tree: ModelTree, q: np.ndarray, v: np.ndarray, *,
 
 @dataclass(frozen=True, kw_only=True)
 class RefereeAnswer:
-    """The referee at S states: its rows, and v̇ (S, nv) rigid (both ways) and soft."""
+    """The referee at S states: its rows, M and h there, and v̇ (S, nv) rigid (both ways)
+    and soft."""
 
     rows: Rows
+    mass: np.ndarray
+    bias: np.ndarray
     reduced: np.ndarray
     multipliers: np.ndarray
     soft: np.ndarray
@@ -204,8 +207,8 @@ def referee(tree: ModelTree, q: np.ndarray, v: np.ndarray, *, tau: np.ndarray,
         out["soft"].append(soft(*args, J=jac, a_ref=a_ref, regularizer=regularizer(
             tree, diagonal=diagonal[s], value=held.value[s])).vdot)
     nv = v.shape[1]
-    return RefereeAnswer(rows=held, **{k: np.array(x).reshape(-1, nv)
-                                       for k, x in out.items()})
+    return RefereeAnswer(rows=held, mass=mass, bias=bias,
+                         **{k: np.array(x).reshape(-1, nv) for k, x in out.items()})
 
 
 def row_space_gap(engine: np.ndarray, referee_rows: np.ndarray) -> float:
@@ -257,7 +260,7 @@ def measure(tree: ModelTree, reading: ClosedReading, states: ClosedStates, *,
     q, v = states.q, states.v
     ref = referee(tree, q, v, tau=tau, diagonal=reading.diagonal[:, pick])
     jac = reading.jacobian[:, pick]
-    mass, bias, _, _ = TreeDynamics(bodies(tree), tree.gravity).at_states(q, v)
+    mass, bias = ref.mass, ref.bias  # (evaluated once, by the referee)
     free = np.linalg.solve(mass, (tau - bias)[..., None])[..., 0]
     kappa, gain = _conditioning(tree, mass, ref.rows, diagonal=reading.diagonal[:, pick])
     scale = max(float(np.abs(free).max(initial=0.0)), float(np.abs(ref.soft).max(initial=0.0)),
