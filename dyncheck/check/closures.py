@@ -60,8 +60,7 @@ def referee_closures(tree: ModelTree) -> list[Closure]:
 
     out: list[Closure] = []
     for c in tree.closures:
-        if c.kind is ClosureKind.CONNECT or (c.kind is ClosureKind.WELD
-                                             and c.rotation_scale == 0.0):
+        if c.kind is ClosureKind.CONNECT or _turns_freely(c):
             out.append(Connect(body1=at(c.joint1), body2=at(c.joint2), point1=c.point1,
                                point2=c.point2))
         elif c.kind is ClosureKind.WELD:
@@ -75,10 +74,23 @@ def referee_closures(tree: ModelTree) -> list[Closure]:
     return out
 
 
+def _turns_freely(c: Held) -> bool:
+    """A weld that holds no rotation (torquescale 0): the referee's connect."""
+    return c.kind is ClosureKind.WELD and c.rotation_scale == 0.0
+
+
 def row_sizes(tree: ModelTree) -> list[int]:
     """Each closure's rows in the referee (a weld whose rotation is free: a connect's 3)."""
-    return [3 if c.kind is ClosureKind.WELD and c.rotation_scale == 0.0 else c.rows
-            for c in tree.closures]
+    return [3 if _turns_freely(c) else c.rows for c in tree.closures]
+
+
+def _per_row(tree: ModelTree) -> list[tuple[Held, Softness, bool]]:
+    """Each of the referee's rows: its closure, that closure's soft model, and whether it is
+    a weld's rotation row."""
+    out: list[tuple[Held, Softness, bool]] = []
+    for c, size in zip(tree.closures, row_sizes(tree), strict=True):
+        out += [(c, softness(c), size == 6 and k >= 3) for k in range(size)]
+    return out
 
 
 def engine_rows(tree: ModelTree) -> np.ndarray:
@@ -159,13 +171,12 @@ def regularizer(tree: ModelTree, *, diagonal: np.ndarray, value: np.ndarray) -> 
     approximation of A's diagonal (``diagonal``, on its rows), a weld's rotation rows by
     4/scale² (the engine's rows are ½ · scale times a rotation of the referee's: the same
     soft solve needs R scaled by the inverse square)."""
-    per_row: list[Softness] = []
-    scale: list[float] = []
-    for c, size in zip(tree.closures, row_sizes(tree), strict=True):
-        per_row += [softness(c)] * size
-        scale += [1.0] * 3 + [4.0 / c.rotation_scale**2] * 3 if size == 6 else [1.0] * size
-    d = np.array([s.impedance(np.array([r]))[0] for s, r in zip(per_row, value, strict=True)])
-    return (1 - d) / d * diagonal * np.array(scale)
+    rows_of = _per_row(tree)
+    scale = np.array([4.0 / c.rotation_scale**2 if turning else 1.0
+                      for c, _, turning in rows_of])
+    d = np.array([s.impedance(np.array([r]))[0]
+                  for (_, s, _), r in zip(rows_of, value, strict=True)])
+    return (1 - d) / d * diagonal * scale
 
 
 def reference_row(tree: ModelTree, *, value: np.ndarray, rate: np.ndarray,
@@ -174,14 +185,10 @@ def reference_row(tree: ModelTree, *, value: np.ndarray, rate: np.ndarray,
     less J̇ v on the rows of a closure whose engine takes it in
     (:attr:`~dyncheck.adapters.closures.Closure.bias_in_reference`)."""
     out: list[float] = []
-    k = 0
-    for c, size in zip(tree.closures, row_sizes(tree), strict=True):
-        s = softness(c)
-        for _ in range(size):
-            d = float(s.impedance(np.array([value[k]]))[0])
-            out.append(-s.damping * rate[k] - s.stiffness * d * value[k]
-                       - (jdot_v[k] if c.bias_in_reference else 0.0))
-            k += 1
+    for k, (c, s, _) in enumerate(_per_row(tree)):
+        d = float(s.impedance(np.array([value[k]]))[0])
+        out.append(-s.damping * rate[k] - s.stiffness * d * value[k]
+                   - (jdot_v[k] if c.bias_in_reference else 0.0))
     return np.array(out)
 
 
