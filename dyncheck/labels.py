@@ -31,6 +31,22 @@ COMPUTED_INERTIA = "inertia computed with otherwise than held (a measured engine
 spherical joint: the link's principal moments in the link's axes, its inertial frame's
 rotation dropped): :attr:`~dyncheck.adapters.model_tree.TreeJoint.computed_inertia`."""
 
+PLACEMENT = "model placed elsewhere as a whole (no dynamics depend on where it sits)"
+"""Two readings place the whole model apart by one translation, or a turn that keeps gravity."""
+STORED_INERTIA = "inertia stored to the engine's own accuracy"
+"""An engine stores a body's inertia to an accuracy it declares (its own rounding)."""
+MESH_ROUNDING = "mass properties from float32 mesh vertices"
+"""Two engines integrate a body's mass properties from the same mesh in float32 vertices."""
+MESH_VOLUME = "mesh volume taken two ways (MuJoCo's inertia=\"legacy\"/\"convex\")"
+"""One engine takes a mesh's volume by MuJoCo's legacy or convex rule, the other exactly."""
+NO_ACTUATORS_READ = "an engine's parser makes no actuator of what the file holds"
+"""An engine holds no actuator where another reads the file's (MuJoCo's URDF compiler)."""
+EULER_DAMPING = "MuJoCo's Euler step integrates joint damping implicitly"
+"""MuJoCo's Euler step solves with M + h D where the joints have damping D (a step's
+control Jacobian differs from the explicit chain rule by that)."""
+SOFT_CONSTRAINT = "soft constraint (MuJoCo solref/solimp impedance model)"
+"""MuJoCo's equality constraints are soft: its constrained dynamics are the soft model's."""
+
 # The derivative pairs (dyncheck.check.derivative_pairs)
 DEFECT = "engine's analytic derivatives unlike its own finite differences"
 """The label of a derivative row explained by an engine's declared defect: its analytic

@@ -6,6 +6,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from dyncheck.cases import Case
+from dyncheck.labels import SOFT_CONSTRAINT
+
+__all__ = ["ENGINE_DEFECT", "GRAVITY_DEFAULT", "INERTIA_STORED", "POINT_INERTIA",
+           "SOFT_CONSTRAINT", "TENSOR", "Variant", "book_variant"]
 
 
 @dataclass(frozen=True)
@@ -49,7 +53,6 @@ TENSOR = (("I11", 0, 0), ("I22", 1, 1), ("I33", 2, 2), ("I12", 0, 1), ("I13", 0,
           ("I23", 1, 2))
 """A rigid body case's parameters naming its inertia tensor's entries."""
 GRAVITY_DEFAULT = "MJCF gravity option not read"
-SOFT_CONSTRAINT = "soft constraint (MuJoCo solref/solimp impedance model)"
 
 
 def book_variant(case: Case) -> Variant:

@@ -10,6 +10,7 @@ import numpy as np
 from dyncheck.adapters.actuators import Activation, Actuator
 from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.check.rows import CheckRow, Section
+from dyncheck.labels import NO_ACTUATORS_READ
 from dyncheck.vocabulary import Verdict
 
 FIELD_RTOL = 1e-9
@@ -19,11 +20,12 @@ UNKNOWN = "cause unknown"
 
 def section_row(model: str, *, subject: str, field: str, a: str, b: str, verdict: Verdict,
          note: str, value_a: str = "", value_b: str = "", error: float = 0.0,
-         tolerance: float = 0.0, basis: str = "", worst: int = -1) -> CheckRow:
+         tolerance: float = 0.0, basis: str = "", worst: int = -1,
+         convention: str = "") -> CheckRow:
     return CheckRow(model=model, section=Section.ACTUATION, subject=subject, field=field,
                     impl_a=a, impl_b=b, value_a=value_a, value_b=value_b, error=error,
                     tolerance=tolerance, basis=basis, verdict=verdict, note=note,
-                    worst_state=worst)
+                    convention=convention, worst_state=worst)
 
 
 def limits(actuator: Actuator) -> object:
@@ -108,7 +110,7 @@ def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[Che
         return [section_row(model, subject="model", field="actuators", a=a, b=b, value_a="none",
                      value_b=f"{len(other.actuators)} ({other.actuators[0].what}, …)",
                      verdict=Verdict.EXPLAINED if why else Verdict.FAILED,
-                     note=why or UNKNOWN)]
+                     note=why or UNKNOWN, convention=NO_ACTUATORS_READ if why else "")]
     pairs = match(canonical.actuators, other.actuators)
     rows = []
     for k, mine in enumerate(canonical.actuators):

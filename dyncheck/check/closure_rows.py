@@ -21,6 +21,7 @@ from dyncheck.check.computed import canonical_reading
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.check.states import States
 from dyncheck.errors import EngineError, Unsupported
+from dyncheck.labels import SOFT_CONSTRAINT
 from dyncheck.roster import REFEREE
 from dyncheck.vocabulary import Verdict
 
@@ -30,11 +31,11 @@ SOFT_BASIS = "64 eps x k(M) x k(A + R)"
 
 def _row(model: str, *, subject: str, field: str, engine: str, verdict: Verdict, note: str,
          value_a: str = "", value_b: str = "", error: float = 0.0, tolerance: float = 0.0,
-         basis: str = "") -> CheckRow:
+         basis: str = "", convention: str = "") -> CheckRow:
     return CheckRow(model=model, section=Section.CLOSURES, subject=subject, field=field,
                     impl_a=REFEREE if engine else "", impl_b=engine, value_a=value_a,
                     value_b=value_b, error=error, tolerance=tolerance, basis=basis,
-                    verdict=verdict, note=note)
+                    verdict=verdict, note=note, convention=convention)
 
 
 def _without(name: str) -> str:
@@ -165,5 +166,6 @@ def _engine_rows(model: str, name: str, engine: ModelEngine, states: closures.Cl
            if soft else "cause unknown: it holds its constraints rigidly"}
     out.append(_row(model, subject="forward (rigid)", field="max rel error", engine=name,
                     verdict=rigid, error=found.rigid, tolerance=found.bound,
-                    basis=SOFT_BASIS, note=why[rigid]))
+                    basis=SOFT_BASIS, note=why[rigid],
+                    convention=SOFT_CONSTRAINT if rigid is Verdict.EXPLAINED else ""))
     return out

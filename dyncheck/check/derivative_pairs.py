@@ -126,18 +126,6 @@ OWN_DIFFERENCES = ("{engine}'s analytic derivative is beyond the bound ({raw}); 
 (:attr:`Derivatives.defect`): its own finite differences within the bound."""
 
 
-
-def label(row: CheckRow) -> str:
-    """The label of an explained derivative row, from the known cause its note states: a
-    declared defect (:data:`~dyncheck.labels.DEFECT`) or two readings
-    (:data:`~dyncheck.labels.READINGS`); empty otherwise."""
-    if row.verdict is not Verdict.EXPLAINED:
-        return ""
-    causes = {"its own finite differences agree": DEFECT,
-              "read the model differently: compared after": READINGS}
-    return next((name for said, name in causes.items() if said in row.note), "")
-
-
 def after_defects(model: str, tree: ModelTree, *, name_a: str, da: Derivatives, name_b: str,
                   db: Derivatives, ref: Referee, eps: float = EPS) -> list[CheckRow]:
     """:func:`compare`, and where a side declares a defect of its analytic derivatives
@@ -163,7 +151,7 @@ def after_defects(model: str, tree: ModelTree, *, name_a: str, da: Derivatives, 
         else:
             size = f"error {first_try.error:.3g} against {first_try.tolerance:.3g}"
             out.append(replace(first_try, verdict=Verdict.EXPLAINED, note=OWN_DIFFERENCES.format(
-                engine=engine, raw=size, defect=declared.defect)))
+                engine=engine, raw=size, defect=declared.defect), convention=DEFECT))
     return out
 
 
@@ -188,7 +176,7 @@ def across_readings(model: str, tree: ModelTree, *, name_a: str, da: Derivatives
         if raw.verdict is not Verdict.FAILED:  # alike without the readings' difference
             out.append(raw)
         elif r.verdict is Verdict.PASSED:
-            out.append(replace(r, verdict=Verdict.EXPLAINED, note=note))
+            out.append(replace(r, verdict=Verdict.EXPLAINED, note=note, convention=READINGS))
         elif r.verdict is Verdict.FAILED:
             out.append(replace(r, note=f"beyond what the readings account for: {r.note}"))
         else:

@@ -16,12 +16,15 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 
 from dyncheck.adapters.model_tree import JointType, ModelTree, TreeJoint
 from dyncheck.check.computed import depth, size
 from dyncheck.check.rows import CheckRow, Section
+from dyncheck.labels import MESH_ROUNDING as MESH_ROUNDING_CAUSE
+from dyncheck.labels import MESH_VOLUME, PLACEMENT, STORED_INERTIA
 from dyncheck.precision import ROUNDOFF_FACTOR, eps_name
 from dyncheck.vocabulary import Quantity, Verdict
 
@@ -158,13 +161,13 @@ def placement(a: ModelTree, b: ModelTree, tol: float) -> Placement | None:
 
 
 def _placement_row(a: ModelTree, b: ModelTree, moved: Placement,
-                   tol: float) -> tuple[Verdict, str]:
+                   tol: float) -> tuple[Verdict, str, str]:
     """The verdict and note of the one row a placement gets: a translation, or a turn that
     keeps gravity (none, or along the turn's axis), changes no dynamics — explained; a turn
     that changes gravity's direction in the model is a difference of the dynamics."""
     if not moved.turned:
         return Verdict.EXPLAINED, SHIFTED.format(a=a.engine, b=b.engine,
-                                                 t=shown_value(moved.translation))
+                                                 t=shown_value(moved.translation)), PLACEMENT
     from scipy.spatial.transform import Rotation  # (a placement found: rare; 0.3 s import)
 
     rotvec = Rotation.from_matrix(moved.rotation).as_rotvec()
@@ -180,7 +183,8 @@ def _placement_row(a: ModelTree, b: ModelTree, moved: Placement,
                          t=f" and moved by {shown_value(t)} m" if np.abs(t).max() > tol * size(a)
                          else "")
     why = b.hint("model", "placement") or a.hint("model", "placement")
-    return (Verdict.EXPLAINED if kept else Verdict.FAILED), note + (f": {why}" if why else "")
+    note += f": {why}" if why else ""
+    return (Verdict.EXPLAINED, note, PLACEMENT) if kept else (Verdict.FAILED, note, "")
 
 
 def diff(model: str, a: ModelTree, b: ModelTree,
@@ -210,27 +214,38 @@ def diff(model: str, a: ModelTree, b: ModelTree,
             compared += n
     gravity_err = float(np.abs(a.gravity - b.gravity).max())
     if gravity_err > rtol * max(1.0, float(np.abs(a.gravity).max())):
-        found.append(("model", "gravity", a.gravity, b.gravity, gravity_err, rtol,
+        found.append(_Found("model", "gravity", a.gravity, b.gravity, gravity_err, rtol,
                       Verdict.FAILED, a.hint("model", "gravity") or b.hint("model", "gravity")
                       or ""))
     if names_a != names_b and set(names_a) == set(names_b):
-        found.append(("model", "joint order", " ".join(names_a), " ".join(names_b), 0.0, 0.0,
+        found.append(_Found("model", "joint order", " ".join(names_a), " ".join(names_b), 0.0, 0.0,
                       Verdict.PASSED, "the engines order the joints differently; matched by "
                       "name"))
-    if not any(f[6] is Verdict.FAILED for f in found):
-        found.append(("model", "all fields", f"{len(a.joints)} joints",
+    if not any(f.verdict is Verdict.FAILED for f in found):
+        found.append(_Found("model", "all fields", f"{len(a.joints)} joints",
                       f"{len(b.joints)} joints", 0.0, rtol, Verdict.PASSED,
                       f"{compared} fields agree to round-off"))
-    return [CheckRow(model=model, section=Section.DESCRIPTION, subject=subject, field=field,
-                     impl_a=a.engine, impl_b=b.engine, value_a=shown_value(va),
-                     value_b=shown_value(vb), error=err, tolerance=tol,
-                     basis=basis if tol else "", verdict=verdict, note=note)
-            for subject, field, va, vb, err, tol, verdict, note in found]
+    return [CheckRow(model=model, section=Section.DESCRIPTION, subject=f.subject, field=f.field,
+                     impl_a=a.engine, impl_b=b.engine, value_a=shown_value(f.value_a),
+                     value_b=shown_value(f.value_b), error=f.error, tolerance=f.tolerance,
+                     basis=basis if f.tolerance else "", verdict=f.verdict, note=f.note,
+                     convention=f.convention)
+            for f in found]
 
 
-_Found = tuple[str, str, object, object, float, float, Verdict, str]
-"""One difference before it is a row: subject, field, the two values, error, tolerance,
-verdict, note."""
+class _Found(NamedTuple):
+    """One difference before it is a row."""
+
+    subject: str
+    field: str
+    value_a: object
+    value_b: object
+    error: float
+    tolerance: float
+    verdict: Verdict
+    note: str
+    convention: str = ""
+    """An explained difference's cause (:mod:`dyncheck.labels`)."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -248,9 +263,9 @@ def _presence(a: ModelTree, b: ModelTree, names_a: list[str],
     for name in names_a:
         if name not in names_b:
             why = b.hint(name, "joint") or b.hint("model", "joint")
-            found.append((name, "joint", "present", "absent", np.inf, 0.0, Verdict.FAILED,
+            found.append(_Found(name, "joint", "present", "absent", np.inf, 0.0, Verdict.FAILED,
                           f"{b.engine} has no joint {name!r}" + (f": {why}" if why else "")))
-    found += [(name, "joint", "absent", "present", np.inf, 0.0, Verdict.FAILED,
+    found += [_Found(name, "joint", "absent", "present", np.inf, 0.0, Verdict.FAILED,
                f"{a.engine} has no joint {name!r}") for name in names_b if name not in names_a]
     return found
 
@@ -261,12 +276,12 @@ def _placement(a: ModelTree, b: ModelTree, moved: Placement, *, rtol: float,
     where turned, t alone where not."""
     from scipy.spatial.transform import Rotation
 
-    verdict, note = _placement_row(a, b, moved, rtol)
+    verdict, note, convention = _placement_row(a, b, moved, rtol)
     turn = Rotation.from_matrix(moved.rotation).as_rotvec()
     shown = np.concatenate([moved.translation, turn]) if moved.turned else moved.translation
-    return ("model", "placement", np.zeros_like(shown), shown,
-            max(float(np.abs(moved.translation).max()) / length, float(np.abs(turn).max())),
-            rtol, verdict, note)
+    return _Found("model", "placement", np.zeros_like(shown), shown,
+                  max(float(np.abs(moved.translation).max()) / length,
+                      float(np.abs(turn).max())), rtol, verdict, note, convention)
 
 
 def _joint(a: ModelTree, b: ModelTree, ja: TreeJoint, jb: TreeJoint, *, scale: _Scale,
@@ -279,7 +294,7 @@ def _joint(a: ModelTree, b: ModelTree, ja: TreeJoint, jb: TreeJoint, *, scale: _
     found: list[_Found] = []
     if ja.parent != jb.parent:
         gone = ja.parent is not None and ja.parent not in [j.name for j in b.joints]
-        found.append((ja.name, "parent", ja.parent, jb.parent, np.inf, 0.0, Verdict.FAILED,
+        found.append(_Found(ja.name, "parent", ja.parent, jb.parent, np.inf, 0.0, Verdict.FAILED,
                       f"follows from joint {ja.parent!r}, which {b.engine} has not" if gone
                       else b.hint(ja.name, "parent") or ""))
     if (ja.range is None) != (jb.range is None) or (
@@ -289,7 +304,7 @@ def _joint(a: ModelTree, b: ModelTree, ja: TreeJoint, jb: TreeJoint, *, scale: _
         known = b.hint(ja.name, "range") or a.hint(ja.name, "range") or (
             (b.hint("model", "slide range") or a.hint("model", "slide range"))
             if ja.type is JointType.SLIDE else None)
-        found.append((ja.name, "range", ja.range, jb.range, np.inf, 0.0, Verdict.FAILED,
+        found.append(_Found(ja.name, "range", ja.range, jb.range, np.inf, 0.0, Verdict.FAILED,
                       "joint limits read differently (the dynamics leave limits out; states "
                       f"are sampled within {a.engine}'s)" + (f": {known}" if known else "")))
     compared = 0
@@ -298,8 +313,7 @@ def _joint(a: ModelTree, b: ModelTree, ja: TreeJoint, jb: TreeJoint, *, scale: _
         if err > rtol * size_of:
             at = _Differs(a=a, b=b, ja=ja, jb=jb, field=field, err=err, size=size_of,
                           scale=scale)
-            verdict, note = _cause(at, invalid)
-            found.append((ja.name, field, va, vb, err / size_of, rtol, verdict, note))
+            found.append(_Found(ja.name, field, va, vb, err / size_of, rtol, *_cause(at, invalid)))
     return found, compared
 
 
@@ -346,25 +360,27 @@ def _meshes_exact(at: _Differs) -> str | None:
                                off=exact) if exact else None
 
 
-KNOWN_CAUSES: tuple[Callable[[_Differs], str | None], ...] = (
-    _stored, _meshes_rounded, _meshes_exact)
-"""The causes that explain a field read differently, tried in order: each gives its note
-(with its predicted or measured size) where its premise holds on the two readings."""
+KNOWN_CAUSES: tuple[tuple[str, Callable[[_Differs], str | None]], ...] = (
+    (STORED_INERTIA, _stored), (MESH_ROUNDING_CAUSE, _meshes_rounded),
+    (MESH_VOLUME, _meshes_exact))
+"""The causes that explain a field read differently (each by its label), tried in order:
+each gives its note (with its predicted or measured size) where its premise holds on the
+two readings."""
 
 
-def _cause(at: _Differs, invalid: Mapping[str, str]) -> tuple[Verdict, str]:
-    """Explained by the first known cause that holds; otherwise failed, naming the reading's
-    hint, the invalid body it follows from, or the two engines."""
-    for cause in KNOWN_CAUSES:
+def _cause(at: _Differs, invalid: Mapping[str, str]) -> tuple[Verdict, str, str]:
+    """Explained by the first known cause that holds (its note and label); otherwise failed,
+    naming the reading's hint, the invalid body it follows from, or the two engines."""
+    for convention, cause in KNOWN_CAUSES:
         note = cause(at)
         if note:
-            return Verdict.EXPLAINED, note
+            return Verdict.EXPLAINED, note, convention
     known = at.hinted
     if not known and at.field in BODY_FIELDS and at.ja.body in invalid:
         known = FOLLOWS_FROM_INVALID.format(body=at.ja.body, why=invalid[at.ja.body],
                                             a=at.a.engine, b=at.b.engine)
     return Verdict.FAILED, known or (f"{at.a.engine} and {at.b.engine} read {at.ja.name!r} "
-                                     f"({at.ja.body}) differently")
+                                     f"({at.ja.body}) differently"), ""
 
 
 BODY_FIELDS = frozenset({"mass", "com", "inertia"})

@@ -172,13 +172,13 @@ def compare(
             rtol *= kappa
             basis += f" x cond(M) {kappa:.3g}"
         error = float(errors[worst]) / scale
-        verdict, note = Verdict.PASSED, ""
+        verdict, note, convention = Verdict.PASSED, "", ""
         if error > rtol:
             verdict = Verdict.FAILED
             note = "cause unknown"
             for known in _candidates(explanations.get(quantity), readings.get(quantity)):
                 if _as_predicted(actual - desired, errors, known.size, rtol * scale):
-                    verdict, note = Verdict.EXPLAINED, known.note
+                    verdict, note, convention = Verdict.EXPLAINED, known.note, known.label
                     break
             else:
                 if quantity in readings:
@@ -190,7 +190,8 @@ def compare(
             CheckRow(
                 model=model, section=Section.DYNAMICS, subject=quantity, field="max rel error",
                 impl_a=name_a, impl_b=name_b, value_a="", value_b="", error=error,
-                tolerance=rtol, basis=basis, verdict=verdict, note=note, worst_state=worst,
+                tolerance=rtol, basis=basis, verdict=verdict, note=note,
+                convention=convention, worst_state=worst,
             )
         )
     return rows

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from dyncheck import labels
 from dyncheck.adapters.actuators import EULER_DAMPING, InputJacobian
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import ModelTree
@@ -97,6 +98,7 @@ def rows(model: str, *, canon: Canonical, tree: ModelTree, acts: law.JointActuat
     worst = np.unravel_index(int(np.argmax(off / allowed)), off.shape)
     within = bool(np.all(off <= allowed))
     verdict = Verdict.PASSED if within else Verdict.FAILED
+    convention = ""
     note = "" if within else (
         f"{engine} differs from the chain rule at state {worst[0]}, entry ({worst[1]}, "
         f"{worst[2]}): {off[worst]:.3g} beyond its predicted {allowed[worst]:.3g}: "
@@ -105,7 +107,7 @@ def rows(model: str, *, canon: Canonical, tree: ModelTree, acts: law.JointActuat
         damped = _expected(canon, acts, mass=mass + h * np.diag(damping), bias=bias, q=q,
                            v=v, u=u, h=h, integrator=found.integrator)
         if np.all(np.abs(found.matrix - damped) <= allowed):
-            verdict = Verdict.EXPLAINED
+            verdict, convention = Verdict.EXPLAINED, labels.EULER_DAMPING
             note = (f"{tree.hint('model', EULER_DAMPING)}: predicted "
                     f"{float(np.abs(damped - expected).max()) / scale:.3g} of B's scale, "
                     f"measured {float(off.max()) / scale:.3g}; with M + h D it meets the "
@@ -117,7 +119,7 @@ def rows(model: str, *, canon: Canonical, tree: ModelTree, acts: law.JointActuat
         error=float(off.max()) / scale, tolerance=float(allowed.max()) / scale,
         basis=(f"the chain rule through the referee's M, h and actuator law (complex step "
                f"in u); {method}; controls inside their ranges"),
-        verdict=verdict, note=note, worst_state=int(worst[0]))
+        verdict=verdict, note=note, convention=convention, worst_state=int(worst[0]))
 
 
 def _expected(canon: Canonical, acts: law.JointActuators, *, mass: np.ndarray,

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from dyncheck.check import causes
+from dyncheck.check.causes import Beside
 from dyncheck.check.rows import CheckResult, Section, accepted
 from dyncheck.check.verdicts import per_engine
 from dyncheck.escaping import file_name, markdown, markdown_code, markdown_table
@@ -103,9 +105,10 @@ def _table(frame: pd.DataFrame, columns: list[str]) -> str:
 
 
 def page(result: CheckResult, versions: dict[str, str] | None = None, *,
-         indexed: bool = False) -> str:
+         indexed: bool = False, there: Beside | None = None) -> str:
     """The Markdown page (``versions``: the provenance, read now when not given;
-    ``indexed``: written beside the index of several models, which it links to)."""
+    ``indexed``: written beside the index of several models, which it links to; ``there``:
+    the catalogue and tutorials beside its folder, which the causes link to)."""
     versions = _versions(result) if versions is None else versions
     rows = result.rows
     c = counts(result)
@@ -137,6 +140,7 @@ def page(result: CheckResult, versions: dict[str, str] | None = None, *,
                ["section", "subject", "field", "impl_a", "impl_b", "value_a", "value_b",
                 "error", "verdict", "note"]),
         "",
+        *causes.lines(rows, there or Beside()),
     ]
     for section in Section:
         part = rows[rows["section"] == section.value]
@@ -192,6 +196,7 @@ def write(result: CheckResult, out: Path, *, name: str | None = None,
     result = without_paths(result)
     csv_path, md_path = within(out, f"{name}.csv"), within(out, f"{name}.md")
     versions = _versions(result)
-    write_together({csv_path: to_csv(result.rows), md_path: page(result, versions, indexed=indexed),
+    md = page(result, versions, indexed=indexed, there=causes.beside(out))
+    write_together({csv_path: to_csv(result.rows), md_path: md,
                     out / PROVENANCE: provenance_json(versions)})
     return [csv_path, md_path, out / PROVENANCE]

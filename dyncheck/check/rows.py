@@ -43,6 +43,10 @@ class CheckRow:
     basis: str
     verdict: Verdict
     note: str
+    convention: str = ""
+    """An explained row's cause: the label (:mod:`dyncheck.labels`) of the property that
+    explains it, which :data:`~dyncheck.explain.explanations.EXPLANATIONS` describes and
+    links to its catalogue entry and tutorial; empty otherwise."""
     worst_state: int = -1
     accepted: str = ""
     """A failed row's acceptance (``--accept``): the known finding's reason; empty otherwise."""
@@ -54,7 +58,7 @@ states (an actuation row's other fields compare readings)."""
 
 COLUMNS = [
     "model", "section", "subject", "field", "impl_a", "impl_b", "value_a", "value_b", "error",
-    "tolerance", "basis", "verdict", "note", "worst_state", "accepted",
+    "tolerance", "basis", "verdict", "note", "convention", "worst_state", "accepted",
 ]
 
 

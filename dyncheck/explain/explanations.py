@@ -17,13 +17,20 @@ from dyncheck.labels import (
     CHARTS_DIFFER,
     COMPUTED_INERTIA,
     DEFECT,
+    EULER_DAMPING,
     GYROSCOPIC_IMPLICIT,
     HELD_FORCE,
+    MESH_ROUNDING,
+    MESH_VOLUME,
     NAIVE_GROUP_RK4,
+    NO_ACTUATORS_READ,
+    PLACEMENT,
     PRE_ASYMPTOTIC,
     READING,
     READINGS,
     ROTOR_ENERGY,
+    SOFT_CONSTRAINT,
+    STORED_INERTIA,
     TRUNCATION,
     Origin,
 )
@@ -32,19 +39,27 @@ from dyncheck.variants import (
     GRAVITY_DEFAULT,
     INERTIA_STORED,
     POINT_INERTIA,
-    SOFT_CONSTRAINT,
 )
 
 
 @dataclass(frozen=True, kw_only=True)
 class Explanation:
+    """A property that explains a row: whose it is, what it is, and where it is taught."""
+
     origin: Origin
     text: str
+    entry: str = ""
+    """The conventions catalogue's entry that demonstrates it (``dyncheck explain ENTRY``),
+    or empty."""
+    tutorial: str = ""
+    """The executed tutorial that teaches it (``reports/tutorials/TUTORIAL.md``), or empty
+    (then the entry's own, :data:`~dyncheck.explain.entry.TUTORIALS`)."""
 
 
 EXPLANATIONS: dict[str, Explanation] = {
     COMPUTED_INERTIA: Explanation(
         origin=Origin.ENGINE,
+        entry="pybullet-spherical-inertia", tutorial="10_moving_to_pybullet",
         text="PyBullet 3.2.7's spherical joint computes with its child link's principal "
         "moments taken in the link's own axes: the rotation of the link's inertial frame "
         "(which its URDF importer finds by diagonalizing the tensor, and holds: "
@@ -59,6 +74,7 @@ EXPLANATIONS: dict[str, Explanation] = {
     ),
     POINT_INERTIA: Explanation(
         origin=Origin.ENGINE,
+        entry="point-mass-inertia-floor",
         text="MuJoCo's compiler rejects a moving body whose mass or inertia is below mjMINVAL "
         "(1e-15), so the MJCF gives each of the book's point masses a small isotropic inertia "
         "(`Multibody.mjcf_point_inertia`). MuJoCo and `pinocchio-mjcf` read it; `pinocchio` "
@@ -79,6 +95,7 @@ EXPLANATIONS: dict[str, Explanation] = {
     ),
     READINGS: Explanation(
         origin=Origin.ENGINE,
+        tutorial="06_what_parsers_read",
         text="Two engines read a field the dynamics use differently (Drake's armature on a "
         "joint without an actuator): their derivatives are compared after the referee's on "
         "one reading minus on the other's, measured, which accounts for the difference.",
@@ -107,6 +124,7 @@ EXPLANATIONS: dict[str, Explanation] = {
     ),
     GRAVITY_DEFAULT: Explanation(
         origin=Origin.ENGINE,
+        entry="drake-mjcf-options",
         text="Pinocchio's MJCF parser (`pin.buildModelFromMJCF`, Pinocchio 4.1) and Newton's "
         "MJCF importer (`ModelBuilder.add_mjcf`, Newton 1.8) do not read `<option gravity>`: "
         "the loaded model keeps the engine's default (0, 0, −9.81) m/s² whatever the file "
@@ -126,6 +144,7 @@ EXPLANATIONS: dict[str, Explanation] = {
     ),
     SOFT_CONSTRAINT: Explanation(
         origin=Origin.ENGINE,
+        entry="soft-vs-exact-constraints",
         text="MuJoCo's equality constraints are soft (Computation chapter, soft constraints): "
         "the constraint force f = −(A + R)⁻¹(J a₀ − a_ref) with A = J M⁻¹ Jᵀ, "
         "R = (1 − d)/d · A and a_ref = −b ṙ − k d(r) r (b = 2/(dmax τ), "
@@ -148,6 +167,7 @@ EXPLANATIONS: dict[str, Explanation] = {
     ),
     CHARTS_DIFFER: Explanation(
         origin=Origin.ENGINE,
+        entry="rk4-on-the-rotation-group",
         text="Drake steps a ball joint's roll-pitch-yaw angles and a free joint's quaternion "
         "components (ω in world axes); sympy.physics.mechanics models a rotating body in "
         "generalized coordinates (Example 9's angles) and steps their rates; MuJoCo — and "
@@ -169,6 +189,7 @@ EXPLANATIONS: dict[str, Explanation] = {
     ),
     NAIVE_GROUP_RK4: Explanation(
         origin=Origin.ENGINE,
+        entry="rk4-on-the-rotation-group",
         text="Before MuJoCo 4.0.0, `mjINT_RK4` advanced a ball or free joint's quaternion by "
         "the weighted sum of its four stages' angular velocities, as if all four lay in one "
         "tangent space; the stages' tangent spaces differ by O(h) rotations whose commutators "
@@ -203,6 +224,7 @@ EXPLANATIONS: dict[str, Explanation] = {
     ),
     ARMATURE_AXES: Explanation(
         origin=Origin.ENGINE,
+        entry="free-body-velocity-frames",
         text="Pinocchio (4.x) adds a joint's armature A to its own equations as A v̇ₑ in its "
         "own velocity coordinates vₑ = T v; for a free flyer those hold the linear velocity "
         "in body axes, whose derivative is not the body's acceleration (v̇ₑ = T v̇ + Ṫ v). "
@@ -213,11 +235,61 @@ EXPLANATIONS: dict[str, Explanation] = {
     ),
     READING: Explanation(
         origin=Origin.ENGINE,
+        tutorial="06_what_parsers_read",
         text="Two engines read the model file differently (their parsers: the description "
         "rows name each field and the fix). `dyncheck check` measures the effect: the "
         "referee evaluated on each engine's own reading, their difference the prediction, "
         "and each differing field's share by substitution (one field group of one reading "
         "put into the other). A row is `explained` only when the engines' difference is the "
         "referee's within round-off; each engine is judged on its own reading separately.",
+    ),
+    PLACEMENT: Explanation(
+        origin=Origin.ENGINE,
+        text="Two engines place the whole model apart: every joint anchor and centre of mass "
+        "moved by one vector, or turned about an axis that keeps gravity (a parser that drops "
+        "the root body's pos, say). Under uniform gravity no dynamics depend on where the "
+        "model sits: the description rows are compared after that placement, which is "
+        "measured (the same vector or turn for every joint).",
+    ),
+    STORED_INERTIA: Explanation(
+        origin=Origin.ENGINE,
+        text="An engine stores a body's inertia to an accuracy it declares "
+        "(`ModelTree.inertia_accuracy`: its own rounding of the tensor); the difference is "
+        "predicted as √6 × that accuracy × trace(I), and a row is `explained` only within it.",
+    ),
+    MESH_ROUNDING: Explanation(
+        origin=Origin.ENGINE,
+        entry="geometry-derived-inertia",
+        text="Both engines integrate a body's mass properties from the same mesh, in float32 "
+        "vertices: the difference is bounded by the vertices' rounding, propagated through "
+        "the volume integrals, and a row is `explained` only within that bound.",
+    ),
+    MESH_VOLUME: Explanation(
+        origin=Origin.ENGINE,
+        entry="geometry-derived-inertia",
+        text="MuJoCo takes a mesh's volume by its default inertia=\"legacy\" (which "
+        "overcounts a non-convex mesh) or by \"convex\" (its hull), as its documentation "
+        "says; another engine computes it exactly. A row is `explained` only when that "
+        "engine's reading agrees with MuJoCo's own reading of the model loaded again with "
+        "inertia=\"exact\" (measured). Fix: inertia=\"exact\" on the <mesh>, or the "
+        "body's <inertial>.",
+    ),
+    NO_ACTUATORS_READ: Explanation(
+        origin=Origin.ENGINE,
+        tutorial="12_the_same_action",
+        text="An engine's parser makes no actuator of elements another engine reads as "
+        "actuators — MuJoCo's URDF compiler of a URDF's <transmission> elements (the format "
+        "gives it none), Drake's MJCF parser of the actuator tags it ignores — as the engine's "
+        "adapter states, its premise checked on the file (the elements counted). Fix: give "
+        "that engine the actuators in a form it reads (<actuator> elements in an MJCF of the "
+        "robot, for MuJoCo).",
+    ),
+    EULER_DAMPING: Explanation(
+        origin=Origin.ENGINE,
+        entry="passive-damping",
+        text="MuJoCo's Euler step integrates joint damping implicitly, solving with M + h D "
+        "(its documentation: the Euler integrator's implicit damping), so a step's Jacobian "
+        "in the controls is the chain rule through M + h D, not M. A row is `explained` only "
+        "when MuJoCo's Jacobian meets the chain rule with M + h D within the bound.",
     ),
 }

@@ -53,7 +53,6 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
     from dyncheck.adapters.formats.files import read
     from dyncheck.check import derivatives, engines
     from dyncheck.check.alignment import align_by_body
-    from dyncheck.check.derivative_pairs import label
     from dyncheck.check.states import States
 
     names = [n for n in MODELS if n in impl_names]
@@ -110,7 +109,7 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
                              with_referee=REFEREE in impl_names)
     return failed + [_row(case, r.subject, r.impl_a, r.impl_b, str(r.verdict), r.note,
                           error=r.error, tolerance=r.tolerance, basis=r.basis,
-                          worst=r.worst_state, convention=label(r)) for r in found]
+                          worst=r.worst_state, convention=r.convention) for r in found]
 
 
 def _row(case: Case, quantity: str, a: str, b: str, verdict: str, note: str, *,
