@@ -17,8 +17,10 @@ IMPLS = ("reference", "mujoco", "pinocchio", "drake")
 
 
 def _row(section, a, b, verdict, subject="mass_matrix", error=0.0, tolerance=1e-12, note=""):
-    return dict(zip(COLUMNS, ["m", section.value, subject, "all", a, b, "", "", error,
-                              tolerance, "", verdict.value, note, -1, ""], strict=True))
+    row = dict.fromkeys(COLUMNS, "")
+    return row | {"model": "m", "section": section.value, "subject": subject, "field": "all",
+                  "impl_a": a, "impl_b": b, "error": error, "tolerance": tolerance,
+                  "verdict": verdict.value, "note": note, "worst_state": -1}
 
 
 def _frame(*rows):
