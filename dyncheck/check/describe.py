@@ -290,7 +290,7 @@ def _joint(a: ModelTree, b: ModelTree, ja: TreeJoint, jb: TreeJoint, *, scale: _
     its known cause), and how many fields were compared."""
     rtol = scale.rtol
     if ja.type is not jb.type:
-        return [(ja.name, "type", ja.type, jb.type, np.inf, 0.0, Verdict.FAILED, "")], 0
+        return [_Found(ja.name, "type", ja.type, jb.type, np.inf, 0.0, Verdict.FAILED, "")], 0
     found: list[_Found] = []
     if ja.parent != jb.parent:
         gone = ja.parent is not None and ja.parent not in [j.name for j in b.joints]

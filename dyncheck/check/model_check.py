@@ -37,6 +37,8 @@ from dyncheck.check import (
     validity,
 )
 from dyncheck.check import engines as engine_processes
+from dyncheck.check.against import Other, read_other
+from dyncheck.check.against import rows as against_rows
 from dyncheck.check.alignment import align_by_body
 from dyncheck.check.computed import canonical_of
 from dyncheck.check.derivatives import expected_seconds
@@ -123,7 +125,6 @@ def check_model(
     instead of sampled ones (:func:`~dyncheck.check.given_states.given`)."""
     source_path = inputs.model_path(str(path))
     given = given_states_of(given_states, most=inputs.MAX_STATES)
-    against_path = inputs.model_path(str(against)) if against is not None else None
     inputs.states(states)
     chosen = implementations(impls)
     if not any(i in ENGINES for i in chosen):
@@ -132,6 +133,9 @@ def check_model(
     model = name or shown(source_path.stem)
     source = read(source_path, floating=floating)
     inputs.massive(source_path, source)
+    other = None if against is None else read_other(
+        str(against), engine=next(i for i in chosen if i in ENGINES), floating=floating,
+        isolate=isolate, limits=limits)
     if isolate and not engine_processes.can_isolate():
         isolate = False
         source = replace(source, notes=(*source.notes, engine_processes.IN_PROCESS_NOTE))
@@ -142,7 +146,7 @@ def check_model(
         with np.errstate(all="ignore"):
             return _check(model, source_path, source, engines=engines, chosen=chosen,
                           states=states, seed=seed, floating=floating,
-                          against_path=against_path, load_seconds=time.perf_counter() - t0,
+                          other=other, load_seconds=time.perf_counter() - t0,
                           derivatives=derivatives, actuators=actuators, say=say, given=given)
     finally:
         engine_processes.stop(engines)
@@ -150,7 +154,7 @@ def check_model(
 
 def _check(model: str, source_path: Path, source: ModelFile, *,
            engines: dict[str, ModelEngine | NotLoaded], chosen: tuple[str, ...],
-           states: int, seed: int, floating: bool, against_path: Path | None,
+           states: int, seed: int, floating: bool, other: Other | None,
            load_seconds: float, derivatives: bool = False, actuators: bool = True,
            say: Callable[[str], None] | None = None,
            given: GivenStates | None = None) -> CheckResult:
@@ -171,8 +175,8 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
         f"{first.engine}'s), its derivatives on {first.engine}'s"
     )
     differing = _readings(model, source, loaded, rows, notes)
-    if against_path is not None:
-        rows.extend(_against(model, canonical_tree, read(against_path, floating=floating)))
+    if other is not None:
+        rows.extend(against_rows(model, canonical_tree, other))
     canon = layout.canonical(canonical_tree)
     inputs.fits_in_memory(count=states if given is None else given.n, nv=canon.nv,
                           arrays=2 + 3 * len(loaded))  # referee, engines, their readings, pairs
@@ -477,14 +481,3 @@ def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch
                 parts=parts, loaded=loaded, own=own, differing=differing, eps=eps,
                 vertices=mesh, standing=factor))
     return rows
-
-
-def _against(model: str, mine: ModelTree, other: ModelFile) -> list[CheckRow]:
-    """The description diff against another file (the previous version of the model), both
-    read by the same engine."""
-    from dyncheck.adapters.mujoco.model import MujocoModel
-
-    theirs = MujocoModel(other).tree
-    label = f"against:{other.path.name}"
-    return describe.diff(model, replace(theirs, engine=label),
-                         replace(mine, engine=f"{mine.engine}:{model}"))

@@ -344,7 +344,9 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    "each engine's reading of them, their force at sampled controls and MuJoCo's "
                    "step Jacobian in the controls are compared)")
     p.add_argument("--against", type=path_arg, default=None, metavar="PATH",
-                   help="also compare what MuJoCo reads with this other file (a previous version)")
+                   help="also compare the model's reading with this other file's (a previous "
+                   "version), both read by the first engine (MuJoCo by default), the other "
+                   "compiled in a process of its own")
     p.add_argument("--baseline", type=path_arg, default=None, metavar="FILE",
                    help="hold every row to this stored baseline of the same models: exit 1 "
                    "when a row moved (its verdict, its error by more than its tolerance, a "

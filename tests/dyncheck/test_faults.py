@@ -1690,6 +1690,19 @@ ROUND3 = (  # #59 and #60: readings measured, refusals named, folders held
           answer=r"^dyncheck: error: ulimit -v must be at least 4096 MiB for `dyncheck run`"),
 )
 
+SELF_ATTACHING = """<mujoco>
+  <asset><model name="me" file="self.xml"/></asset>
+  <worldbody>
+    <body name="b"><joint type="hinge"/><geom size="0.1" mass="1"/>
+      <attach model="me" body="b" prefix="x"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+"""A model that attaches itself: MuJoCo 4.0's compiler recurses until its stack ends
+(SIGSEGV, measured)."""
+
+
 def _several(**named: str) -> Callable[[Path], Path]:
     """Several files written into the test's folder (a model and the file an option reads;
     a name with a double underscore is written with a dot there: ``a__xml`` → ``a.xml``)."""
@@ -1777,6 +1790,17 @@ ROUND4 = (  # #79 and #81: the CI gate's files, special files, sizes, versions o
     Fault(kind="MJCF mesh that is a FIFO", area="check", prepare=_fifo_mesh,
           argv=("check", "{tmp}/a.xml", "--out", OUT),
           answer=r"<mesh file> names 'pipe\.stl', which is not a regular file \(a FIFO\)"),
+    Fault(kind="--against model that <attach>es itself (MuJoCo crashes compiling it)",
+          area="check", exit=1,
+          prepare=_several(a__xml=SMALL_MJCF, self__xml=SELF_ATTACHING),
+          argv=("check", "{tmp}/a.xml", "--against", "{tmp}/self.xml", "--impl", "reference",
+                "--impl", "mujoco", "--states", "5", "--out", OUT),
+          answer=r"mujoco could not read it: mujoco crashed while loading the model"),
+    Fault(kind="--against model MuJoCo refuses (compiled in its own process)", area="check",
+          prepare=_several(bad__xml="<mujoco><worldbody><body><joint type='bogus'/>"
+                           "<geom size='0.1' mass='1'/></body></worldbody></mujoco>"),
+          argv=("check", BRANCHES, "--against", "{tmp}/bad.xml", "--out", OUT),
+          answer=r"<tmp>/bad\.xml: mujoco refused"),
     Fault(kind="--against model whose mesh is a FIFO", area="check", prepare=_fifo_mesh,
           argv=("check", BRANCHES, "--against", "{tmp}/a.xml", "--out", OUT),
           answer=r"<mesh file> names 'pipe\.stl', which is not a regular file \(a FIFO\)"),
