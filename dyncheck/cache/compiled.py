@@ -43,6 +43,22 @@ ENGINES = ("jax", "warp")
 """The compiled caches, one folder each."""
 MANIFEST = ".manifest"
 MAGIC = b"dyncheck-compiled-1\n"
+MANIFEST_MOST = 64 << 20
+"""The largest manifest read (a listing of names and digests: megabytes at most)."""
+
+
+def _regular(path: Path) -> int | None:
+    """``path`` opened for reading where it is a regular file (never through a link, never
+    blocking: a FIFO there would hang the command), else None."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except OSError:
+        return None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        return None
+    return fd
+
 
 def _entries(folder: Path) -> dict[str, Path]:
     """Every path below ``folder`` but the manifest, by its name relative to it (links and
@@ -59,13 +75,10 @@ def _entries(folder: Path) -> dict[str, Path]:
 
 def _digest(path: Path) -> str | None:
     """SHA-256 of a regular file (None for anything else: never opened through a link)."""
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
-    except OSError:
+    fd = _regular(path)
+    if fd is None:
         return None
     try:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            return None
         h = hashlib.sha256()
         with os.fdopen(os.dup(fd), "rb") as f:
             for block in iter(lambda: f.read(1 << 20), b""):
@@ -81,11 +94,18 @@ def _tag(secret: bytes, payload: bytes) -> bytes:
 
 def _vouched(folder: Path, secret: bytes) -> dict[str, str]:
     """The entries the manifest vouches for (name → SHA-256); none where it is missing,
-    forged or unreadable."""
+    forged, unreadable, too large or not a regular file."""
+    fd = _regular(folder / MANIFEST)
+    if fd is None:
+        return {}
     try:
-        data = (folder / MANIFEST).read_bytes() if not (folder / MANIFEST).is_symlink() \
-            else b""
+        with os.fdopen(os.dup(fd), "rb") as f:
+            data = f.read(MANIFEST_MOST + 1)
     except OSError:
+        return {}
+    finally:
+        os.close(fd)
+    if len(data) > MANIFEST_MOST:
         return {}
     head = len(MAGIC) + 32
     if not data.startswith(MAGIC) or len(data) < head \
@@ -181,10 +201,13 @@ def _take(folder: Path) -> int | None:
     import fcntl
 
     try:
-        fd = os.open(folder / ".lock", os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o600)
+        fd = os.open(folder / ".lock", os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK,
+                     0o600)
     except OSError:
         return None
     try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):  # a FIFO, a device: not a lock of ours
+            raise OSError("not a regular file")
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
         os.close(fd)

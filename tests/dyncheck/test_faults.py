@@ -1903,6 +1903,10 @@ DEDICATED = (
     ("a compiled-code folder others can write", "not used: JAX keeps no persistent cache, "
      "Warp compiles into a temporary folder (it wrote ~/.cache/warp even under --no-cache)",
      "tests/dyncheck/cache/test_compiled.py::test_a_folder_others_can_write_is_not_used"),
+    ("a FIFO where the compiled-code manifest lives", "read as no manifest, never opened "
+     "blocking: every entry compiled again, at once (it hung run and check until killed)",
+     "tests/dyncheck/cache/test_compiled.py::test_a_manifest_that_is_a_fifo_is_no_manifest_"
+     "and_never_blocks"),
 )
 
 OBSERVED: dict[int, tuple[int, str]] = {}

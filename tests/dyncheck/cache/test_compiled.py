@@ -71,6 +71,30 @@ def test_without_an_authentic_manifest_nothing_is_trusted(tmp_path, damage):
     assert sorted(compiled_caches.verify(folder, SECRET)) == ["a", "b", "sub/c"]
 
 
+def test_a_manifest_that_is_a_fifo_is_no_manifest_and_never_blocks(tmp_path):
+    """#81: a FIFO planted where the manifest lives hung every command that checked the
+    folder (reading it waits for a writer forever). It is read as no manifest: nothing
+    trusted, every entry deleted, at once."""
+    import threading
+
+    folder = _filled(tmp_path)
+    manifest = folder / compiled_caches.MANIFEST
+    manifest.unlink()
+    os.mkfifo(manifest)
+    removed: list[str] = []
+    worker = threading.Thread(
+        target=lambda: removed.extend(compiled_caches.verify(folder, SECRET)), daemon=True)
+    worker.start()
+    worker.join(10)
+    if worker.is_alive():  # the old answer: blocked on the FIFO; let it go, then fail
+        with open(os.open(manifest, os.O_WRONLY | os.O_NONBLOCK), "wb"):
+            pass
+        pytest.fail("reading a FIFO manifest blocked")
+    assert sorted(removed) == ["a", "b", "sub/c"]
+    compiled_caches.sign(folder, SECRET)  # the FIFO replaced by a signed manifest
+    assert manifest.is_file() and compiled_caches.verify(folder, SECRET) == []
+
+
 def test_a_command_checks_the_folder_and_signs_it_when_it_ends(tmp_path, monkeypatch):
     """A planted entry is gone before the command's engines see the folder; what the
     command's engines write is vouched for by the next command; --no-cache uses none."""
