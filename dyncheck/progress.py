@@ -10,8 +10,11 @@ import time
 from typing import Any, TextIO
 
 
-def _seconds(s: float) -> str:
-    return f"{s:.1f} s" if s < 120 else f"{s / 60:.1f} min"
+def seconds_text(s: float) -> str:
+    """A duration as a reader takes it in: seconds, minutes or hours."""
+    if s < 120:
+        return f"{s:.1f} s"
+    return f"{s / 60:.1f} min" if s < 7200 else f"{s / 3600:.1f} h"
 
 
 class Progress:
@@ -55,10 +58,10 @@ class Progress:
         elapsed = now - self.start
         left = ""
         if self.total and self.count < self.total:
-            left = f", about {_seconds(elapsed / self.count * (self.total - self.count))} to go"
+            left = f", about {seconds_text(elapsed / self.count * (self.total - self.count))} to go"
         of = f"/{self.total}" if self.total else ""
-        print(f"dyncheck {self.what}: [{self.count}{of}] {unit} done in {_seconds(took)} "
-              f"(elapsed {_seconds(elapsed)}{left})", file=self.stream, flush=True)
+        print(f"dyncheck {self.what}: [{self.count}{of}] {unit} done in {seconds_text(took)} "
+              f"(elapsed {seconds_text(elapsed)}{left})", file=self.stream, flush=True)
 
     def close(self) -> None:
         if self.bar is not None:

@@ -44,7 +44,7 @@ from dyncheck.implementations import (
     implementations_for,
     make_implementation,
 )
-from dyncheck.progress import Progress
+from dyncheck.progress import Progress, seconds_text
 from dyncheck.results import to_csv, write_atomic
 
 
@@ -91,14 +91,44 @@ NO_PORTS = "all but the ports"
 engine calls accounts for (a port's batched call is its rawest: it has no raw loop)."""
 
 
-def bench(case: Case, states: int, repeats: int, progress: Progress | None = None) -> pd.DataFrame:
+CALIBRATION_STATES = 200
+"""The states each implementation evaluates (twice: a port compiles on the first) to
+estimate a benchmark's time before it starts (:func:`expected_seconds`)."""
+SWEEP_PASSES = 5
+"""How many times a benchmark evaluates every state per repeat: an engine's raw calls, its
+batched adapter and its implementation, then the whole sweep with and without the ports."""
+
+
+def expected_seconds(case: Case, impls: dict[str, object], *, states: int, repeats: int,
+                     memory_sizes: Sequence[int]) -> float:
+    """About how long :func:`main` takes: each implementation's per-state time measured on
+    :data:`CALIBRATION_STATES` states (its first call, which compiles a port, counted once),
+    times the states it will evaluate — :data:`SWEEP_PASSES` passes of ``states`` per repeat,
+    and each memory sweep once."""
+    sample = case.sample_states(CALIBRATION_STATES)
+    per_state = compile_once = 0.0
+    for impl in impls.values():
+        t0 = time.perf_counter()
+        impl.evaluate(sample)  # type: ignore[attr-defined]
+        t1 = time.perf_counter()
+        impl.evaluate(sample)  # type: ignore[attr-defined]
+        t2 = time.perf_counter()
+        per_state += (t2 - t1) / CALIBRATION_STATES
+        compile_once += max(0.0, (t1 - t0) - (t2 - t1))
+    evaluated = SWEEP_PASSES * repeats * states + sum(memory_sizes)
+    return per_state * evaluated + compile_once * (1 + len(memory_sizes))
+
+
+def bench(case: Case, states: int, repeats: int, progress: Progress | None = None, *,
+          impls: dict | None = None) -> pd.DataFrame:
     """Per-state times (µs) of every part and the whole sweep, one row each (``progress``:
-    told as each implementation is done)."""
+    told as each implementation is done; ``impls``: the implementations, built here where
+    not given)."""
     from dyncheck import coordinates as co
     from dyncheck.comparison import compare_instantaneous
 
     sample = case.sample_states(states)
-    impls = {n: make_implementation(n, case) for n in implementations_for(case)}
+    impls = impls or {n: make_implementation(n, case) for n in implementations_for(case)}
     rows = []
 
     def add(part: str, impl: str, seconds: float) -> None:
@@ -307,13 +337,22 @@ def main(case_name: str, states: int, repeats: int, memory_sizes: list[int], out
          jobs: int = 1, dask: str | None = None, quiet: bool = False) -> str:
     """The benchmark of one case (the module's docstring), its progress on stderr: a line per
     implementation and per memory size, each with the time still expected."""
+    import sys
+
     case = get_case(case_name)
-    progress = Progress("bench", len(implementations_for(case)) + len(memory_sizes) + 1,
-                        quiet=quiet)
+    impls = {n: make_implementation(n, case) for n in implementations_for(case)}
+    if not quiet:  # announced before the long work, whatever its size
+        took = expected_seconds(case, impls, states=states, repeats=repeats,
+                                memory_sizes=memory_sizes)
+        print(f"dyncheck bench: about {seconds_text(took)} expected on this machine ({states} "
+              f"states x {repeats} repeats over {len(impls)} implementations, memory sweeps "
+              f"of {', '.join(map(str, memory_sizes)) or 'none'}; --states, --repeats and "
+              "--memory change it)", file=sys.stderr, flush=True)
+    progress = Progress("bench", len(impls) + len(memory_sizes) + 1, quiet=quiet)
     # on the workers first: an unreachable scheduler is an error before the long work
     sliced = None if jobs <= 1 and dask is None else sliced_sweep(
         case, implementations_for(case), states, jobs=jobs, dask=dask, repeats=repeats)
-    times = bench(case, states, repeats, progress)
+    times = bench(case, states, repeats, progress, impls=impls)
     progress.done("whole sweeps")
     rat = ratios(times)
     peaks = []

@@ -15,6 +15,9 @@ from dyncheck.commands.options import (
     positive,
 )
 
+MEMORY_DEFAULT_MOST = 1_000_000
+"""The largest memory sweep ``bench`` measures unless asked (the committed benchmark's)."""
+
 
 def bench_command(args: argparse.Namespace) -> int:
     from dyncheck.bench import engines as bench
@@ -34,6 +37,8 @@ def bench_command(args: argparse.Namespace) -> int:
     get_case(args.case)
     positive("--states", args.states, BENCH_MAX["--states"])
     positive("--repeats", args.repeats, BENCH_MAX["--repeats"])
+    if args.memory is None:  # the default follows --states: the sweep's size and ten times it
+        args.memory = sorted({min(n, MEMORY_DEFAULT_MOST) for n in (args.states, 10 * args.states)})
     for n in args.memory:
         positive("--memory", n, BENCH_MAX["--memory"])
     claim_out(args.out)
@@ -51,9 +56,10 @@ def _arguments(p: argparse.ArgumentParser) -> None:
         "--memory",
         type=int,
         nargs="*",
-        default=[100_000, 1_000_000],
+        default=None,
         metavar="N",
-        help="sweep sizes whose peak memory is measured in fresh processes",
+        help="sweep sizes whose peak memory is measured in fresh processes (default: --states "
+        f"and ten times it, each at most {MEMORY_DEFAULT_MOST}; none given: none measured)",
     )
     p.add_argument("--out", type=path_arg, default=OUT,
                    help=f"report folder (default: {OUT}; the committed benchmark: --out "

@@ -1907,6 +1907,14 @@ DEDICATED = (
      "blocking: every entry compiled again, at once (it hung run and check until killed)",
      "tests/dyncheck/cache/test_compiled.py::test_a_manifest_that_is_a_fifo_is_no_manifest_"
      "and_never_blocks"),
+    ("bench of 10^7 states (hours of sweeps)", "its time estimated from each implementation "
+     "measured on 200 states and said in one line before the first sweep, with the options "
+     "that change it (it ran for hours unannounced)",
+     "tests/dyncheck/bench/test_engines.py::test_the_estimate_is_said_before_the_work"),
+    ("bench --states without --memory", "memory sweeps of --states and ten times it (at most "
+     "10^6) — they were 10^5 and 10^6 whatever --states said",
+     "tests/dyncheck/bench/test_engines.py::test_the_memory_sweeps_follow_the_states_asked_"
+     "for"),
 )
 
 OBSERVED: dict[int, tuple[int, str]] = {}
