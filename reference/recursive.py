@@ -21,8 +21,8 @@ m 𝐠 at the centres of mass. M comes from composite bodies (each joint's colum
 inertia of everything it carries, the same sums).
 
 Inputs and layout as :class:`~dyncheck.reference.tree.TreeDynamics` (world axes at the
-reference configuration; MuJoCo's coordinates: a free joint (p, w x y z) with velocity (world
-linear, body angular), a ball's velocity in its child's axes). Every operation is analytic
+reference configuration; MuJoCo's coordinates: a free joint (p, w x y z) in its parent's axes with
+velocity (linear in those axes, body angular), a ball's velocity in its child's axes). Every operation is analytic
 (rotations by sin and cos, a quaternion normalised by q·q, not |q|²), so the algorithm runs on
 complex numbers: a complex step through it gives its derivatives exactly to round-off.
 """
@@ -135,12 +135,15 @@ class RecursiveDynamics(Tree):
             w = rp @ current  # the child's axes: its velocity's columns
             return (rot, pivot - rot @ body.anchor,
                     np.concatenate([w, np.cross(pivot[..., None], w, axis=-2)], -2))
-        # free: a world pose, velocity (world linear of the anchor, body angular)
-        world = quat_matrix(qj[..., 3:7])
-        # (broadcast to the parent's rows; about its own origin unless absolute)
-        position = (qj[..., :3] if absolute else 0 * qj[..., :3]) + 0 * tp
+        # free: a pose in the parent's axes (the world's at the root), velocity (the anchor's
+        # linear in the parent's axes, body angular relative to the parent)
+        world = rp @ quat_matrix(qj[..., 3:7])
+        if body.parent >= 0:
+            position = (rp @ qj[..., :3, None])[..., 0] + tp
+        else:  # (broadcast to the parent's rows; about its own origin unless absolute)
+            position = (qj[..., :3] if absolute else 0 * qj[..., :3]) + 0 * tp
         rot = world @ body.frame.T
-        eye = np.broadcast_to(np.eye(3), world.shape)
+        eye = np.broadcast_to(rp, world.shape)
         linear = np.concatenate([np.zeros_like(eye), eye], -2)
         angular = np.concatenate([world, np.cross(position[..., None], world, axis=-2)], -2)
         return rot, position - rot @ body.anchor, np.concatenate([linear, angular], -1)
@@ -165,7 +168,7 @@ class RecursiveDynamics(Tree):
                  ) -> tuple[np.ndarray, np.ndarray]:
         """Body j's velocity V = V_parent + S v_j and acceleration A = A_parent + S v̇_j +
         Ṡ v_j ((..., 6) each) — Ṡ v_j = V_parent × S v_j for columns fixed in a body, and
-        ṗ × ω for a free joint's translation, whose columns are the world's."""
+        ṗ × ω for a free joint's translation, whose columns are its parent's axes."""
         motion = (cols @ vj[..., None])[..., 0]
         if parent is not None:
             vp, ap = parent
@@ -173,9 +176,9 @@ class RecursiveDynamics(Tree):
         else:
             vel, acc = motion, root
         acc = acc + (cols @ aj[..., None])[..., 0]
-        if self.bodies[j].kind == "free":
-            acc = acc + np.concatenate(
-                [np.zeros_like(vj[..., :3]), _cross(vj[..., :3], motion[..., :3])], -1)
+        if self.bodies[j].kind == "free":  # its translation's columns: the parent's axes
+            slid = (cols[..., 3:, :3] @ vj[..., :3, None])[..., 0]
+            acc = acc + np.concatenate([np.zeros_like(slid), _cross(slid, motion[..., :3])], -1)
         return vel, acc
 
     def _force(self, j: int, rot: np.ndarray, trans: np.ndarray, vel: np.ndarray,

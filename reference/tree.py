@@ -14,12 +14,13 @@ The derivatives ∂_k g are exact: complex-step (g evaluated at q + i·η·e_k, 
 imaginary part / η — no subtraction, so no cancellation: error ~ ε relative). Ball and free
 joints are taken in a local chart at the sampled state, R = R_s exp(ξ̂), ξ = 0 there, so that
 ξ̇ = ω in the body's axes and (ξ̈ = ω̇ at the chart's centre) Euler's equations come out; a free
-body's position is its world position. The chart's exp and right Jacobian are evaluated by
+joint's pose is held in its parent's axes (the world's at the root: a free body's position is
+its world position), as a free flyer below a moving link is in Pinocchio. The chart's exp and right Jacobian are evaluated by
 their series in θ² = ξ·ξ, exact here because |ξ| ≤ η.
 
 Inputs are in world axes at the reference configuration (the same point of view as the
 engines' neutral trees); coordinates q follow MuJoCo's layout (a free joint (p, w x y z), its
-velocity (world linear, body angular)); a joint's angle is measured from ``zero``.
+velocity (linear in its parent's axes — the world's at the root —, body angular)); a joint's angle is measured from ``zero``.
 """
 
 from __future__ import annotations
@@ -293,13 +294,13 @@ class TreeDynamics(Tree):
             rot = rp @ current @ body.frame.T
             trans = pivot - np.einsum("srij,j->sri", rot, anchor)
             columns = [(span, rp @ current @ jr, pivot)]
-        else:  # free: q = (p, quat) world pose; x = (dp, ξ)
+        else:  # free: q = (p, quat) pose in the parent's axes (the world's at the root)
             e, jr = _exp_and_jr(xj[..., 3:])
-            world = _quat_matrix(q[:, qs + 3 : qs + 7])[:, None] @ e
-            position = q[:, None, qs : qs + 3] + xj[..., :3]
+            world = rp @ _quat_matrix(q[:, qs + 3 : qs + 7])[:, None] @ e
+            position = np.einsum("srij,srj->sri", rp, q[:, None, qs : qs + 3] + xj[..., :3]) + tp
             rot = world @ body.frame.T
             trans = position - np.einsum("srij,j->sri", rot, anchor)
-            columns = [(slice(vs, vs + 3), np.broadcast_to(np.eye(3), rot.shape), None),
+            columns = [(slice(vs, vs + 3), np.broadcast_to(rp, rot.shape), None),
                        (slice(vs + 3, vs + 6), world @ jr, position)]
         return rot, trans, columns
 

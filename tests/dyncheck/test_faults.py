@@ -1845,10 +1845,15 @@ DEDICATED = (
      "the command's own result and every page (exit 0 on a good model), no traceback — it was "
      "a false refusal ('no engine could load it') and exit 120, or exit 2 after one line",
      "tests/dyncheck/test_cli.py::test_a_closed_or_full_standard_stream_fails_no_model"),
-    ("a referee whose two methods disagree (a URDF floating joint below a moving link)",
-     "its own row failed naming itself, no engine judged against it — Pinocchio's rows "
+    ("a referee whose two methods disagree (its recursion mutated by 1e-6)",
+     "its own row failed naming itself, no engine judged against it, nor its derivatives",
+     "tests/check/test_referee.py::test_a_mutated_recursion_fails_the_tie"),
+    ("a URDF floating joint below a moving link", "held in its parent's frame: the referee's "
+     "two methods agree to round-off and Pinocchio agrees with it on every dynamics and "
+     "derivative row — the referee disagreed with itself (M by 0.87) and Pinocchio's rows "
      "failed 'cause unknown'",
-     "tests/check/test_referee.py::test_a_referee_that_disagrees_with_itself_judges_no_engine"),
+     "tests/check/test_referee.py::test_a_floating_joint_below_a_moving_link_is_held_in_its_"
+     "parents_frame"),
     ("a known finding accepted (--accept), a new one beside it", "the accepted row on the "
      "page as accepted with its reason, exit 0; the new one fails, exit 1",
      "tests/check/test_acceptance.py::test_a_finding_not_accepted_still_fails"),
