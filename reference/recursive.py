@@ -21,10 +21,11 @@ m 𝐠 at the centres of mass. M comes from composite bodies (each joint's colum
 inertia of everything it carries, the same sums).
 
 Inputs and layout as :class:`~dyncheck.reference.tree.TreeDynamics` (world axes at the
-reference configuration; MuJoCo's coordinates: a free joint (p, w x y z) in its parent's axes with
-velocity (linear in those axes, body angular), a ball's velocity in its child's axes). Every operation is analytic
-(rotations by sin and cos, a quaternion normalised by q·q, not |q|²), so the algorithm runs on
-complex numbers: a complex step through it gives its derivatives exactly to round-off.
+reference configuration; MuJoCo's coordinates: a free joint (p, w x y z) in its parent's
+axes with velocity (linear in those axes, body angular), a ball's velocity in its child's
+axes). Every operation is analytic (rotations by sin and cos, a quaternion normalised by
+q·q, not |q|²), so the algorithm runs on complex numbers: a complex step through it gives its
+derivatives exactly to round-off.
 """
 
 from __future__ import annotations

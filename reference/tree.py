@@ -15,12 +15,13 @@ imaginary part / η — no subtraction, so no cancellation: error ~ ε relative)
 joints are taken in a local chart at the sampled state, R = R_s exp(ξ̂), ξ = 0 there, so that
 ξ̇ = ω in the body's axes and (ξ̈ = ω̇ at the chart's centre) Euler's equations come out; a free
 joint's pose is held in its parent's axes (the world's at the root: a free body's position is
-its world position), as a free flyer below a moving link is in Pinocchio. The chart's exp and right Jacobian are evaluated by
-their series in θ² = ξ·ξ, exact here because |ξ| ≤ η.
+its world position), as a free flyer below a moving link is in Pinocchio. The chart's exp
+and right Jacobian are evaluated by their series in θ² = ξ·ξ, exact here because |ξ| ≤ η.
 
 Inputs are in world axes at the reference configuration (the same point of view as the
 engines' neutral trees); coordinates q follow MuJoCo's layout (a free joint (p, w x y z), its
-velocity (linear in its parent's axes — the world's at the root —, body angular)); a joint's angle is measured from ``zero``.
+velocity (linear in its parent's axes — the world's at the root —, body angular)); a joint's
+angle is measured from ``zero``.
 """
 
 from __future__ import annotations
