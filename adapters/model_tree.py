@@ -337,6 +337,11 @@ class Derivatives:
     empty; then :attr:`own_differences` holds the engine's finite differences of its own
     dynamics, which the check compares after its analytic ones."""
     own_differences: Derivatives | None = None
+    about_origin: tuple[str, ...] = ()
+    """The fields the engine forms from spatial quantities about the world origin (a world-
+    axes algorithm: a body's inertia there carries m |c|², c its distance from the origin):
+    their round-off grows as ε (X/ℓ)², X how far the model stands from the origin, ℓ its
+    size — where the others' grows as ε X/ℓ."""
 
 
 def derivatives(found: dict[str, np.ndarray], *, method: str, step: float = 0.0,

@@ -35,11 +35,12 @@ def _predicted(found: Derivatives, ref: Referee, field: str) -> np.ndarray:
     one-sided differences of step s, s/2 |∂²τ/∂x²| + s²/6 |∂³τ/∂x³| + 2 δτ/s (the Taylor
     remainder's next term matters where the curvature vanishes; in v, τ is quadratic: no
     third term) through |M⁻¹| for the forward derivatives, which it forms from its inverse
-    ones."""
+    ones. δτ is the engine's round-off of τ: the referee's estimate times max(1, X/ℓ), for an
+    engine takes lever arms as differences of positions X from the origin."""
     if not found.step:
         return np.zeros_like(getattr(found, field))
     s = found.step
-    roundoff = 2 * ref.roundoff[:, None, None] / s
+    roundoff = 2 * ref.standing * ref.roundoff[:, None, None] / s
     if field == "forward_tau":
         return np.zeros_like(found.forward_tau)
     key = "inverse" if field.startswith("inverse") else "forward"
@@ -55,9 +56,10 @@ def _floor(ref: Referee, field: str) -> np.ndarray:
     """The round-off of an entry computed from terms of τ's size (per state), per unit of
     q (δτ) or of v (δτ / the velocities' spread): what an entry that is zero in exact
     arithmetic (a ball joint's ∂τ/∂q without gravity torque) carries; through |M⁻¹| for
-    the forward derivatives."""
-    per_q = ref.roundoff[:, None, None]
-    per = {"q": per_q, "v": ref.roundoff_v[:, None, None], "tau": np.zeros_like(per_q)}
+    the forward derivatives; times max(1, X/ℓ), as :func:`_predicted`'s δτ."""
+    per_q = ref.standing * ref.roundoff[:, None, None]
+    per = {"q": per_q, "v": ref.standing * ref.roundoff_v[:, None, None],
+           "tau": np.zeros_like(per_q)}
     bound = np.broadcast_to(per[field.split("_", 1)[1]], ref.inverse_mass.shape)
     return np.abs(ref.inverse_mass) @ bound if field.startswith("forward") else bound
 
@@ -74,6 +76,9 @@ def compare(model: str, tree: ModelTree, *, name_a: str, da: Derivatives, name_b
         scale = max(float(np.abs(desired).max()), float(np.abs(actual).max()), 1e-300)
         rtol = ROUNDOFF_FACTOR * eps * d * ref.standing \
             * (kappa if field.startswith("forward") else 1.0)
+        about_origin = [n for n, f in ((name_a, da), (name_b, db)) if field in f.about_origin]
+        if about_origin and ref.standing > 1:
+            rtol *= ref.standing
         allowed = np.full(desired.shape, rtol * scale) + _floor(ref, field) * eps / EPS
         # an entry zero in exact arithmetic everywhere (a slide's ∂τ/∂q): errors relative to
         # its round-off floor, not to a scale of zero
@@ -81,6 +86,8 @@ def compare(model: str, tree: ModelTree, *, name_a: str, da: Derivatives, name_b
         basis = f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth {d}"
         if ref.standing > 1:
             basis += f" x X/l {ref.standing:.3g} (positions far from the origin)"
+            if about_origin:
+                basis += f", squared for {about_origin[0]}'s (formed about the world origin)"
         if field.startswith("forward"):
             basis += f" x cond(M) {kappa:.3g}"
         basis += " (of the largest entry, and of tau's terms per unit of q or v)"

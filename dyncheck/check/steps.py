@@ -310,11 +310,12 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
     fd = np.abs(found.coarse - found.matrix) / 3 + \
         2 * ROUNDOFF_FACTOR * EPS * depth(tree) * x_scale / (2 * found.fd_step)
     # v₊ = v + h v̇: v̇'s round-off is amplified by κ(M) (a point mass on a ball joint: the
-    # file's 1e-8 inertia about the rod), and differenced over 2 s
+    # file's 1e-8 inertia about the rod) and by X/ℓ (the engine's lever arms, differences of
+    # positions far from the origin), and differenced over 2 s
     kappa = np.linalg.cond(ref.inverse_mass)[:, None, None]
     acceleration = np.abs(ref.forward).max(axis=1)[:, None, None]
-    amplified = 2 * ROUNDOFF_FACTOR * EPS * depth(tree) * kappa * h * acceleration \
-        / (2 * found.fd_step)
+    amplified = 2 * ROUNDOFF_FACTOR * EPS * depth(tree) * ref.standing * kappa * h \
+        * acceleration / (2 * found.fd_step)
     fd[:, nv:] += amplified
     fd[:, :nv] += 2 * h * amplified  # q₊ = q ⊕ h v₊ (J_r ≤ 1 + h|ω|)
     ref_error = np.zeros_like(expected)
@@ -325,7 +326,7 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
     for joint, _, estimate in blocks:
         rows = _block(canon, joint)
         ref_error[:, rows[:, None], rows[None, :]] = estimate
-    allowed = ROUNDOFF_FACTOR * EPS * depth(tree) * scale + fd + ref_error
+    allowed = ROUNDOFF_FACTOR * EPS * depth(tree) * ref.standing * scale + fd + ref_error
     worst = np.unravel_index(int(np.argmax(off / allowed)), off.shape)
     within = bool(np.all(off <= allowed))
     note = "" if within else (
@@ -336,7 +337,9 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
         subject=f"step Jacobian ({found.integrator} at h = {h:g})", field="max rel error",
         impl_a="reference", impl_b=engine, value_a="", value_b="",
         error=float(off.max()) / scale, tolerance=float(allowed.max()) / scale,
-        basis=(f"round-off: {ROUNDOFF_FACTOR} eps x tree depth {depth(tree)}; + {engine}'s "
+        basis=(f"round-off: {ROUNDOFF_FACTOR} eps x tree depth {depth(tree)}"
+               + (f" x X/l {ref.standing:.3g} (positions far from the origin)"
+                  if ref.standing > 1 else "") + f"; + {engine}'s "
                f"centered differences' error (steps {found.fd_step:g}, {2 * found.fd_step:g}); "
                "+ the referee's own round-off x h"
                + ("; a standalone free body's implicit block: its Richardson estimate"

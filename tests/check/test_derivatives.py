@@ -277,3 +277,37 @@ def test_own_differences_that_disagree_too_leave_the_row_failed(monkeypatch, tmp
     failed = _rows(result, section="derivatives", verdict="failed")
     assert set(failed["subject"]) == {"d(inverse)/dq"}
     assert all("its own finite differences differ too" in n for n in failed["note"])
+
+
+FAR = """<mujoco model="far">
+  <worldbody>
+    <body name="b1" pos="{x} 0 1">
+      <joint name="j1" type="hinge" axis="0 1 0"/>
+      <inertial pos="0 0 -0.5" mass="1" diaginertia="0.1 0.1 0.01"/>
+      <body name="b2" pos="0 0 -1">
+        <joint name="j2" type="hinge" axis="0 1 0"/>
+        <inertial pos="0 0 -0.5" mass="1" diaginertia="0.1 0.1 0.01"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+"""A double pendulum placed ``x`` m along the world's x axis (under uniform gravity its
+dynamics, and so its derivatives, do not depend on x)."""
+
+
+@pytest.mark.parametrize("x", [1e3, 1e6])
+def test_derivatives_far_from_the_origin_are_judged_by_bounds_that_travel(tmp_path, x):
+    """#81: 1 km from the origin 11 derivative rows failed for every pair of engines, 17 at
+    1000 km; at the origin all passed. Expected: the same pass far away, the bounds carrying
+    X/ℓ for every engine's round-off (its finite differences' 2 δτ / s, a step Jacobian's
+    v̇) and (X/ℓ)² for Pinocchio's derivatives formed about the world origin
+    (tests/adapters/pinocchio/test_model.py measures that)."""
+    path = tmp_path / "far.xml"
+    path.write_text(FAR.format(x=x))
+    result = check_model(path, impls=("reference", "mujoco", "pinocchio"), states=40,
+                         derivatives=True, isolate=False)
+    rows = _rows(result, section="derivatives")
+    assert len(rows) >= 13 and set(rows["verdict"]) == {"passed"}, \
+        rows[rows["verdict"] != "passed"][["subject", "impl_a", "impl_b", "note"]]
+    assert rows["basis"].str.contains("X/l").any()

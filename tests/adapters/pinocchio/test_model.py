@@ -200,3 +200,31 @@ def test_an_unbounded_revolute_joint_is_not_stepped(tmp_path):
     model = PinocchioModel(read(path))
     with pytest.raises(Unsupported, match="unbounded revolute"):
         model.simulate(np.array([1.0, 0.0]), np.zeros(1), 0.01, 3, integrator="euler")
+
+
+@pytest.mark.parametrize(("x", "within"), [(0.0, 1e-13), (1e3, 1e-8), (1e6, 1e-2)])
+def test_abas_derivatives_lose_digits_as_the_square_of_the_distance(tmp_path, x, within):
+    """Pinocchio's ``computeABADerivatives`` works in world axes: its M⁻¹ against the inverse
+    of ``crba``'s M (an independent computation in local frames) loses digits as (X/ℓ)² —
+    ε (X/ℓ)² is 5.5e-15, 5.5e-11, 5.5e-5 for ℓ ≈ 2 m — which the check's derivative bounds
+    declare (``PinocchioModel.derivatives``' ``about_origin``). Each bound is 100 times
+    that, and at 1000 km the error exceeds what ε X/ℓ would allow (1e-10)."""
+    from tests.check.test_derivatives import FAR
+
+    path = tmp_path / "far.xml"
+    path.write_text(FAR.format(x=x))
+    model = pin.buildModelFromMJCF(str(path))
+    data = model.createData()
+    rng = np.random.default_rng(0)
+    worst = 0.0
+    for _ in range(20):
+        q, v = rng.uniform(-3, 3, model.nq), rng.uniform(-3, 3, model.nv)
+        pin.computeABADerivatives(model, data, q, v, np.zeros(model.nv))
+        upper = np.asarray(data.Minv)
+        minv = np.triu(upper) + np.triu(upper, 1).T
+        mass = pin.crba(model, data, q)
+        exact = np.linalg.inv(np.triu(mass) + np.triu(mass, 1).T)
+        worst = max(worst, float(np.abs(minv - exact).max() / np.abs(exact).max()))
+    assert worst <= within
+    if x >= 1e6:
+        assert worst > 1e-10  # beyond a bound linear in X/ℓ: the square is the engine's
