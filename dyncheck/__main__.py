@@ -110,15 +110,15 @@ def _main(argv: Sequence[str] | None) -> int:
     from dyncheck.workers import end_now
 
     try:
-        args = _parser().parse_args(argv)
-    except SystemExit as exc:  # --help (0) or a one-line usage error (2), already printed
-        return int(exc.code or 0)
-    from dyncheck.cache.compiled import held
-    from dyncheck.ci_outputs import json_on_stdout
-    from dyncheck.commands.options import settings_of
-    from dyncheck.workers import settled
+        try:  # (a signal while the parser's modules load is answered as any other)
+            args = _parser().parse_args(argv)
+        except SystemExit as exc:  # --help (0) or a one-line usage error (2), already printed
+            return int(exc.code or 0)
+        from dyncheck.cache.compiled import held
+        from dyncheck.ci_outputs import json_on_stdout
+        from dyncheck.commands.options import settings_of
+        from dyncheck.workers import settled
 
-    try:
         _address_space(args)
         # handed to every unit of work (dyncheck.settings), with the compiled-code folder
         # checked before any engine runs and signed when the command ends

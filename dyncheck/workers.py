@@ -18,6 +18,7 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from contextlib import contextmanager
+from functools import partial
 from multiprocessing import parent_process as mp_parent_process
 from pathlib import Path
 from typing import Any
@@ -232,12 +233,39 @@ def on_sigterm() -> Iterator[None]:
     interrupt = signal.getsignal(signal.SIGINT)
     if interrupt is signal.default_int_handler:
         signal.signal(signal.SIGINT, _raise_interrupt)
+    hook = sys.unraisablehook
+    sys.unraisablehook = partial(_deliver_again, otherwise=hook)
     try:
         yield
     finally:
         signal.signal(signal.SIGTERM, previous)
         signal.signal(signal.SIGINT, interrupt)
+        sys.unraisablehook = hook
         _ENDING.clear()
+
+
+def _deliver_again(unraisable: Any, *,
+                   otherwise: Callable[[Any], object] = sys.__unraisablehook__) -> None:
+    """A signal's exception raised where Python cannot propagate it — a handler that ran
+    inside an at-fork hook, a finalizer or a weak reference's callback ("Exception ignored
+    in: <function _acquireLock>", then the process went on as if never signalled) — is not
+    printed: the signal is sent again a moment later, from a thread, so that its handler
+    runs once this hook has returned (raised here, it would be lost here too). Any other
+    such exception goes to ``otherwise`` (the hook before, Python's own)."""
+    from dyncheck.errors import Terminated
+
+    signum = signal.SIGTERM if isinstance(unraisable.exc_value, Terminated) else \
+        signal.SIGINT if isinstance(unraisable.exc_value, KeyboardInterrupt) else None
+    if signum is None:
+        otherwise(unraisable)
+        return
+    again = threading.Timer(AGAIN_S, os.kill, (os.getpid(), signum))
+    again.daemon = True
+    again.start()
+
+
+AGAIN_S = 0.05
+"""How long after a lost signal it is sent again (:func:`_deliver_again`)."""
 
 
 def _raise_terminated(signum: int, frame: object) -> None:
@@ -262,7 +290,39 @@ def _worker_start(parent: int) -> None:
     die_with_parent(parent)
     exit_without_collecting()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, _raise_terminated)
+    signal.signal(signal.SIGTERM, _worker_terminated)
+    sys.unraisablehook = _deliver_again
+
+
+_IN_UNIT = threading.Event()
+"""Set while this process computes a unit of work (:func:`_under`)."""
+
+
+def _worker_terminated(signum: int, frame: object) -> None:
+    """A pool worker's SIGTERM: inside a unit, :class:`~dyncheck.errors.Terminated` unwinds
+    it (:func:`_under`); idle, waiting for the next unit, the worker exits at once — the
+    exception there ended in the pool's loop, whose process printed its traceback ("Process
+    ForkProcess-1: Traceback …", on every Ctrl-C that found a worker idle)."""
+    _ENDING.set()
+    if not _IN_UNIT.is_set():
+        os._exit(143)
+    _raise_terminated(signum, frame)
+
+
+def _forked_quiet() -> None:
+    """In a process forked while a command answers signals (a pool's worker before its
+    initializer has run, an engine's process): SIGTERM ends it at once unless it computes a
+    unit, Ctrl-C is its parent's to answer. It inherited the command's handlers, which raised
+    in multiprocessing's start-up code, and printed ("Process ForkProcess-2: Traceback …
+    Terminated", SIGINT as a pool started)."""
+    _IN_UNIT.clear()
+    if signal.getsignal(signal.SIGTERM) is _raise_terminated:
+        signal.signal(signal.SIGTERM, _worker_terminated)
+    if signal.getsignal(signal.SIGINT) is _raise_interrupt:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+os.register_at_fork(after_in_child=_forked_quiet)
 
 
 def exit_without_collecting() -> None:
@@ -301,6 +361,7 @@ def _under(settings: Settings, fn: Callable[..., Any], *args: Any) -> Any:
     :func:`stop`) unwinds the unit — its engines killed, their files removed — and exits."""
     from dyncheck.errors import Terminated
 
+    _IN_UNIT.set()
     try:
         with settled(settings):
             return fn(*args)
@@ -309,6 +370,8 @@ def _under(settings: Settings, fn: Callable[..., Any], *args: Any) -> Any:
             end_now()
             os._exit(143)  # (a pool's worker: nothing of it is waited for)
         raise
+    finally:
+        _IN_UNIT.clear()
 
 
 def _timed(settings: Settings, fn: Callable[..., Any], *args: Any) -> tuple[float, Any]:

@@ -1919,6 +1919,14 @@ DEDICATED = (
      "failed for every pair of engines",
      "tests/check/test_derivatives.py::test_derivatives_far_from_the_origin_are_judged_by_"
      "bounds_that_travel"),
+    ("Ctrl-C at five moments of a four-case run and of check --jobs 2 (its modules loading, "
+     "its pool starting, its workers up, after one and two units)", "exit 130 and one line "
+     "at each, no traceback, no 'Exception ignored', no process left — a worker forked with "
+     "the command's handlers printed its Terminated, an idle worker its pool loop's, a signal "
+     "while the modules loaded Python's KeyboardInterrupt, and a half-built finalizer an "
+     "AttributeError at exit",
+     "tests/dyncheck/test_script.py::test_ctrl_c_ends_every_moment_with_one_line_and_nothing_"
+     "left"),
     ("bench of 10^7 states (hours of sweeps)", "its time estimated from each implementation "
      "measured on 200 states and said in one line before the first sweep, with the options "
      "that change it (it ran for hours unannounced)",
