@@ -22,10 +22,15 @@ answer: an improvement is a change a maintainer must see and accept as a new bas
 from __future__ import annotations
 
 import json
+import os
 import re
+import stat
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 import pandas as pd
@@ -122,13 +127,41 @@ TEXTS = {"value_a": str, "value_b": str}
 """Columns read as text whatever they hold (a reading "2" stays "2", never 2.0)."""
 
 
+CSV_MOST = 1 << 30
+"""The largest table read (``diff``, ``--baseline``): a check's rows are a few hundred bytes
+each, a run's thousands of rows."""
+
+
+@contextmanager
+def regular_file(path: Path, flag: str, *, most: int) -> Iterator[BinaryIO]:
+    """``path`` open for reading where it is a regular file of at most ``most`` bytes (opened
+    without blocking, its kind read from the open file: a FIFO there hung ``diff`` and
+    ``--baseline`` until killed), else a one-line InvalidInput naming ``flag``."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError as exc:
+        raise InvalidInput(flag, str(path), f"a readable file ({exc.strerror})") from None
+    info = os.fstat(fd)
+    if not stat.S_ISREG(info.st_mode):
+        os.close(fd)
+        raise InvalidInput(flag, str(path), "a regular file (not a FIFO, device or socket)")
+    if info.st_size > most:
+        os.close(fd)
+        raise InvalidInput(flag, str(path), f"a file of at most {most >> 20} MiB (it has "
+                           f"{info.st_size >> 20} MiB)")
+    os.set_blocking(fd, True)
+    with os.fdopen(fd, "rb") as f:
+        yield f
+
+
 def read_csv(path: Path, flag: str) -> pd.DataFrame:
     """A CSV table of dyncheck's (``#`` lines are comments, empty cells NaN, :data:`TEXTS`
     as text); a one-line InvalidInput naming ``flag`` and the path when it cannot be read or
     parsed."""
     try:
-        return pd.read_csv(path, keep_default_na=False, na_values=[""], comment="#",
-                           dtype=TEXTS)
+        with regular_file(path, flag, most=CSV_MOST) as f:
+            return pd.read_csv(f, keep_default_na=False, na_values=[""], comment="#",
+                               dtype=TEXTS)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise InvalidInput(flag, str(path), f"a CSV file ({reason})") from None

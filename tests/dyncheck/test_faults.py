@@ -1703,6 +1703,55 @@ SELF_ATTACHING = """<mujoco>
 (SIGSEGV, measured)."""
 
 
+def _fifos(*names: str) -> Callable[[Path], Path]:
+    """A model ``m.urdf`` and named pipes beside it (no writer: a reader blocks forever)."""
+    def make(tmp: Path) -> Path:
+        (tmp / "m.urdf").write_text(URDF)
+        for name in names:
+            os.mkfifo(tmp / name)
+        return tmp
+    return make
+
+
+def _sparse(name: str, size: int) -> Callable[[Path], Path]:
+    """A model ``m.urdf`` and a file of ``size`` bytes that takes no disk (a hole)."""
+    def make(tmp: Path) -> Path:
+        (tmp / "m.urdf").write_text(URDF)
+        with open(tmp / name, "wb") as f:
+            f.truncate(size)
+        return tmp
+    return make
+
+
+FIFO_INPUTS = (  # #81: only regular files are read, whatever option names them
+    Fault(kind="run --baseline a FIFO (hung until killed)", area="run", prepare=_fifos("b.csv"),
+          argv=("run", "simple_pendulum", "--baseline", "{tmp}/b.csv", "--out", OUT),
+          answer=r"--baseline must be a regular file \(not a FIFO, device or socket\)"),
+    Fault(kind="check --baseline a FIFO (hung until killed)", area="check",
+          prepare=_fifos("b.csv"),
+          argv=("check", "{tmp}/m.urdf", "--baseline", "{tmp}/b.csv", "--out", OUT),
+          answer=r"--baseline must be a regular file \(not a FIFO, device or socket\)"),
+    Fault(kind="diff of a FIFO (hung until killed)", area="diff", prepare=_fifos("a.csv"),
+          argv=("diff", "{tmp}/a.csv", "{tmp}/a.csv"),
+          answer=r"RUN_A must be a regular file \(not a FIFO, device or socket\)"),
+    Fault(kind="run --baseline of 2 GiB", area="run", prepare=_sparse("b.csv", 2 << 30),
+          argv=("run", "simple_pendulum", "--baseline", "{tmp}/b.csv", "--out", OUT),
+          answer=r"--baseline must be a file of at most 1024 MiB \(it has 2048 MiB\)"),
+    Fault(kind="check --accept a FIFO", area="check", prepare=_fifos("a.toml"),
+          argv=("check", "{tmp}/m.urdf", "--accept", "{tmp}/a.toml", "--out", OUT),
+          answer=r"--accept must be an existing TOML file"),
+    Fault(kind="check --states-file a FIFO", area="check", prepare=_fifos("s.npy"),
+          argv=("check", "{tmp}/m.urdf", "--states-file", "{tmp}/s.npy", "--out", OUT),
+          answer=r"--states-file must be an existing regular file"),
+    Fault(kind="check --against a FIFO", area="check", prepare=_fifos("old.xml"),
+          argv=("check", "{tmp}/m.urdf", "--against", "{tmp}/old.xml", "--out", OUT),
+          answer=r"<tmp>/old\.xml: not a file"),
+    Fault(kind="a model path that is a FIFO", area="check", prepare=_fifos("p.urdf"),
+          argv=("check", "{tmp}/p.urdf", "--out", OUT),
+          answer=r"<tmp>/p\.urdf: not a file"),
+)
+
+
 def _several(**named: str) -> Callable[[Path], Path]:
     """Several files written into the test's folder (a model and the file an option reads;
     a name with a double underscore is written with a dot there: ``a__xml`` → ``a.xml``)."""
@@ -1836,8 +1885,8 @@ ROUND4 = (  # #79 and #81: the CI gate's files, special files, sizes, versions o
           answer=r"--bisect must be the engine of --engine \(mujoco\)"),
 )
 
-FAULTS = (*FAULTS, *HOSTILE_MODELS, *MORE_FAULTS, *EXTRA_FAULTS, *OUTPUT_PATHS, *NAMES, *DEEP,
-          *ROUND3, *ROUND4)
+FAULTS = (*FAULTS, *FIFO_INPUTS, *HOSTILE_MODELS, *MORE_FAULTS, *EXTRA_FAULTS, *OUTPUT_PATHS,
+          *NAMES, *DEEP, *ROUND3, *ROUND4)
 
 
 DEDICATED = (
