@@ -77,7 +77,7 @@ def model_path(text: str) -> Path:
                                      f"regular file ({_kind(asset)}): no engine may open it")
         deepest = nesting(inlined)
         if deepest > MAX_NESTING:
-            raise ModelFileError(path, f"bodies nested {deepest} deep (the check walks "
+            raise ModelFileError(path, f"XML elements nested {deepest} deep (the check walks "
                                  f"trees at most {MAX_NESTING} deep; split the model)")
     if root.tag == "robot" and (deepest := _chain_depth(root)) > MAX_NESTING:
         raise ModelFileError(path, f"links chained {deepest} deep (the check walks trees "

@@ -1703,6 +1703,16 @@ SELF_ATTACHING = """<mujoco>
 (SIGSEGV, measured)."""
 
 
+def _several(**named: str) -> Callable[[Path], Path]:
+    """Several files written into the test's folder (a model and the file an option reads;
+    a name with a double underscore is written with a dot there: ``a__xml`` → ``a.xml``)."""
+    def make(tmp: Path) -> Path:
+        for name, content in named.items():
+            (tmp / name.replace("__", ".")).write_text(content)
+        return tmp
+    return make
+
+
 def _fifos(*names: str) -> Callable[[Path], Path]:
     """A model ``m.urdf`` and named pipes beside it (no writer: a reader blocks forever)."""
     def make(tmp: Path) -> Path:
@@ -1722,6 +1732,10 @@ def _sparse(name: str, size: int) -> Callable[[Path], Path]:
         return tmp
     return make
 
+
+MASSLESS_URDF = """<robot name="r"><link name="base"/><link name="a"/>
+<joint name="j" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"""
 
 FIFO_INPUTS = (  # #81: only regular files are read, whatever option names them
     Fault(kind="run --baseline a FIFO (hung until killed)", area="run", prepare=_fifos("b.csv"),
@@ -1749,17 +1763,33 @@ FIFO_INPUTS = (  # #81: only regular files are read, whatever option names them
     Fault(kind="a model path that is a FIFO", area="check", prepare=_fifos("p.urdf"),
           argv=("check", "{tmp}/p.urdf", "--out", OUT),
           answer=r"<tmp>/p\.urdf: not a file"),
+    Fault(kind="--against a URDF whose moving links are massless (compiled and diffed before)",
+          area="check", prepare=_several(old__urdf=MASSLESS_URDF),
+          argv=("check", BRANCHES, "--against", "{tmp}/old.urdf", "--out", OUT),
+          answer=r"<tmp>/old\.urdf: no moving link states an <inertial> with a positive mass"),
+    Fault(kind="--against an MJCF that includes a FIFO", area="check",
+          prepare=lambda tmp: (_fifos("inc.xml")(tmp), (tmp / "old.xml").write_text(
+              "<mujoco><include file='inc.xml'/><worldbody><body><joint type='hinge'/>"
+              "<geom size='0.1' mass='1'/></body></worldbody></mujoco>")),
+          argv=("check", BRANCHES, "--against", "{tmp}/old.xml", "--out", OUT),
+          answer=r"<tmp>/old\.xml: <include file='inc\.xml'>: not a regular file"),
+    Fault(kind="--against an MJCF whose texture is a device", area="check",
+          prepare=_several(old__xml="<mujoco><asset><texture name='t' type='2d' "
+                           "file='/dev/zero'/></asset><worldbody><body><joint type='hinge'/>"
+                           "<geom size='0.1' mass='1'/></body></worldbody></mujoco>"),
+          argv=("check", BRANCHES, "--against", "{tmp}/old.xml", "--out", OUT),
+          answer=r"names 'zero', which is not a regular file \(a character device\)"),
+    Fault(kind="--against an MJCF nested 2100 bodies deep", area="check",
+          prepare=_several(old__xml="<mujoco><worldbody>" + "<body><joint type='hinge'/>"
+                           "<geom size='0.1' mass='1'/>" * 2100 + "</body>" * 2100
+                           + "</worldbody></mujoco>"),
+          argv=("check", BRANCHES, "--against", "{tmp}/old.xml", "--out", OUT),
+          answer=r"XML elements nested 2103 deep \(the check walks trees at most 2000 deep"),
+    Fault(kind="bench --memory 0", area="bench", argv=("bench", "--memory", "0", "--out", OUT),
+          answer=r"--memory must be a positive integer at most 100000000, got 0$"),
 )
 
 
-def _several(**named: str) -> Callable[[Path], Path]:
-    """Several files written into the test's folder (a model and the file an option reads;
-    a name with a double underscore is written with a dot there: ``a__xml`` → ``a.xml``)."""
-    def make(tmp: Path) -> Path:
-        for name, content in named.items():
-            (tmp / name.replace("__", ".")).write_text(content)
-        return tmp
-    return make
 
 
 def _memory(size: int) -> Callable[[pytest.MonkeyPatch, Path], None]:
@@ -1976,6 +2006,9 @@ DEDICATED = (
      "AttributeError at exit",
      "tests/dyncheck/test_script.py::test_ctrl_c_ends_every_moment_with_one_line_and_nothing_"
      "left"),
+    ("a FIFO where the compiled-code folder's lock lives", "not taken: the command compiles "
+     "afresh, as when another holds the folder (it was locked as if a lock file)",
+     "tests/dyncheck/cache/test_compiled.py::test_a_lock_that_is_a_fifo_is_not_taken"),
     ("bench of 10^7 states (hours of sweeps)", "its time estimated from each implementation "
      "measured on 200 states and said in one line before the first sweep, with the options "
      "that change it (it ran for hours unannounced)",

@@ -95,6 +95,19 @@ def test_a_manifest_that_is_a_fifo_is_no_manifest_and_never_blocks(tmp_path):
     assert manifest.is_file() and compiled_caches.verify(folder, SECRET) == []
 
 
+def test_a_lock_that_is_a_fifo_is_not_taken(tmp_path, monkeypatch):
+    """A FIFO planted where the folder's lock lives is no lock of ours: the command goes on
+    without the folder (compiling afresh, as when another command holds it), at once."""
+    monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("DYNCHECK_CACHE_KEY", str(tmp_path / "key"))
+    folder = tmp_path / "cache" / "compiled"
+    (folder / "jax").mkdir(parents=True, mode=0o700)
+    folder.chmod(0o700)
+    os.mkfifo(folder / ".lock")
+    with compiled_caches.held(Settings()) as settings:
+        assert settings.compiled is None
+
+
 def test_a_command_checks_the_folder_and_signs_it_when_it_ends(tmp_path, monkeypatch):
     """A planted entry is gone before the command's engines see the folder; what the
     command's engines write is vouched for by the next command; --no-cache uses none."""
