@@ -17,25 +17,15 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 from collections.abc import Sequence
-from typing import NoReturn, TextIO
+from typing import TYPE_CHECKING, Any, NoReturn, TextIO
 
-from dyncheck.commands import (
-    baseline,
-    bench,
-    check,
-    diff,
-    errata,
-    explain,
-    listing,
-    report,
-    run,
-    tutorials,
-    versions,
-)
-from dyncheck.commands.options import one_line
 from dyncheck.errors import DyncheckError, InvalidInput, Terminated
+
+if TYPE_CHECKING:
+    from dyncheck.commands.flags import Command
 
 
 class _Parser(argparse.ArgumentParser):
@@ -47,12 +37,36 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
-COMMANDS = {c.name: c for c in (
-    listing.COMMAND, run.COMMAND, check.COMMAND, diff.COMMAND, versions.COMMAND,
-    tutorials.COMMAND, report.COMMAND, explain.COMMAND, errata.COMMAND, baseline.COMMAND,
-    bench.COMMAND)}
-"""Every subcommand, in the order ``--help`` lists them: each is its module's
-:class:`~dyncheck.commands.flags.Command` (flags, help, example and handler together)."""
+def commands() -> dict[str, Command]:
+    """Every subcommand, in the order ``--help`` lists them: each is its module's
+    :class:`~dyncheck.commands.flags.Command` (flags, help, example and handler together).
+    Imported here, not with this module: loading them takes a quarter of a second (numpy,
+    pandas, the engines' records), during which :func:`console` answers signals itself."""
+    from dyncheck.commands import (
+        baseline,
+        bench,
+        check,
+        diff,
+        errata,
+        explain,
+        listing,
+        report,
+        run,
+        tutorials,
+        versions,
+    )
+
+    return {c.name: c for c in (
+        listing.COMMAND, run.COMMAND, check.COMMAND, diff.COMMAND, versions.COMMAND,
+        tutorials.COMMAND, report.COMMAND, explain.COMMAND, errata.COMMAND, baseline.COMMAND,
+        bench.COMMAND)}
+
+
+def __getattr__(name: str) -> Any:
+    """``COMMANDS``: :func:`commands`, as the module's attribute."""
+    if name == "COMMANDS":
+        return commands()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -69,7 +83,7 @@ def _parser() -> argparse.ArgumentParser:
 
     p.add_argument("--version", action="version", version=f"dyncheck {dyncheck_version()}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    for command in COMMANDS.values():
+    for command in commands().values():
         one = sub.add_parser(command.name, help=command.help,
                              epilog=f"example: {command.example}")
         command.arguments(one)
@@ -124,8 +138,10 @@ def _main(argv: Sequence[str] | None) -> int:
         # checked before any engine runs and signed when the command ends
         with held(settings_of(args)) as settings, settled(settings), \
                 json_on_stdout(vars(args).get("json")):
-            return COMMANDS[args.command].handler(args)
+            return commands()[args.command].handler(args)
     except DyncheckError as exc:
+        from dyncheck.commands.options import one_line
+
         print(f"dyncheck: error: {one_line(str(exc))}", file=sys.stderr)
         return 2
     except OSError as exc:  # a write that failed mid-way (disk full, file-size limit)
@@ -146,17 +162,59 @@ def _main(argv: Sequence[str] | None) -> int:
         release_outs()  # the output folders this command held (claim_out)
 
 
+ENDED = {signal.SIGINT: ("interrupted", 130), signal.SIGTERM: ("terminated", 143)}
+"""What each signal ends a command with: the word its one line says, the exit status."""
+
+
+def _while_loading(signum: int, frame: object) -> None:
+    raise SystemExit(signum)
+
+
+def _said(signum: int) -> int:
+    word, code = ENDED[signal.Signals(signum)]
+    print(f"dyncheck: {word} (nothing half-written)", file=sys.stderr)
+    return code
+
+
 def console() -> int:
     """The ``dyncheck`` command: :func:`main` in a process that exits without a last garbage
     collection (:func:`dyncheck.workers.exit_without_collecting`), its output to a reader
-    that may leave (:class:`_LeavingReader`)."""
-    from dyncheck.workers import exit_without_collecting
+    that may leave (:class:`_LeavingReader`). Ctrl-C or SIGTERM while the commands' modules
+    load ended it with Python's traceback from inside an import: they are answered here —
+    one line, 130 or 143, nothing was written yet — until :func:`main`'s handlers take over.
+    A signalled command ends without the interpreter's shutdown (:func:`_end_now`)."""
+    for signum in ENDED:
+        signal.signal(signum, _while_loading)
+    try:
+        commands()
+        from dyncheck.workers import exit_without_collecting
+    except SystemExit as exc:
+        return _end_now(_said(int(exc.code or signal.SIGINT)))
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    try:
+        exit_without_collecting()
+        _open_standard_streams()
+        sys.stdout = _LeavingReader(sys.stdout)
+        sys.stderr = _LeavingReader(sys.stderr)
+        code = main()
+    except KeyboardInterrupt:  # (in the instant before main's own handlers)
+        code = _said(signal.SIGINT)
+    return _end_now(code) if code in {c for _, c in ENDED.values()} else code
 
-    exit_without_collecting()
-    _open_standard_streams()
-    sys.stdout = _LeavingReader(sys.stdout)
-    sys.stderr = _LeavingReader(sys.stderr)
-    return main()
+
+def _end_now(code: int) -> int:
+    """End a signalled command without the interpreter's shutdown: its line is said, its
+    files whole, its workers and engines stopped — what is left are multiprocessing's
+    finalizers, which the signal may have caught half-built and which then print a
+    traceback at exit ("Exception ignored in: <Finalize object, dead>")."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(code)
 
 
 def _open_standard_streams() -> None:

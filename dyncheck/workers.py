@@ -229,6 +229,9 @@ def on_sigterm() -> Iterator[None]:
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    if not _FORK_HOOK:
+        os.register_at_fork(after_in_child=_forked_quiet)
+        _FORK_HOOK.append(True)
     previous = signal.signal(signal.SIGTERM, _raise_terminated)
     interrupt = signal.getsignal(signal.SIGINT)
     if interrupt is signal.default_int_handler:
@@ -249,19 +252,40 @@ def _deliver_again(unraisable: Any, *,
     """A signal's exception raised where Python cannot propagate it — a handler that ran
     inside an at-fork hook, a finalizer or a weak reference's callback ("Exception ignored
     in: <function _acquireLock>", then the process went on as if never signalled) — is not
-    printed: the signal is sent again a moment later, from a thread, so that its handler
-    runs once this hook has returned (raised here, it would be lost here too). Any other
-    such exception goes to ``otherwise`` (the hook before, Python's own)."""
+    printed: a pool's worker ends at once (its engines closed), the command's own process
+    has the signal sent again a moment later, from a thread started without waiting (a
+    second signal during the wait raised inside this hook too), so that its handler runs
+    once this hook has returned. Once a signal has asked the process to end, what the
+    interrupted machinery leaves unraisable (a finalizer caught half-built: "Exception
+    ignored in: <Finalize object, dead>") is its consequence, not news: not printed. Any
+    other goes to ``otherwise`` (the hook before, Python's own)."""
+    import _thread
+
     from dyncheck.errors import Terminated
 
     signum = signal.SIGTERM if isinstance(unraisable.exc_value, Terminated) else \
         signal.SIGINT if isinstance(unraisable.exc_value, KeyboardInterrupt) else None
     if signum is None:
-        otherwise(unraisable)
+        if not ending():
+            otherwise(unraisable)
         return
-    again = threading.Timer(AGAIN_S, os.kill, (os.getpid(), signum))
-    again.daemon = True
-    again.start()
+    if mp_parent_process() is not None:
+        exit_worker()
+    _thread.start_new_thread(_send_later, (signum,))
+
+
+def exit_worker() -> None:
+    """A pool's worker told to end: its engines closed (:func:`end_now`) with further
+    signals held off — a second SIGTERM raised inside that cleanup, where nothing could
+    catch it —, then gone at once (nothing of it is waited for)."""
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM, signal.SIGINT})
+    end_now()
+    os._exit(143)
+
+
+def _send_later(signum: int) -> None:
+    time.sleep(AGAIN_S)
+    os.kill(os.getpid(), signum)
 
 
 AGAIN_S = 0.05
@@ -303,6 +327,8 @@ def _worker_terminated(signum: int, frame: object) -> None:
     it (:func:`_under`); idle, waiting for the next unit, the worker exits at once — the
     exception there ended in the pool's loop, whose process printed its traceback ("Process
     ForkProcess-1: Traceback …", on every Ctrl-C that found a worker idle)."""
+    if _ENDING.is_set():
+        return  # (already unwinding: a second SIGTERM would break into its cleanup)
     _ENDING.set()
     if not _IN_UNIT.is_set():
         os._exit(143)
@@ -322,8 +348,9 @@ def _forked_quiet() -> None:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-os.register_at_fork(after_in_child=_forked_quiet)
-
+_FORK_HOOK: list[bool] = []
+"""Whether :func:`_forked_quiet` is registered (once a process: Python cannot unregister it;
+it acts only where a command's handlers are in force)."""
 
 def exit_without_collecting() -> None:
     """At this process's exit, skip the interpreter's final cyclic garbage collection over
@@ -367,8 +394,7 @@ def _under(settings: Settings, fn: Callable[..., Any], *args: Any) -> Any:
             return fn(*args)
     except Terminated:
         if mp_parent_process() is not None and ending():
-            end_now()
-            os._exit(143)  # (a pool's worker: nothing of it is waited for)
+            exit_worker()
         raise
     finally:
         _IN_UNIT.clear()

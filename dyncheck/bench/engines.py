@@ -29,7 +29,7 @@ import queue as queue_module
 import resource
 import statistics
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from functools import partial, reduce
 from pathlib import Path
 
@@ -41,6 +41,7 @@ from dyncheck.errors import EngineError
 from dyncheck.implementations import (
     IMPLEMENTATIONS,
     EngineImplementation,
+    Implementation,
     implementations_for,
     make_implementation,
 )
@@ -99,8 +100,8 @@ SWEEP_PASSES = 5
 batched adapter and its implementation, then the whole sweep with and without the ports."""
 
 
-def expected_seconds(case: Case, impls: dict[str, object], *, states: int, repeats: int,
-                     memory_sizes: Sequence[int]) -> float:
+def expected_seconds(case: Case, impls: Mapping[str, Implementation], *, states: int,
+                     repeats: int, memory_sizes: Sequence[int]) -> float:
     """About how long :func:`main` takes: each implementation's per-state time measured on
     :data:`CALIBRATION_STATES` states (its first call, which compiles a port, counted once),
     times the states it will evaluate — :data:`SWEEP_PASSES` passes of ``states`` per repeat,
@@ -109,9 +110,9 @@ def expected_seconds(case: Case, impls: dict[str, object], *, states: int, repea
     per_state = compile_once = 0.0
     for impl in impls.values():
         t0 = time.perf_counter()
-        impl.evaluate(sample)  # type: ignore[attr-defined]
+        impl.evaluate(sample)
         t1 = time.perf_counter()
-        impl.evaluate(sample)  # type: ignore[attr-defined]
+        impl.evaluate(sample)
         t2 = time.perf_counter()
         per_state += (t2 - t1) / CALIBRATION_STATES
         compile_once += max(0.0, (t1 - t0) - (t2 - t1))
@@ -120,7 +121,7 @@ def expected_seconds(case: Case, impls: dict[str, object], *, states: int, repea
 
 
 def bench(case: Case, states: int, repeats: int, progress: Progress | None = None, *,
-          impls: dict | None = None) -> pd.DataFrame:
+          impls: dict[str, Implementation] | None = None) -> pd.DataFrame:
     """Per-state times (µs) of every part and the whole sweep, one row each (``progress``:
     told as each implementation is done; ``impls``: the implementations, built here where
     not given)."""

@@ -2004,7 +2004,7 @@ DEDICATED = (
      "the command's handlers printed its Terminated, an idle worker its pool loop's, a signal "
      "while the modules loaded Python's KeyboardInterrupt, and a half-built finalizer an "
      "AttributeError at exit",
-     "tests/dyncheck/test_script.py::test_ctrl_c_ends_every_moment_with_one_line_and_nothing_"
+     "tests/dyncheck/test_main.py::test_ctrl_c_ends_every_moment_with_one_line_and_nothing_"
      "left"),
     ("a FIFO where the compiled-code folder's lock lives", "not taken: the command compiles "
      "afresh, as when another holds the folder (it was locked as if a lock file)",

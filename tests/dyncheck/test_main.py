@@ -1,5 +1,5 @@
-"""The ``dyncheck`` script (:mod:`dyncheck.script`) under Ctrl-C (#81): at every moment of a
-four-case ``run`` and of a ``check --jobs 2`` — while its modules load, while its pool
+"""The ``dyncheck`` script (:func:`dyncheck.__main__.console`) under Ctrl-C (#81): at every
+moment of a four-case ``run`` and of a ``check --jobs 2`` — while its modules load, while its pool
 starts, with its workers up, and after each finished unit — it ends with 130 and one line,
 stderr holds no "Traceback" and no "Exception ignored", and no process of its session is
 left running. Expected: the promise of the README's exit statuses, not dyncheck's code."""
@@ -16,19 +16,19 @@ from pathlib import Path
 import pytest
 
 MODELS = Path(__file__).resolve().parents[1] / "check" / "models"
-SCRIPT = "import sys; from dyncheck.script import console; sys.exit(console())"
+SCRIPT = "import sys; from dyncheck.__main__ import console; sys.exit(console())"
 """The installed script's two lines (its entry point), run by this interpreter."""
 SLOW_IMPORT = """
 import importlib.abc, sys, time
 class Slow(importlib.abc.MetaPathFinder):
     def find_spec(self, name, path, target=None):
-        if name == "dyncheck.__main__":
+        if name == "dyncheck.commands":
             print("loading", flush=True)
             time.sleep(30)
         return None
 sys.meta_path.insert(0, Slow())
 """ + SCRIPT
-"""The script with the command's modules made to load for 30 s: a signal then arrives while
+"""The script with the commands' modules made to load for 30 s: a signal then arrives while
 they load, whatever the machine's speed."""
 
 
