@@ -183,6 +183,9 @@ def console() -> int:
     load ended it with Python's traceback from inside an import: they are answered here —
     one line, 130 or 143, nothing was written yet — until :func:`main`'s handlers take over.
     A signalled command ends without the interpreter's shutdown (:func:`_end_now`)."""
+    from dyncheck.confinement import stack_room
+
+    stack_room()
     for signum in ENDED:
         signal.signal(signum, _while_loading)
     try:

@@ -91,3 +91,30 @@ def floor_mib(command: str, impls: tuple[str, ...] = ()) -> int | None:
     if command in ("run", "bench", "tutorials"):
         return FLOOR_MIB["engines"]
     return None
+
+
+STACK_MIB = 64
+"""The stack this process asks for (``ulimit -s``): the model walks, pickling a deep tree
+for an engine's process and the engines' own parsers recurse through C, body by body; a
+200-link chain under a 1 MiB stack ended dyncheck in a segmentation fault (exit 139, no
+message; measured). Linux grows the main thread's stack up to the limit in force when it
+grows, so a soft limit raised here takes effect at once, and children inherit it."""
+
+
+def stack_room() -> None:
+    """Raise this process's soft stack limit to :data:`STACK_MIB` (at most its hard limit):
+    what the caller's ``ulimit -s`` left is never less than the command needs, unless the
+    hard limit itself is (then :func:`stack_mib` says so, refused up front)."""
+    soft, hard = resource.getrlimit(resource.RLIMIT_STACK)
+    want = STACK_MIB << 20
+    if soft == resource.RLIM_INFINITY or soft >= want:
+        return
+    raised = want if hard == resource.RLIM_INFINITY else min(want, hard)
+    if raised > soft:
+        resource.setrlimit(resource.RLIMIT_STACK, (raised, hard))
+
+
+def stack_mib() -> int | None:
+    """This process's stack limit in MiB (None: unlimited)."""
+    soft, _hard = resource.getrlimit(resource.RLIMIT_STACK)
+    return None if soft == resource.RLIM_INFINITY else soft >> 20

@@ -125,3 +125,32 @@ def test_a_run_s_worker_dies_with_the_run(tmp_path):
     while _alive(worker) and time.monotonic() < gone:
         time.sleep(0.05)
     assert not _alive(worker)
+
+
+def test_a_small_soft_stack_is_raised_and_a_deep_chain_checked(tmp_path):
+    """#81: under ``ulimit -S -s 1024`` (a 1 MiB soft stack, the hard one unlimited) a
+    200-link chain ended ``dyncheck check`` in a segmentation fault (exit 139, no message).
+    The command raises its soft limit to what it needs (64 MiB) before any work: the same
+    check passes (expected: the chain is a valid model, exit 0)."""
+    import resource
+    import subprocess
+    import sys
+
+    from tests.dyncheck.test_faults import CHAIN_200
+
+    path = tmp_path / "chain.xml"
+    path.write_text(CHAIN_200)
+
+    def small_stack() -> None:
+        _, hard = resource.getrlimit(resource.RLIMIT_STACK)
+        resource.setrlimit(resource.RLIMIT_STACK, (1 << 20, hard))
+
+    _, hard = resource.getrlimit(resource.RLIMIT_STACK)
+    if hard != resource.RLIM_INFINITY and hard < 64 << 20:
+        pytest.skip("this machine's hard stack limit is below 64 MiB")
+    done = subprocess.run(
+        [sys.executable, "-c", "import sys; from dyncheck.__main__ import console; "
+         "sys.exit(console())", "check", str(path), "--impl", "reference", "--impl", "mujoco",
+         "--states", "5", "--quiet", "--out", str(tmp_path / "out")],
+        preexec_fn=small_stack, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, (done.returncode, done.stderr[-2000:])

@@ -1733,6 +1733,11 @@ def _sparse(name: str, size: int) -> Callable[[Path], Path]:
     return make
 
 
+CHAIN_200 = "<mujoco><worldbody>" + "".join(
+    f'<body pos="0 0 -0.1"><joint name="j{i}" type="hinge" axis="0 1 0"/>'
+    '<geom size="0.05" mass="1"/>' for i in range(200)) + "</body>" * 200 + \
+    "</worldbody></mujoco>"
+"""A chain of 200 hinges, 203 XML levels deep."""
 MASSLESS_URDF = """<robot name="r"><link name="base"/><link name="a"/>
 <joint name="j" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
 <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"""
@@ -1785,6 +1790,13 @@ FIFO_INPUTS = (  # #81: only regular files are read, whatever option names them
                            + "</worldbody></mujoco>"),
           argv=("check", BRANCHES, "--against", "{tmp}/old.xml", "--out", OUT),
           answer=r"XML elements nested 2103 deep \(the check walks trees at most 2000 deep"),
+    Fault(kind="a 200-link chain under a 2 MiB stack whose hard limit is 2 MiB (ulimit -s 2048: "
+          "a segmentation fault of dyncheck, exit 139, no message)", area="check",
+          prepare=_several(a__xml=CHAIN_200), patch=lambda mp, tmp: mp.setattr(
+              "dyncheck.confinement.stack_mib", lambda: 2),
+          argv=("check", "{tmp}/a.xml", "--out", OUT),
+          answer=r"<tmp>/a\.xml: a tree 203 levels deep needs about 4\.2 MiB of stack, more "
+          r"than this process's 2 MiB \(ulimit -s; raise it"),
     Fault(kind="bench --memory 0", area="bench", argv=("bench", "--memory", "0", "--out", OUT),
           answer=r"--memory must be a positive integer at most 100000000, got 0$"),
 )
@@ -2009,6 +2021,11 @@ DEDICATED = (
     ("a FIFO where the compiled-code folder's lock lives", "not taken: the command compiles "
      "afresh, as when another holds the folder (it was locked as if a lock file)",
      "tests/dyncheck/cache/test_compiled.py::test_a_lock_that_is_a_fifo_is_not_taken"),
+    ("a 200-link chain under a 1 MiB soft stack (ulimit -S -s 1024)", "the command raises "
+     "its soft stack limit to 64 MiB before any work and checks the model (exit 0) — a "
+     "segmentation fault of dyncheck itself, exit 139, no message",
+     "tests/dyncheck/test_confinement.py::test_a_small_soft_stack_is_raised_and_a_deep_chain_"
+     "checked"),
     ("bench of 10^7 states (hours of sweeps)", "its time estimated from each implementation "
      "measured on 200 states and said in one line before the first sweep, with the options "
      "that change it (it ran for hours unannounced)",
