@@ -95,10 +95,12 @@ level). Measured: a 200-level MJCF chain ended dyncheck in a segmentation fault 
 
 
 def _stack_holds(path: Path, levels: int) -> None:
-    """Refuse up front a tree deeper than this process's stack holds (``ulimit -s`` whose
-    hard limit :func:`~dyncheck.confinement.stack_room` could not raise past)."""
+    """Refuse up front a tree deeper than this process's stack holds once its soft limit is
+    raised as far as the hard one allows (:func:`~dyncheck.confinement.stack_room`; the
+    command does so first, the Python API here)."""
     from dyncheck import confinement
 
+    confinement.stack_room()  # (what the hard limit allows, in this process too)
     have = confinement.stack_mib()
     need = STACK_BASE_MIB + levels * STACK_PER_LEVEL_KIB / 1024
     if have is not None and have < need:
