@@ -341,8 +341,11 @@ def main(case_name: str, states: int, repeats: int, memory_sizes: list[int], out
     import sys
 
     case = get_case(case_name)
+    # on the workers first: an unreachable scheduler is an error before the long work
+    sliced = None if jobs <= 1 and dask is None else sliced_sweep(
+        case, implementations_for(case), states, jobs=jobs, dask=dask, repeats=repeats)
     impls = {n: make_implementation(n, case) for n in implementations_for(case)}
-    if not quiet:  # announced before the long work, whatever its size
+    if not quiet:  # announced before this process's sweeps, whatever their size
         took = expected_seconds(case, impls, states=states, repeats=repeats,
                                 memory_sizes=memory_sizes)
         print(f"dyncheck bench: about {seconds_text(took)} expected on this machine ({states} "
@@ -350,9 +353,6 @@ def main(case_name: str, states: int, repeats: int, memory_sizes: list[int], out
               f"of {', '.join(map(str, memory_sizes)) or 'none'}; --states, --repeats and "
               "--memory change it)", file=sys.stderr, flush=True)
     progress = Progress("bench", len(impls) + len(memory_sizes) + 1, quiet=quiet)
-    # on the workers first: an unreachable scheduler is an error before the long work
-    sliced = None if jobs <= 1 and dask is None else sliced_sweep(
-        case, implementations_for(case), states, jobs=jobs, dask=dask, repeats=repeats)
     times = bench(case, states, repeats, progress, impls=impls)
     progress.done("whole sweeps")
     rat = ratios(times)
