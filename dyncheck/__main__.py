@@ -207,7 +207,7 @@ def console() -> int:
     return _end_now(code) if code in {c for _, c in ENDED.values()} else code
 
 
-def _end_now(code: int) -> int:
+def _end_now(code: int) -> NoReturn:
     """End a signalled command without the interpreter's shutdown: its line is said, its
     files whole, its workers and engines stopped — what is left are multiprocessing's
     finalizers, which the signal may have caught half-built and which then print a
