@@ -64,6 +64,25 @@ def test_b_against_the_chain_rule_on_a_servo_arm(servo_arm):
     assert list(force["verdict"]) == ["passed"]
 
 
+def test_a_joints_force_clamp_drops_the_servos_damping_from_the_implicit_step(tmp_path):
+    """Position servos, every other joint's actuatorfrcrange (3 N m) holding the summed force
+    at most states: MuJoCo 4.0's implicitfast step then solves with no −kv at those joints (measured
+    with mjd_transitionFD, the clamp on the actuator's forcerange alike), and its B meets the
+    chain rule through the referee (independent: the book's general method and the
+    clean-room actuator law). Failed on the law that kept −kv there (0.13 of B's scale)."""
+    path = tmp_path / "clamped_arm.xml"
+    text = arm(SERVOS.replace(' forcerange="-40 40"', ""))
+    for k in (0, 2, 4, 6):  # the others' columns of B see the clamped joints' step matrix
+        text = text.replace(f'name="j{k}" type="hinge"',
+                            f'name="j{k}" type="hinge" actuatorfrcrange="-3 3"')
+    path.write_text(text)
+    result = check_model(path, impls=("mujoco", "reference"), states=8, isolate=False)
+    steps = _rows(result, impl_b="mujoco")
+    steps = steps[steps["subject"].str.startswith("step Jacobian in the controls (implicit")]
+    assert len(steps) == 1
+    assert (steps["verdict"] == "passed").all(), steps[["note", "error", "tolerance"]]
+
+
 def test_a_gear_changed_by_one_percent_in_a_reading_fails(servo_arm, monkeypatch):
     """Mutation: MuJoCo's reading of one actuator's gear 1 % off what it computes with — its
     force against the referee on that reading fails, and so do its forward dynamics with the

@@ -3,6 +3,8 @@ MuJoCo's documented general actuator, τ = g · clamp(gain · a + bias, forceran
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -85,6 +87,17 @@ def test_velocity_derivative_by_hand():
     held = one(gear=2.0, gain=(10.0, 0, 0), bias=(0, -10.0, -2.0), force=(-0.1, 0.1))
     d = law.velocity_derivative(held, np.array([[0.2]]), np.array([[0.6]]), np.array([[0.7]]))
     assert float(d[0, 0, 0]) == 0.0
+
+
+@pytest.mark.parametrize(("joint", "expected"), [((-100.0, 100.0), -8.0), ((-0.1, 0.1), 0.0)])
+def test_a_joint_range_that_holds_the_sum_drops_the_velocity_derivative(joint, expected):
+    """The servo above on a joint whose range holds its force (τ = 2 (10 · 0.7 − 10 · 0.2 −
+    2 · 0.6) = 7.6, beyond 0.1): no −kv in the implicit step's matrix, as MuJoCo 4.0
+    defines it (independent: mjd_transitionFD measured); within a wide range, g² (−kv)."""
+    acts = replace(one(gear=2.0, gain=(10.0, 0, 0), bias=(0, -10.0, -2.0)),
+                   joint_low=np.array([joint[0]]), joint_high=np.array([joint[1]]))
+    d = law.velocity_derivative(acts, np.array([[0.2]]), np.array([[0.6]]), np.array([[0.7]]))
+    assert float(d[0, 0, 0]) == pytest.approx(expected, rel=1e-15)
 
 
 @pytest.mark.parametrize(("u", "slope"), [(0.7, 2.0 * 10.0), (5.0, 0.0)])
