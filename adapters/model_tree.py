@@ -194,6 +194,21 @@ class TreeJoint:
 
 
 @dataclass(frozen=True, kw_only=True)
+class FixedReading:
+    """The engine's own reading of a copy of the model with one hint's fix applied: the
+    counterfactual that proves (or disproves) the cause the hint names (#77). ``subject``
+    and ``fields``: the hint's (joint, or ``model`` for every joint); ``tree``: the copy as
+    the engine reads it, None where it refused the copy (``refused``: its words)."""
+
+    subject: str
+    fields: tuple[str, ...]
+    fix: str
+    """The fix, in words (as the hint names it)."""
+    tree: ModelTree | None
+    refused: str = ""
+
+
+@dataclass(frozen=True, kw_only=True)
 class ModelTree:
     """What one engine holds after reading a file."""
 
@@ -236,6 +251,23 @@ class ModelTree:
     """The reading with the joints of each body in the order the file writes them, where the
     engine applies them in another (Newton's D6 joint: slides first); None where it applies
     them as written. The referee on both measures what the order changes."""
+
+    measured: frozenset[str] = frozenset()
+    """The :attr:`hints` (their text) the engine proved by its own measurement: its own
+    report of what it did (a correction it warned of), or the difference measured on its
+    counterfactual reading (:attr:`as_written`) or its converted plant."""
+    fixed: tuple[FixedReading, ...] = ()
+    """Its readings of copies of the model, each with one hint's fix applied (the fix
+    measured, :class:`FixedReading`); a hint without one is not verified."""
+
+    def fixed_reading(self, joint: str, name: str) -> FixedReading | None:
+        """The fixed copy's reading for the hint :meth:`hint` gives (``joint``'s own, else
+        the model's), if its fix was applied."""
+        for wanted in (joint, "model"):
+            if any(j == wanted and f == name for j, f, _ in self.hints):
+                return next((r for r in self.fixed
+                             if r.subject == wanted and name in r.fields), None)
+        return None
 
     def hint(self, joint: str, name: str) -> str | None:
         for wanted in (joint, "model"):

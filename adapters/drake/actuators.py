@@ -22,6 +22,7 @@ from dyncheck.adapters.actuators import Actuation, Actuator, Transmission
 from dyncheck.adapters.drake.defaults import class_gain_hints
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
+from dyncheck.adapters.proof import Proof
 from dyncheck.adapters.registration import Format
 
 GEAR = (
@@ -79,20 +80,21 @@ def read(plant: Any) -> tuple[Actuator, ...]:
 
 
 def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
-        tuple[str, str, str], ...]:
+        tuple[tuple[str, str, str], ...], frozenset[str]]:
     """(actuator, field, why) for what Drake is known to read otherwise, each premise
     checked on the plant (``tags``: the file's actuator elements per joint); actuator
     ``model``: of the file's actuators Drake holds none of, and what its automatic
-    differentiation drops (measured on the plant converted)."""
-    out = []
+    differentiation drops; and the hints measured (:attr:`ModelTree.measured`: the
+    converted plant's gains, the class defaults' fix verified on a copy)."""
+    out, measured = [], []
     servos = [i for i in plant.GetJointActuatorIndices()
               if plant.get_joint_actuator(i).has_controller()]
     if servos:
         converted = plant.ToAutoDiffXd()
         dropped = sum(not converted.get_joint_actuator(i).has_controller() for i in servos)
         if dropped:
-            out.append(("model", "control derivatives",
-                        PD_DROPPED.format(count=dropped, total=len(servos))))
+            measured.append(PD_DROPPED.format(count=dropped, total=len(servos)))
+            out.append(("model", "control derivatives", measured[-1]))
     root = inline(source.path) if source.format is Format.MJCF else None
     stated_kv = root is not None and _states_kv(root)
     for index in plant.GetJointActuatorIndices():
@@ -108,7 +110,8 @@ def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
                       if not t.startswith(("<motor>", "<position>"))})
     if ignored:
         out.append(("model", "actuator", IGNORED.format(tags=", ".join(ignored))))
-    return (*out, *(class_gain_hints(plant, source, root) if root is not None else ()))
+    classes = class_gain_hints(plant, source, root) if root is not None else ()
+    return (*out, *classes), frozenset((*measured, *(w for _, _, w in classes)))
 
 
 def _states_kv(root: ET.Element) -> bool:
@@ -183,3 +186,13 @@ def _desired_ports(plant: Any, indices: list[Any]) -> dict[int, tuple[Any, list[
             out[key] = (plant.get_desired_state_input_port(instance), [])
         out[key][1].append(place)
     return out
+
+
+PROOFS = {
+    "GEAR": Proof.SUSPECTED,
+    "DAMPING": Proof.SUSPECTED,
+    "EFFORT": Proof.SUSPECTED,
+    "PD_DROPPED": Proof.MEASURED,
+    "IGNORED": Proof.SUSPECTED,
+}
+"""How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

@@ -15,6 +15,7 @@ from typing import Any
 
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.mjcf_copy import standalone
+from dyncheck.adapters.proof import Proof
 
 CLASS_GAINS = (
     "Drake's MJCF parser takes a <position>'s defaults only from a class with a <position> "
@@ -106,3 +107,9 @@ def class_gain_hints(plant: Any, source: ModelFile,
                                  held=float(held[o.actuator].get_controller_gains().p))
         out += [(o.actuator, "gain", why), (o.actuator, "bias", why)]
     return tuple(out)
+
+
+PROOFS = {
+    "CLASS_GAINS": Proof.FIX,
+}
+"""How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

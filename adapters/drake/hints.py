@@ -14,6 +14,7 @@ from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import joints
 from dyncheck.adapters.formats.mjcf_unread import springdampers
 from dyncheck.adapters.model_tree import JointType, TreeJoint
+from dyncheck.adapters.proof import Proof
 from dyncheck.adapters.registration import Format
 
 UNACTUATED_ARMATURE = (
@@ -162,3 +163,12 @@ def ignored_frames(notes: Sequence[str]) -> tuple[tuple[str, str, str], ...]:
     return (("model", "joint", IGNORED_FRAME),) if said else ()
 
 
+PROOFS = {
+    "UNACTUATED_ARMATURE": Proof.SUSPECTED,
+    "UNREAD_ACTUATOR": Proof.SUSPECTED,
+    "BALL_ARMATURE": Proof.SUSPECTED,
+    "FIRST_OF_SEVERAL": Proof.SUSPECTED,
+    "SKIPPED_CLASS": Proof.SUSPECTED,
+    "IGNORED_FRAME": Proof.SUSPECTED,
+}
+"""How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

@@ -315,13 +315,13 @@ class DrakeModel(ModelEngine):
             )
         gravity = np.asarray(plant.gravity_field().gravity_vector(), float)
         driven = actuators(self._source) if self._source.format is Format.MJCF else {}
+        read, measured = drake_actuators.hints(plant, self._source, driven)
         hints = tuple((j.name, "armature", armature_hint(j, driven.get(j.name, [])))
                       for j in joints if j.name not in reflected and self._source.format is
-                      Format.MJCF) + ignored_frames(notes) + file_hints(self._source) + \
-            drake_actuators.hints(plant, self._source, driven)
+                      Format.MJCF) + ignored_frames(notes) + file_hints(self._source) + read
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
                          nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,
-                         hints=hints, actuators=drake_actuators.read(plant))
+                         hints=hints, measured=measured, actuators=drake_actuators.read(plant))
 
     def couple(self, couplings: Sequence[Coupling]) -> None:
         """The couplings closed with Drake's M and h (:mod:`.simulation`: Drake's

@@ -9,6 +9,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Iterator
 
 from dyncheck.adapters.formats.mjcf_copy import joints
+from dyncheck.adapters.proof import Proof
 
 SPRINGDAMPER = (
     "{engine}'s MJCF parser does not read springdamper=\"{value}\", from which MuJoCo derives "
@@ -26,3 +27,9 @@ def springdampers(root: ET.Element, engine: str) -> Iterator[tuple[str, str, str
         value = joint.attrs.get("springdamper")
         if name and value and any(float(x) for x in value.split()):
             yield name, "damping", SPRINGDAMPER.format(engine=engine, value=value)
+
+
+PROOFS = {
+    "SPRINGDAMPER": Proof.SUSPECTED,
+}
+"""How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

@@ -24,6 +24,7 @@ from dyncheck.adapters.actuators import (
 )
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
+from dyncheck.adapters.proof import Proof
 from dyncheck.adapters.registration import Format
 from dyncheck.vocabulary import Integrator
 
@@ -211,3 +212,9 @@ class MujocoActuation:
                         u: np.ndarray) -> tuple[InputJacobian, ...]:
         """MuJoCo's B of one Euler and one implicitfast step (:meth:`Actuated.input_jacobians`)."""
         return self._on().input_jacobians(q, v, u, self.fd_step)
+
+
+PROOFS = {
+    "UNREAD_TRANSMISSIONS": Proof.MEASURED,
+}
+"""How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

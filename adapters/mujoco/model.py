@@ -54,6 +54,7 @@ from dyncheck.adapters.mujoco.api import (
 from dyncheck.adapters.mujoco.dynamics import evaluate, step_differences
 from dyncheck.adapters.mujoco.meshes import TEXT_MESHES, mesh_rounding
 from dyncheck.adapters.mujoco.simulation import MujocoRun
+from dyncheck.adapters.proof import Proof
 from dyncheck.adapters.registration import Format
 from dyncheck.errors import EngineError
 from dyncheck.vocabulary import Integrator
@@ -227,7 +228,9 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
             self._hints: tuple[tuple[str, str, str], ...] = (("model", "gravity", GRAVITY_OFF),)
         else:
             self._hints = ()
-        self._hints += _total_mass_hints(source) + actuators.file_hints(source)
+        unread = actuators.file_hints(source)  # (shown only where MuJoCo holds none: measured)
+        self._measured = frozenset(w for _, _, w in (*self._hints, *unread))
+        self._hints += _total_mass_hints(source) + unread
         m.opt.disableflags |= int(_SMOOTH_ONLY)
         m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
         self._closed.opt.disableflags = m.opt.disableflags  # (the same smooth dynamics)
@@ -320,8 +323,8 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
                     for k, j in enumerate(joints)}
         return ModelTree(
             engine=ENGINE, joints=tuple(joints), gravity=self._gravity.copy(),
-            nq=m.nq, nv=m.nv, notes=notes + unheld, hints=self._hints, closures=held,
-            closures_read=True,
+            nq=m.nq, nv=m.nv, notes=notes + unheld, hints=self._hints, measured=self._measured,
+            closures=held, closures_read=True,
             actuators=actuators.read(m, [_joint_name(m, j) for j in range(m.njnt)]),
             mesh_rounding={name: bound for name, bound in by_joint.items() if bound > 0},
         )
@@ -479,3 +482,10 @@ def _joint_name(m: mujoco.MjModel, j: int) -> str:
             and _TYPES[int(m.jnt_type[k])] == kind]
     body = m.body(b).name or f"body {b}"
     return f"{body}:{kind}" if len(same) == 1 else f"{body}:{kind}{same.index(j)}"
+
+
+PROOFS = {
+    "GRAVITY_OFF": Proof.MEASURED,
+    "TOTAL_MASS": Proof.SUSPECTED,
+}
+"""How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from dyncheck.adapters.actuators import Actuation, Actuator, Transmission
+from dyncheck.adapters.proof import Proof
 
 MOTORS = (
     "newton's MJCF importer keeps the file's {count} actuators that are no <position> or "
@@ -135,3 +136,11 @@ def actuation(model: Any, newton: Any, actuators: list[tuple[int, int]], *, q: n
         model.joint_target_ke.assign(ke)
         model.joint_target_kd.assign(kd)
     return Actuation(tau=tau, forward=forward, floor=floor)
+
+
+PROOFS = {
+    "MOTORS": Proof.SUSPECTED,
+    "GEAR": Proof.SUSPECTED,
+    "BOUNDS": Proof.SUSPECTED,
+}
+"""How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

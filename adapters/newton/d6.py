@@ -17,6 +17,7 @@ from dataclasses import replace
 import numpy as np
 
 from dyncheck.adapters.model_tree import JointType, Layout, ModelTree, TreeJoint
+from dyncheck.adapters.proof import Proof
 
 D6_ORDER = (
     "Newton fused the joints of body {body!r} ({written}, as written) into one D6 joint, "
@@ -67,3 +68,9 @@ def written_order(tree: ModelTree, written: Sequence[Sequence[str]]) -> ModelTre
                   for j in joints if j.name not in names]
         joints[at:at] = rechained
     return replace(tree, joints=tuple(joints), as_written=None)
+
+
+PROOFS = {
+    "D6_ORDER": Proof.MEASURED,
+}
+"""How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

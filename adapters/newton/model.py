@@ -42,6 +42,7 @@ from dyncheck.adapters.model_tree import (
 )
 from dyncheck.adapters.newton import actuators as newton_actuators
 from dyncheck.adapters.newton.d6 import D6_ORDER, d6_chain, written_order
+from dyncheck.adapters.proof import Proof
 from dyncheck.adapters.registration import Format
 from dyncheck.errors import EngineError, Unsupported
 
@@ -256,7 +257,8 @@ class NewtonModel(ModelEngine):
                   carried: dict[int, list[int]],
                   fused: dict[int, list[tuple[str, JointType]]]) -> ModelTree:
         """The tree of ``joints`` with its hints (inertias Newton corrected, fused joints'
-        order), actuators and, where it fused joints, their written order."""
+        order: both measured, by Newton's own report and by the referee on the order as
+        written), actuators and, where it fused joints, their written order."""
         m, child = self.model, self.model.joint_child.numpy()
         hints: list[tuple[str, str, str]] = []
         for j in range(len(self.types)):
@@ -277,7 +279,8 @@ class NewtonModel(ModelEngine):
         tree = ModelTree(engine=ENGINE, joints=tuple(joints),
                          gravity=np.asarray(m.gravity.numpy()[0], float),
                          nq=m.joint_coord_count, nv=m.joint_dof_count, notes=notes, eps=EPS32,
-                         hints=(*hints, *newton_actuators.hints(m, acts)), actuators=acts)
+                         hints=(*hints, *newton_actuators.hints(m, acts)),
+                         measured=frozenset(w for _, _, w in hints), actuators=acts)
         if not fused:
             return tree
         return replace(tree, as_written=written_order(
@@ -421,3 +424,9 @@ class NewtonModel(ModelEngine):
                      for j in np.flatnonzero(of == k)]
             out.append(np.concatenate(index) if index else np.zeros(0, int))
         return out
+
+
+PROOFS = {
+    "CORRECTED": Proof.MEASURED,
+}
+"""How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

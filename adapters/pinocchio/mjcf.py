@@ -11,6 +11,7 @@ from __future__ import annotations
 import re
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable
+from typing import NamedTuple
 
 import numpy as np
 
@@ -18,10 +19,29 @@ from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import Placed, children, geoms, joints
 from dyncheck.adapters.formats.mjcf_unread import springdampers
+from dyncheck.adapters.pinocchio.fixes import (
+    CLASS_MASSES,
+    NAME_BODIES,
+    ONE_TREE,
+    Edit,
+    Fix,
+    both,
+    joint_pos,
+)
+from dyncheck.adapters.proof import Proof
 from dyncheck.adapters.registration import Format
 
 Hint = tuple[str, str, str]
 """(joint, field, why): see :attr:`dyncheck.adapters.model_tree.ModelTree.hints`."""
+
+
+class Found(NamedTuple):
+    """A hint and the edit of the file that its fix names (None: no file edit undoes it)."""
+
+    subject: str
+    field: str
+    why: str
+    edit: Edit | None = None
 
 INCLUDES_SKIPPED = (
     "; the file has <include> elements, which Pinocchio skips: the body it keeps is the first "
@@ -49,6 +69,7 @@ ROOT_PLACEMENT = (
     "the model in a top-level body of your own without pos or orientation, or rotate "
     "gravity by the same turn)"
 )
+GRAVITY_FIX = "model.gravity set after loading to the gravity the file states"
 GRAVITY_IGNORED = (
     "Pinocchio's MJCF parser does not read <option gravity=\"{gravity}\"> (its model keeps "
     "its default, 0 0 -9.81; measured) (fix: set model.gravity after loading)"
@@ -133,41 +154,69 @@ def hints(source: ModelFile, held: frozenset[str] = frozenset()) -> tuple[Hint, 
     missing (``held``: the bodies Pinocchio's model holds, measured — which top-level body it
     kept is read from it, not assumed); slide ranges, gravity; each body's mass, centre of
     mass and inertia on the joints that carry it; joint positions and damping."""
+    return tuple((f.subject, f.field, f.why) for f in found(source, held))
+
+
+def fixes(source: ModelFile, held: frozenset[str] = frozenset()) -> tuple[Fix, ...]:
+    """The fix of each of :func:`hints` that an edit of the file applies, one per hint (its
+    fields gathered)."""
+    out: dict[tuple[str, str], tuple[list[str], Edit]] = {}
+    for f in found(source, held):
+        if f.edit is not None:
+            out.setdefault((f.subject, f.why), ([], f.edit))[0].append(f.field)
+    return tuple(Fix(subject=subject, fields=tuple(fields), edit=edit)
+                 for (subject, _), (fields, edit) in out.items())
+
+
+def found(source: ModelFile, held: frozenset[str] = frozenset()) -> tuple[Found, ...]:
+    """:func:`hints` with the edit each one's fix names."""
     if source.format is not Format.MJCF:
         return ()
     root = inline(source.path)
     includes = re.search(r"<include\b", source.text) is not None  # (the file's own text)
     return (*_model_hints(root, bare_bodies(root), held, includes), *_body_hints(root),
-            *_joint_hints(root), *springdampers(root, "Pinocchio"))
+            *_joint_hints(root), *(Found(*h) for h in springdampers(root, "Pinocchio")))
 
 
 def _model_hints(root: ET.Element, bare: int, held: frozenset[str],
-                 includes: bool) -> Iterable[Hint]:
+                 includes: bool) -> Iterable[Found]:
     bodies = [b.get("name", "(unnamed)") for world in root.findall("worldbody")
               for b in world.findall("body")]
-    missing = [BARE_BODY.format(count=bare)] if bare else []
+    missing = [(BARE_BODY.format(count=bare), NAME_BODIES)] if bare else []
     kept = [b for b in bodies if b in held] if held else bodies[:1]
     dropped = [b for b in bodies if b not in kept]
     if len(bodies) > 1 and len(kept) == 1 and dropped:
         others = ", ".join(repr(b) for b in dropped[:5]) + (" …" if len(dropped) > 5 else "")
-        missing.append(FIRST_BODY_ONLY.format(first=kept[0], others=others)
-                       + (INCLUDES_SKIPPED if includes and kept[0] != bodies[0] else ""))
+        missing.append((FIRST_BODY_ONLY.format(first=kept[0], others=others)
+                        + (INCLUDES_SKIPPED if includes and kept[0] != bodies[0] else ""),
+                        ONE_TREE))
     if missing:
-        yield "model", "joint", "; ".join(missing)
+        yield Found("model", "joint", "; ".join(why for why, _ in missing),
+                    both(*(edit for _, edit in missing)))
     angle = [c.get("angle") for c in root.iter("compiler") if c.get("angle")]
     if (angle[-1] if angle else "degree") == "degree" and any(
             j.get("type") == "slide" for j in root.iter("joint")):
-        yield "model", "slide range", SLIDE_RANGE
+        yield Found("model", "slide range", SLIDE_RANGE)
     tops = [b for world in root.findall("worldbody") for b in children(world, "body")]
     placed = [k for k in ("pos", "quat", "euler", "axisangle", "xyaxes", "zaxis")
               if tops and k in tops[0].attrib]
     if placed and not (children(tops[0], "joint") or children(tops[0], "freejoint")):
         where = ", ".join(f'{k}="{tops[0].get(k)}"' for k in placed)
-        yield "model", "placement", ROOT_PLACEMENT.format(body=tops[0].get("name", "(unnamed)"),
-                                                          where=where)
+        yield Found("model", "placement", ROOT_PLACEMENT.format(
+            body=tops[0].get("name", "(unnamed)"), where=where), ONE_TREE)
+    gravity = stated_gravity(root)
+    if gravity is not None:
+        yield Found("model", "gravity", GRAVITY_IGNORED.format(
+            gravity=" ".join(f"{g:g}" for g in gravity)))
+
+
+def stated_gravity(root: ET.Element) -> np.ndarray | None:
+    """The gravity the MJCF ``root`` states, where it is not Pinocchio's default."""
     stated = [o.get("gravity", "") for o in root.iter("option") if o.get("gravity")]
-    if stated and not np.allclose([float(x) for x in stated[-1].split()], (0.0, 0.0, -9.81)):
-        yield "model", "gravity", GRAVITY_IGNORED.format(gravity=stated[-1])
+    if not stated:
+        return None
+    gravity = np.array([float(x) for x in stated[-1].split()])
+    return None if np.allclose(gravity, (0.0, 0.0, -9.81)) else gravity
 
 
 def _weighs(geom: Placed) -> bool:
@@ -181,7 +230,7 @@ def _visual(geom: Placed) -> bool:
     return geom.attrs.get("contype", "1") == "0" and geom.attrs.get("conaffinity", "1") == "0"
 
 
-def _body_hints(root: ET.Element) -> Iterable[Hint]:
+def _body_hints(root: ET.Element) -> Iterable[Found]:
     """Mass, centre of mass and inertia: per body without ``<inertial>``, on the joints that
     carry its mass (its own, else those of the nearest moving ancestor it is welded to)."""
     counts: dict[int, dict[str, int]] = {}  # body → reason → how many of its geoms
@@ -201,16 +250,18 @@ def _body_hints(root: ET.Element) -> Iterable[Hint]:
     if not counts:
         return
     for group, names in _carriers(root):
-        why = []
+        why, reasons = [], []
         for reason in (MESH_UNIT, VISUAL_MASSLESS, DEFAULT_MASS):
             where = [f"{b.get('name', '(unnamed)')!r} {n} geom{'s' * (n > 1)}"
                      for b in group if (n := counts.get(id(b), {}).get(reason, 0))]
             if where:
                 why.append(reason.format(where="body " + ", ".join(where)))
-        if why:
+                reasons.append(reason)
+        if why:  # (a mesh's or a visual geom's inertia: no edit of the file states it)
+            edit = CLASS_MASSES if reasons == [DEFAULT_MASS] else None
             for name in names or ("model",):
                 for field in ("mass", "com", "inertia"):
-                    yield name, field, "; ".join(why)
+                    yield Found(name, field, "; ".join(why), edit)
 
 
 def _carriers(root: ET.Element) -> Iterable[tuple[list[ET.Element], tuple[str, ...]]]:
@@ -242,7 +293,7 @@ def _carriers(root: ET.Element) -> Iterable[tuple[list[ET.Element], tuple[str, .
     return out
 
 
-def _joint_hints(root: ET.Element) -> Iterable[Hint]:
+def _joint_hints(root: ET.Element) -> Iterable[Found]:
     """A joint's position from a default class; its range where it has a ``ref`` or is not
     limited."""
     for joint in joints(root):
@@ -252,10 +303,28 @@ def _joint_hints(root: ET.Element) -> Iterable[Hint]:
         pos = joint.attrs.get("pos")
         if pos and "pos" not in joint.stated and any(float(x) for x in pos.split()):
             cls = joint.element.get("class")
-            yield name, "anchor", DEFAULT_POS.format(
-                pos=pos, cls=f"class {cls!r}" if cls else "a default class")
+            yield Found(name, "anchor", DEFAULT_POS.format(
+                pos=pos, cls=f"class {cls!r}" if cls else "a default class"),
+                joint_pos(name, pos))
         if "range" in joint.attrs:
             if joint.attrs.get("limited") == "false":
-                yield name, "range", UNLIMITED_RANGE
+                yield Found(name, "range", UNLIMITED_RANGE)
             elif float(joint.attrs.get("ref", "0")) != 0.0:
-                yield name, "range", REF_RANGE.format(ref=joint.attrs["ref"])
+                yield Found(name, "range", REF_RANGE.format(ref=joint.attrs["ref"]))
+
+
+PROOFS = {
+    "FIRST_BODY_ONLY": Proof.FIX,
+    "BARE_BODY": Proof.FIX,
+    "SLIDE_RANGE": Proof.SUSPECTED,
+    "ROOT_PLACEMENT": Proof.FIX,
+    "GRAVITY_IGNORED": Proof.FIX,
+    "MESH_UNIT": Proof.SUSPECTED,
+    "VISUAL_MASSLESS": Proof.SUSPECTED,
+    "DEFAULT_MASS": Proof.FIX,
+    "DEFAULT_POS": Proof.FIX,
+    "REF_RANGE": Proof.SUSPECTED,
+    "UNLIMITED_RANGE": Proof.SUSPECTED,
+    "LATER_DEFAULTS": Proof.FIX,
+}
+"""How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

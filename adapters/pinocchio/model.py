@@ -31,9 +31,7 @@ import pinocchio as pin
 
 from dyncheck.adapters.base import Field, ModelEngine, Offer
 from dyncheck.adapters.closures import ClosedReading
-from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -48,14 +46,8 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
-from dyncheck.adapters.pinocchio import closures, mimic
-from dyncheck.adapters.pinocchio.mjcf import (
-    BARE_BODY,
-    CLASS_LOOKUP_FAILED,
-    bare_bodies,
-    hints,
-    later_defaults,
-)
+from dyncheck.adapters.pinocchio import closures, counterfactual, mimic
+from dyncheck.adapters.pinocchio.mjcf import hints
 from dyncheck.adapters.pinocchio.simulation import Stepping
 from dyncheck.adapters.registration import Format
 from dyncheck.cases.multibody import Coupling
@@ -113,14 +105,7 @@ def _load(source: ModelFile) -> pin.Model:
         text = text.split("message:", 1)[1] if "message:" in text else text
         message = " ".join(text.split()) or type(exc).__name__
         if source.format is Format.MJCF:
-            root = inline(source.path)
-            if (count := bare_bodies(root)):
-                message += f" ({BARE_BODY.format(count=count)})"
-            # a cause is stated only where the engine's own words are its symptom (#77), on
-            # the file as Pinocchio reads it: its own text, no <include> followed
-            if CLASS_LOOKUP_FAILED in message and (why := later_defaults(
-                    parsing.root(source.text))):
-                message += f" ({why})"
+            message = counterfactual.refusal(source, message)
         raise EngineError(f"pinocchio refused {source.path}: {message}") from None
 
 
@@ -206,7 +191,8 @@ class PinocchioModel(ModelEngine):
     """A Pinocchio model and its neutral tree. Options (the run's, :mod:`.model_adapter`):
     ``gravity`` as the model's (its MJCF parser reads none), ``inertias`` (body name → its
     rotational inertia about its centre of mass, body axes) in place of the file's: the
-    book's point masses exact.
+    book's point masses exact; ``fixes``: read a copy with each hint's fix applied
+    (:attr:`ModelTree.fixed`).
 
     It has no time integrator: :mod:`.simulation` steps its forward dynamics by
     MuJoCo's integrators' definitions and scipy's DOP853."""
@@ -219,7 +205,8 @@ class PinocchioModel(ModelEngine):
     :mod:`.integrators`)."""
 
     def __init__(self, source: ModelFile, *, gravity: np.ndarray | None = None,
-                 inertias: Mapping[str, np.ndarray] | None = None) -> None:
+                 inertias: Mapping[str, np.ndarray] | None = None,
+                 fixes: bool = True) -> None:
         self.model = _load(source)
         self._closures_read = True
         self._mimics, unread = self._mimic_joints(source)
@@ -234,12 +221,16 @@ class PinocchioModel(ModelEngine):
         self.data = self.model.createData()
         self._rows: np.ndarray | None = None
         notes: tuple[str, ...] = ()
-        self._hints = hints(source, frozenset(
-            f.name for f in self.model.frames if f.type == pin.FrameType.BODY))
+        held = frozenset(f.name for f in self.model.frames if f.type == pin.FrameType.BODY)
+        self._hints = hints(source, held)
         if source.floating and source.format is Format.URDF:
             notes = ("pinocchio: JointModelFreeFlyer 'root_joint' at the URDF root",)
         notes += unread
         self.tree = self._tree(notes)
+        if fixes and self._hints:  # each hint's fix measured on a copy (#77)
+            self.tree = replace(self.tree, fixed=counterfactual.fixed_readings(
+                source, held, lambda copy, g: PinocchioModel(
+                    copy, gravity=g, inertias=inertias, fixes=False).tree))
         self.stepping = self._stepper()  # its v̇ in MuJoCo's layout, and its runs there
 
     def _mimic_joints(self, source: ModelFile) -> tuple[mimic.Mimics | None, tuple[str, ...]]:

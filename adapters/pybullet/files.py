@@ -14,6 +14,7 @@ import pybullet as pb
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile, urdf_inertials
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
+from dyncheck.adapters.proof import Proof
 from dyncheck.adapters.registration import Format
 from dyncheck.errors import EngineError
 
@@ -179,3 +180,15 @@ def defaulted(source: ModelFile, links: list[Link]) -> tuple[tuple[str, str, str
            for joint, names in out.items()}
     return tuple((joint, field, text) for joint, text in why.items()
                  for field in ("mass", "com", "inertia"))
+
+
+PROOFS = {
+    "GRAVITY_HINT": Proof.SUSPECTED,
+    "ARMATURE_HINT": Proof.MEASURED,
+    "ACCURACY_HINT": Proof.PREDICTED,
+    "NO_INERTIAL": Proof.SUSPECTED,
+    "ZEROED_INERTIA": Proof.SUSPECTED,
+    "INERTIA_HINT": Proof.SUSPECTED,
+    "DENSITY_HINT": Proof.SUSPECTED,
+}
+"""How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

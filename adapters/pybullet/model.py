@@ -267,7 +267,8 @@ class PybulletModel(PybulletState, ModelEngine):
         self._masses = [(link.body, link.index, link.mass) for link in links]
         return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=self.gravity.copy(),
                          nq=q_at, nv=v_at, notes=notes, hints=hints, eps=self._read_eps,
-                         inertia_accuracy=DIAGONALIZATION)
+                         inertia_accuracy=DIAGONALIZATION,
+                         measured=frozenset({ARMATURE_HINT}))  # (its API holds none)
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray, *,
                  gravity: np.ndarray | None = None) -> Dynamics:

@@ -9,6 +9,7 @@ import numpy as np
 
 from dyncheck.adapters.actuators import Activation, Actuator
 from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.check.proofs import Remeasured, is_proved, proved, unmeasured
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.labels import NO_ACTUATORS_READ
 from dyncheck.vocabulary import Verdict
@@ -93,7 +94,25 @@ def match(mine: tuple[Actuator, ...], theirs: tuple[Actuator, ...]) -> dict[int,
 
 
 def _hint(tree: ModelTree, actuator: str, field: str) -> str:
-    return tree.hint(actuator, field) or UNKNOWN
+    """Why ``tree``'s engine holds ``actuator`` (or none) otherwise, where it proved it."""
+    return unmeasured(tree, actuator, field) or UNKNOWN
+
+
+def _field_cause(other: ModelTree, actuator: str, field: str, *, expected: object,
+                 canonical: str) -> str:
+    """Why ``other`` reads ``field`` of ``actuator`` otherwise than ``expected`` (the
+    canonical engine's value), proved by its fix where it has one: the field of the fixed
+    reading's actuator against ``expected``."""
+    def measure(tree: ModelTree) -> Remeasured:
+        fixed = next((x for x in tree.actuators if x.name == actuator), None)
+        if fixed is None:
+            return Remeasured(closed=False, left=1.0, outcome=f"holds no {actuator!r}")
+        value = compared_fields(fixed)[field]
+        closed = same(expected, value, rtol=FIELD_RTOL)
+        return Remeasured(closed=closed, left=0.0 if closed else 1.0, outcome=(
+            f"reads the {field} of {actuator!r} as {canonical} does ({shown_value(value)})"
+            if closed else f"reads the {field} of {actuator!r} as {shown_value(value)}"))
+    return proved(other, actuator, field, measure=measure) or UNKNOWN
 
 
 def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[CheckRow]:
@@ -105,12 +124,13 @@ def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[Che
     explained where its reason is known (MuJoCo's URDF compiler makes no actuator: the
     format gives it none to read)."""
     a, b = canonical.engine, other.engine
-    why = canonical.hint("model", "actuator")
+    why = unmeasured(canonical, "model", "actuator")
     if not canonical.actuators and other.actuators:  # once, not once per actuator
+        known = why is not None and is_proved(why)
         return [section_row(model, subject="model", field="actuators", a=a, b=b, value_a="none",
                      value_b=f"{len(other.actuators)} ({other.actuators[0].what}, …)",
-                     verdict=Verdict.EXPLAINED if why else Verdict.FAILED,
-                     note=why or UNKNOWN, convention=NO_ACTUATORS_READ if why else "")]
+                     verdict=Verdict.EXPLAINED if known else Verdict.FAILED,
+                     note=why or UNKNOWN, convention=NO_ACTUATORS_READ if known else "")]
     pairs = match(canonical.actuators, other.actuators)
     rows = []
     for k, mine in enumerate(canonical.actuators):
@@ -132,7 +152,9 @@ def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[Che
         for f in differ:
             rows.append(section_row(model, subject=mine.name, field=f, a=a, b=b,
                              value_a=shown_value(ours[f]), value_b=shown_value(found[f]),
-                             verdict=Verdict.FAILED, note=_hint(other, theirs.name, f)))
+                             verdict=Verdict.FAILED,
+                             note=_field_cause(other, theirs.name, f, expected=ours[f],
+                                               canonical=a)))
     held = set(pairs.values())
     for k, theirs in enumerate(other.actuators):
         if k not in held and theirs.modelled:

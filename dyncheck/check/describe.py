@@ -14,55 +14,23 @@ parallel-axis term: 1e-8 kg m² of a point mass 1 m from its pivot to ~1e-16 abs
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass, replace
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
 
 from dyncheck.adapters.model_tree import JointType, ModelTree, TreeJoint
 from dyncheck.check.computed import depth, size
+from dyncheck.check.joint_fields import compare, shown_value
+from dyncheck.check.placement import Placement, placement
+from dyncheck.check.proofs import Remeasured, proved, unmeasured
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.labels import MESH_ROUNDING as MESH_ROUNDING_CAUSE
 from dyncheck.labels import MESH_VOLUME, PLACEMENT, STORED_INERTIA
 from dyncheck.precision import ROUNDOFF_FACTOR, eps_name
 from dyncheck.vocabulary import Quantity, Verdict
-
-
-def shown_value(value: object) -> str:
-    if isinstance(value, np.ndarray):
-        text = np.array2string(value, precision=6, separator=" ", max_line_width=10**6)
-        return " ".join(text.split())
-    if isinstance(value, float):
-        return f"{value:.9g}"
-    return str(value)
-
-
-def _compare(a: TreeJoint, b: TreeJoint, length: float) -> Iterator[tuple[str, object, object,
-                                                                           float, float]]:
-    """(field, value_a, value_b, error, scale) for every numeric field of a joint."""
-    if a.type in (JointType.HINGE, JointType.SLIDE):
-        yield "axis", a.axis, b.axis, float(np.abs(a.axis - b.axis).max()), 1.0
-    if a.type is JointType.HINGE:  # any point of the axis line: distance of b's from a's line
-        off = float(np.linalg.norm(np.cross(b.anchor - a.anchor, a.axis)))
-        yield "anchor", a.anchor, b.anchor, off, length
-    elif a.type in (JointType.BALL, JointType.FREE):
-        yield "anchor", a.anchor, b.anchor, float(np.abs(a.anchor - b.anchor).max()), length
-    mass_scale = max(a.mass, b.mass, 1e-300)
-    yield "mass", a.mass, b.mass, abs(a.mass - b.mass), mass_scale
-    if max(a.mass, b.mass) > 0:
-        yield "com", a.com, b.com, float(np.abs(a.com - b.com).max()), length
-    lever = float(np.linalg.norm(a.com - a.anchor))
-    inertia_scale = max(  # an engine holding the inertia about its body origin (Drake) holds
-        float(np.abs(a.inertia).max()), float(np.abs(b.inertia).max()),  # it to round-off of
-        mass_scale * lever**2, mass_scale * length**2 * 1e-6, 1e-300,  # m d², d the lever
-    )
-    yield "inertia", a.inertia, b.inertia, float(np.abs(a.inertia - b.inertia).max()), \
-        inertia_scale
-    for name in ("armature", "damping"):
-        va, vb = np.asarray(getattr(a, name)), np.asarray(getattr(b, name))
-        scale = max(float(np.abs(va).max(initial=0)), float(np.abs(vb).max(initial=0)), 1e-300)
-        yield name, va, vb, float(np.abs(va - vb).max(initial=0)), scale
 
 
 def _stored_inertia(a: ModelTree, b: ModelTree, joint: TreeJoint) -> tuple[float, str] | None:
@@ -96,70 +64,6 @@ GRAVITY_KEPT = (
 )
 
 
-@dataclass(frozen=True, kw_only=True)
-class Placement:
-    """The one rigid motion x_b = R x_a + t that carries every common joint of ``a`` onto
-    ``b``'s (anchors and centres of mass as points, axes as directions)."""
-
-    rotation: np.ndarray
-    translation: np.ndarray
-
-    @property
-    def turned(self) -> bool:
-        return bool(np.abs(self.rotation - np.eye(3)).max() > 0)
-
-    def undo(self, joint: TreeJoint) -> TreeJoint:
-        """``joint`` of ``b`` carried back into ``a``'s placement."""
-        back = self.rotation.T
-        return replace(joint, anchor=back @ (joint.anchor - self.translation),
-                       com=back @ (joint.com - self.translation), axis=back @ joint.axis,
-                       frame=back @ joint.frame, inertia=back @ joint.inertia @ self.rotation)
-
-
-def placement(a: ModelTree, b: ModelTree, tol: float) -> Placement | None:
-    """The rigid motion (:class:`Placement`) that carries every common joint of ``a`` onto
-    ``b``'s, where there is one and it is not the identity (within ``tol``): the model placed
-    elsewhere in the world, or turned (Pinocchio's MJCF parser puts a jointless top-level
-    body at the world origin, unrotated — measured). The rotation from the joints' axes and
-    the directions between their points (Kabsch's SVD); a translation alone where those
-    directions do not fix one."""
-    pairs = [(ja, b.joint(ja.name)) for ja in a.joints
-             if ja.name in {j.name for j in b.joints} and b.joint(ja.name).type is ja.type]
-    points = [(ja.com, jb.com) for ja, jb in pairs if ja.mass > 0 and jb.mass > 0]
-    points += [(ja.anchor, jb.anchor) for ja, jb in pairs if ja.type is not JointType.SLIDE]
-    if not points:
-        return None
-    directions = [(ja.axis, jb.axis) for ja, jb in pairs
-                  if ja.type in (JointType.HINGE, JointType.SLIDE)]
-    directions += [(pa - points[0][0], pb - points[0][1]) for pa, pb in points[1:]]
-    if not all(np.isfinite(x).all() for pair in (*points, *directions) for x in pair):
-        return None  # a tree read with NaN (a broken file): nothing to place
-    rotation = np.eye(3)
-    if directions:
-        da = np.array([d for d, _ in directions])
-        db = np.array([d for _, d in directions])
-        if np.linalg.matrix_rank(da, tol=tol) >= 2:
-            u, _, vt = np.linalg.svd(db.T @ da)
-            rotation = u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt
-            if np.abs(rotation - np.eye(3)).max() <= tol:
-                rotation = np.eye(3)
-    t = points[0][1] - rotation @ points[0][0]
-    if not np.abs(rotation - np.eye(3)).max() and float(np.abs(t).max()) <= tol:
-        return None
-    moved = Placement(rotation=rotation, translation=t)
-    for ja, jb in pairs:
-        back = moved.undo(jb)
-        if np.abs(ja.axis - back.axis).max() > tol:
-            return None
-        off = back.anchor - ja.anchor
-        off = np.cross(off, ja.axis) if ja.type is JointType.HINGE else off
-        if ja.type is not JointType.SLIDE and float(np.abs(off).max()) > tol:
-            return None
-        if ja.mass > 0 and back.mass > 0 and float(np.abs(back.com - ja.com).max()) > tol:
-            return None
-    return moved
-
-
 def _placement_row(a: ModelTree, b: ModelTree, moved: Placement,
                    tol: float) -> tuple[Verdict, str, str]:
     """The verdict and note of the one row a placement gets: a translation, or a turn that
@@ -182,9 +86,22 @@ def _placement_row(a: ModelTree, b: ModelTree, moved: Placement,
     note = TURNED.format(a=a.engine, b=b.engine, angle=angle, axis=axis, effect=effect,
                          t=f" and moved by {shown_value(t)} m" if np.abs(t).max() > tol * size(a)
                          else "")
-    why = b.hint("model", "placement") or a.hint("model", "placement")
+    why = _placement_cause(a, b, tol)
     note += f": {why}" if why else ""
     return (Verdict.EXPLAINED, note, PLACEMENT) if kept else (Verdict.FAILED, note, "")
+
+
+def _placement_cause(a: ModelTree, b: ModelTree, tol: float) -> str | None:
+    """The hint that explains a placement (``b``'s, else ``a``'s), proved by its fix: the
+    fixed copy placed where the other engine places the model."""
+    side, other = (b, a) if b.hint("model", "placement") else (a, b)
+
+    def measure(tree: ModelTree) -> Remeasured:
+        moved = placement(other, tree, tol) if side is b else placement(tree, other, tol)
+        return Remeasured(closed=moved is None, left=0.0 if moved is None else 1.0,
+                          outcome=f"places the model where {other.engine} does"
+                          if moved is None else "places it elsewhere still")
+    return proved(side, "model", "placement", measure=measure)
 
 
 def diff(model: str, a: ModelTree, b: ModelTree,
@@ -215,8 +132,7 @@ def diff(model: str, a: ModelTree, b: ModelTree,
     gravity_err = float(np.abs(a.gravity - b.gravity).max())
     if gravity_err > rtol * max(1.0, float(np.abs(a.gravity).max())):
         found.append(_Found("model", "gravity", a.gravity, b.gravity, gravity_err, rtol,
-                      Verdict.FAILED, a.hint("model", "gravity") or b.hint("model", "gravity")
-                      or ""))
+                      Verdict.FAILED, _gravity_cause(a, b, rtol) or ""))
     if names_a != names_b and set(names_a) == set(names_b):
         found.append(_Found("model", "joint order", " ".join(names_a), " ".join(names_b), 0.0, 0.0,
                       Verdict.PASSED, "the engines order the joints differently; matched by "
@@ -231,6 +147,22 @@ def diff(model: str, a: ModelTree, b: ModelTree,
                      basis=basis if f.tolerance else "", verdict=f.verdict, note=f.note,
                      convention=f.convention)
             for f in found]
+
+
+def _gravity_cause(a: ModelTree, b: ModelTree, rtol: float) -> str | None:
+    """The hint that explains a gravity read otherwise (``a``'s, else ``b``'s), proved by its
+    fix: the fixed reading's gravity the other engine's."""
+    side, other = (a, b) if a.hint("model", "gravity") else (b, a)
+
+    def measure(tree: ModelTree) -> Remeasured:
+        err = float(np.abs(tree.gravity - other.gravity).max())
+        scale = max(1.0, float(np.abs(other.gravity).max()))
+        before = max(float(np.abs(side.gravity - other.gravity).max()), 1e-300)
+        closed = err <= rtol * scale
+        return Remeasured(closed=closed, left=err / before, outcome=(
+            f"holds gravity {shown_value(tree.gravity)}, as {other.engine} does" if closed
+            else f"holds gravity {shown_value(tree.gravity)}"))
+    return proved(side, "model", "gravity", measure=measure)
 
 
 class _Found(NamedTuple):
@@ -262,12 +194,19 @@ def _presence(a: ModelTree, b: ModelTree, names_a: list[str],
     found: list[_Found] = []
     for name in names_a:
         if name not in names_b:
-            why = b.hint(name, "joint") or b.hint("model", "joint")
+            why = proved(b, name, "joint", measure=partial(_holds, name=name))
             found.append(_Found(name, "joint", "present", "absent", np.inf, 0.0, Verdict.FAILED,
                           f"{b.engine} has no joint {name!r}" + (f": {why}" if why else "")))
     found += [_Found(name, "joint", "absent", "present", np.inf, 0.0, Verdict.FAILED,
                f"{a.engine} has no joint {name!r}") for name in names_b if name not in names_a]
     return found
+
+
+def _holds(tree: ModelTree, *, name: str) -> Remeasured:
+    """Whether a fixed reading holds the joint its engine lacked."""
+    held = name in {j.name for j in tree.joints}
+    return Remeasured(closed=held, left=0.0 if held else 1.0,
+                      outcome=f"holds joint {name!r}" if held else f"has no joint {name!r}")
 
 
 def _placement(a: ModelTree, b: ModelTree, moved: Placement, *, rtol: float,
@@ -296,19 +235,19 @@ def _joint(a: ModelTree, b: ModelTree, ja: TreeJoint, jb: TreeJoint, *, scale: _
         gone = ja.parent is not None and ja.parent not in [j.name for j in b.joints]
         found.append(_Found(ja.name, "parent", ja.parent, jb.parent, np.inf, 0.0, Verdict.FAILED,
                       f"follows from joint {ja.parent!r}, which {b.engine} has not" if gone
-                      else b.hint(ja.name, "parent") or ""))
+                      else unmeasured(b, ja.name, "parent") or ""))
     if (ja.range is None) != (jb.range is None) or (
         ja.range is not None and jb.range is not None
         and np.abs(np.subtract(ja.range, jb.range)).max() > rtol * max(1.0, *map(abs, ja.range))
     ):
-        known = b.hint(ja.name, "range") or a.hint(ja.name, "range") or (
-            (b.hint("model", "slide range") or a.hint("model", "slide range"))
+        known = unmeasured(b, ja.name, "range") or unmeasured(a, ja.name, "range") or (
+            (unmeasured(b, "model", "slide range") or unmeasured(a, "model", "slide range"))
             if ja.type is JointType.SLIDE else None)
         found.append(_Found(ja.name, "range", ja.range, jb.range, np.inf, 0.0, Verdict.FAILED,
                       "joint limits read differently (the dynamics leave limits out; states "
                       f"are sampled within {a.engine}'s)" + (f": {known}" if known else "")))
     compared = 0
-    for field, va, vb, err, size_of in _compare(ja, jb, scale.length):
+    for field, va, vb, err, size_of in compare(ja, jb, scale.length):
         compared += 1
         if err > rtol * size_of:
             at = _Differs(a=a, b=b, ja=ja, jb=jb, field=field, err=err, size=size_of,
@@ -375,12 +314,35 @@ def _cause(at: _Differs, invalid: Mapping[str, str]) -> tuple[Verdict, str, str]
         note = cause(at)
         if note:
             return Verdict.EXPLAINED, note, convention
-    known = at.hinted
+    known = _proved_hint(at)
     if not known and at.field in BODY_FIELDS and at.ja.body in invalid:
         known = FOLLOWS_FROM_INVALID.format(body=at.ja.body, why=invalid[at.ja.body],
                                             a=at.a.engine, b=at.b.engine)
     return Verdict.FAILED, known or (f"{at.a.engine} and {at.b.engine} read {at.ja.name!r} "
                                      f"({at.ja.body}) differently"), ""
+
+
+def _proved_hint(at: _Differs) -> str | None:
+    """The hint that explains the field (``b``'s, else ``a``'s), proved by its fix: the field
+    of the fixed reading against the other engine's, within the same bound."""
+    side = at.b if at.b.hint(at.ja.name, at.field) is not None else at.a
+    other = at.a if side is at.b else at.b
+
+    def measure(tree: ModelTree) -> Remeasured:
+        try:
+            fixed = tree.joint(at.ja.name)
+        except KeyError:
+            return Remeasured(closed=False, left=1.0, outcome=f"has no joint {at.ja.name!r}")
+        mine, theirs = (at.ja, fixed) if side is at.b else (fixed, at.jb)
+        err, scale = next((e, s) for f, _, _, e, s in compare(mine, theirs, at.scale.length)
+                          if f == at.field)
+        closed = err <= at.scale.rtol * scale
+        return Remeasured(closed=closed, left=err / max(at.err, 1e-300), outcome=(
+            f"reads the {at.field} of {at.ja.name!r} as {other.engine} does "
+            f"({err / scale:.2g} of the scale)" if closed else
+            f"reads the {at.field} of {at.ja.name!r} {err / scale:.3g} of the scale from "
+            f"{other.engine}'s"))
+    return proved(side, at.ja.name, at.field, measure=measure)
 
 
 BODY_FIELDS = frozenset({"mass", "com", "inertia"})
@@ -430,7 +392,7 @@ def _exact_meshes(a: ModelTree, b: ModelTree, ja: TreeJoint, jb: TreeJoint, fiel
     except KeyError:
         return None
     allowed = rtol + _mesh_bound(a, b, ja.name, field)
-    for name, _, _, err, scale in _compare(exact, jb, length):
+    for name, _, _, err, scale in compare(exact, jb, length):
         if name == field:
             return err / scale if err <= allowed * scale else None
     return None

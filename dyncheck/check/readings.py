@@ -20,8 +20,8 @@ from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import partial
 from dyncheck.check.computed import bodies, canonical_armature, in_layout, parents_first
-from dyncheck.check.describe import placement
 from dyncheck.check.dynamics import QUANTITIES, Prediction, values
+from dyncheck.check.placement import placement
 from dyncheck.check.referee import TIE_STATES, ReferenceModel
 from dyncheck.check.states import States
 from dyncheck.labels import READING

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from dyncheck.adapters.model_tree import ModelTree
-from dyncheck.check.describe import shown_value
+from dyncheck.check.joint_fields import shown_value
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
 from dyncheck.vocabulary import Verdict

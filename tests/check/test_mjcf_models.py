@@ -687,7 +687,8 @@ def test_two_top_level_defaults_are_pinocchios_refusal_named_with_its_fix(tmp_pa
     """#59: Pinocchio 4.1's MJCF parser reads only the first top-level <default> (measured:
     a class of the second is unknown to it, its raw message "unordered_map::at"). The load
     row names the cause, checked on the file (class 'b' used, defined in the second block),
-    and the fix; the fix applied (one block), Pinocchio loads the file and reads it alike."""
+    and the fix; the fix applied (one block), Pinocchio loads the file and reads it alike,
+    and the load row says so: the fix was applied to a copy and measured (#77)."""
     a = '<default class="a"><joint damping="0.1"/></default>'
     b = '<default class="b"><joint damping="0.3"/></default>'
     defaults = (f"<default>{a}{b}</default>" if one_block
@@ -703,6 +704,9 @@ def test_two_top_level_defaults_are_pinocchios_refusal_named_with_its_fix(tmp_pa
     assert "reads only the first of the file's 2 top-level <default> blocks" in load["note"]
     assert "'b' used here is defined in a later one" in load["note"]
     assert "fix: put every class under one top-level <default>" in load["note"]
+    # #77: the fix applied to a copy, which Pinocchio then loads (the one-block case above)
+    assert "fix verified: with every class put under one top-level <default>, Pinocchio " \
+        "loads the model" in load["note"]
 
 
 def _binary_stl(path, low, high):
