@@ -22,9 +22,7 @@ answer: an improvement is a change a maintainer must see and accept as a new bas
 from __future__ import annotations
 
 import json
-import os
 import re
-import stat
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -38,6 +36,7 @@ import pandas as pd
 from dyncheck.errors import InvalidInput
 from dyncheck.escaping import markdown_code, markdown_table
 from dyncheck.provenance import NOT_USED
+from dyncheck.regular_files import NotRegular, Refusal, open_regular
 from dyncheck.results import DISCREPANCY_KEY, PROVENANCE, SEVERITY, VERDICTS, texts
 
 FACTOR = 10.0
@@ -138,20 +137,16 @@ def regular_file(path: Path, flag: str, *, most: int) -> Iterator[BinaryIO]:
     without blocking, its kind read from the open file: a FIFO there hung ``diff`` and
     ``--baseline`` until killed), else a one-line InvalidInput naming ``flag``."""
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
-    except OSError as exc:
+        with open_regular(path, follow=True, most=most) as f:
+            yield f
+    except FileNotFoundError as exc:
         raise InvalidInput(flag, str(path), f"a readable file ({exc.strerror})") from None
-    info = os.fstat(fd)
-    if not stat.S_ISREG(info.st_mode):
-        os.close(fd)
-        raise InvalidInput(flag, str(path), "a regular file (not a FIFO, device or socket)")
-    if info.st_size > most:
-        os.close(fd)
-        raise InvalidInput(flag, str(path), f"a file of at most {most >> 20} MiB (it has "
-                           f"{info.st_size >> 20} MiB)")
-    os.set_blocking(fd, True)
-    with os.fdopen(fd, "rb") as f:
-        yield f
+    except NotRegular as exc:
+        wanted = {Refusal.UNOPENABLE: f"a readable file ({exc.reason})",
+                  Refusal.NOT_REGULAR: "a regular file (not a FIFO, device or socket)",
+                  Refusal.TOO_LARGE: f"a file of at most {most >> 20} MiB (it has "
+                                     f"{exc.size >> 20} MiB)"}[exc.refusal]
+        raise InvalidInput(flag, str(path), wanted) from None
 
 
 def read_csv(path: Path, flag: str) -> pd.DataFrame:

@@ -14,6 +14,7 @@ position servo's control is its target q_d (v_d = 0, no feed-forward).
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -22,6 +23,8 @@ from dyncheck.adapters.actuators import Actuation, Actuator, Transmission
 from dyncheck.adapters.drake.defaults import class_gain_hints
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
+from dyncheck.adapters.formats.mjcf_copy import class_defaults
+from dyncheck.adapters.model_tree import FixedReading, ModelTree
 from dyncheck.adapters.proof import Proof
 from dyncheck.adapters.registration import Format
 
@@ -114,6 +117,51 @@ def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
     return (*out, *classes), frozenset((*measured, *(w for _, _, w in classes)))
 
 
+def file_kv(root: ET.Element) -> dict[str, float]:
+    """Each ``<position>``'s kv as MuJoCo's compiler gives it (``root``: the file, its
+    includes inlined): its own, else its class's, else 0; by its name, and by its joint's
+    where the joint has no other ``<position>`` (an unnamed actuator)."""
+    classes = class_defaults(root, "position", ("kv",))
+    out: dict[str, float] = {}
+    by_joint: dict[str, list[float]] = {}
+    for element in (e for block in root.findall("actuator") for e in block.findall("position")):
+        stated = element.get("kv") or classes.get(element.get("class", "main"), {}).get("kv")
+        kv = float(stated or 0.0)
+        if element.get("name"):
+            out[element.get("name", "")] = kv
+        if element.get("joint"):
+            by_joint.setdefault(element.get("joint", ""), []).append(kv)
+    return {**{f"joint {j}": k[0] for j, k in by_joint.items() if len(k) == 1}, **out}
+
+
+def damping_fixed(plant: Any, root: ET.Element, tree: ModelTree) -> tuple[FixedReading, ...]:
+    """The fix :data:`DAMPING` names, measured: each servo whose damping Drake holds other
+    than the file's kv given PdControllerGains(p = its kp, d = kv) after parsing, and the
+    actuators read back (the plant's gains restored after)."""
+    stated = file_kv(root)
+    kv = {a.name(): stated.get(a.name(), stated.get(f"joint {a.joint().name()}"))
+          for a in map(plant.get_joint_actuator, plant.GetJointActuatorIndices())}
+    targets = [plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices()]
+    targets = [a for a in targets if a.has_controller() and kv[a.name()] is not None
+               and float(a.get_controller_gains().d) != kv[a.name()]]
+    if not targets:
+        return ()
+    from pydrake.multibody.tree import PdControllerGains
+
+    saved = [a.get_controller_gains() for a in targets]
+    try:
+        for a, gains in zip(targets, saved, strict=True):
+            a.set_controller_gains(PdControllerGains(p=gains.p, d=kv[a.name()]))
+        fixed = replace(tree, actuators=read(plant))
+    finally:
+        for a, gains in zip(targets, saved, strict=True):
+            a.set_controller_gains(gains)
+    return tuple(FixedReading(
+        subject=a.name(), fields=("bias",), tree=fixed,
+        fix=f"JointActuator.set_controller_gains(PdControllerGains(p={float(g.p):g}, "
+            f"d={kv[a.name()]:g})) after parsing") for a, g in zip(targets, saved, strict=True))
+
+
 def _states_kv(root: ET.Element) -> bool:
     """Whether the file (``root``: its includes inlined) gives any ``<position>`` a nonzero
     ``kv``, directly or through a default class: the premise of :data:`DAMPING`."""
@@ -190,7 +238,7 @@ def _desired_ports(plant: Any, indices: list[Any]) -> dict[int, tuple[Any, list[
 
 PROOFS = {
     "GEAR": Proof.SUSPECTED,
-    "DAMPING": Proof.SUSPECTED,
+    "DAMPING": Proof.FIX,
     "EFFORT": Proof.SUSPECTED,
     "PD_DROPPED": Proof.MEASURED,
     "IGNORED": Proof.SUSPECTED,

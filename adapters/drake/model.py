@@ -26,6 +26,7 @@ import re
 import tempfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -47,6 +48,7 @@ from dyncheck.adapters.drake import simulation as drake_simulation
 from dyncheck.adapters.drake.hints import actuators, armature_hint, file_hints, ignored_frames
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
+from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import for_parser
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -319,9 +321,13 @@ class DrakeModel(ModelEngine):
         hints = tuple((j.name, "armature", armature_hint(j, driven.get(j.name, [])))
                       for j in joints if j.name not in reflected and self._source.format is
                       Format.MJCF) + ignored_frames(notes) + file_hints(self._source) + read
-        return ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
+        tree = ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
                          nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,
                          hints=hints, measured=measured, actuators=drake_actuators.read(plant))
+        if self._source.format is not Format.MJCF:
+            return tree
+        return replace(tree, fixed=drake_actuators.damping_fixed(
+            plant, inline(self._source.path), tree))
 
     def couple(self, couplings: Sequence[Coupling]) -> None:
         """The couplings closed with Drake's M and h (:mod:`.simulation`: Drake's

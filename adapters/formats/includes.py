@@ -6,13 +6,12 @@ where the main file's folder has none)."""
 
 from __future__ import annotations
 
-import os
-import stat
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from dyncheck.adapters.formats import parsing
 from dyncheck.errors import EngineError
+from dyncheck.regular_files import NotRegular, Refusal, open_regular
 
 MAX_INCLUDE_BYTES = 64 * 2**20
 MAX_INCLUDE_DEPTH = 32
@@ -50,20 +49,18 @@ def asset_file(root: ET.Element, folder: Path, element: ET.Element,
 def _read(path: Path, including: Path) -> ET.Element:
     """An included file's root, read only if it is a regular file (a FIFO or a device would
     block or never end)."""
+    where = f"{including}: <include file={path.name!r}>"
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
-    except OSError as exc:
-        raise EngineError(f"{including}: <include file={path.name!r}>: cannot be read "
-                          f"({exc.strerror})") from None
-    info = os.fstat(fd)  # before fdopen, which refuses a folder with its fd for a name
-    if not stat.S_ISREG(info.st_mode):
-        os.close(fd)
-        raise EngineError(f"{including}: <include file={path.name!r}>: not a regular file")
-    with os.fdopen(fd, "rb") as handle:
-        if info.st_size > MAX_INCLUDE_BYTES:
-            raise EngineError(f"{including}: <include file={path.name!r}>: larger than "
-                              f"{MAX_INCLUDE_BYTES // 2**20} MiB")
-        raw = handle.read()
+        with open_regular(path, follow=True, most=MAX_INCLUDE_BYTES) as handle:
+            raw = handle.read()
+    except FileNotFoundError as exc:
+        raise EngineError(f"{where}: cannot be read ({exc.strerror})") from None
+    except NotRegular as exc:
+        raise EngineError(where + {
+            Refusal.UNOPENABLE: f": cannot be read ({exc.reason})",
+            Refusal.NOT_REGULAR: ": not a regular file",
+            Refusal.TOO_LARGE: f": larger than {MAX_INCLUDE_BYTES // 2**20} MiB"}[exc.refusal]
+        ) from None
     try:
         return parsing.root(raw)
     except ET.ParseError as exc:

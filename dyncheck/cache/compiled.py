@@ -37,6 +37,7 @@ from pathlib import Path
 
 from dyncheck.adapters.compiled import private, released
 from dyncheck.cache import store
+from dyncheck.regular_files import NotRegular, open_regular
 from dyncheck.settings import Settings
 
 ENGINES = ("jax", "warp")
@@ -45,19 +46,6 @@ MANIFEST = ".manifest"
 MAGIC = b"dyncheck-compiled-1\n"
 MANIFEST_MOST = 64 << 20
 """The largest manifest read (a listing of names and digests: megabytes at most)."""
-
-
-def _regular(path: Path) -> int | None:
-    """``path`` opened for reading where it is a regular file (never through a link, never
-    blocking: a FIFO there would hang the command), else None."""
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
-    except OSError:
-        return None
-    if not stat.S_ISREG(os.fstat(fd).st_mode):
-        os.close(fd)
-        return None
-    return fd
 
 
 def _entries(folder: Path) -> dict[str, Path]:
@@ -75,17 +63,14 @@ def _entries(folder: Path) -> dict[str, Path]:
 
 def _digest(path: Path) -> str | None:
     """SHA-256 of a regular file (None for anything else: never opened through a link)."""
-    fd = _regular(path)
-    if fd is None:
-        return None
     try:
-        h = hashlib.sha256()
-        with os.fdopen(os.dup(fd), "rb") as f:
+        with open_regular(path, follow=False) as f:
+            h = hashlib.sha256()
             for block in iter(lambda: f.read(1 << 20), b""):
                 h.update(block)
-        return h.hexdigest()
-    finally:
-        os.close(fd)
+            return h.hexdigest()
+    except (NotRegular, OSError):
+        return None
 
 
 def _tag(secret: bytes, payload: bytes) -> bytes:
@@ -95,17 +80,10 @@ def _tag(secret: bytes, payload: bytes) -> bytes:
 def _vouched(folder: Path, secret: bytes) -> dict[str, str]:
     """The entries the manifest vouches for (name → SHA-256); none where it is missing,
     forged, unreadable, too large or not a regular file."""
-    fd = _regular(folder / MANIFEST)
-    if fd is None:
-        return {}
     try:
-        with os.fdopen(os.dup(fd), "rb") as f:
+        with open_regular(folder / MANIFEST, follow=False, most=MANIFEST_MOST) as f:
             data = f.read(MANIFEST_MOST + 1)
-    except OSError:
-        return {}
-    finally:
-        os.close(fd)
-    if len(data) > MANIFEST_MOST:
+    except (NotRegular, OSError):
         return {}
     head = len(MAGIC) + 32
     if not data.startswith(MAGIC) or len(data) < head \

@@ -32,7 +32,6 @@ import io
 import os
 import pickle
 import secrets
-import stat
 import sys
 import tempfile
 from collections.abc import Callable
@@ -41,6 +40,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from dyncheck.adapters.compiled import private_folder
+from dyncheck.regular_files import NotRegular, Refusal, open_regular
 
 T = TypeVar("T")
 
@@ -92,16 +92,14 @@ def _inside(path: Path, folder: Path) -> bool:
 
 def _read_key(path: Path) -> bytes:
     """The key at ``path`` (a ValueError naming what is wrong with it)."""
-    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
     try:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            raise ValueError(f"{path} is not a regular file")
-        if info.st_uid != os.getuid() or info.st_mode & 0o077:
-            raise ValueError(f"{path} must belong to this user and be private (chmod 600)")
-        key = os.read(fd, KEY_BYTES + 1)
-    finally:
-        os.close(fd)
+        with open_regular(path, follow=False) as f:
+            info = os.fstat(f.fileno())
+            if info.st_uid != os.getuid() or info.st_mode & 0o077:
+                raise ValueError(f"{path} must belong to this user and be private (chmod 600)")
+            key = f.read(KEY_BYTES + 1)
+    except NotRegular as exc:
+        raise ValueError(f"{path} {exc}") from None
     if len(key) != KEY_BYTES:
         raise ValueError(f"{path} holds {len(key)} bytes, not {KEY_BYTES}")
     return key
@@ -165,21 +163,11 @@ def _read(path: Path, name: str, secret: bytes) -> bytes:
     """The authenticated payload at ``path``; FileNotFoundError where there is none,
     :class:`Invalid` where what is there is not to be read."""
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
-    except OSError as exc:
-        if isinstance(exc, FileNotFoundError):
-            raise
-        raise Invalid(f"cannot be opened ({exc.strerror})") from None
-    try:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            raise Invalid("is not a regular file")
-        if info.st_size > MAX_ENTRY_BYTES:
-            raise Invalid(f"is {info.st_size} bytes (more than {MAX_ENTRY_BYTES})")
-        with os.fdopen(os.dup(fd), "rb") as f:
+        with open_regular(path, follow=False, most=MAX_ENTRY_BYTES) as f:
             data = f.read(MAX_ENTRY_BYTES + 1)
-    finally:
-        os.close(fd)
+    except NotRegular as exc:
+        raise Invalid(f"is {exc.size} bytes (more than {MAX_ENTRY_BYTES})"
+                      if exc.refusal is Refusal.TOO_LARGE else str(exc)) from None
     head = len(MAGIC) + TAG_BYTES
     if not data.startswith(MAGIC) or len(data) < head:
         raise Invalid("is not a dyncheck cache entry")

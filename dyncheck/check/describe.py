@@ -1,7 +1,8 @@
 """Step 3 of a model check: what each engine read (the neutral trees compared field by field,
 joints matched by name; a field read differently explained only by a known cause whose
-premise holds, :data:`KNOWN_CAUSES`). Whether each body is physically possible (step 4) is
-:mod:`.validity`'s.
+premise holds, :data:`KNOWN_CAUSES`; a difference an engine's hint names gets that cause only
+where its fix, applied to a copy, closes it, :mod:`.proofs`). Whether each body is physically
+possible (step 4) is :mod:`.validity`'s.
 
 Tolerances: every field is the file's numbers carried through a chain of rigid transforms
 (one per joint and fused link above it), so two parsers of the same text differ by round-off

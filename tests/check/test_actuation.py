@@ -110,6 +110,10 @@ def test_drake_reads_a_servo_otherwise_with_its_cause(servo_arm):
     read = _rows(result, impl_b="drake", verdict="failed")
     assert {"bias", "limits"} <= set(read["field"])
     assert read[read["field"] == "bias"]["note"].str.contains("'kd'").all()
+    # #77: the fix measured, kv = 5 given to Drake's PD gains on its plant, closes the bias
+    assert read[read["field"] == "bias"]["note"].str.contains(
+        r"fix verified: with JointActuator.set_controller_gains\(PdControllerGains\(p=50, "
+        r"d=5\)\) after parsing, drake reads the bias").all()
     judged = _rows(result, impl_a="reference", impl_b="drake").set_index("subject")["verdict"]
     assert judged["actuator force"] == judged["forward dynamics with the control"] == "passed"
     assert judged["d(forward)/d(u)"] == "failed"  # its ToAutoDiffXd drops the PD gains
@@ -284,3 +288,20 @@ def test_a_fix_that_does_not_close_the_gap_writes_no_cause(tmp_path, monkeypatch
     bias = _rows(result, impl_b="drake", verdict="failed")
     note = bias[bias["field"] == "bias"]["note"].iloc[0]
     assert note == "cause unknown"
+
+
+def test_a_wrong_kv_does_not_verify_drakes_damping_cause(servo_arm, monkeypatch):
+    """The verifier of "the file's kv is lost" can fail: given a wrong kv (1 where the file
+    states 5), the fix applied to Drake's plant leaves the bias read otherwise, so the row
+    says the cause is unknown and the fix accounts for none of it."""
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    from dyncheck.adapters.drake import actuators as drake_actuators
+
+    monkeypatch.setattr(drake_actuators, "file_kv", lambda root: {
+        f"joint j{k}": 1.0 for k in range(len(AXES))})
+    result = check_model(servo_arm, impls=("mujoco", "drake"), states=4, isolate=False)
+    bias = _rows(result, impl_b="drake", field="bias")
+    assert len(bias) == len(AXES)
+    assert bias["note"].str.startswith("cause unknown: the named fix (JointActuator."
+                                       "set_controller_gains(PdControllerGains(p=50, d=1))").all()
+    assert not bias["note"].str.contains("fix verified").any()
