@@ -164,8 +164,8 @@ def ignored_frames(notes: Sequence[str]) -> tuple[tuple[str, str, str], ...]:
 
 
 PROOFS = {
-    "UNACTUATED_ARMATURE": Proof.SUSPECTED,
-    "UNREAD_ACTUATOR": Proof.SUSPECTED,
+    "UNACTUATED_ARMATURE": Proof.FIX,
+    "UNREAD_ACTUATOR": Proof.FIX,
     "BALL_ARMATURE": Proof.SUSPECTED,
     "FIRST_OF_SEVERAL": Proof.SUSPECTED,
     "SKIPPED_CLASS": Proof.SUSPECTED,

@@ -45,11 +45,12 @@ from dyncheck.adapters.actuators import Actuation
 from dyncheck.adapters.base import Field, ModelEngine, Offer, Steps
 from dyncheck.adapters.drake import actuators as drake_actuators
 from dyncheck.adapters.drake import simulation as drake_simulation
+from dyncheck.adapters.drake.counterfactual import armature_fixed
 from dyncheck.adapters.drake.hints import actuators, armature_hint, file_hints, ignored_frames
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
-from dyncheck.adapters.formats.mjcf_copy import for_parser
+from dyncheck.adapters.formats.mjcf_copy import for_parser, placed
 from dyncheck.adapters.model_tree import (
     Axes,
     DerivativeChart,
@@ -229,7 +230,8 @@ class DrakeModel(ModelEngine):
                         Offer.BODY_FORCES})
     steps_in_a_chart = True  # its integrators advance q = (roll, pitch, yaw) and (w, x, y, z, p)
 
-    def __init__(self, source: ModelFile) -> None:
+    def __init__(self, source: ModelFile, *, fixes: bool = True) -> None:
+        self._fixes = fixes  # (False: a copy read to measure a fix)
         self.plant, said, notes, self._damping = _plant(source)
         self.parser_warnings = tuple(dict.fromkeys(said))
         self._source = source
@@ -326,8 +328,18 @@ class DrakeModel(ModelEngine):
                          hints=hints, measured=measured, actuators=drake_actuators.read(plant))
         if self._source.format is not Format.MJCF:
             return tree
-        return replace(tree, fixed=drake_actuators.damping_fixed(
-            plant, inline(self._source.path), tree))
+        root = inline(self._source.path)
+        fixed = drake_actuators.damping_fixed(plant, root, tree)
+        if self._fixes:  # each armature hint's fix measured on a copy (#77)
+            armed = {p.element.get("name") for p in placed(root, "joint", ("armature",))
+                     if float(p.attrs.get("armature", "0") or 0) != 0.0}
+            bare = [j for j in joints if j.name not in reflected and j.name in armed
+                    and j.type not in (JointType.BALL, JointType.FREE)]
+            fixed += armature_fixed(
+                self._source, unactuated=[j.name for j in bare if not driven.get(j.name)],
+                unread=[j.name for j in bare if driven.get(j.name)],
+                read=lambda copy: DrakeModel(copy, fixes=False).tree)
+        return replace(tree, fixed=fixed)
 
     def couple(self, couplings: Sequence[Coupling]) -> None:
         """The couplings closed with Drake's M and h (:mod:`.simulation`: Drake's

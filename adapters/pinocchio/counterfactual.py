@@ -13,10 +13,11 @@ import numpy as np
 import pinocchio as pin
 
 from dyncheck.adapters.formats import parsing
+from dyncheck.adapters.formats.edits import Edit, applied
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.model_tree import FixedReading, ModelTree
-from dyncheck.adapters.pinocchio.fixes import ONE_DEFAULTS, Edit, applied
+from dyncheck.adapters.pinocchio.fixes import ONE_DEFAULTS
 from dyncheck.adapters.pinocchio.mjcf import (
     BARE_BODY,
     CLASS_LOOKUP_FAILED,

@@ -10,22 +10,11 @@ top-level bodies under one body that has no pose and no joint.
 
 from __future__ import annotations
 
-import copy
 import xml.etree.ElementTree as ET
-from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from pathlib import Path
-from typing import NamedTuple
 
-from dyncheck.adapters.formats.mjcf_copy import geoms, joints, standalone
-
-
-class Edit(NamedTuple):
-    """An in-place edit of an (inlined) MJCF root, and what it does in words."""
-
-    words: str
-    apply: Callable[[ET.Element], None]
-
+from dyncheck.adapters.formats.edits import Edit
+from dyncheck.adapters.formats.mjcf_copy import geoms, joints
 
 ROOT = "dyncheck_root"
 """The name of the body :data:`ONE_TREE` puts the top-level bodies under."""
@@ -92,20 +81,3 @@ CLASS_MASSES = Edit("the mass each geom takes from a default class written on th
 NAME_BODIES = Edit("every body without attributes named", _name_bodies)
 ONE_TREE = Edit("the top-level bodies put under one body without pose or joint", _one_tree)
 ONE_DEFAULTS = Edit("every class put under one top-level <default>", _one_defaults)
-
-
-def both(*edits: Edit) -> Edit:
-    """The edits applied in order."""
-    def edit(root: ET.Element) -> None:
-        for one in edits:
-            one.apply(root)
-    return Edit(" and ".join(e.words for e in edits), edit)
-
-
-def applied(root: ET.Element, folder: Path, edits: Sequence[Edit]) -> str:
-    """The text of a copy of ``root`` (includes inlined) with ``edits`` applied, its asset
-    paths absolute (``folder``: the main file's), so that it reads the same from anywhere."""
-    fixed = copy.deepcopy(root)
-    for edit in edits:
-        edit.apply(fixed)
-    return standalone(fixed, folder)

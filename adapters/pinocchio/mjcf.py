@@ -15,6 +15,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from dyncheck.adapters.formats.edits import Edit, both
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import Placed, children, geoms, joints
@@ -23,9 +24,7 @@ from dyncheck.adapters.pinocchio.fixes import (
     CLASS_MASSES,
     NAME_BODIES,
     ONE_TREE,
-    Edit,
     Fix,
-    both,
     joint_pos,
 )
 from dyncheck.adapters.proof import Proof

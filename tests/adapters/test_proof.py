@@ -18,8 +18,7 @@ from dyncheck.adapters.proof import Proof
 
 SUSPECTED = {
     "drake.actuators": {"GEAR", "EFFORT", "IGNORED"},
-    "drake.hints": {"UNACTUATED_ARMATURE", "UNREAD_ACTUATOR", "BALL_ARMATURE",
-                    "FIRST_OF_SEVERAL", "SKIPPED_CLASS", "IGNORED_FRAME"},
+    "drake.hints": {"BALL_ARMATURE", "FIRST_OF_SEVERAL", "SKIPPED_CLASS", "IGNORED_FRAME"},
     "formats.mjcf_unread": {"SPRINGDAMPER"},
     "mujoco.model": {"TOTAL_MASS"},
     "newton.actuators": {"MOTORS", "GEAR", "BOUNDS"},

@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from dyncheck.adapters.formats.edits import Edit
 from dyncheck.adapters.model_tree import FixedReading, ModelTree
-from dyncheck.adapters.pinocchio import fixes as pinocchio_fixes
 from dyncheck.adapters.pinocchio import mjcf as pinocchio_mjcf
 from dyncheck.check.model_check import check_model
 from dyncheck.check.proofs import FIX_VERIFIED, Remeasured, proved
@@ -73,7 +73,7 @@ def test_a_fix_that_does_not_close_the_gap_leaves_the_cause_unknown(four_causes,
     """A planted wrong fix for the joint's class pos (an edit that changes nothing): the
     copy reads the anchor as the file did, so the row says the named fix accounts for 0 %
     and the cause is unknown — never "fix verified"."""
-    nothing = pinocchio_fixes.Edit("nothing changed", lambda root: None)
+    nothing = Edit("nothing changed", lambda root: None)
     monkeypatch.setattr(pinocchio_mjcf, "joint_pos", lambda name, pos: nothing)
     note = _described(four_causes)[("ja", "anchor")].note
     assert note.startswith("cause unknown: the named fix (nothing changed) accounts for 0 %")
@@ -87,7 +87,7 @@ def test_a_copy_the_engine_refuses_proves_nothing(four_causes, monkeypatch):
         for geom in root.iter("geom"):
             geom.set("class", "defined_nowhere")
     monkeypatch.setattr(pinocchio_mjcf, "CLASS_MASSES",
-                        pinocchio_fixes.Edit("a broken copy", breaks))
+                        Edit("a broken copy", breaks))
     rows = _described(four_causes)
     for key in (("ja", "mass"), ("ja", "inertia")):
         assert rows[key].note.startswith("cause unknown: pinocchio refused the copy with the "
@@ -118,7 +118,7 @@ def test_the_note_follows_the_remeasured_difference(closed, left, expected):
     assert proved(_tree(), "j", "g", measure=measure) is None
 
 
-NOTHING = pinocchio_fixes.Edit("nothing changed", lambda root: None)
+NOTHING = Edit("nothing changed", lambda root: None)
 
 PLACED = """<mujoco model="placed"><worldbody>
   <body name="base" pos="0.2 0 1" euler="0 0 30"><body name="l1">
@@ -173,3 +173,39 @@ def test_the_defaults_refusal_is_not_named_where_its_fix_does_not_load(tmp_path,
     assert load["verdict"] == "failed"
     assert "unordered_map::at" in load["note"]
     assert "top-level <default>" not in load["note"], load["note"]
+
+
+ARMATURE = """<mujoco model="armature"><worldbody><body name="a" pos="0 0 1">
+  <joint name="j" type="hinge" axis="0 1 0" armature="0.05"/>
+  <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/>
+  <body name="b" pos="0.3 0 0"><joint name="k" type="hinge" axis="0 1 0" armature="0.02"/>
+    <geom type="sphere" size="0.05" pos="0.1 0 0"/></body></body></worldbody>
+  <actuator><general joint="k" gainprm="2"/></actuator></mujoco>"""
+"""Armature on a joint no actuator drives ('j') and on one driven by a <general> only ('k'):
+Drake's MJCF parser keeps armature only as an actuator's reflected inertia, and reads no
+<general> (measured, :mod:`dyncheck.adapters.drake.hints`)."""
+
+
+@pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-no-op"])
+def test_drakes_armature_causes_are_verified_by_their_fixes(tmp_path, monkeypatch, plant):
+    """The copy with a <motor> on 'j' and 'k''s <general> written as <motor>, parsed by Drake,
+    holds MuJoCo's armature (MuJoCo's compiler the expected value): "fix verified". With the
+    fixes planted as edits that change nothing, both causes are unknown."""
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    from dyncheck.adapters.drake import counterfactual
+
+    if plant:
+        monkeypatch.setattr(counterfactual, "motors", lambda joints: NOTHING)
+        monkeypatch.setattr(counterfactual, "as_motors", lambda joints: NOTHING)
+    path = tmp_path / "armature.xml"
+    path.write_text(ARMATURE)
+    rows = check_model(path, states=4, impls=("mujoco", "drake"), isolate=False).rows
+    rows = rows[(rows["section"] == "description") & (rows["field"] == "armature")]
+    notes = dict(zip(rows["subject"], rows["note"], strict=True))
+    assert set(notes) == {"j", "k"}
+    for joint, note in notes.items():
+        assert (FIX_VERIFIED in note) is not plant, (joint, note)
+        assert ("cause unknown" in note) is plant, (joint, note)
+    if not plant:
+        assert "with a <motor> on 'j', drake reads the armature of 'j' as mujoco" in notes["j"]
+        assert "with the actuators on 'k' written as <motor>, drake reads" in notes["k"]

@@ -1,0 +1,37 @@
+"""An edit of a copy of an MJCF file, in words and as a function of its (inlined) root: the
+fix a hint names, applied so that the engine concerned can read the copy and the difference
+be measured again (#77; :mod:`dyncheck.check.proofs`)."""
+
+from __future__ import annotations
+
+import copy
+import xml.etree.ElementTree as ET
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import NamedTuple
+
+from dyncheck.adapters.formats.mjcf_copy import standalone
+
+
+class Edit(NamedTuple):
+    """An in-place edit of an (inlined) MJCF root, and what it does in words."""
+
+    words: str
+    apply: Callable[[ET.Element], None]
+
+
+def both(*edits: Edit) -> Edit:
+    """The edits applied in order."""
+    def edit(root: ET.Element) -> None:
+        for one in edits:
+            one.apply(root)
+    return Edit(" and ".join(e.words for e in edits), edit)
+
+
+def applied(root: ET.Element, folder: Path, edits: Sequence[Edit]) -> str:
+    """The text of a copy of ``root`` (includes inlined) with ``edits`` applied, its asset
+    paths absolute (``folder``: the main file's), so that it reads the same from anywhere."""
+    fixed = copy.deepcopy(root)
+    for edit in edits:
+        edit.apply(fixed)
+    return standalone(fixed, folder)
