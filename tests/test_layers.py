@@ -49,7 +49,7 @@ def test_adapters_never_import_the_reference_or_the_comparison_layer(path):
     for name in _imports(path):
         if name.startswith("dyncheck."):
             allowed = ("dyncheck.adapters", "dyncheck.cases", "dyncheck.errors",
-                       "dyncheck.vocabulary", "dyncheck.settings")
+                       "dyncheck.vocabulary", "dyncheck.settings", "dyncheck.regular_files")
             assert name.startswith(allowed), f"{path.name} imports {name}"
 
 
@@ -85,15 +85,16 @@ def test_the_rule_reader_sees_function_level_imports(tmp_path):
 
 
 def _layer(module: str) -> str | None:
-    """The layer of a dyncheck module name: errors, the vocabulary and the settings (the
-    bottom: they import nothing of dyncheck but one another), reference, cases, adapters, or
+    """The layer of a dyncheck module name: errors, the vocabulary, the settings and the
+    opener of untrusted files (the bottom: they import nothing of dyncheck but one
+    another), reference, cases, adapters, or
     the comparison layer (everything else under dyncheck/)."""
     if not module.startswith("dyncheck"):
         return None
     parts = module.split(".")
     if len(parts) == 1:
         return "comparison"
-    if parts[1] in ("errors", "vocabulary", "settings"):
+    if parts[1] in ("errors", "vocabulary", "settings", "regular_files"):
         return "errors"
     return parts[1] if parts[1] in ("reference", "cases", "adapters") else "comparison"
 
@@ -102,7 +103,8 @@ def _layer_of_path(path: Path) -> str:
     rel = path.relative_to(ROOT).parts
     if rel[0] in ("reference", "cases", "adapters"):
         return rel[0]
-    bottom = path.name in ("errors.py", "vocabulary.py", "settings.py") and len(rel) == 2
+    bottom = path.name in ("errors.py", "vocabulary.py", "settings.py",
+                           "regular_files.py") and len(rel) == 2
     return "errors" if bottom else "comparison"
 
 

@@ -317,23 +317,31 @@ class DrakeModel(ModelEngine):
                     ),
                 )
             )
-        gravity = np.asarray(plant.gravity_field().gravity_vector(), float)
+        return self._finish(joints, notes, reflected)
+
+    def _finish(self, joints: list[TreeJoint], notes: tuple[str, ...],
+                reflected: dict[str, float]) -> ModelTree:
+        """The tree of ``joints`` with its hints and actuators, and its hints' fixes measured
+        (#77): the servos' kv set on the plant, and each armature hint's fix applied to a copy
+        of the MJCF and read."""
+        plant = self.plant
         driven = actuators(self._source) if self._source.format is Format.MJCF else {}
         read, measured = drake_actuators.hints(plant, self._source, driven)
         hints = tuple((j.name, "armature", armature_hint(j, driven.get(j.name, [])))
                       for j in joints if j.name not in reflected and self._source.format is
                       Format.MJCF) + ignored_frames(notes) + file_hints(self._source) + read
-        tree = ModelTree(engine=ENGINE, joints=tuple(joints), gravity=gravity,
+        tree = ModelTree(engine=ENGINE, joints=tuple(joints),
+                         gravity=np.asarray(plant.gravity_field().gravity_vector(), float),
                          nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,
                          hints=hints, measured=measured, actuators=drake_actuators.read(plant))
         if self._source.format is not Format.MJCF:
             return tree
         root = inline(self._source.path)
-        fixed = drake_actuators.damping_fixed(plant, root, tree)
-        if self._fixes:  # each armature hint's fix measured on a copy (#77)
+        fixed = drake_actuators.damping_fixed(self.plant, root, tree)
+        if self._fixes:
             armed = {p.element.get("name") for p in placed(root, "joint", ("armature",))
                      if float(p.attrs.get("armature", "0") or 0) != 0.0}
-            bare = [j for j in joints if j.name not in reflected and j.name in armed
+            bare = [j for j in tree.joints if j.name not in reflected and j.name in armed
                     and j.type not in (JointType.BALL, JointType.FREE)]
             fixed += armature_fixed(
                 self._source, unactuated=[j.name for j in bare if not driven.get(j.name)],

@@ -162,8 +162,16 @@ def zeroed(source: ModelFile, links: list[Link]) -> tuple[tuple[str, str, str], 
 
 def defaulted(source: ModelFile, links: list[Link]) -> tuple[tuple[str, str, str], ...]:
     """Why a joint's mass reads 1 kg more: a URDF link it carries has no ``<inertial>``."""
+    why = {joint: NO_INERTIAL.format(links=", ".join(repr(n) for n in names))
+           for joint, names in bare_links(source, links).items()}
+    return tuple((joint, field, text) for joint, text in why.items()
+                 for field in ("mass", "com", "inertia"))
+
+
+def bare_links(source: ModelFile, links: list[Link]) -> dict[str, list[str]]:
+    """Each joint that carries URDF links without ``<inertial>``, and those links."""
     if source.format is not Format.URDF:
-        return ()
+        return {}
     bare = {link.get("name", "") for link in parsing.root(source.text).findall("link")
             if link.find("inertial") is None}
     by_key = {(link.body, link.index): link for link in links}
@@ -176,17 +184,14 @@ def defaulted(source: ModelFile, links: list[Link]) -> tuple[tuple[str, str, str
             owner = by_key.get((owner.body, owner.parent))
         if owner is not None:
             out.setdefault(owner.joint, []).append(link.name)
-    why = {joint: NO_INERTIAL.format(links=", ".join(repr(n) for n in names))
-           for joint, names in out.items()}
-    return tuple((joint, field, text) for joint, text in why.items()
-                 for field in ("mass", "com", "inertia"))
+    return out
 
 
 PROOFS = {
     "GRAVITY_HINT": Proof.SUSPECTED,
     "ARMATURE_HINT": Proof.MEASURED,
     "ACCURACY_HINT": Proof.PREDICTED,
-    "NO_INERTIAL": Proof.SUSPECTED,
+    "NO_INERTIAL": Proof.FIX,
     "ZEROED_INERTIA": Proof.SUSPECTED,
     "INERTIA_HINT": Proof.SUSPECTED,
     "DENSITY_HINT": Proof.SUSPECTED,

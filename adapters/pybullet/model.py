@@ -38,6 +38,7 @@ declared on the tree so that the check predicts the difference it makes.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 import pybullet as pb
@@ -56,6 +57,7 @@ from dyncheck.adapters.model_tree import (
     lump,
 )
 from dyncheck.adapters.pybullet.base import base_state, place_base, world_linear
+from dyncheck.adapters.pybullet.counterfactual import inertial_fixed
 from dyncheck.adapters.pybullet.couplings import GEARED, Gear, gears, multipliers
 from dyncheck.adapters.pybullet.files import (
     ACCURACY_HINT,
@@ -66,6 +68,7 @@ from dyncheck.adapters.pybullet.files import (
     GRAVITY_HINT,
     MAX_LINKS,
     Link,
+    bare_links,
     defaulted,
     load,
     mjcf_hints,
@@ -109,9 +112,11 @@ class PybulletModel(PybulletState, ModelEngine):
                     "its POSITION_CONTROL and VELOCITY_CONTROL motors are constraints, not a "
                     "force law: tutorial 12)")
 
-    def __init__(self, source: ModelFile, *, gravity: np.ndarray | None = None) -> None:
+    def __init__(self, source: ModelFile, *, gravity: np.ndarray | None = None,
+                 fixes: bool = True) -> None:
         """``gravity``: what the user sets with ``setGravity`` (a URDF states none; PyBullet's
-        MJCF reader ignores the file's); None: (0, 0, −9.81)."""
+        MJCF reader ignores the file's); None: (0, 0, −9.81). ``fixes``: read a copy with
+        each hint's fix applied (:attr:`ModelTree.fixed`)."""
         self.client = pb.connect(pb.DIRECT)
         self.gravity = GRAVITY.copy() if gravity is None else np.asarray(gravity, float)
         pb.setGravity(*self.gravity, physicsClientId=self.client)
@@ -130,9 +135,21 @@ class PybulletModel(PybulletState, ModelEngine):
         if source.format is Format.URDF:
             hints += (("model", "inertia accuracy", ACCURACY_HINT),)
         self.tree = self._tree(links, notes, hints)
+        if fixes:  # (#77: the fix of a bare link measured on a copy)
+            self.tree = replace(self.tree, fixed=inertial_fixed(
+                source, bare_links(source, links), lambda copy: self._copy_tree(copy)))
         self._balls = any(kind == pb.JOINT_SPHERICAL for joints in self._movable.values()
                           for _, kind in joints)
         self._gears: list[Gear] = []
+
+    def _copy_tree(self, copy: ModelFile) -> ModelTree:
+        """The tree of ``copy`` as PyBullet reads it under the same gravity, its client
+        closed after."""
+        model = PybulletModel(copy, gravity=self.gravity, fixes=False)
+        try:
+            return model.tree
+        finally:
+            pb.disconnect(physicsClientId=model.client)
 
     def _moving_base(self, body: int) -> bool:
         """Whether PyBullet gave ``body`` a moving base: its mass matrix has 6 more rows than

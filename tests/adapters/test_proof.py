@@ -24,8 +24,7 @@ SUSPECTED = {
     "newton.actuators": {"MOTORS", "GEAR", "BOUNDS"},
     "pinocchio.mjcf": {"SLIDE_RANGE", "MESH_UNIT", "VISUAL_MASSLESS", "REF_RANGE",
                        "UNLIMITED_RANGE"},
-    "pybullet.files": {"GRAVITY_HINT", "NO_INERTIAL", "ZEROED_INERTIA", "INERTIA_HINT",
-                       "DENSITY_HINT"},
+    "pybullet.files": {"GRAVITY_HINT", "ZEROED_INERTIA", "INERTIA_HINT", "DENSITY_HINT"},
 }
 """The work left: causes written on a page as "cause unknown; suspected"."""
 

@@ -209,3 +209,42 @@ def test_drakes_armature_causes_are_verified_by_their_fixes(tmp_path, monkeypatc
     if not plant:
         assert "with a <motor> on 'j', drake reads the armature of 'j' as mujoco" in notes["j"]
         assert "with the actuators on 'k' written as <motor>, drake reads" in notes["k"]
+
+
+BARE_LINK = """<robot name="bare">
+  <link name="base"><inertial><mass value="2"/>
+    <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <link name="arm"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/></inertial></link>
+  <link name="tool"/>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="arm"/>
+    <axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="10" velocity="1"/></joint>
+  <joint name="mount" type="fixed"><parent link="arm"/><child link="tool"/>
+    <origin xyz="0.4 0 0"/></joint>
+</robot>"""
+"""A frame link ('tool') without <inertial>: PyBullet gives it 1 kg and a unit inertia, MuJoCo
+none (measured, :data:`~dyncheck.adapters.pybullet.files.NO_INERTIAL`)."""
+
+
+@pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-no-op"])
+def test_pybullets_bare_link_cause_is_verified_by_its_fix(tmp_path, monkeypatch, plant):
+    """The copy with a massless <inertial> on 'tool', loaded by PyBullet, holds MuJoCo's
+    mass, centre of mass and inertia on 'shoulder' (MuJoCo's compiler the expected value:
+    1 kg at 0.2 m): "fix verified"; with the fix planted as the file unchanged, the cause is
+    unknown and the fix accounts for 0 %."""
+    pytest.importorskip("pybullet", reason="the pybullet extra is not installed")
+    from dyncheck.adapters.pybullet import counterfactual
+
+    if plant:
+        monkeypatch.setattr(counterfactual, "massless", lambda text, links: text)
+    path = tmp_path / "bare.urdf"
+    path.write_text(BARE_LINK)
+    rows = check_model(path, states=4, impls=("mujoco", "pybullet"), isolate=False).rows
+    rows = rows[(rows["section"] == "description") & (rows["subject"] == "shoulder")]
+    assert set(rows["field"]) == {"mass", "com", "inertia"}
+    for note in rows["note"]:
+        if plant:
+            assert note.startswith("cause unknown: the named fix (a massless <inertial> on "
+                                   "'tool') accounts for 0 %"), note
+        else:
+            assert "fix verified: with a massless <inertial> on 'tool', pybullet reads" in note
