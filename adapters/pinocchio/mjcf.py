@@ -18,7 +18,14 @@ import numpy as np
 from dyncheck.adapters.formats.edits import Edit, both
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
-from dyncheck.adapters.formats.mjcf_copy import Placed, children, geoms, joints
+from dyncheck.adapters.formats.mjcf_copy import (
+    JOINT_KEYS,
+    Placed,
+    children,
+    geoms,
+    joints,
+    placed,
+)
 from dyncheck.adapters.formats.mjcf_unread import springdampers
 from dyncheck.adapters.pinocchio.fixes import (
     CLASS_MASSES,
@@ -292,6 +299,37 @@ def _carriers(root: ET.Element) -> Iterable[tuple[list[ET.Element], tuple[str, .
     return out
 
 
+def predicted_ranges(source: ModelFile) -> dict[str, dict[str, tuple[float, float]]]:
+    """The range hints' predictions (each hint's text → joint → the range Pinocchio holds if
+    the cause is what the hint says), from the file: a slide's range × π/180 under degrees
+    (:data:`SLIDE_RANGE`), a hinge's range less its ref (:data:`REF_RANGE`), the range of a
+    joint that states ``limited="false"`` (:data:`UNLIMITED_RANGE`), angles in radians."""
+    if source.format is not Format.MJCF:
+        return {}
+    root = inline(source.path)
+    angle = [c.get("angle") for c in root.iter("compiler") if c.get("angle")]
+    degrees = (angle[-1] if angle else "degree") == "degree"
+    unit = np.pi / 180 if degrees else 1.0
+    out: dict[str, dict[str, tuple[float, float]]] = {}
+    for joint in placed(root, "joint", (*JOINT_KEYS, "type")):
+        name, stated = joint.element.get("name"), joint.attrs.get("range")
+        if not name or not stated:
+            continue
+        low, high = (float(x) for x in stated.split())
+        kind = joint.attrs.get("type", "hinge")
+        if kind == "slide" and degrees:
+            out.setdefault(SLIDE_RANGE, {})[name] = (low * unit, high * unit)
+        if kind != "hinge":
+            continue
+        ref = float(joint.attrs.get("ref", "0")) * unit
+        if joint.attrs.get("limited") == "false":
+            out.setdefault(UNLIMITED_RANGE, {})[name] = (low * unit, high * unit)
+        elif ref:
+            out.setdefault(REF_RANGE.format(ref=joint.attrs["ref"]), {})[name] = (
+                low * unit - ref, high * unit - ref)
+    return out
+
+
 def _joint_hints(root: ET.Element) -> Iterable[Found]:
     """A joint's position from a default class; its range where it has a ``ref`` or is not
     limited."""
@@ -315,15 +353,15 @@ def _joint_hints(root: ET.Element) -> Iterable[Found]:
 PROOFS = {
     "FIRST_BODY_ONLY": Proof.FIX,
     "BARE_BODY": Proof.FIX,
-    "SLIDE_RANGE": Proof.SUSPECTED,
+    "SLIDE_RANGE": Proof.PREDICTED,
     "ROOT_PLACEMENT": Proof.FIX,
     "GRAVITY_IGNORED": Proof.FIX,
     "MESH_UNIT": Proof.SUSPECTED,
     "VISUAL_MASSLESS": Proof.SUSPECTED,
     "DEFAULT_MASS": Proof.FIX,
     "DEFAULT_POS": Proof.FIX,
-    "REF_RANGE": Proof.SUSPECTED,
-    "UNLIMITED_RANGE": Proof.SUSPECTED,
+    "REF_RANGE": Proof.PREDICTED,
+    "UNLIMITED_RANGE": Proof.PREDICTED,
     "LATER_DEFAULTS": Proof.FIX,
 }
 """How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

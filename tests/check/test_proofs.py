@@ -6,6 +6,8 @@ cause unknown."""
 
 from __future__ import annotations
 
+import ast
+
 import numpy as np
 import pytest
 
@@ -248,3 +250,49 @@ def test_pybullets_bare_link_cause_is_verified_by_its_fix(tmp_path, monkeypatch,
                                    "'tool') accounts for 0 %"), note
         else:
             assert "fix verified: with a massless <inertial> on 'tool', pybullet reads" in note
+
+
+RANGES = """<mujoco model="ranges">
+  <worldbody>
+    <body name="cart" pos="0 0 1">
+      <joint name="slider" type="slide" axis="1 0 0" range="-1.8 1.8" limited="true"/>
+      <geom type="box" size="0.1 0.1 0.1"/>
+      <body name="pole">
+        <joint name="hinge" type="hinge" axis="0 1 0" range="-110 110" ref="-90" limited="true"/>
+        <geom type="capsule" fromto="0 0 0 0 0 0.5" size="0.02"/>
+        <body name="tip" pos="0 0 0.5">
+          <joint name="free_hinge" type="hinge" axis="0 1 0" range="-30 30" limited="false"/>
+          <geom type="sphere" size="0.05"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""
+"""Three ranges Pinocchio's MJCF parser reads otherwise (measured, :mod:`.mjcf`): a slide's
+range converted as an angle, a hinge's range less its ref, a range with limited="false"."""
+
+
+@pytest.mark.parametrize("plant", [False, True], ids=["predicted", "planted-wrong"])
+def test_pinocchios_range_causes_are_proved_by_their_predictions(tmp_path, monkeypatch,
+                                                                   plant):
+    """Each range row names its cause only where Pinocchio's reading meets the cause's
+    prediction from the file (worked by hand: (-1.8, 1.8) × π/180 = ±0.0314; (-110°, 110°)
+    less ref −90° = (−20°, 200°); ±30° read though unlimited). With the predictions planted
+    wrong (each bound doubled), every cause is only suspected."""
+    path = tmp_path / "ranges.xml"
+    path.write_text(RANGES)
+    if plant:
+        real = pinocchio_mjcf.predicted_ranges
+
+        def doubled(source):
+            return {why: {j: (2 * lo, 2 * hi) for j, (lo, hi) in ranges.items()}
+                    for why, ranges in real(source).items()}
+        from dyncheck.adapters.pinocchio import model as pinocchio_model
+        monkeypatch.setattr(pinocchio_model, "predicted_ranges", doubled)
+    rows = _described(path)
+    hand = {"slider": (-0.0314159, 0.0314159), "hinge": (np.radians(-20), np.radians(200)),
+            "free_hinge": (np.radians(-30), np.radians(30))}
+    for joint, expected in hand.items():
+        row = rows[(joint, "range")]
+        assert np.allclose(ast.literal_eval(row.value_b), expected, rtol=1e-5), (joint, row.value_b)
+        assert ("suspected" in row.note) is plant, (joint, row.note)
