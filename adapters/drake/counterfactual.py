@@ -8,12 +8,10 @@ from __future__ import annotations
 import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Sequence
-from dataclasses import replace
 from pathlib import Path
 
-from dyncheck.adapters.formats.edits import Edit, applied
+from dyncheck.adapters.formats.edits import Edit, copied
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.model_tree import FixedReading, ModelTree
 from dyncheck.errors import EngineError, Unsupported
 
@@ -53,22 +51,19 @@ def as_motors(joints: Sequence[str]) -> Edit:
                 + " written as <motor>", edit)
 
 
-def armature_fixed(source: ModelFile, *, unactuated: Sequence[str], unread: Sequence[str],
-                   read: Read) -> tuple[FixedReading, ...]:
-    """Drake's reading of the MJCF ``source`` with each armature hint's fix applied: one copy
-    for the joints no actuator drives, one for those driven only by actuators Drake did not
-    read."""
+def armature_fixed(source: ModelFile, root: ET.Element, *, unactuated: Sequence[str],
+                   unread: Sequence[str], read: Read) -> tuple[FixedReading, ...]:
+    """Drake's reading of the MJCF ``source`` (``root``: its includes inlined) with each
+    armature hint's fix applied: one copy for the joints no actuator drives, one for those
+    driven only by actuators Drake did not read."""
     out: list[FixedReading] = []
     for joints, edit in ((unactuated, motors(unactuated)), (unread, as_motors(unread))):
         if not joints:
             continue
         tree, refused = None, ""
         with tempfile.TemporaryDirectory(prefix="dyncheck-drake-fix-") as folder:
-            text = applied(inline(source.path), source.path.resolve().parent, (edit,))
-            path = Path(folder) / "fixed.xml"
-            path.write_text(text, encoding="utf-8")
             try:
-                tree = read(replace(source, path=path, text=text, notes=()))
+                tree = read(copied(source, root, (edit,), Path(folder)))
             except (EngineError, Unsupported) as exc:
                 refused = str(exc)
         out += [FixedReading(subject=j, fields=("armature",), fix=edit.words, tree=tree,

@@ -344,7 +344,7 @@ class DrakeModel(ModelEngine):
             bare = [j for j in tree.joints if j.name not in reflected and j.name in armed
                     and j.type not in (JointType.BALL, JointType.FREE)]
             fixed += armature_fixed(
-                self._source, unactuated=[j.name for j in bare if not driven.get(j.name)],
+                self._source, root, unactuated=[j.name for j in bare if not driven.get(j.name)],
                 unread=[j.name for j in bare if driven.get(j.name)],
                 read=lambda copy: DrakeModel(copy, fixes=False).tree)
         return replace(tree, fixed=fixed)

@@ -7,9 +7,11 @@ from __future__ import annotations
 import copy
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import NamedTuple
 
+from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.mjcf_copy import standalone
 
 
@@ -35,3 +37,13 @@ def applied(root: ET.Element, folder: Path, edits: Sequence[Edit]) -> str:
     for edit in edits:
         edit.apply(fixed)
     return standalone(fixed, folder)
+
+
+def copied(source: ModelFile, root: ET.Element, edits: Sequence[Edit], folder: Path) -> ModelFile:
+    """The MJCF ``source`` as a copy of ``root`` (its document as the engine should read it)
+    with ``edits`` :func:`applied`, written in ``folder``: what an engine reads to measure a
+    fix."""
+    text = applied(root, source.path.resolve().parent, edits)
+    path = folder / "fixed.xml"
+    path.write_text(text, encoding="utf-8")
+    return replace(source, path=path, text=text, notes=())

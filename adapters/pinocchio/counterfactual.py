@@ -5,25 +5,25 @@ cause written only where the copy with its fix loads."""
 from __future__ import annotations
 
 import tempfile
-from collections.abc import Callable
-from dataclasses import replace
+import xml.etree.ElementTree as ET
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
 from dyncheck.adapters.formats import parsing
-from dyncheck.adapters.formats.edits import Edit, applied
+from dyncheck.adapters.formats.edits import copied
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.model_tree import FixedReading, ModelTree
-from dyncheck.adapters.pinocchio.fixes import ONE_DEFAULTS
+from dyncheck.adapters.pinocchio import mjcf
+from dyncheck.adapters.pinocchio.fixes import ONE_DEFAULTS, Fix
 from dyncheck.adapters.pinocchio.mjcf import (
     BARE_BODY,
     CLASS_LOOKUP_FAILED,
     GRAVITY_FIX,
     bare_bodies,
-    fixes,
     later_defaults,
     stated_gravity,
 )
@@ -35,40 +35,40 @@ Read = Callable[[ModelFile, "np.ndarray | None"], ModelTree]
 INLINED = " (the copy's <include>s inlined)"
 
 
-def _copy(source: ModelFile, root_edits: tuple[Edit, ...], folder: Path, *,
-          own_text: bool = False) -> ModelFile:
-    """The copy of ``source`` with ``root_edits`` applied, written in ``folder``: inlined
-    (or, ``own_text``, the file's own text as Pinocchio reads it, no include followed)."""
-    root = parsing.root(source.text) if own_text else inline(source.path)
-    text = applied(root, source.path.resolve().parent, root_edits)
-    path = folder / "fixed.xml"
-    path.write_text(text, encoding="utf-8")
-    return replace(source, path=path, text=text, notes=())
-
-
-def fixed_readings(source: ModelFile, held: frozenset[str],
+def fixed_readings(source: ModelFile, root: ET.Element, fixes: Sequence[Fix],
                    read: Read) -> tuple[FixedReading, ...]:
-    """Pinocchio's reading of the copy with each hint's fix applied (one copy per fix), and
-    of the file with the gravity it states set after loading (the fix its gravity hint
-    names)."""
+    """Pinocchio's reading of the copy of ``root`` (the file, its includes inlined) with each
+    of ``fixes`` applied (one copy per fix), and of the file with the gravity it states set
+    after loading (the fix its gravity hint names)."""
     out = []
     includes = "<include" in source.text
     with tempfile.TemporaryDirectory(prefix="dyncheck-pinocchio-fix-") as folder:
-        for fix in fixes(source, held):
+        for fix in fixes:
             words = fix.edit.words + (INLINED if includes else "")
             try:
-                tree = read(_copy(source, (fix.edit,), Path(folder)), None)
+                tree = read(copied(source, root, (fix.edit,), Path(folder)), None)
             except (EngineError, Unsupported) as exc:
                 out.append(FixedReading(subject=fix.subject, fields=fix.fields, fix=words,
                                         tree=None, refused=str(exc)))
                 continue
             out.append(FixedReading(subject=fix.subject, fields=fix.fields, fix=words,
                                     tree=tree))
-    gravity = stated_gravity(inline(source.path)) if "gravity" in source.text else None
+    gravity = stated_gravity(root)
     if gravity is not None:
         out.append(FixedReading(subject="model", fields=("gravity",), fix=GRAVITY_FIX,
                                 tree=read(source, gravity)))
     return tuple(out)
+
+
+def predictions_met(tree: ModelTree, root: ET.Element) -> frozenset[str]:
+    """The range hints whose prediction (:func:`.mjcf.predicted_ranges`; ``root``: the MJCF,
+    its includes inlined) Pinocchio's reading meets on every joint it names (to 1e-9 of the
+    range): their cause measured."""
+    held = {j.name: j.range for j in tree.joints}
+    return frozenset(why for why, ranges in mjcf.predicted_ranges(root).items()
+                     if all(held.get(j) is not None
+                            and np.allclose(held[j], r, rtol=1e-9, atol=1e-12)  # type: ignore[arg-type]
+                            for j, r in ranges.items()))
 
 
 def refusal(source: ModelFile, message: str) -> str:
@@ -81,7 +81,7 @@ def refusal(source: ModelFile, message: str) -> str:
     # Pinocchio reads it (its own text, no <include> followed), and its fix loads
     if CLASS_LOOKUP_FAILED in message and (why := later_defaults(parsing.root(source.text))):
         with tempfile.TemporaryDirectory(prefix="dyncheck-pinocchio-fix-") as folder:
-            fixed = _copy(source, (ONE_DEFAULTS,), Path(folder), own_text=True)
+            fixed = copied(source, parsing.root(source.text), (ONE_DEFAULTS,), Path(folder))
             try:
                 pin.buildModelFromMJCF(str(fixed.path))
             except Exception:  # the fix does not load: the cause is not proved, not written

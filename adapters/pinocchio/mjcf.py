@@ -10,14 +10,13 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import NamedTuple
 
 import numpy as np
 
 from dyncheck.adapters.formats.edits import Edit, both
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import (
     JOINT_KEYS,
     Placed,
@@ -155,30 +154,32 @@ def bare_bodies(root: ET.Element) -> int:
     return sum(1 for body in root.iter("body") if not body.attrib)
 
 
-def hints(source: ModelFile, held: frozenset[str] = frozenset()) -> tuple[Hint, ...]:
-    """Why Pinocchio's reading of an MJCF differs, where the file shows the cause: joints
-    missing (``held``: the bodies Pinocchio's model holds, measured — which top-level body it
-    kept is read from it, not assumed); slide ranges, gravity; each body's mass, centre of
-    mass and inertia on the joints that carry it; joint positions and damping."""
-    return tuple((f.subject, f.field, f.why) for f in found(source, held))
+def hints(found: Sequence[Found]) -> tuple[Hint, ...]:
+    """Why Pinocchio's reading of an MJCF differs, where the file shows the cause
+    (``found``: :func:`found`)."""
+    return tuple((f.subject, f.field, f.why) for f in found)
 
 
-def fixes(source: ModelFile, held: frozenset[str] = frozenset()) -> tuple[Fix, ...]:
-    """The fix of each of :func:`hints` that an edit of the file applies, one per hint (its
-    fields gathered)."""
+def fixes(found: Sequence[Found]) -> tuple[Fix, ...]:
+    """The fix of each of the hints ``found`` (:func:`found`) that an edit of the file
+    applies, one per hint (its fields gathered)."""
     out: dict[tuple[str, str], tuple[list[str], Edit]] = {}
-    for f in found(source, held):
+    for f in found:
         if f.edit is not None:
             out.setdefault((f.subject, f.why), ([], f.edit))[0].append(f.field)
     return tuple(Fix(subject=subject, fields=tuple(fields), edit=edit)
                  for (subject, _), (fields, edit) in out.items())
 
 
-def found(source: ModelFile, held: frozenset[str] = frozenset()) -> tuple[Found, ...]:
-    """:func:`hints` with the edit each one's fix names."""
-    if source.format is not Format.MJCF:
+def found(source: ModelFile, root: ET.Element | None,
+          held: frozenset[str] = frozenset()) -> tuple[Found, ...]:
+    """Each hint of the MJCF ``source`` (``root``: its includes inlined; None for a URDF)
+    with the edit its fix names: joints missing (``held``: the bodies Pinocchio's model
+    holds, measured — which top-level body it kept is read from it, not assumed); slide
+    ranges, gravity; each body's mass, centre of mass and inertia on the joints that carry
+    it; joint positions and damping."""
+    if source.format is not Format.MJCF or root is None:
         return ()
-    root = inline(source.path)
     includes = re.search(r"<include\b", source.text) is not None  # (the file's own text)
     return (*_model_hints(root, bare_bodies(root), held, includes), *_body_hints(root),
             *_joint_hints(root), *(Found(*h) for h in springdampers(root, "Pinocchio")))
@@ -299,14 +300,12 @@ def _carriers(root: ET.Element) -> Iterable[tuple[list[ET.Element], tuple[str, .
     return out
 
 
-def predicted_ranges(source: ModelFile) -> dict[str, dict[str, tuple[float, float]]]:
+def predicted_ranges(root: ET.Element) -> dict[str, dict[str, tuple[float, float]]]:
     """The range hints' predictions (each hint's text → joint → the range Pinocchio holds if
     the cause is what the hint says), from the file: a slide's range × π/180 under degrees
     (:data:`SLIDE_RANGE`), a hinge's range less its ref (:data:`REF_RANGE`), the range of a
-    joint that states ``limited="false"`` (:data:`UNLIMITED_RANGE`), angles in radians."""
-    if source.format is not Format.MJCF:
-        return {}
-    root = inline(source.path)
+    joint that states ``limited="false"`` (:data:`UNLIMITED_RANGE`), angles in radians
+    (``root``: the MJCF, its includes inlined)."""
     angle = [c.get("angle") for c in root.iter("compiler") if c.get("angle")]
     degrees = (angle[-1] if angle else "degree") == "degree"
     unit = np.pi / 180 if degrees else 1.0

@@ -32,6 +32,7 @@ import pinocchio as pin
 from dyncheck.adapters.base import Field, ModelEngine, Offer
 from dyncheck.adapters.closures import ClosedReading
 from dyncheck.adapters.formats.files import ModelFile
+from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -46,8 +47,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
-from dyncheck.adapters.pinocchio import closures, counterfactual, mimic
-from dyncheck.adapters.pinocchio.mjcf import hints, predicted_ranges
+from dyncheck.adapters.pinocchio import closures, counterfactual, mimic, mjcf
 from dyncheck.adapters.pinocchio.simulation import Stepping
 from dyncheck.adapters.registration import Format
 from dyncheck.cases.multibody import Coupling
@@ -107,16 +107,6 @@ def _load(source: ModelFile) -> pin.Model:
         if source.format is Format.MJCF:
             message = counterfactual.refusal(source, message)
         raise EngineError(f"pinocchio refused {source.path}: {message}") from None
-
-
-def _predictions_met(tree: ModelTree, source: ModelFile) -> frozenset[str]:
-    """The range hints whose prediction (:func:`.mjcf.predicted_ranges`) Pinocchio's reading
-    meets on every joint it names (to 1e-9 of the range): their cause measured."""
-    held = {j.name: j.range for j in tree.joints}
-    return frozenset(why for why, ranges in predicted_ranges(source).items()
-                     if all(held.get(j) is not None
-                            and np.allclose(held[j], r, rtol=1e-9, atol=1e-12)  # type: ignore[arg-type]
-                            for j, r in ranges.items()))
 
 
 def _rotor_in_kinetic(m: pin.Model, q0: np.ndarray) -> dict[int, bool]:
@@ -232,16 +222,18 @@ class PinocchioModel(ModelEngine):
         self._rows: np.ndarray | None = None
         notes: tuple[str, ...] = ()
         held = frozenset(f.name for f in self.model.frames if f.type == pin.FrameType.BODY)
-        self._hints = hints(source, held)
+        root = inline(source.path) if source.format is Format.MJCF else None
+        found = mjcf.found(source, root, held)
+        self._hints = mjcf.hints(found)
         if source.floating and source.format is Format.URDF:
             notes = ("pinocchio: JointModelFreeFlyer 'root_joint' at the URDF root",)
         notes += unread
         self.tree = self._tree(notes)
-        self.tree = replace(self.tree, measured=_predictions_met(self.tree, source))
-        if fixes and self._hints:  # each hint's fix measured on a copy (#77)
-            self.tree = replace(self.tree, fixed=counterfactual.fixed_readings(
-                source, held, lambda copy, g: PinocchioModel(
-                    copy, gravity=g, inertias=inertias, fixes=False).tree))
+        if root is not None:  # each hint measured: its prediction, its fix on a copy (#77)
+            self.tree = replace(self.tree, measured=counterfactual.predictions_met(
+                self.tree, root), fixed=counterfactual.fixed_readings(
+                source, root, mjcf.fixes(found), lambda copy, g: PinocchioModel(
+                    copy, gravity=g, inertias=inertias, fixes=False).tree) if fixes else ())
         self.stepping = self._stepper()  # its v̇ in MuJoCo's layout, and its runs there
 
     def _mimic_joints(self, source: ModelFile) -> tuple[mimic.Mimics | None, tuple[str, ...]]:

@@ -5,6 +5,7 @@ the hints a page gives where its reading is known to differ (:mod:`.model`)."""
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -160,10 +161,11 @@ def zeroed(source: ModelFile, links: list[Link]) -> tuple[tuple[str, str, str], 
                  for name in sorted(bad) if name in joints)
 
 
-def defaulted(source: ModelFile, links: list[Link]) -> tuple[tuple[str, str, str], ...]:
-    """Why a joint's mass reads 1 kg more: a URDF link it carries has no ``<inertial>``."""
+def defaulted(bare: Mapping[str, list[str]]) -> tuple[tuple[str, str, str], ...]:
+    """Why a joint's mass reads 1 kg more: a URDF link it carries has no ``<inertial>``
+    (``bare``: :func:`bare_links`)."""
     why = {joint: NO_INERTIAL.format(links=", ".join(repr(n) for n in names))
-           for joint, names in bare_links(source, links).items()}
+           for joint, names in bare.items()}
     return tuple((joint, field, text) for joint, text in why.items()
                  for field in ("mass", "com", "inertia"))
 

@@ -131,13 +131,13 @@ class PybulletModel(PybulletState, ModelEngine):
         hints: tuple[tuple[str, str, str], ...] = (("model", "armature", ARMATURE_HINT),)
         if source.format is Format.MJCF:
             hints += (("model", "gravity", GRAVITY_HINT), *mjcf_hints(source))
-        hints += zeroed(source, links) + defaulted(source, links)
+        bare = bare_links(source, links)
+        hints += zeroed(source, links) + defaulted(bare)
         if source.format is Format.URDF:
             hints += (("model", "inertia accuracy", ACCURACY_HINT),)
         self.tree = self._tree(links, notes, hints)
         if fixes:  # (#77: the fix of a bare link measured on a copy)
-            self.tree = replace(self.tree, fixed=inertial_fixed(
-                source, bare_links(source, links), lambda copy: self._copy_tree(copy)))
+            self.tree = replace(self.tree, fixed=inertial_fixed(source, bare, self._copy_tree))
         self._balls = any(kind == pb.JOINT_SPHERICAL for joints in self._movable.values()
                           for _, kind in joints)
         self._gears: list[Gear] = []

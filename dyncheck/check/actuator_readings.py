@@ -9,7 +9,7 @@ import numpy as np
 
 from dyncheck.adapters.actuators import Activation, Actuator
 from dyncheck.adapters.model_tree import ModelTree
-from dyncheck.check.proofs import Remeasured, is_proved, proved, unmeasured
+from dyncheck.check.proofs import Remeasured, proved, unmeasured
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.labels import NO_ACTUATORS_READ
 from dyncheck.vocabulary import Verdict
@@ -126,7 +126,7 @@ def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[Che
     a, b = canonical.engine, other.engine
     why = unmeasured(canonical, "model", "actuator")
     if not canonical.actuators and other.actuators:  # once, not once per actuator
-        known = why is not None and is_proved(why)
+        known = canonical.hint("model", "actuator") in canonical.measured
         return [section_row(model, subject="model", field="actuators", a=a, b=b, value_a="none",
                      value_b=f"{len(other.actuators)} ({other.actuators[0].what}, …)",
                      verdict=Verdict.EXPLAINED if known else Verdict.FAILED,

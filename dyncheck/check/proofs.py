@@ -63,8 +63,3 @@ def unmeasured(tree: ModelTree, subject: str, field: str) -> str | None:
     if why is None or why in tree.measured:
         return why
     return UNVERIFIED.format(why=why)
-
-
-def is_proved(note: str) -> bool:
-    """Whether a note written by :func:`proved` or :func:`unmeasured` states a cause."""
-    return not note.startswith("cause unknown")

@@ -284,11 +284,10 @@ def test_pinocchios_range_causes_are_proved_by_their_predictions(tmp_path, monke
     if plant:
         real = pinocchio_mjcf.predicted_ranges
 
-        def doubled(source):
+        def doubled(root):
             return {why: {j: (2 * lo, 2 * hi) for j, (lo, hi) in ranges.items()}
-                    for why, ranges in real(source).items()}
-        from dyncheck.adapters.pinocchio import model as pinocchio_model
-        monkeypatch.setattr(pinocchio_model, "predicted_ranges", doubled)
+                    for why, ranges in real(root).items()}
+        monkeypatch.setattr(pinocchio_mjcf, "predicted_ranges", doubled)
     rows = _described(path)
     hand = {"slider": (-0.0314159, 0.0314159), "hinge": (np.radians(-20), np.radians(200)),
             "free_hinge": (np.radians(-30), np.radians(30))}
