@@ -209,6 +209,30 @@ class FixedReading:
 
 
 @dataclass(frozen=True, kw_only=True)
+class Inertial:
+    """A body's mass properties as an MJCF ``<inertial>`` states them, in the body's frame:
+    its centre of mass ``pos``, principal axes ``quat`` (w x y z), ``mass`` and principal
+    moments ``diaginertia``."""
+
+    pos: tuple[float, ...]
+    quat: tuple[float, ...]
+    mass: float
+    diaginertia: tuple[float, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class WantsInertials:
+    """A hint whose fix is "give the body an ``<inertial>``": the (``subject``, ``fields``)
+    it explains and the ``bodies`` (by name) the fix gives one, stating what the canonical
+    engine compiled for them (:attr:`ModelTree.inertials`). The comparison layer applies it
+    to a copy and has the engine read that copy (:attr:`ModelTree.fixed`)."""
+
+    subject: str
+    fields: tuple[str, ...]
+    bodies: tuple[str, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
 class ModelTree:
     """What one engine holds after reading a file."""
 
@@ -259,6 +283,12 @@ class ModelTree:
     fixed: tuple[FixedReading, ...] = ()
     """Its readings of copies of the model, each with one hint's fix applied (the fix
     measured, :class:`FixedReading`); a hint without one is not verified."""
+    inertials: Mapping[str, Inertial] = field(default_factory=dict)
+    """Body name → its mass properties as the engine compiled them from the file (MuJoCo, on
+    an MJCF): what a copy states so that another engine reads the same, the fix of
+    :attr:`wants_inertials`; empty where the engine offers none."""
+    wants_inertials: tuple[WantsInertials, ...] = ()
+    """Its hints whose fix states a body's inertial (:class:`WantsInertials`)."""
 
     def fixed_reading(self, joint: str, name: str) -> FixedReading | None:
         """The fixed copy's reading for the hint :meth:`hint` gives (``joint``'s own, else

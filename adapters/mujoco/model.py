@@ -41,7 +41,7 @@ from dyncheck.adapters.model_tree import (
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
-from dyncheck.adapters.mujoco import actuators, closures
+from dyncheck.adapters.mujoco import actuators, closures, inertials
 from dyncheck.adapters.mujoco.actuators import MujocoActuation
 from dyncheck.adapters.mujoco.api import (
     GYROSCOPIC_IMPLICIT,
@@ -245,6 +245,8 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
             m.tendon_armature[:] = 0.0
             self._closed.tendon_armature[:] = 0.0
         self.tree = self._tree(notes)
+        if source.format is Format.MJCF:  # what a copy states for another engine (#77)
+            self.tree = replace(self.tree, inertials=inertials.compiled(m))
         if not exact_meshes and self._inertias.meshes_weigh(m, self._inertias.inexact_meshes):
             self.tree = replace(self.tree, exact_meshes=self._exact_meshes(source))
 

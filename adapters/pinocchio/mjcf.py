@@ -26,6 +26,7 @@ from dyncheck.adapters.formats.mjcf_copy import (
     placed,
 )
 from dyncheck.adapters.formats.mjcf_unread import springdampers
+from dyncheck.adapters.model_tree import WantsInertials
 from dyncheck.adapters.pinocchio.fixes import (
     CLASS_MASSES,
     NAME_BODIES,
@@ -47,6 +48,9 @@ class Found(NamedTuple):
     field: str
     why: str
     edit: Edit | None = None
+    bodies: tuple[str, ...] = ()
+    """The bodies its fix gives an ``<inertial>`` stating what MuJoCo compiles (none: its
+    fix is ``edit``, or no edit of the file)."""
 
 INCLUDES_SKIPPED = (
     "; the file has <include> elements, which Pinocchio skips: the body it keeps is the first "
@@ -171,6 +175,17 @@ def fixes(found: Sequence[Found]) -> tuple[Fix, ...]:
                  for (subject, _), (fields, edit) in out.items())
 
 
+def wants_inertials(found: Sequence[Found]) -> tuple[WantsInertials, ...]:
+    """The hints ``found`` (:func:`found`) whose fix gives bodies an ``<inertial>`` (the
+    comparison layer states the canonical engine's), one per hint (its fields gathered)."""
+    out: dict[tuple[str, str], tuple[list[str], tuple[str, ...]]] = {}
+    for f in found:
+        if f.bodies:
+            out.setdefault((f.subject, f.why), ([], f.bodies))[0].append(f.field)
+    return tuple(WantsInertials(subject=subject, fields=tuple(fields), bodies=bodies)
+                 for (subject, _), (fields, bodies) in out.items())
+
+
 def found(source: ModelFile, root: ET.Element | None,
           held: frozenset[str] = frozenset()) -> tuple[Found, ...]:
     """Each hint of the MJCF ``source`` (``root``: its includes inlined; None for a URDF)
@@ -264,11 +279,13 @@ def _body_hints(root: ET.Element) -> Iterable[Found]:
             if where:
                 why.append(reason.format(where="body " + ", ".join(where)))
                 reasons.append(reason)
-        if why:  # (a mesh's or a visual geom's inertia: no edit of the file states it)
+        if why:  # (a mesh's or a visual geom's inertia: the canonical engine's, stated)
             edit = CLASS_MASSES if reasons == [DEFAULT_MASS] else None
+            weighed = [b.get("name") for b in group if counts.get(id(b))]
+            bodies = tuple(n for n in weighed if n) if edit is None and all(weighed) else ()
             for name in names or ("model",):
                 for field in ("mass", "com", "inertia"):
-                    yield Found(name, field, "; ".join(why), edit)
+                    yield Found(name, field, "; ".join(why), edit, bodies)
 
 
 def _carriers(root: ET.Element) -> Iterable[tuple[list[ET.Element], tuple[str, ...]]]:
@@ -355,8 +372,8 @@ PROOFS = {
     "SLIDE_RANGE": Proof.PREDICTED,
     "ROOT_PLACEMENT": Proof.FIX,
     "GRAVITY_IGNORED": Proof.FIX,
-    "MESH_UNIT": Proof.SUSPECTED,
-    "VISUAL_MASSLESS": Proof.SUSPECTED,
+    "MESH_UNIT": Proof.FIX,
+    "VISUAL_MASSLESS": Proof.FIX,
     "DEFAULT_MASS": Proof.FIX,
     "DEFAULT_POS": Proof.FIX,
     "REF_RANGE": Proof.PREDICTED,

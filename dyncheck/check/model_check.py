@@ -34,6 +34,7 @@ from dyncheck.check import (
     partial_pairs,
     predicted,
     readings,
+    stated_inertials,
     validity,
 )
 from dyncheck.check import engines as engine_processes
@@ -147,16 +148,27 @@ def check_model(
             return _check(model, source_path, source, engines=engines, chosen=chosen,
                           states=states, seed=seed, floating=floating,
                           other=other, load_seconds=time.perf_counter() - t0,
-                          derivatives=derivatives, actuators=actuators, say=say, given=given)
+                          derivatives=derivatives, actuators=actuators, say=say, given=given,
+                          load=_copies(isolate=isolate, limits=limits))
     finally:
         engine_processes.stop(engines)
+
+
+def _copies(*, isolate: bool, limits: engine_processes.Limits | None) -> stated_inertials.Load:
+    """How an engine reads a copy of the model (a fix applied): as it read the file, in a
+    process of its own where the check isolates engines, stopped once it has read it."""
+    def load(engine: str, copy: ModelFile) -> ModelEngine | NotLoaded:
+        started = engine_processes.start([engine], copy, isolate=isolate, limits=limits)
+        engine_processes.stop(started)
+        return started[engine]
+    return load
 
 
 def _check(model: str, source_path: Path, source: ModelFile, *,
            engines: dict[str, ModelEngine | NotLoaded], chosen: tuple[str, ...],
            states: int, seed: int, floating: bool, other: Other | None,
-           load_seconds: float, derivatives: bool = False, actuators: bool = True,
-           say: Callable[[str], None] | None = None,
+           load_seconds: float, load: stated_inertials.Load, derivatives: bool = False,
+           actuators: bool = True, say: Callable[[str], None] | None = None,
            given: GivenStates | None = None) -> CheckResult:
     """The check's steps in order: what loaded, what each engine read and whether it is
     physically possible, the dynamics at the same states, every pair compared, and the
@@ -166,6 +178,7 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     seconds: dict[str, float] = {"load": load_seconds}
     loaded = _loaded(model, source_path, source, engines, rows, notes)
     first = next(iter(loaded.values()))
+    stated_inertials.measured(source, first.tree, loaded, load=load)
     canonical_tree = canonical_of(first.tree)
     if canonical_tree.nv == 0:
         raise inputs.ModelFileError(source_path, "has no degrees of freedom (nothing moves)")

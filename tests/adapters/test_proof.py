@@ -22,7 +22,6 @@ SUSPECTED = {
     "formats.mjcf_unread": {"SPRINGDAMPER"},
     "mujoco.model": {"TOTAL_MASS"},
     "newton.actuators": {"MOTORS", "GEAR", "BOUNDS"},
-    "pinocchio.mjcf": {"MESH_UNIT", "VISUAL_MASSLESS"},
     "pybullet.files": {"GRAVITY_HINT", "ZEROED_INERTIA", "INERTIA_HINT", "DENSITY_HINT"},
 }
 """The work left: causes written on a page as "cause unknown; suspected"."""
