@@ -230,6 +230,10 @@ class WantsInertials:
     subject: str
     fields: tuple[str, ...]
     bodies: tuple[str, ...]
+    every: bool = False
+    """Every body stated, and the compiler's ``settotalmass`` dropped (the masses stated
+    are already the scaled ones). On the canonical engine's tree: its hint's fix, read by
+    each other engine (an attribute only it applies)."""
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -36,6 +36,7 @@ from dyncheck.adapters.model_tree import (
     Orientation,
     Transition,
     TreeJoint,
+    WantsInertials,
     lump,
 )
 from dyncheck.adapters.model_tree import (
@@ -230,7 +231,8 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
             self._hints = ()
         unread = actuators.file_hints(source)  # (shown only where MuJoCo holds none: measured)
         self._measured = frozenset(w for _, _, w in (*self._hints, *unread))
-        self._hints += _total_mass_hints(source) + unread
+        scaled = _total_mass_hints(source)
+        self._hints += scaled + unread
         m.opt.disableflags |= int(_SMOOTH_ONLY)
         m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
         self._closed.opt.disableflags = m.opt.disableflags  # (the same smooth dynamics)
@@ -246,7 +248,11 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
             self._closed.tendon_armature[:] = 0.0
         self.tree = self._tree(notes)
         if source.format is Format.MJCF:  # what a copy states for another engine (#77)
-            self.tree = replace(self.tree, inertials=inertials.compiled(m))
+            stated = inertials.compiled(m)
+            every = bool(scaled) and len(stated) == m.nbody - 1  # (every body named)
+            self.tree = replace(self.tree, inertials=stated, wants_inertials=(WantsInertials(
+                subject="model", fields=("mass", "inertia", "com"), bodies=tuple(stated),
+                every=True),) if every else ())
         if not exact_meshes and self._inertias.meshes_weigh(m, self._inertias.inexact_meshes):
             self.tree = replace(self.tree, exact_meshes=self._exact_meshes(source))
 
@@ -488,6 +494,6 @@ def _joint_name(m: mujoco.MjModel, j: int) -> str:
 
 PROOFS = {
     "GRAVITY_OFF": Proof.MEASURED,
-    "TOTAL_MASS": Proof.SUSPECTED,
+    "TOTAL_MASS": Proof.FIX,
 }
 """How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

@@ -18,7 +18,7 @@ from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.formats.edits import Edit, copied
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
-from dyncheck.adapters.model_tree import FixedReading, Inertial, ModelTree
+from dyncheck.adapters.model_tree import FixedReading, Inertial, ModelTree, WantsInertials
 from dyncheck.adapters.registration import Format
 from dyncheck.check.alignment import align_by_body
 from dyncheck.check.engines import NotLoaded
@@ -28,14 +28,16 @@ Load = Callable[[str, ModelFile], "ModelEngine | NotLoaded"]
 isolates engines."""
 
 WORDS = "an <inertial> on {bodies} stating the mass, centre of mass and inertia {engine} compiles"
+DROPPED = ", settotalmass dropped"
 SHOWN = 4
 """How many bodies the fix's words name (then "… (n bodies)")."""
 
 
-def edit(inertials: Mapping[str, Inertial], *, engine: str) -> Edit:
+def edit(inertials: Mapping[str, Inertial], *, engine: str, every: bool = False) -> Edit:
     """Give each body named in ``inertials`` that ``<inertial>`` (in place of its own), and
     make a compiler's ``inertiafromgeom="true"`` (which ignores every ``<inertial>``, in
-    MuJoCo and Pinocchio alike) ``"auto"``: the model MuJoCo compiles stays the same."""
+    MuJoCo and Pinocchio alike) ``"auto"``; with ``every`` (every body stated, the scaled
+    masses), drop the compiler's ``settotalmass``: the model MuJoCo compiles stays the same."""
     names = sorted(inertials)
     shown = ", ".join(repr(n) for n in names[:SHOWN]) + (
         f" … ({len(names)} bodies)" if len(names) > SHOWN else "")
@@ -44,6 +46,8 @@ def edit(inertials: Mapping[str, Inertial], *, engine: str) -> Edit:
         for compiler in root.iter("compiler"):
             if compiler.get("inertiafromgeom") == "true":
                 compiler.set("inertiafromgeom", "auto")
+            if every:
+                compiler.attrib.pop("settotalmass", None)
         for body in root.iter("body"):
             stated = inertials.get(body.get("name", ""))
             if stated is None:
@@ -55,7 +59,8 @@ def edit(inertials: Mapping[str, Inertial], *, engine: str) -> Edit:
                 "quat": " ".join(repr(x) for x in stated.quat),
                 "mass": repr(stated.mass),
                 "diaginertia": " ".join(repr(x) for x in stated.diaginertia)}))
-    return Edit(WORDS.format(bodies=shown, engine=engine), apply)
+    return Edit(WORDS.format(bodies=shown, engine=engine)
+                + (DROPPED if every else ""), apply)
 
 
 def measured(source: ModelFile, canonical: ModelTree, loaded: dict[str, ModelEngine], *,
@@ -67,17 +72,39 @@ def measured(source: ModelFile, canonical: ModelTree, loaded: dict[str, ModelEng
     if source.format is not Format.MJCF or not canonical.inertials:
         return
     for engine, m in loaded.items():
-        wants = [w for w in m.tree.wants_inertials if m.tree is not canonical
-                 and all(b in canonical.inertials for b in w.bodies)]
+        if m.tree is canonical:
+            continue
+        own = [w for w in m.tree.wants_inertials
+               if all(b in canonical.inertials for b in w.bodies)]
+        theirs = _canonical_hints(canonical, m.tree)
+        wants = own + [w for w, _ in theirs]
         if not wants:
             continue
         fix = edit({b: canonical.inertials[b] for w in wants for b in w.bodies},
-                   engine=canonical.engine)
+                   engine=canonical.engine, every=any(w.every for w in wants))
         with tempfile.TemporaryDirectory(prefix="dyncheck-inertials-") as folder:
             copy = copied(source, inline(source.path), (fix,), Path(folder))
             read = load(engine, copy)
         tree = None if isinstance(read, NotLoaded) else align_by_body(canonical, read.tree)[0]
         refused = read.message if isinstance(read, NotLoaded) else ""
-        m.tree = replace(m.tree, fixed=(*m.tree.fixed, *(
+        m.tree = replace(m.tree, hints=(*m.tree.hints, *(h for _, h in theirs)), fixed=(
+            *m.tree.fixed, *(
             FixedReading(subject=w.subject, fields=w.fields, fix=fix.words, tree=tree,
                          refused=refused) for w in wants)))
+
+
+def _canonical_hints(canonical: ModelTree, tree: ModelTree) -> list[
+        tuple[WantsInertials, tuple[str, str, str]]]:
+    """The canonical engine's hints whose fix states every body's inertial (an attribute
+    only it applies, ``settotalmass``), each with the hint as ``tree``'s own (the other
+    engine reads otherwise; the copy is its counterfactual): where ``tree`` gives no hint of
+    its own for the field."""
+    out = []
+    for want in canonical.wants_inertials:
+        why = canonical.hint(want.subject, want.fields[0])
+        if why is None or not want.every:
+            continue
+        for name in want.fields:
+            if tree.hint(want.subject, name) is None:
+                out.append((replace(want, fields=(name,)), (want.subject, name, why)))
+    return out

@@ -20,7 +20,6 @@ SUSPECTED = {
     "drake.actuators": {"GEAR", "EFFORT", "IGNORED"},
     "drake.hints": {"BALL_ARMATURE", "FIRST_OF_SEVERAL", "SKIPPED_CLASS", "IGNORED_FRAME"},
     "formats.mjcf_unread": {"SPRINGDAMPER"},
-    "mujoco.model": {"TOTAL_MASS"},
     "newton.actuators": {"MOTORS", "GEAR", "BOUNDS"},
     "pybullet.files": {"GRAVITY_HINT", "ZEROED_INERTIA", "INERTIA_HINT", "DENSITY_HINT"},
 }

@@ -367,3 +367,40 @@ def test_a_body_mujoco_cannot_name_leaves_the_cause_suspected(tmp_path):
     rows = _weighed(tmp_path, body="")
     note = rows[("j1", "mass")].note
     assert note.startswith("cause unknown; suspected, its fix not measured"), note
+
+
+SCALED = """<mujoco model="scaled"><compiler settotalmass="3"/><worldbody>
+  <body name="a" pos="0 0 1"><joint name="a_j" type="hinge" axis="0 1 0"/>
+    <inertial pos="0 0 -0.2" mass="1" diaginertia="0.02 0.02 0.002"/>
+    <body name="b" pos="0 0 -0.4"><joint name="b_j" type="hinge" axis="0 1 0"/>
+      <geom type="sphere" size="0.05"/></body></body>
+</worldbody></mujoco>"""
+"""MuJoCo scales 1 kg and a 0.05 m sphere (0.52 kg) to 3 kg in all (<compiler
+settotalmass>); Pinocchio's parser ignores the attribute (:data:`TOTAL_MASS` of MuJoCo's
+reading)."""
+
+
+@pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-unscaled"])
+def test_settotalmass_is_verified_by_stating_the_scaled_masses(tmp_path, monkeypatch, plant):
+    """The copy with MuJoCo's compiled (scaled) <inertial> on every body and settotalmass
+    dropped, read by Pinocchio, holds MuJoCo's masses (MuJoCo's compiler the expected value):
+    "fix verified". With the stated masses planted unscaled (the file's own sum, 1.52 kg,
+    instead of 3 kg: each divided by 3 / 1.52), the cause is unknown."""
+    from dyncheck.adapters.mujoco import inertials
+
+    if plant:
+        real = inertials.compiled
+        monkeypatch.setattr(inertials, "compiled", lambda m: {
+            name: replace(x, mass=x.mass * (1 + 4 / 3 * np.pi * 0.05**3 * 1000) / 3)
+            for name, x in real(m).items()})
+    path = tmp_path / "scaled.xml"
+    path.write_text(SCALED)
+    rows = _described(path)
+    for key in (("a_j", "mass"), ("b_j", "mass")):
+        note = rows[key].note
+        assert "settotalmass" in note, note
+        assert (FIX_VERIFIED in note) is not plant, (key, note)
+        assert note.startswith("cause unknown: the named fix") is plant, (key, note)
+    if not plant:
+        assert "settotalmass dropped, pinocchio reads the mass of 'a_j' as mujoco does" \
+               in rows[("a_j", "mass")].note
