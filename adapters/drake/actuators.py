@@ -162,6 +162,39 @@ def damping_fixed(plant: Any, root: ET.Element, tree: ModelTree) -> tuple[FixedR
             f"d={kv[a.name()]:g})) after parsing") for a, g in zip(targets, saved, strict=True))
 
 
+def gear_fixed(plant: Any, tree: ModelTree) -> tuple[FixedReading, ...]:
+    """The fix :data:`GEAR` names, measured: each motor (no PD gains) whose gear ratio is
+    not 1 given the file's control u scaled by its gear at Drake's actuation input, and the
+    force Drake then applies to its joint (its net actuation output, the effort limit
+    applied; u within half of it) read back per unit of u: the gear it acts with."""
+    indices = list(plant.GetJointActuatorIndices())
+    targets = [k for k, i in enumerate(indices)
+               if float(plant.get_joint_actuator(i).default_gear_ratio()) != 1.0
+               and not plant.get_joint_actuator(i).has_controller()]
+    if not targets:
+        return ()
+    context = plant.CreateDefaultContext()
+    for instance_port, members in _desired_ports(plant, indices).values():
+        instance_port.FixValue(context, np.zeros(2 * len(members)))  # (the servos: off)
+    matrix, net = plant.MakeActuationMatrix(), plant.get_net_actuation_output_port()
+    acting: dict[str, tuple[float, float]] = {}
+    for k in targets:
+        actuator = plant.get_joint_actuator(indices[k])
+        gear, limit = float(actuator.default_gear_ratio()), float(actuator.effort_limit())
+        u = min(1.0, 0.5 * limit / abs(gear)) if np.isfinite(limit) else 1.0
+        given = np.zeros(len(indices))
+        given[k] = gear * u
+        plant.get_actuation_input_port().FixValue(context, given)
+        tau = matrix @ net.Eval(context)
+        acting[actuator.name()] = (gear, float(tau[actuator.joint().velocity_start()]) / u)
+    fixed = replace(tree, actuators=tuple(
+        replace(a, gear=acting[a.name][1]) if a.name in acting else a for a in tree.actuators))
+    return tuple(FixedReading(
+        subject=name, fields=("gear",), tree=fixed,
+        fix=f"the control scaled by the gear ({gear:g}) at Drake's actuation input")
+        for name, (gear, _) in acting.items())
+
+
 def _states_kv(root: ET.Element) -> bool:
     """Whether the file (``root``: its includes inlined) gives any ``<position>`` a nonzero
     ``kv``, directly or through a default class: the premise of :data:`DAMPING`."""
@@ -237,7 +270,7 @@ def _desired_ports(plant: Any, indices: list[Any]) -> dict[int, tuple[Any, list[
 
 
 PROOFS = {
-    "GEAR": Proof.SUSPECTED,
+    "GEAR": Proof.FIX,
     "DAMPING": Proof.FIX,
     "EFFORT": Proof.SUSPECTED,
     "PD_DROPPED": Proof.MEASURED,

@@ -337,7 +337,8 @@ class DrakeModel(ModelEngine):
         if self._source.format is not Format.MJCF:
             return tree
         root = inline(self._source.path)
-        fixed = drake_actuators.damping_fixed(self.plant, root, tree)
+        fixed = drake_actuators.damping_fixed(self.plant, root, tree) + \
+            drake_actuators.gear_fixed(self.plant, tree)
         if self._fixes:
             armed = {p.element.get("name") for p in placed(root, "joint", ("armature",))
                      if float(p.attrs.get("armature", "0") or 0) != 0.0}

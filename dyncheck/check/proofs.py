@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from enum import StrEnum
 
 from dyncheck.adapters.model_tree import ModelTree
 
@@ -19,6 +20,26 @@ PART = ("cause unknown: the named fix ({fix}) accounts for {share:.0f} % of the 
         "{engine} still {outcome}")
 FIX_VERIFIED = "fix verified"
 """The words every proved cause carries (the check pages and their tests find them)."""
+
+
+class Standing(StrEnum):
+    """Where a row's cause stands, read from its note (:func:`standing`)."""
+
+    VERIFIED = "fix verified"
+    SHORT = "fix measured, gap left: cause unknown"
+    SUSPECTED = "suspected, fix not measured"
+    UNNAMED = "no cause named, or the engine's own measurement or prediction"
+
+
+def standing(note: str) -> Standing:
+    """How the cause in a row's ``note`` was proved, by the words :func:`proved` writes."""
+    if UNVERIFIED.split("{")[0] in note:
+        return Standing.SUSPECTED
+    if PART.split("(")[0] in note or "refused the copy with the named fix" in note:
+        return Standing.SHORT
+    if f"; {FIX_VERIFIED}: with " in note:
+        return Standing.VERIFIED
+    return Standing.UNNAMED
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -17,7 +17,7 @@ import dyncheck.adapters as adapters
 from dyncheck.adapters.proof import Proof
 
 SUSPECTED = {
-    "drake.actuators": {"GEAR", "EFFORT", "IGNORED"},
+    "drake.actuators": {"EFFORT", "IGNORED"},
     "drake.hints": {"BALL_ARMATURE", "FIRST_OF_SEVERAL", "SKIPPED_CLASS", "IGNORED_FRAME"},
     "formats.mjcf_unread": {"SPRINGDAMPER"},
     "newton.actuators": {"MOTORS", "GEAR", "BOUNDS"},

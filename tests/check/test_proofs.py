@@ -16,7 +16,7 @@ from dyncheck.adapters.formats.edits import Edit
 from dyncheck.adapters.model_tree import FixedReading, ModelTree
 from dyncheck.adapters.pinocchio import mjcf as pinocchio_mjcf
 from dyncheck.check.model_check import check_model
-from dyncheck.check.proofs import FIX_VERIFIED, Remeasured, proved
+from dyncheck.check.proofs import FIX_VERIFIED, Remeasured, Standing, proved, standing
 
 FOUR_CAUSES = """<mujoco model="four_causes">
   <option gravity="0 0 -5"/>
@@ -404,3 +404,57 @@ def test_settotalmass_is_verified_by_stating_the_scaled_masses(tmp_path, monkeyp
     if not plant:
         assert "settotalmass dropped, pinocchio reads the mass of 'a_j' as mujoco does" \
                in rows[("a_j", "mass")].note
+
+
+@pytest.mark.parametrize(("closed", "left", "fixed", "expected"), [
+    (True, 0.0, True, Standing.VERIFIED),
+    (False, 0.4, True, Standing.SHORT),
+    (False, 1.0, False, Standing.SHORT),
+    (None, 0.0, True, Standing.SUSPECTED),
+])
+def test_a_notes_standing_is_read_from_the_words_proved_writes(closed, left, fixed, expected):
+    """Each of the four notes :func:`proved` writes (a fix closing the gap, leaving 60 %,
+    refused; no fix measured) reads back as its standing: what the acceptance script
+    (benchmarks/causes.py) counts."""
+    reading = FixedReading(subject="model", fields=("f",), fix="stated",
+                           tree=_tree() if fixed else None, refused="" if fixed else "no")
+    tree = _tree(fixed=() if closed is None else (reading,))
+    note = proved(tree, "j", "f", measure=lambda t: Remeasured(
+        closed=bool(closed), left=left, outcome="reads it"))
+    assert note is not None
+    assert standing(note) is expected, note
+    assert standing("explained: predicted up to 1e-12 of the scale") is Standing.UNNAMED
+
+
+GEARED = """<mujoco model="geared"><worldbody>
+  <body name="cart" pos="0 0 1"><joint name="slide" type="slide" axis="1 0 0"/>
+    <geom type="box" size="0.1 0.1 0.1"/></body></worldbody>
+  <actuator><motor name="push" joint="slide" gear="100" ctrlrange="-3 3"/></actuator>
+</mujoco>"""
+"""A motor on a gear of 100: MuJoCo's force is 100 u; Drake's joint actuator applies its input
+as it is (:data:`dyncheck.adapters.drake.actuators.GEAR`)."""
+
+
+@pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-no-op"])
+def test_drakes_gear_cause_is_verified_by_scaling_the_control(tmp_path, monkeypatch, plant):
+    """With the control scaled by the gear at Drake's actuation input, the force Drake
+    applies to the slide per unit of control is 100, MuJoCo's gear (MuJoCo's compiler the
+    expected value): "fix verified". With the fix planted as one that changes nothing (the
+    reading before the fix), the cause is unknown."""
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    from dyncheck.adapters.drake import actuators as drake_actuators
+
+    if plant:
+        real = drake_actuators.gear_fixed
+        monkeypatch.setattr(drake_actuators, "gear_fixed", lambda p, tree: tuple(
+            replace(r, tree=tree) for r in real(p, tree)))
+    path = tmp_path / "geared.xml"
+    path.write_text(GEARED)
+    rows = check_model(path, states=4, impls=("mujoco", "drake"), isolate=False).rows
+    row = rows[(rows["section"] == "actuation") & (rows["field"] == "gear")].iloc[0]
+    assert (row.value_a, row.value_b) == ("100", "1"), (row.value_a, row.value_b)
+    assert (FIX_VERIFIED in row.note) is not plant, row.note
+    assert row.note.startswith("cause unknown") is plant, row.note
+    if not plant:
+        assert "with the control scaled by the gear (100) at Drake's actuation input, drake " \
+               "reads the gear of 'push' as mujoco does (100)" in row.note
