@@ -254,7 +254,7 @@ LITERAL_ELSEWHERE = {
     ("dyncheck/report/figures.py", "trajectory"): "a figure's file name, not a quantity",
     ("dyncheck/check/dynamics.py", "mass_matrix"): "a field of Dynamics, not the quantity",
     ("adapters/model_tree.py", "euler"): "Orientation.EULER: Example 9's angles in q",
-    ("adapters/pinocchio/mjcf.py", "euler"): "MJCF's body attribute euler=, an orientation",
+    ("adapters/formats/mjcf_copy.py", "euler"): "MJCF's body attribute euler=, an orientation",
 }
 """Strings spelled like a member of the vocabulary that mean something else."""
 

@@ -1,7 +1,8 @@
-"""Drake's armature hints proved by their fixes (#77): the fix each names (an actuator on the
-joint; the joint's actuators written as ``<motor>``) applied to a copy of the MJCF, the copy
-parsed by Drake and read (:class:`~dyncheck.adapters.model_tree.FixedReading`), so that the
-comparison layer measures the armature again."""
+"""Drake's hints proved by their fixes (#77): the fix each names (an actuator on the joint;
+the joint's actuators written as ``<motor>``; one joint per body; a class's attribute written
+on the joint) applied to a copy of the MJCF, the copy parsed by Drake and read
+(:class:`~dyncheck.adapters.model_tree.FixedReading`), so that the comparison layer measures
+the field again."""
 
 from __future__ import annotations
 
@@ -10,8 +11,10 @@ import xml.etree.ElementTree as ET
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from dyncheck.adapters.drake.hints import Lost, lost_across_gaps, several_joints
 from dyncheck.adapters.formats.edits import Edit, copied
 from dyncheck.adapters.formats.files import ModelFile
+from dyncheck.adapters.formats.mjcf_copy import POSE
 from dyncheck.adapters.model_tree import FixedReading, ModelTree
 from dyncheck.errors import EngineError, Unsupported
 
@@ -51,6 +54,69 @@ def as_motors(joints: Sequence[str]) -> Edit:
                 + " written as <motor>", edit)
 
 
+def _split(body: ET.Element, parent: ET.Element, k: int) -> None:
+    """``body``'s joints each on a body of its own, nested in the file's order: the first
+    on a massless body at ``body``'s pose, the last on ``body`` itself, now unmoved within
+    them (MuJoCo composes a body's joints in that order, each in the frame the ones before
+    it moved: the same model)."""
+    def holder(n: int) -> ET.Element:
+        made = ET.Element("body", {"name": f"{body.get('name', 'body')}_dyncheck_{k}_{n}"})
+        if body.get("childclass"):
+            made.set("childclass", body.get("childclass", ""))
+        return made
+
+    at = list(parent).index(body)
+    parent.remove(body)
+    outer = inner = holder(0)
+    for key in POSE:  # (the outermost of the split bodies at its pose)
+        if key in body.attrib:
+            outer.set(key, body.attrib.pop(key))
+    joints = body.findall("joint")
+    for n, joint in enumerate(joints[:-1]):
+        body.remove(joint)
+        inner.append(joint)
+        if n < len(joints) - 2:
+            inner.append(nested := holder(n + 1))
+            inner = nested
+    inner.append(body)
+    parent.insert(at, outer)
+
+
+def _split_all(root: ET.Element) -> None:
+    """Split every body with several joints (:func:`_split`), in document order."""
+    parent = {id(child): p for p in root.iter() for child in p}
+    for k, body in enumerate(several_joints(root)):
+        _split(body, parent[id(body)], k)
+
+
+SPLIT = Edit("one joint per body, massless bodies between them", _split_all)
+"""Every body with several joints split so that each joint has a body of its own (the fix
+:data:`.hints.FIRST_OF_SEVERAL` names)."""
+
+
+def written(lost: Sequence[Lost]) -> Edit:
+    """Each attribute Drake loses across a class gap written on its joint, with the value the
+    class gives it (the fix :data:`.hints.SKIPPED_CLASS` names)."""
+    def edit(root: ET.Element) -> None:
+        by_joint = {j.get("name"): j for j in root.iter("joint") if j.get("name")}
+        for one in lost:
+            by_joint[one.joint].set(one.attribute, one.value)
+    words = [f'{x.attribute}="{x.value}" written on {x.joint!r}' for x in lost]
+    return Edit(", ".join(words[:4]) + (f" … ({len(words)} attributes)" if len(words) > 4
+                                        else ""), edit)
+
+
+def _read(source: ModelFile, root: ET.Element, edit: Edit,
+          read: Read) -> tuple[ModelTree | None, str]:
+    """Drake's reading of a copy of ``root`` with ``edit`` applied, or its words refusing
+    it."""
+    with tempfile.TemporaryDirectory(prefix="dyncheck-drake-fix-") as folder:
+        try:
+            return read(copied(source, root, (edit,), Path(folder))), ""
+        except (EngineError, Unsupported) as exc:
+            return None, str(exc)
+
+
 def armature_fixed(source: ModelFile, root: ET.Element, *, unactuated: Sequence[str],
                    unread: Sequence[str], read: Read) -> tuple[FixedReading, ...]:
     """Drake's reading of the MJCF ``source`` (``root``: its includes inlined) with each
@@ -58,14 +124,26 @@ def armature_fixed(source: ModelFile, root: ET.Element, *, unactuated: Sequence[
     driven only by actuators Drake did not read."""
     out: list[FixedReading] = []
     for joints, edit in ((unactuated, motors(unactuated)), (unread, as_motors(unread))):
-        if not joints:
-            continue
-        tree, refused = None, ""
-        with tempfile.TemporaryDirectory(prefix="dyncheck-drake-fix-") as folder:
-            try:
-                tree = read(copied(source, root, (edit,), Path(folder)))
-            except (EngineError, Unsupported) as exc:
-                refused = str(exc)
-        out += [FixedReading(subject=j, fields=("armature",), fix=edit.words, tree=tree,
-                             refused=refused) for j in joints]
+        if joints:
+            tree, refused = _read(source, root, edit, read)
+            out += [FixedReading(subject=j, fields=("armature",), fix=edit.words, tree=tree,
+                                 refused=refused) for j in joints]
+    return tuple(out)
+
+
+def file_fixed(source: ModelFile, root: ET.Element, *, read: Read) -> tuple[FixedReading, ...]:
+    """Drake's reading of the MJCF ``source`` (``root``: its includes inlined) with the
+    fixes of the hints the file shows: every body of several joints split (each named joint
+    but the last: its anchor and axis), and each attribute lost across a class gap written
+    on its joint (its field); one copy each."""
+    split = [(name, ("anchor", "axis")) for body in several_joints(root)
+             for name in [j.get("name") for j in body.findall("joint")][:-1] if name]
+    lost = lost_across_gaps(root)
+    out: list[FixedReading] = []
+    for edit, subjects in ((SPLIT, split), (written(lost), [(x.joint, (x.field,))
+                                                             for x in lost])):
+        if subjects:
+            tree, refused = _read(source, root, edit, read)
+            out += [FixedReading(subject=joint, fields=fields, fix=edit.words, tree=tree,
+                                 refused=refused) for joint, fields in subjects]
     return tuple(out)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
+from typing import NamedTuple
 
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
@@ -73,11 +74,17 @@ def armature_hint(joint: TreeJoint, actuators: list[str]) -> str:
     return UNACTUATED_ARMATURE.format(joint=joint.name)
 
 
+def several_joints(root: ET.Element) -> list[ET.Element]:
+    """The bodies of the MJCF ``root`` (includes inlined) with several ``<joint>`` elements,
+    in document order: those :data:`FIRST_OF_SEVERAL` is about."""
+    return [body for body in root.iter("body") if len(body.findall("joint")) > 1]
+
+
 def _first_of_several(root: ET.Element) -> tuple[tuple[str, str, str], ...]:
     """Why every joint but the last of a body with several reads differently in Drake (the
     MJCF ``root``, includes inlined)."""
     out: list[tuple[str, str, str]] = []
-    for body in root.iter("body"):
+    for body in several_joints(root):
         named = [j.get("name") for j in body.findall("joint")]
         for k, name in enumerate(named[:-1], start=1):
             if name:
@@ -103,7 +110,23 @@ LOST_ACROSS_A_GAP = {"armature": "armature", "damping": "damping", "axis": "axis
 field each shows in."""
 
 
+class Lost(NamedTuple):
+    """A joint attribute Drake loses across a class gap: the joint, the attribute and the
+    value the class gives it, the description field it shows in, and why."""
+
+    joint: str
+    attribute: str
+    value: str
+    field: str
+    why: str
+
+
 def _skipped_classes(root: ET.Element) -> tuple[tuple[str, str, str], ...]:
+    """:func:`lost_across_gaps` as hints."""
+    return tuple((lost.joint, lost.field, lost.why) for lost in lost_across_gaps(root))
+
+
+def lost_across_gaps(root: ET.Element) -> list[Lost]:
     """Joint attributes Drake loses on their way down the default classes: a joint whose
     class (``class``, else the nearest ``childclass``) inherits an attribute from an
     ancestor class across a class without a ``<joint>`` element (the MJCF ``root``,
@@ -117,7 +140,7 @@ def _skipped_classes(root: ET.Element) -> tuple[tuple[str, str, str], ...]:
             walk(child, chain)
 
     walk(root, [])
-    out: list[tuple[str, str, str]] = []
+    out: list[Lost] = []
     for placed in joints(root):
         joint, chain = placed.element, chains.get(placed.cls, [])
         if not joint.get("name") or len(chain) < 2:
@@ -133,11 +156,13 @@ def _skipped_classes(root: ET.Element) -> tuple[tuple[str, str, str], ...]:
                       and f not in joint.attrib
                       and not any(e is not None and f in e.attrib for e in below)]
             for field in fields:
-                out.append((joint.get("name", ""), LOST_ACROSS_A_GAP[field],
-                            SKIPPED_CLASS.format(joint=joint.get("name"), fields=field,
-                                                 source=default.get("class", "main"),
-                                                 gap=later[0].get("class"))))
-    return tuple(out)
+                out.append(Lost(joint=joint.get("name", ""), attribute=field,
+                                value=own.attrib[field], field=LOST_ACROSS_A_GAP[field],
+                                why=SKIPPED_CLASS.format(
+                                    joint=joint.get("name"), fields=field,
+                                    source=default.get("class", "main"),
+                                    gap=later[0].get("class"))))
+    return out
 
 
 def file_hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
@@ -167,8 +192,8 @@ PROOFS = {
     "UNACTUATED_ARMATURE": Proof.FIX,
     "UNREAD_ACTUATOR": Proof.FIX,
     "BALL_ARMATURE": Proof.SUSPECTED,
-    "FIRST_OF_SEVERAL": Proof.SUSPECTED,
-    "SKIPPED_CLASS": Proof.SUSPECTED,
+    "FIRST_OF_SEVERAL": Proof.FIX,
+    "SKIPPED_CLASS": Proof.FIX,
     "IGNORED_FRAME": Proof.SUSPECTED,
 }
 """How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

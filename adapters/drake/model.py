@@ -45,7 +45,7 @@ from dyncheck.adapters.actuators import Actuation
 from dyncheck.adapters.base import Field, ModelEngine, Offer, Steps
 from dyncheck.adapters.drake import actuators as drake_actuators
 from dyncheck.adapters.drake import simulation as drake_simulation
-from dyncheck.adapters.drake.counterfactual import armature_fixed
+from dyncheck.adapters.drake.counterfactual import armature_fixed, file_fixed
 from dyncheck.adapters.drake.hints import actuators, armature_hint, file_hints, ignored_frames
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
@@ -348,6 +348,8 @@ class DrakeModel(ModelEngine):
                 self._source, root, unactuated=[j.name for j in bare if not driven.get(j.name)],
                 unread=[j.name for j in bare if driven.get(j.name)],
                 read=lambda copy: DrakeModel(copy, fixes=False).tree)
+            fixed += file_fixed(self._source, root,
+                                read=lambda copy: DrakeModel(copy, fixes=False).tree)
         return replace(tree, fixed=fixed)
 
     def couple(self, couplings: Sequence[Coupling]) -> None:

@@ -44,6 +44,8 @@ GEOM_INERTIA_KEYS = ("type", "mesh", "mass", "density", "group", "contype", "con
 inertia (in MuJoCo; ``contype``/``conaffinity`` in Pinocchio's MJCF parser)."""
 JOINT_KEYS = ("pos", "springdamper", "damping", "stiffness", "range", "ref", "limited")
 """The joint attributes (from defaults too) that parsers are known to read differently."""
+POSE = ("pos", "quat", "euler", "axisangle", "xyaxes", "zaxis")
+"""A body's pose attributes: its position and the five ways MJCF writes an orientation."""
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -19,6 +19,7 @@ from dyncheck.adapters.formats.edits import Edit, both
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.mjcf_copy import (
     JOINT_KEYS,
+    POSE,
     Placed,
     children,
     geoms,
@@ -220,8 +221,7 @@ def _model_hints(root: ET.Element, bare: int, held: frozenset[str],
             j.get("type") == "slide" for j in root.iter("joint")):
         yield Found("model", "slide range", SLIDE_RANGE)
     tops = [b for world in root.findall("worldbody") for b in children(world, "body")]
-    placed = [k for k in ("pos", "quat", "euler", "axisangle", "xyaxes", "zaxis")
-              if tops and k in tops[0].attrib]
+    placed = [k for k in POSE if tops and k in tops[0].attrib]
     if placed and not (children(tops[0], "joint") or children(tops[0], "freejoint")):
         where = ", ".join(f'{k}="{tops[0].get(k)}"' for k in placed)
         yield Found("model", "placement", ROOT_PLACEMENT.format(

@@ -57,3 +57,15 @@ def align_by_body(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree, lis
                          f"{old!r} = {new!r}" for old, new in by_place.items()))
     return replace(tree, joints=joints, hints=tuple(
         (renames.get(j, j), f, why) for j, f, why in tree.hints)), notes
+
+
+def with_fixed_aligned(canonical: ModelTree, tree: ModelTree) -> ModelTree:
+    """``tree`` with the reading of each fixed copy (:attr:`ModelTree.fixed`) aligned with the
+    canonical engine's as the tree itself is (:func:`align_by_body`): a fix is measured on
+    the joints by their canonical names (Pinocchio names a body's several joints by their
+    composite, in the copy as in the file)."""
+    if not tree.fixed:
+        return tree
+    return replace(tree, fixed=tuple(
+        replace(r, tree=align_by_body(canonical, r.tree)[0]) if r.tree is not None else r
+        for r in tree.fixed))

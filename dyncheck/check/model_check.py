@@ -40,7 +40,7 @@ from dyncheck.check import (
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.against import Other, read_other
 from dyncheck.check.against import rows as against_rows
-from dyncheck.check.alignment import align_by_body
+from dyncheck.check.alignment import align_by_body, with_fixed_aligned
 from dyncheck.check.computed import canonical_of
 from dyncheck.check.derivatives import expected_seconds
 from dyncheck.check.derivatives import rows as derivative_rows
@@ -249,8 +249,9 @@ def _loaded(model: str, source_path: Path, source: ModelFile,
                 raise inputs.ModelFileError(source_path, result.message)
             continue
         if loaded:
-            result.tree, renamed = align_by_body(next(iter(loaded.values())).tree,
-                                                  result.tree)
+            canonical = next(iter(loaded.values())).tree
+            result.tree, renamed = align_by_body(canonical, result.tree)
+            result.tree = with_fixed_aligned(canonical, result.tree)
             notes.extend(renamed)
         loaded[engine] = result
         notes.extend(result.tree.notes)

@@ -18,7 +18,7 @@ from dyncheck.adapters.proof import Proof
 
 SUSPECTED = {
     "drake.actuators": {"EFFORT", "IGNORED"},
-    "drake.hints": {"BALL_ARMATURE", "FIRST_OF_SEVERAL", "SKIPPED_CLASS", "IGNORED_FRAME"},
+    "drake.hints": {"BALL_ARMATURE", "IGNORED_FRAME"},
     "formats.mjcf_unread": {"SPRINGDAMPER"},
     "newton.actuators": {"MOTORS", "GEAR", "BOUNDS"},
     "pybullet.files": {"GRAVITY_HINT", "ZEROED_INERTIA", "INERTIA_HINT", "DENSITY_HINT"},

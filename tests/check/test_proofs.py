@@ -458,3 +458,87 @@ def test_drakes_gear_cause_is_verified_by_scaling_the_control(tmp_path, monkeypa
     if not plant:
         assert "with the control scaled by the gear (100) at Drake's actuation input, drake " \
                "reads the gear of 'push' as mujoco does (100)" in row.note
+
+
+SEVERAL = """<mujoco model="several">
+  <default>
+    <default class="top"><joint axis="1 0 0" damping="3" armature="0.01"/>
+      <default class="gap"><geom size="0.05"/>
+        <default class="leaf"><geom type="sphere"/></default></default></default>
+  </default>
+  <worldbody>
+    <body name="hip" pos="0.3 0 1" euler="0 0 30">
+      <joint name="hx" type="hinge" axis="1 0 0" pos="0.05 0 0"/>
+      <joint name="hy" type="hinge" axis="0 1 0"/>
+      <joint name="hz" type="hinge" axis="0 0 1"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.4" size="0.04"/>
+      <body name="shin" pos="0 0 -0.4" childclass="leaf">
+        <joint name="knee" type="hinge"/>
+        <geom pos="0 0 -0.2"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""
+"""Three joints in one body offset and turned 30° about z (Drake's MJCF parser places the
+first two as if the body had no pose: :data:`~dyncheck.adapters.drake.hints.FIRST_OF_SEVERAL`),
+and a joint whose class 'leaf' inherits axis, damping and armature from 'top' across 'gap',
+which has no <joint> (Drake reads the element's defaults:
+:data:`~dyncheck.adapters.drake.hints.SKIPPED_CLASS`)."""
+
+
+@pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-no-op"])
+def test_drakes_joint_placement_and_class_gap_causes_are_verified(tmp_path, monkeypatch,
+                                                                    plant):
+    """The copy with one joint per body (massless bodies between) and the copy with the
+    class's attributes written on 'knee', parsed by Drake, hold MuJoCo's anchors and axes of
+    'hx' and 'hy' and 'knee''s axis and damping (MuJoCo's compiler the expected value):
+    "fix verified". With both fixes planted as edits that change nothing, every cause is
+    unknown."""
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    from dyncheck.adapters.drake import counterfactual
+
+    if plant:
+        monkeypatch.setattr(counterfactual, "SPLIT", NOTHING)
+        monkeypatch.setattr(counterfactual, "written", lambda lost: NOTHING)
+    path = tmp_path / "several.xml"
+    path.write_text(SEVERAL)
+    rows = check_model(path, states=4, impls=("mujoco", "drake"), isolate=False).rows
+    rows = rows[rows["section"] == "description"]
+    notes = {(r.subject, r.field): r.note for r in rows.itertuples()}
+    expected = {("hx", "anchor"), ("hx", "axis"), ("hy", "anchor"), ("knee", "axis"),
+                ("knee", "damping")}
+    assert expected <= set(notes), sorted(notes)
+    for key in expected:
+        assert (FIX_VERIFIED in notes[key]) is not plant, (key, notes[key])
+        assert notes[key].startswith("cause unknown") is plant, (key, notes[key])
+    if not plant:
+        assert "with one joint per body, massless bodies between them, drake reads the " \
+               "anchor of 'hx' as mujoco does" in notes[("hx", "anchor")]
+        assert "damping=\"3\" written on 'knee'" in notes[("knee", "damping")]
+
+
+TARGET = """<mujoco model="target"><worldbody>
+  <body name="arm" pos="0 0 1"><joint name="shoulder" type="hinge" axis="0 1 0"/>
+    <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02"/></body>
+  <body name="target" pos="0.2 0 0.5">
+    <joint name="target_x" type="slide" axis="1 0 0"/>
+    <joint name="target_y" type="slide" axis="0 1 0"/>
+    <geom type="sphere" size="0.02"/></body>
+</worldbody></mujoco>"""
+"""dm_control's reacher in small: a second top-level body (Pinocchio keeps the first only)
+with two joints, which Pinocchio's parser makes one composite joint, in the copy as in the
+file."""
+
+
+def test_a_fixed_copy_is_read_by_the_canonical_names(tmp_path):
+    """The copy with one tree holds 'target''s two slides, as a composite Pinocchio names its
+    own way: measured by the canonical names (matched by body and place, as the file's
+    reading is), the fix closes the gap — the joints' rows say "fix verified", not "accounts
+    for 0 %" (MuJoCo's compiler: both slides are there)."""
+    path = tmp_path / "target.xml"
+    path.write_text(TARGET)
+    rows = _described(path)
+    for joint in ("target_x", "target_y"):
+        note = rows[(joint, "joint")].note
+        assert f"{FIX_VERIFIED}: with the top-level bodies put under one body without pose " \
+               f"or joint, pinocchio holds joint {joint!r}" in note, note
