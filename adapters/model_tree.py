@@ -221,15 +221,17 @@ class Inertial:
 
 
 @dataclass(frozen=True, kw_only=True)
-class WantsInertials:
-    """A hint whose fix is "give the body an ``<inertial>``": the (``subject``, ``fields``)
-    it explains and the ``bodies`` (by name) the fix gives one, stating what the canonical
-    engine compiled for them (:attr:`ModelTree.inertials`). The comparison layer applies it
-    to a copy and has the engine read that copy (:attr:`ModelTree.fixed`)."""
+class WantsCompiled:
+    """A hint whose fix states in the file what the canonical engine compiled: "give the body
+    an ``<inertial>``" (``bodies``, by name) or "state stiffness= and damping= on the joint"
+    (``joints``); the (``subject``, ``fields``) it explains. The comparison layer applies it
+    to a copy, with the canonical engine's values (:attr:`ModelTree.inertials`,
+    :attr:`ModelTree.springs`), and has the engine read that copy (:attr:`ModelTree.fixed`)."""
 
     subject: str
     fields: tuple[str, ...]
-    bodies: tuple[str, ...]
+    bodies: tuple[str, ...] = ()
+    joints: tuple[str, ...] = ()
     every: bool = False
     """Every body stated, and the compiler's ``settotalmass`` dropped (the masses stated
     are already the scaled ones). On the canonical engine's tree: its hint's fix, read by
@@ -290,9 +292,12 @@ class ModelTree:
     inertials: Mapping[str, Inertial] = field(default_factory=dict)
     """Body name → its mass properties as the engine compiled them from the file (MuJoCo, on
     an MJCF): what a copy states so that another engine reads the same, the fix of
-    :attr:`wants_inertials`; empty where the engine offers none."""
-    wants_inertials: tuple[WantsInertials, ...] = ()
-    """Its hints whose fix states a body's inertial (:class:`WantsInertials`)."""
+    :attr:`wants_compiled`; empty where the engine offers none."""
+    springs: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    """Joint name → its (stiffness, damping) as the engine compiled them (MuJoCo, on an MJCF:
+    ``springdamper`` resolved); empty where the engine offers none."""
+    wants_compiled: tuple[WantsCompiled, ...] = ()
+    """Its hints whose fix states what the canonical engine compiled (:class:`WantsCompiled`)."""
 
     def fixed_reading(self, joint: str, name: str) -> FixedReading | None:
         """The fixed copy's reading for the hint :meth:`hint` gives (``joint``'s own, else

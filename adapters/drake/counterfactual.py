@@ -8,14 +8,18 @@ from __future__ import annotations
 
 import tempfile
 import xml.etree.ElementTree as ET
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
+from dyncheck.adapters.drake import actuators as drake_actuators
 from dyncheck.adapters.drake.hints import Lost, lost_across_gaps, several_joints
 from dyncheck.adapters.formats.edits import Edit, copied
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.mjcf_copy import POSE
-from dyncheck.adapters.model_tree import FixedReading, ModelTree
+from dyncheck.adapters.formats.mjcf_copy import POSE, placed
+from dyncheck.adapters.formats.mjcf_unread import springdampers
+from dyncheck.adapters.model_tree import FixedReading, JointType, ModelTree, WantsCompiled
 from dyncheck.errors import EngineError, Unsupported
 
 Read = Callable[[ModelFile], ModelTree]
@@ -147,3 +151,30 @@ def file_fixed(source: ModelFile, root: ET.Element, *, read: Read) -> tuple[Fixe
             out += [FixedReading(subject=joint, fields=fields, fix=edit.words, tree=tree,
                                  refused=refused) for joint, fields in subjects]
     return tuple(out)
+
+
+def measured(source: ModelFile, root: ET.Element, plant: Any, tree: ModelTree, *,
+             reflected: Mapping[str, float], driven: Mapping[str, list[str]],
+             read: Read | None) -> ModelTree:
+    """``tree`` (Drake's reading of the MJCF ``source``, ``root`` its includes inlined) with
+    its hints' fixes measured (#77): the servos' kv set and the controls scaled by the gear
+    on the plant; where ``read`` reads a copy, each armature hint's fix and each of the
+    file's hints' applied to a copy and read; and the springdamper hints the comparison
+    layer measures (their copy states what MuJoCo compiled: :attr:`ModelTree.
+    wants_compiled`). ``reflected``: the joints whose armature Drake holds; ``driven``: the
+    file's actuators per joint."""
+    tree = replace(tree, wants_compiled=tuple(
+        WantsCompiled(subject=j, fields=(f,), joints=(j,))
+        for j, f, _ in springdampers(root, "Drake")))
+    fixed = drake_actuators.damping_fixed(plant, root, tree) + \
+        drake_actuators.gear_fixed(plant, tree)
+    if read is not None:
+        armed = {p.element.get("name") for p in placed(root, "joint", ("armature",))
+                 if float(p.attrs.get("armature", "0") or 0) != 0.0}
+        bare = [j for j in tree.joints if j.name not in reflected and j.name in armed
+                and j.type not in (JointType.BALL, JointType.FREE)]
+        fixed += armature_fixed(
+            source, root, unactuated=[j.name for j in bare if not driven.get(j.name)],
+            unread=[j.name for j in bare if driven.get(j.name)], read=read)
+        fixed += file_fixed(source, root, read=read)
+    return replace(tree, fixed=fixed)

@@ -26,7 +26,6 @@ import re
 import tempfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -44,13 +43,13 @@ from pydrake.multibody.tree import (
 from dyncheck.adapters.actuators import Actuation
 from dyncheck.adapters.base import Field, ModelEngine, Offer, Steps
 from dyncheck.adapters.drake import actuators as drake_actuators
+from dyncheck.adapters.drake import counterfactual
 from dyncheck.adapters.drake import simulation as drake_simulation
-from dyncheck.adapters.drake.counterfactual import armature_fixed, file_fixed
 from dyncheck.adapters.drake.hints import actuators, armature_hint, file_hints, ignored_frames
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
-from dyncheck.adapters.formats.mjcf_copy import for_parser, placed
+from dyncheck.adapters.formats.mjcf_copy import for_parser
 from dyncheck.adapters.model_tree import (
     Axes,
     DerivativeChart,
@@ -336,21 +335,10 @@ class DrakeModel(ModelEngine):
                          hints=hints, measured=measured, actuators=drake_actuators.read(plant))
         if self._source.format is not Format.MJCF:
             return tree
-        root = inline(self._source.path)
-        fixed = drake_actuators.damping_fixed(self.plant, root, tree) + \
-            drake_actuators.gear_fixed(self.plant, tree)
-        if self._fixes:
-            armed = {p.element.get("name") for p in placed(root, "joint", ("armature",))
-                     if float(p.attrs.get("armature", "0") or 0) != 0.0}
-            bare = [j for j in tree.joints if j.name not in reflected and j.name in armed
-                    and j.type not in (JointType.BALL, JointType.FREE)]
-            fixed += armature_fixed(
-                self._source, root, unactuated=[j.name for j in bare if not driven.get(j.name)],
-                unread=[j.name for j in bare if driven.get(j.name)],
-                read=lambda copy: DrakeModel(copy, fixes=False).tree)
-            fixed += file_fixed(self._source, root,
-                                read=lambda copy: DrakeModel(copy, fixes=False).tree)
-        return replace(tree, fixed=fixed)
+        return counterfactual.measured(
+            self._source, inline(self._source.path), plant, tree, reflected=reflected,
+            driven=driven, read=(lambda copy: DrakeModel(copy, fixes=False).tree)
+            if self._fixes else None)
 
     def couple(self, couplings: Sequence[Coupling]) -> None:
         """The couplings closed with Drake's M and h (:mod:`.simulation`: Drake's

@@ -30,6 +30,6 @@ def springdampers(root: ET.Element, engine: str) -> Iterator[tuple[str, str, str
 
 
 PROOFS = {
-    "SPRINGDAMPER": Proof.SUSPECTED,
+    "SPRINGDAMPER": Proof.FIX,
 }
 """How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

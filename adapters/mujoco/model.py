@@ -36,13 +36,12 @@ from dyncheck.adapters.model_tree import (
     Orientation,
     Transition,
     TreeJoint,
-    WantsInertials,
     lump,
 )
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,
 )
-from dyncheck.adapters.mujoco import actuators, closures, inertials
+from dyncheck.adapters.mujoco import actuators, closures, compiled
 from dyncheck.adapters.mujoco.actuators import MujocoActuation
 from dyncheck.adapters.mujoco.api import (
     GYROSCOPIC_IMPLICIT,
@@ -248,11 +247,7 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
             self._closed.tendon_armature[:] = 0.0
         self.tree = self._tree(notes)
         if source.format is Format.MJCF:  # what a copy states for another engine (#77)
-            stated = inertials.compiled(m)
-            every = bool(scaled) and len(stated) == m.nbody - 1  # (every body named)
-            self.tree = replace(self.tree, inertials=stated, wants_inertials=(WantsInertials(
-                subject="model", fields=("mass", "inertia", "com"), bodies=tuple(stated),
-                every=True),) if every else ())
+            self.tree = compiled.stated(self.tree, m, scaled=bool(scaled))
         if not exact_meshes and self._inertias.meshes_weigh(m, self._inertias.inexact_meshes):
             self.tree = replace(self.tree, exact_meshes=self._exact_meshes(source))
 

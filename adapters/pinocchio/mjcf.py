@@ -27,7 +27,7 @@ from dyncheck.adapters.formats.mjcf_copy import (
     placed,
 )
 from dyncheck.adapters.formats.mjcf_unread import springdampers
-from dyncheck.adapters.model_tree import WantsInertials
+from dyncheck.adapters.model_tree import WantsCompiled
 from dyncheck.adapters.pinocchio.fixes import (
     CLASS_MASSES,
     NAME_BODIES,
@@ -52,6 +52,8 @@ class Found(NamedTuple):
     bodies: tuple[str, ...] = ()
     """The bodies its fix gives an ``<inertial>`` stating what MuJoCo compiles (none: its
     fix is ``edit``, or no edit of the file)."""
+    joints: tuple[str, ...] = ()
+    """The joints its fix gives the stiffness and damping MuJoCo compiles."""
 
 INCLUDES_SKIPPED = (
     "; the file has <include> elements, which Pinocchio skips: the body it keeps is the first "
@@ -176,15 +178,16 @@ def fixes(found: Sequence[Found]) -> tuple[Fix, ...]:
                  for (subject, _), (fields, edit) in out.items())
 
 
-def wants_inertials(found: Sequence[Found]) -> tuple[WantsInertials, ...]:
-    """The hints ``found`` (:func:`found`) whose fix gives bodies an ``<inertial>`` (the
-    comparison layer states the canonical engine's), one per hint (its fields gathered)."""
-    out: dict[tuple[str, str], tuple[list[str], tuple[str, ...]]] = {}
+def wants_compiled(found: Sequence[Found]) -> tuple[WantsCompiled, ...]:
+    """The hints ``found`` (:func:`found`) whose fix states what MuJoCo compiled (the
+    comparison layer writes the copy), one per hint (its fields gathered)."""
+    out: dict[tuple[str, str], tuple[list[str], Found]] = {}
     for f in found:
-        if f.bodies:
-            out.setdefault((f.subject, f.why), ([], f.bodies))[0].append(f.field)
-    return tuple(WantsInertials(subject=subject, fields=tuple(fields), bodies=bodies)
-                 for (subject, _), (fields, bodies) in out.items())
+        if f.bodies or f.joints:
+            out.setdefault((f.subject, f.why), ([], f))[0].append(f.field)
+    return tuple(WantsCompiled(subject=subject, fields=tuple(fields), bodies=f.bodies,
+                               joints=f.joints)
+                 for (subject, _), (fields, f) in out.items())
 
 
 def found(source: ModelFile, root: ET.Element | None,
@@ -198,7 +201,8 @@ def found(source: ModelFile, root: ET.Element | None,
         return ()
     includes = re.search(r"<include\b", source.text) is not None  # (the file's own text)
     return (*_model_hints(root, bare_bodies(root), held, includes), *_body_hints(root),
-            *_joint_hints(root), *(Found(*h) for h in springdampers(root, "Pinocchio")))
+            *_joint_hints(root),
+            *(Found(*h, joints=(h[0],)) for h in springdampers(root, "Pinocchio")))
 
 
 def _model_hints(root: ET.Element, bare: int, held: frozenset[str],

@@ -230,7 +230,7 @@ class PinocchioModel(ModelEngine):
         notes += unread
         self.tree = self._tree(notes)
         if root is not None:  # each hint measured: its prediction, its fix on a copy (#77)
-            self.tree = replace(self.tree, wants_inertials=mjcf.wants_inertials(found),
+            self.tree = replace(self.tree, wants_compiled=mjcf.wants_compiled(found),
                                 measured=counterfactual.predictions_met(
                 self.tree, root), fixed=counterfactual.fixed_readings(
                 source, root, mjcf.fixes(found), lambda copy, g: PinocchioModel(

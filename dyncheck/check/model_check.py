@@ -28,13 +28,13 @@ from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import (
     actuation,
     closure_rows,
+    compiled_copy,
     describe,
     inputs,
     partial,
     partial_pairs,
     predicted,
     readings,
-    stated_inertials,
     validity,
 )
 from dyncheck.check import engines as engine_processes
@@ -154,7 +154,7 @@ def check_model(
         engine_processes.stop(engines)
 
 
-def _copies(*, isolate: bool, limits: engine_processes.Limits | None) -> stated_inertials.Load:
+def _copies(*, isolate: bool, limits: engine_processes.Limits | None) -> compiled_copy.Load:
     """How an engine reads a copy of the model (a fix applied): as it read the file, in a
     process of its own where the check isolates engines, stopped once it has read it."""
     def load(engine: str, copy: ModelFile) -> ModelEngine | NotLoaded:
@@ -167,7 +167,7 @@ def _copies(*, isolate: bool, limits: engine_processes.Limits | None) -> stated_
 def _check(model: str, source_path: Path, source: ModelFile, *,
            engines: dict[str, ModelEngine | NotLoaded], chosen: tuple[str, ...],
            states: int, seed: int, floating: bool, other: Other | None,
-           load_seconds: float, load: stated_inertials.Load, derivatives: bool = False,
+           load_seconds: float, load: compiled_copy.Load, derivatives: bool = False,
            actuators: bool = True, say: Callable[[str], None] | None = None,
            given: GivenStates | None = None) -> CheckResult:
     """The check's steps in order: what loaded, what each engine read and whether it is
@@ -178,7 +178,7 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     seconds: dict[str, float] = {"load": load_seconds}
     loaded = _loaded(model, source_path, source, engines, rows, notes)
     first = next(iter(loaded.values()))
-    stated_inertials.measured(source, first.tree, loaded, load=load)
+    compiled_copy.measured(source, first.tree, loaded, load=load)
     canonical_tree = canonical_of(first.tree)
     if canonical_tree.nv == 0:
         raise inputs.ModelFileError(source_path, "has no degrees of freedom (nothing moves)")

@@ -19,7 +19,6 @@ from dyncheck.adapters.proof import Proof
 SUSPECTED = {
     "drake.actuators": {"EFFORT", "IGNORED"},
     "drake.hints": {"BALL_ARMATURE", "IGNORED_FRAME"},
-    "formats.mjcf_unread": {"SPRINGDAMPER"},
     "newton.actuators": {"MOTORS", "GEAR", "BOUNDS"},
     "pybullet.files": {"GRAVITY_HINT", "ZEROED_INERTIA", "INERTIA_HINT", "DENSITY_HINT"},
 }

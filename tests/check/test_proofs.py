@@ -334,17 +334,17 @@ def _weighed(tmp_path, body="a"):
 
 
 @pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-wrong"])
-def test_pinocchios_geom_weighing_causes_are_verified_by_stated_inertials(tmp_path,
+def test_pinocchios_geom_weighing_causes_are_verified_by_compiled_copy(tmp_path,
                                                                           monkeypatch, plant):
     """The copy with MuJoCo's compiled <inertial> on 'a' and 'b', read by Pinocchio, holds
     MuJoCo's mass, centre of mass and inertia on both joints (MuJoCo's compiler the expected
     value): each row "fix verified". With the stated inertials planted wrong (each mass and
     inertia doubled, each centre of mass moved 5 cm), every cause is unknown."""
-    from dyncheck.adapters.mujoco import inertials
+    from dyncheck.adapters.mujoco import compiled
 
     if plant:
-        real = inertials.compiled
-        monkeypatch.setattr(inertials, "compiled", lambda m: {
+        real = compiled.inertials
+        monkeypatch.setattr(compiled, "inertials", lambda m: {
             name: replace(x, mass=2 * x.mass, pos=tuple(p + 0.05 for p in x.pos),
                           diaginertia=tuple(2 * i for i in x.diaginertia))
             for name, x in real(m).items()})
@@ -386,11 +386,11 @@ def test_settotalmass_is_verified_by_stating_the_scaled_masses(tmp_path, monkeyp
     dropped, read by Pinocchio, holds MuJoCo's masses (MuJoCo's compiler the expected value):
     "fix verified". With the stated masses planted unscaled (the file's own sum, 1.52 kg,
     instead of 3 kg: each divided by 3 / 1.52), the cause is unknown."""
-    from dyncheck.adapters.mujoco import inertials
+    from dyncheck.adapters.mujoco import compiled
 
     if plant:
-        real = inertials.compiled
-        monkeypatch.setattr(inertials, "compiled", lambda m: {
+        real = compiled.inertials
+        monkeypatch.setattr(compiled, "inertials", lambda m: {
             name: replace(x, mass=x.mass * (1 + 4 / 3 * np.pi * 0.05**3 * 1000) / 3)
             for name, x in real(m).items()})
     path = tmp_path / "scaled.xml"
@@ -542,3 +542,37 @@ def test_a_fixed_copy_is_read_by_the_canonical_names(tmp_path):
         note = rows[(joint, "joint")].note
         assert f"{FIX_VERIFIED}: with the top-level bodies put under one body without pose " \
                f"or joint, pinocchio holds joint {joint!r}" in note, note
+
+
+SPRUNG = """<mujoco model="sprung"><worldbody>
+  <body name="a" pos="0 0 1"><joint name="j" type="hinge" axis="0 1 0" springdamper="0.001 50"/>
+    <geom type="sphere" size="0.1" pos="0.2 0 0"/></body>
+</worldbody></mujoco>"""
+"""springdamper="0.001 50" on a 4.19 kg sphere: MuJoCo derives stiffness 73.7 and damping 369
+from the joint's inertia; Pinocchio's and Drake's parsers read neither
+(:data:`~dyncheck.adapters.formats.mjcf_unread.SPRINGDAMPER`)."""
+
+
+@pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-wrong"])
+@pytest.mark.parametrize("engine", ["pinocchio", "drake"])
+def test_springdamper_is_verified_by_stating_the_compiled_values(tmp_path, monkeypatch,
+                                                                engine, plant):
+    """The copy with MuJoCo's compiled stiffness and damping written on 'j' (springdamper
+    "0 0"), read by the engine, holds MuJoCo's damping (MuJoCo's compiler the expected
+    value): "fix verified". With the stated damping planted wrong (doubled), the cause is
+    unknown."""
+    if engine == "drake":
+        pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    from dyncheck.adapters.mujoco import compiled
+
+    if plant:
+        real = compiled.springs
+        monkeypatch.setattr(compiled, "springs", lambda m: {
+            name: (k, 2 * d) for name, (k, d) in real(m).items()})
+    path = tmp_path / "sprung.xml"
+    path.write_text(SPRUNG)
+    rows = check_model(path, states=4, impls=("mujoco", engine), isolate=False).rows
+    note = rows[(rows["section"] == "description") & (rows["field"] == "damping")].iloc[0].note
+    assert (FIX_VERIFIED in note) is not plant, note
+    assert ("springdamper=\"0.001 50\"" in note) is not plant, note
+    assert note.startswith("cause unknown: the named fix") is plant, note

@@ -1,9 +1,11 @@
-"""A hint whose fix is "give the body an ``<inertial>``" (an engine weighing the body's geoms
-otherwise than the canonical engine: Pinocchio and a mesh or a visual geom), measured (#77):
-a copy of the file states, on each body the hint names, the mass properties the canonical
-engine compiled (:attr:`~dyncheck.adapters.model_tree.ModelTree.inertials`), the engine
+"""A hint whose fix states in the file what the canonical engine compiled, measured (#77):
+"give the body an ``<inertial>``" (an engine weighing the body's geoms otherwise than the
+canonical engine: Pinocchio and a mesh or a visual geom; a parser ignoring ``settotalmass``)
+or "state stiffness= and damping= on the joint" (a parser ignoring ``springdamper``). A copy
+of the file states, on each body and joint the hints name, what the canonical engine compiled
+(:attr:`~dyncheck.adapters.model_tree.ModelTree.inertials`, ``springs``), the engine
 concerned reads the copy, and its reading joins the engine's fixed readings, where
-:mod:`.proofs` measures the difference again. Where the copy closes it, the geoms were the
+:mod:`.proofs` measures the difference again. Where the copy closes it, the hint named the
 cause; where it does not, the cause is unknown and the row says how much is left."""
 
 from __future__ import annotations
@@ -15,10 +17,10 @@ from dataclasses import replace
 from pathlib import Path
 
 from dyncheck.adapters.base import ModelEngine
-from dyncheck.adapters.formats.edits import Edit, copied
+from dyncheck.adapters.formats.edits import Edit, both, copied
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
-from dyncheck.adapters.model_tree import FixedReading, Inertial, ModelTree, WantsInertials
+from dyncheck.adapters.model_tree import FixedReading, Inertial, ModelTree, WantsCompiled
 from dyncheck.adapters.registration import Format
 from dyncheck.check.alignment import align_by_body
 from dyncheck.check.engines import NotLoaded
@@ -29,8 +31,30 @@ isolates engines."""
 
 WORDS = "an <inertial> on {bodies} stating the mass, centre of mass and inertia {engine} compiles"
 DROPPED = ", settotalmass dropped"
+SPRING_WORDS = "stiffness= and damping= on {joints} stating what {engine} compiles"
 SHOWN = 4
 """How many bodies the fix's words name (then "… (n bodies)")."""
+
+
+def _named(names: list[str], what: str) -> str:
+    """The first :data:`SHOWN` names, then how many in all."""
+    return ", ".join(repr(n) for n in names[:SHOWN]) + (
+        f" … ({len(names)} {what})" if len(names) > SHOWN else "")
+
+
+def springs(stated: Mapping[str, tuple[float, float]], *, engine: str) -> Edit:
+    """Write on each joint named in ``stated`` its (stiffness, damping) and
+    ``springdamper="0 0"`` (which overrides a class's, so that MuJoCo too takes the values
+    written: the model it compiles stays the same)."""
+    def apply(root: ET.Element) -> None:
+        for joint in root.iter("joint"):
+            values = stated.get(joint.get("name", ""))
+            if values is not None:
+                joint.set("springdamper", "0 0")
+                joint.set("stiffness", repr(values[0]))
+                joint.set("damping", repr(values[1]))
+    return Edit(SPRING_WORDS.format(joints=_named(sorted(stated), "joints"), engine=engine),
+                apply)
 
 
 def edit(inertials: Mapping[str, Inertial], *, engine: str, every: bool = False) -> Edit:
@@ -38,9 +62,7 @@ def edit(inertials: Mapping[str, Inertial], *, engine: str, every: bool = False)
     make a compiler's ``inertiafromgeom="true"`` (which ignores every ``<inertial>``, in
     MuJoCo and Pinocchio alike) ``"auto"``; with ``every`` (every body stated, the scaled
     masses), drop the compiler's ``settotalmass``: the model MuJoCo compiles stays the same."""
-    names = sorted(inertials)
-    shown = ", ".join(repr(n) for n in names[:SHOWN]) + (
-        f" … ({len(names)} bodies)" if len(names) > SHOWN else "")
+    shown = _named(sorted(inertials), "bodies")
 
     def apply(root: ET.Element) -> None:
         for compiler in root.iter("compiler"):
@@ -65,24 +87,25 @@ def edit(inertials: Mapping[str, Inertial], *, engine: str, every: bool = False)
 
 def measured(source: ModelFile, canonical: ModelTree, loaded: dict[str, ModelEngine], *,
              load: Load) -> None:
-    """Each engine of ``loaded`` (but the canonical one) whose hints want bodies' inertials
-    stated reads one copy with every such body given the canonical engine's; its reading
-    joins its fixed readings, one per hint (a refused copy: the engine's words). Hints on a
-    body the canonical engine compiled no inertial for (an unnamed one) stay unmeasured."""
-    if source.format is not Format.MJCF or not canonical.inertials:
+    """Each engine of ``loaded`` (but the canonical one) whose hints want what the canonical
+    engine compiled stated reads one copy stating it on every body and joint they name; its
+    reading joins its fixed readings, one per hint (a refused copy: the engine's words).
+    Hints on a body or joint the canonical engine compiled nothing for (an unnamed one) stay
+    unmeasured."""
+    if source.format is not Format.MJCF or not (canonical.inertials or canonical.springs):
         return
     for engine, m in loaded.items():
         if m.tree is canonical:
             continue
-        own = [w for w in m.tree.wants_inertials
-               if all(b in canonical.inertials for b in w.bodies)]
+        own = [w for w in m.tree.wants_compiled
+               if all(b in canonical.inertials for b in w.bodies)
+               and all(j in canonical.springs for j in w.joints)]
         theirs = _canonical_hints(canonical, m.tree)
         wants = own + [w for w, _ in theirs]
         if not wants:
             continue
-        fix = edit({b: canonical.inertials[b] for w in wants for b in w.bodies},
-                   engine=canonical.engine, every=any(w.every for w in wants))
-        with tempfile.TemporaryDirectory(prefix="dyncheck-inertials-") as folder:
+        fix = _fix(canonical, wants)
+        with tempfile.TemporaryDirectory(prefix="dyncheck-compiled-") as folder:
             copy = copied(source, inline(source.path), (fix,), Path(folder))
             read = load(engine, copy)
         tree = None if isinstance(read, NotLoaded) else align_by_body(canonical, read.tree)[0]
@@ -93,14 +116,23 @@ def measured(source: ModelFile, canonical: ModelTree, loaded: dict[str, ModelEng
                          refused=refused) for w in wants)))
 
 
+def _fix(canonical: ModelTree, wants: list[WantsCompiled]) -> Edit:
+    """One edit stating, for every body and joint ``wants`` name, the canonical engine's."""
+    bodies = {b: canonical.inertials[b] for w in wants for b in w.bodies}
+    joints = {j: canonical.springs[j] for w in wants for j in w.joints}
+    edits = ([edit(bodies, engine=canonical.engine, every=any(w.every for w in wants))]
+             if bodies else []) + ([springs(joints, engine=canonical.engine)] if joints else [])
+    return both(*edits)
+
+
 def _canonical_hints(canonical: ModelTree, tree: ModelTree) -> list[
-        tuple[WantsInertials, tuple[str, str, str]]]:
+        tuple[WantsCompiled, tuple[str, str, str]]]:
     """The canonical engine's hints whose fix states every body's inertial (an attribute
     only it applies, ``settotalmass``), each with the hint as ``tree``'s own (the other
     engine reads otherwise; the copy is its counterfactual): where ``tree`` gives no hint of
     its own for the field."""
     out = []
-    for want in canonical.wants_inertials:
+    for want in canonical.wants_compiled:
         why = canonical.hint(want.subject, want.fields[0])
         if why is None or not want.every:
             continue
