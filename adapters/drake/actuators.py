@@ -52,6 +52,8 @@ PD_DROPPED = (
     "the converted plant, JointActuator.set_controller_gains; dyncheck explain "
     "drake-autodiff-pd-gains)"
 )
+READ_TAGS = ("<motor>", "<position>")
+"""The actuator elements Drake's MJCF parser reads (as ``<tag>`` in the file's list)."""
 IGNORED = (
     "Drake's MJCF parser reads only <motor> and <position> actuators and ignores {tags} with "
     "a warning (fix: write them as <motor> or <position>, or add the actuator in Drake)"
@@ -110,7 +112,7 @@ def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
         if np.isfinite(actuator.effort_limit()) and source.format is Format.MJCF:
             out.append((name, "limits", EFFORT.format(limit=actuator.effort_limit())))
     ignored = sorted({t.split(" ")[0] for found in tags.values() for t in found
-                      if not t.startswith(("<motor>", "<position>"))})
+                      if not t.startswith(READ_TAGS)})
     if ignored:
         out.append(("model", "actuator", IGNORED.format(tags=", ".join(ignored))))
     classes = class_gain_hints(plant, source, root) if root is not None else ()
@@ -274,6 +276,6 @@ PROOFS = {
     "DAMPING": Proof.FIX,
     "EFFORT": Proof.SUSPECTED,
     "PD_DROPPED": Proof.MEASURED,
-    "IGNORED": Proof.SUSPECTED,
+    "IGNORED": Proof.FIX,
 }
 """How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

@@ -177,4 +177,20 @@ def measured(source: ModelFile, root: ET.Element, plant: Any, tree: ModelTree, *
             source, root, unactuated=[j.name for j in bare if not driven.get(j.name)],
             unread=[j.name for j in bare if driven.get(j.name)], read=read)
         fixed += file_fixed(source, root, read=read)
+        fixed += ignored_fixed(source, root, driven=driven, read=read)
     return replace(tree, fixed=fixed)
+
+
+def ignored_fixed(source: ModelFile, root: ET.Element, *, driven: Mapping[str, list[str]],
+                  read: Read) -> tuple[FixedReading, ...]:
+    """Drake's reading of the MJCF ``source`` with every actuator it ignores (neither
+    ``<motor>`` nor ``<position>``: ``driven``, the file's actuators per joint) written as
+    ``<motor>``, the fix :data:`.actuators.IGNORED` names (the model's actuator hint)."""
+    joints = sorted(j for j, tags in driven.items()
+                    if any(not t.startswith(drake_actuators.READ_TAGS) for t in tags))
+    if not joints:
+        return ()
+    edit = as_motors(joints)
+    tree, refused = _read(source, root, edit, read)
+    return (FixedReading(subject="model", fields=("actuator",), fix=edit.words, tree=tree,
+                         refused=refused),)

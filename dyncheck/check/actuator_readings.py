@@ -98,6 +98,20 @@ def _hint(tree: ModelTree, actuator: str, field: str) -> str:
     return unmeasured(tree, actuator, field) or UNKNOWN
 
 
+def _absent_cause(other: ModelTree, mine: Actuator) -> str:
+    """Why ``other`` holds no actuator matching the canonical engine's ``mine``, proved by
+    its fix where it has one: the fixed reading holds one on the same joint (by name where
+    ``mine`` drives no joint)."""
+    def measure(tree: ModelTree) -> Remeasured:
+        held = any(x.joint == mine.joint if mine.joint else x.name == mine.name
+                   for x in tree.actuators)
+        where = f"on {mine.joint!r}" if mine.joint else f"named {mine.name!r}"
+        return Remeasured(closed=held, left=0.0 if held else 1.0,
+                          outcome=f"holds an actuator {where}" if held
+                          else f"still holds no actuator {where}")
+    return proved(other, "model", "actuator", measure=measure) or UNKNOWN
+
+
 def _field_cause(other: ModelTree, actuator: str, field: str, *, expected: object,
                  canonical: str) -> str:
     """Why ``other`` reads ``field`` of ``actuator`` otherwise than ``expected`` (the
@@ -139,7 +153,7 @@ def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[Che
         if k not in pairs:
             rows.append(section_row(model, subject=mine.name, field="actuator", a=a, b=b,
                              value_a=mine.what, value_b="absent", verdict=Verdict.FAILED,
-                             note=_hint(other, "model", "actuator")))
+                             note=_absent_cause(other, mine)))
             continue
         theirs = other.actuators[pairs[k]]
         ours, found = compared_fields(mine), compared_fields(theirs)

@@ -576,3 +576,41 @@ def test_springdamper_is_verified_by_stating_the_compiled_values(tmp_path, monke
     assert (FIX_VERIFIED in note) is not plant, note
     assert ("springdamper=\"0.001 50\"" in note) is not plant, note
     assert note.startswith("cause unknown: the named fix") is plant, note
+
+
+IGNORED = """<mujoco model="ignored"><worldbody>
+  <body name="a" pos="0 0 1"><joint name="j" type="hinge" axis="0 1 0"/>
+    <geom type="sphere" size="0.1" pos="0.2 0 0"/>
+    <body name="b" pos="0.4 0 0"><joint name="k" type="hinge" axis="0 1 0"/>
+      <geom type="sphere" size="0.1" pos="0.2 0 0"/></body></body>
+</worldbody>
+<actuator><general name="g" joint="j" gainprm="2"/><velocity name="v" joint="k" kv="3"/>
+</actuator></mujoco>"""
+"""A <general> and a <velocity>, which Drake's MJCF parser ignores with a warning
+(:data:`~dyncheck.adapters.drake.actuators.IGNORED`)."""
+
+
+@pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-no-op"])
+def test_drakes_ignored_actuators_are_verified_by_writing_them_as_motors(tmp_path,
+                                                                          monkeypatch, plant):
+    """The copy with both actuators written as <motor>, parsed by Drake, holds an actuator on
+    'j' and on 'k' (MuJoCo's compiler holds both): each "absent" row says "fix verified".
+    With the fix planted as an edit that changes nothing, the cause is unknown."""
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    from dyncheck.adapters.drake import counterfactual
+
+    if plant:
+        monkeypatch.setattr(counterfactual, "as_motors", lambda joints: NOTHING)
+    path = tmp_path / "ignored.xml"
+    path.write_text(IGNORED)
+    rows = check_model(path, states=4, impls=("mujoco", "drake"), isolate=False).rows
+    rows = rows[(rows["section"] == "actuation") & (rows["field"] == "actuator")]
+    notes = dict(zip(rows["subject"], rows["note"], strict=True))
+    assert set(notes) == {"g", "v"}, notes
+    for name, note in notes.items():
+        assert "ignores <general>, <velocity>" in note or plant, (name, note)
+        assert (FIX_VERIFIED in note) is not plant, (name, note)
+        assert note.startswith("cause unknown") is plant, (name, note)
+    if not plant:
+        assert "with the actuators on 'j', 'k' written as <motor>, drake holds an actuator " \
+               "on 'j'" in notes["g"]
