@@ -209,6 +209,17 @@ class FixedReading:
 
 
 @dataclass(frozen=True, kw_only=True)
+class FixedCopy:
+    """A copy of the model with every fix of the engine's hints that edits the file applied
+    together (``fix``: in words; ``text``: the copy, its includes inlined and its asset
+    paths absolute): what the engine is run on to answer whether it computes the whole
+    model, where it reads the file itself only in part or otherwise (#77)."""
+
+    fix: str
+    text: str
+
+
+@dataclass(frozen=True, kw_only=True)
 class Inertial:
     """A body's mass properties as an MJCF ``<inertial>`` states them, in the body's frame:
     its centre of mass ``pos``, principal axes ``quat`` (w x y z), ``mass`` and principal
@@ -296,6 +307,8 @@ class ModelTree:
     springs: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     """Joint name → its (stiffness, damping) as the engine compiled them (MuJoCo, on an MJCF:
     ``springdamper`` resolved); empty where the engine offers none."""
+    with_fixes: FixedCopy | None = None
+    """The copy with every file edit its hints name applied together, where it has any."""
     wants_compiled: tuple[WantsCompiled, ...] = ()
     """Its hints whose fix states what the canonical engine compiled (:class:`WantsCompiled`)."""
 

@@ -15,7 +15,7 @@ from typing import Any
 
 from dyncheck.adapters.drake import actuators as drake_actuators
 from dyncheck.adapters.drake.hints import Lost, lost_across_gaps, several_joints
-from dyncheck.adapters.formats.edits import Edit, copied
+from dyncheck.adapters.formats.edits import Edit, copied, fixed_copy
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.mjcf_copy import POSE, placed
 from dyncheck.adapters.formats.mjcf_unread import springdampers
@@ -173,12 +173,23 @@ def measured(source: ModelFile, root: ET.Element, plant: Any, tree: ModelTree, *
                  if float(p.attrs.get("armature", "0") or 0) != 0.0}
         bare = [j for j in tree.joints if j.name not in reflected and j.name in armed
                 and j.type not in (JointType.BALL, JointType.FREE)]
-        fixed += armature_fixed(
-            source, root, unactuated=[j.name for j in bare if not driven.get(j.name)],
-            unread=[j.name for j in bare if driven.get(j.name)], read=read)
+        unactuated = [j.name for j in bare if not driven.get(j.name)]
+        unread = [j.name for j in bare if driven.get(j.name)]
+        fixed += armature_fixed(source, root, unactuated=unactuated, unread=unread, read=read)
         fixed += file_fixed(source, root, read=read)
         fixed += ignored_fixed(source, root, driven=driven, read=read)
+        lost, rewritten = lost_across_gaps(root), sorted({*unread, *_ignored(driven)})
+        tree = replace(tree, with_fixes=fixed_copy(source, root, [edit for edit, wanted in (
+            (motors(unactuated), unactuated), (as_motors(rewritten), rewritten),
+            (SPLIT, several_joints(root)), (written(lost), lost)) if wanted]))
     return replace(tree, fixed=fixed)
+
+
+def _ignored(driven: Mapping[str, list[str]]) -> list[str]:
+    """The joints driven by an actuator Drake's MJCF parser ignores (``driven``: the file's
+    actuators per joint)."""
+    return sorted(j for j, tags in driven.items()
+                  if any(not t.startswith(drake_actuators.READ_TAGS) for t in tags))
 
 
 def ignored_fixed(source: ModelFile, root: ET.Element, *, driven: Mapping[str, list[str]],
@@ -186,8 +197,7 @@ def ignored_fixed(source: ModelFile, root: ET.Element, *, driven: Mapping[str, l
     """Drake's reading of the MJCF ``source`` with every actuator it ignores (neither
     ``<motor>`` nor ``<position>``: ``driven``, the file's actuators per joint) written as
     ``<motor>``, the fix :data:`.actuators.IGNORED` names (the model's actuator hint)."""
-    joints = sorted(j for j, tags in driven.items()
-                    if any(not t.startswith(drake_actuators.READ_TAGS) for t in tags))
+    joints = _ignored(driven)
     if not joints:
         return ()
     edit = as_motors(joints)

@@ -13,6 +13,7 @@ from typing import NamedTuple
 
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.mjcf_copy import standalone
+from dyncheck.adapters.model_tree import FixedCopy
 
 
 class Edit(NamedTuple):
@@ -47,3 +48,13 @@ def copied(source: ModelFile, root: ET.Element, edits: Sequence[Edit], folder: P
     path = folder / "fixed.xml"
     path.write_text(text, encoding="utf-8")
     return replace(source, path=path, text=text, notes=())
+
+
+def fixed_copy(source: ModelFile, root: ET.Element, edits: Sequence[Edit]) -> FixedCopy | None:
+    """The copy of the MJCF ``source`` (``root``: its includes inlined) with every one of
+    ``edits`` applied together (:attr:`~dyncheck.adapters.model_tree.ModelTree.with_fixes`);
+    None where there is none."""
+    if not edits:
+        return None
+    return FixedCopy(fix=both(*edits).words,
+                     text=applied(root, source.path.resolve().parent, edits))

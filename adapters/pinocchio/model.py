@@ -31,6 +31,7 @@ import pinocchio as pin
 
 from dyncheck.adapters.base import Field, ModelEngine, Offer
 from dyncheck.adapters.closures import ClosedReading
+from dyncheck.adapters.formats.edits import fixed_copy
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
@@ -230,11 +231,14 @@ class PinocchioModel(ModelEngine):
         notes += unread
         self.tree = self._tree(notes)
         if root is not None:  # each hint measured: its prediction, its fix on a copy (#77)
-            self.tree = replace(self.tree, wants_compiled=mjcf.wants_compiled(found),
-                                measured=counterfactual.predictions_met(
-                self.tree, root), fixed=counterfactual.fixed_readings(
-                source, root, mjcf.fixes(found), lambda copy, g: PinocchioModel(
-                    copy, gravity=g, inertias=inertias, fixes=False).tree) if fixes else ())
+            edits = mjcf.fixes(found) if fixes else ()
+            self.tree = replace(
+                self.tree, wants_compiled=mjcf.wants_compiled(found),
+                measured=counterfactual.predictions_met(self.tree, root),
+                with_fixes=fixed_copy(source, root, [f.edit for f in edits]),
+                fixed=counterfactual.fixed_readings(
+                    source, root, edits, lambda copy, g: PinocchioModel(
+                        copy, gravity=g, inertias=inertias, fixes=False).tree) if fixes else ())
         self.stepping = self._stepper()  # its v̇ in MuJoCo's layout, and its runs there
 
     def _mimic_joints(self, source: ModelFile) -> tuple[mimic.Mimics | None, tuple[str, ...]]:

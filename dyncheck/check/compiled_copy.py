@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import tempfile
 import xml.etree.ElementTree as ET
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import AbstractContextManager, contextmanager
 from dataclasses import replace
 from pathlib import Path
 
@@ -22,12 +23,27 @@ from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.model_tree import FixedReading, Inertial, ModelTree, WantsCompiled
 from dyncheck.adapters.registration import Format
+from dyncheck.check import engines as engine_processes
 from dyncheck.check.alignment import align_by_body
 from dyncheck.check.engines import NotLoaded
 
-Load = Callable[[str, ModelFile], "ModelEngine | NotLoaded"]
-"""An engine (by name) loading a copy of the model: in a process of its own where the check
-isolates engines."""
+Start = Callable[[str, ModelFile], AbstractContextManager["ModelEngine | NotLoaded"]]
+"""An engine (by name) loaded on a copy of the model for as long as the context lasts: in a
+process of its own where the check isolates engines."""
+
+
+def starter(*, isolate: bool, limits: engine_processes.Limits | None) -> Start:
+    """How an engine reads a copy of the model (a fix applied): as it read the file, in a
+    process of its own where the check isolates engines (within ``limits``), stopped when
+    done."""
+    @contextmanager
+    def start(engine: str, copy: ModelFile) -> Iterator[ModelEngine | NotLoaded]:
+        started = engine_processes.start([engine], copy, isolate=isolate, limits=limits)
+        try:
+            yield started[engine]
+        finally:
+            engine_processes.stop(started)
+    return start
 
 WORDS = "an <inertial> on {bodies} stating the mass, centre of mass and inertia {engine} compiles"
 DROPPED = ", settotalmass dropped"
@@ -86,7 +102,7 @@ def edit(inertials: Mapping[str, Inertial], *, engine: str, every: bool = False)
 
 
 def measured(source: ModelFile, canonical: ModelTree, loaded: dict[str, ModelEngine], *,
-             load: Load) -> None:
+             start: Start) -> None:
     """Each engine of ``loaded`` (but the canonical one) whose hints want what the canonical
     engine compiled stated reads one copy stating it on every body and joint they name; its
     reading joins its fixed readings, one per hint (a refused copy: the engine's words).
@@ -97,17 +113,14 @@ def measured(source: ModelFile, canonical: ModelTree, loaded: dict[str, ModelEng
     for engine, m in loaded.items():
         if m.tree is canonical:
             continue
-        own = [w for w in m.tree.wants_compiled
-               if all(b in canonical.inertials for b in w.bodies)
-               and all(j in canonical.springs for j in w.joints)]
-        theirs = _canonical_hints(canonical, m.tree)
-        wants = own + [w for w, _ in theirs]
+        wants, theirs = wanted(canonical, m.tree)
         if not wants:
             continue
-        fix = _fix(canonical, wants)
+        fix = stating(canonical, wants)
         with tempfile.TemporaryDirectory(prefix="dyncheck-compiled-") as folder:
             copy = copied(source, inline(source.path), (fix,), Path(folder))
-            read = load(engine, copy)
+            with start(engine, copy) as read:
+                pass  # (its tree is read on loading)
         tree = None if isinstance(read, NotLoaded) else align_by_body(canonical, read.tree)[0]
         refused = read.message if isinstance(read, NotLoaded) else ""
         m.tree = replace(m.tree, hints=(*m.tree.hints, *(h for _, h in theirs)), fixed=(
@@ -116,7 +129,21 @@ def measured(source: ModelFile, canonical: ModelTree, loaded: dict[str, ModelEng
                          refused=refused) for w in wants)))
 
 
-def _fix(canonical: ModelTree, wants: list[WantsCompiled]) -> Edit:
+def wanted(canonical: ModelTree, tree: ModelTree) -> tuple[
+        list[WantsCompiled], list[tuple[WantsCompiled, tuple[str, str, str]]]]:
+    """What ``tree``'s engine wants stated that the canonical engine compiled (its own
+    hints', and the canonical engine's hints' it takes as its own: :func:`_canonical_hints`,
+    the second list with those hints)."""
+    if not (canonical.inertials or canonical.springs):
+        return [], []
+    own = [w for w in tree.wants_compiled
+           if all(b in canonical.inertials for b in w.bodies)
+           and all(j in canonical.springs for j in w.joints)]
+    theirs = _canonical_hints(canonical, tree)
+    return own + [w for w, _ in theirs], theirs
+
+
+def stating(canonical: ModelTree, wants: list[WantsCompiled]) -> Edit:
     """One edit stating, for every body and joint ``wants`` name, the canonical engine's."""
     bodies = {b: canonical.inertials[b] for w in wants for b in w.bodies}
     joints = {j: canonical.springs[j] for w in wants for j in w.joints}

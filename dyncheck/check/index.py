@@ -189,6 +189,20 @@ def frame(entries: list[Entry], engines: tuple[str, ...]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def coverage(entries: list[Entry], engines: tuple[str, ...]) -> str:
+    """On how many of the models checked (not refused) the referee judged each engine on the
+    whole model: on its reading of the file, or of a copy with the fixes its causes name
+    (:attr:`EngineVerdict.whole`)."""
+    checked = [e for e in entries if not e.refused]
+    counted = [(engine, sum(any(v.engine == engine and v.whole for v in e.verdicts)
+                            for e in checked))
+               for engine in engines if any(v.engine == engine for e in checked
+                                            for v in e.verdicts)]
+    return ("The referee judged each engine on the whole model (on its reading of the file, "
+            "or of a copy with every fix its causes name that edits the file) on: "
+            + ", ".join(f"{engine} {n} of {len(checked)}" for engine, n in counted) + ".")
+
+
 def index_page(entries: list[Entry], engines: tuple[str, ...]) -> str:
     table = frame(entries, engines)
     shown = table.copy()
@@ -209,6 +223,8 @@ def index_page(entries: list[Entry], engines: tuple[str, ...]) -> str:
         "referee, the book's general method, on that engine's own reading (computes what it "
         "read / computes differently as explained / computes differently / not compared). "
         "Each model's page gives the reasons and the fixes in its first lines.",
+        "",
+        coverage(entries, engines),
         "",
         markdown_table(shown, escaped=("model", "outcome")),
         "",

@@ -36,6 +36,7 @@ from dyncheck.check import (
     predicted,
     readings,
     validity,
+    with_fix,
 )
 from dyncheck.check import engines as engine_processes
 from dyncheck.check.against import Other, read_other
@@ -149,25 +150,15 @@ def check_model(
                           states=states, seed=seed, floating=floating,
                           other=other, load_seconds=time.perf_counter() - t0,
                           derivatives=derivatives, actuators=actuators, say=say, given=given,
-                          load=_copies(isolate=isolate, limits=limits))
+                          start=compiled_copy.starter(isolate=isolate, limits=limits))
     finally:
         engine_processes.stop(engines)
-
-
-def _copies(*, isolate: bool, limits: engine_processes.Limits | None) -> compiled_copy.Load:
-    """How an engine reads a copy of the model (a fix applied): as it read the file, in a
-    process of its own where the check isolates engines, stopped once it has read it."""
-    def load(engine: str, copy: ModelFile) -> ModelEngine | NotLoaded:
-        started = engine_processes.start([engine], copy, isolate=isolate, limits=limits)
-        engine_processes.stop(started)
-        return started[engine]
-    return load
 
 
 def _check(model: str, source_path: Path, source: ModelFile, *,
            engines: dict[str, ModelEngine | NotLoaded], chosen: tuple[str, ...],
            states: int, seed: int, floating: bool, other: Other | None,
-           load_seconds: float, load: compiled_copy.Load, derivatives: bool = False,
+           load_seconds: float, start: compiled_copy.Start, derivatives: bool = False,
            actuators: bool = True, say: Callable[[str], None] | None = None,
            given: GivenStates | None = None) -> CheckResult:
     """The check's steps in order: what loaded, what each engine read and whether it is
@@ -178,7 +169,7 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     seconds: dict[str, float] = {"load": load_seconds}
     loaded = _loaded(model, source_path, source, engines, rows, notes)
     first = next(iter(loaded.values()))
-    compiled_copy.measured(source, first.tree, loaded, load=load)
+    compiled_copy.measured(source, first.tree, loaded, start=start)
     canonical_tree = canonical_of(first.tree)
     if canonical_tree.nv == 0:
         raise inputs.ModelFileError(source_path, "has no degrees of freedom (nothing moves)")
@@ -203,6 +194,12 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     rows.extend(_pairs(model, canon, canonical_tree, batch, loaded, parts, results, differing,
                        own))
     rows.extend(closure_rows.rows(model, canonical_tree, loaded, batch))
+    name = next(iter(loaded))  # (the canonical engine's)
+    rows.extend(with_fix.rows(
+        model, source, canon=canon, canonical_tree=canonical_tree, batch=batch,
+        referee=own[name].dynamics if name in own else None, loaded=loaded,
+        targets=[e for e in loaded if e != name and (
+            e in differing or parts.get(e) is not None or e in unmatched)], start=start))
     if actuators and any(m.tree.actuators for m in loaded.values()):
         t0 = time.perf_counter()
         computed = {e: m for e, m in loaded.items() if e in results}  # (a failed one: its row)

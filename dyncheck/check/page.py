@@ -37,6 +37,8 @@ TITLES = {
     Section.ACTUATION: "Actuation (each engine's actuators against the first reading of them; "
                        "their force and step Jacobian in the controls against the referee)",
     Section.DERIVATIVES: "Derivatives (canonical chart; MuJoCo's by its own finite differences)",
+    Section.WITH_FIX: "With the fix (each engine that reads the file in part or otherwise, run "
+                      "on a copy with every fix its causes name that edits the file)",
 }
 
 
@@ -144,8 +146,8 @@ def page(result: CheckResult, versions: dict[str, str] | None = None, *,
     ]
     for section in Section:
         part = rows[rows["section"] == section.value]
-        if section in (Section.DERIVATIVES, Section.ACTUATION, Section.CLOSURES) and \
-                not len(part):
+        if section in (Section.DERIVATIVES, Section.ACTUATION, Section.CLOSURES,
+                       Section.WITH_FIX) and not len(part):
             continue  # not asked for, or nothing to check: no section that reads "none"
         lines += [f"## {TITLES[section]}", "",
                   _table(_marked(part), ["subject", "field", "impl_a", "impl_b", "error",

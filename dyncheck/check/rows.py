@@ -22,6 +22,8 @@ class Section(StrEnum):
     CLOSURES = "closures"
     ACTUATION = "actuation"
     DERIVATIVES = "derivatives"
+    WITH_FIX = "with the fix"
+    """An engine reading the file in part or otherwise, run on a copy with its fixes (#77)."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -52,6 +54,11 @@ class CheckRow:
     """A failed row's acceptance (``--accept``): the known finding's reason; empty otherwise."""
 
 
+WITH_FIX = "with the fix ({fix})"
+"""How a "with the fix" row's note begins (``fix``: the fixes in words)."""
+WITH_FIX_READING = "reading"
+"""The field of a "with the fix" row that says how the engine reads the copy
+(:mod:`.with_fix`)."""
 COMPUTED = "max rel error"
 """The field of a row that compares computed values, the largest relative error over the
 states (an actuation row's other fields compare readings)."""

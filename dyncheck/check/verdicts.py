@@ -12,7 +12,7 @@ from enum import StrEnum
 
 import pandas as pd
 
-from dyncheck.check.rows import COMPUTED, Section
+from dyncheck.check.rows import COMPUTED, WITH_FIX, WITH_FIX_READING, Section
 from dyncheck.roster import REFEREE
 from dyncheck.vocabulary import Verdict
 
@@ -55,6 +55,21 @@ class Controls(StrEnum):
     """No actuation rows: the model has no actuator, or they were not asked for."""
 
 
+class WithFix(StrEnum):
+    """How the engine reads and computes a copy with every fix its causes name that edits the
+    file (the "with the fix" rows, :mod:`.with_fix`): where it reads the file in part or
+    otherwise."""
+
+    ALIKE = "reads the model alike and computes what it read"
+    EXPLAINED = "reads the model alike and computes it differently only as explained"
+    DIFFER = "reads the model alike and computes differently"
+    READ_ONLY = "reads the model alike (computing not compared)"
+    OTHERWISE = "still reads it otherwise"
+    REFUSED = "refused the copy"
+    ABSENT = ""
+    """No copy: it reads the file alike, or names no fix that edits the file."""
+
+
 @dataclass(frozen=True, kw_only=True)
 class EngineVerdict:
     engine: str
@@ -64,6 +79,10 @@ class EngineVerdict:
     agreement_why: str
     controls: Controls = Controls.ABSENT
     controls_why: str = ""
+    with_fix: WithFix = WithFix.ABSENT
+    fix: str = ""
+    """The fixes the copy applies, in words."""
+    with_fix_why: str = ""
 
     @property
     def ok(self) -> bool:
@@ -75,15 +94,28 @@ class EngineVerdict:
     def line(self) -> str:
         """One sentence: the reading, then the dynamics, each with its first reason."""
         reading = self.reading.value + (f" ({self.reading_why})" if self.reading_why else "")
-        if self.reading in (Reading.REFUSED, Reading.SKIPPED):  # nothing computed
+        if self.reading is Reading.SKIPPED:  # nothing computed
             return reading
         agreement = self.agreement.value + (f" ({self.agreement_why})"
                                             if self.agreement_why else "")
+        fixed = "" if self.with_fix is WithFix.ABSENT else (
+            f"; with the fix ({self.fix}): {self.with_fix.value}"
+            + (f" ({self.with_fix_why})" if self.with_fix_why else ""))
+        if self.reading is Reading.REFUSED:
+            return reading + fixed
         if self.controls is Controls.ABSENT:
-            return f"{reading}; {agreement}"
+            return f"{reading}; {agreement}{fixed}"
         controls = self.controls.value + (f" ({self.controls_why})" if self.controls_why
                                           else "")
-        return f"{reading}; {agreement}; {controls}"
+        return f"{reading}; {agreement}; {controls}{fixed}"
+
+    @property
+    def whole(self) -> bool:
+        """Whether the referee judged the engine on the whole model: on the file (its reading
+        whole, its dynamics compared) or on the copy with its fixes (:class:`WithFix`)."""
+        return (self.reading in (Reading.ALIKE, Reading.DIFFERENTLY)
+                and self.agreement is not Agreement.NOT_COMPARED) or self.with_fix in (
+            WithFix.ALIKE, WithFix.EXPLAINED, WithFix.DIFFER)
 
 
 def _first_notes(rows: pd.DataFrame, limit: int = 2) -> str:
@@ -212,6 +244,32 @@ def _controls(engine: str, rows: pd.DataFrame) -> tuple[Controls, str]:
     return Controls.ALIKE, ""
 
 
+def _with_fix(engine: str, rows: pd.DataFrame) -> tuple[WithFix, str, str]:
+    """One rule, in this order: no "with the fix" row of the engine → absent; its copy
+    refused → refused; read otherwise → otherwise; no dynamics compared → read only; a
+    failed dynamics row → differ; an explained one → explained; else alike. With the fixes
+    in words and the first reason."""
+    part = rows[(rows["section"] == Section.WITH_FIX) & (rows["impl_b"] == engine)]
+    reading = part[part["field"] == WITH_FIX_READING]
+    if reading.empty:
+        return WithFix.ABSENT, "", ""
+    first = reading.iloc[0]
+    fix = str(first["value_a"])
+    if first["verdict"] == Verdict.FAILED:
+        kind = WithFix.REFUSED if first["value_b"] == "refused" else WithFix.OTHERWISE
+        return kind, fix, str(first["note"]).removeprefix(WITH_FIX.format(fix=fix)).lstrip(",: ")
+    computed = part[part["field"] != WITH_FIX_READING]
+    failed = computed[computed["verdict"] == Verdict.FAILED]
+    explained = computed[computed["verdict"] == Verdict.EXPLAINED]
+    if computed.empty:
+        return WithFix.READ_ONLY, fix, ""
+    if not failed.empty:
+        return WithFix.DIFFER, fix, ", ".join(dict.fromkeys(failed["subject"]))
+    if not explained.empty:
+        return WithFix.EXPLAINED, fix, ", ".join(dict.fromkeys(explained["subject"]))
+    return WithFix.ALIKE, fix, "the referee on the canonical reading"
+
+
 def per_engine(rows: pd.DataFrame, impls: tuple[str, ...]) -> list[EngineVerdict]:
     """One verdict per engine asked for (the referee is the judge, not judged)."""
     loads = rows[(rows["section"] == Section.LOAD) & (rows["verdict"] == Verdict.PASSED)]
@@ -225,7 +283,9 @@ def per_engine(rows: pd.DataFrame, impls: tuple[str, ...]) -> list[EngineVerdict
         controls, controls_why = _controls(engine, rows)
         if engine == canonical and controls is Controls.ALIKE:
             controls_why = "the canonical reading"
+        with_fix, fix, with_fix_why = _with_fix(engine, rows)
         out.append(EngineVerdict(engine=engine, reading=reading, reading_why=reading_why,
                                  agreement=agreement, agreement_why=agreement_why,
-                                 controls=controls, controls_why=controls_why))
+                                 controls=controls, controls_why=controls_why,
+                                 with_fix=with_fix, fix=fix, with_fix_why=with_fix_why))
     return out
