@@ -190,17 +190,21 @@ def frame(entries: list[Entry], engines: tuple[str, ...]) -> pd.DataFrame:
 
 
 def coverage(entries: list[Entry], engines: tuple[str, ...]) -> str:
-    """On how many of the models checked (not refused) the referee judged each engine on the
-    whole model: on its reading of the file, or of a copy with the fixes its causes name
-    (:attr:`EngineVerdict.whole`)."""
-    checked = [e for e in entries if not e.refused]
-    counted = [(engine, sum(any(v.engine == engine and v.whole for v in e.verdicts)
-                            for e in checked))
-               for engine in engines if any(v.engine == engine for e in checked
-                                            for v in e.verdicts)]
-    return ("The referee judged each engine on the whole model (on its reading of the file, "
-            "or of a copy with every fix its causes name that edits the file) on: "
-            + ", ".join(f"{engine} {n} of {len(checked)}" for engine, n in counted) + ".")
+    """On how many of the models the first engine read (MuJoCo, where asked for: the models
+    it compiles) the referee judged each engine on the whole model: on its reading of the
+    file, or of a copy with the fixes its causes name (:attr:`EngineVerdict.whole`)."""
+    present = [e for e in engines if any(v.engine == e for x in entries for v in x.verdicts)]
+    if not present:
+        return ""
+    first = present[0]
+    read = [x for x in entries if any(v.engine == first and v.reading not in (
+        Reading.REFUSED, Reading.SKIPPED) for v in x.verdicts)]
+    whole = {engine: sum(any(v.engine == engine and v.whole for v in x.verdicts)
+                         for x in read) for engine in present}
+    counted = ", ".join(f"{engine} {n}" for engine, n in whole.items())
+    return (f"Of the {len(read)} models {first} read, the referee judged each engine on the "
+            "whole model (on its reading of the file, or of a copy with every fix its causes "
+            f"name that edits the file) on: {counted}.")
 
 
 def index_page(entries: list[Entry], engines: tuple[str, ...]) -> str:

@@ -128,7 +128,8 @@ def test_the_with_fix_answer_follows_from_its_rows_by_one_rule(rows, expected):
 
 def test_the_index_counts_the_engines_judged_on_the_whole_model():
     """Three models: Pinocchio holds part of one and is judged on its fixed copy, holds part
-    of another with no fix that closes it, and reads the third alike: 2 of 3."""
+    of another with no fix that closes it, and reads the third alike: 2 of the 3 it read
+    (the first engine's models are the denominator)."""
     def verdict(reading, with_fix):
         return EngineVerdict(engine="pinocchio", reading=reading, reading_why="",
                              agreement=index.Agreement.AGREE, agreement_why="",
@@ -137,4 +138,5 @@ def test_the_index_counts_the_engines_judged_on_the_whole_model():
                for m, r, w in (("a", Reading.PART, WithFix.ALIKE),
                                ("b", Reading.PART, WithFix.OTHERWISE),
                                ("c", Reading.ALIKE, WithFix.ABSENT))]
-    assert "pinocchio 2 of 3" in index.coverage(entries, ("pinocchio",))
+    assert "Of the 3 models pinocchio read" in index.coverage(entries, ("pinocchio",))
+    assert index.coverage(entries, ("pinocchio",)).endswith("on: pinocchio 2.")
