@@ -299,6 +299,17 @@ INPUT_STATES = 8
 2 nu steps a state, twice)."""
 
 
+PART = ("not compared: {engine} holds part of the model (the description rows say which "
+        "joints), and a force on the joints it lacks has nowhere to act")
+
+
+def held_in_part(model: str, engines: list[str]) -> list[CheckRow]:
+    """One skipped row per engine whose dynamics were compared on part of the model only:
+    its actuators are not (their forces act in the canonical layout)."""
+    return [_row(model, subject="model", field=FORCE, a=engine, b="", verdict=Verdict.SKIPPED,
+                 note=PART.format(engine=engine)) for engine in engines]
+
+
 def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
          loaded: dict[str, ModelEngine], seed: int, smooth: dict[str, Dynamics] | None = None,
          own: dict[str, Dynamics] | None = None) -> tuple[list[CheckRow], list[str]]:

@@ -305,3 +305,27 @@ def test_a_wrong_kv_does_not_verify_drakes_damping_cause(servo_arm, monkeypatch)
     assert bias["note"].str.startswith("cause unknown: the named fix (JointActuator."
                                        "set_controller_gains(PdControllerGains(p=50, d=1))").all()
     assert not bias["note"].str.contains("fix verified").any()
+
+
+FRAMED = """<mujoco model="framed"><worldbody>
+  <body name="arm" pos="0 0 1"><joint name="shoulder" type="hinge" axis="0 1 0"/>
+    <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02"/></body>
+  <frame pos="1 0 0"><body name="cart"><joint name="slide" type="slide" axis="1 0 0"/>
+    <geom type="box" size="0.1 0.1 0.1"/></body></frame>
+</worldbody><actuator><motor joint="shoulder"/></actuator></mujoco>"""
+"""Drake's MJCF parser ignores <frame> (measured): it holds the arm, not the cart."""
+
+
+def test_an_engine_holding_part_of_the_model_has_its_actuators_skipped(tmp_path):
+    """Drake holds part of the model (its dynamics compared on the joints it holds): its
+    actuators' force is one skipped row that says why — never an exception out of the check
+    (a force in the canonical layout on joints it lacks; the check once raised KeyError on
+    mujoco_warp's flex/floppy.xml)."""
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    path = tmp_path / "framed.xml"
+    path.write_text(FRAMED)
+    result = check_model(path, states=4, impls=("reference", "mujoco", "drake"),
+                         isolate=False)
+    rows = _rows(result, section="actuation", impl_a="drake")
+    assert list(rows["verdict"]) == ["skipped"], rows[["field", "verdict", "note"]]
+    assert "drake holds part of the model" in rows.iloc[0]["note"]
