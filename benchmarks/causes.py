@@ -3,7 +3,8 @@ model given (files, or folders walked for ``*.xml`` and ``*.urdf``), every verif
 (each hint's fix applied to a copy and read by its engine, :mod:`dyncheck.check.proofs`),
 and each row that names a cause counted by where it stands: fix verified; the fix measured
 and a gap left (cause unknown, its share stated); suspected (its fix not measured: a cause
-dyncheck cannot yet prove). Exits 1 where any row is only suspected, naming each.
+dyncheck cannot yet prove). Exits 1 where any row is only suspected, or the check crashed on a
+model (a defect of dyncheck's own), naming each.
 
     python benchmarks/causes.py MODEL_OR_FOLDER... [--impl mujoco,pinocchio,drake]
         [--states 10] [--out causes.md]
@@ -40,13 +41,22 @@ def models(paths: list[Path]) -> list[Path]:
     return out
 
 
+CRASHED = "dyncheck crashed (a defect of ours)"
+
+
+def _one(path: Path, standing: str, note: str) -> pd.DataFrame:
+    return pd.DataFrame([{"model": path.name, "impl_b": "", "subject": "", "field": "",
+                          "standing": standing, "note": note}])
+
+
 def causes(path: Path, *, impls: tuple[str, ...], states: int) -> pd.DataFrame:
     """The rows of ``path``'s check that name a cause, with where each stands."""
     try:
         rows = check_model(path, impls=impls, states=states).rows
     except DyncheckError as exc:  # refused by every engine, or not a model: its own row
-        return pd.DataFrame([{"model": path.name, "impl_b": "", "subject": "", "field": "",
-                              "standing": "refused", "note": str(exc).splitlines()[0]}])
+        return _one(path, "refused", str(exc).splitlines()[0])
+    except Exception as exc:  # a defect of dyncheck's own: counted, and the run goes on
+        return _one(path, CRASHED, f"{type(exc).__name__}: {exc}")
     rows = rows[rows["note"].astype(str) != ""].copy()
     rows["standing"] = [standing(n).value for n in rows["note"]]
     rows = rows[rows["standing"] != Standing.UNNAMED.value]
@@ -68,9 +78,9 @@ def main() -> int:
     table = pd.concat([causes(p, impls=tuple(args.impl.split(",")), states=args.states)
                        for p in found], ignore_index=True)
     counts = table.groupby("standing").size().rename("rows").reset_index()
-    suspected = table[table["standing"] == Standing.SUSPECTED.value]
+    suspected = table[table["standing"].isin((Standing.SUSPECTED.value, CRASHED))]
     text = (f"# Causes re-proved: {len(found)} models\n\n"
-            + markdown_table(counts) + "\n\n## Suspected (fix not measured)\n\n"
+            + markdown_table(counts) + "\n\n## Suspected (fix not measured), and crashes\n\n"
             + (markdown_table(suspected.drop(columns="standing")) if len(suspected)
                else "none") + "\n")
     if args.out:

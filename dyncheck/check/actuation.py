@@ -11,6 +11,7 @@ over 1.5 times the control that reaches the force bound (saturated); else in [âˆ
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -191,6 +192,9 @@ def _against_referee(model: str, tree: ModelTree, f: Forces, *, acts: law.JointA
 
 
 FORWARD = "forward dynamics with the control"
+SINGULAR = ("not compared: M on {engine}'s reading is singular at a sampled state (a joint "
+            "whose motion no mass resists, or two joints along one direction), so no forward "
+            "dynamics are defined")
 
 
 def _forward_row(model: str, tree: ModelTree, f: Forces, *, forward: np.ndarray,
@@ -204,7 +208,11 @@ def _forward_row(model: str, tree: ModelTree, f: Forces, *, forward: np.ndarray,
     tdot_v = np.array([s.tdot_v for s in f.maps])
     with_u = np.linalg.solve(t, (forward - tdot_v)[..., None])[..., 0]
     tau = (np.swapaxes(t, 1, 2) @ expected[..., None])[..., 0]
-    increment = np.linalg.solve(own.mass_matrix, tau[..., None])[..., 0]
+    try:
+        increment = np.linalg.solve(own.mass_matrix, tau[..., None])[..., 0]
+    except np.linalg.LinAlgError:  # the model's own fault, which its dynamics row names
+        return _row(model, subject=FORWARD, field=COMPUTED, a=REFEREE, b=tree.engine,
+                    verdict=Verdict.SKIPPED, note=SINGULAR.format(engine=tree.engine))
     found = with_u - smooth.forward
     scale = max(float(np.abs(increment).max(initial=0.0)),
                 float(np.abs(smooth.forward).max(initial=0.0)), 1e-300)
@@ -301,13 +309,34 @@ INPUT_STATES = 8
 
 PART = ("not compared: {engine} holds part of the model (the description rows say which "
         "joints), and a force on the joints it lacks has nowhere to act")
+UNDEFINED = ("not compared: the model's dynamics are not defined as read (the referee's "
+             "{fields} on {engine}'s reading are not finite: its dynamics row says why)")
 
 
-def held_in_part(model: str, engines: list[str]) -> list[CheckRow]:
-    """One skipped row per engine whose dynamics were compared on part of the model only:
-    its actuators are not (their forces act in the canonical layout)."""
-    return [_row(model, subject="model", field=FORCE, a=engine, b="", verdict=Verdict.SKIPPED,
-                 note=PART.format(engine=engine)) for engine in engines]
+def section(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,
+            loaded: dict[str, ModelEngine], seed: int, smooth: dict[str, Dynamics],
+            parts: Mapping[str, object], own: dict[str, Dynamics]) -> tuple[
+                list[CheckRow], list[str]]:
+    """The actuation section (:func:`rows`) of the engines whose dynamics were computed
+    (``smooth``) on the whole model; one skipped row for each that holds part of it, and one
+    for the model where its dynamics are not defined as read (the referee's on the
+    canonical reading not finite: a singular M)."""
+    first = next(iter(loaded))
+    bad = [f for f in ("mass_matrix", "forward") if first in own and not np.all(
+        np.isfinite(getattr(own[first], f)))]
+    if bad:
+        return [_row(model, subject="model", field=FORCE, a=REFEREE, b="",
+                     verdict=Verdict.SKIPPED, note=UNDEFINED.format(
+                         fields=", ".join(bad), engine=first))], []
+    whole = {e: m for e, m in loaded.items() if e in smooth and parts.get(e) is None}
+    out = [_row(model, subject="model", field=FORCE, a=e, b="", verdict=Verdict.SKIPPED,
+                note=PART.format(engine=e))
+           for e in loaded if e in smooth and parts.get(e) is not None]
+    if not whole:
+        return out, []
+    found, said = rows(model, canon=canon, canonical=canonical, batch=batch, loaded=whole,
+                       seed=seed, smooth=smooth, own=own)
+    return out + found, said
 
 
 def rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: States,

@@ -4,8 +4,10 @@ with the canonical engine's before any field is compared)."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import replace
 
+from dyncheck.adapters.closures import Closure
 from dyncheck.adapters.model_tree import ModelTree, TreeJoint
 
 
@@ -56,7 +58,18 @@ def align_by_body(canonical: ModelTree, tree: ModelTree) -> tuple[ModelTree, lis
                      "the file) matched by their place in the tree: " + ", ".join(
                          f"{old!r} = {new!r}" for old, new in by_place.items()))
     return replace(tree, joints=joints, hints=tuple(
-        (renames.get(j, j), f, why) for j, f, why in tree.hints)), notes
+        (renames.get(j, j), f, why) for j, f, why in tree.hints),
+        closures=tuple(_renamed(c, renames) for c in tree.closures)), notes
+
+
+def _renamed(closure: Closure, renames: Mapping[str, str]) -> Closure:
+    """``closure`` with the joints it names renamed as its tree's are (a free joint Drake
+    names after its body, held by a ``<connect>``)."""
+    def name(joint: str | None) -> str | None:
+        return None if joint is None else renames.get(joint, joint)
+    return replace(closure, joint1=name(closure.joint1), joint2=name(closure.joint2),
+                   first=tuple((renames.get(j, j), k) for j, k in closure.first),
+                   second=tuple((renames.get(j, j), k) for j, k in closure.second))
 
 
 def with_fixed_aligned(canonical: ModelTree, tree: ModelTree) -> ModelTree:

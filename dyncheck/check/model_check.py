@@ -202,14 +202,9 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
             e in differing or parts.get(e) is not None or e in unmatched)], start=start))
     if actuators and any(m.tree.actuators for m in loaded.values()):
         t0 = time.perf_counter()
-        computed = {e: m for e, m in loaded.items()  # (a failed one, a partial one: its row)
-                    if e in results and parts.get(e) is None}
-        rows.extend(actuation.held_in_part(model, [e for e in loaded if e in results
-                                                  and parts.get(e) is not None]))
-        found, said = actuation.rows(
-            model, canon=canon, canonical=canonical_tree, batch=batch, loaded=computed,
-            seed=seed, smooth=results, own={e: r.dynamics for e, r in own.items()},
-        ) if computed else ([], [])
+        found, said = actuation.section(
+            model, canon=canon, canonical=canonical_tree, batch=batch, loaded=loaded,
+            seed=seed, smooth=results, parts=parts, own={e: r.dynamics for e, r in own.items()})
         rows.extend(found)
         notes.extend(said)
         seconds["actuation"] = time.perf_counter() - t0

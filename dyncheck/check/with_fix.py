@@ -64,8 +64,9 @@ def rows(model: str, source: ModelFile, *, canon: layout.Canonical, canonical_tr
          targets: list[str], start: compiled_copy.Start) -> list[CheckRow]:
     """For each engine of ``targets`` (those reading the file in part or otherwise) that
     names a fix editing the file: a row saying how it reads the copy with every such fix
-    (alike, or the first field still read otherwise, or its refusal), and where alike, its
-    dynamics on the copy against the ``referee`` on the canonical reading."""
+    (alike in every field the dynamics use, or the first such field still read otherwise,
+    or its refusal), and where alike, its dynamics on the copy against the ``referee`` on
+    the canonical reading."""
     out: list[CheckRow] = []
     if source.format is not Format.MJCF:
         return out
@@ -81,8 +82,8 @@ def rows(model: str, source: ModelFile, *, canon: layout.Canonical, canonical_tr
                                 fix=words, value="refused"))
                 continue
             tree = align_by_body(canonical_tree, fixed.tree)[0]
-            still = [r for r in describe.diff(model, canonical_tree, tree)
-                     if r.verdict is Verdict.FAILED]
+            still = [r for r in describe.diff(model, canonical_tree, tree)  # (what enters
+                     if r.verdict is Verdict.FAILED and r.field in describe.ENTERS]  # M, h)
             if still or [j.name for j in tree.joints] != list(canon.names):
                 first = still[0] if still else None
                 out.append(_row(model, engine, Verdict.FAILED, (

@@ -329,3 +329,27 @@ def test_an_engine_holding_part_of_the_model_has_its_actuators_skipped(tmp_path)
     rows = _rows(result, section="actuation", impl_a="drake")
     assert list(rows["verdict"]) == ["skipped"], rows[["field", "verdict", "note"]]
     assert "drake holds part of the model" in rows.iloc[0]["note"]
+
+
+SINGULAR = """<mujoco model="singular"><worldbody>
+  <body name="box"><joint name="s1" type="slide" axis="1 0 0"/>
+    <joint name="s2" type="slide" axis="0 1 0"/><joint name="s3" type="slide" axis="1 1 0"/>
+    <geom type="box" size=".05 .05 .05" mass="1"/></body>
+</worldbody><actuator><motor joint="s1"/><motor joint="s3"/></actuator></mujoco>"""
+"""MJX's actuator/general_dyntype.xml in small: a third slide along the sum of the first two,
+so M is singular (rank 2 of 3: an independent derivation) and no forward dynamics exist."""
+
+
+def test_a_model_whose_dynamics_are_undefined_skips_its_actuation_once(tmp_path):
+    """The dynamics row names the singular M; the actuation section is one skipped row that
+    points to it — never a LinAlgError out of the check (it once raised one here)."""
+    path = tmp_path / "singular.xml"
+    path.write_text(SINGULAR)
+    result = check_model(path, states=4, impls=("reference", "mujoco", "pinocchio"),
+                         isolate=False)
+    rows = _rows(result)
+    assert list(rows["verdict"]) == ["skipped"], rows[["impl_a", "field", "note"]]
+    assert "the model's dynamics are not defined as read" in rows.iloc[0]["note"]
+    dynamics = result.rows[(result.rows["section"] == "dynamics")
+                           & (result.rows["impl_a"] == "reference")]
+    assert dynamics["note"].str.contains("M is singular").any(), dynamics["note"].tolist()
