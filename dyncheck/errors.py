@@ -7,7 +7,8 @@ that names the field (or argument) and the offending value.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 
@@ -94,6 +95,26 @@ class Unsupported(DyncheckError):
 
 class EngineError(DyncheckError, RuntimeError):
     """An engine call failed or returned a non-finite value."""
+
+
+class Defect(DyncheckError, RuntimeError):
+    """dyncheck failed on an input by a fault of its own (not the input's, not an engine's):
+    said in one line that names the model and asks for a report, costing only that model's
+    line where several are checked."""
+
+
+@contextmanager
+def as_defect(what: str) -> Iterator[None]:
+    """An exception of dyncheck's own while working on ``what`` (a model, shown), said in
+    one line that names it (:class:`Defect`): never a traceback, and where several are
+    checked, only its line. dyncheck's errors pass as they are."""
+    try:
+        yield
+    except (DyncheckError, MemoryError):  # (its own words; a process out of memory)
+        raise
+    except Exception as exc:
+        raise Defect(f"{what}: dyncheck failed on this model, a defect of its own (please "
+                     f"report it): {type(exc).__name__}: {exc}") from exc
 
 
 class Terminated(KeyboardInterrupt):

@@ -56,7 +56,7 @@ from dyncheck.check.given_states import given as given_states_of
 from dyncheck.check.referee import ReferenceModel, standing_of
 from dyncheck.check.rows import COLUMNS, CheckResult, CheckRow, Section
 from dyncheck.check.states import States, condition
-from dyncheck.errors import InvalidInput, UnknownName
+from dyncheck.errors import InvalidInput, UnknownName, as_defect
 from dyncheck.escaping import shown
 from dyncheck.vocabulary import Quantity, Verdict
 
@@ -145,7 +145,7 @@ def check_model(
     engines = engine_processes.start([i for i in chosen if i in ENGINES], source,
                                      isolate=isolate, limits=limits)
     try:  # an overflow is a non-finite value, reported as a row: never a warning on stderr
-        with np.errstate(all="ignore"):
+        with np.errstate(all="ignore"), as_defect(shown(str(source_path))):
             return _check(model, source_path, source, engines=engines, chosen=chosen,
                           states=states, seed=seed, floating=floating,
                           other=other, load_seconds=time.perf_counter() - t0,

@@ -393,3 +393,35 @@ def test_dynamics_undefined_on_the_model_as_read_are_not_a_computing_finding(tmp
     failed = rows[rows["verdict"] == "failed"]
     assert list(failed["impl_a"]) == ["reference"], failed
     assert "M is singular" in failed["note"].iloc[0] and not result.ok
+
+
+def test_a_defect_of_dyncheck_costs_one_model_one_line(tmp_path, monkeypatch, capsys):
+    """An exception of dyncheck's own inside a model's check (planted: the closure rows raise
+    KeyError, as they once did on a file an engine names otherwise) is one line naming the
+    model and asking for a report; with two models, the other's page is still written and
+    the broken one is a line of the index — never a traceback."""
+    from dyncheck.__main__ import main
+    from dyncheck.check import closure_rows
+
+    chain = ('<mujoco model="{n}"><worldbody><body name="a" pos="0 0 1"><joint name="j" '
+             'axis="0 1 0"/><geom type="sphere" size="0.1" pos="0.2 0 0"/></body></worldbody>'
+             '</mujoco>')
+    for name in ("first", "second"):
+        (tmp_path / f"{name}.xml").write_text(chain.format(n=name))
+    real = closure_rows.rows
+
+    def planted(model, *args, **kwargs):
+        if model == "first":
+            raise KeyError("planted")
+        return real(model, *args, **kwargs)
+    monkeypatch.setattr(closure_rows, "rows", planted)
+    code = main(["check", str(tmp_path / "first.xml"), str(tmp_path / "second.xml"),
+                 "--states", "3", "--impl", "mujoco", "--out", str(tmp_path / "out"),
+                 "--jobs", "1"])
+    err = capsys.readouterr().err
+    assert code != 0
+    assert "Traceback" not in err
+    lines = [line for line in err.splitlines() if "defect of its own" in line]
+    assert len(lines) == 1 and "first.xml" in lines[0] and "KeyError" in lines[0], err
+    assert (tmp_path / "out" / "second.md").is_file()
+    assert "defect of its own" in (tmp_path / "out" / "index.md").read_text()
