@@ -24,12 +24,13 @@ from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check.actuator_readings import UNKNOWN, match, reading_rows
 from dyncheck.check.actuator_readings import section_row as _row
 from dyncheck.check.computed import depth
+from dyncheck.check.dynamics import QUANTITIES
 from dyncheck.check.engines import REFEREE
 from dyncheck.check.rows import COMPUTED, CheckRow
 from dyncheck.check.states import States, condition
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.reference import actuation as law
-from dyncheck.vocabulary import Verdict
+from dyncheck.vocabulary import Quantity, Verdict
 
 FORCE = "actuator force"
 DYNAMICS = {Activation.NONE: law.NONE, Activation.INTEGRATOR: law.INTEGRATOR,
@@ -322,8 +323,8 @@ def section(model: str, *, canon: Canonical, canonical: ModelTree, batch: States
     for the model where its dynamics are not defined as read (the referee's on the
     canonical reading not finite: a singular M)."""
     first = next(iter(loaded))
-    bad = [f for f in ("mass_matrix", "forward") if first in own and not np.all(
-        np.isfinite(getattr(own[first], f)))]
+    bad = [f for f in (QUANTITIES[Quantity.MASS_MATRIX], QUANTITIES[Quantity.FORWARD_DYNAMICS])
+           if first in own and not np.all(np.isfinite(getattr(own[first], f)))]
     if bad:
         return [_row(model, subject="model", field=FORCE, a=REFEREE, b="",
                      verdict=Verdict.SKIPPED, note=UNDEFINED.format(

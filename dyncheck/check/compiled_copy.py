@@ -12,10 +12,11 @@ from __future__ import annotations
 
 import tempfile
 import xml.etree.ElementTree as ET
-from collections.abc import Callable, Iterator, Mapping
-from contextlib import AbstractContextManager, contextmanager
+from collections.abc import Callable, Mapping
+from contextlib import AbstractContextManager
 from dataclasses import replace
 from pathlib import Path
+from typing import Protocol
 
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.formats.edits import Edit, both, copied
@@ -23,27 +24,19 @@ from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.model_tree import FixedReading, Inertial, ModelTree, WantsCompiled
 from dyncheck.adapters.registration import Format
-from dyncheck.check import engines as engine_processes
 from dyncheck.check.alignment import align_by_body
-from dyncheck.check.engines import NotLoaded
 
-Start = Callable[[str, ModelFile], AbstractContextManager["ModelEngine | NotLoaded"]]
+
+class Refused(Protocol):
+    """Why an engine has no model of a copy (:class:`.engines.NotLoaded`)."""
+
+    @property
+    def message(self) -> str: ...
+
+Start = Callable[[str, ModelFile], AbstractContextManager["ModelEngine | Refused"]]
 """An engine (by name) loaded on a copy of the model for as long as the context lasts: in a
-process of its own where the check isolates engines."""
+process of its own where the check isolates engines (:func:`.engines.running`)."""
 
-
-def starter(*, isolate: bool, limits: engine_processes.Limits | None) -> Start:
-    """How an engine reads a copy of the model (a fix applied): as it read the file, in a
-    process of its own where the check isolates engines (within ``limits``), stopped when
-    done."""
-    @contextmanager
-    def start(engine: str, copy: ModelFile) -> Iterator[ModelEngine | NotLoaded]:
-        started = engine_processes.start([engine], copy, isolate=isolate, limits=limits)
-        try:
-            yield started[engine]
-        finally:
-            engine_processes.stop(started)
-    return start
 
 WORDS = "an <inertial> on {bodies} stating the mass, centre of mass and inertia {engine} compiles"
 DROPPED = ", settotalmass dropped"
@@ -121,8 +114,8 @@ def measured(source: ModelFile, canonical: ModelTree, loaded: dict[str, ModelEng
             copy = copied(source, inline(source.path), (fix,), Path(folder))
             with start(engine, copy) as read:
                 pass  # (its tree is read on loading)
-        tree = None if isinstance(read, NotLoaded) else align_by_body(canonical, read.tree)[0]
-        refused = read.message if isinstance(read, NotLoaded) else ""
+        tree = align_by_body(canonical, read.tree)[0] if isinstance(read, ModelEngine) else None
+        refused = "" if isinstance(read, ModelEngine) else read.message
         m.tree = replace(m.tree, hints=(*m.tree.hints, *(h for _, h in theirs)), fixed=(
             *m.tree.fixed, *(
             FixedReading(subject=w.subject, fields=w.fields, fix=fix.words, tree=tree,

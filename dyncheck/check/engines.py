@@ -25,7 +25,7 @@ import signal
 import sys
 import tempfile
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
 from typing import Any
@@ -428,6 +428,18 @@ def start(names: list[str], source: ModelFile, *, isolate: bool,
         return {name: load(name, source) for name in names}
     started = {name: Isolated(name, source, limits) for name in names}
     return {name: proxy.loaded() for name, proxy in started.items()}
+
+
+@contextlib.contextmanager
+def running(name: str, source: ModelFile, *, isolate: bool,
+            limits: Limits | None = None) -> Iterator[ModelEngine | NotLoaded]:
+    """Engine ``name`` loaded on ``source`` (a copy of the model with a fix applied, #77) as
+    :func:`start` loads it, for as long as the context lasts."""
+    started = start([name], source, isolate=isolate, limits=limits)
+    try:
+        yield started[name]
+    finally:
+        stop(started)
 
 
 def stop(engines: dict[str, ModelEngine | NotLoaded]) -> None:

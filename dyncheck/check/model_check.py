@@ -13,6 +13,7 @@ Usable from a user's own test suite::
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Callable
 from dataclasses import replace
@@ -150,7 +151,8 @@ def check_model(
                           states=states, seed=seed, floating=floating,
                           other=other, load_seconds=time.perf_counter() - t0,
                           derivatives=derivatives, actuators=actuators, say=say, given=given,
-                          start=compiled_copy.starter(isolate=isolate, limits=limits))
+                          start=functools.partial(engine_processes.running, isolate=isolate,
+                                        limits=limits))
     finally:
         engine_processes.stop(engines)
 

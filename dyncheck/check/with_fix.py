@@ -26,7 +26,6 @@ from dyncheck.adapters.registration import Format
 from dyncheck.check import compiled_copy, describe, predicted
 from dyncheck.check.alignment import align_by_body
 from dyncheck.check.dynamics import compare
-from dyncheck.check.engines import NotLoaded
 from dyncheck.check.referee import standing_of
 from dyncheck.check.rows import COMPUTED, WITH_FIX, WITH_FIX_READING, CheckRow, Section
 from dyncheck.check.states import States
@@ -77,7 +76,7 @@ def rows(model: str, source: ModelFile, *, canon: layout.Canonical, canonical_tr
         text, words = made
         fix = WITH_FIX.format(fix=words)
         with _written(source, text) as copy, start(engine, copy) as fixed:
-            if isinstance(fixed, NotLoaded):
+            if not isinstance(fixed, ModelEngine):
                 out.append(_row(model, engine, Verdict.FAILED, f"{fix}: {fixed.message}",
                                 fix=words, value="refused"))
                 continue
@@ -110,7 +109,7 @@ def _computed(model: str, engine: str, fix: str, *, canon: layout.Canonical,
         dyn = layout_batch.to_canonical(maps, fixed.dynamics(q_e, v_e, a_e))
     except Exception as exc:  # its failure on the copy costs this row only
         return [replace(_row(model, engine, Verdict.FAILED, f"{fix}: {type(exc).__name__}: "
-                             f"{exc}", fix=fix, value="failed"), subject="dynamics",
+                             f"{exc}", fix=fix, value="computing failed"), subject="dynamics",
                         field=COMPUTED)]
     vertices = 0.0 if tree.mesh_rounding else 2 * max(canonical_tree.mesh_rounding.values(),
                                                       default=0.0)
