@@ -8,6 +8,8 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from collections.abc import Iterator
 
+import numpy as np
+
 from dyncheck.adapters.formats.mjcf_copy import joints
 from dyncheck.adapters.proof import Proof
 
@@ -27,6 +29,17 @@ def springdampers(root: ET.Element, engine: str) -> Iterator[tuple[str, str, str
         value = joint.attrs.get("springdamper")
         if name and value and any(float(x) for x in value.split()):
             yield name, "damping", SPRINGDAMPER.format(engine=engine, value=value)
+
+
+def stated_gravity(root: ET.Element) -> np.ndarray | None:
+    """The gravity the MJCF ``root`` (includes inlined) states in ``<option gravity>``,
+    where it is not the 0 0 −9.81 that Pinocchio and PyBullet keep when they do not read
+    it (their default, and MuJoCo's)."""
+    stated = [o.get("gravity", "") for o in root.iter("option") if o.get("gravity")]
+    if not stated:
+        return None
+    gravity = np.array([float(x) for x in stated[-1].split()])
+    return None if np.allclose(gravity, (0.0, 0.0, -9.81)) else gravity
 
 
 PROOFS = {

@@ -26,7 +26,7 @@ from dyncheck.adapters.formats.mjcf_copy import (
     joints,
     placed,
 )
-from dyncheck.adapters.formats.mjcf_unread import springdampers
+from dyncheck.adapters.formats.mjcf_unread import springdampers, stated_gravity
 from dyncheck.adapters.model_tree import WantsCompiled
 from dyncheck.adapters.pinocchio.fixes import (
     CLASS_MASSES,
@@ -234,15 +234,6 @@ def _model_hints(root: ET.Element, bare: int, held: frozenset[str],
     if gravity is not None:
         yield Found("model", "gravity", GRAVITY_IGNORED.format(
             gravity=" ".join(f"{g:g}" for g in gravity)))
-
-
-def stated_gravity(root: ET.Element) -> np.ndarray | None:
-    """The gravity the MJCF ``root`` states, where it is not Pinocchio's default."""
-    stated = [o.get("gravity", "") for o in root.iter("option") if o.get("gravity")]
-    if not stated:
-        return None
-    gravity = np.array([float(x) for x in stated[-1].split()])
-    return None if np.allclose(gravity, (0.0, 0.0, -9.81)) else gravity
 
 
 def _weighs(geom: Placed) -> bool:

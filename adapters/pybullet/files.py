@@ -27,6 +27,7 @@ GRAVITY_HINT = (
     "PyBullet's MJCF reader does not read <option gravity> (a PyBullet user sets it with "
     "setGravity; here 0 0 -9.81)"
 )
+GRAVITY_FIX = "setGravity({gravity}) after loading, the gravity the file states"
 ARMATURE_HINT = "PyBullet has no joint armature (rotor inertia): its M leaves it out"
 DIAGONALIZATION = 1e-6
 """PyBullet's URDF importer stores a link's inertia as principal moments found by
@@ -190,7 +191,7 @@ def bare_links(source: ModelFile, links: list[Link]) -> dict[str, list[str]]:
 
 
 PROOFS = {
-    "GRAVITY_HINT": Proof.SUSPECTED,
+    "GRAVITY_HINT": Proof.FIX,
     "ARMATURE_HINT": Proof.MEASURED,
     "ACCURACY_HINT": Proof.PREDICTED,
     "NO_INERTIAL": Proof.FIX,

@@ -45,9 +45,12 @@ import pybullet as pb
 
 from dyncheck.adapters.base import Field, ModelEngine, Offer
 from dyncheck.adapters.formats.files import ModelFile
+from dyncheck.adapters.formats.includes import inline
+from dyncheck.adapters.formats.mjcf_unread import stated_gravity
 from dyncheck.adapters.model_tree import (
     Axes,
     Dynamics,
+    FixedReading,
     GravityFrame,
     JointType,
     Layout,
@@ -65,6 +68,7 @@ from dyncheck.adapters.pybullet.files import (
     DIAGONALIZATION,
     FLAGS_NOTE,
     FREE_BASE,
+    GRAVITY_FIX,
     GRAVITY_HINT,
     MAX_LINKS,
     Link,
@@ -136,16 +140,29 @@ class PybulletModel(PybulletState, ModelEngine):
         if source.format is Format.URDF:
             hints += (("model", "inertia accuracy", ACCURACY_HINT),)
         self.tree = self._tree(links, notes, hints)
-        if fixes:  # (#77: the fix of a bare link measured on a copy)
-            self.tree = replace(self.tree, fixed=inertial_fixed(source, bare, self._copy_tree))
+        if fixes:  # (#77: the fix of a bare link measured on a copy; the stated gravity set)
+            self.tree = replace(self.tree, fixed=inertial_fixed(
+                source, bare, self._copy_tree) + self._gravity_fixed(source))
         self._balls = any(kind == pb.JOINT_SPHERICAL for joints in self._movable.values()
                           for _, kind in joints)
         self._gears: list[Gear] = []
 
-    def _copy_tree(self, copy: ModelFile) -> ModelTree:
-        """The tree of ``copy`` as PyBullet reads it under the same gravity, its client
-        closed after."""
-        model = PybulletModel(copy, gravity=self.gravity, fixes=False)
+    def _gravity_fixed(self, source: ModelFile) -> tuple[FixedReading, ...]:
+        """The fix :data:`GRAVITY_HINT` names, measured: the MJCF read again with
+        ``setGravity`` given the gravity the file states (where it states one other than
+        PyBullet's)."""
+        stated = stated_gravity(inline(source.path)) if source.format is Format.MJCF else None
+        if stated is None or np.allclose(stated, self.gravity):
+            return ()
+        return (FixedReading(subject="model", fields=("gravity",), fix=GRAVITY_FIX.format(
+            gravity=" ".join(f"{g:g}" for g in stated)),
+            tree=self._copy_tree(source, gravity=stated)),)
+
+    def _copy_tree(self, copy: ModelFile, *, gravity: np.ndarray | None = None) -> ModelTree:
+        """The tree of ``copy`` as PyBullet reads it under the same gravity (or
+        ``gravity``), its client closed after."""
+        model = PybulletModel(copy, gravity=self.gravity if gravity is None else gravity,
+                              fixes=False)
         try:
             return model.tree
         finally:

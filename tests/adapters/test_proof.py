@@ -20,7 +20,7 @@ SUSPECTED = {
     "drake.actuators": {"EFFORT"},
     "drake.hints": {"BALL_ARMATURE", "IGNORED_FRAME"},
     "newton.actuators": {"MOTORS", "GEAR", "BOUNDS"},
-    "pybullet.files": {"GRAVITY_HINT", "ZEROED_INERTIA", "INERTIA_HINT", "DENSITY_HINT"},
+    "pybullet.files": {"ZEROED_INERTIA", "INERTIA_HINT", "DENSITY_HINT"},
 }
 """The work left: causes written on a page as "cause unknown; suspected"."""
 

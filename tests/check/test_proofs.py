@@ -614,3 +614,33 @@ def test_drakes_ignored_actuators_are_verified_by_writing_them_as_motors(tmp_pat
     if not plant:
         assert "with the actuators on 'j', 'k' written as <motor>, drake holds an actuator " \
                "on 'j'" in notes["g"]
+
+
+GRAVITY = """<mujoco model="grav"><option gravity="0 0 -5"/><worldbody>
+  <body name="a" pos="0 0 1"><joint name="j" type="hinge" axis="0 1 0"/>
+    <geom type="sphere" size="0.1" pos="0.2 0 0"/></body>
+</worldbody></mujoco>"""
+"""<option gravity="0 0 -5">, which PyBullet's MJCF reader does not read (its gravity is what
+setGravity gives: :data:`~dyncheck.adapters.pybullet.files.GRAVITY_HINT`)."""
+
+
+@pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-wrong"])
+def test_pybullets_gravity_cause_is_verified_by_setting_it(tmp_path, monkeypatch, plant):
+    """PyBullet read again with setGravity(0 0 -5) holds MuJoCo's gravity (MuJoCo's compiler
+    the expected value): "fix verified"; with the stated gravity planted wrong (−7), the
+    cause is unknown."""
+    pytest.importorskip("pybullet", reason="the pybullet extra is not installed")
+    from dyncheck.adapters.pybullet import model as pybullet_model
+
+    if plant:
+        monkeypatch.setattr(pybullet_model, "stated_gravity",
+                            lambda root: np.array([0.0, 0.0, -7.0]))
+    path = tmp_path / "grav.xml"
+    path.write_text(GRAVITY)
+    rows = check_model(path, states=4, impls=("mujoco", "pybullet"), isolate=False).rows
+    note = rows[rows["field"] == "gravity"].iloc[0].note
+    assert (FIX_VERIFIED in note) is not plant, note
+    assert note.startswith("cause unknown") is plant, note
+    if not plant:
+        assert "with setGravity(0 0 -5) after loading, the gravity the file states, pybullet " \
+               "holds gravity [ 0. 0. -5.], as mujoco does" in note
