@@ -23,7 +23,7 @@ from dyncheck.adapters.actuators import Actuation, Actuator, Transmission
 from dyncheck.adapters.drake.defaults import class_gain_hints
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
-from dyncheck.adapters.formats.mjcf_copy import class_defaults
+from dyncheck.adapters.formats.mjcf_copy import class_defaults, placed
 from dyncheck.adapters.model_tree import FixedReading, ModelTree
 from dyncheck.adapters.proof import Proof
 from dyncheck.adapters.registration import Format
@@ -40,10 +40,16 @@ DAMPING = (
     "parsing, JointActuator.set_controller_gains(PdControllerGains(p=kp, d=kv)))"
 )
 EFFORT = (
-    "Drake's MJCF parser makes one symmetric effort limit of a <motor>'s or <position>'s "
-    "ctrlrange and forcerange (the smaller of their largest magnitudes, here {limit:g}): on "
-    "a position servo, whose ctrlrange bounds the target position, that bounds its torque "
-    "(fix: set the effort limit after parsing, JointActuator.set_effort_limit)"
+    "Drake's MJCF parser makes one symmetric effort limit (here {limit:g}) of a <motor>'s or "
+    "<position>'s ctrlrange and forcerange, ignoring a joint's actuatorfrcrange: on a "
+    "position servo, whose ctrlrange bounds the target position, that bounds its torque "
+    "(fix: set the effort limit after parsing, JointActuator.set_effort_limit, to the force "
+    "bound the file states)"
+)
+CONTROL_RANGE = (
+    "Drake's joint actuator holds no control range: a servo's target (its desired-state "
+    "input) is not bounded, the file's ctrlrange going into its effort limit instead (fix: "
+    "bound the target where it is set)"
 )
 PD_DROPPED = (
     "Drake's scalar conversion to AutoDiffXd (MultibodyPlant.ToAutoDiffXd) drops the PD "
@@ -109,8 +115,13 @@ def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
             out.append((name, "gear", GEAR.format(gear=gear)))
         if actuator.has_controller() and stated_kv:  # (its premise: a kv to lose, #77)
             out.append((name, "bias", DAMPING.format(d=actuator.get_controller_gains().d)))
-        if np.isfinite(actuator.effort_limit()) and source.format is Format.MJCF:
-            out.append((name, "limits", EFFORT.format(limit=actuator.effort_limit())))
+        if source.format is Format.MJCF:
+            servo = actuator.has_controller()
+            out.append((name, "force range" if servo else "limits",
+                        EFFORT.format(limit=actuator.effort_limit())))
+            if servo:  # (a field its API does not hold: measured)
+                measured.append(CONTROL_RANGE)
+                out.append((name, "control range", CONTROL_RANGE))
     ignored = sorted({t.split(" ")[0] for found in tags.values() for t in found
                       if not t.startswith(READ_TAGS)})
     if ignored:
@@ -197,6 +208,79 @@ def gear_fixed(plant: Any, tree: ModelTree) -> tuple[FixedReading, ...]:
         for name, (gear, _) in acting.items())
 
 
+def file_force_bounds(root: ET.Element) -> dict[str, tuple[float, float] | None]:
+    """Each ``<motor>``'s and ``<position>``'s bound on the force it applies to its joint as
+    MuJoCo's compiler gives it (``root``: the file, its includes inlined): gear × its
+    forcerange (its own, else its class's; limited where ``forcelimited`` says so, else
+    where stated) ∩ its joint's ``actuatorfrcrange``; None where unbounded. By its name, and
+    by its joint's (``joint NAME``) where the joint has no other."""
+    keys = ("forcerange", "forcelimited", "gear")
+    classes = {tag: class_defaults(root, tag, keys) for tag in READ_TAGS_BY_ELEMENT}
+    joint_bounds = {p.element.get("name"): _bound(p.attrs.get("actuatorfrcrange"),
+                                                  p.attrs.get("actuatorfrclimited"))
+                    for p in placed(root, "joint", ("actuatorfrcrange", "actuatorfrclimited"))}
+    out: dict[str, tuple[float, float] | None] = {}
+    by_joint: dict[str, list[tuple[float, float] | None]] = {}
+    for block in root.findall("actuator"):
+        for element in (e for e in block if e.tag in READ_TAGS_BY_ELEMENT):
+            attrs = {**classes[element.tag].get(element.get("class", "main"), {}),
+                     **{k: v for k, v in element.attrib.items() if k in keys}}
+            gear = float((attrs.get("gear") or "1").split()[0])
+            own = _bound(attrs.get("forcerange"), attrs.get("forcelimited"))
+            bound = None if own is None else tuple(sorted((gear * own[0], gear * own[1])))
+            joint = element.get("joint", "")
+            held = joint_bounds.get(joint)
+            if held is not None:
+                bound = held if bound is None else (max(bound[0], held[0]),
+                                                    min(bound[1], held[1]))
+            if element.get("name"):
+                out[element.get("name", "")] = bound  # type: ignore[assignment]
+            by_joint.setdefault(joint, []).append(bound)  # type: ignore[arg-type]
+    return {**{f"joint {j}": b[0] for j, b in by_joint.items() if len(b) == 1}, **out}
+
+
+READ_TAGS_BY_ELEMENT = ("motor", "position")
+"""The actuator elements Drake's MJCF parser reads, by tag (:data:`READ_TAGS`)."""
+
+
+def _bound(stated: str | None, limited: str | None) -> tuple[float, float] | None:
+    """A range as MuJoCo's compiler takes it: limited where ``limited`` is "true", or where
+    it is "auto" or absent and the range is stated (``autolimits``, MuJoCo's default)."""
+    if not stated or limited == "false":
+        return None
+    low, high = (float(x) for x in stated.split()[:2])
+    return None if low == high == 0.0 else (low, high)
+
+
+def effort_fixed(plant: Any, root: ET.Element, tree: ModelTree) -> tuple[FixedReading, ...]:
+    """The fix :data:`EFFORT` names, measured: each actuator on a gear of 1 given the effort
+    limit of the force bound the file states (:func:`file_force_bounds`: the largest
+    magnitude, Drake's limit being symmetric; infinite where the file bounds none), and the
+    actuators read back (the plant's limits restored after)."""
+    stated = file_force_bounds(root)
+    targets = []
+    for index in plant.GetJointActuatorIndices():
+        a = plant.get_joint_actuator(index)
+        key = a.name() if a.name() in stated else f"joint {a.joint().name()}"
+        if key in stated and float(a.default_gear_ratio()) == 1.0:
+            bound = stated[key]
+            targets.append((a, np.inf if bound is None else max(abs(bound[0]), abs(bound[1]))))
+    targets = [(a, limit) for a, limit in targets if float(a.effort_limit()) != limit]
+    if not targets:
+        return ()
+    saved = [float(a.effort_limit()) for a, _ in targets]
+    try:
+        for a, limit in targets:
+            a.set_effort_limit(limit)
+        fixed = replace(tree, actuators=read(plant))
+    finally:
+        for (a, _), limit in zip(targets, saved, strict=True):
+            a.set_effort_limit(limit)
+    return tuple(FixedReading(
+        subject=a.name(), fields=("limits", "force range"), tree=fixed,
+        fix=f"JointActuator.set_effort_limit({limit:g}) after parsing") for a, limit in targets)
+
+
 def _states_kv(root: ET.Element) -> bool:
     """Whether the file (``root``: its includes inlined) gives any ``<position>`` a nonzero
     ``kv``, directly or through a default class: the premise of :data:`DAMPING`."""
@@ -274,7 +358,8 @@ def _desired_ports(plant: Any, indices: list[Any]) -> dict[int, tuple[Any, list[
 PROOFS = {
     "GEAR": Proof.FIX,
     "DAMPING": Proof.FIX,
-    "EFFORT": Proof.SUSPECTED,
+    "EFFORT": Proof.FIX,
+    "CONTROL_RANGE": Proof.MEASURED,
     "PD_DROPPED": Proof.MEASURED,
     "IGNORED": Proof.FIX,
 }

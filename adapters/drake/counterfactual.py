@@ -167,7 +167,7 @@ def measured(source: ModelFile, root: ET.Element, plant: Any, tree: ModelTree, *
         WantsCompiled(subject=j, fields=(f,), joints=(j,))
         for j, f, _ in springdampers(root, "Drake")))
     fixed = drake_actuators.damping_fixed(plant, root, tree) + \
-        drake_actuators.gear_fixed(plant, tree)
+        drake_actuators.gear_fixed(plant, tree) + drake_actuators.effort_fixed(plant, root, tree)
     if read is not None:
         armed = {p.element.get("name") for p in placed(root, "joint", ("armature",))
                  if float(p.attrs.get("armature", "0") or 0) != 0.0}

@@ -92,7 +92,8 @@ def hints(model: Any, actuators: tuple[Actuator, ...]) -> tuple[tuple[str, str, 
     except (AttributeError, TypeError):  # a URDF: none
         count = 0
     out = [(a.name, field, why) for a in actuators
-           for field, why in (("gear", GEAR), ("limits", BOUNDS))]
+           for field, why in (("gear", GEAR), ("limits", BOUNDS), ("control range", BOUNDS),
+                              ("force range", BOUNDS))]
     if count > len(actuators):
         out.append(("model", "actuator", MOTORS.format(count=count - len(actuators))))
     return tuple(out)

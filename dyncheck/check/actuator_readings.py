@@ -29,21 +29,39 @@ def section_row(model: str, *, subject: str, field: str, a: str, b: str, verdict
                     convention=convention, worst_state=worst)
 
 
+def motor_like(actuator: Actuator) -> bool:
+    """A fixed gain and no bias or activation: its force is gain × control, so its bounds
+    act as one interval of force (:func:`limits`)."""
+    return actuator.gain[1:] == (0.0, 0.0) and actuator.bias == (0.0, 0.0, 0.0) and \
+        actuator.activation is Activation.NONE
+
+
+def _interval(low: float, high: float, *bounds: tuple[float, float] | None) -> object:
+    """[low, high] ∩ each bound; None where nothing bounds it."""
+    for bound in bounds:
+        if bound is not None:
+            low, high = max(low, bound[0]), min(high, bound[1])
+    return None if not (np.isfinite(low) or np.isfinite(high)) else (float(low), float(high))
+
+
 def limits(actuator: Actuator) -> object:
-    """The bounds as they act: for a motor-like law (fixed gain, no bias) the force interval
-    the ranges leave, gain × control range ∩ force range ∩ the joint's range; else the three
-    ranges as given."""
-    if actuator.gain[1:] == (0.0, 0.0) and actuator.bias == (0.0, 0.0, 0.0) and \
-            actuator.activation is Activation.NONE:
-        low, high = -np.inf, np.inf
-        if actuator.ctrl_range is not None:
-            ends = sorted(actuator.gain[0] * np.array(actuator.ctrl_range))
-            low, high = ends[0], ends[1]
-        for bound in (actuator.force_range, actuator.joint_range):
-            if bound is not None:
-                low, high = max(low, bound[0]), min(high, bound[1])
-        return None if not (np.isfinite(low) or np.isfinite(high)) else (float(low), float(high))
-    return (actuator.ctrl_range, actuator.force_range, actuator.joint_range)
+    """A motor-like actuator's bounds as they act (:func:`motor_like`): the force interval
+    the ranges leave, gain × control range ∩ force range ∩ the joint's range."""
+    low, high = -np.inf, np.inf
+    if actuator.ctrl_range is not None:
+        ends = sorted(actuator.gain[0] * np.array(actuator.ctrl_range))
+        low, high = ends[0], ends[1]
+    return _interval(low, high, actuator.force_range, actuator.joint_range)
+
+
+def force_bound(actuator: Actuator) -> object:
+    """The force the actuator may apply to its joint: gear × its force range ∩ its joint's
+    (the sum's) range; None where unbounded."""
+    low, high = -np.inf, np.inf
+    if actuator.force_range is not None:
+        ends = sorted(actuator.gear * np.array(actuator.force_range))
+        low, high = ends[0], ends[1]
+    return _interval(low, high, actuator.joint_range)
 
 
 def shown_value(value: object) -> str:
@@ -72,11 +90,15 @@ def same(a: object, b: object, *, rtol: float) -> bool:
                 and np.array_equal(x[~finite], y[~finite]))
 
 
-def compared_fields(actuator: Actuator) -> dict[str, object]:
-    """The fields two readings compare: gear, gain, bias, the acting bounds, activation."""
-    return {"gear": actuator.gear, "gain": actuator.gain, "bias": actuator.bias,
-            "limits": limits(actuator), "activation": actuator.activation.value,
-            "time constant": actuator.time_constant}
+def compared_fields(actuator: Actuator, *, motor: bool) -> dict[str, object]:
+    """The fields two readings compare: gear, gain, bias, the bounds (a motor-like
+    actuator's as they act; another's control range and the force it may apply), the
+    activation. ``motor``: whether the canonical reading's is motor-like
+    (:func:`motor_like`): both readings' bounds are compared as it decides."""
+    bounds: dict[str, object] = {"limits": limits(actuator)} if motor else {
+        "control range": actuator.ctrl_range, "force range": force_bound(actuator)}
+    return {"gear": actuator.gear, "gain": actuator.gain, "bias": actuator.bias, **bounds,
+            "activation": actuator.activation.value, "time constant": actuator.time_constant}
 
 
 def match(mine: tuple[Actuator, ...], theirs: tuple[Actuator, ...]) -> dict[int, int]:
@@ -113,7 +135,7 @@ def _absent_cause(other: ModelTree, mine: Actuator) -> str:
 
 
 def _field_cause(other: ModelTree, actuator: str, field: str, *, expected: object,
-                 canonical: str) -> str:
+                 canonical: str, motor: bool) -> str:
     """Why ``other`` reads ``field`` of ``actuator`` otherwise than ``expected`` (the
     canonical engine's value), proved by its fix where it has one: the field of the fixed
     reading's actuator against ``expected``."""
@@ -121,7 +143,7 @@ def _field_cause(other: ModelTree, actuator: str, field: str, *, expected: objec
         fixed = next((x for x in tree.actuators if x.name == actuator), None)
         if fixed is None:
             return Remeasured(closed=False, left=1.0, outcome=f"holds no {actuator!r}")
-        value = compared_fields(fixed)[field]
+        value = compared_fields(fixed, motor=motor)[field]
         closed = same(expected, value, rtol=FIELD_RTOL)
         return Remeasured(closed=closed, left=0.0 if closed else 1.0, outcome=(
             f"reads the {field} of {actuator!r} as {canonical} does ({shown_value(value)})"
@@ -156,19 +178,20 @@ def reading_rows(model: str, canonical: ModelTree, other: ModelTree) -> list[Che
                              note=_absent_cause(other, mine)))
             continue
         theirs = other.actuators[pairs[k]]
-        ours, found = compared_fields(mine), compared_fields(theirs)
+        motor = motor_like(mine)
+        ours, found = compared_fields(mine, motor=motor), compared_fields(theirs, motor=motor)
         differ = [f for f in ours if not same(ours[f], found[f], rtol=FIELD_RTOL)]
         if not differ:
             rows.append(section_row(model, subject=mine.name, field="reading", a=a, b=b,
                              value_a=mine.what, value_b=theirs.what, verdict=Verdict.PASSED,
-                             note=f"gear, gain, bias, limits and activation alike ({b}'s "
+                             note=f"gear, gain, bias, bounds and activation alike ({b}'s "
                                   f"{theirs.what})"))
         for f in differ:
             rows.append(section_row(model, subject=mine.name, field=f, a=a, b=b,
                              value_a=shown_value(ours[f]), value_b=shown_value(found[f]),
                              verdict=Verdict.FAILED,
                              note=_field_cause(other, theirs.name, f, expected=ours[f],
-                                               canonical=a)))
+                                               canonical=a, motor=motor)))
     held = set(pairs.values())
     for k, theirs in enumerate(other.actuators):
         if k not in held and theirs.modelled:

@@ -17,7 +17,6 @@ import dyncheck.adapters as adapters
 from dyncheck.adapters.proof import Proof
 
 SUSPECTED = {
-    "drake.actuators": {"EFFORT"},
     "drake.hints": {"BALL_ARMATURE", "IGNORED_FRAME"},
     "newton.actuators": {"MOTORS", "GEAR", "BOUNDS"},
     "pybullet.files": {"ZEROED_INERTIA", "INERTIA_HINT", "DENSITY_HINT"},

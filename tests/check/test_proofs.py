@@ -644,3 +644,51 @@ def test_pybullets_gravity_cause_is_verified_by_setting_it(tmp_path, monkeypatch
     if not plant:
         assert "with setGravity(0 0 -5) after loading, the gravity the file states, pybullet " \
                "holds gravity [ 0. 0. -5.], as mujoco does" in note
+
+
+EFFORT = """<mujoco model="effort">
+  <default><default class="hand"><position forcerange="-2 2" kp="5"/></default></default>
+  <worldbody>
+    <body name="a" pos="0 0 1"><joint name="j" type="hinge" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02"/>
+      <body name="b" pos="0.3 0 0">
+        <joint name="k" type="hinge" axis="0 1 0" actuatorfrcrange="-1.5 1.5"/>
+        <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02"/></body></body>
+  </worldbody>
+  <actuator>
+    <position name="pj" joint="j" class="hand" ctrlrange="-0.5 0.2"/>
+    <position name="pk" joint="k" kp="5" ctrlrange="-1 1" forcerange="-4 4"/>
+  </actuator></mujoco>"""
+"""Two servos: 'pj' takes forcerange ±2 from its class (MuJoCo's force bound ±2; Drake's
+effort limit the smaller magnitude, 0.5); 'pk' states ±4, its joint's actuatorfrcrange
+±1.5 (MuJoCo's bound ±1.5, which Drake ignores: its limit 1): :data:`.drake.actuators.
+EFFORT`."""
+
+
+@pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-wrong"])
+def test_drakes_effort_limit_is_verified_by_setting_the_stated_bound(tmp_path, monkeypatch,
+                                                                      plant):
+    """With each effort limit set after parsing to the force bound the file states (through
+    the class, with the joint's range), Drake reads MuJoCo's force range on both servos
+    (MuJoCo's compiler the expected value: ±2, ±1.5): "fix verified". With the stated bounds
+    planted doubled, the cause is unknown. Each servo's control range, which Drake's API does
+    not hold, is named by that measured property."""
+    pytest.importorskip("pydrake", reason="the drake extra is not installed")
+    from dyncheck.adapters.drake import actuators as drake_actuators
+
+    if plant:
+        real = drake_actuators.file_force_bounds
+        monkeypatch.setattr(drake_actuators, "file_force_bounds", lambda root: {
+            k: None if b is None else (2 * b[0], 2 * b[1]) for k, b in real(root).items()})
+    path = tmp_path / "effort.xml"
+    path.write_text(EFFORT)
+    rows = check_model(path, states=4, impls=("mujoco", "drake"), isolate=False).rows
+    rows = rows[rows["section"] == "actuation"]
+    force = rows[rows["field"] == "force range"].set_index("subject")
+    assert list(force["value_a"]) == ["(-2, 2)", "(-1.5, 1.5)"], force["value_a"]
+    for name, note in force["note"].items():
+        assert (FIX_VERIFIED in note) is not plant, (name, note)
+        assert note.startswith("cause unknown") is plant, (name, note)
+    control = rows[rows["field"] == "control range"]
+    assert len(control) == 2
+    assert control["note"].str.startswith("Drake's joint actuator holds no control range").all()
