@@ -53,6 +53,13 @@ def four_causes(tmp_path_factory):
     return path
 
 
+def _checked(tmp_path, text, engine):
+    """The rows of MuJoCo's and ``engine``'s check of the model ``text``, written here."""
+    path = tmp_path / "model.xml"
+    path.write_text(text)
+    return check_model(path, states=4, impls=("mujoco", engine), isolate=False).rows
+
+
 def _described(path):
     rows = check_model(path, states=4, impls=("mujoco", "pinocchio"), isolate=False).rows
     rows = rows[(rows["section"] == "description") & (rows["impl_b"] == "pinocchio")]
@@ -200,9 +207,7 @@ def test_drakes_armature_causes_are_verified_by_their_fixes(tmp_path, monkeypatc
     if plant:
         monkeypatch.setattr(counterfactual, "motors", lambda joints: NOTHING)
         monkeypatch.setattr(counterfactual, "as_motors", lambda joints: NOTHING)
-    path = tmp_path / "armature.xml"
-    path.write_text(ARMATURE)
-    rows = check_model(path, states=4, impls=("mujoco", "drake"), isolate=False).rows
+    rows = _checked(tmp_path, ARMATURE, "drake")
     rows = rows[(rows["section"] == "description") & (rows["field"] == "armature")]
     notes = dict(zip(rows["subject"], rows["note"], strict=True))
     assert set(notes) == {"j", "k"}
@@ -448,9 +453,7 @@ def test_drakes_gear_cause_is_verified_by_scaling_the_control(tmp_path, monkeypa
         real = drake_actuators.gear_fixed
         monkeypatch.setattr(drake_actuators, "gear_fixed", lambda p, tree: tuple(
             replace(r, tree=tree) for r in real(p, tree)))
-    path = tmp_path / "geared.xml"
-    path.write_text(GEARED)
-    rows = check_model(path, states=4, impls=("mujoco", "drake"), isolate=False).rows
+    rows = _checked(tmp_path, GEARED, "drake")
     row = rows[(rows["section"] == "actuation") & (rows["field"] == "gear")].iloc[0]
     assert (row.value_a, row.value_b) == ("100", "1"), (row.value_a, row.value_b)
     assert (FIX_VERIFIED in row.note) is not plant, row.note
@@ -500,9 +503,7 @@ def test_drakes_joint_placement_and_class_gap_causes_are_verified(tmp_path, monk
     if plant:
         monkeypatch.setattr(counterfactual, "SPLIT", NOTHING)
         monkeypatch.setattr(counterfactual, "written", lambda lost: NOTHING)
-    path = tmp_path / "several.xml"
-    path.write_text(SEVERAL)
-    rows = check_model(path, states=4, impls=("mujoco", "drake"), isolate=False).rows
+    rows = _checked(tmp_path, SEVERAL, "drake")
     rows = rows[rows["section"] == "description"]
     notes = {(r.subject, r.field): r.note for r in rows.itertuples()}
     expected = {("hx", "anchor"), ("hx", "axis"), ("hy", "anchor"), ("knee", "axis"),
@@ -569,9 +570,7 @@ def test_springdamper_is_verified_by_stating_the_compiled_values(tmp_path, monke
         real = compiled.springs
         monkeypatch.setattr(compiled, "springs", lambda m: {
             name: (k, 2 * d) for name, (k, d) in real(m).items()})
-    path = tmp_path / "sprung.xml"
-    path.write_text(SPRUNG)
-    rows = check_model(path, states=4, impls=("mujoco", engine), isolate=False).rows
+    rows = _checked(tmp_path, SPRUNG, engine)
     note = rows[(rows["section"] == "description") & (rows["field"] == "damping")].iloc[0].note
     assert (FIX_VERIFIED in note) is not plant, note
     assert ("springdamper=\"0.001 50\"" in note) is not plant, note
@@ -601,9 +600,7 @@ def test_drakes_ignored_actuators_are_verified_by_writing_them_as_motors(tmp_pat
 
     if plant:
         monkeypatch.setattr(counterfactual, "as_motors", lambda joints: NOTHING)
-    path = tmp_path / "ignored.xml"
-    path.write_text(IGNORED)
-    rows = check_model(path, states=4, impls=("mujoco", "drake"), isolate=False).rows
+    rows = _checked(tmp_path, IGNORED, "drake")
     rows = rows[(rows["section"] == "actuation") & (rows["field"] == "actuator")]
     notes = dict(zip(rows["subject"], rows["note"], strict=True))
     assert set(notes) == {"g", "v"}, notes
@@ -635,9 +632,7 @@ def test_pybullets_gravity_cause_is_verified_by_setting_it(tmp_path, monkeypatch
     if plant:
         monkeypatch.setattr(pybullet_model, "stated_gravity",
                             lambda root: np.array([0.0, 0.0, -7.0]))
-    path = tmp_path / "grav.xml"
-    path.write_text(GRAVITY)
-    rows = check_model(path, states=4, impls=("mujoco", "pybullet"), isolate=False).rows
+    rows = _checked(tmp_path, GRAVITY, "pybullet")
     note = rows[rows["field"] == "gravity"].iloc[0].note
     assert (FIX_VERIFIED in note) is not plant, note
     assert note.startswith("cause unknown") is plant, note
@@ -680,9 +675,7 @@ def test_drakes_effort_limit_is_verified_by_setting_the_stated_bound(tmp_path, m
         real = drake_actuators.file_force_bounds
         monkeypatch.setattr(drake_actuators, "file_force_bounds", lambda root: {
             k: None if b is None else (2 * b[0], 2 * b[1]) for k, b in real(root).items()})
-    path = tmp_path / "effort.xml"
-    path.write_text(EFFORT)
-    rows = check_model(path, states=4, impls=("mujoco", "drake"), isolate=False).rows
+    rows = _checked(tmp_path, EFFORT, "drake")
     rows = rows[rows["section"] == "actuation"]
     force = rows[rows["field"] == "force range"].set_index("subject")
     assert list(force["value_a"]) == ["(-2, 2)", "(-1.5, 1.5)"], force["value_a"]
