@@ -9,6 +9,8 @@ from typing import Protocol
 
 import pandas as pd
 
+from dyncheck.environments import Installer, Made
+
 
 def reproducer_lines(outcomes: dict[str, dict[str, str]]) -> list[str]:
     """A table of each reproducer's outcome under each release (release → name → outcome;
@@ -36,20 +38,26 @@ class Stepped(Protocol):
     def back(self) -> tuple[str, ...]: ...
 
 
-def environment_lines(seconds: float | None,
-                      environments: dict[tuple[str, str], tuple[float | None, int]]) -> list[str]:
-    """What the matrix cost on this machine: its time, each environment's size and making."""
+def environment_lines(seconds: float | None, made: dict[tuple[str, str], Made],
+                      disk: int) -> list[str]:
+    """What the matrix cost on this machine: its time, the disk its environments hold (files
+    linked from several counted once, :func:`dyncheck.environments.disk`), each one's size,
+    what it adds, and its making."""
     lines = []
     if seconds is not None:
         lines += [f"This page took {seconds / 60:.1f} min on this machine, making the "
                   "environments not made before included.", ""]
-    if environments:
-        total = sum(size for _, size in environments.values())
+    if made:
+        copies = sum(m.apparent for m in made.values())
+        shared = any(m.by is Installer.UV for m in made.values())
         lines += [f"The environments (made once, reused; `dyncheck versions "
-                  f"--remove-environments` deletes them) hold {total / 2**30:.1f} GiB:", ""]
-        lines += [f"- {e} {r}: {size / 2**30:.2f} GiB"
-                  + (f", made in {made:.0f} s" if made is not None else "")
-                  for (e, r), (made, size) in environments.items()]
+                  f"--remove-environments` deletes them) hold {disk / 2**30:.1f} GiB on disk"
+                  + (" with the cache of files uv links them to" if shared else "")
+                  + f"; as copies they would hold {copies / 2**30:.1f} GiB:", ""]
+        lines += [f"- {e} {r}: {m.apparent / 2**30:.2f} GiB, {m.own / 2**30:.2f} GiB of its "
+                  f"own, made by {m.by.value}"
+                  + (f" in {m.seconds:.0f} s" if m.seconds is not None else "")
+                  for (e, r), m in made.items()]
         lines += [""]
     return lines
 

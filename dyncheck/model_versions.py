@@ -24,13 +24,14 @@ from pathlib import Path
 
 import pandas as pd
 
-from dyncheck import diff, reproduced, versions
+from dyncheck import diff, environments, reproduced, versions
 from dyncheck.cache.store import cache_root
 from dyncheck.check import baseline as check_baseline
 from dyncheck.check.engines import ENGINES as CHECKED
+from dyncheck.environments import UV_CACHE, VENVS, Made, ReleaseUnavailable, disk
 from dyncheck.escaping import markdown, markdown_code, markdown_table
 from dyncheck.matrix_lines import defect_lines, environment_lines, reproducer_lines
-from dyncheck.versions import Engine, Log, ReleaseFailed, ReleaseUnavailable
+from dyncheck.versions import Engine, Log, ReleaseFailed
 
 FOLDER = "checks"
 """Under the cache folder: each release's check of a set of models."""
@@ -89,7 +90,7 @@ def check_release(eng: Engine, release: str, models: Models, *, log: Log) -> Pat
         capture_output=True, text=True, check=False)
     if result.returncode not in (0, 1, 2) or not rows_of(out).shape[0]:  # 2: one refused
         raise ReleaseFailed(eng.name, release,  # among several: its rows say so
-                            models.without_paths(versions.last_line(result.stderr)))
+                            models.without_paths(environments.reason(result.stderr)))
     log(f"running the reproducers of {eng.name}'s defects under {release}")
     reproduced.reproduce(python, eng.impls, out)
     (out / DONE).write_text(release + "\n")
@@ -162,7 +163,7 @@ def matrix(eng: Engine, releases: Sequence[str], models: Models, *, log: Log,
 
 def page(steps: Sequence[ModelStep], outcomes: dict[str, dict[str, str]], models: Models,
          *, seconds: float | None = None,
-         environments: dict[str, tuple[float | None, int]] | None = None) -> str:
+         made: dict[str, Made] | None = None, disk: int = 0) -> str:
     """The matrix as Markdown: per step, what moved in the models (every moved row), the
     defects fixed or back; then each release's reproducers' outcomes."""
     names = ", ".join(markdown_code(p.name) for p in models.paths)
@@ -176,7 +177,7 @@ def page(steps: Sequence[ModelStep], outcomes: dict[str, dict[str, str]], models
              "row appeared or vanished).", ""]
     lines += environment_lines(
         seconds, {(steps[0].engine if steps else "", r): m
-                  for r, m in (environments or {}).items()})
+                  for r, m in (made or {}).items()}, disk)
     for s in steps:
         lines += [f"## {s.engine} {s.old} → {s.new}", "", *defect_lines(s)]
         if s.moved is None:
@@ -203,16 +204,15 @@ def bisect(eng: Engine, good: str, bad: str, models: Models, *, log: Log,
 
 
 def remove_environments() -> tuple[int, int]:
-    """Delete every release environment and cached release run or check (``dyncheck versions
-    --remove-environments``): the folders removed and the bytes they held."""
-    count, size = 0, 0
-    for name in ("venvs", "runs", FOLDER):
-        top = cache_root() / name
+    """Delete every release environment, uv's cache of their files and every cached release
+    run or check (``dyncheck versions --remove-environments``): the folders removed and the
+    bytes they held on disk."""
+    tops = [cache_root() / name for name in (VENVS, UV_CACHE, "runs", FOLDER)]
+    size, count = disk(tops), 0
+    for top in tops:
         if not top.is_dir():
             continue
         for child in top.iterdir():
-            size += sum(f.lstat().st_size for f in child.rglob("*") if f.is_file()
-                        and not f.is_symlink()) if child.is_dir() else child.lstat().st_size
             if child.is_dir() and not child.is_symlink():
                 shutil.rmtree(child)
             else:

@@ -25,16 +25,16 @@ import itertools
 import re
 import subprocess
 import sys
-import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
 
-from dyncheck import diff, reproduced
+from dyncheck import diff, environments, reproduced
 from dyncheck.adapters import REGISTRY, Needs
 from dyncheck.cache.store import cache_root
+from dyncheck.environments import Log, Made, ReleaseUnavailable
 from dyncheck.errors import ROOT, DyncheckError, InvalidInput, UnknownName
 from dyncheck.matrix_lines import defect_lines, environment_lines, reproducer_lines
 from dyncheck.progress import Progress
@@ -120,81 +120,16 @@ def code_key() -> str:
     return key + ("+dirty" if dirty else "")
 
 
-Log = Callable[[str], None]
 
 
 def environment(eng: Engine, release: str, *, log: Log) -> Path:
-    """The Python of the release's virtual environment, created once (cached)."""
-    folder = cache_root() / "venvs" / f"{eng.name}-{release}"
-    python = folder / "bin" / "python"
-    done = folder / ".installed"
-    if done.exists():
-        _install_checkout(python, folder)
-        return python
-    log(f"creating {folder} ({eng.package}=={release})")
-    started = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "venv", "--clear", str(folder)], check=True)
-    pins = folder / "constraints.txt"
-    pins.write_text(constraints(eng, (ROOT / "constraints.txt").read_text(), release))
+    """The Python of the release's environment (:func:`dyncheck.environments.make`): the
+    engine at that release, every other library at ``constraints.txt``."""
     wanted = [p for p in (*CORE, *eng.extra) if p != eng.package]
     wanted += [r for n in eng.needs_of(release) for r in n.require]
-    pip = [str(python), "-m", "pip", "install", "--disable-pip-version-check"]  # not -q: the
-    # resolver explains a conflict only when not quiet (read by last_line)
-    result = subprocess.run(
-        [*pip, "-c", str(pins), *wanted, f"{eng.package}=={release}"],
-        capture_output=True, text=True, check=False,
-    )
-    if result.returncode != 0:
-        raise ReleaseUnavailable(eng.name, release, last_line(result.stderr))
-    _install_checkout(python, folder)
-    done.write_text(f"{release}\n{time.perf_counter() - started:.1f}\n")  # the seconds it took
-    return python
-
-
-def environment_made(eng: Engine, release: str) -> tuple[float | None, int]:
-    """The seconds the release's environment took to make (None where not recorded) and the
-    bytes it holds now (0 where there is none)."""
-    folder = cache_root() / "venvs" / f"{eng.name}-{release}"
-    done = folder / ".installed"
-    if not done.exists():
-        return None, 0
-    lines = done.read_text().split()
-    seconds = float(lines[1]) if len(lines) > 1 else None
-    size = sum(f.lstat().st_size for f in folder.rglob("*") if f.is_file() and not f.is_symlink())
-    return seconds, size
-
-
-def _install_checkout(python: Path, folder: Path) -> None:
-    """dyncheck from this checkout, editable and without its ranges — reinstalled when the
-    environment was made from another checkout (a clone can run the matrix while this one is
-    being edited)."""
-    marker = folder / ".checkout"
-    if marker.exists() and marker.read_text().strip() == str(ROOT):
-        return
-    subprocess.run([str(python), "-m", "pip", "install", "--disable-pip-version-check", "-q",
-                    "--no-deps", "-e", str(ROOT)], check=True, capture_output=True)
-    marker.write_text(f"{ROOT}\n")
-
-
-class ReleaseUnavailable(DyncheckError):
-    """A release that pip cannot install here (no wheel for this Python or platform)."""
-
-    def __init__(self, engine: str, release: str, reason: str) -> None:
-        super().__init__(f"{engine} {release} cannot be installed: {reason}")
-
-
-def last_line(text: str) -> str:
-    """pip's reason in one line: the dependency that conflicts with a pinned version, else
-    its last line."""
-    lines = [ln.strip() for ln in text.splitlines() if ln.strip() and "WARNING" not in ln]
-    pinned = [ln for ln in lines if "The user requested (constraint)" in ln]
-    if pinned:
-        pin = pinned[0].split("(constraint)", 1)[1].strip()
-        name = pin.split("=")[0].strip()
-        cause = [ln for ln in lines if f"depends on {name}" in ln and "<" in ln]
-        if cause:
-            return f"{cause[0]}, but constraints.txt pins {pin}"
-    return lines[-1] if lines else "pip failed"
+    return environments.make(
+        eng.name, release, requirements=[*wanted, f"{eng.package}=={release}"],
+        pins=constraints(eng, (ROOT / "constraints.txt").read_text(), release), log=log)
 
 
 def run_release(
@@ -230,7 +165,7 @@ def run_release(
         capture_output=True, text=True, check=False,
     )
     if result.returncode not in (0, 1) or not (out / "discrepancies.csv").exists():
-        raise ReleaseFailed(eng.name, release, last_line(result.stderr))
+        raise ReleaseFailed(eng.name, release, environments.reason(result.stderr))
     missing = _not_importable(out / "discrepancies.csv", eng.impls)
     if missing:
         raise ReleaseFailed(eng.name, release, f"the engine does not import there: {missing}")
@@ -327,12 +262,12 @@ def matrix(
 
 def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None = None,
          seconds: float | None = None,
-         environments: dict[tuple[str, str], tuple[float | None, int]] | None = None) -> str:
+         made: dict[tuple[str, str], Made] | None = None, disk: int = 0) -> str:
     """``reports/versions.md``: per engine, per consecutive pair, the counts of each move and
     every moved row grouped by (case, quantity, pair, integrator), with its largest ratio.
     ``notes`` (engine, old, new) → the explanation found for that step; ``seconds`` the time
-    the matrix took, ``environments`` (engine, release) → the seconds each environment took
-    to make (None: made before) and its size."""
+    the matrix took, ``made`` (engine, release) → its environment, ``disk`` the bytes they hold
+    together (:func:`dyncheck.environments.held`)."""
     notes = notes or {}
     lines = [
         "# Engine versions: what moved between releases",
@@ -344,7 +279,7 @@ def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None
         "changed` when the change vanishes with the step like dt^p).",
         "",
     ]
-    lines += environment_lines(seconds, environments or {})
+    lines += environment_lines(seconds, made or {}, disk)
     for name in dict.fromkeys(s.engine for s in steps):
         lines += [f"## {name}", ""]
         needs = ENGINES[name].needs if name in ENGINES else ()
@@ -440,7 +375,7 @@ def published(eng: Engine) -> list[str]:
         if line.startswith("Available versions:"):
             found = [v.strip() for v in line.split(":", 1)[1].split(",")]
             return sorted(found, key=_release_key)
-    raise ReleaseUnavailable(eng.name, "*", last_line(result.stderr or result.stdout))
+    raise ReleaseUnavailable(eng.name, "*", environments.reason(result.stderr or result.stdout))
 
 
 def _release_key(text: str) -> tuple[int, ...]:

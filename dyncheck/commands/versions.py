@@ -8,6 +8,7 @@ from pathlib import Path
 from dyncheck.commands import flags
 from dyncheck.commands.flags import Command
 from dyncheck.commands.options import OUT, check_out_file, log, path_arg, positive
+from dyncheck.environments import Made
 from dyncheck.errors import InvalidInput
 from dyncheck.progress import Progress
 from dyncheck.workers import default_jobs
@@ -17,7 +18,7 @@ def versions_command(args: argparse.Namespace) -> int:
     """Exit 0 (the matrix reports moves; it does not judge them)."""
     import time
 
-    from dyncheck import versions
+    from dyncheck import environments, versions
     from dyncheck.cases import get_case
     from dyncheck.errors import NeedsCheckout
     from dyncheck.explain.releases import EXPLANATIONS
@@ -52,12 +53,19 @@ def versions_command(args: argparse.Namespace) -> int:
     with Progress("versions", releases, quiet=args.quiet) as progress:
         steps = versions.matrix(names, cases=args.case, jobs=args.jobs, log=log,
                               reuse=args.reuse, progress=progress)
-    made = {(n, r): versions.environment_made(versions.engine(n), r) for n in names
-            for r in versions.engine(n).releases}
+    made = _made([(n, r) for n in names for r in versions.engine(n).releases])
     write_atomic(out, versions.page(steps, notes=EXPLANATIONS, seconds=time.perf_counter() - t0,
-                                    environments={k: m for k, m in made.items() if m[1]}))
+                                    made=made, disk=environments.held(made)))
     print(f"version matrix written to {out}")
     return 0
+
+
+def _made(names: list[tuple[str, str]]) -> dict[tuple[str, str], Made]:
+    """The environments of the releases named that exist."""
+    from dyncheck import environments
+
+    found = {(n, r): environments.made(n, r) for n, r in names}
+    return {k: m for k, m in found.items() if m is not None}
 
 
 def _remove() -> int:
@@ -74,7 +82,7 @@ def _on_models(args: argparse.Namespace) -> int:
     """``versions MODEL... --engine E``: the user's models under each release of E."""
     import time
 
-    from dyncheck import model_versions, versions
+    from dyncheck import environments, model_versions, versions
     from dyncheck.check import inputs
     from dyncheck.results import write_atomic
 
@@ -106,11 +114,11 @@ def _on_models(args: argparse.Namespace) -> int:
     with Progress("versions", len(releases), quiet=args.quiet) as progress:
         steps, outcomes = model_versions.matrix(eng, releases, models, log=log,
                                                 done=progress.done)
-    made = {r: versions.environment_made(eng, r) for r in releases}
+    made = _made([(eng.name, r) for r in releases])
     write_atomic(out, model_versions.page(steps, outcomes, models,
                                           seconds=time.perf_counter() - t0,
-                                          environments={r: m for r, m in made.items()
-                                                        if m[1]}))
+                                          made={r: m for (_, r), m in made.items()},
+                                          disk=environments.held(made)))
     moved = sum(len(s.moved) for s in steps if s.moved is not None)
     print(f"{moved} rows moved over {len(releases)} releases of {eng.name}: {out}")
     return 0

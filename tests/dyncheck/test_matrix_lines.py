@@ -3,17 +3,26 @@
 from __future__ import annotations
 
 from dyncheck import matrix_lines
+from dyncheck.environments import Installer, Made
 
 
 def test_the_page_says_what_the_matrix_cost_and_each_reproducer_under_each_release():
     """#79: the matrix's time, each environment's size and making, and a table of every
     reproducer's outcome per release (expected: the values given, as written)."""
-    lines = matrix_lines.environment_lines(90.0, {("mujoco", "3.3.7"): (46.0, 2**30),
-                                              ("mujoco", "4.0.0"): (None, 2**29)})
+    uv, pip = Installer.UV, Installer.PIP
+    lines = matrix_lines.environment_lines(
+        90.0, {("mujoco", "3.3.7"): Made(seconds=46.0, by=uv, apparent=2**30, own=2**28),
+               ("mujoco", "4.0.0"): Made(seconds=None, by=uv, apparent=2**29, own=0)},
+        2**30 + 2**28)
     text = "\n".join(lines)
-    assert "took 1.5 min" in text and "hold 1.5 GiB" in text
-    assert "- mujoco 3.3.7: 1.00 GiB, made in 46 s" in text
-    assert "- mujoco 4.0.0: 0.50 GiB\n" in text + "\n"
+    assert "took 1.5 min" in text
+    assert "hold 1.2 GiB on disk with the cache of files uv links them to" in text
+    assert "as copies they would hold 1.5 GiB" in text
+    assert "- mujoco 3.3.7: 1.00 GiB, 0.25 GiB of its own, made by uv in 46 s" in text
+    assert "- mujoco 4.0.0: 0.50 GiB, 0.00 GiB of its own, made by uv\n" in text + "\n"
+    copies = "\n".join(matrix_lines.environment_lines(
+        None, {("drake", "1.51.1"): Made(seconds=9.0, by=pip, apparent=2**30, own=2**30)}, 2**30))
+    assert "hold 1.0 GiB on disk; as copies" in copies and "made by pip in 9 s" in copies
     table = "\n".join(matrix_lines.reproducer_lines({"1.40.0": {"d": "does not run"},
                                                  "1.51.1": {"d": "stands", "e": "fixed"}}))
     assert "| d            | does not run | stands   |" in table

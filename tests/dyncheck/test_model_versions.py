@@ -8,13 +8,14 @@ install is a step that says why; bisection names "b"."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
 
 from dyncheck import model_versions, versions
 from dyncheck.__main__ import main
-from dyncheck.versions import ReleaseUnavailable
+from dyncheck.environments import ReleaseUnavailable
 
 ARM = ('<mujoco model="arm"><worldbody><body name="a" pos="0 0 1">'
        '<joint name="j1" type="hinge" axis="0 1 0"/>'
@@ -100,12 +101,16 @@ def test_a_model_s_content_keys_its_cached_checks(tmp_path):
 
 def test_remove_environments_deletes_what_the_matrix_cached(tmp_path, monkeypatch):
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
-    for name in ("venvs/mujoco-3.3.7/bin", "runs/k/mujoco-3.3.7", "checks/k/mujoco-x"):
+    for name in ("venvs/mujoco-3.3.7/bin", "runs/k/mujoco-3.3.7", "checks/k/mujoco-x",
+                 "uv/archive-v0/a"):
         (tmp_path / name).mkdir(parents=True)
         (tmp_path / name / "f").write_bytes(b"x" * 10)
+    os.link(tmp_path / "venvs/mujoco-3.3.7/bin/f", tmp_path / "venvs/mujoco-3.3.7/g")
     (tmp_path / "figures").mkdir()
-    assert model_versions.remove_environments() == (3, 30)
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["checks", "figures", "runs", "venvs"]
+    # 4 folders, 4 files of 10 bytes + a second link to one of them (held once: 40 bytes)
+    assert model_versions.remove_environments() == (4, 40)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["checks", "figures", "runs", "uv",
+                                                          "venvs"]
     assert not any((tmp_path / "venvs").iterdir())
 
 

@@ -48,18 +48,6 @@ def test_a_release_series_needs_are_applied_to_its_environment_only(release, num
     assert bool(required) is not numpy_pinned
 
 
-def test_pip_conflict_is_named_in_one_line():
-    stderr = (
-        "WARNING: Location 'x' is ignored\n"
-        "    cmeel-boost 1.89.0 depends on numpy<2.4 and >=2.3\n"
-        "    The user requested (constraint) numpy==2.4.6\n"
-        "ERROR: ResolutionImpossible: for help visit https://pip.pypa.io\n"
-    )
-    assert versions.last_line(stderr) == (
-        "cmeel-boost 1.89.0 depends on numpy<2.4 and >=2.3, but constraints.txt pins numpy==2.4.6"
-    )
-
-
 def test_unknown_engine():
     with pytest.raises(UnknownName, match="unknown engine 'bullet'"):
         versions.engine("bullet")
