@@ -45,21 +45,26 @@ def environment_lines(seconds: float | None, made: dict[tuple[str, str], Made],
     what it adds, and its making."""
     lines = []
     if seconds is not None:
-        lines += [f"This page took {seconds / 60:.1f} min on this machine, making the "
-                  "environments not made before included.", ""]
+        took = f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.1f} min"
+        lines += [f"This page took {took} on this machine, making the environments not made "
+                  "before included.", ""]
     if made:
         copies = sum(m.apparent for m in made.values())
         shared = any(m.by is Installer.UV for m in made.values())
         lines += [f"The environments (made once, reused; `dyncheck versions "
-                  f"--remove-environments` deletes them) hold {disk / 2**30:.1f} GiB on disk"
+                  f"--remove-environments` deletes them) hold {_size(disk)} on disk"
                   + (" with the cache of files uv links them to" if shared else "")
-                  + f"; as copies they would hold {copies / 2**30:.1f} GiB:", ""]
-        lines += [f"- {e} {r}: {m.apparent / 2**30:.2f} GiB, {m.own / 2**30:.2f} GiB of its "
-                  f"own, made by {m.by.value}"
+                  + f"; as copies they would hold {_size(copies)}:", ""]
+        lines += [f"- {e} {r}: {_size(m.apparent)}, {_size(m.own)} of its own, made by "
+                  f"{m.by.value}"
                   + (f" in {m.seconds:.0f} s" if m.seconds is not None else "")
                   for (e, r), m in made.items()]
         lines += [""]
     return lines
+
+
+def _size(size: int) -> str:
+    return f"{size / 2**30:.2f} GiB" if size >= 2**30 else f"{size / 2**20:.0f} MiB"
 
 
 def defect_lines(step: Stepped) -> list[str]:

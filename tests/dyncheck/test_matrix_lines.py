@@ -15,14 +15,16 @@ def test_the_page_says_what_the_matrix_cost_and_each_reproducer_under_each_relea
                ("mujoco", "4.0.0"): Made(seconds=None, by=uv, apparent=2**29, own=0)},
         2**30 + 2**28)
     text = "\n".join(lines)
-    assert "took 1.5 min" in text
-    assert "hold 1.2 GiB on disk with the cache of files uv links them to" in text
-    assert "as copies they would hold 1.5 GiB" in text
-    assert "- mujoco 3.3.7: 1.00 GiB, 0.25 GiB of its own, made by uv in 46 s" in text
-    assert "- mujoco 4.0.0: 0.50 GiB, 0.00 GiB of its own, made by uv\n" in text + "\n"
+    assert "took 90 s" in text
+    assert "hold 1.25 GiB on disk with the cache of files uv links them to" in text
+    assert "as copies they would hold 1.50 GiB" in text
+    assert "- mujoco 3.3.7: 1.00 GiB, 256 MiB of its own, made by uv in 46 s" in text
+    assert "- mujoco 4.0.0: 512 MiB, 0 MiB of its own, made by uv\n" in text + "\n"
     copies = "\n".join(matrix_lines.environment_lines(
-        None, {("drake", "1.51.1"): Made(seconds=9.0, by=pip, apparent=2**30, own=2**30)}, 2**30))
-    assert "hold 1.0 GiB on disk; as copies" in copies and "made by pip in 9 s" in copies
+        150.0, {("drake", "1.51.1"): Made(seconds=9.0, by=pip, apparent=2**30, own=2**30)},
+        2**30))
+    assert "took 2.5 min" in copies
+    assert "hold 1.00 GiB on disk; as copies" in copies and "made by pip in 9 s" in copies
     table = "\n".join(matrix_lines.reproducer_lines({"1.40.0": {"d": "does not run"},
                                                  "1.51.1": {"d": "stands", "e": "fixed"}}))
     assert "| d            | does not run | stands   |" in table
