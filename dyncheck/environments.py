@@ -5,8 +5,8 @@ With uv (the extra ``versions``) each environment is made by ``uv venv`` and ``u
 install`` from one cache of unpacked wheels under the cache folder, its files hard-linked
 from there: a library at the same version is stored on disk once however many environments
 hold it. Without uv, pip makes each one (the standard library's :mod:`venv`), a full copy.
-The page of a matrix says which, and the disk its environments hold (:func:`disk`, each file
-counted once however many links it has).
+The page of a matrix says which, and the disk its environments hold (:func:`footprint`, each
+file counted once however many links it has).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import stat
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
@@ -166,9 +166,25 @@ def disk(tops: Iterable[Path]) -> int:
     return sum(seen.values())
 
 
-def held(names: Iterable[tuple[str, str]]) -> int:
-    """The disk the named environments hold together with the cache of files they link to."""
-    return disk([*(folder(n, r) for n, r in names), cache_root() / UV_CACHE])
+@dataclass(frozen=True, kw_only=True)
+class Footprint:
+    """What a page's environments cost: each as it stands, the disk they hold together (each
+    file once however many of them link it) and what uv's cache holds beyond every
+    environment (its files no environment links; shared by all of them)."""
+
+    made: Mapping[tuple[str, str], Made]
+    """(engine, release) → its environment, for those that exist."""
+    disk: int
+    cache: int
+
+
+def footprint(names: Iterable[tuple[str, str]]) -> Footprint:
+    """The :class:`Footprint` of the named (engine, release) environments."""
+    found = {(n, r): made(n, r) for n, r in names}
+    present = {k: m for k, m in found.items() if m is not None}
+    cache = sum(info.st_size for info in _files([cache_root() / UV_CACHE])
+                if info.st_nlink == 1)
+    return Footprint(made=present, disk=disk(folder(n, r) for n, r in present), cache=cache)
 
 
 class ReleaseUnavailable(DyncheckError):

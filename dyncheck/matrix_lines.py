@@ -9,7 +9,7 @@ from typing import Protocol
 
 import pandas as pd
 
-from dyncheck.environments import Installer, Made
+from dyncheck.environments import Footprint, Installer
 
 
 def reproducer_lines(outcomes: dict[str, dict[str, str]]) -> list[str]:
@@ -38,26 +38,25 @@ class Stepped(Protocol):
     def back(self) -> tuple[str, ...]: ...
 
 
-def environment_lines(seconds: float | None, made: dict[tuple[str, str], Made],
-                      disk: int) -> list[str]:
-    """What the matrix cost on this machine: its time, the disk its environments hold (files
-    linked from several counted once, :func:`dyncheck.environments.disk`), each one's size,
-    what it adds, and its making."""
+def environment_lines(seconds: float | None, footprint: Footprint | None) -> list[str]:
+    """What the matrix cost on this machine: its time, the disk its environments hold
+    (:class:`~dyncheck.environments.Footprint`), each one's size, what it adds, its making."""
     lines = []
     if seconds is not None:
         took = f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.1f} min"
         lines += [f"This page took {took} on this machine, making the environments not made "
                   "before included.", ""]
-    if made:
+    if footprint is not None and footprint.made:
+        made = footprint.made
         copies = sum(m.apparent for m in made.values())
         shared = any(m.by is Installer.UV for m in made.values())
-        lines += [f"The environments (made once, reused; `dyncheck versions "
-                  f"--remove-environments` deletes them) hold {_size(disk)} on disk"
-                  + (" with the cache of files uv links them to" if shared else "")
-                  + f"; as copies they would hold {_size(copies)}:", ""]
+        lines += ["The environments (made once, reused; `dyncheck versions "
+                  f"--remove-environments` deletes them) hold {_size(footprint.disk)} on disk, "
+                  f"each file once however many of them link it (as copies: {_size(copies)})"
+                  + (f"; uv's cache, shared by every release environment, holds "
+                     f"{_size(footprint.cache)} more" if shared else "") + ":", ""]
         lines += [f"- {e} {r}: {_size(m.apparent)}, {_size(m.own)} of its own, made by "
-                  f"{m.by.value}"
-                  + (f" in {m.seconds:.0f} s" if m.seconds is not None else "")
+                  f"{m.by.value}" + (f" in {m.seconds:.0f} s" if m.seconds is not None else "")
                   for (e, r), m in made.items()]
         lines += [""]
     return lines

@@ -28,7 +28,7 @@ from dyncheck import diff, environments, reproduced, versions
 from dyncheck.cache.store import cache_root
 from dyncheck.check import baseline as check_baseline
 from dyncheck.check.engines import ENGINES as CHECKED
-from dyncheck.environments import UV_CACHE, VENVS, Made, ReleaseUnavailable, disk
+from dyncheck.environments import UV_CACHE, VENVS, Footprint, ReleaseUnavailable, disk
 from dyncheck.escaping import markdown, markdown_code, markdown_table
 from dyncheck.matrix_lines import defect_lines, environment_lines, reproducer_lines
 from dyncheck.versions import Engine, Log, ReleaseFailed
@@ -163,7 +163,7 @@ def matrix(eng: Engine, releases: Sequence[str], models: Models, *, log: Log,
 
 def page(steps: Sequence[ModelStep], outcomes: dict[str, dict[str, str]], models: Models,
          *, seconds: float | None = None,
-         made: dict[str, Made] | None = None, disk: int = 0) -> str:
+         footprint: Footprint | None = None) -> str:
     """The matrix as Markdown: per step, what moved in the models (every moved row), the
     defects fixed or back; then each release's reproducers' outcomes."""
     names = ", ".join(markdown_code(p.name) for p in models.paths)
@@ -175,9 +175,7 @@ def page(steps: Sequence[ModelStep], outcomes: dict[str, dict[str, str]], models
              "releases are compared row by row as a check is held to its baseline (a verdict "
              "changed, an error moved by more than its row's tolerance, a reading changed, a "
              "row appeared or vanished).", ""]
-    lines += environment_lines(
-        seconds, {(steps[0].engine if steps else "", r): m
-                  for r, m in (made or {}).items()}, disk)
+    lines += environment_lines(seconds, footprint)
     for s in steps:
         lines += [f"## {s.engine} {s.old} → {s.new}", "", *defect_lines(s)]
         if s.moved is None:

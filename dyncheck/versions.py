@@ -34,7 +34,7 @@ import pandas as pd
 from dyncheck import diff, environments, reproduced
 from dyncheck.adapters import REGISTRY, Needs
 from dyncheck.cache.store import cache_root
-from dyncheck.environments import Log, Made, ReleaseUnavailable
+from dyncheck.environments import Footprint, Log, ReleaseUnavailable
 from dyncheck.errors import ROOT, DyncheckError, InvalidInput, UnknownName
 from dyncheck.matrix_lines import defect_lines, environment_lines, reproducer_lines
 from dyncheck.progress import Progress
@@ -101,8 +101,10 @@ def constraints(eng: Engine, text: str, release: str = "") -> str:
     return "\n".join(keep) + "\n"
 
 
-SOURCES = ("reference", "adapters", "cases", "dyncheck", ":(exclude)dyncheck/versions.py",
-           ":(exclude)dyncheck/__main__.py", ":(exclude)dyncheck/diff.py")
+SOURCES = ("reference", "adapters", "cases", "dyncheck",
+           *(f":(exclude)dyncheck/{own}" for own in (
+               "versions.py", "model_versions.py", "environments.py", "matrix_lines.py",
+               "commands/versions.py", "__main__.py", "diff.py")))
 """The code whose content keys the cached runs (the matrix's own code and pages left out)."""
 
 
@@ -262,12 +264,11 @@ def matrix(
 
 def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None = None,
          seconds: float | None = None,
-         made: dict[tuple[str, str], Made] | None = None, disk: int = 0) -> str:
+         footprint: Footprint | None = None) -> str:
     """``reports/versions.md``: per engine, per consecutive pair, the counts of each move and
     every moved row grouped by (case, quantity, pair, integrator), with its largest ratio.
     ``notes`` (engine, old, new) → the explanation found for that step; ``seconds`` the time
-    the matrix took, ``made`` (engine, release) → its environment, ``disk`` the bytes they hold
-    together (:func:`dyncheck.environments.held`)."""
+    the matrix took, ``footprint`` what its environments hold."""
     notes = notes or {}
     lines = [
         "# Engine versions: what moved between releases",
@@ -279,7 +280,7 @@ def page(steps: Sequence[Step], *, notes: dict[tuple[str, str, str], str] | None
         "changed` when the change vanishes with the step like dt^p).",
         "",
     ]
-    lines += environment_lines(seconds, made or {}, disk)
+    lines += environment_lines(seconds, footprint)
     for name in dict.fromkeys(s.engine for s in steps):
         lines += [f"## {name}", ""]
         needs = ENGINES[name].needs if name in ENGINES else ()

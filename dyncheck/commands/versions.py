@@ -8,7 +8,6 @@ from pathlib import Path
 from dyncheck.commands import flags
 from dyncheck.commands.flags import Command
 from dyncheck.commands.options import OUT, check_out_file, log, path_arg, positive
-from dyncheck.environments import Made
 from dyncheck.errors import InvalidInput
 from dyncheck.progress import Progress
 from dyncheck.workers import default_jobs
@@ -53,19 +52,12 @@ def versions_command(args: argparse.Namespace) -> int:
     with Progress("versions", releases, quiet=args.quiet) as progress:
         steps = versions.matrix(names, cases=args.case, jobs=args.jobs, log=log,
                               reuse=args.reuse, progress=progress)
-    made = _made([(n, r) for n in names for r in versions.engine(n).releases])
     write_atomic(out, versions.page(steps, notes=EXPLANATIONS, seconds=time.perf_counter() - t0,
-                                    made=made, disk=environments.held(made)))
+                                    footprint=environments.footprint(
+                                        (n, r) for n in names
+                                        for r in versions.engine(n).releases)))
     print(f"version matrix written to {out}")
     return 0
-
-
-def _made(names: list[tuple[str, str]]) -> dict[tuple[str, str], Made]:
-    """The environments of the releases named that exist."""
-    from dyncheck import environments
-
-    found = {(n, r): environments.made(n, r) for n, r in names}
-    return {k: m for k, m in found.items() if m is not None}
 
 
 def _remove() -> int:
@@ -114,11 +106,9 @@ def _on_models(args: argparse.Namespace) -> int:
     with Progress("versions", len(releases), quiet=args.quiet) as progress:
         steps, outcomes = model_versions.matrix(eng, releases, models, log=log,
                                                 done=progress.done)
-    made = _made([(eng.name, r) for r in releases])
-    write_atomic(out, model_versions.page(steps, outcomes, models,
-                                          seconds=time.perf_counter() - t0,
-                                          made={r: m for (_, r), m in made.items()},
-                                          disk=environments.held(made)))
+    write_atomic(out, model_versions.page(
+        steps, outcomes, models, seconds=time.perf_counter() - t0,
+        footprint=environments.footprint((eng.name, r) for r in releases)))
     moved = sum(len(s.moved) for s in steps if s.moved is not None)
     print(f"{moved} rows moved over {len(releases)} releases of {eng.name}: {out}")
     return 0

@@ -46,7 +46,10 @@ def test_a_made_environment_is_measured_as_a_copy_and_as_what_it_adds(tmp_path, 
     made = environments.made("mujoco", "3.3.7")
     assert made is not None
     assert (made.seconds, made.by, made.apparent, made.own) == (12.5, Installer.UV, 1014, 14)
-    assert environments.held([("mujoco", "3.3.7")]) == 1014
+    (tmp_path / "uv" / "unlinked.whl").write_bytes(b"w" * 500)
+    footprint = environments.footprint([("mujoco", "3.3.7"), ("mujoco", "4.0.0")])
+    assert list(footprint.made) == [("mujoco", "3.3.7")]
+    assert (footprint.disk, footprint.cache) == (1014, 500)
 
 
 def test_pip_conflict_is_named_in_one_line():
@@ -121,7 +124,7 @@ def test_two_environments_share_their_files_under_uv_and_copy_them_under_pip(
     assert one is (how is Installer.UV)
     made = [environments.made("toy", r) for r in ("a", "b")]
     assert all(m is not None and m.by is how and m.apparent > len(TOY) for m in made)
-    held = environments.held([("toy", "a"), ("toy", "b")])
+    held = environments.footprint([("toy", "a"), ("toy", "b")]).disk
     if how is Installer.UV:
         assert all(m is not None and m.own < len(TOY) for m in made)
         assert held < sum(m.apparent for m in made if m is not None) - len(TOY) // 2
