@@ -247,6 +247,10 @@ class WantsCompiled:
     """Every body stated, and the compiler's ``settotalmass`` dropped (the masses stated
     are already the scaled ones). On the canonical engine's tree: its hint's fix, read by
     each other engine (an attribute only it applies)."""
+    box: bool = False
+    """The bodies' geoms replaced by one box of the stated inertia, at its centre of mass and
+    principal axes: for an engine that takes a body's mass from ``<inertial>`` but its
+    inertia from the geoms only (PyBullet's MJCF reader)."""
 
 
 @dataclass(frozen=True, kw_only=True)

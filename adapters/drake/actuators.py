@@ -14,8 +14,9 @@ position servo's control is its target q_d (v_d = 0, no feed-forward).
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -130,21 +131,35 @@ def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
     return (*out, *classes), frozenset((*measured, *(w for _, _, w in classes)))
 
 
+T = TypeVar("T")
+
+
 def file_kv(root: ET.Element) -> dict[str, float]:
     """Each ``<position>``'s kv as MuJoCo's compiler gives it (``root``: the file, its
-    includes inlined): its own, else its class's, else 0; by its name, and by its joint's
-    where the joint has no other ``<position>`` (an unnamed actuator)."""
-    classes = class_defaults(root, "position", ("kv",))
-    out: dict[str, float] = {}
-    by_joint: dict[str, list[float]] = {}
-    for element in (e for block in root.findall("actuator") for e in block.findall("position")):
-        stated = element.get("kv") or classes.get(element.get("class", "main"), {}).get("kv")
-        kv = float(stated or 0.0)
-        if element.get("name"):
-            out[element.get("name", "")] = kv
-        if element.get("joint"):
-            by_joint.setdefault(element.get("joint", ""), []).append(kv)
-    return {**{f"joint {j}": k[0] for j, k in by_joint.items() if len(k) == 1}, **out}
+    includes inlined): its own, else its class's, else 0 (:func:`per_actuator`)."""
+    return per_actuator(root, ("position",), ("kv",),
+                        lambda attrs, _: float(attrs.get("kv") or 0.0))
+
+
+def per_actuator(root: ET.Element, tags: Sequence[str], keys: Sequence[str],
+                 value: Callable[[Mapping[str, str], ET.Element], T]) -> dict[str, T]:
+    """``value`` of each actuator of ``tags`` in ``root`` (the file, its includes inlined),
+    from its attributes ``keys`` as MuJoCo's compiler resolves them (its own, else its
+    class's); by its name, and by its joint's (``joint NAME``) where the joint has no other
+    (an unnamed actuator)."""
+    classes = {tag: class_defaults(root, tag, tuple(keys)) for tag in tags}
+    out: dict[str, T] = {}
+    by_joint: dict[str, list[T]] = {}
+    for block in root.findall("actuator"):
+        for element in (e for e in block if e.tag in tags):
+            attrs = {**classes[element.tag].get(element.get("class", "main"), {}),
+                     **{k: v for k, v in element.attrib.items() if k in keys}}
+            got = value(attrs, element)
+            if element.get("name"):
+                out[element.get("name", "")] = got
+            if element.get("joint"):
+                by_joint.setdefault(element.get("joint", ""), []).append(got)
+    return {**{f"joint {j}": v[0] for j, v in by_joint.items() if len(v) == 1}, **out}
 
 
 def damping_fixed(plant: Any, root: ET.Element, tree: ModelTree) -> tuple[FixedReading, ...]:
@@ -212,31 +227,24 @@ def file_force_bounds(root: ET.Element) -> dict[str, tuple[float, float] | None]
     """Each ``<motor>``'s and ``<position>``'s bound on the force it applies to its joint as
     MuJoCo's compiler gives it (``root``: the file, its includes inlined): gear × its
     forcerange (its own, else its class's; limited where ``forcelimited`` says so, else
-    where stated) ∩ its joint's ``actuatorfrcrange``; None where unbounded. By its name, and
-    by its joint's (``joint NAME``) where the joint has no other."""
-    keys = ("forcerange", "forcelimited", "gear")
-    classes = {tag: class_defaults(root, tag, keys) for tag in READ_TAGS_BY_ELEMENT}
+    where stated) ∩ its joint's ``actuatorfrcrange``; None where unbounded
+    (:func:`per_actuator`)."""
     joint_bounds = {p.element.get("name"): _bound(p.attrs.get("actuatorfrcrange"),
                                                   p.attrs.get("actuatorfrclimited"))
                     for p in placed(root, "joint", ("actuatorfrcrange", "actuatorfrclimited"))}
-    out: dict[str, tuple[float, float] | None] = {}
-    by_joint: dict[str, list[tuple[float, float] | None]] = {}
-    for block in root.findall("actuator"):
-        for element in (e for e in block if e.tag in READ_TAGS_BY_ELEMENT):
-            attrs = {**classes[element.tag].get(element.get("class", "main"), {}),
-                     **{k: v for k, v in element.attrib.items() if k in keys}}
-            gear = float((attrs.get("gear") or "1").split()[0])
-            own = _bound(attrs.get("forcerange"), attrs.get("forcelimited"))
-            bound = None if own is None else tuple(sorted((gear * own[0], gear * own[1])))
-            joint = element.get("joint", "")
-            held = joint_bounds.get(joint)
-            if held is not None:
-                bound = held if bound is None else (max(bound[0], held[0]),
-                                                    min(bound[1], held[1]))
-            if element.get("name"):
-                out[element.get("name", "")] = bound  # type: ignore[assignment]
-            by_joint.setdefault(joint, []).append(bound)  # type: ignore[arg-type]
-    return {**{f"joint {j}": b[0] for j, b in by_joint.items() if len(b) == 1}, **out}
+
+    def bound_of(attrs: Mapping[str, str], element: ET.Element) -> tuple[float, float] | None:
+        gear = float((attrs.get("gear") or "1").split()[0])
+        own = _bound(attrs.get("forcerange"), attrs.get("forcelimited"))
+        bound = None if own is None else (min(gear * own[0], gear * own[1]),
+                                          max(gear * own[0], gear * own[1]))
+        held = joint_bounds.get(element.get("joint", ""))
+        if held is not None:
+            bound = held if bound is None else (max(bound[0], held[0]), min(bound[1], held[1]))
+        return bound
+
+    return per_actuator(root, READ_TAGS_BY_ELEMENT, ("forcerange", "forcelimited", "gear"),
+                        bound_of)
 
 
 READ_TAGS_BY_ELEMENT = ("motor", "position")

@@ -6,11 +6,9 @@ the field again."""
 
 from __future__ import annotations
 
-import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
-from pathlib import Path
 from typing import Any
 
 from dyncheck.adapters.drake import actuators as drake_actuators
@@ -114,9 +112,9 @@ def _read(source: ModelFile, root: ET.Element, edit: Edit,
           read: Read) -> tuple[ModelTree | None, str]:
     """Drake's reading of a copy of ``root`` with ``edit`` applied, or its words refusing
     it."""
-    with tempfile.TemporaryDirectory(prefix="dyncheck-drake-fix-") as folder:
+    with copied(source, root, (edit,)) as copy:
         try:
-            return read(copied(source, root, (edit,), Path(folder))), ""
+            return read(copy), ""
         except (EngineError, Unsupported) as exc:
             return None, str(exc)
 

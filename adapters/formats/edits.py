@@ -4,9 +4,11 @@ be measured again (#77; :mod:`dyncheck.check.proofs`)."""
 
 from __future__ import annotations
 
+import contextlib
 import copy
+import tempfile
 import xml.etree.ElementTree as ET
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import NamedTuple
@@ -40,14 +42,21 @@ def applied(root: ET.Element, folder: Path, edits: Sequence[Edit]) -> str:
     return standalone(fixed, folder)
 
 
-def copied(source: ModelFile, root: ET.Element, edits: Sequence[Edit], folder: Path) -> ModelFile:
+@contextlib.contextmanager
+def written(source: ModelFile, text: str) -> Iterator[ModelFile]:
+    """The MJCF ``source`` as the copy ``text``, written in a folder of its own for as long
+    as the context lasts: what an engine reads to measure a fix."""
+    with tempfile.TemporaryDirectory(prefix="dyncheck-fix-") as folder:
+        path = Path(folder) / "fixed.xml"
+        path.write_text(text, encoding="utf-8")
+        yield replace(source, path=path, text=text, notes=())
+
+
+def copied(source: ModelFile, root: ET.Element,
+           edits: Sequence[Edit]) -> contextlib.AbstractContextManager[ModelFile]:
     """The MJCF ``source`` as a copy of ``root`` (its document as the engine should read it)
-    with ``edits`` :func:`applied`, written in ``folder``: what an engine reads to measure a
-    fix."""
-    text = applied(root, source.path.resolve().parent, edits)
-    path = folder / "fixed.xml"
-    path.write_text(text, encoding="utf-8")
-    return replace(source, path=path, text=text, notes=())
+    with ``edits`` :func:`applied`, :func:`written` for as long as the context lasts."""
+    return written(source, applied(root, source.path.resolve().parent, edits))
 
 
 def fixed_copy(source: ModelFile, root: ET.Element, edits: Sequence[Edit]) -> FixedCopy | None:

@@ -4,10 +4,8 @@ cause written only where the copy with its fix loads."""
 
 from __future__ import annotations
 
-import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Sequence
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -42,17 +40,16 @@ def fixed_readings(source: ModelFile, root: ET.Element, fixes: Sequence[Fix],
     after loading (the fix its gravity hint names)."""
     out = []
     includes = "<include" in source.text
-    with tempfile.TemporaryDirectory(prefix="dyncheck-pinocchio-fix-") as folder:
-        for fix in fixes:
-            words = fix.edit.words + (INLINED if includes else "")
+    for fix in fixes:
+        words = fix.edit.words + (INLINED if includes else "")
+        with copied(source, root, (fix.edit,)) as copy:
             try:
-                tree = read(copied(source, root, (fix.edit,), Path(folder)), None)
+                tree = read(copy, None)
             except (EngineError, Unsupported) as exc:
                 out.append(FixedReading(subject=fix.subject, fields=fix.fields, fix=words,
                                         tree=None, refused=str(exc)))
                 continue
-            out.append(FixedReading(subject=fix.subject, fields=fix.fields, fix=words,
-                                    tree=tree))
+        out.append(FixedReading(subject=fix.subject, fields=fix.fields, fix=words, tree=tree))
     gravity = stated_gravity(root)
     if gravity is not None:
         out.append(FixedReading(subject="model", fields=("gravity",), fix=GRAVITY_FIX,
@@ -80,8 +77,7 @@ def refusal(source: ModelFile, message: str) -> str:
     # a cause is stated only where the engine's own words are its symptom, on the file as
     # Pinocchio reads it (its own text, no <include> followed), and its fix loads
     if CLASS_LOOKUP_FAILED in message and (why := later_defaults(parsing.root(source.text))):
-        with tempfile.TemporaryDirectory(prefix="dyncheck-pinocchio-fix-") as folder:
-            fixed = copied(source, parsing.root(source.text), (ONE_DEFAULTS,), Path(folder))
+        with copied(source, parsing.root(source.text), (ONE_DEFAULTS,)) as fixed:
             try:
                 pin.buildModelFromMJCF(str(fixed.path))
             except Exception:  # the fix does not load: the cause is not proved, not written

@@ -15,6 +15,7 @@ import pybullet as pb
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile, urdf_inertials
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
+from dyncheck.adapters.model_tree import WantsCompiled
 from dyncheck.adapters.proof import Proof
 from dyncheck.adapters.registration import Format
 from dyncheck.errors import EngineError
@@ -46,38 +47,46 @@ NO_INERTIAL = (
 ZEROED_INERTIA = (
     "PyBullet's URDF importer sets the inertia of {links} to zero: it breaks the triangle "
     "inequality I1 + I2 >= I3 (its warning: 'Bad inertia tensor properties, setting inertia "
-    "to zero') (fix: correct the file's inertia)"
+    "to zero'; measured: PyBullet holds a zero inertia there) (fix: correct the file's "
+    "inertia)"
 )
 INERTIA_HINT = (
     "PyBullet's MJCF reader does not take a body's inertia from <inertial diaginertia> or "
-    "fullinertia (measured: zero, or computed from its geoms) (fix: check the URDF in "
-    "PyBullet, or give the bodies geoms whose inertia is the intended one)"
+    "fullinertia: it takes the mass and computes the inertia from the body's geoms (fix: one "
+    "box geom of the intended inertia in place of the body's geoms)"
 )
 DENSITY_HINT = (
     "PyBullet's MJCF reader weighs a geom at density 1000 kg/m^3 whatever the file's "
     "density ({densities} on this body's geoms, theirs or their default's) (measured on "
-    "PyBullet 3.2.7: a box geom with density=\"800\" weighs 1000 x its volume) (fix: check "
-    "the URDF in PyBullet)"
+    "PyBullet 3.2.7: a box geom with density=\"800\" weighs 1000 x its volume) (fix: state "
+    "the body's mass in an <inertial>)"
 )
+Hint = tuple[str, str, str]
 
 
-def mjcf_hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
+def mjcf_hints(source: ModelFile) -> tuple[tuple[Hint, ...], tuple[WantsCompiled, ...]]:
     """Why a body of an MJCF reads other mass or inertia in PyBullet, where the file shows
     the premise: an ``<inertial>`` with a tensor (which its reader does not take), or geoms
     weighed at a density other than 1000 (their own ``density`` or the top-level default's;
-    a class's is not resolved here: no hint, cause unknown). Named on the body's joints."""
+    a class's is not resolved here: no hint, cause unknown). Named on the body's joints, each
+    with its fix (a named body's): what MuJoCo compiled stated in an ``<inertial>``, in place
+    of the geoms too for the inertia."""
     if source.format is not Format.MJCF:
-        return ()
+        return (), ()
     root = parsing.root(source.text)
     default = root.find("default/geom")
     fallback = default.get("density") if default is not None else None
-    out: list[tuple[str, str, str]] = []
+    out: list[Hint] = []
+    wants: list[WantsCompiled] = []
     for body in root.iter("body"):
         joints = [j.get("name", "") for j in body.findall("joint") if j.get("name")]
+        named = (body.get("name"),) if body.get("name") else ()
         inertial = body.find("inertial")
         if inertial is not None:
             if inertial.get("diaginertia") or inertial.get("fullinertia"):
                 out += [(j, "inertia", INERTIA_HINT) for j in joints]
+                wants += [WantsCompiled(subject=j, fields=("inertia",), bodies=named, box=True)
+                          for j in joints if named]
             continue
         densities = sorted({float(d) for g in body.findall("geom") if g.get("mass") is None
                             and g.get("class") is None
@@ -85,7 +94,9 @@ def mjcf_hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
         if densities:
             why = DENSITY_HINT.format(densities=", ".join(f"{d:g}" for d in densities))
             out += [(j, "mass", why) for j in joints]  # (its inertia: other causes too)
-    return tuple(out)
+            wants += [WantsCompiled(subject=j, fields=("mass",), bodies=named)
+                      for j in joints if named]
+    return tuple(out), tuple(wants)
 
 
 MAX_LINKS = 128
@@ -149,17 +160,22 @@ def load(client: int, source: ModelFile) -> list[int]:
     return bodies
 
 
-def zeroed(source: ModelFile, links: list[Link]) -> tuple[tuple[str, str, str], ...]:
-    """Why a URDF link's inertia reads zero: the file's breaks the triangle inequality
-    (PyBullet zeroes it), named on the joint that moves the link."""
+def zeroed(source: ModelFile, links: list[Link]) -> tuple[Hint, ...]:
+    """Why a URDF link's inertia reads zero: the file's breaks the triangle inequality (a
+    moment negative or above the sum of the others, by any amount: PyBullet's importer
+    compares its principal moments so) and PyBullet holds a zero inertia for it (measured on
+    the link read back: where rounding decides, what it holds does), named on the joint that
+    moves the link."""
+    read = {link.name: link for link in links}
     bad = set()
     for stated in urdf_inertials(source):
         moments = np.linalg.eigvalsh(np.array(stated.inertia))
-        if moments[0] + moments[1] < moments[2] * (1.0 - 1e-12):
+        link = read.get(stated.link)
+        if ((moments[0] < 0 or moments[0] + moments[1] < moments[2]) and link is not None
+                and not np.any(link.inertia)):
             bad.add(stated.link)
-    joints = {link.name: link.joint for link in links}
-    return tuple((joints[name], "inertia", ZEROED_INERTIA.format(links=repr(name)))
-                 for name in sorted(bad) if name in joints)
+    return tuple((read[name].joint, "inertia", ZEROED_INERTIA.format(links=repr(name)))
+                 for name in sorted(bad))
 
 
 def defaulted(bare: Mapping[str, list[str]]) -> tuple[tuple[str, str, str], ...]:
@@ -195,8 +211,8 @@ PROOFS = {
     "ARMATURE_HINT": Proof.MEASURED,
     "ACCURACY_HINT": Proof.PREDICTED,
     "NO_INERTIAL": Proof.FIX,
-    "ZEROED_INERTIA": Proof.SUSPECTED,
-    "INERTIA_HINT": Proof.SUSPECTED,
-    "DENSITY_HINT": Proof.SUSPECTED,
+    "ZEROED_INERTIA": Proof.MEASURED,
+    "INERTIA_HINT": Proof.FIX,
+    "DENSITY_HINT": Proof.FIX,
 }
 """How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

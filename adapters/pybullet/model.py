@@ -45,12 +45,9 @@ import pybullet as pb
 
 from dyncheck.adapters.base import Field, ModelEngine, Offer
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.includes import inline
-from dyncheck.adapters.formats.mjcf_unread import stated_gravity
 from dyncheck.adapters.model_tree import (
     Axes,
     Dynamics,
-    FixedReading,
     GravityFrame,
     JointType,
     Layout,
@@ -60,7 +57,7 @@ from dyncheck.adapters.model_tree import (
     lump,
 )
 from dyncheck.adapters.pybullet.base import base_state, place_base, world_linear
-from dyncheck.adapters.pybullet.counterfactual import inertial_fixed
+from dyncheck.adapters.pybullet.counterfactual import gravity_fixed, inertial_fixed
 from dyncheck.adapters.pybullet.couplings import GEARED, Gear, gears, multipliers
 from dyncheck.adapters.pybullet.files import (
     ACCURACY_HINT,
@@ -68,7 +65,6 @@ from dyncheck.adapters.pybullet.files import (
     DIAGONALIZATION,
     FLAGS_NOTE,
     FREE_BASE,
-    GRAVITY_FIX,
     GRAVITY_HINT,
     MAX_LINKS,
     Link,
@@ -133,30 +129,21 @@ class PybulletModel(PybulletState, ModelEngine):
         links = [link for body in self.bodies for link in self._links(body)]
         notes = (FLAGS_NOTE,) if source.format is Format.URDF else ()
         hints: tuple[tuple[str, str, str], ...] = (("model", "armature", ARMATURE_HINT),)
+        weighed, wants = mjcf_hints(source)
         if source.format is Format.MJCF:
-            hints += (("model", "gravity", GRAVITY_HINT), *mjcf_hints(source))
+            hints += (("model", "gravity", GRAVITY_HINT), *weighed)
         bare = bare_links(source, links)
         hints += zeroed(source, links) + defaulted(bare)
         if source.format is Format.URDF:
             hints += (("model", "inertia accuracy", ACCURACY_HINT),)
-        self.tree = self._tree(links, notes, hints)
+        self.tree = replace(self._tree(links, notes, hints), wants_compiled=wants)
         if fixes:  # (#77: the fix of a bare link measured on a copy; the stated gravity set)
             self.tree = replace(self.tree, fixed=inertial_fixed(
-                source, bare, self._copy_tree) + self._gravity_fixed(source))
+                source, bare, self._copy_tree) + gravity_fixed(
+                source, self.gravity, self._copy_tree))
         self._balls = any(kind == pb.JOINT_SPHERICAL for joints in self._movable.values()
                           for _, kind in joints)
         self._gears: list[Gear] = []
-
-    def _gravity_fixed(self, source: ModelFile) -> tuple[FixedReading, ...]:
-        """The fix :data:`GRAVITY_HINT` names, measured: the MJCF read again with
-        ``setGravity`` given the gravity the file states (where it states one other than
-        PyBullet's)."""
-        stated = stated_gravity(inline(source.path)) if source.format is Format.MJCF else None
-        if stated is None or np.allclose(stated, self.gravity):
-            return ()
-        return (FixedReading(subject="model", fields=("gravity",), fix=GRAVITY_FIX.format(
-            gravity=" ".join(f"{g:g}" for g in stated)),
-            tree=self._copy_tree(source, gravity=stated)),)
 
     def _copy_tree(self, copy: ModelFile, *, gravity: np.ndarray | None = None) -> ModelTree:
         """The tree of ``copy`` as PyBullet reads it under the same gravity (or

@@ -10,12 +10,10 @@ cause; where it does not, the cause is unknown and the row says how much is left
 
 from __future__ import annotations
 
-import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Mapping
 from contextlib import AbstractContextManager
 from dataclasses import replace
-from pathlib import Path
 from typing import Protocol
 
 from dyncheck.adapters.base import ModelEngine
@@ -38,8 +36,18 @@ Start = Callable[[str, ModelFile], AbstractContextManager["ModelEngine | Refused
 process of its own where the check isolates engines (:func:`.engines.running`)."""
 
 
+def read_tree(start: Start, engine: str, copy: ModelFile) -> tuple[ModelTree | None, str]:
+    """What ``engine`` holds after reading ``copy`` (its tree is read on loading; the engine
+    is closed after), or its words refusing it."""
+    with start(engine, copy) as read:
+        if isinstance(read, ModelEngine):
+            return read.tree, ""
+        return None, read.message
+
+
 WORDS = "an <inertial> on {bodies} stating the mass, centre of mass and inertia {engine} compiles"
 DROPPED = ", settotalmass dropped"
+BOXED = ", the geoms of {bodies} replaced by one box of that inertia"
 SPRING_WORDS = "stiffness= and damping= on {joints} stating what {engine} compiles"
 SHOWN = 4
 """How many bodies the fix's words name (then "… (n bodies)")."""
@@ -66,11 +74,14 @@ def springs(stated: Mapping[str, tuple[float, float]], *, engine: str) -> Edit:
                 apply)
 
 
-def edit(inertials: Mapping[str, Inertial], *, engine: str, every: bool = False) -> Edit:
+def edit(inertials: Mapping[str, Inertial], *, engine: str, every: bool = False,
+         boxed: frozenset[str] = frozenset()) -> Edit:
     """Give each body named in ``inertials`` that ``<inertial>`` (in place of its own), and
     make a compiler's ``inertiafromgeom="true"`` (which ignores every ``<inertial>``, in
     MuJoCo and Pinocchio alike) ``"auto"``; with ``every`` (every body stated, the scaled
-    masses), drop the compiler's ``settotalmass``: the model MuJoCo compiles stays the same."""
+    masses), drop the compiler's ``settotalmass``; the bodies of ``boxed`` get one box of
+    that inertia in place of their geoms (:func:`_box`). The model MuJoCo compiles stays the
+    same: it takes a body's mass properties from a stated ``<inertial>``."""
     shown = _named(sorted(inertials), "bodies")
 
     def apply(root: ET.Element) -> None:
@@ -79,6 +90,7 @@ def edit(inertials: Mapping[str, Inertial], *, engine: str, every: bool = False)
                 compiler.set("inertiafromgeom", "auto")
             if every:
                 compiler.attrib.pop("settotalmass", None)
+        named = _referenced(root) if boxed else set()
         for body in root.iter("body"):
             stated = inertials.get(body.get("name", ""))
             if stated is None:
@@ -90,8 +102,49 @@ def edit(inertials: Mapping[str, Inertial], *, engine: str, every: bool = False)
                 "quat": " ".join(repr(x) for x in stated.quat),
                 "mass": repr(stated.mass),
                 "diaginertia": " ".join(repr(x) for x in stated.diaginertia)}))
-    return Edit(WORDS.format(bodies=shown, engine=engine)
-                + (DROPPED if every else ""), apply)
+            if body.get("name") in boxed:
+                for parent, geom in _own_geoms(body):
+                    if geom.get("name") not in named:
+                        parent.remove(geom)
+                if stated.mass > 0:
+                    body.insert(1, _box(stated))
+    return Edit(WORDS.format(bodies=shown, engine=engine) + (DROPPED if every else "")
+                + (BOXED.format(bodies=_named(sorted(boxed), "bodies")) if boxed else ""),
+                apply)
+
+
+def _box(stated: Inertial) -> ET.Element:
+    """A box (MuJoCo ignores its mass and inertia: the ``<inertial>`` beside it decides) whose
+    inertia at the stated mass is the stated one: half-sizes a, b, c with I₁ = m (b² + c²) / 3
+    and so on, i.e. a² = 3 (I₂ + I₃ − I₁) / (2m); placed at the centre of mass along the principal
+    axes, colliding with nothing."""
+    i1, i2, i3 = stated.diaginertia
+    squares = [3 * (j + k - i) / (2 * stated.mass) for i, j, k in
+               ((i1, i2, i3), (i2, i3, i1), (i3, i1, i2))]
+    half = [max(x, 1e-12) ** 0.5 for x in squares]  # (a degenerate moment: a thin box)
+    return ET.Element("geom", {
+        "type": "box", "size": " ".join(repr(h) for h in half),
+        "pos": " ".join(repr(x) for x in stated.pos),
+        "quat": " ".join(repr(x) for x in stated.quat),
+        "contype": "0", "conaffinity": "0"})
+
+
+def _own_geoms(body: ET.Element) -> list[tuple[ET.Element, ET.Element]]:
+    """The geoms of ``body`` itself (its children's and those of its ``<frame>``s, not those
+    of the bodies it carries), each with its parent element."""
+    out = []
+    for child in body:
+        if child.tag == "geom":
+            out.append((body, child))
+        elif child.tag == "frame":
+            out += _own_geoms(child)
+    return out
+
+
+def _referenced(root: ET.Element) -> set[str]:
+    """Every value an attribute other than a name holds: the geoms whose name may be
+    referred to there (a contact pair, a tendon's wrap, a sensor) are kept."""
+    return {v for el in root.iter() for k, v in el.attrib.items() if k != "name"}
 
 
 def measured(source: ModelFile, canonical: ModelTree, loaded: dict[str, ModelEngine], *,
@@ -110,12 +163,9 @@ def measured(source: ModelFile, canonical: ModelTree, loaded: dict[str, ModelEng
         if not wants:
             continue
         fix = stating(canonical, wants)
-        with tempfile.TemporaryDirectory(prefix="dyncheck-compiled-") as folder:
-            copy = copied(source, inline(source.path), (fix,), Path(folder))
-            with start(engine, copy) as read:
-                pass  # (its tree is read on loading)
-        tree = align_by_body(canonical, read.tree)[0] if isinstance(read, ModelEngine) else None
-        refused = "" if isinstance(read, ModelEngine) else read.message
+        with copied(source, inline(source.path), (fix,)) as copy:
+            read, refused = read_tree(start, engine, copy)
+        tree = align_by_body(canonical, read)[0] if read is not None else None
         m.tree = replace(m.tree, hints=(*m.tree.hints, *(h for _, h in theirs)), fixed=(
             *m.tree.fixed, *(
             FixedReading(subject=w.subject, fields=w.fields, fix=fix.words, tree=tree,
@@ -140,8 +190,10 @@ def stating(canonical: ModelTree, wants: list[WantsCompiled]) -> Edit:
     """One edit stating, for every body and joint ``wants`` name, the canonical engine's."""
     bodies = {b: canonical.inertials[b] for w in wants for b in w.bodies}
     joints = {j: canonical.springs[j] for w in wants for j in w.joints}
-    edits = ([edit(bodies, engine=canonical.engine, every=any(w.every for w in wants))]
-             if bodies else []) + ([springs(joints, engine=canonical.engine)] if joints else [])
+    boxed = frozenset(b for w in wants if w.box for b in w.bodies)
+    edits = ([edit(bodies, engine=canonical.engine, every=any(w.every for w in wants),
+                   boxed=boxed)] if bodies else [])
+    edits += [springs(joints, engine=canonical.engine)] if joints else []
     return both(*edits)
 
 

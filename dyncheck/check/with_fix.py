@@ -9,16 +9,12 @@ says both (:mod:`.verdicts`)."""
 
 from __future__ import annotations
 
-import contextlib
-import tempfile
-from collections.abc import Iterator
 from dataclasses import replace
-from pathlib import Path
 
 from dyncheck.adapters import layout, layout_batch
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.formats import parsing
-from dyncheck.adapters.formats.edits import applied
+from dyncheck.adapters.formats.edits import applied, written
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
@@ -75,7 +71,7 @@ def rows(model: str, source: ModelFile, *, canon: layout.Canonical, canonical_tr
             continue
         text, words = made
         fix = WITH_FIX.format(fix=words)
-        with _written(source, text) as copy, start(engine, copy) as fixed:
+        with written(source, text) as copy, start(engine, copy) as fixed:
             if not isinstance(fixed, ModelEngine):
                 out.append(_row(model, engine, Verdict.FAILED, f"{fix}: {fixed.message}",
                                 fix=words, value="refused"))
@@ -120,12 +116,3 @@ def _computed(model: str, engine: str, fix: str, *, canon: layout.Canonical,
                     vertices=vertices, standing=standing_of(canonical_tree, batch.q))
     return [replace(r, section=Section.WITH_FIX, note=f"{fix}: {r.note}" if r.note else fix)
             for r in found]
-
-
-@contextlib.contextmanager
-def _written(source: ModelFile, text: str) -> Iterator[ModelFile]:
-    """The copy written in a folder of its own, removed after."""
-    with tempfile.TemporaryDirectory(prefix="dyncheck-with-fix-") as folder:
-        path = Path(folder) / "fixed.xml"
-        path.write_text(text, encoding="utf-8")
-        yield replace(source, path=path, text=text, notes=())

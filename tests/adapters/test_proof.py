@@ -19,7 +19,6 @@ from dyncheck.adapters.proof import Proof
 SUSPECTED = {
     "drake.hints": {"BALL_ARMATURE", "IGNORED_FRAME"},
     "newton.actuators": {"MOTORS", "GEAR", "BOUNDS"},
-    "pybullet.files": {"ZEROED_INERTIA", "INERTIA_HINT", "DENSITY_HINT"},
 }
 """The work left: causes written on a page as "cause unknown; suspected"."""
 

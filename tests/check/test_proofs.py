@@ -627,10 +627,10 @@ def test_pybullets_gravity_cause_is_verified_by_setting_it(tmp_path, monkeypatch
     the expected value): "fix verified"; with the stated gravity planted wrong (−7), the
     cause is unknown."""
     pytest.importorskip("pybullet", reason="the pybullet extra is not installed")
-    from dyncheck.adapters.pybullet import model as pybullet_model
+    from dyncheck.adapters.pybullet import counterfactual
 
     if plant:
-        monkeypatch.setattr(pybullet_model, "stated_gravity",
+        monkeypatch.setattr(counterfactual, "stated_gravity",
                             lambda root: np.array([0.0, 0.0, -7.0]))
     rows = _checked(tmp_path, GRAVITY, "pybullet")
     note = rows[rows["field"] == "gravity"].iloc[0].note
@@ -685,3 +685,87 @@ def test_drakes_effort_limit_is_verified_by_setting_the_stated_bound(tmp_path, m
     control = rows[rows["field"] == "control range"]
     assert len(control) == 2
     assert control["note"].str.startswith("Drake's joint actuator holds no control range").all()
+
+
+PYBULLET_WEIGHED = """<mujoco model="pybullet_weighed">
+  <worldbody>
+    <body name="base" pos="0 0 1">
+      <body name="a">
+        <joint name="ja" type="hinge" axis="0 1 0"/>
+        <inertial pos="0.1 0 -0.05" mass="2" fullinertia="0.03 0.04 0.05 0.005 -0.002 0.003"/>
+        <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/>
+        <body name="b" pos="0.3 0 0">
+          <joint name="jb" type="hinge" axis="1 0 0"/>
+          <geom type="box" size="0.05 0.1 0.15" density="800"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""
+"""Two bodies PyBullet's MJCF reader weighs otherwise (measured on PyBullet 3.2.7): 'a'
+states its inertia in full, which PyBullet replaces by its capsule's at 2 kg
+(:data:`~dyncheck.adapters.pybullet.files.INERTIA_HINT`); 'b's box is of density 800
+(4.8 kg in MuJoCo), which PyBullet weighs at 1000 (6 kg: :data:`~dyncheck.adapters.
+pybullet.files.DENSITY_HINT`)."""
+
+
+@pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-wrong"])
+def test_pybullets_weighing_causes_are_verified_by_compiled_copy(tmp_path, monkeypatch,
+                                                                   plant):
+    """The copy with MuJoCo's compiled <inertial> on 'a' (its geoms replaced by one box of
+    that inertia) and on 'b', read by PyBullet, holds MuJoCo's inertia on 'ja' and mass on
+    'jb' (MuJoCo's compiler the expected value): "fix verified". With the stated inertials
+    planted wrong (mass and inertia doubled), both causes are unknown."""
+    pytest.importorskip("pybullet", reason="the pybullet extra is not installed")
+    from dyncheck.adapters.mujoco import compiled
+
+    if plant:
+        real = compiled.inertials
+        monkeypatch.setattr(compiled, "inertials", lambda m: {
+            name: replace(x, mass=2 * x.mass, diaginertia=tuple(2 * i for i in x.diaginertia))
+            for name, x in real(m).items()})
+    rows = _checked(tmp_path, PYBULLET_WEIGHED, "pybullet")
+    rows = rows[(rows["section"] == "description") & (rows["impl_b"] == "pybullet")]
+    found = {(r.subject, r.field): r for r in rows.itertuples()}
+    for key, words in ((("ja", "inertia"), "the geoms of 'a' replaced by one box of that "
+                        "inertia, pybullet reads the inertia of 'ja' as mujoco does"),
+                       (("jb", "mass"), "pybullet reads the mass of 'jb' as mujoco does")):
+        note = found[key].note
+        assert found[key].verdict == "failed", key
+        assert (FIX_VERIFIED in note) is not plant, (key, note)
+        assert note.startswith("cause unknown: the named fix") is plant, (key, note)
+        assert (words in note) is not plant, (key, note)
+
+
+ZEROED = """<robot name="zeroed">
+  <link name="base"><inertial><mass value="2"/>
+    <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <link name="arm"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
+    <inertia ixx="{ixx}" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.05"/></inertial></link>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="arm"/>
+    <axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="10" velocity="1"/></joint>
+</robot>"""
+"""'arm's moments 0.01 + 0.01 < 0.05 break the triangle inequality (PyBullet's importer
+zeroes them, its warning says); with ixx = 0.045 they do not; with ixx = 0.039999999999999
+they break it by 2.5e-14 relative, which PyBullet's strict comparison of its moments
+(``Z > X + Y``, bullet3's BulletUrdfImporter) zeroes too."""
+
+
+@pytest.mark.parametrize(("ixx", "zeroed"), [("0.01", True), ("0.045", False),
+                                             ("0.039999999999999", True)])
+def test_pybullets_zeroed_inertia_is_stated_where_it_holds_zero(tmp_path, ixx, zeroed):
+    """The cause is written where PyBullet holds a zero inertia for the link (read back from
+    PyBullet; its importer's rule, a principal moment above the sum of the others, decides
+    which), and nowhere else."""
+    pytest.importorskip("pybullet", reason="the pybullet extra is not installed")
+    from dyncheck.adapters.formats.files import read
+    from dyncheck.adapters.pybullet.files import ZEROED_INERTIA
+    from dyncheck.adapters.pybullet.model import PybulletModel
+
+    path = tmp_path / "zeroed.urdf"
+    path.write_text(ZEROED.format(ixx=ixx))
+    model = PybulletModel(read(path))
+    joint = next(j for j in model.tree.joints if j.name == "shoulder")
+    assert (not np.any(joint.inertia)) is zeroed
+    hint = model.tree.hint("shoulder", "inertia") or ""
+    assert (ZEROED_INERTIA.format(links="'arm'") == hint) is zeroed, hint
