@@ -191,6 +191,10 @@ class TreeJoint:
     where a measured defect makes it differ from the ``inertia`` it holds (PyBullet's
     spherical joint: its link's principal moments taken in the link's axes); None: the held
     one."""
+    parts: int = 1
+    """How many bodies' mass properties the engine summed into this joint's body (rigidly
+    joined links lumped): the round-off of its mass, centre of mass and inertia grows with
+    the sum (:mod:`dyncheck.check.describe`)."""
 
 
 @dataclass(frozen=True, kw_only=True)

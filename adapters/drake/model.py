@@ -302,6 +302,7 @@ class DrakeModel(ModelEngine):
                     body=joint.child_body().name(), axis=np.asarray(axis, float),
                     anchor=np.asarray(child_pose.translation(), float),
                     frame=child_pose.rotation().matrix(), mass=mass, com=com, inertia=inertia,
+                    parts=len(masses),
                     armature=(reflected.get(joint.name(), 0.0),) if nv == 1 else (0.0,) * nv,
                     damping=self._damping.get(joint.name(), (0.0,) * nv),
                     range=(float(lower[0]), float(upper[0])) if limited else None,

@@ -288,8 +288,8 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
                 parent = last_joint.get(a)
             last_joint[b] = j
             is_last = j == first + int(m.body_jntnum[b]) - 1
+            members = groups[b] if is_last else []
             if is_last:
-                members = groups[b]
                 mass, com, inertia = lump(
                     [float(m.body_mass[i]) for i in members],
                     [d.xipos[i].copy() for i in members],
@@ -313,7 +313,7 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
                     axis=axis,
                     anchor=d.xanchor[j].copy() if kind is not JointType.FREE else d.xpos[b].copy(),
                     frame=d.xmat[b].reshape(3, 3).copy(),
-                    mass=mass, com=com, inertia=inertia,
+                    mass=mass, com=com, inertia=inertia, parts=max(len(members), 1),
                     armature=tuple(float(x) for x in m.dof_armature[dofs]),
                     damping=tuple(float(x) for x in m.dof_damping[dofs]),
                     range=(float(m.jnt_range[j, 0]), float(m.jnt_range[j, 1])) if limited else None,

@@ -33,12 +33,14 @@ MOTORS = (
 GEAR = (
     "newton's MJCF importer makes a servo's drive stiffness and damping the file's kp and kv "
     "as written, without the gear (MuJoCo's servo on a gear g acts on its joint as g² kp, "
-    "g² kv, with the control scaled by g)"
+    "g² kv, with the control divided by g) (fix: set the drive's ke and kd to g² kp and "
+    "g² kv and its target to u / g)"
 )
 BOUNDS = (
     "newton's Featherstone solver bounds neither a drive's target nor its force (the file's "
     "ctrlrange and forcerange are kept for its MuJoCo solver; joint_effort_limit is not "
-    "applied by SolverFeatherstone)"
+    "applied by SolverFeatherstone; measured: a control ten times beyond the control range "
+    "gives ten times the force of a unit control, beyond the force range too)"
 )
 
 
@@ -140,8 +142,8 @@ def actuation(model: Any, newton: Any, actuators: list[tuple[int, int]], *, q: n
 
 
 PROOFS = {
-    "MOTORS": Proof.SUSPECTED,
-    "GEAR": Proof.SUSPECTED,
-    "BOUNDS": Proof.SUSPECTED,
+    "MOTORS": Proof.FIX,
+    "GEAR": Proof.FIX,
+    "BOUNDS": Proof.MEASURED,
 }
 """How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

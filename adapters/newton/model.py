@@ -41,6 +41,7 @@ from dyncheck.adapters.model_tree import (
     lump,
 )
 from dyncheck.adapters.newton import actuators as newton_actuators
+from dyncheck.adapters.newton.counterfactual import bounds_measured, gear_fixed, motors_fixed
 from dyncheck.adapters.newton.d6 import D6_ORDER, d6_chain, written_order
 from dyncheck.adapters.proof import Proof
 from dyncheck.adapters.registration import Format
@@ -246,7 +247,8 @@ class NewtonModel(ModelEngine):
                 body=self._body(int(child[j])),
                 axis=frame[:3, :3] @ axes[vs] if nv == 1 else np.zeros(3),
                 anchor=frame[:3, 3], frame=frame[:3, :3], mass=total, com=centre,
-                inertia=tensor, armature=tuple(float(x) for x in armature[dofs]),
+                inertia=tensor, parts=max(len(parts), 1),
+                armature=tuple(float(x) for x in armature[dofs]),
                 damping=tuple(float(x) for x in damping[dofs]),
                 range=(float(lower[vs]), float(upper[vs])) if limited else None,
                 layout=layout,
@@ -267,7 +269,8 @@ class NewtonModel(ModelEngine):
             if named:
                 why = CORRECTED.format(bodies=", ".join(repr(b) for b in named))
                 hints.append((self._name(j), "inertia", why))
-        acts = newton_actuators.read(m, self.newton, [self._name(j) for j in range(m.joint_count)])
+        names = [self._name(j) for j in range(m.joint_count)]
+        acts = newton_actuators.read(m, self.newton, names)
         fused = {j: chain for j, chain in fused.items()  # (slides only: applied as written)
                  if [n for n, _ in chain] != self._name(j).split("_")}
         for j, chain in fused.items():
@@ -280,7 +283,10 @@ class NewtonModel(ModelEngine):
                          gravity=np.asarray(m.gravity.numpy()[0], float),
                          nq=m.joint_coord_count, nv=m.joint_dof_count, notes=notes, eps=EPS32,
                          hints=(*hints, *newton_actuators.hints(m, acts)),
-                         measured=frozenset(w for _, _, w in hints), actuators=acts)
+                         measured=frozenset(w for _, _, w in hints)
+                         | bounds_measured(m, self.newton), actuators=acts)
+        tree = replace(tree, fixed=gear_fixed(m, self.newton, tree, names)  # (#77: proved on
+                       + motors_fixed(m, self.newton, tree, names))  # its own solver)
         if not fused:
             return tree
         return replace(tree, as_written=written_order(

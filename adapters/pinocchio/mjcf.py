@@ -111,8 +111,8 @@ DEFAULT_POS = (
     "write pos= on the joint)"
 )
 REF_RANGE = (
-    "Pinocchio's MJCF parser subtracts the joint's ref={ref} from its range while its "
-    "coordinate keeps ref (its qpos0 holds it): its limits are shifted by −ref (measured: "
+    "Pinocchio's MJCF parser subtracts the ref={ref} of joint {joint!r} from its range while "
+    "its coordinate keeps ref (its qpos0 holds it): its limits are shifted by −ref (measured: "
     "range=\"-110 110\" ref=\"-90\" read as (-20°, 200°)) (fix: none in the file that keeps "
     "it the same model; the dynamics here leave limits out)"
 )
@@ -336,7 +336,7 @@ def predicted_ranges(root: ET.Element) -> dict[str, dict[str, tuple[float, float
         if joint.attrs.get("limited") == "false":
             out.setdefault(UNLIMITED_RANGE, {})[name] = (low * unit, high * unit)
         elif ref:
-            out.setdefault(REF_RANGE.format(ref=joint.attrs["ref"]), {})[name] = (
+            out.setdefault(REF_RANGE.format(ref=joint.attrs["ref"], joint=name), {})[name] = (
                 low * unit - ref, high * unit - ref)
     return out
 
@@ -358,7 +358,7 @@ def _joint_hints(root: ET.Element) -> Iterable[Found]:
             if joint.attrs.get("limited") == "false":
                 yield Found(name, "range", UNLIMITED_RANGE)
             elif float(joint.attrs.get("ref", "0")) != 0.0:
-                yield Found(name, "range", REF_RANGE.format(ref=joint.attrs["ref"]))
+                yield Found(name, "range", REF_RANGE.format(ref=joint.attrs["ref"], joint=name))
 
 
 PROOFS = {

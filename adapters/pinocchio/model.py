@@ -21,6 +21,7 @@ integrators' definitions and scipy's DOP853 on its forward dynamics).
 from __future__ import annotations
 
 import tempfile
+from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -282,6 +283,7 @@ class PinocchioModel(ModelEngine):
         pin.forwardKinematics(m, d, q0)
         bodies = {f.parentJoint: f.name for f in reversed(list(m.frames))
                   if f.type == pin.FrameType.BODY}
+        summed = Counter(f.parentJoint for f in m.frames if f.type == pin.FrameType.BODY)
         joints: list[TreeJoint] = []
         last_name: dict[int, str] = {}  # Pinocchio joint → the name of its last component
         for i in range(1, m.njoints):
@@ -310,6 +312,7 @@ class PinocchioModel(ModelEngine):
                         com=d.oMi[i].act(inertia.lever).copy() if last else np.zeros(3),
                         inertia=(d.oMi[i].rotation @ inertia.inertia @ d.oMi[i].rotation.T
                                  if last else np.zeros((3, 3))),
+                        parts=max(summed[i], 1) if last else 1,
                         armature=tuple(float(x) for x in m.armature[dofs]),
                         damping=tuple(float(x) for x in m.damping[dofs]),
                         range=(float(lower), float(upper)) if limited else None,

@@ -80,7 +80,7 @@ def mjcf_hints(source: ModelFile) -> tuple[tuple[Hint, ...], tuple[WantsCompiled
     wants: list[WantsCompiled] = []
     for body in root.iter("body"):
         joints = [j.get("name", "") for j in body.findall("joint") if j.get("name")]
-        named = (body.get("name"),) if body.get("name") else ()
+        named = (body.get("name", ""),) if body.get("name") else ()
         inertial = body.find("inertial")
         if inertial is not None:
             if inertial.get("diaginertia") or inertial.get("fullinertia"):

@@ -259,7 +259,7 @@ class PybulletModel(PybulletState, ModelEngine):
                 joints.append(TreeJoint(
                     name=link.joint, type=JointType.FREE, parent=None,
                     body=link.name, axis=np.zeros(3), anchor=link.origin, frame=link.rotation,
-                    mass=mass, com=com, inertia=inertia, armature=(0.0,) * 6,
+                    mass=mass, com=com, inertia=inertia, parts=len(parts), armature=(0.0,) * 6,
                     damping=(0.0,) * 6, range=None, gravity_frame=GravityFrame.RPY_REVERSED,
                     layout=Layout(q_start=q_at, v_start=v_at, nq=7, nv=6, quat=Orientation.XYZW,
                                   angular_first=True, linear_axes=Axes.WORLD,
@@ -273,7 +273,7 @@ class PybulletModel(PybulletState, ModelEngine):
             joints.append(TreeJoint(
                 name=link.joint, type=kind, parent=parent.joint if parent else None,
                 body=link.name, axis=link.axis, anchor=link.origin,
-                frame=link.rotation, mass=mass, com=com, inertia=inertia,
+                frame=link.rotation, mass=mass, com=com, inertia=inertia, parts=len(parts),
                 armature=(0.0,) * kind.nv, damping=(link.damping,) * kind.nv,
                 computed_inertia=computed,
                 range=(lower, upper) if lower <= upper and not ball else None,

@@ -12,6 +12,7 @@ from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.check.proofs import Remeasured, proved, unmeasured
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.labels import NO_ACTUATORS_READ
+from dyncheck.precision import ROUNDOFF_FACTOR
 from dyncheck.vocabulary import Verdict
 
 FIELD_RTOL = 1e-9
@@ -143,8 +144,9 @@ def _field_cause(other: ModelTree, actuator: str, field: str, *, expected: objec
         fixed = next((x for x in tree.actuators if x.name == actuator), None)
         if fixed is None:
             return Remeasured(closed=False, left=1.0, outcome=f"holds no {actuator!r}")
-        value = compared_fields(fixed, motor=motor)[field]
-        closed = same(expected, value, rtol=FIELD_RTOL)
+        value = compared_fields(fixed, motor=motor)[field]  # (measured by the engine's
+        # arithmetic where the fix is a counterfactual on it: to its round-off)
+        closed = same(expected, value, rtol=max(FIELD_RTOL, ROUNDOFF_FACTOR * tree.eps))
         return Remeasured(closed=closed, left=0.0 if closed else 1.0, outcome=(
             f"reads the {field} of {actuator!r} as {canonical} does ({shown_value(value)})"
             if closed else f"reads the {field} of {actuator!r} as {shown_value(value)}"))

@@ -16,7 +16,7 @@ parallel-axis term: 1e-8 kg m² of a point mass 1 m from its pivot to ~1e-16 abs
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
 from typing import NamedTuple
 
@@ -115,7 +115,9 @@ def diff(model: str, a: ModelTree, b: ModelTree,
     invalid = invalid or {}
     eps = max(a.eps, b.eps)  # a float32 engine's numbers are rounded to float32
     rtol = ROUNDOFF_FACTOR * eps * max(depth(a), depth(b))
-    basis = f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth {max(depth(a), depth(b))}"
+    basis = (f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x tree depth "
+             f"{max(depth(a), depth(b))}; a body's mass, centre of mass and inertia + "
+             f"{ROUNDOFF_FACTOR} {eps_name(eps)} per body lumped into it beyond the first")
     length = size(a)
     moved = placement(a, b, rtol * length)
     names_a, names_b = [j.name for j in a.joints], [j.name for j in b.joints]
@@ -126,7 +128,7 @@ def diff(model: str, a: ModelTree, b: ModelTree,
     for ja in a.joints:
         if ja.name in names_b:
             jb = b.joint(ja.name) if moved is None else moved.undo(b.joint(ja.name))
-            more, n = _joint(a, b, ja, jb, scale=_Scale(rtol=rtol, length=length),
+            more, n = _joint(a, b, ja, jb, scale=_Scale(rtol=rtol, length=length, eps=eps),
                              invalid=invalid)
             found += more
             compared += n
@@ -187,6 +189,13 @@ class _Scale:
 
     rtol: float
     length: float
+    eps: float
+
+
+SUMMED = ("mass", "com", "inertia")
+"""The fields an engine sums over the bodies it lumps into a joint's body
+(:attr:`~dyncheck.adapters.model_tree.TreeJoint.parts`): each body beyond the first adds one
+more rounding of the sum, 64 ε of it."""
 
 
 def _presence(a: ModelTree, b: ModelTree, names_a: list[str],
@@ -248,12 +257,15 @@ def _joint(a: ModelTree, b: ModelTree, ja: TreeJoint, jb: TreeJoint, *, scale: _
                       "joint limits read differently (the dynamics leave limits out; states "
                       f"are sampled within {a.engine}'s)" + (f": {known}" if known else "")))
     compared = 0
+    summed = ROUNDOFF_FACTOR * scale.eps * (max(ja.parts, jb.parts) - 1)
     for field, va, vb, err, size_of in compare(ja, jb, scale.length):
         compared += 1
-        if err > rtol * size_of:
+        bound = rtol + (summed if field in SUMMED else 0.0)
+        if err > bound * size_of:
             at = _Differs(a=a, b=b, ja=ja, jb=jb, field=field, err=err, size=size_of,
-                          scale=scale)
-            found.append(_Found(ja.name, field, va, vb, err / size_of, rtol, *_cause(at, invalid)))
+                          scale=replace(scale, rtol=bound))
+            found.append(_Found(ja.name, field, va, vb, err / size_of, bound,
+                                *_cause(at, invalid)))
     return found, compared
 
 

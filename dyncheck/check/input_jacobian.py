@@ -74,7 +74,11 @@ def rows(model: str, *, canon: Canonical, tree: ModelTree, acts: law.JointActuat
     expected = _expected(canon, acts, mass=mass, bias=bias, q=q, v=v, u=u, h=h,
                          integrator=found.integrator)
     off = np.abs(found.matrix - expected)
-    scale = max(float(np.abs(expected).max(initial=0.0)), 1e-300)
+    # B's scale: its largest entry, the engine's where the chain rule's is 0 (a B the
+    # engine finds where none is due is then wrong by 100 %); 1 where both are 0, the
+    # error and bound then absolute (a floor of 1e-300 had made the bound ~1e295)
+    scale = max(float(np.abs(expected).max(initial=0.0)),
+                float(np.abs(found.matrix).max(initial=0.0))) or 1.0
     eps = max(EPS, tree.eps)
     kappa = np.linalg.cond(mass)[:, None, None]
     roundoff = ROUNDOFF_FACTOR * eps * depth(tree)

@@ -18,7 +18,6 @@ from dyncheck.adapters.proof import Proof
 
 SUSPECTED = {
     "drake.hints": {"BALL_ARMATURE", "IGNORED_FRAME"},
-    "newton.actuators": {"MOTORS", "GEAR", "BOUNDS"},
 }
 """The work left: causes written on a page as "cause unknown; suspected"."""
 

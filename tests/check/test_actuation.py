@@ -83,6 +83,36 @@ def test_a_joints_force_clamp_drops_the_servos_damping_from_the_implicit_step(tm
     assert (steps["verdict"] == "passed").all(), steps[["note", "error", "tolerance"]]
 
 
+@pytest.mark.parametrize("planted", [0.0, 1e-3])
+def test_a_b_that_is_zero_is_held_to_a_bound_not_to_1e295(tmp_path, monkeypatch, planted):
+    """Actuators of gain 0: B is 0 by the chain rule (independent: the actuator law gives no
+    force). MuJoCo's zero B passes within the finite differences' round-off bound, absolute
+    (it had been ~1e295: B's scale floored at 1e-300); a B planted at 1e-3 in one entry
+    fails, at 100 % of its scale."""
+    if planted:
+        real = mujoco_actuators.Actuated.input_jacobians
+
+        def shifted(self, *args, **kwargs):
+            out = []
+            for found in real(self, *args, **kwargs):
+                matrix = found.matrix.copy()
+                matrix[:, 0, 0] += planted
+                out.append(replace(found, matrix=matrix, coarse=matrix))
+            return tuple(out)
+        monkeypatch.setattr(mujoco_actuators.Actuated, "input_jacobians", shifted)
+    path = tmp_path / "unpowered.xml"
+    path.write_text(arm('<general joint="{j}" gainprm="0" ctrlrange="-1 1"/>'))
+    result = check_model(path, impls=("mujoco", "reference"), states=4, isolate=False)
+    steps = _rows(result, impl_b="mujoco")
+    steps = steps[steps["subject"].str.startswith("step Jacobian in the controls")]
+    assert len(steps) == 2
+    assert (steps["verdict"] == ("failed" if planted else "passed")).all()
+    if planted:  # (error and bound relative to the planted entry, B's scale)
+        assert (steps["error"] == 1.0).all() and (steps["tolerance"] < 0.1).all()
+    else:  # (absolute: the finite differences' round-off, 1.3e-5 here)
+        assert (steps["tolerance"] < 1e-4).all(), steps[["subject", "tolerance"]]
+
+
 def test_a_gear_changed_by_one_percent_in_a_reading_fails(servo_arm, monkeypatch):
     """Mutation: MuJoCo's reading of one actuator's gear 1 % off what it computes with — its
     force against the referee on that reading fails, and so do its forward dynamics with the

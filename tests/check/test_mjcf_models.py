@@ -516,7 +516,8 @@ def test_a_slide_range_pinocchio_reads_as_degrees_is_named(tmp_path, angle):
 
 
 @pytest.mark.parametrize(("attrs", "expected", "cause"), [
-    ('range="-110 110" ref="-90"', (-20.0, 200.0), "subtracts the joint's ref=-90 from its range"),
+    ('range="-110 110" ref="-90"', (-20.0, 200.0),
+     "subtracts the ref=-90 of joint 'j' from its range"),
     ('range="-60 60" limited="false"', (-60.0, 60.0), "even where limited=\"false\""),
 ])
 def test_a_range_pinocchio_reads_differently_is_named(tmp_path, attrs, expected, cause):

@@ -769,3 +769,48 @@ def test_pybullets_zeroed_inertia_is_stated_where_it_holds_zero(tmp_path, ixx, z
     assert (not np.any(joint.inertia)) is zeroed
     hint = model.tree.hint("shoulder", "inertia") or ""
     assert (ZEROED_INERTIA.format(links="'arm'") == hint) is zeroed, hint
+
+
+NEWTON_ACTUATED = """<mujoco model="newton_actuated"><worldbody>
+  <body name="a" pos="0 0 1"><joint name="j" type="hinge" axis="0 1 0"/>
+    <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/>
+    <body name="b" pos="0.3 0 0"><joint name="k" type="hinge" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/></body></body>
+  </worldbody>
+  <actuator>
+    <position name="p" joint="j" kp="50" kv="5" gear="2" ctrlrange="-1 1" forcerange="-3 3"/>
+    <motor name="m" joint="k" gear="3"/>
+  </actuator></mujoco>"""
+"""A servo on a gear of 2 (Newton's importer makes its drive kp and kv as written: its gear,
+control range and force range rows fail) and a motor (Newton's Featherstone solver applies
+none: its row says absent): :data:`~dyncheck.adapters.newton.actuators.GEAR`, ``BOUNDS``,
+``MOTORS``."""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-halved-clamped"])
+def test_newtons_actuator_causes_are_proved_on_its_solver(tmp_path, monkeypatch, plant):
+    """Newton's drive with ke, kd × 4 and its target ÷ 2 acts with MuJoCo's gear (2, MuJoCo's
+    compiler the expected value) and the motor applied as control.joint_f is held: "fix
+    verified"; the servo's bounds are measured unapplied (ten times beyond the control
+    range, ten times the force). With every force Newton's solver gives planted halved and
+    clamped at 6 N m, the gear fix leaves the cause unknown and the bounds' cause is
+    suspected, not measured; the motor is still held."""
+    pytest.importorskip("newton", reason="the newton extra is not installed")
+    from dyncheck.adapters.newton import counterfactual
+
+    if plant:
+        real = counterfactual._per_unit
+        monkeypatch.setattr(counterfactual, "_per_unit", lambda *args: [
+            float(np.clip(f / 2, -6.0, 6.0)) for f in real(*args)])
+    rows = _checked(tmp_path, NEWTON_ACTUATED, "newton")
+    rows = rows[(rows["section"] == "actuation") & (rows["impl_b"] == "newton")]
+    notes = {(r.subject, r.field): r.note for r in rows.itertuples()}
+    gear, motor = notes[("p", "gear")], notes[("m", "actuator")]
+    assert (FIX_VERIFIED in gear) is not plant, gear
+    assert gear.startswith("cause unknown: the named fix") is plant, gear
+    for field in ("control range", "force range"):
+        note = notes[("p", field)]
+        assert note.startswith("cause unknown; suspected") is plant, note
+        assert note.startswith("newton's Featherstone solver bounds neither") is not plant, note
+    assert FIX_VERIFIED in motor and "newton holds an actuator on 'k'" in motor, motor
