@@ -53,18 +53,23 @@ def stated(model: Any) -> list[Stated]:
     except (AttributeError, TypeError):
         return []
     kinds, ids = attrs.actuator_trntype.numpy(), attrs.actuator_trnid.numpy()
+    starts = model.joint_qd_start.numpy()
+    # (its trnid holds the joint's degree of freedom, measured: a motor on the hinge after a
+    # free joint names dof 6; the hinge owning it)
+    owner = {int(starts[j]): j for j in range(model.joint_count)
+             if int(starts[j + 1]) - int(starts[j]) == 1}
     gears, ctrl = attrs.actuator_gear.numpy(), attrs.actuator_ctrlrange.numpy()
     has_ctrl, force = attrs.actuator_has_ctrlrange.numpy(), attrs.actuator_forcerange.numpy()
     has_force = attrs.actuator_has_forcerange.numpy()
     limited = attrs.actuator_forcelimited.numpy()  # 0 false, 1 true, 2 auto (where stated)
     out = []
     for k, label in enumerate(labels):
-        if int(kinds[k]) != 0:  # a joint's transmission only
+        if int(kinds[k]) != 0 or int(ids[k][0]) not in owner:  # a hinge's or a slide's only
             continue
         g = float(gears[k][0])
         bounded = int(limited[k]) == 1 or (int(limited[k]) == 2 and bool(has_force[k]))
         ends = sorted((g * float(force[k][0]), g * float(force[k][1])))
-        out.append(Stated(name=str(label), joint=int(ids[k][0]), gear=g,
+        out.append(Stated(name=str(label), joint=owner[int(ids[k][0])], gear=g,
                           ctrl=(float(ctrl[k][0]), float(ctrl[k][1])) if has_ctrl[k] else None,
                           force=(ends[0], ends[1]) if bounded else None))
     return out
