@@ -153,6 +153,19 @@ def motors_fixed(model: Any, newton: Any, tree: ModelTree,
                          fix="each <motor> applied as control.joint_f = gear × u at its joint"),)
 
 
+def proved(model: Any, newton: Any, tree: ModelTree, names: list[str]) -> ModelTree:
+    """``tree`` with its actuator causes proved on Newton's solver: the fixes' readings in
+    ``fixed``, :data:`~.actuators.BOUNDS` in ``measured`` where measured. A proof that fails
+    costs only itself: its causes stay suspected and a note on the page says why."""
+    try:
+        fixed = gear_fixed(model, newton, tree, names) + motors_fixed(model, newton, tree, names)
+        measured = bounds_measured(model, newton)
+    except Exception as exc:  # (the engine's or ours: said on the page, never a crash)
+        return replace(tree, notes=(*tree.notes, f"newton: its actuator causes could not be "
+                                    f"measured on its solver ({type(exc).__name__}: {exc})"))
+    return replace(tree, fixed=(*tree.fixed, *fixed), measured=tree.measured | measured)
+
+
 def bounds_measured(model: Any, newton: Any) -> frozenset[str]:
     """:data:`~.actuators.BOUNDS` where measured: every drive whose file actuator states a
     control or force range gives, at a control :data:`BEYOND` × its largest bound, that

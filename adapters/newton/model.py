@@ -41,7 +41,7 @@ from dyncheck.adapters.model_tree import (
     lump,
 )
 from dyncheck.adapters.newton import actuators as newton_actuators
-from dyncheck.adapters.newton.counterfactual import bounds_measured, gear_fixed, motors_fixed
+from dyncheck.adapters.newton.counterfactual import proved
 from dyncheck.adapters.newton.d6 import D6_ORDER, d6_chain, written_order
 from dyncheck.adapters.proof import Proof
 from dyncheck.adapters.registration import Format
@@ -283,10 +283,8 @@ class NewtonModel(ModelEngine):
                          gravity=np.asarray(m.gravity.numpy()[0], float),
                          nq=m.joint_coord_count, nv=m.joint_dof_count, notes=notes, eps=EPS32,
                          hints=(*hints, *newton_actuators.hints(m, acts)),
-                         measured=frozenset(w for _, _, w in hints)
-                         | bounds_measured(m, self.newton), actuators=acts)
-        tree = replace(tree, fixed=gear_fixed(m, self.newton, tree, names)  # (#77: proved on
-                       + motors_fixed(m, self.newton, tree, names))  # its own solver)
+                         measured=frozenset(w for _, _, w in hints), actuators=acts)
+        tree = proved(m, self.newton, tree, names)  # (#77: on its own solver)
         if not fused:
             return tree
         return replace(tree, as_written=written_order(

@@ -814,3 +814,24 @@ def test_newtons_actuator_causes_are_proved_on_its_solver(tmp_path, monkeypatch,
         assert note.startswith("cause unknown; suspected") is plant, note
         assert note.startswith("newton's Featherstone solver bounds neither") is not plant, note
     assert FIX_VERIFIED in motor and "newton holds an actuator on 'k'" in motor, motor
+
+
+@pytest.mark.slow
+def test_a_proof_that_fails_on_newtons_solver_costs_only_itself(tmp_path, monkeypatch):
+    """A proof raising inside Newton's solver (planted) leaves Newton's model loaded, its
+    actuator causes unproved, and a note on the page naming the error (it had crashed the
+    loading: an IndexError on a motor after a free joint)."""
+    pytest.importorskip("newton", reason="the newton extra is not installed")
+    from dyncheck.adapters.formats.files import read
+    from dyncheck.adapters.newton import counterfactual
+    from dyncheck.adapters.newton.model import NewtonModel
+
+    def planted(*args):
+        raise RuntimeError("planted")
+    monkeypatch.setattr(counterfactual, "gear_fixed", planted)
+    path = tmp_path / "actuated.xml"
+    path.write_text(NEWTON_ACTUATED)
+    tree = NewtonModel(read(path)).tree
+    assert tree.fixed == ()
+    assert any("could not be measured on its solver (RuntimeError: planted)" in n
+               for n in tree.notes), tree.notes
