@@ -5,6 +5,7 @@ the hints a page gives where its reading is known to differ (:mod:`.model`)."""
 from __future__ import annotations
 
 import tempfile
+import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -65,38 +66,54 @@ Hint = tuple[str, str, str]
 
 
 def mjcf_hints(source: ModelFile) -> tuple[tuple[Hint, ...], tuple[WantsCompiled, ...]]:
-    """Why a body of an MJCF reads other mass or inertia in PyBullet, where the file shows
-    the premise: an ``<inertial>`` with a tensor (which its reader does not take), or geoms
-    weighed at a density other than 1000 (their own ``density`` or the top-level default's;
-    a class's is not resolved here: no hint, cause unknown). Named on the body's joints, each
-    with its fix (a named body's): what MuJoCo compiled stated in an ``<inertial>``, in place
-    of the geoms too for the inertia."""
+    """Why a joint's body of an MJCF reads other mass or inertia in PyBullet, where the file
+    shows the premise on a body it carries (its own, or one welded to it: no joint of its
+    own): an ``<inertial>`` with a tensor (which its reader does not take), or geoms weighed
+    at a density other than 1000 (their own ``density`` or the top-level default's; a
+    class's is not resolved here: no hint, cause unknown). Each with its fix, on every named
+    body the joint carries: what MuJoCo compiled stated in an ``<inertial>``, in place of the
+    geoms too where the inertia is the tensor's."""
     if source.format is not Format.MJCF:
         return (), ()
     root = parsing.root(source.text)
     default = root.find("default/geom")
     fallback = default.get("density") if default is not None else None
+    parent = {child: body for body in root.iter() for child in body if child.tag == "body"}
+    carried: dict[str, tuple[list[str], list[str], set[float]]] = {}  # joint → (tensor
+    for body in root.iter("body"):  # bodies, density bodies, densities)
+        joints, holder = _joints_of(body), body
+        while not joints and holder in parent:
+            holder = parent[holder]
+            joints = _joints_of(holder)
+        inertial = body.find("inertial")
+        tensor = inertial is not None and bool(
+            inertial.get("diaginertia") or inertial.get("fullinertia"))
+        densities = set() if inertial is not None else {
+            float(d) for g in body.findall("geom") if g.get("mass") is None
+            and g.get("class") is None and (d := g.get("density", fallback)) is not None
+        } - {1000.0}
+        for j in joints if tensor or densities else ():
+            held = carried.setdefault(j, ([], [], set()))
+            (held[0] if tensor else held[1]).append(body.get("name", ""))
+            held[2].update(densities)
     out: list[Hint] = []
     wants: list[WantsCompiled] = []
-    for body in root.iter("body"):
-        joints = [j.get("name", "") for j in body.findall("joint") if j.get("name")]
-        named = (body.get("name", ""),) if body.get("name") else ()
-        inertial = body.find("inertial")
-        if inertial is not None:
-            if inertial.get("diaginertia") or inertial.get("fullinertia"):
-                out += [(j, "inertia", INERTIA_HINT) for j in joints]
-                wants += [WantsCompiled(subject=j, fields=("inertia",), bodies=named, box=True)
-                          for j in joints if named]
-            continue
-        densities = sorted({float(d) for g in body.findall("geom") if g.get("mass") is None
-                            and g.get("class") is None
-                            and (d := g.get("density", fallback)) is not None} - {1000.0})
+    for j, (tensors, weighed, densities) in carried.items():
+        fields = (("inertia",) if tensors else ()) + (("mass",) if densities else ())
         if densities:
-            why = DENSITY_HINT.format(densities=", ".join(f"{d:g}" for d in densities))
-            out += [(j, "mass", why) for j in joints]  # (its inertia: other causes too)
-            wants += [WantsCompiled(subject=j, fields=("mass",), bodies=named)
-                      for j in joints if named]
+            why = DENSITY_HINT.format(densities=", ".join(f"{d:g}" for d in sorted(densities)))
+            out += [(j, "mass", why)] + ([] if tensors else [(j, "inertia", why)])
+            fields += () if tensors else ("inertia",)
+        out += [(j, "inertia", INERTIA_HINT)] if tensors else []
+        bodies = tuple(b for b in (*tensors, *weighed) if b)
+        if bodies and len(bodies) == len(tensors) + len(weighed):  # (every one named)
+            wants.append(WantsCompiled(subject=j, fields=fields, bodies=bodies,
+                                       box=bool(tensors)))
     return tuple(out), tuple(wants)
+
+
+def _joints_of(body: ET.Element) -> list[str]:
+    return [j.get("name", "") for j in body.findall("joint") if j.get("name")]
 
 
 MAX_LINKS = 128

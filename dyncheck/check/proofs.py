@@ -16,7 +16,7 @@ from dyncheck.adapters.model_tree import ModelTree
 VERIFIED = "fix verified: with {fix}, {engine} {outcome}"
 UNVERIFIED = "cause unknown; suspected, its fix not measured: {why}"
 REFUSED = "cause unknown: {engine} refused the copy with the named fix ({fix}): {refused}"
-PART = ("cause unknown: the named fix ({fix}) accounts for {share:.0f} % of the difference; "
+PART = ("cause unknown: the named fix ({fix}) accounts for {share} of the difference; "
         "{engine} still {outcome}")
 FIX_VERIFIED = "fix verified"
 """The words every proved cause carries (the check pages and their tests find them)."""
@@ -72,8 +72,9 @@ def proved(tree: ModelTree, subject: str, field: str, *,
     if again.closed:
         return f"{why}; " + VERIFIED.format(fix=reading.fix, engine=tree.engine,
                                             outcome=again.outcome)
-    return PART.format(fix=reading.fix, share=100 * max(0.0, 1.0 - again.left),
-                       engine=tree.engine, outcome=again.outcome)
+    share = 100 * max(0.0, 1.0 - again.left)  # (all but a sliver: how much is left, not "100 %")
+    shown = f"{share:.0f} %" if share < 99.5 else f"all but {again.left:.2g}"
+    return PART.format(fix=reading.fix, share=shown, engine=tree.engine, outcome=again.outcome)
 
 
 def unmeasured(tree: ModelTree, subject: str, field: str) -> str | None:

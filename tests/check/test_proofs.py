@@ -113,10 +113,13 @@ def _tree(**more):
     (True, 0.0, "why; fix verified: with the fix, e reads it"),
     (False, 0.38, "cause unknown: the named fix (the fix) accounts for 62 % of the "
                   "difference; e still reads it"),
+    (False, 3e-9, "cause unknown: the named fix (the fix) accounts for all but 3e-09 of the "
+                  "difference; e still reads it"),
 ])
 def test_the_note_follows_the_remeasured_difference(closed, left, expected):
     """The note's forms, worked by hand: closed (the hint and "fix verified"), partly closed
-    (the share the fix accounts for, 1 − 0.38 = 62 %); with no fix measured, the hint only
+    (the share the fix accounts for, 1 − 0.38 = 62 %; all but 3e-9 where 100 % would round
+    away what is left: found on pybullet_data's pusher); with no fix measured, the hint only
     suspected; measured by the engine itself, the hint; no hint, None."""
     def measure(tree):
         return Remeasured(closed=closed, left=left, outcome="reads it")
@@ -697,6 +700,7 @@ PYBULLET_WEIGHED = """<mujoco model="pybullet_weighed">
         <body name="b" pos="0.3 0 0">
           <joint name="jb" type="hinge" axis="1 0 0"/>
           <geom type="box" size="0.05 0.1 0.15" density="800"/>
+          <body name="c" pos="0 0.2 0"><geom type="sphere" size="0.05" density="500"/></body>
         </body>
       </body>
     </body>
@@ -705,16 +709,18 @@ PYBULLET_WEIGHED = """<mujoco model="pybullet_weighed">
 """Two bodies PyBullet's MJCF reader weighs otherwise (measured on PyBullet 3.2.7): 'a'
 states its inertia in full, which PyBullet replaces by its capsule's at 2 kg
 (:data:`~dyncheck.adapters.pybullet.files.INERTIA_HINT`); 'b's box is of density 800
-(4.8 kg in MuJoCo), which PyBullet weighs at 1000 (6 kg: :data:`~dyncheck.adapters.
-pybullet.files.DENSITY_HINT`)."""
+(4.8 kg in MuJoCo), which PyBullet weighs at 1000 (6 kg), and so is the sphere of 'c',
+welded to 'b' (no joint: 'jb' carries it): :data:`~dyncheck.adapters.pybullet.files.
+DENSITY_HINT`."""
 
 
 @pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-wrong"])
 def test_pybullets_weighing_causes_are_verified_by_compiled_copy(tmp_path, monkeypatch,
                                                                    plant):
     """The copy with MuJoCo's compiled <inertial> on 'a' (its geoms replaced by one box of
-    that inertia) and on 'b', read by PyBullet, holds MuJoCo's inertia on 'ja' and mass on
-    'jb' (MuJoCo's compiler the expected value): "fix verified". With the stated inertials
+    that inertia) and on 'b' and 'c', read by PyBullet, holds MuJoCo's inertia on 'ja' and
+    mass on 'jb' (MuJoCo's compiler the expected value): "fix verified" (with 'c' left out,
+    the fix had accounted for part of 'jb's mass only). With the stated inertials
     planted wrong (mass and inertia doubled), both causes are unknown."""
     pytest.importorskip("pybullet", reason="the pybullet extra is not installed")
     from dyncheck.adapters.mujoco import compiled
