@@ -15,7 +15,7 @@ knowing the engine.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, fields, replace
 from enum import StrEnum
 from typing import Any
@@ -463,3 +463,14 @@ class Transition:
     """The free joints whose velocities the step updates with (M + h ∂h/∂v)⁻¹ rather than
     M⁻¹: MuJoCo's implicitfast on a standalone free body (``mjd_freeMhat``, ≥ 3.11: the
     bias's — gyroscopic — derivative in the body's own 6×6 solve)."""
+
+
+def geared(tree: ModelTree, acting: Mapping[str, tuple[float, float]],
+           fix: Callable[[float], str]) -> tuple[FixedReading, ...]:
+    """The fixed readings of a fix made on the engine that has each actuator named in
+    ``acting`` act with the gear measured with it (name → the file's gear, the measured
+    one): one per actuator, its ``gear`` field, ``fix(file's gear)`` its words."""
+    fixed = replace(tree, actuators=tuple(
+        replace(a, gear=acting[a.name][1]) if a.name in acting else a for a in tree.actuators))
+    return tuple(FixedReading(subject=name, fields=("gear",), tree=fixed, fix=fix(gear))
+                 for name, (gear, _) in acting.items())

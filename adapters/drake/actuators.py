@@ -25,7 +25,7 @@ from dyncheck.adapters.drake.defaults import class_gain_hints
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import class_defaults, placed
-from dyncheck.adapters.model_tree import FixedReading, ModelTree
+from dyncheck.adapters.model_tree import FixedReading, ModelTree, geared
 from dyncheck.adapters.proof import Proof
 from dyncheck.adapters.registration import Format
 
@@ -215,12 +215,8 @@ def gear_fixed(plant: Any, tree: ModelTree) -> tuple[FixedReading, ...]:
         plant.get_actuation_input_port().FixValue(context, given)
         tau = matrix @ net.Eval(context)
         acting[actuator.name()] = (gear, float(tau[actuator.joint().velocity_start()]) / u)
-    fixed = replace(tree, actuators=tuple(
-        replace(a, gear=acting[a.name][1]) if a.name in acting else a for a in tree.actuators))
-    return tuple(FixedReading(
-        subject=name, fields=("gear",), tree=fixed,
-        fix=f"the control scaled by the gear ({gear:g}) at Drake's actuation input")
-        for name, (gear, _) in acting.items())
+    return geared(tree, acting,
+                  lambda g: f"the control scaled by the gear ({g:g}) at Drake's actuation input")
 
 
 def file_force_bounds(root: ET.Element) -> dict[str, tuple[float, float] | None]:

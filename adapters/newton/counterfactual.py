@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from dyncheck.adapters.actuators import Actuator, Transmission
-from dyncheck.adapters.model_tree import FixedReading, ModelTree
+from dyncheck.adapters.model_tree import FixedReading, ModelTree, geared
 from dyncheck.adapters.newton.actuators import BOUNDS, actuation, drives
 
 RTOL = 1e-4
@@ -120,12 +120,8 @@ def gear_fixed(model: Any, newton: Any, tree: ModelTree,
         dof = int(starts[j])
         gain = float(kd[dof] if mode == velocity else ke[dof])  # (the file's kp, or kv)
         acting[f"{names[j]} drive"] = (by_joint[j].gear, force / gain if gain else 0.0)
-    fixed = replace(tree, actuators=tuple(
-        replace(a, gear=acting[a.name][1]) if a.name in acting else a for a in tree.actuators))
-    return tuple(FixedReading(
-        subject=name, fields=("gear",), tree=fixed,
-        fix=f"the drive's ke and kd set to {g:g}² × kp and kv and its target to u / {g:g}")
-        for name, (g, _) in acting.items())
+    return geared(tree, acting, lambda g: f"the drive's ke and kd set to {g:g}² × kp and kv "
+                                          f"and its target to u / {g:g}")
 
 
 def motors_fixed(model: Any, newton: Any, tree: ModelTree,
