@@ -13,6 +13,7 @@ from typing import Any
 
 from dyncheck.adapters.drake import actuators as drake_actuators
 from dyncheck.adapters.drake.hints import Lost, lost_across_gaps, several_joints
+from dyncheck.adapters.formats import frames
 from dyncheck.adapters.formats.edits import Edit, copied, fixed_copy
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.mjcf_copy import POSE, placed
@@ -176,8 +177,14 @@ def measured(source: ModelFile, root: ET.Element, plant: Any, tree: ModelTree, *
         fixed += armature_fixed(source, root, unactuated=unactuated, unread=unread, read=read)
         fixed += file_fixed(source, root, read=read)
         fixed += ignored_fixed(source, root, driven=driven, read=read)
+        framed = root.find(".//frame") is not None
+        if framed:  # (the fix IGNORED_FRAME names: the frames undone, each joint held again)
+            held, refused = _read(source, root, frames.FLATTEN, read)
+            fixed += (FixedReading(subject="model", fields=("joint",), fix=frames.FLATTEN.words,
+                                   tree=held, refused=refused),)
         lost, rewritten = lost_across_gaps(root), sorted({*unread, *_ignored(driven)})
         tree = replace(tree, with_fixes=fixed_copy(source, root, [edit for edit, wanted in (
+            (frames.FLATTEN, framed),
             (motors(unactuated), unactuated), (as_motors(rewritten), rewritten),
             (SPLIT, several_joints(root)), (written(lost), lost)) if wanted]))
     return replace(tree, fixed=fixed)

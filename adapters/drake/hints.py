@@ -176,8 +176,8 @@ def file_hints(source: ModelFile) -> tuple[tuple[str, str, str], ...]:
 
 IGNORED_FRAME = (
     "Drake's MJCF parser ignores <frame> (its own warning: 'currently unsupported and will be "
-    "ignored'): the bodies and joints inside a frame are not in its model (fix: move the "
-    "frame's pos and orientation onto the bodies it holds)"
+    "ignored'): the bodies and joints inside a frame are not in its model (fix: move each "
+    "frame's pos and orientation onto what it holds and remove the frame)"
 )
 
 
@@ -194,6 +194,6 @@ PROOFS = {
     "BALL_ARMATURE": Proof.SUSPECTED,
     "FIRST_OF_SEVERAL": Proof.FIX,
     "SKIPPED_CLASS": Proof.FIX,
-    "IGNORED_FRAME": Proof.SUSPECTED,
+    "IGNORED_FRAME": Proof.FIX,
 }
 """How each cause this module states is proved (:mod:`dyncheck.adapters.proof`)."""

@@ -475,19 +475,31 @@ def test_floating_on_an_mjcf_is_said_not_silently_ignored(tmp_path):
     assert {j for j in _rows(result, "load")["note"]} == {"nq=1 nv=1"}
 
 
-def test_a_body_in_a_frame_drake_ignores_names_the_frame_and_the_fix(tmp_path):
+@pytest.mark.parametrize("plant", [False, True], ids=["fix", "planted-no-op"])
+def test_a_body_in_a_frame_drake_ignores_names_the_frame_and_the_fix(tmp_path, monkeypatch,
+                                                                      plant):
     """MuJoCo reads <frame>; Drake's MJCF parser ignores it (its own warning) and with it
-    the bodies inside: the missing joint's row says why and how to write the file instead.
-    Expected: Drake's reading (no joint) and its parser's warning, read from Drake itself."""
+    the bodies inside: the missing joint's row says why, and that the fix (the frame's pose
+    moved onto the body, the frame removed) is verified: Drake then holds the joint. With the
+    fix planted as a no-op, the cause is unknown. Expected: Drake's reading (no joint, then
+    the joint) and its parser's warning, read from Drake itself."""
     pytest.importorskip("pydrake")
+    from dyncheck.adapters.formats import frames
+    from dyncheck.adapters.formats.edits import Edit
+
+    if plant:
+        monkeypatch.setattr(frames, "FLATTEN", Edit(frames.FLATTEN.words, lambda root: None))
     body = ('<frame pos="0 0 1"><body name="b"><joint name="j" type="hinge"/>'
             '<geom size="0.1"/></body></frame>')
     result = check_model(_write(tmp_path, "framed", body), states=3,
                          impls=("reference", "mujoco", "drake"))
     missing = _rows(result, "description", "failed")
     assert list(missing["subject"]) == ["j"]
-    assert missing["note"].str.contains("ignores <frame>").all()
-    assert missing["note"].str.contains("fix: move the frame's pos").all()
+    note = missing["note"].iloc[0]
+    assert ("ignores <frame>" in note and "fix: move each frame's pos" in note) is not plant
+    assert ("fix verified: with each <frame>'s pos and orientation moved onto what it holds, "
+            "the frame removed, drake holds joint 'j'" in note) is not plant, note
+    assert ("cause unknown: the named fix" in note) is plant, note
 
 
 @pytest.mark.parametrize("angle", ["degree", "radian"])
