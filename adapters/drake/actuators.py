@@ -13,6 +13,7 @@ position servo's control is its target q_d (v_d = 0, no feed-forward).
 
 from __future__ import annotations
 
+import functools
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
@@ -132,6 +133,25 @@ def hints(plant: Any, source: ModelFile, tags: dict[str, list[str]]) -> tuple[
 
 
 T = TypeVar("T")
+
+
+@functools.cache
+def multi_dof_refusal() -> str:
+    """Drake's own words refusing a ``JointActuator`` on a ball joint, measured on a plant
+    built for it (one body on a ``BallRpyJoint``); empty where Drake takes one."""
+    from pydrake.multibody.plant import MultibodyPlant
+    from pydrake.multibody.tree import BallRpyJoint, SpatialInertia, UnitInertia
+
+    plant = MultibodyPlant(0.0)
+    body = plant.AddRigidBody("probe", SpatialInertia(
+        mass=1.0, p_PScm_E=np.zeros(3), G_SP_E=UnitInertia.SolidSphere(0.1)))
+    ball = plant.AddJoint(BallRpyJoint("probe_ball", plant.world_frame(), body.body_frame()))
+    try:
+        plant.AddJointActuator("probe_actuator", ball)
+    except RuntimeError as exc:
+        words = " ".join(str(exc).split())
+        return words.split(" -- ", 1)[-1].split(". ", 1)[0]
+    return ""
 
 
 def file_kv(root: ET.Element) -> dict[str, float]:

@@ -32,9 +32,11 @@ UNREAD_ACTUATOR = (
 )
 BALL_ARMATURE = (
     "Drake's MJCF parser keeps armature only as the reflected inertia of an actuator, and "
-    "only a one-degree-of-freedom joint carries one: Drake's M leaves out the armature of "
-    "the {kind} joint of body {body!r} (fix: model the rotor as body inertia)"
+    "only a one-degree-of-freedom joint carries one{measured}: Drake's M leaves out the "
+    "armature of the {kind} joint of body {body!r} (no fix in the file keeps the same model: "
+    "a rotor written as body inertia also loads the joints above it)"
 )
+REFUSED_ACTUATOR = " (measured: its AddJointActuator on a ball joint says \"{words}\")"
 
 
 FIRST_OF_SEVERAL = (
@@ -63,12 +65,13 @@ def actuators(source: ModelFile) -> dict[str, list[str]]:
     return out
 
 
-def armature_hint(joint: TreeJoint, actuators: list[str]) -> str:
+def armature_hint(joint: TreeJoint, actuators: list[str], refusal: str = "") -> str:
     """Why Drake holds no armature on ``joint``, from what the file says drives it (checked
     on the file, not assumed): no actuator, actuators Drake did not read, or a ball or free
-    joint."""
+    joint (``refusal``: Drake's own words refusing an actuator on one, where measured)."""
     if joint.type in (JointType.BALL, JointType.FREE):
-        return BALL_ARMATURE.format(body=joint.body, kind=joint.type)
+        return BALL_ARMATURE.format(body=joint.body, kind=joint.type, measured=(
+            REFUSED_ACTUATOR.format(words=refusal) if refusal else ""))
     if actuators:
         return UNREAD_ACTUATOR.format(joint=joint.name, actuators=", ".join(actuators))
     return UNACTUATED_ARMATURE.format(joint=joint.name)
@@ -191,7 +194,7 @@ def ignored_frames(notes: Sequence[str]) -> tuple[tuple[str, str, str], ...]:
 PROOFS = {
     "UNACTUATED_ARMATURE": Proof.FIX,
     "UNREAD_ACTUATOR": Proof.FIX,
-    "BALL_ARMATURE": Proof.SUSPECTED,
+    "BALL_ARMATURE": Proof.MEASURED,
     "FIRST_OF_SEVERAL": Proof.FIX,
     "SKIPPED_CLASS": Proof.FIX,
     "IGNORED_FRAME": Proof.FIX,

@@ -45,7 +45,13 @@ from dyncheck.adapters.base import Field, ModelEngine, Offer, Steps
 from dyncheck.adapters.drake import actuators as drake_actuators
 from dyncheck.adapters.drake import counterfactual
 from dyncheck.adapters.drake import simulation as drake_simulation
-from dyncheck.adapters.drake.hints import actuators, armature_hint, file_hints, ignored_frames
+from dyncheck.adapters.drake.hints import (
+    REFUSED_ACTUATOR,
+    actuators,
+    armature_hint,
+    file_hints,
+    ignored_frames,
+)
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
@@ -327,9 +333,13 @@ class DrakeModel(ModelEngine):
         plant = self.plant
         driven = actuators(self._source) if self._source.format is Format.MJCF else {}
         read, measured = drake_actuators.hints(plant, self._source, driven)
-        hints = tuple((j.name, "armature", armature_hint(j, driven.get(j.name, [])))
-                      for j in joints if j.name not in reflected and self._source.format is
-                      Format.MJCF) + ignored_frames(notes) + file_hints(self._source) + read
+        refusal = drake_actuators.multi_dof_refusal()
+        armature = tuple((j.name, "armature", armature_hint(j, driven.get(j.name, []), refusal))
+                         for j in joints if j.name not in reflected and self._source.format is
+                         Format.MJCF)
+        measured |= {w for _, _, w in armature if refusal and REFUSED_ACTUATOR.format(
+            words=refusal) in w}  # (BALL_ARMATURE: the engine's own refusal)
+        hints = armature + ignored_frames(notes) + file_hints(self._source) + read
         tree = ModelTree(engine=ENGINE, joints=tuple(joints),
                          gravity=np.asarray(plant.gravity_field().gravity_vector(), float),
                          nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,

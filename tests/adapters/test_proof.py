@@ -17,7 +17,6 @@ import dyncheck.adapters as adapters
 from dyncheck.adapters.proof import Proof
 
 SUSPECTED = {
-    "drake.hints": {"BALL_ARMATURE"},
 }
 """The work left: causes written on a page as "cause unknown; suspected"."""
 

@@ -841,3 +841,26 @@ def test_a_proof_that_fails_on_newtons_solver_costs_only_itself(tmp_path, monkey
     assert tree.fixed == ()
     assert any("could not be measured on its solver (RuntimeError: planted)" in n
                for n in tree.notes), tree.notes
+
+
+BALL = """<mujoco model="ball"><worldbody>
+  <body name="a" pos="0 0 1"><joint name="ball" type="ball" armature="0.02"/>
+    <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03"/></body>
+  </worldbody></mujoco>"""
+"""A ball joint with armature, which Drake's plant holds as no actuator's reflected inertia."""
+
+
+@pytest.mark.parametrize("plant", [False, True], ids=["measured", "planted-accepted"])
+def test_drakes_ball_armature_is_measured_by_its_own_refusal(tmp_path, monkeypatch, plant):
+    """Drake refuses a JointActuator on a ball joint (its own words, read from a plant built
+    for it): the armature row names that refusal, measured. Planted as if Drake took one,
+    the cause is only suspected."""
+    pytest.importorskip("pydrake")
+    from dyncheck.adapters.drake import actuators as drake_actuators
+
+    if plant:
+        monkeypatch.setattr(drake_actuators, "multi_dof_refusal", lambda: "")
+    rows = _checked(tmp_path, BALL, "drake")
+    note = rows[(rows["field"] == "armature") & (rows["impl_b"] == "drake")].iloc[0].note
+    assert ("only supports actuators for single degree-of-freedom joints" in note) is not plant
+    assert note.startswith("cause unknown; suspected") is plant, note
