@@ -9,6 +9,7 @@ from dataclasses import replace
 
 import mujoco
 
+from dyncheck.adapters.formats.bodies import key
 from dyncheck.adapters.model_tree import Inertial, ModelTree, WantsCompiled
 
 SPRINGS = (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
@@ -16,12 +17,12 @@ SPRINGS = (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
 
 
 def inertials(m: mujoco.MjModel) -> dict[str, Inertial]:
-    """Body name → its compiled inertial (``body_ipos``, ``body_iquat``, ``body_mass``,
-    ``body_inertia``: the body's frame, as ``<inertial>`` takes them); unnamed bodies and
-    the world left out."""
+    """Body key (its name, else ``#`` its id: :mod:`~dyncheck.adapters.formats.bodies`) → its
+    compiled inertial (``body_ipos``, ``body_iquat``, ``body_mass``, ``body_inertia``: the
+    body's frame, as ``<inertial>`` takes them); the world left out."""
     out = {}
     for b in range(1, m.nbody):
-        name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b)
+        name = key(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) or "", b)
         if name:
             out[name] = Inertial(
                 pos=tuple(float(x) for x in m.body_ipos[b]),

@@ -15,6 +15,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from dyncheck.adapters.formats.bodies import keys
 from dyncheck.adapters.formats.edits import Edit, both
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.mjcf_copy import (
@@ -251,6 +252,7 @@ def _body_hints(root: ET.Element) -> Iterable[Found]:
     """Mass, centre of mass and inertia: per body without ``<inertial>``, on the joints that
     carry its mass (its own, else those of the nearest moving ancestor it is welded to)."""
     counts: dict[int, dict[str, int]] = {}  # body → reason → how many of its geoms
+    keyed = keys(root)  # (an unnamed body by its place: MuJoCo's body id)
     for geom in geoms(root):
         if geom.body.tag != "body" or geom.body.find("inertial") is not None:
             continue
@@ -269,15 +271,15 @@ def _body_hints(root: ET.Element) -> Iterable[Found]:
     for group, names in _carriers(root):
         why, reasons = [], []
         for reason in (MESH_UNIT, VISUAL_MASSLESS, DEFAULT_MASS):
-            where = [f"{b.get('name', '(unnamed)')!r} {n} geom{'s' * (n > 1)}"
+            where = [f"{keyed[id(b)]!r} {n} geom{'s' * (n > 1)}"
                      for b in group if (n := counts.get(id(b), {}).get(reason, 0))]
             if where:
                 why.append(reason.format(where="body " + ", ".join(where)))
                 reasons.append(reason)
         if why:  # (a mesh's or a visual geom's inertia: the canonical engine's, stated)
             edit = CLASS_MASSES if reasons == [DEFAULT_MASS] else None
-            weighed = [b.get("name") for b in group if counts.get(id(b))]
-            bodies = tuple(n for n in weighed if n) if edit is None and all(weighed) else ()
+            weighed = [keyed[id(b)] for b in group if counts.get(id(b))]
+            bodies = tuple(weighed) if edit is None else ()
             for name in names or ("model",):
                 for field in ("mass", "com", "inertia"):
                     yield Found(name, field, "; ".join(why), edit, bodies)

@@ -14,7 +14,9 @@ import numpy as np
 import pybullet as pb
 
 from dyncheck.adapters.formats import parsing
+from dyncheck.adapters.formats.bodies import keys
 from dyncheck.adapters.formats.files import ModelFile, urdf_inertials
+from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
 from dyncheck.adapters.model_tree import WantsCompiled
 from dyncheck.adapters.proof import Proof
@@ -75,7 +77,8 @@ def mjcf_hints(source: ModelFile) -> tuple[tuple[Hint, ...], tuple[WantsCompiled
     geoms too where the inertia is the tensor's."""
     if source.format is not Format.MJCF:
         return (), ()
-    root = parsing.root(source.text)
+    root = inline(source.path)  # (its bodies keyed as MuJoCo numbers them: includes in)
+    keyed = keys(root)
     default = root.find("default/geom")
     fallback = default.get("density") if default is not None else None
     parent = {child: body for body in root.iter() for child in body if child.tag == "body"}
@@ -94,7 +97,7 @@ def mjcf_hints(source: ModelFile) -> tuple[tuple[Hint, ...], tuple[WantsCompiled
         } - {1000.0}
         for j in joints if tensor or densities else ():
             held = carried.setdefault(j, ([], [], set()))
-            (held[0] if tensor else held[1]).append(body.get("name", ""))
+            (held[0] if tensor else held[1]).append(keyed[id(body)])
             held[2].update(densities)
     out: list[Hint] = []
     wants: list[WantsCompiled] = []
@@ -105,10 +108,8 @@ def mjcf_hints(source: ModelFile) -> tuple[tuple[Hint, ...], tuple[WantsCompiled
             out += [(j, "mass", why)] + ([] if tensors else [(j, "inertia", why)])
             fields += () if tensors else ("inertia",)
         out += [(j, "inertia", INERTIA_HINT)] if tensors else []
-        bodies = tuple(b for b in (*tensors, *weighed) if b)
-        if bodies and len(bodies) == len(tensors) + len(weighed):  # (every one named)
-            wants.append(WantsCompiled(subject=j, fields=fields, bodies=bodies,
-                                       box=bool(tensors)))
+        wants.append(WantsCompiled(subject=j, fields=fields, bodies=(*tensors, *weighed),
+                                   box=bool(tensors)))
     return tuple(out), tuple(wants)
 
 

@@ -17,6 +17,7 @@ from dataclasses import replace
 from typing import Protocol
 
 from dyncheck.adapters.base import ModelEngine
+from dyncheck.adapters.formats.bodies import keys
 from dyncheck.adapters.formats.edits import Edit, both, copied
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
@@ -91,8 +92,9 @@ def edit(inertials: Mapping[str, Inertial], *, engine: str, every: bool = False,
             if every:
                 compiler.attrib.pop("settotalmass", None)
         named = _referenced(root) if boxed else set()
+        keyed = keys(root)
         for body in root.iter("body"):
-            stated = inertials.get(body.get("name", ""))
+            stated = inertials.get(keyed[id(body)])
             if stated is None:
                 continue
             for old in body.findall("inertial"):
@@ -102,7 +104,7 @@ def edit(inertials: Mapping[str, Inertial], *, engine: str, every: bool = False,
                 "quat": " ".join(repr(x) for x in stated.quat),
                 "mass": repr(stated.mass),
                 "diaginertia": " ".join(repr(x) for x in stated.diaginertia)}))
-            if body.get("name") in boxed:
+            if keyed[id(body)] in boxed:
                 for parent, geom in _own_geoms(body):
                     if geom.get("name") not in named:
                         parent.remove(geom)

@@ -369,12 +369,22 @@ def test_pinocchios_geom_weighing_causes_are_verified_by_compiled_copy(tmp_path,
                in rows[("j1", "mass")].note
 
 
-def test_a_body_mujoco_cannot_name_leaves_the_cause_suspected(tmp_path):
-    """An unnamed mesh body: no compiled inertial can be matched to it, so no copy is read
-    and the cause stays "suspected", never "fix verified"."""
+@pytest.mark.parametrize("plant", [False, True], ids=["by-place", "planted-one-off"])
+def test_an_unnamed_body_is_found_by_its_place_among_the_bodies(tmp_path, monkeypatch, plant):
+    """An unnamed mesh body is keyed by its place among the file's bodies, MuJoCo's body id
+    ('#1'): the copy states MuJoCo's compiled inertial on it and Pinocchio then reads its
+    mass as MuJoCo does (it had stayed "suspected"). With MuJoCo's ids planted one off, the
+    copy states nothing on it: the cause is unknown, never "fix verified"."""
+    from dyncheck.adapters.mujoco import compiled
+
+    if plant:
+        real = compiled.key
+        monkeypatch.setattr(compiled, "key", lambda name, index: real(name, index + 1))
     rows = _weighed(tmp_path, body="")
     note = rows[("j1", "mass")].note
-    assert note.startswith("cause unknown; suspected, its fix not measured"), note
+    assert "body '#1' 1 geom" in note or plant, note
+    assert ("fix verified: with an <inertial> on '#1', 'b'" in note) is not plant, note
+    assert note.startswith("cause unknown") is plant, note
 
 
 SCALED = """<mujoco model="scaled"><compiler settotalmass="3"/><worldbody>
