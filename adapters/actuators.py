@@ -96,6 +96,11 @@ class Actuation:
     floor: np.ndarray | None = None
     """Per state, the size of what the engine subtracted to find τ (Newton: its net joint
     force without the drives), which its round-off is relative to; None: nothing."""
+    joint_tau: np.ndarray | None = None
+    """Where the engine also holds actuators outside the neutral form (a tendon's, a site's,
+    a muscle's: MuJoCo), the force of its joint actuators alone (n, nv), each joint's
+    ``actuatorfrcrange`` applied to their sum: what an engine holding only those applies;
+    None: ``tau`` is that."""
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -140,6 +140,24 @@ def activations(m: mujoco.MjModel, u: np.ndarray) -> np.ndarray:
     return act
 
 
+def _joint_actuators_alone(m: mujoco.MjModel, d: mujoco.MjData,
+                           modelled: list[bool]) -> np.ndarray:
+    """The generalized force of the ``modelled`` actuators (joint transmissions on hinges and
+    slides) alone: gear × ``actuator_force`` at each one's degree of freedom, each joint's
+    ``actuatorfrcrange`` applied to the sum, as MuJoCo applies it to the sum of all."""
+    out = np.zeros(m.nv)
+    for k, kept in enumerate(modelled):
+        if kept and int(m.actuator_trntype[k]) == int(mujoco.mjtTrn.mjTRN_JOINT):
+            joint = int(m.actuator_trnid[k, 0])
+            out[m.jnt_dofadr[joint]] += m.actuator_gear[k, 0] * d.actuator_force[k]
+    for joint in range(m.njnt):
+        if m.jnt_actfrclimited[joint] and int(m.jnt_type[joint]) in (
+                int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)):
+            dof = m.jnt_dofadr[joint]
+            out[dof] = np.clip(out[dof], *m.jnt_actfrcrange[joint])
+    return out
+
+
 class Actuated:
     """MuJoCo with :func:`with_actuation`'s copy of the check's model."""
 
@@ -153,15 +171,22 @@ class Actuated:
         d.qfrc_applied[:] = 0.0
         d.act[:] = activations(self.model, u[None])[0]
 
-    def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
-        """``qfrc_actuator`` and ``qacc`` after ``mj_forward`` at each state and control."""
-        n, nv = len(q), self.model.nv
+    def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray,
+                  modelled: list[bool] | None = None) -> Actuation:
+        """``qfrc_actuator`` and ``qacc`` after ``mj_forward`` at each state and control;
+        where some actuator is not ``modelled`` (a tendon's, a site's), the force of the
+        others alone too: gear × ``actuator_force`` at each one's joint, each joint's
+        ``actuatorfrcrange`` applied to the sum (:attr:`Actuation.joint_tau`)."""
+        m, n, nv = self.model, len(q), self.model.nv
         tau, forward = np.empty((n, nv)), np.empty((n, nv))
+        alone = None if modelled is None or all(modelled) else np.zeros((n, nv))
         for i in range(n):
             self._set(q[i], v[i], u[i])
-            mujoco.mj_forward(self.model, self.data)
+            mujoco.mj_forward(m, self.data)
             tau[i], forward[i] = self.data.qfrc_actuator, self.data.qacc
-        return Actuation(tau=tau, forward=forward)
+            if alone is not None:
+                alone[i] = _joint_actuators_alone(m, self.data, modelled or [])
+        return Actuation(tau=tau, forward=forward, joint_tau=alone)
 
     def input_jacobians(self, q: np.ndarray, v: np.ndarray, u: np.ndarray,
                         fd_step: float) -> tuple[InputJacobian, ...]:
@@ -205,8 +230,12 @@ class MujocoActuation:
         return self._actuated
 
     def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
-        """MuJoCo's ``qfrc_actuator`` and ``qacc`` at each state and control."""
-        return self._on().actuation(q, v, u)
+        """MuJoCo's ``qfrc_actuator`` and ``qacc`` at each state and control, and its joint
+        actuators' force alone where it holds others (:meth:`Actuated.actuation`)."""
+        tree = getattr(self, "tree", None)
+        held = list(tree.actuators) if tree is not None else []
+        modelled = [a.modelled for a in held] if len(held) == self.model.nu else None
+        return self._on().actuation(q, v, u, modelled)
 
     def input_jacobians(self, q: np.ndarray, v: np.ndarray,
                         u: np.ndarray) -> tuple[InputJacobian, ...]:

@@ -90,6 +90,9 @@ class Forces:
     floor: float = 0.0
     """The size the engine's round-off is relative to beyond the force's own (its
     :attr:`~dyncheck.adapters.actuators.Actuation.floor`)."""
+    joint_tau: np.ndarray | None = None
+    """Its joint actuators' force alone, where it holds others (its
+    :attr:`~dyncheck.adapters.actuators.Actuation.joint_tau`)."""
 
 
 def controls_for(canonical: ModelTree, tree: ModelTree, u: np.ndarray) -> np.ndarray:
@@ -130,7 +133,7 @@ def force_rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: Sta
             continue
         found[engine] = Forces(tau=answer.tau, controls=u_e, q=q_e, v=v_e, maps=maps,
                                floor=float(np.max(answer.floor, initial=0.0))
-                               if answer.floor is not None else 0.0)
+                               if answer.floor is not None else 0.0, joint_tau=answer.joint_tau)
         acts = joint_actuators(m.tree)
         if acts is None:
             others = ", ".join(a.what for a in m.tree.actuators if not a.modelled)
@@ -244,16 +247,27 @@ def _clamped(acts: law.JointActuators, f: Forces) -> str:
             f"{u.size}")
 
 
+ALONE = ("; the joint actuators' force alone (the actuators outside the neutral form, which "
+         "one engine alone holds, left out)")
+
+
 def _pair(model: str, *, tree_a: ModelTree, a: Forces, tree_b: ModelTree, b: Forces,
           differing: dict[str, list[str]]) -> CheckRow:
-    """Two engines' forces on the hinges and slides both hold (by joint name)."""
+    """Two engines' forces on the hinges and slides both hold (by joint name): of their joint
+    actuators alone where only one holds actuators outside the neutral form (a tendon's, a
+    site's: named once in the section, never a difference of this row)."""
     cols_a, cols_b = [], []
     for joint in tree_a.joints:
         if joint.layout.nv == 1 and any(j.name == joint.name for j in tree_b.joints):
             cols_a.append(joint.layout.v_start)
             cols_b.append(tree_b.joint(joint.name).layout.v_start)
-    off = np.abs(a.tau[:, cols_a] - b.tau[:, cols_b])
-    scale = max(float(np.abs(a.tau).max(initial=0.0)), float(np.abs(b.tau).max(initial=0.0)),
+    both = not all(x.modelled for x in tree_a.actuators) and \
+        not all(x.modelled for x in tree_b.actuators)
+    tau_a = a.tau if both or a.joint_tau is None else a.joint_tau
+    tau_b = b.tau if both or b.joint_tau is None else b.joint_tau
+    alone = tau_a is not a.tau or tau_b is not b.tau
+    off = np.abs(tau_a[:, cols_a] - tau_b[:, cols_b])
+    scale = max(float(np.abs(tau_a).max(initial=0.0)), float(np.abs(tau_b).max(initial=0.0)),
                 a.floor, b.floor, 1e-300)
     tolerance = ROUNDOFF_FACTOR * max(EPS, tree_a.eps, tree_b.eps)
     error = float(off.max(initial=0.0)) / scale
@@ -268,8 +282,8 @@ def _pair(model: str, *, tree_a: ModelTree, a: Forces, tree_b: ModelTree, b: For
     return _row(model, subject=FORCE, field=COMPUTED, a=tree_a.engine, b=tree_b.engine,
                 verdict=Verdict.PASSED if ok else Verdict.FAILED, error=error,
                 tolerance=tolerance, worst=worst, note=note,
-                basis=f"the same controls as each reads them; round-off {ROUNDOFF_FACTOR} eps "
-                      "of the largest force")
+                basis=f"the same controls as each reads them{ALONE if alone else ''}; round-off "
+                      f"{ROUNDOFF_FACTOR} eps of the largest force")
 
 
 def _derivative_rows(model: str, *, canon: Canonical, holding: ModelTree, batch: States,
