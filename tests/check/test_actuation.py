@@ -218,8 +218,8 @@ def test_a_forward_dynamics_that_drops_part_of_the_force_fails(servo_arm, monkey
 
     real = mujoco_actuators.Actuated.actuation
 
-    def shifted(self, q, v, u):
-        found = real(self, q, v, u)
+    def shifted(self, q, v, u, *rest):
+        found = real(self, q, v, u, *rest)
         return Actuation(tau=found.tau, forward=found.forward
                          + 0.01 * np.abs(found.forward).max())
 
