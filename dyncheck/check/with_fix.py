@@ -83,7 +83,8 @@ def rows(model: str, source: ModelFile, *, canon: layout.Canonical, canonical_tr
                 first = still[0] if still else None
                 out.append(_row(model, engine, Verdict.FAILED, (
                     f"{fix}, {engine} still reads the {first.field} of {first.subject!r} "
-                    f"otherwise: {first.note}" if first else
+                    f"otherwise ({first.error:.3g} of its scale): cause unknown (the copy "
+                    "has the fixes its causes name applied)" if first else
                     f"{fix}, {engine} holds other joints than {canonical_tree.engine}"),
                     fix=words, value="read otherwise"))
                 continue
