@@ -255,6 +255,7 @@ LITERAL_ELSEWHERE = {
     ("dyncheck/check/dynamics.py", "mass_matrix"): "a field of Dynamics, not the quantity",
     ("adapters/model_tree.py", "euler"): "Orientation.EULER: Example 9's angles in q",
     ("adapters/formats/mjcf_copy.py", "euler"): "MJCF's body attribute euler=, an orientation",
+    ("adapters/formats/frames.py", "euler"): "MJCF's orientation attribute euler=",
 }
 """Strings spelled like a member of the vocabulary that mean something else."""
 

@@ -140,11 +140,10 @@ def multi_dof_refusal() -> str:
     """Drake's own words refusing a ``JointActuator`` on a ball joint, measured on a plant
     built for it (one body on a ``BallRpyJoint``); empty where Drake takes one."""
     from pydrake.multibody.plant import MultibodyPlant
-    from pydrake.multibody.tree import BallRpyJoint, SpatialInertia, UnitInertia
+    from pydrake.multibody.tree import BallRpyJoint, SpatialInertia
 
     plant = MultibodyPlant(0.0)
-    body = plant.AddRigidBody("probe", SpatialInertia(
-        mass=1.0, p_PScm_E=np.zeros(3), G_SP_E=UnitInertia.SolidSphere(0.1)))
+    body = plant.AddRigidBody("probe", SpatialInertia.SolidSphereWithMass(1.0, 0.1))
     ball = plant.AddJoint(BallRpyJoint("probe_ball", plant.world_frame(), body.body_frame()))
     try:
         plant.AddJointActuator("probe_actuator", ball)

@@ -20,8 +20,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from dyncheck.adapters.formats.edits import Edit
+from dyncheck.adapters.formats.mjcf_copy import POSE
 
-ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
+ORIENTATIONS = POSE[1:]
 
 
 def _floats(text: str) -> np.ndarray:
@@ -34,16 +35,16 @@ def rotation(element: ET.Element, *, degrees: bool, sequence: str) -> Rotation:
         w, x, y, z = _floats(element.get("quat", ""))
         return Rotation.from_quat([x, y, z, w])
     if element.get("axisangle"):
-        *axis, angle = _floats(element.get("axisangle", ""))
-        unit = np.asarray(axis) / np.linalg.norm(axis)
-        return Rotation.from_rotvec(unit * (np.radians(angle) if degrees else angle))
+        values = _floats(element.get("axisangle", ""))
+        unit = values[:3] / np.linalg.norm(values[:3])
+        return Rotation.from_rotvec(unit * (np.radians(values[3]) if degrees else values[3]))
     if element.get("euler"):
         angles = _floats(element.get("euler", ""))
         angles = np.radians(angles) if degrees else angles
         turn = Rotation.identity()
-        for axis, angle in zip(sequence, angles, strict=True):
-            step = Rotation.from_rotvec(angle * np.eye(3)["xyz".index(axis.lower())])
-            turn = turn * step if axis.islower() else step * turn
+        for letter, angle in zip(sequence, angles, strict=True):
+            step = Rotation.from_rotvec(angle * np.eye(3)["xyz".index(letter.lower())])
+            turn = turn * step if letter.islower() else step * turn
         return turn
     if element.get("xyaxes"):
         values = _floats(element.get("xyaxes", ""))
@@ -54,11 +55,11 @@ def rotation(element: ET.Element, *, degrees: bool, sequence: str) -> Rotation:
     if element.get("zaxis"):
         z = _floats(element.get("zaxis", ""))
         z /= np.linalg.norm(z)
-        axis = np.cross([0.0, 0.0, 1.0], z)
-        if np.linalg.norm(axis) < 1e-14:
+        normal = np.cross([0.0, 0.0, 1.0], z)
+        if np.linalg.norm(normal) < 1e-14:
             return Rotation.identity() if z[2] > 0 else Rotation.from_rotvec([np.pi, 0, 0])
-        angle = np.arctan2(np.linalg.norm(axis), z[2])
-        return Rotation.from_rotvec(axis / np.linalg.norm(axis) * angle)
+        tilt = np.arctan2(np.linalg.norm(normal), z[2])
+        return Rotation.from_rotvec(normal / np.linalg.norm(normal) * tilt)
     return Rotation.identity()
 
 

@@ -61,11 +61,27 @@ def predictions_met(tree: ModelTree, root: ET.Element) -> frozenset[str]:
     """The range hints whose prediction (:func:`.mjcf.predicted_ranges`; ``root``: the MJCF,
     its includes inlined) Pinocchio's reading meets on every joint it names (to 1e-9 of the
     range): their cause measured."""
-    held = {j.name: j.range for j in tree.joints}
+    held = {**_by_place(tree, root), **{j.name: j.range for j in tree.joints}}
     return frozenset(why for why, ranges in mjcf.predicted_ranges(root).items()
                      if all(held.get(j) is not None
                             and np.allclose(held[j], r, rtol=1e-9, atol=1e-12)  # type: ignore[arg-type]
                             for j, r in ranges.items()))
+
+
+def _by_place(tree: ModelTree, root: ET.Element) -> dict[str, tuple[float, float] | None]:
+    """Each of the file's joints' range as Pinocchio holds it, found by its body and its
+    place among that body's joints: Pinocchio holds a body's several joints as the
+    components of one composite joint, named otherwise (measured: dm_control's fish)."""
+    held: dict[str, list] = {}
+    for joint in tree.joints:
+        held.setdefault(joint.body, []).append(joint)
+    out = {}
+    for body in root.iter("body"):
+        names = [x.get("name", "") for x in body if x.tag in ("joint", "freejoint")]
+        mine = held.get(body.get("name", ""), [])
+        if len(mine) == len(names):
+            out.update({name: j.range for name, j in zip(names, mine, strict=True) if name})
+    return out
 
 
 def refusal(source: ModelFile, message: str) -> str:

@@ -306,6 +306,38 @@ def test_pinocchios_range_causes_are_proved_by_their_predictions(tmp_path, monke
         assert ("suspected" in row.note) is plant, (joint, row.note)
 
 
+TWO_JOINT_RANGES = """<mujoco model="fins">
+  <default><default class="fin"><joint type="hinge" limited="false" range="-60 60"/></default>
+  </default>
+  <worldbody><body name="fin" pos="0 0 1" childclass="fin">
+    <joint name="fin_roll" axis="1 0 0"/><joint name="fin_pitch" axis="0 1 0"/>
+    <geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.02"/></body></worldbody>
+</mujoco>"""
+"""dm_control's fish: a body with two joints, unlimited by their class yet with a range;
+Pinocchio holds them as one composite joint's components, named otherwise."""
+
+
+@pytest.mark.parametrize("plant", [False, True], ids=["predicted", "planted-wrong"])
+def test_a_range_prediction_finds_a_composites_joints_by_their_place(tmp_path, monkeypatch,
+                                                                      plant):
+    """Both joints' ranges, read by Pinocchio though unlimited (±60°: worked by hand), meet
+    the prediction where each file joint is found by its body and its place there (they were
+    looked up by name, missed, and the cause stayed "suspected" on dm_control's fish and
+    point_mass). Planted doubled, the cause is suspected."""
+    path = tmp_path / "fins.xml"
+    path.write_text(TWO_JOINT_RANGES)
+    if plant:
+        real = pinocchio_mjcf.predicted_ranges
+        monkeypatch.setattr(pinocchio_mjcf, "predicted_ranges", lambda root: {
+            why: {j: (2 * lo, 2 * hi) for j, (lo, hi) in ranges.items()}
+            for why, ranges in real(root).items()})
+    rows = _described(path)
+    for joint in ("fin_roll", "fin_pitch"):
+        row = rows[(joint, "range")]
+        assert np.allclose(ast.literal_eval(row.value_b), np.radians([-60, 60])), row.value_b
+        assert ("suspected" in row.note) is plant, (joint, row.note)
+
+
 CUBE_OBJ = "\n".join(
     [f"v {x} {y} {z}" for z in (-0.1, 0.1) for y, x in ((-0.1, -0.1), (-0.1, 0.1), (0.1, 0.1),
                                                          (0.1, -0.1))]
