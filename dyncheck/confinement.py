@@ -43,7 +43,10 @@ def release_output(errors: str | None = None) -> None:
     if errors is None:
         os.dup2(null, 2)
     else:
-        err = os.open(errors, os.O_WRONLY | os.O_APPEND)
+        try:
+            err = os.open(errors, os.O_WRONLY | os.O_APPEND)
+        except FileNotFoundError:  # the parent let this process go before it started (its
+            os._exit(0)  # folder removed on an interrupt): nothing to do, nothing to say
         os.dup2(err, 2)
         os.close(err)
     os.close(null)

@@ -154,3 +154,16 @@ def test_a_small_soft_stack_is_raised_and_a_deep_chain_checked(tmp_path):
          "--states", "5", "--quiet", "--out", str(tmp_path / "out")],
         preexec_fn=small_stack, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, (done.returncode, done.stderr[-2000:])
+
+
+def test_an_engine_let_go_before_it_started_exits_without_a_word(tmp_path):
+    """An engine process whose errors file is gone when it starts (the check removed its
+    folder on Ctrl-C while the process was being started: CI's ctrl-c test met it once)
+    exits 0 at once, writing nothing. It raised FileNotFoundError, a traceback on the
+    user's terminal."""
+    gone = tmp_path / "removed" / "engine.err"
+    result = subprocess.run(
+        [sys.executable, "-c", "from dyncheck.confinement import release_output; "
+         f"release_output({str(gone)!r}); print('went on')"],
+        capture_output=True, text=True, timeout=60, check=False)
+    assert (result.returncode, result.stdout, result.stderr) == (0, "", "")
