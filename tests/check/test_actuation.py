@@ -283,34 +283,28 @@ TENDON_SERVO = TENDON.replace('<motor name="t" tendon="coupled"',
 control, acts at every sampled state (a motor's is 0 at a zero control)."""
 
 
-def test_a_tendons_actuator_stays_out_of_the_pair_force_row(tmp_path):
+@pytest.mark.parametrize("planted", [1.0, 1.01], ids=["as-computed", "planted-1%-off"])
+def test_a_tendons_actuator_stays_out_of_the_pair_force_row(tmp_path, monkeypatch, planted):
     """The force MuJoCo and Drake apply to the joints, compared pair-wise, is their joint
     actuators' alone: the tendon's servo, which Drake does not hold, is not a difference of
     that row (it had failed by the servo's force). Expected: MuJoCo's own
     ``actuator_force`` × gear of 'm0', against Drake's force (a third engine), to round-off.
-    With MuJoCo's joint-actuator force planted 1 % off, the row fails."""
-    pytest.importorskip("pydrake", reason="the drake extra is not installed")
-    path = tmp_path / "tendon.xml"
-    path.write_text(TENDON_SERVO)
-    result = check_model(path, impls=("mujoco", "drake", "reference"), states=5,
-                         isolate=False)
-    (row,) = _rows(result, subject="actuator force", impl_a="mujoco",
-                   impl_b="drake").itertuples()
-    assert row.verdict == "passed" and "the joint actuators' force alone" in row.basis, row
-
-
-def test_a_joint_actuator_force_alone_planted_off_fails(tmp_path, monkeypatch):
+    With MuJoCo's joint-actuator force planted 1 % off, the row fails by 0.01 / 1.01."""
     pytest.importorskip("pydrake", reason="the drake extra is not installed")
     real = mujoco_actuators._joint_actuators_alone
     monkeypatch.setattr(mujoco_actuators, "_joint_actuators_alone",
-                        lambda *args: real(*args) * 1.01)
+                        lambda *args: real(*args) * planted)
     path = tmp_path / "tendon.xml"
     path.write_text(TENDON_SERVO)
     result = check_model(path, impls=("mujoco", "drake", "reference"), states=5,
                          isolate=False)
     (row,) = _rows(result, subject="actuator force", impl_a="mujoco",
                    impl_b="drake").itertuples()
-    assert row.verdict == "failed" and row.error == pytest.approx(0.01 / 1.01, rel=1e-6)
+    assert "the joint actuators' force alone" in row.basis, row
+    if planted == 1.0:
+        assert row.verdict == "passed", row
+    else:
+        assert row.verdict == "failed" and row.error == pytest.approx(0.01 / 1.01, rel=1e-6)
 
 
 KP_IN_A_PARENT_CLASS = """<mujoco model="kp">
