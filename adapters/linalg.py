@@ -27,3 +27,23 @@ def kkt(M: np.ndarray, rhs: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.n
     b[:n] = rhs
     x = solve(K, b)
     return x[:n], x[n:]
+
+
+RANK_RTOL = 1e-10
+"""A singular value of a constraint Jacobian below this fraction of its largest counts as
+zero (its entries are lever arms and direction cosines of order one)."""
+
+
+def closed(M: np.ndarray, rhs: np.ndarray, J: np.ndarray,
+           drift: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """v̇ and f of M v̇ − Jᵀ f = rhs, J v̇ = −``drift`` (J̇ v): a tree closed by rigid
+    constraints, J's dependent rows left out (its rank from its singular values, a planar
+    loop's 3-D rows being dependent); f on J's rows, the least-norm."""
+    u, s, vt = np.linalg.svd(J, full_matrices=False)
+    rank = int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
+    n = M.shape[0]
+    K = np.zeros((n + rank, n + rank))
+    K[:n, :n], K[:n, n:], K[n:, :n] = M, -vt[:rank].T, vt[:rank]
+    b = np.concatenate([rhs, -(u[:, :rank].T @ drift) / s[:rank]])
+    x = solve(K, b)
+    return x[:n], u[:, :rank] @ (x[n:] / s[:rank])

@@ -292,6 +292,9 @@ class ModelTree:
     """Whether its loader reads the file's constraints into :attr:`closures` (False: none
     are read, whatever the file holds: its notes say why where it was given a copy
     without them)."""
+    closures_unheld: tuple[tuple[str, str], ...] = ()
+    """Each kind of constraint (:class:`~dyncheck.adapters.closures.ClosureKind`'s value) its
+    parser drops, with its own words (a warning) where it says so."""
     exact_meshes: ModelTree | None = None
     """The engine's reading with every mesh's volume and inertia computed exactly (MuJoCo:
     ``inertia="exact"`` instead of its default ``"legacy"``, which overcounts a non-convex

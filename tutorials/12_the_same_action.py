@@ -75,7 +75,7 @@ from pydrake.multibody.parsing import Parser  # noqa: E402
 from pydrake.multibody.plant import MultibodyPlant  # noqa: E402
 from pydrake.multibody.tree import PdControllerGains  # noqa: E402
 
-from dyncheck.adapters.drake.model import parser_warnings  # noqa: E402
+from dyncheck.adapters.drake.parsing import parser_warnings  # noqa: E402
 
 rng = np.random.default_rng(3)
 states = [(rng.uniform(-1, 1, 2), rng.uniform(-2, 2, 2), rng.uniform(-TARGET, TARGET, 2))

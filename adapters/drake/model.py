@@ -21,28 +21,22 @@ world).
 
 from __future__ import annotations
 
-import logging
-import re
-import tempfile
 from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
-from pathlib import Path
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 from pydrake.autodiffutils import AutoDiffXd
-from pydrake.multibody.parsing import Parser
-from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import (
-    BodyIndex,
     MultibodyForces,
     MultibodyForces_,
-    QuaternionFloatingJoint,
 )
 
 from dyncheck.adapters.actuators import Actuation
 from dyncheck.adapters.base import Field, ModelEngine, Offer, Steps
+from dyncheck.adapters.closures import ClosedReading
 from dyncheck.adapters.drake import actuators as drake_actuators
+from dyncheck.adapters.drake import closures as drake_closures
 from dyncheck.adapters.drake import counterfactual
 from dyncheck.adapters.drake import simulation as drake_simulation
 from dyncheck.adapters.drake.hints import (
@@ -52,10 +46,9 @@ from dyncheck.adapters.drake.hints import (
     file_hints,
     ignored_frames,
 )
-from dyncheck.adapters.formats import parsing
+from dyncheck.adapters.drake.parsing import ENGINE, plant_of
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
-from dyncheck.adapters.formats.mjcf_copy import for_parser
 from dyncheck.adapters.model_tree import (
     Axes,
     DerivativeChart,
@@ -73,157 +66,14 @@ from dyncheck.adapters.model_tree import (
 )
 from dyncheck.adapters.registration import Format
 from dyncheck.cases.multibody import Coupling
-from dyncheck.errors import DyncheckError, EngineError, Unsupported
+from dyncheck.errors import EngineError, Unsupported
 
-ENGINE = "drake"
-MESH_FORMATS = (".obj",)
-"""The mesh files Drake's MJCF parser reads (others: the geoms dropped where they carry no
-inertia, see :mod:`dyncheck.adapters.formats.mjcf_copy`)."""
 _TYPES = {
     "revolute": JointType.HINGE,
     "prismatic": JointType.SLIDE,
     "quaternion_floating": JointType.FREE,
     "ball_rpy": JointType.BALL,
 }
-class _Capture(logging.Handler):
-    def __init__(self) -> None:
-        super().__init__()
-        self.messages: list[str] = []
-
-    def emit(self, record: logging.LogRecord) -> None:
-        self.messages.append(record.getMessage().split("warning: ", 1)[-1])
-
-
-@contextmanager
-def parser_warnings() -> Iterator[list[str]]:
-    """Drake's log messages while the block runs (its parser's warnings: what it ignores or
-    changes), kept in the yielded list instead of printed."""
-    capture = _Capture()
-    log = logging.getLogger("drake")
-    log.addHandler(capture)
-    propagate, log.propagate = log.propagate, False
-    try:
-        yield capture.messages
-    finally:
-        log.removeHandler(capture)
-        log.propagate = propagate
-
-
-def parse_xml(xml: str, time_step: float = 0.0) -> tuple[MultibodyPlant, list[str]]:
-    """Drake's MJCF parser on ``xml`` as it is (no copy made for it), and its warnings: the
-    parser itself, as the catalogue's demonstrations measure it."""
-    plant = MultibodyPlant(time_step)
-    with parser_warnings() as warnings:
-        Parser(plant).AddModelsFromString(xml, "xml")
-    plant.Finalize()
-    return plant, warnings
-
-
-def _plant(source: ModelFile) -> tuple[MultibodyPlant, list[str], tuple[str, ...],
-                                       dict[str, tuple]]:
-    """The finalized plant, its parser's warnings, the notes on the reading, and each
-    joint's damping (zeroed in the plant)."""
-    plant = MultibodyPlant(0.0)
-    notes: list[str] = []
-    with parser_warnings() as warnings, tempfile.TemporaryDirectory() as meshes:
-        try:
-            if source.format is Format.MJCF and (copy := for_parser(
-                    source.path, ENGINE, MESH_FORMATS, massless_aborts=True,
-                    constraints_refused=True, convert_into=Path(meshes))).text:
-                Parser(plant).AddModelsFromString(copy.text, "xml")
-                notes.extend(copy.notes)
-            elif source.format is Format.MJCF:
-                Parser(plant).AddModels(str(source.path))
-            else:
-                Parser(plant).AddModelsFromString(source.text, "urdf")
-        except DyncheckError:
-            raise
-        except Exception as exc:
-            raise EngineError(
-                f"drake refused {source.path}: {' '.join(str(exc).split())}"
-            ) from None
-    notes.extend(_summary(warnings))
-    if source.format is Format.URDF:
-        notes.extend(_floating_joints(plant, source.text))
-        root = _urdf_root(plant)
-        if root is None:
-            notes.append("drake: the URDF's root link is 'world' (already welded)")
-        elif source.floating:
-            plant.AddJoint(QuaternionFloatingJoint("root_joint", plant.world_frame(),
-                                                   root.body_frame()))
-            notes.append("drake: QuaternionFloatingJoint 'root_joint' at the URDF root")
-        else:
-            plant.WeldFrames(plant.world_frame(), root.body_frame())
-    damping = {}
-    for index in plant.GetJointIndices():
-        joint = plant.get_joint(index)
-        if joint.num_velocities() > 0:
-            damping[joint.name()] = tuple(float(x) for x in joint.default_damping_vector())
-            joint.set_default_damping_vector(np.zeros(joint.num_velocities()))
-    plant.Finalize()
-    return plant, warnings, tuple(notes), damping
-
-
-def _summary(warnings: list[str]) -> list[str]:
-    """Drake's parser warnings for the report, in Drake's own words: each distinct one once
-    with its count, messages that differ only in their numbers (an inertia warning's matrix)
-    counted as one and shown by the first in full (whitespace collapsed; capped at
-    :data:`MESSAGE_CHARS` against a hostile file's flood)."""
-    first: dict[str, str] = {}
-    counts: dict[str, int] = {}
-    for message in warnings:
-        text = " ".join(message.split())
-        key = re.sub(r"[-+]?\d[\d.eE+-]*", "#", text).replace(" ", "")
-        first.setdefault(key, text)
-        counts[key] = counts.get(key, 0) + 1
-    out = []
-    for key, text in first.items():
-        shown = text if len(text) <= MESSAGE_CHARS else text[:MESSAGE_CHARS] + " […]"
-        n = counts[key]
-        out.append(f"drake parser warning ({n}x{', the first' if n > 1 else ''}): {shown}")
-    return out
-
-
-MESSAGE_CHARS = 1000
-"""The longest engine message a page quotes whole."""
-
-
-def _floating_joints(plant: MultibodyPlant, text: str) -> list[str]:
-    """A URDF ``floating`` joint from the world: Drake's parser leaves its child a free body
-    without a joint (its warning says so); it is given the ``QuaternionFloatingJoint`` of that
-    name that MuJoCo's and Pinocchio's parsers make of it (measured: both read a free joint).
-    One below another link: Drake holds no joint there, an engine's limit (skipped, said)."""
-    notes = []
-    for joint in parsing.root(text).findall("joint"):
-        parent, child = joint.find("parent"), joint.find("child")
-        if joint.get("type") != "floating" or parent is None or child is None:
-            continue
-        if parent.get("link") != "world":
-            raise Unsupported(
-                f"drake: the URDF's floating joint {joint.get('name')!r} is below link "
-                f"{parent.get('link')!r}: Drake's parser leaves its link a free body that no "
-                "joint holds (MuJoCo's and Pinocchio's read a free joint there)")
-        if not plant.HasBodyNamed(child.get("link", "")):
-            continue
-        body = plant.GetBodyByName(child.get("link", ""))
-        plant.AddJoint(QuaternionFloatingJoint(joint.get("name", ""), plant.world_frame(),
-                                               body.body_frame()))
-        notes.append(f"drake: the URDF's floating joint {joint.get('name')!r} given as a "
-                     "QuaternionFloatingJoint (Drake's parser leaves its link a free body)")
-    return notes
-
-
-def _urdf_root(plant: MultibodyPlant):
-    """The link no joint points to (URDF: one, or none when a link named ``world`` welds the
-    model to Drake's world)."""
-    children = {plant.get_joint(i).child_body().index() for i in plant.GetJointIndices()}
-    candidates = [
-        plant.get_body(BodyIndex(b)) for b in range(1, plant.num_bodies())
-        if BodyIndex(b) not in children
-    ]
-    if len(candidates) > 1:
-        raise EngineError(f"drake: expected one URDF root link, found {len(candidates)}")
-    return candidates[0] if candidates else None
 
 
 class DrakeModel(ModelEngine):
@@ -232,12 +82,12 @@ class DrakeModel(ModelEngine):
     engine = ENGINE
     offers = frozenset({Offer.DERIVATIVES, Offer.ACTUATION, Offer.CONTROL_DERIVATIVES,
                         Offer.STEPPING, Offer.CONTROLLED_STEPPING, Offer.COUPLINGS,
-                        Offer.BODY_FORCES})
+                        Offer.BODY_FORCES, Offer.CLOSURES})
     steps_in_a_chart = True  # its integrators advance q = (roll, pitch, yaw) and (w, x, y, z, p)
 
     def __init__(self, source: ModelFile, *, fixes: bool = True) -> None:
         self._fixes = fixes  # (False: a copy read to measure a fix)
-        self.plant, said, notes, self._damping = _plant(source)
+        self.plant, said, notes, self._damping = plant_of(source)
         self.parser_warnings = tuple(dict.fromkeys(said))
         self._source = source
         self.context = self.plant.CreateDefaultContext()
@@ -249,7 +99,29 @@ class DrakeModel(ModelEngine):
         self._actuated: Any = None  # the context of actuation (its PD controllers armed)
         self._rows: np.ndarray | None = None  # the couplings C v = 0 it holds (Drake's order)
         self._ad_actuated: Any = None  # the same for the AutoDiffXd plant
-        self.tree = self._tree(notes)
+        self._balls: tuple[drake_closures.Ball, ...] = ()
+        self.tree = self._closures(self._tree(notes))
+
+    def _closures(self, tree: ModelTree) -> ModelTree:
+        """Its tree with the constraints Drake's MJCF parser holds (:mod:`.closures`, read on
+        a discrete-time plant parsed with them), or the note of why none are read."""
+        root = inline(self._source.path) if self._source.format is Format.MJCF else None
+        if root is None or not any(len(block) for block in root.findall("equality")):
+            return tree
+        try:
+            discrete, said, _, _ = plant_of(self._source, kept=True)
+            held = drake_closures.read(root, held=discrete.num_constraints(), warnings=said,
+                                       plant=self.plant, context=self.context)
+        except (Unsupported, EngineError) as exc:
+            return replace(tree, notes=(*tree.notes, f"{exc}; its constraints are not read"))
+        self._balls = held.balls
+        return replace(tree, closures=held.closures, closures_read=True,
+                       closures_unheld=held.unheld)
+
+    def closed(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> ClosedReading:
+        """Its M and h closed by its ball constraints (:func:`.closures.closed`)."""
+        return drake_closures.closed(self.plant, self.context, self._balls, q=q, v=v,
+                                     tau=tau)
 
     def _tree(self, notes: tuple[str, ...]) -> ModelTree:
         plant, ctx = self.plant, self.context

@@ -80,7 +80,7 @@ def drake_forces(*, fixed: bool) -> np.ndarray:
 
 def drake_mjcf_actuators() -> Entry:
     """Drake's servo force against MuJoCo's, as parsed and fixed."""
-    from dyncheck.adapters.drake.model import parser_warnings
+    from dyncheck.adapters.drake.parsing import parser_warnings
 
     expected = mujoco_forces()
     with parser_warnings():  # (its warnings on the attributes it does not read)
@@ -158,7 +158,7 @@ def _servo_slope(scalar: str, *, gains: bool = False) -> float:
 def drake_autodiff_pd_gains() -> Entry:
     """Drake's ∂v̇/∂(servo target) by automatic differentiation, as converted and with the
     gains set again, against its own finite differences."""
-    from dyncheck.adapters.drake.model import parser_warnings
+    from dyncheck.adapters.drake.parsing import parser_warnings
 
     with parser_warnings():
         expected = _servo_slope("double")

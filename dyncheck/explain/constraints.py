@@ -104,7 +104,7 @@ def drake_equality() -> Entry:
     from pydrake.multibody.plant import DiscreteContactApproximation, MultibodyPlant
     from pydrake.systems.analysis import Simulator
 
-    from dyncheck.adapters.drake.model import parse_xml
+    from dyncheck.adapters.drake.parsing import parse_xml
 
     (m1, m2, g), h = ATWOOD, 1e-3
     book = (m1 - m2) * g / (m1 + m2)  # Example 6

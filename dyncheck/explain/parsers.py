@@ -77,7 +77,7 @@ def drake_mjcf_options() -> Entry:
     import mujoco
     from pydrake.math import RigidTransform
 
-    from dyncheck.adapters.drake.model import parse_xml
+    from dyncheck.adapters.drake.parsing import parse_xml
 
     xml = (
         "<mujoco model='m'><compiler eulerseq='zyx'/>"

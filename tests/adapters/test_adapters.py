@@ -280,7 +280,7 @@ def test_drake_parser_ignores_the_tendon_equality():
     """Measured: Drake's MJCF parser warns that it ignores <tendon> and the tendon equality,
     and loads no constraint — why Drake's loader closes the cords itself (a KKT solve with
     Drake's M and h)."""
-    from dyncheck.adapters.drake.model import parse_xml
+    from dyncheck.adapters.drake.parsing import parse_xml
 
     plant, warnings = parse_xml(to_mjcf(get_case("atwood").multibody()))
     assert plant.num_velocities() == 2 and plant.num_constraints() == 0

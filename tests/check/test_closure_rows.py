@@ -10,7 +10,7 @@ import pytest
 
 from dyncheck.adapters.formats.files import read
 from dyncheck.adapters.offers import Offer
-from dyncheck.check.engines import DEFAULT, ENGINES
+from dyncheck.check.engines import ENGINES
 from dyncheck.check.model_check import check_model
 from dyncheck.check.verdicts import Agreement, per_engine
 from tests.check.test_closures import FOUR_BAR
@@ -18,8 +18,10 @@ from tests.conftest import loader
 
 CLOSING = [e for e in ENGINES if Offer.CLOSURES in loader(e).offers]
 """The engines a check loads whose loader computes with the file's constraints."""
-NOT_CLOSING = [e for e in DEFAULT if e in ENGINES and Offer.CLOSURES not in loader(e).offers]
-"""The engines a check runs by default whose loader offers no constrained dynamics."""
+NOT_CLOSING = [e for e, r in ENGINES.items()
+               if not r.ports and Offer.CLOSURES not in loader(e).offers]
+"""The engines a check loads (ports of another apart) whose loader offers no constrained
+dynamics."""
 STATES = 8
 
 

@@ -1,0 +1,165 @@
+"""Drake's constraints from an MJCF file (#78), and its closed dynamics on them.
+
+Drake's MJCF parser (``detail_mujoco_parser.cc``, ``ParseEquality``) turns a ``<connect>``
+given by ``body1`` and ``anchor`` (and ``body2``, else the world) into a ball constraint,
+``AddBallConstraint(body_A, p_AP, body_B)``: P the anchor in body 1's frame, Q the point of
+body 2 at P in the default configuration. It warns of and ignores a connect given by sites,
+and every ``<weld>``, ``<joint>`` and ``<tendon>``; it warns that ``active`` is unsupported and
+holds the constraint whatever it says. Its Python bindings expose no constraint's spec, so
+which constraints it holds is measured — a discrete-time plant parsed from the file with them
+kept: its ``num_constraints()`` and its warnings — and each held connect's points are the ones
+its parser makes of the file's.
+
+A continuous-time plant refuses any constraint; the closed dynamics are Drake's own M and h
+(the continuous plant, parsed without them) with each ball constraint's rows from Drake's
+kinematics — the points' translational Jacobians (``CalcJacobianTranslationalVelocity``) and
+bias accelerations (``CalcBiasTranslationalAcceleration``) — in the rigid KKT solve
+(:func:`~dyncheck.adapters.linalg.closed`).
+"""
+
+from __future__ import annotations
+
+import re
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import JacobianWrtVariable
+from pydrake.systems.framework import Context
+
+from dyncheck.adapters.closures import ClosedReading, Closure, ClosureKind
+from dyncheck.adapters.linalg import closed as kkt_closed
+from dyncheck.errors import Unsupported
+
+ENGINE = "drake"
+_IGNORED = re.compile(r"The tag '(\w+)' found as a child of 'equality' is currently unsupported")
+_BY_SITES = "connect node uses the site1 and site2 specification"
+
+
+@dataclass(frozen=True, kw_only=True)
+class Ball:
+    """One ball constraint as Drake's parser makes it: point P (``p_AP``, body A's frame) held
+    at Q (``p_BQ``, body B's frame)."""
+
+    body_a: str
+    p_ap: np.ndarray
+    body_b: str
+    p_bq: np.ndarray
+
+
+@dataclass(frozen=True, kw_only=True)
+class Held:
+    """The constraints Drake holds, as neutral closures and as its balls (one each, same
+    order), and each kind it drops with its parser's words."""
+
+    closures: tuple[Closure, ...]
+    balls: tuple[Ball, ...]
+    unheld: tuple[tuple[str, str], ...]
+
+
+def dropped(warnings: list[str]) -> tuple[tuple[str, str], ...]:
+    """Each ``<equality>`` kind the parser's warnings say it ignores, with the warning."""
+    out: dict[str, str] = {}
+    for said in warnings:
+        text = " ".join(said.split())
+        if (found := _IGNORED.search(text)) is not None:
+            out.setdefault(found.group(1), text)
+        elif _BY_SITES in text:
+            out.setdefault(ClosureKind.CONNECT.value, text)
+    return tuple(out.items())
+
+
+def _connects(root: ET.Element) -> list[tuple[str, ET.Element]]:
+    """The file's connects given by body and anchor, as Drake's parser walks them (each
+    ``<equality>`` in order, its connects in order), with their names (``connect k``, k the
+    element's place among the file's equalities, where unnamed)."""
+    out = []
+    place = 0
+    for block in root.findall("equality"):
+        for item in block:
+            if item.tag == "connect" and item.get("body1") is not None:
+                out.append((item.get("name") or f"connect {place}", item))
+            place += 1
+    return out
+
+
+def _owners(plant: MultibodyPlant) -> dict[str, str]:
+    """Each body's name → the moving joint whose child (or a body welded to it) it is."""
+    out = {}
+    for index in plant.GetJointIndices():
+        joint = plant.get_joint(index)
+        if joint.num_velocities() > 0:
+            for body in plant.GetBodiesWeldedTo(joint.child_body()):
+                out[body.name()] = joint.name()
+    return out
+
+
+def read(root: ET.Element, *, held: int, warnings: list[str], plant: MultibodyPlant,
+         context: Context) -> Held:
+    """Drake's constraints on the file ``root`` (inlined), its discrete plant holding
+    ``held`` of them, on ``plant`` (the continuous one): Q where P is at its default
+    configuration, the closures' points in world axes at ``context`` (the tree's reference
+    pose), each on the joint that moves its body. Raises :class:`Unsupported` where the
+    count is not that of the file's connects given by body."""
+    connects = _connects(root)
+    if len(connects) != held:
+        raise Unsupported(f"drake's parser holds {held} constraints where the file gives "
+                          f"{len(connects)} <connect> by body and anchor: which it holds is "
+                          "not known")
+    default, owners = plant.CreateDefaultContext(), _owners(plant)
+    balls, closures = [], []
+    for name, item in connects:
+        body_a, body_b = item.get("body1", ""), item.get("body2") or "world"
+        if not (plant.HasBodyNamed(body_a) and plant.HasBodyNamed(body_b)):
+            raise Unsupported(f"drake holds no body {body_a!r} or {body_b!r} of connect "
+                              f"{name!r} in the model it computes with")
+        a, b = plant.GetBodyByName(body_a), plant.GetBodyByName(body_b)
+        p_ap = np.array([float(x) for x in item.get("anchor", "0 0 0").split()], float)
+        p_bq = b.EvalPoseInWorld(default).inverse().multiply(
+            a.EvalPoseInWorld(default).multiply(p_ap))
+        balls.append(Ball(body_a=body_a, p_ap=p_ap, body_b=body_b,
+                          p_bq=np.asarray(p_bq, float)))
+        closures.append(Closure(
+            kind=ClosureKind.CONNECT, name=name, joint1=owners.get(body_a),
+            joint2=owners.get(body_b),
+            point1=np.asarray(a.EvalPoseInWorld(context).multiply(p_ap), float),
+            point2=np.asarray(b.EvalPoseInWorld(context).multiply(p_bq), float)))
+    return Held(closures=tuple(closures), balls=tuple(balls), unheld=dropped(warnings))
+
+
+def _point(plant: MultibodyPlant, context: Context, body: str,
+           p: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A body point's world position, translational Jacobian and bias acceleration (``p``
+    in the body's frame: Any, as pydrake's stubs type a float array unlike numpy's)."""
+    frame, world = plant.GetBodyByName(body).body_frame(), plant.world_frame()
+    where = frame.CalcPoseInWorld(context).multiply(p)
+    jac = plant.CalcJacobianTranslationalVelocity(context, JacobianWrtVariable.kV, frame, p,
+                                                  world, world)
+    bias = plant.CalcBiasTranslationalAcceleration(context, JacobianWrtVariable.kV, frame,
+                                                   p.reshape(3, 1), world, world)
+    return np.asarray(where, float), np.asarray(jac, float), np.asarray(bias, float)[:, 0]
+
+
+def closed(plant: MultibodyPlant, context: Context, balls: tuple[Ball, ...], *, q: np.ndarray,
+           v: np.ndarray, tau: np.ndarray) -> ClosedReading:
+    """Drake's M and h with its balls' rows (C = p_P − p_Q, J = J_P − J_Q, J̇ v from the
+    bias accelerations) in the rigid KKT solve, state by state (its layout)."""
+    s, nv, m = len(q), plant.num_velocities(), 3 * len(balls)
+    value, force = np.zeros((s, m)), np.zeros((s, m))
+    jacobian, vdot = np.zeros((s, m, nv)), np.zeros((s, nv))
+    for i in range(s):
+        plant.SetPositions(context, q[i])
+        plant.SetVelocities(context, v[i])
+        drift = np.zeros(m)
+        for k, ball in enumerate(balls):
+            p, jp, bp = _point(plant, context, ball.body_a, ball.p_ap)
+            r, jq, bq = _point(plant, context, ball.body_b, ball.p_bq)
+            rows = slice(3 * k, 3 * k + 3)
+            value[i, rows], jacobian[i, rows], drift[rows] = p - r, jp - jq, bp - bq
+        rhs = tau[i] - plant.CalcBiasTerm(context) + plant.CalcGravityGeneralizedForces(context)
+        mass = np.asarray(plant.CalcMassMatrix(context))
+        vdot[i], force[i] = kkt_closed(mass, rhs, jacobian[i], drift)
+    return ClosedReading(value=value, jacobian=jacobian, vdot=vdot, force=force,
+                         diagonal=np.zeros((s, m)))
