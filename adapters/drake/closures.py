@@ -50,13 +50,25 @@ class Ball:
 
 
 @dataclass(frozen=True, kw_only=True)
+class Coupler:
+    """One coupler constraint as Drake's URDF parser makes a ``<mimic>`` joint:
+    q_follower = ``multiplier`` · q_leader + ``offset``."""
+
+    follower: str
+    leader: str
+    multiplier: float
+    offset: float
+
+
+@dataclass(frozen=True, kw_only=True)
 class Held:
-    """The constraints Drake holds, as neutral closures and as its balls (one each, same
-    order), and each kind it drops with its parser's words."""
+    """The constraints Drake holds, as neutral closures and as its balls and couplers (the
+    closures in that order), and each kind it drops with its parser's words."""
 
     closures: tuple[Closure, ...]
-    balls: tuple[Ball, ...]
-    unheld: tuple[tuple[str, str], ...]
+    balls: tuple[Ball, ...] = ()
+    couplers: tuple[Coupler, ...] = ()
+    unheld: tuple[tuple[str, str], ...] = ()
 
 
 def dropped(warnings: list[str]) -> tuple[tuple[str, str], ...]:
@@ -129,6 +141,27 @@ def read(root: ET.Element, *, held: int, warnings: list[str], plant: MultibodyPl
     return Held(closures=tuple(closures), balls=tuple(balls), unheld=dropped(warnings))
 
 
+def mimics(root: ET.Element, *, held: int) -> Held:
+    """Drake's coupler constraints on a URDF's ``<mimic>`` joints (``root``: the file with
+    them), its plant holding ``held`` constraints: one per mimic, as the file writes it
+    (multiplier 1 and offset 0 unless stated). Raises :class:`Unsupported` where the count
+    is not the file's."""
+    couplers = []
+    for joint in root.findall("joint"):
+        if (mimic := joint.find("mimic")) is not None:
+            couplers.append(Coupler(
+                follower=joint.get("name", ""), leader=mimic.get("joint", ""),
+                multiplier=float(mimic.get("multiplier", "1")),
+                offset=float(mimic.get("offset", "0"))))
+    if len(couplers) != held:
+        raise Unsupported(f"drake's parser holds {held} constraints where the URDF gives "
+                          f"{len(couplers)} <mimic> joints: which it holds is not known")
+    return Held(couplers=tuple(couplers), closures=tuple(
+        Closure(kind=ClosureKind.JOINT, name=f"mimic {c.follower}", first=((c.follower, 1.0),),
+                second=((c.leader, 1.0),), polycoef=(c.offset, c.multiplier))
+        for c in couplers))
+
+
 def _point(plant: MultibodyPlant, context: Context, body: str,
            p: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A body point's world position, translational Jacobian and bias acceleration (``p``
@@ -142,13 +175,33 @@ def _point(plant: MultibodyPlant, context: Context, body: str,
     return np.asarray(where, float), np.asarray(jac, float), np.asarray(bias, float)[:, 0]
 
 
-def closed(plant: MultibodyPlant, context: Context, balls: tuple[Ball, ...], *, q: np.ndarray,
+def _coupled(plant: MultibodyPlant, couplers: tuple[Coupler, ...],
+             q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The couplers' values q_f − m q_l − offset at each state (S, k) and their constant
+    rows (k, nv), in Drake's order."""
+    rows = np.zeros((len(couplers), plant.num_velocities()))
+    value = np.zeros((len(q), len(couplers)))
+    for k, c in enumerate(couplers):
+        follower, leader = plant.GetJointByName(c.follower), plant.GetJointByName(c.leader)
+        rows[k, follower.velocity_start()] += 1.0
+        rows[k, leader.velocity_start()] -= c.multiplier
+        value[:, k] = (q[:, follower.position_start()] - c.multiplier
+                       * q[:, leader.position_start()] - c.offset)
+    return value, rows
+
+
+def closed(plant: MultibodyPlant, context: Context, held: Held, *, q: np.ndarray,
            v: np.ndarray, tau: np.ndarray) -> ClosedReading:
     """Drake's M and h with its balls' rows (C = p_P − p_Q, J = J_P − J_Q, J̇ v from the
-    bias accelerations) in the rigid KKT solve, state by state (its layout)."""
-    s, nv, m = len(q), plant.num_velocities(), 3 * len(balls)
+    bias accelerations) and its couplers' (constant rows) in the rigid KKT solve, state by
+    state (its layout)."""
+    balls = held.balls
+    s, nv = len(q), plant.num_velocities()
+    m = 3 * len(balls) + len(held.couplers)
     value, force = np.zeros((s, m)), np.zeros((s, m))
     jacobian, vdot = np.zeros((s, m, nv)), np.zeros((s, nv))
+    value[:, 3 * len(balls):], coupled = _coupled(plant, held.couplers, q)
+    jacobian[:, 3 * len(balls):] = coupled
     for i in range(s):
         plant.SetPositions(context, q[i])
         plant.SetVelocities(context, v[i])

@@ -47,6 +47,7 @@ from dyncheck.adapters.drake.hints import (
     ignored_frames,
 )
 from dyncheck.adapters.drake.parsing import ENGINE, plant_of
+from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.model_tree import (
@@ -99,29 +100,33 @@ class DrakeModel(ModelEngine):
         self._actuated: Any = None  # the context of actuation (its PD controllers armed)
         self._rows: np.ndarray | None = None  # the couplings C v = 0 it holds (Drake's order)
         self._ad_actuated: Any = None  # the same for the AutoDiffXd plant
-        self._balls: tuple[drake_closures.Ball, ...] = ()
+        self._held = drake_closures.Held(closures=())
         self.tree = self._closures(self._tree(notes))
 
     def _closures(self, tree: ModelTree) -> ModelTree:
-        """Its tree with the constraints Drake's MJCF parser holds (:mod:`.closures`, read on
-        a discrete-time plant parsed with them), or the note of why none are read."""
-        root = inline(self._source.path) if self._source.format is Format.MJCF else None
-        if root is None or not any(len(block) for block in root.findall("equality")):
+        """Its tree with the constraints Drake's parsers hold (:mod:`.closures`: an MJCF's
+        read on a discrete-time plant parsed with them, a URDF's ``<mimic>`` joints), or the
+        note of why none are read."""
+        source = self._source
+        mjcf = inline(source.path) if source.format is Format.MJCF else None
+        if not (source.closed_text if mjcf is None else
+                any(len(block) for block in mjcf.findall("equality"))):
             return tree
         try:
-            discrete, said, _, _ = plant_of(self._source, kept=True)
-            held = drake_closures.read(root, held=discrete.num_constraints(), warnings=said,
-                                       plant=self.plant, context=self.context)
+            discrete, said, _, _ = plant_of(source, kept=True)
+            self._held = drake_closures.mimics(
+                parsing.root(source.closed_text), held=discrete.num_constraints()) \
+                if mjcf is None else drake_closures.read(
+                    mjcf, held=discrete.num_constraints(), warnings=said, plant=self.plant,
+                    context=self.context)
         except (Unsupported, EngineError) as exc:
             return replace(tree, notes=(*tree.notes, f"{exc}; its constraints are not read"))
-        self._balls = held.balls
-        return replace(tree, closures=held.closures, closures_read=True,
-                       closures_unheld=held.unheld)
+        return replace(tree, closures=self._held.closures, closures_read=True,
+                       closures_unheld=self._held.unheld)
 
     def closed(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> ClosedReading:
-        """Its M and h closed by its ball constraints (:func:`.closures.closed`)."""
-        return drake_closures.closed(self.plant, self.context, self._balls, q=q, v=v,
-                                     tau=tau)
+        """Its M and h closed by its constraints (:func:`.closures.closed`)."""
+        return drake_closures.closed(self.plant, self.context, self._held, q=q, v=v, tau=tau)
 
     def _tree(self, notes: tuple[str, ...]) -> ModelTree:
         plant, ctx = self.plant, self.context

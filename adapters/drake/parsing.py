@@ -70,8 +70,8 @@ def parse_xml(xml: str, time_step: float = 0.0) -> tuple[MultibodyPlant, list[st
 def plant_of(source: ModelFile, *, kept: bool = False) -> tuple[
         MultibodyPlant, list[str], tuple[str, ...], dict[str, tuple]]:
     """The finalized continuous-time plant (``kept``: the discrete-time plant, an MJCF's
-    constraints kept), its parser's warnings, the notes on the reading, and each joint's
-    damping (zeroed in the plant)."""
+    constraints and a URDF's ``<mimic>`` joints kept), its parser's warnings, the notes on
+    the reading, and each joint's damping (zeroed in the plant)."""
     plant = MultibodyPlant(TIME_STEP if kept else 0.0)
     notes: list[str] = []
     with parser_warnings() as warnings, tempfile.TemporaryDirectory() as meshes:
@@ -84,7 +84,8 @@ def plant_of(source: ModelFile, *, kept: bool = False) -> tuple[
             elif source.format is Format.MJCF:
                 Parser(plant).AddModels(str(source.path))
             else:
-                Parser(plant).AddModelsFromString(source.text, "urdf")
+                Parser(plant).AddModelsFromString(
+                    source.closed_text if kept and source.closed_text else source.text, "urdf")
         except DyncheckError:
             raise
         except Exception as exc:
