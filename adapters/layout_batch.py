@@ -56,6 +56,16 @@ def batch_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray,
     return q_e, t, tdot_v
 
 
+def back(t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """T⁻¹ x at each state (T: (n, engine nv, canonical nv)); where the engine holds
+    velocity coordinates beyond the canonical ones (Newton's loop joints, #78: constraints
+    with coordinates of their own, which T never reaches), T's left inverse T⁺, exact for
+    the x an engine gives there (zero on those coordinates)."""
+    if t.shape[-1] == t.shape[-2]:
+        return np.linalg.solve(t, x[..., None])[..., 0]
+    return (np.linalg.pinv(t) @ x[..., None])[..., 0]
+
+
 def canonical_states(canon: Canonical, tree: ModelTree, q_e: np.ndarray,
                      v_e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Engine states (n, tree.nq), (n, tree.nv) back to canonical ones: the positions by
@@ -65,7 +75,7 @@ def canonical_states(canon: Canonical, tree: ModelTree, q_e: np.ndarray,
     if not len(q_c):
         return q_c, np.zeros((0, canon.nv))
     _, t, _ = batch_map(canon, tree, q_c, np.zeros((len(q_c), canon.nv)))
-    return q_c, np.linalg.solve(t, np.asarray(v_e, float)[..., None])[..., 0]
+    return q_c, back(t, np.asarray(v_e, float))
 
 
 def rpy_batch(rot: np.ndarray) -> np.ndarray:
@@ -147,7 +157,7 @@ def to_canonical(maps: list[StateMap], dyn: Dynamics) -> Dynamics:
     return Dynamics(
         mass_matrix=t_t @ m_e @ t,
         bias=(t_t @ (dyn.bias + (m_e @ tdot_v[..., None])[..., 0])[..., None])[..., 0],
-        forward=np.linalg.solve(t, (dyn.forward - tdot_v)[..., None])[..., 0],
+        forward=back(t, dyn.forward - tdot_v),
         inverse=(t_t @ np.asarray(dyn.inverse)[..., None])[..., 0],
         kinetic=dyn.kinetic, potential=dyn.potential, unavailable=dyn.unavailable,
     )

@@ -20,6 +20,7 @@ v = (velocity of the child's centre of mass, angular velocity), both in the pare
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
@@ -27,6 +28,7 @@ import numpy as np
 
 from dyncheck.adapters.actuators import Actuation
 from dyncheck.adapters.base import Field, ModelEngine, Offer
+from dyncheck.adapters.closures import ClosureKind
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
@@ -41,6 +43,7 @@ from dyncheck.adapters.model_tree import (
     lump,
 )
 from dyncheck.adapters.newton import actuators as newton_actuators
+from dyncheck.adapters.newton import closures as newton_closures
 from dyncheck.adapters.newton.counterfactual import proved
 from dyncheck.adapters.newton.d6 import D6_ORDER, d6_chain, written_order
 from dyncheck.adapters.proof import Proof
@@ -141,6 +144,7 @@ class NewtonModel(ModelEngine):
                                   f"({self._name(j)!r}) is not checked")
         self.kinds, self.fixed = kinds, fixed
         self.q_start, self.v_start = m.joint_q_start.numpy(), m.joint_qd_start.numpy()
+        self.loops = newton_closures.loops(m)  # (#78: constraints, not joints of the tree)
         self.state = m.state()
         notes: tuple[str, ...] = (
             f"newton: {newton.__version__} on Warp's {DEVICE} device, float32",)
@@ -184,7 +188,7 @@ class NewtonModel(ModelEngine):
         mass, com, inertia = m.body_mass.numpy(), m.body_com.numpy(), m.body_inertia.numpy()
         armature, damping = m.joint_armature.numpy(), m.joint_damping.numpy()
         lower, upper = m.joint_limit_lower.numpy(), m.joint_limit_upper.numpy()
-        joint_of = {int(c): j for j, c in enumerate(child)}
+        joint_of = {int(c): j for j, c in enumerate(child) if j not in self.loops}
 
         def mover(body: int) -> int | None:
             """The joint that moves ``body`` (through fixed joints), None: the world."""
@@ -209,7 +213,7 @@ class NewtonModel(ModelEngine):
         last = {j: chain[-1][0] for j, chain in fused.items()}
         for j, t in enumerate(self.types):
             kind = self.kinds.get(int(t))
-            if kind is None and j not in fused:
+            if (kind is None and j not in fused) or j in self.loops:
                 continue
             parts = carried.get(j, [])
             total, centre, tensor = lump(
@@ -253,7 +257,20 @@ class NewtonModel(ModelEngine):
                 range=(float(lower[vs]), float(upper[vs])) if limited else None,
                 layout=layout,
             ))
-        return self._finished(joints, notes, carried=carried, fused=fused)
+        return self._closed(self._finished(joints, notes, carried=carried, fused=fused),
+                            bodies=bodies, mover=mover)
+
+    def _closed(self, tree: ModelTree, *, bodies: np.ndarray,
+                mover: Callable[[int], int | None]) -> ModelTree:
+        """``tree`` with Newton's constraints (:mod:`.closures`: its loop joints at the body
+        poses ``bodies``, each on the tree joint ``mover`` names for its body)."""
+        closures = newton_closures.read(
+            self.model, self.loops,
+            kinds={int(self.newton.JointType.BALL): ClosureKind.CONNECT,
+                   self.fixed: ClosureKind.WELD},
+            bodies=bodies, pose=_pose, name=self._name,
+            mover=lambda b: None if (j := mover(b)) is None else self._name(j))
+        return replace(tree, closures=closures, closures_read=True)
 
     def _finished(self, joints: list[TreeJoint], notes: tuple[str, ...], *,
                   carried: dict[int, list[int]],
@@ -354,7 +371,23 @@ class NewtonModel(ModelEngine):
             centres = np.einsum("bij,bj->bi", bodies[:, :3, :3], self._coms) + bodies[:, :3, 3]
             potential[i] = -float(self._masses @ (centres @ gravity))
         return Dynamics.at(v, mass_matrix=mass, bias=bias, inverse=inverse,
-                           potential=potential)
+                           potential=potential, forward=self._solved(mass, -bias))
+
+    def _solved(self, mass: np.ndarray, force: np.ndarray) -> np.ndarray:
+        """M⁻¹ f on the degrees of freedom its articulations move; a loop joint's own (#78:
+        a constraint, which no articulation moves, its block of M zero) keep v̇ = 0."""
+        if not self.loops:
+            return np.linalg.solve(mass, force[..., None])[..., 0]
+        moved = np.concatenate(self._articulation_dofs())
+        out = np.zeros_like(force, dtype=float)
+        out[:, moved] = np.linalg.solve(mass[:, moved[:, None], moved[None, :]],
+                                        force[:, moved, None])[..., 0]
+        return out
+
+    def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """v̇ at τ: M⁻¹ (τ − h) (:meth:`_solved`)."""
+        d = self.dynamics(q, v, np.zeros_like(v))
+        return self._solved(d.mass_matrix, tau - d.bias)
 
     def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
                  integrator: str, field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:

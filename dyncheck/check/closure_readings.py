@@ -13,7 +13,8 @@ from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.vocabulary import Verdict
 
-BASIS = "64 eps x reach (anchors), 64 eps (rotations, coefficients)"
+BASIS = ("64 eps x reach (anchors), 64 eps (rotations, coefficients); eps the coarser "
+         "arithmetic's")
 
 
 def _ends(c: Closure) -> frozenset[str | None]:
@@ -58,7 +59,7 @@ def rows(model: str, canonical: ModelTree, tree: ModelTree, *, reach: float) -> 
     if tree.engine == canonical.engine:
         return []
     theirs = list(tree.closures)
-    tolerance = ROUNDOFF_FACTOR * EPS
+    tolerance = ROUNDOFF_FACTOR * max(EPS, tree.eps)  # (Newton holds its frames in float32)
     out = []
 
     def row(c: Closure, verdict: Verdict, note: str, *, error: float = 0.0,

@@ -80,10 +80,10 @@ def in_canonical(canon: Canonical, engine: ModelEngine, states: closures.ClosedS
                                                    np.zeros_like(states.v))
     t = np.array([m.t for m in maps])
     tdot_v = np.array([m.tdot_v for m in maps])
-    tau_e = np.linalg.solve(np.swapaxes(t, 1, 2), tau[..., None])[..., 0]  # τ·v invariant
+    tau_e = layout_batch.back(np.swapaxes(t, 1, 2), tau)  # τ·v invariant
     found = engine.closed(q_e, v_e, tau_e)
     return tree, replace(found, jacobian=found.jacobian @ t,
-                         vdot=np.linalg.solve(t, (found.vdot - tdot_v)[..., None])[..., 0])
+                         vdot=layout_batch.back(t, found.vdot - tdot_v))
 
 
 def rows(model: str, canonical_tree: ModelTree, loaded: dict[str, ModelEngine],

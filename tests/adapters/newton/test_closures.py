@@ -1,0 +1,60 @@
+"""Newton's constraints (adapters/newton/closures.py, #78): Newton 1.8's MJCF importer makes a
+``<connect>`` a BALL loop joint, a ``<weld>`` a FIXED loop joint and a ``<joint>`` equality a
+mimic constraint keeping two polynomial terms. Expected values: the files' own numbers and
+MuJoCo's reading of them (float64; Newton holds its frames in float32), and the referee on
+the open tree for the dynamics around the loop."""
+
+from __future__ import annotations
+
+import pytest
+
+pytest.importorskip("newton", reason="needs the 'newton' extra")
+from dyncheck.adapters.formats.files import read
+from dyncheck.adapters.newton.model import NewtonModel
+from dyncheck.check import closure_readings
+from dyncheck.check.model_check import check_model
+from tests.check.test_closures import MODELS
+from tests.conftest import loader
+
+pytestmark = pytest.mark.slow  # (Newton compiles its kernels per model: seconds each)
+
+
+def _both(tmp_path, name: str):
+    path = tmp_path / f"{name}.xml"
+    path.write_text(MODELS[name])
+    return NewtonModel(read(path)), loader("mujoco")(read(path)), path
+
+
+@pytest.mark.parametrize("name", ["four_bar", "ball_loop", "weld"])
+def test_a_loop_joint_is_a_closure_not_a_joint_of_the_tree(name, tmp_path):
+    """Newton's tree holds the file's joints and bodies (a loop joint lumped in made the
+    rocker massless and added a joint of its own), and its closure is MuJoCo's to float32:
+    the same kind between the same joints, its anchors and held rotation within 64 ε₃₂."""
+    newton, mujoco, _ = _both(tmp_path, name)
+    assert [j.name for j in newton.tree.joints] == [j.name for j in mujoco.tree.joints]
+    for mine, theirs in zip(newton.tree.joints, mujoco.tree.joints, strict=True):
+        assert mine.mass == pytest.approx(theirs.mass, rel=1e-6)
+    rows = closure_readings.rows(name, mujoco.tree, newton.tree, reach=1.0)
+    assert [r.verdict for r in rows] == ["passed"] * len(mujoco.tree.closures)
+
+
+def test_around_a_loop_newtons_open_dynamics_are_the_referees(tmp_path):
+    """The four-bar's tree with the loop joint's own coordinates beside it: Newton's M, h,
+    forward and inverse dynamics against the referee's on its reading, within float32."""
+    _, _, path = _both(tmp_path, "four_bar")
+    result = check_model(path, impls=("reference", "mujoco", "newton"), states=8,
+                         actuators=False, isolate=False)
+    mine = result.rows[(result.rows["impl_b"] == "newton") & (result.rows["section"]
+                                                                 == "dynamics")]
+    assert len(mine) and set(mine["verdict"]) == {"passed"}, mine[["subject", "note"]]
+
+
+def test_a_joint_polynomial_keeps_two_terms_in_newton(tmp_path):
+    """The fingers' polycoef "0 1.5 -0.4": Newton's mimic holds 0 + 1.5 q (its importer
+    warns it keeps coef0 and coef1), so its reading differs from MuJoCo's by the dropped
+    -0.4."""
+    newton, mujoco, _ = _both(tmp_path, "fingers")
+    [closure] = newton.tree.closures
+    assert closure.polycoef == (0.0, 1.5)
+    [row] = closure_readings.rows("fingers", mujoco.tree, newton.tree, reach=1.0)
+    assert row.verdict == "failed" and row.error == pytest.approx(0.4)
