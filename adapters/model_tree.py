@@ -294,7 +294,8 @@ class ModelTree:
     without them)."""
     closures_unheld: tuple[tuple[str, str], ...] = ()
     """Each kind of constraint (:class:`~dyncheck.adapters.closures.ClosureKind`'s value) its
-    parser drops, with its own words (a warning) where it says so."""
+    loader drops, with how that is known: its own words (a parser's warning, quoted) or the
+    measurement."""
     exact_meshes: ModelTree | None = None
     """The engine's reading with every mesh's volume and inertia computed exactly (MuJoCo:
     ``inertia="exact"`` instead of its default ``"legacy"``, which overcounts a non-convex

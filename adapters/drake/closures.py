@@ -72,14 +72,15 @@ class Held:
 
 
 def dropped(warnings: list[str]) -> tuple[tuple[str, str], ...]:
-    """Each ``<equality>`` kind the parser's warnings say it ignores, with the warning."""
+    """Each ``<equality>`` kind the parser's warnings say it ignores, with the warning
+    quoted."""
     out: dict[str, str] = {}
     for said in warnings:
         text = " ".join(said.split())
         if (found := _IGNORED.search(text)) is not None:
-            out.setdefault(found.group(1), text)
+            out.setdefault(found.group(1), f"its parser: '{text}'")
         elif _BY_SITES in text:
-            out.setdefault(ClosureKind.CONNECT.value, text)
+            out.setdefault(ClosureKind.CONNECT.value, f"its parser: '{text}'")
     return tuple(out.items())
 
 

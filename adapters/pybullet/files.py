@@ -7,7 +7,7 @@ from __future__ import annotations
 import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -176,6 +176,33 @@ def load(client: int, source: ModelFile) -> list[int]:
     if not bodies:
         raise EngineError(f"pybullet refused {source.path}: no body loaded")
     return bodies
+
+
+def unheld(client: int, source: ModelFile) -> tuple[tuple[str, str], ...] | None:
+    """Each kind of the file's constraints PyBullet's loader drops, in words that say how it
+    was measured (#78: ``getNumConstraints()`` after loading the file with them — an MJCF's
+    ``<equality>``, a URDF's ``<mimic>`` joints, read by a client of their own); None where
+    the file states none, or where PyBullet holds some (which ones, it does not say)."""
+    if source.format is Format.MJCF:
+        kinds = [item.tag for block in inline(source.path).findall("equality")
+                 for item in block]
+        held = pb.getNumConstraints(physicsClientId=client) if kinds else 0
+        how = "loadMJCF"
+    else:
+        kinds = ["joint"] if source.closed_text else []
+        if not kinds:
+            return None
+        other = pb.connect(pb.DIRECT)
+        try:
+            load(other, replace(source, text=source.closed_text))
+            held = pb.getNumConstraints(physicsClientId=other)
+        finally:
+            pb.disconnect(physicsClientId=other)
+        how = "loadURDF of the file with its <mimic> joints"
+    if not kinds or held:
+        return None
+    return tuple((kind, f"measured: getNumConstraints() = 0 after {how}, its loader makes "
+                        "none of the file's constraints") for kind in dict.fromkeys(kinds))
 
 
 def zeroed(source: ModelFile, links: list[Link]) -> tuple[Hint, ...]:

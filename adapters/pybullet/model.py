@@ -74,6 +74,7 @@ from dyncheck.adapters.pybullet.files import (
     mjcf_hints,
     pose,
     rotation_of,
+    unheld,
     zeroed,
 )
 from dyncheck.adapters.pybullet.forces import apply_field, field_force, named_links
@@ -137,6 +138,8 @@ class PybulletModel(PybulletState, ModelEngine):
         if source.format is Format.URDF:
             hints += (("model", "inertia accuracy", ACCURACY_HINT),)
         self.tree = replace(self._tree(links, notes, hints), wants_compiled=wants)
+        if (dropped := unheld(self.client, source)) is not None:  # (#78: measured)
+            self.tree = replace(self.tree, closures_read=True, closures_unheld=dropped)
         if fixes:  # (#77: the fix of a bare link measured on a copy; the stated gravity set)
             self.tree = replace(self.tree, fixed=inertial_fixed(
                 source, bare, self._copy_tree) + gravity_fixed(

@@ -73,7 +73,7 @@ def rows(model: str, canonical: ModelTree, tree: ModelTree, *, reach: float) -> 
     for c in canonical.closures:
         match = next((t for t in theirs if t.kind == c.kind and _ends(t) == _ends(c)), None)
         if match is None:
-            why = f" (its parser: '{said[c.kind]}')" if c.kind in said else ""
+            why = f" ({said[c.kind]})" if c.kind in said else ""
             out.append(row(c, Verdict.FAILED, f"{tree.engine} holds no {_where(c)} (the "
                            f"file's {c.name!r}){why}: its dynamics leave that constraint out",
                            error=float("inf")))

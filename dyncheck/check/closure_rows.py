@@ -114,6 +114,8 @@ def rows(model: str, canonical_tree: ModelTree, loaded: dict[str, ModelEngine],
                             verdict=Verdict.SKIPPED, note=_unread(name, engine.tree)))
             continue
         out += closure_readings.rows(model, canonical_tree, engine.tree, reach=size)
+        if not engine.tree.closures:
+            continue  # (its reading rows say it holds none: nothing to compute with)
         if Offer.CLOSURES not in engine.offers:
             out.append(_row(model, subject="model", field="closed dynamics", engine=name,
                             verdict=Verdict.SKIPPED,
@@ -132,8 +134,6 @@ def _engine_rows(model: str, name: str, engine: ModelEngine, states: closures.Cl
         return [_row(model, subject="model", field="closed dynamics", engine=name,
                      verdict=Verdict.SKIPPED, note=f"{name} holds part of the model (its "
                      "reading rows): its closed dynamics are compared only on the whole")]
-    if not engine.tree.closures:
-        return []  # (its reading rows say it holds none)
     tau = np.zeros_like(states.v)
     try:
         tree, reading = in_canonical(layout.canonical(canonical_tree), engine, states, tau)

@@ -87,11 +87,22 @@ def test_an_engine_off_its_soft_model_differs_on_its_line(engine, four_bar, monk
 
 @pytest.mark.parametrize("engine", NOT_CLOSING)
 def test_an_engine_without_constrained_dynamics_has_one_skipped_row(engine, four_bar):
+    """An engine holding the connect without constrained dynamics dyncheck drives: one
+    skipped row; one holding none: no row in the section, and its reading row fails naming
+    the connect and how its absence is known."""
     result = check_model(four_bar, impls=(*CLOSING[:1], engine, "reference"), states=STATES,
                          isolate=False)
     rows = _section(result, engine)
-    assert rows["verdict"].tolist() == ["skipped"]
-    assert "not compared" in rows["note"].iloc[0]
+    if loader(engine)(read(four_bar)).tree.closures:
+        assert rows["verdict"].tolist() == ["skipped"]
+        assert "not compared" in rows["note"].iloc[0]
+        return
+    assert rows.empty
+    reading = result.rows[(result.rows["impl_b"] == engine)
+                          & (result.rows["field"] == "closure")]
+    assert reading["verdict"].tolist() == ["failed"]
+    assert "holds no connect" in reading["note"].iloc[0]
+    assert "measured: " in reading["note"].iloc[0] or "its parser: " in reading["note"].iloc[0]
 
 
 def test_a_model_without_constraints_has_no_closures_section(tmp_path):
