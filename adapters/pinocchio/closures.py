@@ -16,6 +16,9 @@ import numpy as np
 import pinocchio as pin
 
 from dyncheck.adapters.closures import ClosedReading, Closure, ClosureKind
+from dyncheck.adapters.formats.files import ModelFile
+from dyncheck.adapters.formats.includes import inline
+from dyncheck.adapters.registration import Format
 from dyncheck.errors import Unsupported
 
 ACCURACY = 1e-13
@@ -42,6 +45,20 @@ def load(path: Path, model: pin.Model) -> list:
     if again.njoints != model.njoints or list(again.names) != list(model.names):
         return []
     return held
+
+
+def unheld(source: ModelFile, held: list) -> tuple[tuple[str, str], ...]:
+    """Each kind of the MJCF's ``<equality>`` its parser returns no constraint model for,
+    measured: where it returns one per ``<connect>`` and ``<weld>``, every other kind."""
+    if source.format is not Format.MJCF or "<equality" not in source.text:
+        return ()
+    kinds = [item.tag for block in inline(source.path).findall("equality") for item in block]
+    if len(held) != sum(kind in ("connect", "weld") for kind in kinds):
+        return ()
+    return tuple((kind, f"measured: its MJCF parser returns {len(held)} constraint models "
+                        "(buildModelAndLegacyConstraintsFromMJCF), one per <connect> and "
+                        f"<weld>, none for a <{kind}>")
+                 for kind in dict.fromkeys(kinds) if kind not in ("connect", "weld"))
 
 
 def read(held: list, d: pin.Data, names: dict[int, str]) -> tuple[Closure, ...]:

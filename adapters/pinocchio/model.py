@@ -209,7 +209,7 @@ class PinocchioModel(ModelEngine):
     def __init__(self, source: ModelFile, *, gravity: np.ndarray | None = None,
                  inertias: Mapping[str, np.ndarray] | None = None,
                  fixes: bool = True) -> None:
-        self.model = _load(source)
+        self.model, self._source = _load(source), source
         self._closures_read = True
         self._mimics, unread = self._mimic_joints(source)
         try:
@@ -339,7 +339,7 @@ class PinocchioModel(ModelEngine):
             nq=m.nq, nv=m.nv, notes=notes, hints=self._hints,
             closures=closures.read(self._held, d, {i: n for i, n in last_name.items() if n})
             + mimic.read(self._mimics), closures_read=self._closures_read,
-        )
+            closures_unheld=closures.unheld(self._source, self._held))
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
         m, d = self.model, self.data

@@ -147,6 +147,8 @@ def test_an_engine_on_its_closures_is_the_referee(engine, name, tmp_path):
         found = closure_readings.rows(name, canonical.tree, model.tree, reach=1.0)
         assert {r.subject for r in found if r.verdict == "failed"} == \
             {c.name for c in canonical.tree.closures}
+        assert all("(measured: " in r.note or "(its parser: '" in r.note for r in found), \
+            "a dropped constraint's row says how its absence is known"
         return
     states, found = _measured(model, canonical)
     assert len(states.q) == states.drawn
