@@ -1666,11 +1666,11 @@ ROUND3 = (  # #59 and #60: readings measured, refusals named, folders held
     chk("MJCF armature with a <general> actuator (Drake reads none)", "a.xml",
         _mjcf(ja=' armature="0.2"', tail='<actuator><general joint="j" gear="2"/></actuator>'),
         exit=1, answer=FINDS),
-    chk("MJCF <connect> to the world (removed for Drake, refused by Pinocchio's parser, "
-        "said; MuJoCo's closed dynamics checked)", "a.xml",
+    chk("MJCF <connect> to the world (refused by Drake's and Pinocchio's parsers, said; "
+        "MuJoCo's closed dynamics checked)", "a.xml",
         _mjcf(tail='<equality><connect body1="b" body2="world" anchor="0 0 -0.2"/>'
               "</equality>"), exit=0, answer=AGREE_BUT_SKIPPED),
-    chk("MJCF <joint> equality (removed for Drake; Pinocchio's parser holds none: found)",
+    chk("MJCF <joint> equality (Drake's and Pinocchio's parsers hold none: found)",
         "a.xml", _mjcf(tail='<equality><joint joint1="j" joint2="k"/></equality>'), exit=1,
         answer=FINDS),
     chk("MJCF model 10^6 m from the origin", "a.xml",
