@@ -452,6 +452,10 @@ class ModelEngine(ABC):
         """Its own rows and forward dynamics on its tree's closures (:attr:`Offer.CLOSURES`)."""
         raise Unsupported(f"{self.engine} offers no dynamics with the file's constraints")
 
+    def closed_derivatives(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """∂v̇/∂(q, v) of its constrained dynamics (:attr:`Offer.CLOSED_DERIVATIVES`)."""
+        raise Unsupported(f"{self.engine} offers no derivatives with the file's constraints")
+
     def request(self, kind: str, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Answer:
         """One request of ``kind`` (``dynamics``, ``derivatives``, ``transition``,
         ``actuation`` or ``input_jacobians``, whose ``a`` is the controls, or ``closed``,
@@ -460,7 +464,8 @@ class ModelEngine(ABC):
         method = {"dynamics": self.dynamics, "derivatives": self.derivatives,
                   "transition": self.transition, "actuation": self.actuation,
                   "input_jacobians": self.input_jacobians,
-                  "control_derivatives": self.control_derivatives, "closed": self.closed}[kind]
+                  "control_derivatives": self.control_derivatives, "closed": self.closed,
+                  "closed_derivatives": self.closed_derivatives}[kind]
         t0 = time.perf_counter()
         try:
             return method(q, v, a), time.perf_counter() - t0

@@ -45,6 +45,9 @@ class Offer(StrEnum):
     CLOSURES = "closed"
     """``closed(q, v, τ)``: its own rows and constrained forward dynamics on the constraints
     its tree's ``closures`` hold (:class:`~.closures.ClosedReading`)."""
+    CLOSED_DERIVATIVES = "closed_derivatives"
+    """``closed_derivatives(q, v, τ)``: ∂v̇/∂(q, v) of its constrained forward dynamics, its
+    own (finite differences at its step and twice it: (S, 2, nv, 2 nv))."""
     BODY_FORCES = "body_forces"
     """``body_forces(q, v, field)``: the generalized force of forces at bodies' centres of
     mass (a :data:`Field`), its own (its Jacobians or its solver's sum); and

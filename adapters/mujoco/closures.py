@@ -139,13 +139,44 @@ def read(m: mujoco.MjModel, d: mujoco.MjData,
     return tuple(out), tuple(notes)
 
 
-def closed(m: mujoco.MjModel, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> ClosedReading:
-    """MuJoCo's answer with its equalities alone on (a copy of ``m``: contacts, limits and
-    friction loss off; dense Jacobians), one ``mj_forward`` per state, ``qfrc_applied`` τ."""
+def _equalities_on(m: mujoco.MjModel) -> mujoco.MjModel:
+    """A copy of ``m`` with its equalities alone on (contacts, limits and friction loss off;
+    dense Jacobians)."""
     on = copy.copy(m)
     on.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
     on.opt.disableflags |= int(_OFF_BUT_EQUALITIES)
     on.opt.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
+    return on
+
+
+def closed_derivatives(m: mujoco.MjModel, q: np.ndarray, v: np.ndarray, tau: np.ndarray, *,
+                       step: float) -> np.ndarray:
+    """∂v̇/∂(q, v) of its dynamics with its equalities alone on (S, 2, nv, 2 nv: at
+    ``step`` and twice it), from ``mjd_transitionFD``'s centered differences of one
+    semi-implicit Euler step (its chart for q): v₊ = v + h v̇, so ∂v̇/∂x = (∂v₊/∂x − [0 I])/h
+    (the smooth model's: no damping, whose implicit term would enter the step)."""
+    on = _equalities_on(m)
+    on.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    d = mujoco.MjData(on)
+    nv, h = on.nv, float(on.opt.timestep)
+    size = 2 * nv + on.na
+    matrix = np.zeros((size, size))
+    carried = np.hstack([np.zeros((nv, nv)), np.eye(nv)])
+    out = np.zeros((len(q), 2, nv, 2 * nv))
+    for k in range(len(q)):
+        for j, fd in enumerate((step, 2 * step)):
+            d.qpos[:], d.qvel[:], d.qfrc_applied[:] = q[k], v[k], tau[k]
+            d.ctrl[:] = 0.0
+            mujoco.mj_forward(on, d)
+            mujoco.mjd_transitionFD(on, d, fd, True, matrix, None, None, None)
+            out[k, j] = (matrix[nv : 2 * nv, : 2 * nv] - carried) / h
+    return out
+
+
+def closed(m: mujoco.MjModel, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> ClosedReading:
+    """MuJoCo's answer with its equalities alone on (a copy of ``m``: contacts, limits and
+    friction loss off; dense Jacobians), one ``mj_forward`` per state, ``qfrc_applied`` τ."""
+    on = _equalities_on(m)
     d = mujoco.MjData(on)
     rows = sum(6 if t == mujoco.mjtEq.mjEQ_WELD else 3 if t == mujoco.mjtEq.mjEQ_CONNECT else 1
                for t, active in zip(on.eq_type, on.eq_active0, strict=True) if active)

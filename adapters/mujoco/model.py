@@ -206,7 +206,7 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
     fd_step = FD_STEP
     offers = frozenset({Offer.DERIVATIVES, Offer.TRANSITION, Offer.ACTUATION,
                         Offer.INPUT_JACOBIAN, Offer.FORWARD, Offer.STEPPING, Offer.COUPLINGS,
-                        Offer.BODY_FORCES, Offer.CLOSURES})
+                        Offer.BODY_FORCES, Offer.CLOSURES, Offer.CLOSED_DERIVATIVES})
     gyroscopic_implicit = GYROSCOPIC_IMPLICIT
     rk4_group_order = 4 if RK4_ON_GROUP else 2
     couplings_with_field = True  # tendon equalities and a field in one model
@@ -339,6 +339,10 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
         """Its equalities' rows and its forward dynamics with them on (:func:`.closures.
         closed`)."""
         return closures.closed(self._closed, q, v, tau)
+
+    def closed_derivatives(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """:func:`.closures.closed_derivatives` at :data:`FD_STEP` and twice it."""
+        return closures.closed_derivatives(self._closed, q, v, tau, step=FD_STEP)
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
         e = evaluate(self.model, self.data, q=q, v=v, tau=np.zeros_like(v), a=a)

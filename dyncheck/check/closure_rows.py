@@ -16,7 +16,7 @@ from dyncheck.adapters.closures import ClosedReading
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.adapters.offers import Offer
-from dyncheck.check import closure_readings, closures
+from dyncheck.check import closure_derivatives, closure_readings, closures
 from dyncheck.check.computed import canonical_reading
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.check.states import States
@@ -87,8 +87,10 @@ def in_canonical(canon: Canonical, engine: ModelEngine, states: closures.ClosedS
 
 
 def rows(model: str, canonical_tree: ModelTree, loaded: dict[str, ModelEngine],
-         batch: States) -> list[CheckRow]:
-    """The section's rows (none where the canonical engine reads no closure)."""
+         batch: States, *, derivatives: bool = False) -> list[CheckRow]:
+    """The section's rows (none where the canonical engine reads no closure); with
+    ``derivatives`` (``check --derivatives``), those of the closed dynamics where an engine
+    offers them (:mod:`.closure_derivatives`)."""
     if not canonical_tree.closures:
         return []
     size = reach(canonical_tree)
@@ -122,12 +124,13 @@ def rows(model: str, canonical_tree: ModelTree, loaded: dict[str, ModelEngine],
                             note=_without(name)))
             continue
         out += _engine_rows(model, name, engine, states, size=size,
-                            canonical_tree=canonical_tree)
+                            canonical_tree=canonical_tree, derivatives=derivatives)
     return out
 
 
 def _engine_rows(model: str, name: str, engine: ModelEngine, states: closures.ClosedStates,
-                 *, size: float, canonical_tree: ModelTree) -> list[CheckRow]:
+                 *, size: float, canonical_tree: ModelTree,
+                 derivatives: bool) -> list[CheckRow]:
     """One engine's rows: its constraint rows, its soft model where it holds one, the rigid
     answer — each judged on its own reading of the closures."""
     if {j.name for j in engine.tree.joints} != {j.name for j in canonical_tree.joints}:
@@ -141,6 +144,12 @@ def _engine_rows(model: str, name: str, engine: ModelEngine, states: closures.Cl
         return [_row(model, subject="model", field="closed dynamics", engine=name,
                      verdict=Verdict.FAILED, note=f"{name} failed: {exc}")]
     found = closures.measure(tree, reading, states, tau=tau, reach=size)
+    if derivatives and Offer.CLOSED_DERIVATIVES in engine.offers:
+        derived = closure_derivatives.rows(model, name, engine, states, tree=tree,
+                                           reading=reading,
+                                           canon=layout.canonical(canonical_tree))
+    else:
+        derived = []
     shape = max(found.residual / size, found.jacobian, found.row_space)
     out = [_row(model, subject="model", field="constraint rows", engine=name,
                 verdict=Verdict.PASSED if shape <= found.rows_bound else Verdict.FAILED,
@@ -168,4 +177,4 @@ def _engine_rows(model: str, name: str, engine: ModelEngine, states: closures.Cl
                     verdict=rigid, error=found.rigid, tolerance=found.bound,
                     basis=SOFT_BASIS, note=why[rigid],
                     convention=SOFT_CONSTRAINT if rigid is Verdict.EXPLAINED else ""))
-    return out
+    return out + derived

@@ -365,6 +365,11 @@ class Isolated(ModelEngine):
         offers none)."""
         return self._ask("closed", q, v, tau)
 
+    def closed_derivatives(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """The engine's ∂v̇/∂(q, v) on its closures (:class:`Unsupported` where it offers
+        none)."""
+        return self._ask("closed_derivatives", q, v, tau)
+
     def collect(self) -> tuple[Any, float]:
         """The submitted batch's answer (dynamics or derivatives) and the seconds the engine
         spent on it."""

@@ -68,7 +68,9 @@ DERIVATIVES_NOTE = (
     "the chain rule; the referee's are those of its recursive Newton-Euler algorithm (tied to "
     "the book's general method: the 'referee' row), differentiated by a complex step, exact "
     "to round-off (dyncheck/check/derivatives.py); the step Jacobians at the states their "
-    "rows name"
+    "rows name; with the file's constraints, an engine's own d(forward)/d(q, v) against "
+    "central differences of the referee's constrained method (dyncheck/check/"
+    "closure_derivatives.py)"
 )
 SMOOTH_NOTE = (
     "smooth dynamics only: contacts, joint limits, equality constraints, actuators and passive "
@@ -195,7 +197,8 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     seconds = {k: seconds[k] for k in ("load", REFEREE, *loaded) if k in seconds}
     rows.extend(_pairs(model, canon, canonical_tree, batch, loaded, parts, results, differing,
                        own))
-    rows.extend(closure_rows.rows(model, canonical_tree, loaded, batch))
+    rows.extend(closure_rows.rows(model, canonical_tree, loaded, batch,
+                                  derivatives=derivatives))
     name = next(iter(loaded))  # (the canonical engine's)
     rows.extend(with_fix.rows(
         model, source, canon=canon, canonical_tree=canonical_tree, batch=batch,

@@ -1,0 +1,121 @@
+"""The derivatives of a closed tree's forward dynamics (#78): an engine's own ∂v̇/∂(q, v) with
+its constraints on (MuJoCo: ``mjd_transitionFD`` of its constrained step) against central
+differences of the referee's constrained method on the engine's reading of them — the soft
+model with the engine's parameters where it holds them softly, the rigid answer where it holds
+them rigidly (:func:`.closures.referee`; Lagrange (2.2.23)–(2.2.26) closed by J v̇ = −J̇ v) —
+at the first :data:`STATES` states on the constraints.
+
+Compared on hinges and slides, whose coordinates add (a rotation's chart is not compared here
+yet: one skipped row says so). The tolerance is measured, not chosen: each side's
+finite-difference error is the gap between its differences at its step and at twice it
+(central differences: three times the finer one's truncation, and its round-off's order),
+plus 64 ε; the error is relative to the largest derivative of each block (∂/∂q, ∂/∂v), at
+least 1 (s⁻², s⁻¹).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dyncheck.adapters import layout_batch
+from dyncheck.adapters.base import ModelEngine
+from dyncheck.adapters.closures import ClosedReading
+from dyncheck.adapters.layout import Canonical
+from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.check import closures
+from dyncheck.check.rows import CheckRow, Section
+from dyncheck.errors import EngineError, Unsupported
+from dyncheck.precision import EPS, ROUNDOFF_FACTOR
+from dyncheck.roster import REFEREE
+from dyncheck.vocabulary import Verdict
+
+STATES = 8
+"""States whose derivatives are compared (each costs the referee 8 nv solves)."""
+STEP = 1e-8
+"""The referee's central-difference step (ε^⅓ order: truncation and round-off balanced)."""
+BASIS = "each side's finite differences at its step against twice it, + 64 eps"
+SUBJECT = "derivatives"
+
+
+def _row(model: str, engine: str, *, verdict: Verdict, note: str, error: float = 0.0,
+         tolerance: float = 0.0) -> CheckRow:
+    return CheckRow(model=model, section=Section.CLOSURES, subject=SUBJECT,
+                    field="max rel error", impl_a=REFEREE, impl_b=engine, value_a="",
+                    value_b="", error=error, tolerance=tolerance,
+                    basis=BASIS if tolerance else "", verdict=verdict, note=note)
+
+
+def _referee(tree: ModelTree, q: np.ndarray, v: np.ndarray,
+             diagonal: np.ndarray) -> np.ndarray:
+    """Central differences of the referee's v̇ (S, 2, nv, 2 nv: at :data:`STEP` and twice
+    it), every perturbed state in one call."""
+    s, nv = v.shape
+    cols = np.eye(2 * nv)
+    shift = np.array([[sign * step * cols for sign in (1.0, -1.0)]
+                      for step in (STEP, 2 * STEP)])  # (2 steps, 2 signs, 2nv, 2nv)
+    at = {j.layout.v_start: j.layout.q_start for j in tree.joints}
+    dq = np.zeros((*shift.shape[:3], tree.nq))
+    for vi, qi in at.items():
+        dq[..., qi] = shift[..., vi]
+    qs = (q[:, None, None, None, :] + dq[None]).reshape(-1, tree.nq)
+    vs = (v[:, None, None, None, :] + shift[None, ..., nv:]).reshape(-1, nv)
+    found = closures.referee(tree, qs, vs, tau=np.zeros_like(vs),
+                             diagonal=np.repeat(diagonal, 4 * 2 * nv, axis=0)).soft
+    found = found.reshape(s, 2, 2, 2 * nv, nv)
+    steps = np.array([STEP, 2 * STEP])[None, :, None, None]
+    return np.swapaxes((found[:, :, 0] - found[:, :, 1]) / (2 * steps), 2, 3)
+
+
+def _gaps(mine: np.ndarray, ref: np.ndarray, nv: int) -> tuple[float, float]:
+    """The error and its tolerance, each block relative to its scale."""
+    error = tolerance = 0.0
+    for block in (slice(0, nv), slice(nv, 2 * nv)):
+        scale = max(float(np.abs(ref[:, 0, :, block]).max(initial=0.0)), 1.0)
+        gap = float(np.abs(mine[:, 0, :, block] - ref[:, 0, :, block]).max(initial=0.0))
+        spread = float(np.abs(mine[:, 0, :, block] - mine[:, 1, :, block]).max(initial=0.0)
+                       + np.abs(ref[:, 0, :, block] - ref[:, 1, :, block]).max(initial=0.0))
+        error, tolerance = max(error, gap / scale), max(tolerance, spread / scale)
+    return error, tolerance + ROUNDOFF_FACTOR * EPS
+
+
+def rows(model: str, name: str, engine: ModelEngine, states: closures.ClosedStates, *,
+         canon: Canonical, tree: ModelTree, reading: ClosedReading) -> list[CheckRow]:
+    """The engine's derivatives row (none where it offers none): ``tree`` its reading of
+    the closures in the canonical layout, ``reading`` its answer at ``states``."""
+    turning = [j.name for j in tree.joints if j.layout.nv != 1 or j.layout.nq != 1]
+    if turning:
+        return [_row(model, name, verdict=Verdict.SKIPPED, note=(
+            f"{name}'s derivatives with its constraints are not compared on this model: "
+            f"{turning[0]!r} turns in a rotation's chart (compared on hinges and slides "
+            "only, as yet)"))]
+    q, v = states.q[:STATES], states.v[:STATES]
+    maps, q_e, v_e, _ = layout_batch.engine_states(canon, engine.tree, q, v, np.zeros_like(v))
+    t = np.array([m.t for m in maps])
+    try:
+        found = engine.closed_derivatives(q_e, v_e, np.zeros_like(v_e))
+    except (EngineError, Unsupported) as exc:
+        return [_row(model, name, verdict=Verdict.FAILED, note=f"{name} failed: {exc}")]
+    mine = _mapped(t, found)
+    ref = _referee(tree, q, v, reading.diagonal[: len(q), closures.engine_rows(tree)])
+    error, tolerance = _gaps(mine, ref, tree.nv)
+    ok = error <= tolerance
+    return [_row(model, name, verdict=Verdict.PASSED if ok else Verdict.FAILED,
+                 error=error, tolerance=tolerance,
+                 note="∂v̇/∂(q, v) with its constraints, against the referee's (central "
+                      "differences of its constrained method on this reading)" if ok else
+                      "cause unknown: its derivatives with its constraints are not the "
+                      "referee's on its reading")]
+
+
+def _mapped(t: np.ndarray, found: np.ndarray) -> np.ndarray:
+    """The engine's derivatives in the canonical layout: T⁻¹ D blockdiag(T, T) (T constant
+    on hinges and slides)."""
+    s, _, nv_e, _ = found.shape
+    nv = t.shape[2]
+    out = np.zeros((s, 2, nv, 2 * nv))
+    pinv = np.linalg.pinv(t)
+    for k in range(2):
+        d = found[:, k]
+        out[:, k, :, :nv] = pinv @ d[:, :, :nv_e] @ t
+        out[:, k, :, nv:] = pinv @ d[:, :, nv_e:] @ t
+    return out
