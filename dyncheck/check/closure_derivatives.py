@@ -7,10 +7,10 @@ at the first :data:`STATES` states on the constraints.
 
 Compared on hinges and slides, whose coordinates add (a rotation's chart is not compared here
 yet: one skipped row says so). The tolerance is measured, not chosen: each side's
-finite-difference error is the gap between its differences at its step and at twice it
-(central differences: three times the finer one's truncation, and its round-off's order),
-plus 64 ε; the error is relative to the largest derivative of each block (∂/∂q, ∂/∂v), at
-least 1 (s⁻², s⁻¹).
+finite-difference error is bounded by twice the gap g between its differences at its step δ
+and at 2δ — where truncation (∝ δ²) dominates, the error of the finer is g/3; where round-off
+(∝ 1/δ) does, at most 2g (errors of one sign: c/δ − c/2δ = g) — plus 64 ε; the error is
+relative to the largest derivative of each block (∂/∂q, ∂/∂v), at least 1 (s⁻², s⁻¹).
 """
 
 from __future__ import annotations
@@ -33,7 +33,10 @@ STATES = 8
 """States whose derivatives are compared (each costs the referee 8 nv solves)."""
 STEP = 1e-8
 """The referee's central-difference step (ε^⅓ order: truncation and round-off balanced)."""
-BASIS = "each side's finite differences at its step against twice it, + 64 eps"
+BASIS = "2 x each side's finite-difference gap between its step and twice it, + 64 eps"
+SPREAD_FACTOR = 2.0
+"""A central difference's error per unit of its gap to the one at twice the step (round-off
+bound; truncation needs 1/3)."""
 SUBJECT = "derivatives"
 
 
@@ -75,7 +78,7 @@ def _gaps(mine: np.ndarray, ref: np.ndarray, nv: int) -> tuple[float, float]:
         spread = float(np.abs(mine[:, 0, :, block] - mine[:, 1, :, block]).max(initial=0.0)
                        + np.abs(ref[:, 0, :, block] - ref[:, 1, :, block]).max(initial=0.0))
         error, tolerance = max(error, gap / scale), max(tolerance, spread / scale)
-    return error, tolerance + ROUNDOFF_FACTOR * EPS
+    return error, SPREAD_FACTOR * tolerance + ROUNDOFF_FACTOR * EPS
 
 
 def rows(model: str, name: str, engine: ModelEngine, states: closures.ClosedStates, *,
