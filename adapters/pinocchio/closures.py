@@ -18,6 +18,7 @@ import pinocchio as pin
 from dyncheck.adapters.closures import ClosedReading, Closure, ClosureKind
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
+from dyncheck.adapters.formats.mjcf_copy import utf8_file
 from dyncheck.adapters.registration import Format
 from dyncheck.errors import Unsupported
 
@@ -27,6 +28,14 @@ PROXIMAL_MU = 1e-9
 """Its proximal parameter: any μ > 0 lets it solve redundant rows (a planar loop's 3-D
 connect); the iterations converge to the rigid answer whatever μ."""
 ITERATIONS = 200
+
+
+def from_file(source: ModelFile, model: pin.Model) -> list:
+    """The MJCF file's constraint models as Pinocchio parses them (:func:`load`)."""
+    if source.format is not Format.MJCF or "<equality" not in source.text:
+        return []
+    with utf8_file(source.path) as file:
+        return load(file, model)
 
 
 def load(path: Path, model: pin.Model) -> list:
@@ -108,3 +117,20 @@ def closed(m: pin.Model, held: list, q: np.ndarray, v: np.ndarray, *,
             at += size
     return ClosedReading(value=value, jacobian=jacobian, vdot=vdot, force=force,
                          diagonal=np.zeros((s, rows)), accuracy=ACCURACY)
+
+
+def derivatives(m: pin.Model, held: list, q: np.ndarray, v: np.ndarray, *,
+                tau: np.ndarray) -> np.ndarray:
+    """∂v̇/∂(q, v) of ``constraintDynamics`` at each state, its own
+    (``computeConstraintDynamicsDerivatives``: analytic, so the same at both "steps" of
+    :attr:`~dyncheck.adapters.offers.Offer.CLOSED_DERIVATIVES`' shape (S, 2, nv, 2 nv))."""
+    d = m.createData()
+    datas = [c.createData() for c in held]
+    pin.initConstraintDynamics(m, d, held, datas)
+    settings = pin.ProximalSettings(ACCURACY, PROXIMAL_MU, ITERATIONS)
+    out = np.zeros((len(q), 2, m.nv, 2 * m.nv))
+    for i in range(len(q)):
+        pin.constraintDynamics(m, d, q[i], v[i], tau[i], held, datas, settings)
+        pin.computeConstraintDynamicsDerivatives(m, d, held, datas, settings)
+        out[i, :] = np.hstack([d.ddq_dq, d.ddq_dv])
+    return out

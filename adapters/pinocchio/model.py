@@ -85,14 +85,6 @@ def parse_xml(xml: str) -> pin.Model:
         return pin.buildModelFromMJCF(str(path))
 
 
-def _constraints(source: ModelFile, model: pin.Model) -> list:
-    """The MJCF file's constraint models as Pinocchio parses them (:mod:`.closures`)."""
-    if source.format is not Format.MJCF or "<equality" not in source.text:
-        return []
-    with utf8_file(source.path) as file:
-        return closures.load(file, model)
-
-
 def _load(source: ModelFile) -> pin.Model:
     try:
         if source.format is Format.MJCF:
@@ -201,7 +193,8 @@ class PinocchioModel(ModelEngine):
 
     engine = ENGINE
     offers = frozenset({Offer.DERIVATIVES, Offer.FORWARD, Offer.STEPPING, Offer.SOLVING,
-                        Offer.COUPLINGS, Offer.BODY_FORCES, Offer.CLOSURES})
+                        Offer.COUPLINGS, Offer.BODY_FORCES, Offer.CLOSURES,
+                        Offer.CLOSED_DERIVATIVES})
     definitions: ClassVar[Mapping[str, str]] = {Integrator.IMPLICITFAST: Integrator.EULER}
     """Its ``implicitfast`` is ``euler``: it applies no damping and has no actuators (D = 0,
     :mod:`.integrators`)."""
@@ -213,7 +206,7 @@ class PinocchioModel(ModelEngine):
         self._closures_read = True
         self._mimics, unread = self._mimic_joints(source)
         try:
-            self._held = _constraints(source, self.model)
+            self._held = closures.from_file(source, self.model)
         except Unsupported as exc:
             self._held, self._closures_read = [], False
             unread += (f"{exc}; its constraints are not read",)
@@ -406,6 +399,13 @@ class PinocchioModel(ModelEngine):
         if self._mimics is not None:
             return mimic.closed(self._mimics, self.model.nv, q, v, tau=tau)
         return closures.closed(self.model, self._held, q, v, tau=tau)
+
+    def closed_derivatives(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """Its own derivatives of its constrained dynamics (:func:`.closures.derivatives`)."""
+        if self._mimics is not None:
+            raise Unsupported("pinocchio: the derivatives of its mimic joints' dynamics are "
+                              "not compared (dyncheck drives none yet)")
+        return closures.derivatives(self.model, self._held, q, v, tau=tau)
 
     def couple(self, couplings: Sequence[Coupling]) -> None:
         """The couplings as the constant Jacobian C of Pinocchio's constrained forward

@@ -145,9 +145,11 @@ def _engine_rows(model: str, name: str, engine: ModelEngine, states: closures.Cl
                      verdict=Verdict.FAILED, note=f"{name} failed: {exc}")]
     found = closures.measure(tree, reading, states, tau=tau, reach=size)
     if derivatives and Offer.CLOSED_DERIVATIVES in engine.offers:
-        derived = closure_derivatives.rows(model, name, engine, states, tree=tree,
-                                           reading=reading,
-                                           canon=layout.canonical(canonical_tree))
+        canon = layout.canonical(canonical_tree)
+        derived = closure_derivatives.rows(
+            model, name, engine, states, tree=tree, reading=reading, canon=canon,
+            own=lambda q, v: in_canonical(canon, engine, replace(states, q=q, v=v),
+                                          np.zeros_like(v))[1].vdot)
     else:
         derived = []
     shape = max(found.residual / size, found.jacobian, found.row_space)
