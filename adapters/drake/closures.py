@@ -1,4 +1,4 @@
-"""Drake's constraints from an MJCF file (#78), and its closed dynamics on them.
+"""Drake's constraints (#78): which ones its parsers hold, and its closed dynamics on them.
 
 Drake's MJCF parser (``detail_mujoco_parser.cc``, ``ParseEquality``) turns a ``<connect>``
 given by ``body1`` and ``anchor`` (and ``body2``, else the world) into a ball constraint,
@@ -8,13 +8,14 @@ and every ``<weld>``, ``<joint>`` and ``<tendon>``; it warns that ``active`` is 
 holds the constraint whatever it says. Its Python bindings expose no constraint's spec, so
 which constraints it holds is measured — a discrete-time plant parsed from the file with them
 kept: its ``num_constraints()`` and its warnings — and each held connect's points are the ones
-its parser makes of the file's.
+its parser makes of the file's. Its URDF parser makes each ``<mimic>`` joint a coupler
+constraint, q_follower = multiplier · q_leader + offset (counted the same way).
 
 A continuous-time plant refuses any constraint; the closed dynamics are Drake's own M and h
 (the continuous plant, parsed without them) with each ball constraint's rows from Drake's
 kinematics — the points' translational Jacobians (``CalcJacobianTranslationalVelocity``) and
-bias accelerations (``CalcBiasTranslationalAcceleration``) — in the rigid KKT solve
-(:func:`~dyncheck.adapters.linalg.closed`).
+bias accelerations (``CalcBiasTranslationalAcceleration``), and each coupler's constant
+row — in the rigid KKT solve (:func:`~dyncheck.adapters.linalg.closed`).
 """
 
 from __future__ import annotations
@@ -33,7 +34,6 @@ from dyncheck.adapters.closures import ClosedReading, Closure, ClosureKind
 from dyncheck.adapters.linalg import closed as kkt_closed
 from dyncheck.errors import Unsupported
 
-ENGINE = "drake"
 _IGNORED = re.compile(r"The tag '(\w+)' found as a child of 'equality' is currently unsupported")
 _BY_SITES = "connect node uses the site1 and site2 specification"
 
