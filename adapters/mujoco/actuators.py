@@ -164,6 +164,8 @@ class Actuated:
     def __init__(self, m: mujoco.MjModel) -> None:
         self.model = with_actuation(m)
         self.data = mujoco.MjData(self.model)
+        self.modelled = [not _unmodelled(m, k) for k in range(m.nu)]
+        """Which actuators the neutral form holds (a joint's; not a tendon's or a site's)."""
 
     def _set(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> None:
         d = self.data
@@ -171,21 +173,20 @@ class Actuated:
         d.qfrc_applied[:] = 0.0
         d.act[:] = activations(self.model, u[None])[0]
 
-    def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray,
-                  modelled: list[bool] | None = None) -> Actuation:
+    def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
         """``qfrc_actuator`` and ``qacc`` after ``mj_forward`` at each state and control;
-        where some actuator is not ``modelled`` (a tendon's, a site's), the force of the
+        where some actuator is not :attr:`modelled` (a tendon's, a site's), the force of the
         others alone too: gear × ``actuator_force`` at each one's joint, each joint's
         ``actuatorfrcrange`` applied to the sum (:attr:`Actuation.joint_tau`)."""
         m, n, nv = self.model, len(q), self.model.nv
         tau, forward = np.empty((n, nv)), np.empty((n, nv))
-        alone = None if modelled is None or all(modelled) else np.zeros((n, nv))
+        alone = None if all(self.modelled) else np.zeros((n, nv))
         for i in range(n):
             self._set(q[i], v[i], u[i])
             mujoco.mj_forward(m, self.data)
             tau[i], forward[i] = self.data.qfrc_actuator, self.data.qacc
             if alone is not None:
-                alone[i] = _joint_actuators_alone(m, self.data, modelled or [])
+                alone[i] = _joint_actuators_alone(m, self.data, self.modelled)
         return Actuation(tau=tau, forward=forward, joint_tau=alone)
 
     def input_jacobians(self, q: np.ndarray, v: np.ndarray, u: np.ndarray,
@@ -232,10 +233,7 @@ class MujocoActuation:
     def actuation(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> Actuation:
         """MuJoCo's ``qfrc_actuator`` and ``qacc`` at each state and control, and its joint
         actuators' force alone where it holds others (:meth:`Actuated.actuation`)."""
-        tree = getattr(self, "tree", None)
-        held = list(tree.actuators) if tree is not None else []
-        modelled = [a.modelled for a in held] if len(held) == self.model.nu else None
-        return self._on().actuation(q, v, u, modelled)
+        return self._on().actuation(q, v, u)
 
     def input_jacobians(self, q: np.ndarray, v: np.ndarray,
                         u: np.ndarray) -> tuple[InputJacobian, ...]:
