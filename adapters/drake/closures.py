@@ -98,6 +98,18 @@ def _connects(root: ET.Element) -> list[tuple[str, ET.Element]]:
     return out
 
 
+def _numbers(text: str, count: int, *, where: str) -> np.ndarray:
+    """``count`` numbers written in ``text``; :class:`Unsupported` naming ``where`` and the
+    text otherwise (a file's, untrusted)."""
+    try:
+        out = np.array([float(x) for x in text.split()], float)
+    except ValueError:
+        out = np.zeros(0)
+    if out.shape != (count,) or not np.isfinite(out).all():
+        raise Unsupported(f"drake: {where} is {text[:80]!r}, not {count} finite numbers")
+    return out
+
+
 def _owners(plant: MultibodyPlant) -> dict[str, str]:
     """Each body's name → the moving joint whose child (or a body welded to it) it is."""
     out = {}
@@ -129,7 +141,7 @@ def read(root: ET.Element, *, held: int, warnings: list[str], plant: MultibodyPl
             raise Unsupported(f"drake holds no body {body_a!r} or {body_b!r} of connect "
                               f"{name!r} in the model it computes with")
         a, b = plant.GetBodyByName(body_a), plant.GetBodyByName(body_b)
-        p_ap = np.array([float(x) for x in item.get("anchor", "0 0 0").split()], float)
+        p_ap = _numbers(item.get("anchor", "0 0 0"), 3, where=f"connect {name!r}'s anchor")
         p_bq = b.EvalPoseInWorld(default).inverse().multiply(
             a.EvalPoseInWorld(default).multiply(p_ap))
         balls.append(Ball(body_a=body_a, p_ap=p_ap, body_b=body_b,
@@ -150,10 +162,11 @@ def mimics(root: ET.Element, *, held: int) -> Held:
     couplers = []
     for joint in root.findall("joint"):
         if (mimic := joint.find("mimic")) is not None:
+            where = f"the <mimic> of joint {joint.get('name', '')!r}"
             couplers.append(Coupler(
                 follower=joint.get("name", ""), leader=mimic.get("joint", ""),
-                multiplier=float(mimic.get("multiplier", "1")),
-                offset=float(mimic.get("offset", "0"))))
+                multiplier=float(_numbers(mimic.get("multiplier", "1"), 1, where=where)[0]),
+                offset=float(_numbers(mimic.get("offset", "0"), 1, where=where)[0])))
     if len(couplers) != held:
         raise Unsupported(f"drake's parser holds {held} constraints where the URDF gives "
                           f"{len(couplers)} <mimic> joints: which it holds is not known")

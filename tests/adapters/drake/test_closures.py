@@ -68,3 +68,12 @@ def test_drakes_rows_are_the_derivative_of_its_constraint(tmp_path):
         behind = drake.closed(q - step, v, tau).value[0]
         np.testing.assert_allclose(found.jacobian[0, :, k], (ahead - behind) / (2 * h),
                                    atol=1e-8)
+
+
+@pytest.mark.parametrize("text", ["0.9 0", "0.9 nan 0", "a b c", "1e999 0 0"])
+def test_a_files_numbers_not_three_finite_ones_are_refused_naming_them(text):
+    from dyncheck.adapters.drake.closures import _numbers
+    from dyncheck.errors import Unsupported
+
+    with pytest.raises(Unsupported, match=r"connect 'c''s anchor is .* not 3 finite numbers"):
+        _numbers(text, 3, where="connect 'c''s anchor")
