@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -31,6 +32,7 @@ from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import Context
 
 from dyncheck.adapters.closures import ClosedReading, Closure, ClosureKind
+from dyncheck.adapters.formats.includes import equalities
 from dyncheck.adapters.linalg import closed as kkt_closed
 from dyncheck.errors import Unsupported
 
@@ -88,14 +90,9 @@ def _connects(root: ET.Element) -> list[tuple[str, ET.Element]]:
     """The file's connects given by body and anchor, as Drake's parser walks them (each
     ``<equality>`` in order, its connects in order), with their names (``connect k``, k the
     element's place among the file's equalities, where unnamed)."""
-    out = []
-    place = 0
-    for block in root.findall("equality"):
-        for item in block:
-            if item.tag == "connect" and item.get("body1") is not None:
-                out.append((item.get("name") or f"connect {place}", item))
-            place += 1
-    return out
+    return [(item.get("name") or f"connect {place}", item)
+            for place, item in enumerate(equalities(root))
+            if item.tag == "connect" and item.get("body1") is not None]
 
 
 def _numbers(text: str, count: int, *, where: str) -> np.ndarray:
@@ -110,30 +107,20 @@ def _numbers(text: str, count: int, *, where: str) -> np.ndarray:
     return out
 
 
-def _owners(plant: MultibodyPlant) -> dict[str, str]:
-    """Each body's name → the moving joint whose child (or a body welded to it) it is."""
-    out = {}
-    for index in plant.GetJointIndices():
-        joint = plant.get_joint(index)
-        if joint.num_velocities() > 0:
-            for body in plant.GetBodiesWeldedTo(joint.child_body()):
-                out[body.name()] = joint.name()
-    return out
-
-
 def read(root: ET.Element, *, held: int, warnings: list[str], plant: MultibodyPlant,
-         context: Context) -> Held:
+         context: Context, owners: Mapping[str, str]) -> Held:
     """Drake's constraints on the file ``root`` (inlined), its discrete plant holding
     ``held`` of them, on ``plant`` (the continuous one): Q where P is at its default
     configuration, the closures' points in world axes at ``context`` (the tree's reference
-    pose), each on the joint that moves its body. Raises :class:`Unsupported` where the
-    count is not that of the file's connects given by body."""
+    pose), each on the joint ``owners`` names for its body (the world: none). Raises
+    :class:`Unsupported` where the count is not that of the file's connects given by
+    body."""
     connects = _connects(root)
     if len(connects) != held:
         raise Unsupported(f"drake's parser holds {held} constraints where the file gives "
                           f"{len(connects)} <connect> by body and anchor: which it holds is "
                           "not known")
-    default, owners = plant.CreateDefaultContext(), _owners(plant)
+    default = plant.CreateDefaultContext()
     balls, closures = [], []
     for name, item in connects:
         body_a, body_b = item.get("body1", ""), item.get("body2") or "world"

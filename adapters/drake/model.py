@@ -49,7 +49,7 @@ from dyncheck.adapters.drake.hints import (
 from dyncheck.adapters.drake.parsing import ENGINE, plant_of
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.includes import inline
+from dyncheck.adapters.formats.includes import equalities, inline
 from dyncheck.adapters.model_tree import (
     Axes,
     DerivativeChart,
@@ -91,6 +91,7 @@ class DrakeModel(ModelEngine):
         self.plant, said, notes, self._damping = plant_of(source)
         self.parser_warnings = tuple(dict.fromkeys(said))
         self._source = source
+        self._root = inline(source.path) if source.format is Format.MJCF else None
         self.context = self.plant.CreateDefaultContext()
         actuation = self.plant.get_actuation_input_port()
         if self.plant.num_actuated_dofs() > 0:
@@ -107,10 +108,8 @@ class DrakeModel(ModelEngine):
         """Its tree with the constraints Drake's parsers hold (:mod:`.closures`: an MJCF's
         read on a discrete-time plant parsed with them, a URDF's ``<mimic>`` joints), or the
         note of why none are read."""
-        source = self._source
-        mjcf = inline(source.path) if source.format is Format.MJCF else None
-        if not (source.closed_text if mjcf is None else
-                any(len(block) for block in mjcf.findall("equality"))):
+        source, mjcf = self._source, self._root
+        if not (source.closed_text if mjcf is None else equalities(mjcf)):
             return tree
         try:
             discrete, said, _, _ = plant_of(source, kept=True)
@@ -118,7 +117,8 @@ class DrakeModel(ModelEngine):
                 parsing.root(source.closed_text), held=discrete.num_constraints()) \
                 if mjcf is None else drake_closures.read(
                     mjcf, held=discrete.num_constraints(), warnings=said, plant=self.plant,
-                    context=self.context)
+                    context=self.context, owners={self.plant.get_body(body).name(): joint.name()
+                                                  for body, joint in self._movers.items()})
         except (Unsupported, EngineError) as exc:
             return replace(tree, notes=(*tree.notes, f"{exc}; its constraints are not read"))
         return replace(tree, closures=self._held.closures, closures_read=True,
@@ -147,6 +147,7 @@ class DrakeModel(ModelEngine):
         for joint in moving:
             for body in plant.GetBodiesWeldedTo(joint.child_body()):
                 owner_of[body.index()] = joint
+        self._movers = owner_of  # (its closures' bodies are joined to their joints by it)
         joints = []
         reflected = self._reflected
         for joint in moving:
@@ -221,10 +222,10 @@ class DrakeModel(ModelEngine):
                          gravity=np.asarray(plant.gravity_field().gravity_vector(), float),
                          nq=plant.num_positions(), nv=plant.num_velocities(), notes=notes,
                          hints=hints, measured=measured, actuators=drake_actuators.read(plant))
-        if self._source.format is not Format.MJCF:
+        if self._root is None:  # (a URDF)
             return tree
         return counterfactual.measured(
-            self._source, inline(self._source.path), plant, tree, reflected=reflected,
+            self._source, self._root, plant, tree, reflected=reflected,
             driven=driven, read=(lambda copy: DrakeModel(copy, fixes=False).tree)
             if self._fixes else None)
 

@@ -67,6 +67,12 @@ def _read(path: Path, including: Path) -> ET.Element:
         raise EngineError(f"{path}: not XML ({exc})") from None
 
 
+def equalities(root: ET.Element) -> list[ET.Element]:
+    """The model's equality constraints (``root``: inlined), in the file's order: every
+    ``<equality>`` block's children."""
+    return [item for block in root.findall("equality") for item in block]
+
+
 def inline(path: Path) -> ET.Element:
     """The model's root with every ``<include>`` replaced by the included file's children
     (paths relative to the main file's folder, as MuJoCo resolves them, else to the including

@@ -10,6 +10,7 @@ into world axes) and the anchors' separation.
 from __future__ import annotations
 
 import warnings
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +18,7 @@ import pinocchio as pin
 
 from dyncheck.adapters.closures import ClosedReading, Closure, ClosureKind
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.includes import inline
+from dyncheck.adapters.formats.includes import equalities
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
 from dyncheck.adapters.registration import Format
 from dyncheck.errors import Unsupported
@@ -56,12 +57,11 @@ def load(path: Path, model: pin.Model) -> list:
     return held
 
 
-def unheld(source: ModelFile, held: list) -> tuple[tuple[str, str], ...]:
-    """Each kind of the MJCF's ``<equality>`` its parser returns no constraint model for,
-    measured: where it returns one per ``<connect>`` and ``<weld>``, every other kind."""
-    if source.format is not Format.MJCF or "<equality" not in source.text:
-        return ()
-    kinds = [item.tag for block in inline(source.path).findall("equality") for item in block]
+def unheld(root: ET.Element | None, held: list) -> tuple[tuple[str, str], ...]:
+    """Each kind of the MJCF's ``<equality>`` (``root``: inlined; None, a URDF) its parser
+    returns no constraint model for, measured: where it returns one per ``<connect>`` and
+    ``<weld>``, every other kind."""
+    kinds = [item.tag for item in equalities(root)] if root is not None else []
     if len(held) != sum(kind in ("connect", "weld") for kind in kinds):
         return ()
     return tuple((kind, f"measured: its MJCF parser returns {len(held)} constraint models "

@@ -202,7 +202,7 @@ class PinocchioModel(ModelEngine):
     def __init__(self, source: ModelFile, *, gravity: np.ndarray | None = None,
                  inertias: Mapping[str, np.ndarray] | None = None,
                  fixes: bool = True) -> None:
-        self.model, self._source = _load(source), source
+        self.model = _load(source)
         self._closures_read = True
         self._mimics, unread = self._mimic_joints(source)
         try:
@@ -218,6 +218,7 @@ class PinocchioModel(ModelEngine):
         notes: tuple[str, ...] = ()
         held = frozenset(f.name for f in self.model.frames if f.type == pin.FrameType.BODY)
         root = inline(source.path) if source.format is Format.MJCF else None
+        self._unheld = closures.unheld(root, self._held)
         found = mjcf.found(source, root, held)
         self._hints = mjcf.hints(found)
         if source.floating and source.format is Format.URDF:
@@ -332,7 +333,7 @@ class PinocchioModel(ModelEngine):
             nq=m.nq, nv=m.nv, notes=notes, hints=self._hints,
             closures=closures.read(self._held, d, {i: n for i, n in last_name.items() if n})
             + mimic.read(self._mimics), closures_read=self._closures_read,
-            closures_unheld=closures.unheld(self._source, self._held))
+            closures_unheld=self._unheld)
 
     def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
         m, d = self.model, self.data

@@ -16,7 +16,7 @@ import pybullet as pb
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.bodies import keys
 from dyncheck.adapters.formats.files import ModelFile, urdf_inertials
-from dyncheck.adapters.formats.includes import inline
+from dyncheck.adapters.formats.includes import equalities, inline
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
 from dyncheck.adapters.model_tree import WantsCompiled
 from dyncheck.adapters.proof import Proof
@@ -184,8 +184,7 @@ def unheld(client: int, source: ModelFile) -> tuple[tuple[str, str], ...] | None
     ``<equality>``, a URDF's ``<mimic>`` joints, read by a client of their own); None where
     the file states none, or where PyBullet holds some (which ones, it does not say)."""
     if source.format is Format.MJCF:
-        kinds = [item.tag for block in inline(source.path).findall("equality")
-                 for item in block]
+        kinds = [item.tag for item in equalities(inline(source.path))]
         held = pb.getNumConstraints(physicsClientId=client) if kinds else 0
         how = "loadMJCF"
     else:

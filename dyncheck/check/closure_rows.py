@@ -138,14 +138,14 @@ def _engine_rows(model: str, name: str, engine: ModelEngine, states: closures.Cl
                      verdict=Verdict.SKIPPED, note=f"{name} holds part of the model (its "
                      "reading rows): its closed dynamics are compared only on the whole")]
     tau = np.zeros_like(states.v)
+    canon = layout.canonical(canonical_tree)
     try:
-        tree, reading = in_canonical(layout.canonical(canonical_tree), engine, states, tau)
+        tree, reading = in_canonical(canon, engine, states, tau)
     except (EngineError, Unsupported) as exc:
         return [_row(model, subject="model", field="closed dynamics", engine=name,
                      verdict=Verdict.FAILED, note=f"{name} failed: {exc}")]
     found = closures.measure(tree, reading, states, tau=tau, reach=size)
     if derivatives and Offer.CLOSED_DERIVATIVES in engine.offers:
-        canon = layout.canonical(canonical_tree)
         derived = closure_derivatives.rows(
             model, name, engine, states, tree=tree, reading=reading, canon=canon,
             own=lambda q, v: in_canonical(canon, engine, replace(states, q=q, v=v),
