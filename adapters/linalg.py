@@ -34,13 +34,14 @@ RANK_RTOL = 1e-10
 zero (its entries are lever arms and direction cosines of order one)."""
 
 
-def closed(M: np.ndarray, rhs: np.ndarray, J: np.ndarray,
-           drift: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def closed(M: np.ndarray, rhs: np.ndarray, J: np.ndarray, drift: np.ndarray, *,
+           rtol: float = RANK_RTOL) -> tuple[np.ndarray, np.ndarray]:
     """v̇ and f of M v̇ − Jᵀ f = rhs, J v̇ = −``drift`` (J̇ v): a tree closed by rigid
-    constraints, J's dependent rows left out (its rank from its singular values, a planar
-    loop's 3-D rows being dependent); f on J's rows, the least-norm."""
+    constraints, J's dependent rows left out (its rank from its singular values, those
+    below ``rtol`` of the largest zero: a planar loop's 3-D rows are dependent); f on J's
+    rows, the least-norm."""
     u, s, vt = np.linalg.svd(J, full_matrices=False)
-    rank = int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
+    rank = int(np.sum(s > rtol * s[0])) if s.size and s[0] > 0 else 0
     n = M.shape[0]
     K = np.zeros((n + rank, n + rank))
     K[:n, :n], K[:n, n:], K[n:, :n] = M, -vt[:rank].T, vt[:rank]

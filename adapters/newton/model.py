@@ -28,9 +28,10 @@ import numpy as np
 
 from dyncheck.adapters.actuators import Actuation
 from dyncheck.adapters.base import Field, ModelEngine, Offer
-from dyncheck.adapters.closures import ClosureKind
+from dyncheck.adapters.closures import ClosedReading, ClosureKind
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
+from dyncheck.adapters.formats.includes import equalities, inline
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -122,7 +123,7 @@ class NewtonModel(ModelEngine):
     """A finalized Newton model on the CPU and its neutral tree."""
 
     engine = ENGINE
-    offers = frozenset({Offer.STEPPING, Offer.ACTUATION, Offer.BODY_FORCES})
+    offers = frozenset({Offer.STEPPING, Offer.ACTUATION, Offer.BODY_FORCES, Offer.CLOSURES})
 
     def __init__(self, source: ModelFile) -> None:
         import newton
@@ -138,6 +139,8 @@ class NewtonModel(ModelEngine):
         fixed = int(newton.JointType.FIXED)
         self.d6 = int(newton.JointType.D6)
         self._text = source.text if source.format is Format.MJCF else ""
+        self._equalities = [e.tag for e in equalities(inline(source.path))] \
+            if source.format is Format.MJCF else []
         for j, t in enumerate(self.types):
             if int(t) not in kinds and int(t) not in (fixed, self.d6):
                 raise Unsupported(f"newton joint type {newton.JointType(int(t)).name} "
@@ -145,6 +148,10 @@ class NewtonModel(ModelEngine):
         self.kinds, self.fixed = kinds, fixed
         self.q_start, self.v_start = m.joint_q_start.numpy(), m.joint_qd_start.numpy()
         self.loops = newton_closures.loops(m)  # (#78: constraints, not joints of the tree)
+        self.held = newton_closures.held(m, self.loops, {
+            int(newton.JointType.BALL): ClosureKind.CONNECT,
+            int(newton.JointType.FIXED): ClosureKind.WELD})
+        self.mimics = newton_closures.mimics(m) + self._urdf_mimics(source)
         self.state = m.state()
         notes: tuple[str, ...] = (
             f"newton: {newton.__version__} on Warp's {DEVICE} device, float32",)
@@ -152,6 +159,17 @@ class NewtonModel(ModelEngine):
             notes += ("newton: add_urdf(floating=True): a free joint at the URDF root",)
         self._corrected = corrected
         self.tree = self._tree(notes)
+
+    def _urdf_mimics(self, source: ModelFile) -> tuple[newton_closures.Mimic, ...]:
+        """A URDF's ``<mimic>`` joints as Newton reads them: the file with them loaded a
+        second time (its Featherstone solver steps a mimicking joint as its leader's: the
+        tree every engine's smooth dynamics are checked on leaves them out)."""
+        if source.format is not Format.URDF or not source.closed_text:
+            return ()
+        mimicked, _ = _load(replace(source, text=source.closed_text))
+        if list(mimicked.joint_label) != list(self.model.joint_label):
+            raise Unsupported("newton read the URDF's joints otherwise with its <mimic> kept")
+        return newton_closures.mimics(mimicked)
 
     def _name(self, joint: int) -> str:
         return _last(self.model.joint_label[joint])
@@ -265,12 +283,12 @@ class NewtonModel(ModelEngine):
         """``tree`` with Newton's constraints (:mod:`.closures`: its loop joints at the body
         poses ``bodies``, each on the tree joint ``mover`` names for its body)."""
         closures = newton_closures.read(
-            self.model, self.loops,
-            kinds={int(self.newton.JointType.BALL): ClosureKind.CONNECT,
-                   self.fixed: ClosureKind.WELD},
-            bodies=bodies, pose=_pose, name=self._name,
+            self.model, self.held, self.mimics, bodies=bodies, pose=_pose, name=self._name,
             mover=lambda b: None if (j := mover(b)) is None else self._name(j))
-        return replace(tree, closures=closures, closures_read=True)
+        return replace(tree, closures=closures, closures_read=True,
+                       closures_unheld=newton_closures.unheld(
+                           self._equalities, loops=len(self.held),
+                           mimics=len(self.mimics)))
 
     def _finished(self, joints: list[TreeJoint], notes: tuple[str, ...], *,
                   carried: dict[int, list[int]],
@@ -388,6 +406,15 @@ class NewtonModel(ModelEngine):
         """v̇ at τ: M⁻¹ (τ − h) (:meth:`_solved`)."""
         d = self.dynamics(q, v, np.zeros_like(v))
         return self._solved(d.mass_matrix, tau - d.bias)
+
+    def closed(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> ClosedReading:
+        """Its M and h closed by its constraints' rows from its own kinematics
+        (:func:`.closures.rows`, :func:`.closures.closed`)."""
+        d = self.dynamics(q, v, np.zeros_like(v))
+        held = newton_closures.rows(self.model, self.newton, self.state, loops=self.held,
+                                    mimicked=self.mimics, q=q, v=v, pose=_pose)
+        return newton_closures.closed(d.mass_matrix, tau - d.bias, held,
+                                      moved=np.concatenate(self._articulation_dofs()))
 
     def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
                  integrator: str, field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:

@@ -262,9 +262,11 @@ class Measured:
 
 def measure(tree: ModelTree, reading: ClosedReading, states: ClosedStates, *,
             tau: np.ndarray, reach: float) -> Measured:
-    """The engine's ``reading`` at ``states`` (on ``tree``'s closures) against the referee."""
+    """The engine's ``reading`` at ``states`` (on ``tree``'s closures) against the referee;
+    ε in its bounds the coarser of float64's and the engine's own (``tree.eps``)."""
     pick, rot = engine_rows(tree), rotation_rows(tree)
     q, v = states.q, states.v
+    eps = max(EPS, tree.eps)  # (the engine's arithmetic: Newton's float32)
     ref = referee(tree, q, v, tau=tau, diagonal=reading.diagonal[:, pick])
     jac = reading.jacobian[:, pick]
     mass, bias = ref.mass, ref.bias  # (evaluated once, by the referee)
@@ -285,9 +287,9 @@ def measure(tree: ModelTree, reading: ClosedReading, states: ClosedStates, *,
         soft=float(np.abs(reading.vdot - ref.soft).max(initial=0.0)) / scale,
         rigid=float(np.abs(reading.vdot - ref.multipliers).max(initial=0.0)) / scale,
         predicted=float(np.abs(ref.soft - ref.multipliers).max(initial=0.0)) / scale,
-        scale=scale, bound=ROUNDOFF_FACTOR * EPS * kappa
+        scale=scale, bound=ROUNDOFF_FACTOR * eps * kappa
         + (reading.accuracy * kappa + leftover) / scale,
-        rows_bound=ROUNDOFF_FACTOR * EPS * max(reach, 1.0))
+        rows_bound=ROUNDOFF_FACTOR * eps * max(reach, 1.0))
 
 
 def _conditioning(tree: ModelTree, mass: np.ndarray, held: Rows, *,
