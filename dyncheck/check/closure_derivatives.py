@@ -5,10 +5,14 @@ model with the engine's parameters where it holds them softly, the rigid answer 
 them rigidly (:func:`.closures.referee`; Lagrange (2.2.23)–(2.2.26) closed by J v̇ = −J̇ v) —
 at the first :data:`STATES` states on the constraints. A soft model is defined at every
 state and compared in every direction; a rigid one only on the constraint manifold, and is
-compared along it (:func:`along`).
+compared along it (:func:`along`), as is a weld holding a rotation (:func:`on_manifold`).
 
-Compared on hinges and slides, whose coordinates add (a rotation's chart is not compared here
-yet: one skipped row says so). The tolerance is measured, not chosen: each side's
+Compared in MuJoCo's chart (the canonical layout's): q ⊕ δ adds on hinges and slides, moves
+a free body by its world displacement and turns a ball or a free body by exp(δ) in its own
+axes (``mj_integratePos``; the referee's :func:`~dyncheck.reference.closure.retract`). An
+engine whose velocities on a rotating joint are not the canonical ones (a permutation of
+them) differentiates in another chart, which is not mapped here yet: one skipped row says
+so. The tolerance is measured, not chosen: each side's
 finite-difference error is bounded by twice the gap g between its differences at its step δ
 and at 2δ — where truncation (∝ δ²) dominates, the error of the finer is g/3; where round-off
 (∝ 1/δ) does, at most 2g (errors of one sign: c/δ − c/2δ = g) — plus 64 ε; the error is
@@ -27,9 +31,12 @@ from dyncheck.adapters.closures import ClosedReading
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.check import closures
+from dyncheck.check.computed import bodies
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.errors import EngineError, Unsupported
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
+from dyncheck.reference.closure import retract
+from dyncheck.reference.tree import TreeDynamics
 from dyncheck.roster import REFEREE
 from dyncheck.vocabulary import Verdict
 
@@ -57,16 +64,17 @@ def _row(model: str, engine: str, *, verdict: Verdict, note: str, error: float =
 
 def _perturbed(tree: ModelTree, q: np.ndarray,
                v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Every state moved by ±δ and ±2δ (:data:`STEP`) along each q and v coordinate: (S · 2
-    steps · 2 signs · 2 nv) states."""
-    nv = v.shape[1]
+    """Every state moved by ±δ and ±2δ (:data:`STEP`) along each q direction of MuJoCo's
+    chart (the referee's ``retract``) and each v coordinate: (S · 2 steps · 2 signs · 2 nv)
+    states."""
+    s, nv = v.shape
     cols = np.eye(2 * nv)
     shift = np.array([[sign * step * cols for sign in (1.0, -1.0)]
                       for step in (STEP, 2 * STEP)])  # (2 steps, 2 signs, 2nv, 2nv)
-    dq = np.zeros((*shift.shape[:3], tree.nq))
-    for j in tree.joints:
-        dq[..., j.layout.q_start] = shift[..., j.layout.v_start]
-    return ((q[:, None, None, None, :] + dq[None]).reshape(-1, tree.nq),
+    count = shift.shape[0] * shift.shape[1] * shift.shape[2]
+    dq = np.broadcast_to(shift[None, ..., :nv], (s, *shift.shape[:3], nv)).reshape(-1, nv)
+    solver = TreeDynamics(bodies(tree), tree.gravity)
+    return (retract(solver, np.repeat(q, count, axis=0), dq),
             (v[:, None, None, None, :] + shift[None, ..., nv:]).reshape(-1, nv))
 
 
@@ -111,6 +119,17 @@ def along(d: np.ndarray, jac: np.ndarray, turn: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
+def on_manifold(tree: ModelTree) -> bool:
+    """Whether the derivatives are compared along the constraint manifold alone: a rigid
+    reading (defined on it alone), or a weld holding a rotation — off the manifold its soft
+    answer depends on how the rotation's error is written (the referee: log(R₁ R₂ᵀ), rows
+    ω₁ − ω₂; MuJoCo: torquescale times the error quaternion's vector, rows its exact
+    derivative — measured on the weld test model off the manifold, ``efc_J`` = ∂``efc_pos``/∂q
+    to 2e-11), whose rows differ at first order in the error, so at O(1) in the derivatives
+    across the manifold; along it the error and its first-order change vanish."""
+    return not any(c.soft for c in tree.closures) or bool(closures.rotation_rows(tree).any())
+
+
 def _gaps(mine: np.ndarray, ref: np.ndarray, nv: int) -> tuple[float, float]:
     """The error and its tolerance, each block (the first ``nv`` columns, the rest) relative
     to its scale."""
@@ -131,15 +150,15 @@ def rows(model: str, name: str, engine: ModelEngine, states: closures.ClosedStat
     the closures in the canonical layout, ``reading`` its answer at ``states``, ``own`` its
     constrained v̇ at canonical states (to measure, where it differs, whether its derivatives
     are those of its own forward dynamics)."""
-    turning = [j.name for j in tree.joints if j.layout.nv != 1 or j.layout.nq != 1]
-    if turning:
-        return [_row(model, name, verdict=Verdict.SKIPPED, note=(
-            f"{name}'s derivatives with its constraints are not compared on this model: "
-            f"{turning[0]!r} turns in a rotation's chart (compared on hinges and slides "
-            "only, as yet)"))]
     q, v = states.q[:STATES], states.v[:STATES]
     maps, q_e, v_e, _ = layout_batch.engine_states(canon, engine.tree, q, v, np.zeros_like(v))
     t = np.array([m.t for m in maps])
+    other = _other_chart(tree, t)
+    if other:
+        return [_row(model, name, verdict=Verdict.SKIPPED, note=(
+            f"{name}'s derivatives with its constraints are not compared on this model: its "
+            f"velocities of {other!r} are not MuJoCo's, so it differentiates in another "
+            "chart (mapped between charts on hinges and slides only, as yet)"))]
     try:
         found = engine.closed_derivatives(q_e, v_e, np.zeros_like(v_e))
     except Unsupported as exc:
@@ -149,7 +168,7 @@ def rows(model: str, name: str, engine: ModelEngine, states: closures.ClosedStat
     mine = _mapped(t, found)
     ref, jac, turn = _referee(tree, q, v,
                               reading.diagonal[: len(q), closures.engine_rows(tree)])
-    if not any(c.soft for c in tree.closures):  # (a rigid reading: along the manifold)
+    if on_manifold(tree):
         mine, ref = along(mine, jac, turn), along(ref, jac, turn)
     error, tolerance = _gaps(mine, ref, mine.shape[3] // 2)
     ok = error <= tolerance
@@ -161,6 +180,20 @@ def rows(model: str, name: str, engine: ModelEngine, states: closures.ClosedStat
                            turn=turn))]
 
 
+def _other_chart(tree: ModelTree, t: np.ndarray) -> str:
+    """The first rotating joint (ball, free) whose engine velocities are not the canonical
+    ones, permuted (T's columns there not each a single 1, at every state); empty: none."""
+    for j in tree.joints:
+        if j.layout.nv == 1 and j.layout.nq == 1:
+            continue
+        cols = t[:, :, j.layout.v_start : j.layout.v_start + j.layout.nv]
+        ones = np.round(cols)
+        if np.abs(cols - ones).max(initial=0.0) > 1e-12 or (ones < 0).any() or \
+                (np.abs(ones).sum(axis=1) != 1).any():
+            return j.name
+    return ""
+
+
 def _why(tree: ModelTree, mine: np.ndarray, ref: np.ndarray, vdot: np.ndarray, *,
          jac: np.ndarray, turn: np.ndarray) -> str:
     """Why an engine's derivatives are not the referee's: where central differences of its
@@ -168,7 +201,7 @@ def _why(tree: ModelTree, mine: np.ndarray, ref: np.ndarray, vdot: np.ndarray, *
     its own dynamics (measured, with both sizes); else the cause is unknown."""
     s, nv = jac.shape[0], tree.nv
     theirs = differences(vdot, s, nv)
-    if not any(c.soft for c in tree.closures):
+    if on_manifold(tree):
         theirs = along(theirs, jac, turn)
     k = mine.shape[3] // 2
     apart, bound = _gaps(theirs, ref, k)
@@ -184,7 +217,7 @@ def _why(tree: ModelTree, mine: np.ndarray, ref: np.ndarray, vdot: np.ndarray, *
 
 def _mapped(t: np.ndarray, found: np.ndarray) -> np.ndarray:
     """The engine's derivatives in the canonical layout: T⁻¹ D blockdiag(T, T) (T constant
-    on hinges and slides)."""
+    on hinges and slides, a permutation on the rotating joints compared)."""
     s, _, nv_e, _ = found.shape
     nv = t.shape[2]
     out = np.zeros((s, 2, nv, 2 * nv))
