@@ -14,7 +14,7 @@ class MjxModel(PortModel):
     rk4_group_order = 2  # (its RK4 sums stage velocities in one tangent space: the module's)
     gyroscopic_implicit = False  # (its implicitfast: actuator and damping derivatives only)
     euler_damps_when_disabled = True
-    offers = RUN | {Offer.DERIVATIVES, Offer.ACTUATION, Offer.INPUT_JACOBIAN}
+    offers = RUN | {Offer.DERIVATIVES, Offer.ACTUATION, Offer.INPUT_JACOBIAN, Offer.CLOSURES}
     port_class = "dyncheck.adapters.mjx.port:MjxPort"
 
 

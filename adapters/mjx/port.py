@@ -38,6 +38,7 @@ from mujoco import mjx
 
 from dyncheck.adapters.mujoco.api import INTEGRATORS
 from dyncheck.adapters.mujoco.port import STEPS, Port
+from dyncheck.errors import Unsupported
 from dyncheck.settings import current
 
 
@@ -110,6 +111,34 @@ def _evaluate(mx: Any, q: Any, v: Any, tau: Any, a: Any) -> dict[str, Any]:
         "xipos": d.xipos,
         "efc_force": d._impl.efc_force,
     }
+
+
+def _equalities(mx: Any, q: Any, v: Any, tau: Any) -> dict[str, Any]:
+    """Its ``qacc`` at τ and its constraint rows at one state (vmapped)."""
+    d = mjx.forward(mx, mjx.make_data(mx).replace(qpos=q, qvel=v, qfrc_applied=tau))
+    return {"qacc": d.qacc, "pos": d._impl.efc_pos, "J": d._impl.efc_J,
+            "force": d._impl.efc_force, "aref": d._impl.efc_aref, "D": d._impl.efc_D}
+
+
+def equality_order(m: mujoco.MjModel) -> np.ndarray:
+    """Where MuJoCo's rows of the active equalities (by equality) sit among MJX's, which
+    makes every equality's rows grouped by kind — connects, welds, joints, tendons
+    (``mujoco/mjx/_src/constraint.py``, ``make_constraint``) — active or not, first of all
+    its constraint rows."""
+    kinds = (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD, mujoco.mjtEq.mjEQ_JOINT,
+             mujoco.mjtEq.mjEQ_TENDON)
+    if any(int(t) not in map(int, kinds) for t in m.eq_type):
+        raise Unsupported("mjx: an equality of a kind other than connect, weld, joint, "
+                          "tendon is not among its constraint rows")
+    rows, start = {}, 0
+    for kind in kinds:
+        size = {int(mujoco.mjtEq.mjEQ_CONNECT): 3, int(mujoco.mjtEq.mjEQ_WELD): 6}.get(
+            int(kind), 1)
+        for e in np.flatnonzero(m.eq_type == kind):
+            rows[int(e)] = np.arange(start, start + size)
+            start += size
+    held = [rows[e] for e in range(m.neq) if m.eq_active0[e]]
+    return np.concatenate(held) if held else np.zeros(0, int)
 
 
 def _stretch(mx: Any, d: Any) -> tuple[Any, tuple[Any, Any]]:
@@ -226,6 +255,7 @@ def _input_jacobian(mx: Any, q: Any, v: Any, inputs: tuple[Any, Any]) -> dict[st
 _EVALUATE = jax.jit(jax.vmap(_evaluate, in_axes=(None, 0, 0, 0, 0)))
 _ACTUATE = jax.jit(jax.vmap(_actuate, in_axes=(None, 0, 0, 0)))
 _INPUT_JACOBIAN = jax.jit(jax.vmap(_input_jacobian, in_axes=(None, 0, 0, 0)))
+_EQUALITIES = jax.jit(jax.vmap(_equalities, in_axes=(None, 0, 0, 0)))
 _STRETCH = jax.jit(_stretch)
 _DERIVATIVES = jax.jit(jax.vmap(_derivatives, in_axes=(None, 0, 0, 0)))
 """Compiled once per model structure and precision, shared by every port: the model is an
@@ -250,7 +280,8 @@ class MjxPort(Port):
         static fields key the cache) and batch shape: left alone, a run of every case in one
         process reached the kernel's limit of 65 530 memory maps and died in XLA's LLVM
         ("Cannot allocate memory", then SIGSEGV)."""
-        for jitted in (_EVALUATE, _STRETCH, _DERIVATIVES, _ACTUATE, _INPUT_JACOBIAN):
+        for jitted in (_EVALUATE, _STRETCH, _DERIVATIVES, _ACTUATE, _INPUT_JACOBIAN,
+                       _EQUALITIES):
             cast(Any, jitted).clear_cache()  # a method of jit's wrapper its stubs do not declare
 
     @staticmethod
@@ -297,6 +328,15 @@ class MjxPort(Port):
             args = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, tau, a))
             out = _EVALUATE(self.mx, *args)
             return {k: np.asarray(x) for k, x in out.items()}
+
+    def _equality_batch(self, q: np.ndarray, v: np.ndarray,
+                        tau: np.ndarray) -> dict[str, np.ndarray]:
+        order = equality_order(self.model)
+        with self._precision():
+            args = (jnp.asarray(x, dtype=self.dtype) for x in (q, v, tau))
+            out = {k: np.asarray(x) for k, x in _EQUALITIES(self.mx, *args).items()}
+        return {"qacc": out["qacc"], **{k: out[k][:, order] for k in ("pos", "J", "force",
+                                                                         "aref", "D")}}
 
     def _actuated(self, q: np.ndarray, v: np.ndarray, u: np.ndarray,
                   act: np.ndarray) -> dict[str, np.ndarray]:

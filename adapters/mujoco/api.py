@@ -70,14 +70,17 @@ velocities were summed as if in one tangent space: order 2 there (measured by th
 matrix, ``reports/versions.md``)."""
 
 
-def _jdotv_in_reference() -> bool:
-    """Probe: a point 1 m out on a hinge turning at 1 rad/s, held by a connect where it is:
-    MuJoCo's ``efc_aref`` of the radial row is −J̇ v = ω² r = 1 where the term is held, 0
-    where not (the row's position and velocity are 0)."""
-    xml = """<mujoco><worldbody><body name="arm"><joint type="hinge" axis="0 0 1"/>
+JDOTV_PROBE = """<mujoco><worldbody><body name="arm"><joint type="hinge" axis="0 0 1"/>
 <geom size=".1" mass="1"/></body></worldbody>
 <equality><connect body1="arm" anchor="1 0 0"/></equality></mujoco>"""
-    m = mujoco.MjModel.from_xml_string(xml)
+"""A point 1 m out on a hinge, held by a connect where it is: at 1 rad/s the radial row's
+reference acceleration is −J̇ v = ω² r = 1 where the term is held, 0 where not (the row's
+position and velocity are 0)."""
+
+
+def _jdotv_in_reference() -> bool:
+    """Probe (:data:`JDOTV_PROBE`): MuJoCo's ``efc_aref`` of the radial row."""
+    m = mujoco.MjModel.from_xml_string(JDOTV_PROBE)
     d = mujoco.MjData(m)
     d.qvel[:] = 1.0
     mujoco.mj_forward(m, d)

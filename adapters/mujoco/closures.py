@@ -139,9 +139,9 @@ def read(m: mujoco.MjModel, d: mujoco.MjData,
     return tuple(out), tuple(notes)
 
 
-def _equalities_on(m: mujoco.MjModel) -> mujoco.MjModel:
+def equalities_on(m: mujoco.MjModel) -> mujoco.MjModel:
     """A copy of ``m`` with its equalities alone on (contacts, limits and friction loss off;
-    dense Jacobians)."""
+    dense Jacobians): what MuJoCo and its ports compute the closed dynamics on."""
     on = copy.copy(m)
     on.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
     on.opt.disableflags |= int(_OFF_BUT_EQUALITIES)
@@ -155,7 +155,7 @@ def closed_derivatives(m: mujoco.MjModel, q: np.ndarray, v: np.ndarray, tau: np.
     ``step`` and twice it), from ``mjd_transitionFD``'s centered differences of one
     semi-implicit Euler step (its chart for q): v₊ = v + h v̇, so ∂v̇/∂x = (∂v₊/∂x − [0 I])/h
     (the smooth model's: no damping, whose implicit term would enter the step)."""
-    on = _equalities_on(m)
+    on = equalities_on(m)
     on.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
     d = mujoco.MjData(on)
     nv, h = on.nv, float(on.opt.timestep)
@@ -176,7 +176,7 @@ def closed_derivatives(m: mujoco.MjModel, q: np.ndarray, v: np.ndarray, tau: np.
 def closed(m: mujoco.MjModel, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> ClosedReading:
     """MuJoCo's answer with its equalities alone on (a copy of ``m``: contacts, limits and
     friction loss off; dense Jacobians), one ``mj_forward`` per state, ``qfrc_applied`` τ."""
-    on = _equalities_on(m)
+    on = equalities_on(m)
     d = mujoco.MjData(on)
     rows = sum(6 if t == mujoco.mjtEq.mjEQ_WELD else 3 if t == mujoco.mjtEq.mjEQ_CONNECT else 1
                for t, active in zip(on.eq_type, on.eq_active0, strict=True) if active)

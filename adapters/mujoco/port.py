@@ -78,6 +78,21 @@ class Port(ABC):
         states ``act`` as the port computes them (a port holding a model with actuation on)."""
         return self._chunked(self._actuated, q, v, u, act)
 
+    def equality_rows(self, q: np.ndarray, v: np.ndarray,
+                      tau: np.ndarray) -> dict[str, np.ndarray]:
+        """Every state's ``qacc`` at τ and its active equality rows in MuJoCo's order (by
+        equality, as ``mj_forward`` makes them): ``pos`` (n, m), ``J`` (n, m, nv),
+        ``force``, the reference acceleration ``aref`` and ``D`` = 1/R (n, m), as the port
+        computes them
+        (a port holding a model with its equalities alone on,
+        :func:`.closures.equalities_on`)."""
+        return self._chunked(self._equality_batch, q, v, tau)
+
+    def _equality_batch(self, q: np.ndarray, v: np.ndarray,
+                        tau: np.ndarray) -> dict[str, np.ndarray]:
+        """One chunk of :meth:`equality_rows` (a port that computes them overrides it)."""
+        raise Unsupported(f"{self.name} computes no constraint rows here")
+
     def _chunked(self, batch: Callable[..., dict[str, np.ndarray]],
                  *arrays: np.ndarray) -> dict[str, np.ndarray]:
         """``batch`` over all states, :attr:`chunk` at a time (the last one padded by

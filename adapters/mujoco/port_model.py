@@ -33,9 +33,12 @@ import numpy as np
 
 from dyncheck.adapters.actuators import EULER_DAMPING, Actuation, InputJacobian
 from dyncheck.adapters.base import Field, Offer
+from dyncheck.adapters.closures import ClosedReading, ClosureKind
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.model_tree import Derivatives, Dynamics, derivatives
+from dyncheck.adapters.model_tree import Derivatives, Dynamics, ModelTree, derivatives
+from dyncheck.adapters.mujoco import closures
 from dyncheck.adapters.mujoco.actuators import STEPS, activations, with_actuation
+from dyncheck.adapters.mujoco.api import JDOTV_IN_REFERENCE, JDOTV_PROBE
 from dyncheck.adapters.mujoco.model import MujocoModel
 from dyncheck.adapters.mujoco.port import Port
 from dyncheck.adapters.mujoco.simulation import soft_model
@@ -53,7 +56,7 @@ class PortModel(MujocoModel):
     """MuJoCo's reading of the file, computed on a port."""
 
     engine = ""
-    offers = RUN | {Offer.ACTUATION}
+    offers = RUN | {Offer.ACTUATION, Offer.CLOSURES}
     """Its own derivatives where it has them (MJX's); never a field (see the module)."""
     no_body_forces = ("an external field evaluated at every stage needs MuJoCo's mjcb_passive "
                       "callback, which the port does not offer")
@@ -64,6 +67,8 @@ class PortModel(MujocoModel):
     package: ClassVar[str] = ""
     """The port's package (its version is in the run's and the check's provenance)."""
     _actuated_port: Any = None
+    _closing: Any = None
+    """The port holding the model with its equalities on (:meth:`closed`), made at first use."""
     euler_damps_when_disabled: ClassVar[bool] = False
     """Whether the port's Euler step applies the joints' damping implicitly, (M + h D),
     though the model disables its dampers (MJX: read in ``mujoco/mjx/_src/forward.py``,
@@ -89,6 +94,30 @@ class PortModel(MujocoModel):
             f"computing in {np.dtype(kind.dtype).name} (round-off bounds with eps "
             f"{eps:.3g}); energies from the port's M and centres of mass",
         ), hints=(*self.tree.hints, *self._euler_damping(version)))
+        self.tree = self._reference_bias(self.tree)
+
+    def _reference_bias(self, tree: ModelTree) -> ModelTree:
+        """``tree`` with its connects' and welds' soft model as the port computes it: whether
+        its reference acceleration holds −J̇ v, probed on the port (:data:`.api.JDOTV_PROBE`,
+        the radial row's ``aref``), where the file has any; MuJoCo C's is probed alike."""
+        posed = (ClosureKind.CONNECT, ClosureKind.WELD)
+        if not any(c.kind in posed for c in tree.closures):
+            return tree
+        probe = mujoco.MjModel.from_xml_string(JDOTV_PROBE)
+        port = self._port_type().on_model(closures.equalities_on(probe), name=self.engine)
+        one = np.ones((1, 1))
+        held = bool(port.equality_rows(np.zeros((1, 1)), one, np.zeros((1, 1)))["aref"][0, 0]
+                    > 0.5)
+        if held == JDOTV_IN_REFERENCE:
+            return tree
+        said = "holds" if held else "leaves out"
+        return replace(tree, closures=tuple(
+            replace(c, bias_in_reference=held) if c.kind in posed else c
+            for c in tree.closures), notes=(*tree.notes, (
+                f"{self.engine}: the reference acceleration of its connects' and welds' soft "
+                f"rows {said} −J̇ v (probed on the port: a point on a turning hinge held by "
+                f"a connect), where MuJoCo C {mujoco.__version__} "
+                f"{'holds' if JDOTV_IN_REFERENCE else 'leaves out'} it")))
 
     @classmethod
     def _port_type(cls) -> type[Port]:
@@ -215,6 +244,31 @@ class PortModel(MujocoModel):
         """The port's ``qacc`` and its equality rows' ``efc_force`` at τ, of one solve."""
         raw = self.port.raw(q, v, tau, np.zeros_like(v))
         return raw["qacc"], raw["efc_force"]
+
+    def closed(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> ClosedReading:
+        """The port's own answer with the file's equalities alone on (MuJoCo's compiled
+        model for them, :func:`.closures.equalities_on`, put on the port): its ``qacc`` and
+        its equality rows' ``efc_pos``, ``efc_J``, ``efc_force`` in MuJoCo's order. A's
+        diagonal, from which its soft model forms R, is MuJoCo's ``efc_diagA``: the compiled
+        model's inverse weights at ``qpos0``, which the port holds as MuJoCo compiled them.
+        Its accuracy: how far its answer leaves its own soft rows, |J v̇ − a_ref + R f| with
+        its own R = 1/``efc_D`` (its solver iterates in its precision: float32 in MJX's and
+        MuJoCo Warp's default)."""
+        if self._closing is None:
+            self._closing = self._port_type().on_model(
+                _collisionless(closures.equalities_on(self._closed)), name=self.engine)
+        raw = self._closing.equality_rows(q, v, tau)
+        diagonal = closures.closed(self._closed, q, v, tau).diagonal
+        rate = np.einsum("smn,sn->sm", raw["J"], raw["qacc"])
+        left = rate - raw["aref"] + raw["force"] / np.where(raw["D"] > 0, raw["D"], np.inf)
+        return ClosedReading(value=raw["pos"], jacobian=raw["J"], vdot=raw["qacc"],
+                             force=raw["force"], diagonal=diagonal,
+                             accuracy=float(np.abs(left).max(initial=0.0)))
+
+    def closed_derivatives(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """Never the C engine's (which this class would inherit)."""
+        raise Unsupported(f"{self.engine}: its derivatives with the file's constraints are "
+                          "not taken here")
 
     def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
         raise Unsupported(f"{self.engine}: {self.no_body_forces}")

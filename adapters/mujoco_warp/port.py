@@ -155,6 +155,35 @@ class MujocoWarpPort(Port):
             return {"qfrc_actuator": self.dw.qfrc_actuator.numpy().copy(),
                     "qacc": self.dw.qacc.numpy().copy()}
 
+    def _equality_batch(self, q: np.ndarray, v: np.ndarray,
+                        tau: np.ndarray) -> dict[str, np.ndarray]:
+        """Its ``efc`` rows of type equality ordered by their equality (``efc.id``), its
+        dense ``efc.J`` (a sparse one is refused)."""
+        if getattr(self.mw, "is_sparse", False):
+            raise Unsupported("mujoco-warp holds this model's constraint Jacobian sparse: "
+                              "its rows are not read here")
+        with wp.ScopedDevice(self.device):
+            self._assign("qpos", q)
+            self._assign("qvel", v)
+            self._assign("qfrc_applied", tau)
+            mjw.forward(self.mw, self.dw)
+            kind, ident, pos, jac, force, aref, weight = (x.numpy() for x in (
+                self.dw.efc.type, self.dw.efc.id, self.dw.efc.pos, self.dw.efc.J,
+                self.dw.efc.force, self.dw.efc.aref, self.dw.efc.D))
+            nefc, qacc = self.dw.nefc.numpy(), self.dw.qacc.numpy().copy()
+        equality = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+        picked = []
+        for w in range(CHUNK):
+            rows = np.flatnonzero(kind[w, : nefc[w]] == equality)
+            picked.append(rows[np.argsort(ident[w, rows], kind="stable")])
+        if len({len(r) for r in picked}) != 1:
+            raise Unsupported("mujoco-warp made another number of equality rows in one world")
+        at = np.arange(CHUNK)[:, None]
+        rows = np.array(picked)
+        return {"qacc": qacc, "pos": pos[at, rows],  # (its J's columns padded past nv)
+                "J": jac[at, rows][..., : self.model.nv], "force": force[at, rows],
+                "aref": aref[at, rows], "D": weight[at, rows]}
+
     def _efc_equality(self) -> np.ndarray:
         """efc.force of the equality rows, in equality order, per world."""
         neq = self.model.neq

@@ -314,13 +314,14 @@ def _reference_spread(tree: ModelTree, states: ClosedStates, *, reach: float,
                       rows: float) -> float:
     """How far two implementations' reference accelerations a_ref = −b ṙ − k d r may lie
     apart at the states: each rounds the leftover r (≤ |C| + 64 ε reach) and ṙ (≤ |J v| +
-    64 ε |J| |v|) its own way (0 where no closure is soft)."""
+    64 ε |J| |v|) its own way, ε the engine's (0 where no closure is soft)."""
     soft = [softness(c) for c in tree.closures if c.soft]
     if not soft:
         return 0.0
     speed = float(np.abs(states.v).max(initial=0.0))
-    rate = states.rate + ROUNDOFF_FACTOR * EPS * rows * speed
-    residual = states.residual + ROUNDOFF_FACTOR * EPS * max(reach, 1.0)
+    eps = max(EPS, tree.eps)  # (a float32 engine rounds the state itself)
+    rate = states.rate + ROUNDOFF_FACTOR * eps * rows * speed
+    residual = states.residual + ROUNDOFF_FACTOR * eps * max(reach, 1.0)
     return max(s.damping for s in soft) * rate + max(s.stiffness for s in soft) * residual
 
 
