@@ -112,3 +112,30 @@ def closed(mimics: Mimics, nv: int, q: np.ndarray, v: np.ndarray, *,
                     for c in mimics.couplings]
     return ClosedReading(value=value, jacobian=np.broadcast_to(jac, (s, rows, nv)).copy(),
                          vdot=vdot, force=np.zeros((s, rows)), diagonal=np.zeros((s, rows)))
+
+
+def derivatives(mimics: Mimics, nv: int, q: np.ndarray, v: np.ndarray, *,
+                tau: np.ndarray) -> np.ndarray:
+    """∂v̇/∂(q, v) of :func:`closed` (S, 2, nv, 2 nv: analytic, the same at both "steps"),
+    by ``computeABADerivatives`` on its mimic model: v̇ = G v̇ᵣ(qᵣ, vᵣ, Gᵀ τ), so its
+    columns are the leaders' (a follower's coordinates do not enter it). Pinocchio refusing
+    the mimic joints in that algorithm is its limit, in its own words."""
+    m = mimics.model
+    d = m.createData()
+    g = np.zeros((nv, m.nv))
+    g[mimics.v_of, np.arange(m.nv)] = 1.0
+    for c in mimics.couplings:
+        g[c.v] = c.scaling * g[c.leader_v]
+    out = np.zeros((len(q), 2, nv, 2 * nv))
+    for i in range(len(q)):
+        try:
+            pin.computeABADerivatives(m, d, q[i, mimics.q_of], v[i, mimics.v_of],
+                                      g.T @ tau[i])
+        except RuntimeError as exc:
+            raise Unsupported(f"pinocchio {pin.__version__} offers no derivatives with its "
+                              f"mimic joints: computeABADerivatives on its mimic model says "
+                              f"{' '.join(str(exc).split())!r} (measured)") from None
+        leaders = np.asarray(mimics.v_of)
+        out[i, :, :, leaders] = g @ d.ddq_dq
+        out[i, :, :, nv + leaders] = g @ d.ddq_dv
+    return out

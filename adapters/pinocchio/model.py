@@ -404,8 +404,7 @@ class PinocchioModel(ModelEngine):
     def closed_derivatives(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """Its own derivatives of its constrained dynamics (:func:`.closures.derivatives`)."""
         if self._mimics is not None:
-            raise Unsupported("pinocchio: the derivatives of its mimic joints' dynamics are "
-                              "not compared (dyncheck drives none yet)")
+            return mimic.derivatives(self._mimics, self.model.nv, q, v, tau=tau)
         return closures.derivatives(self.model, self._held, q, v, tau=tau)
 
     def couple(self, couplings: Sequence[Coupling]) -> None:

@@ -141,7 +141,10 @@ def _engine_rows(model: str, name: str, engine: ModelEngine, states: closures.Cl
     canon = layout.canonical(canonical_tree)
     try:
         tree, reading = in_canonical(canon, engine, states, tau)
-    except (EngineError, Unsupported) as exc:
+    except Unsupported as exc:  # (what it, or dyncheck, does not compute: said as such)
+        return [_row(model, subject="model", field="closed dynamics", engine=name,
+                     verdict=Verdict.SKIPPED, note=str(exc))]
+    except EngineError as exc:
         return [_row(model, subject="model", field="closed dynamics", engine=name,
                      verdict=Verdict.FAILED, note=f"{name} failed: {exc}")]
     found = closures.measure(tree, reading, states, tau=tau, reach=size)

@@ -142,3 +142,18 @@ def test_pinocchios_row_says_whether_its_routine_is_its_own_dynamics_derivative(
     else:
         assert row["verdict"] == "failed"
         assert "not the derivative of its own constrained dynamics" in row["note"]
+
+
+def test_pinocchios_mimic_derivatives_are_its_own_or_its_limit_in_its_words(tmp_path):
+    """The URDF gripper's mimic joint: Pinocchio 4.1 refuses mimic joints in
+    ``computeABADerivatives``: one skipped row quoting it (measured on its mimic model); a
+    Pinocchio that takes them is compared on the manifold like any rigid reading and must
+    agree (its derivatives of the reduced ABA are those of its own mimic dynamics)."""
+    if Offer.CLOSED_DERIVATIVES not in loader("pinocchio").offers:
+        pytest.skip("pinocchio offers no derivatives of its constrained dynamics")
+    row = _row("pinocchio", "mimic", tmp_path)
+    if row["verdict"] == "skipped":
+        assert "computeABADerivatives on its mimic model says 'This algorithm does not " \
+               "support Joint Mimic" in row["note"] and "(measured)" in row["note"]
+    else:
+        assert row["verdict"] == "passed", row["note"]
