@@ -146,6 +146,10 @@ def equalities_on(m: mujoco.MjModel) -> mujoco.MjModel:
     on.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
     on.opt.disableflags |= int(_OFF_BUT_EQUALITIES)
     on.opt.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
+    on.opt.cone = mujoco.mjtCone.mjCONE_PYRAMIDAL  # (contacts off: the cone enters no row;
+    # MJX's solver with elliptic cones fails on a model without contact rows, indexing its
+    # empty list of them: "Indexer must have integer or boolean type", dm_control's
+    # manipulator and stacker)
     return on
 
 

@@ -196,7 +196,9 @@ class MujocoWarpPort(Port):
         nefc = self.dw.nefc.numpy()
         for w in range(CHUNK):
             rows = np.flatnonzero(kind[w, : nefc[w]] == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY))
-            out[w] = force[w, rows[np.argsort(ident[w, rows], kind="stable")]]
+            if len(rows):  # (none where the model computes with its equalities off: a check's
+                # smooth dynamics; dm_control's quadruped failed here, "could not broadcast")
+                out[w] = force[w, rows[np.argsort(ident[w, rows], kind="stable")]]
         return out
 
     batches_steps: ClassVar[bool] = True

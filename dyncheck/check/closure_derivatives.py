@@ -10,9 +10,9 @@ compared along it (:func:`along`), as is a weld holding a rotation (:func:`on_ma
 Compared in MuJoCo's chart (the canonical layout's): q ⊕ δ adds on hinges and slides, moves
 a free body by its world displacement and turns a ball or a free body by exp(δ) in its own
 axes (``mj_integratePos``; the referee's :func:`~dyncheck.reference.closure.retract`). An
-engine whose velocities on a rotating joint are not the canonical ones (a permutation of
-them) differentiates in another chart, which is not mapped here yet: one skipped row says
-so. The tolerance is measured, not chosen: each side's
+engine holding other velocities (Pinocchio's free flyer: its linear velocity in the body's
+axes) differentiates in its own chart, mapped into MuJoCo's (:func:`_mapped`). The
+tolerance is measured, not chosen: each side's
 finite-difference error is bounded by twice the gap g between its differences at its step δ
 and at 2δ — where truncation (∝ δ²) dominates, the error of the finer is g/3; where round-off
 (∝ 1/δ) does, at most 2g (errors of one sign: c/δ − c/2δ = g) — plus 64 ε; the error is
@@ -47,6 +47,15 @@ STEP = 1e-7
 model's impedance changes (solimp's width, 1e-3 m by default; truncation ~ (δ/width)²),
 large against round-off (ε |v̇| / δ). Measured on the four-bar's q block: the gap between its
 differences at δ and 2δ is 5.9e-5 at 1e-7, against 1.5e-4 at 1e-8 and 0.60 at 1e-5."""
+OWN_STEP = 1e-4
+"""The step of the engine's own differences where its derivatives are not the referee's
+(:func:`_why`): its forward dynamics may come from an iterative solver exact only to its
+stopping accuracy (Pinocchio's proximal solver on the four-bar on a free base: 1.6e-7 m/s²
+apart between nearby states, measured), which at the referee's step would swamp the
+differences; at 1e-4 that is 1.6e-3 of them, truncation ~1e-8."""
+MAP_STEP = 1e-6
+"""The central-difference step of the layout map's own derivatives (:func:`_map_rates`):
+truncation ~1e-12, round-off ~1e-10 of its entries (order one)."""
 BASIS = "2 x each side's finite-difference gap between its step and twice it, + 64 eps"
 SPREAD_FACTOR = 2.0
 """A central difference's error per unit of its gap to the one at twice the step (round-off
@@ -62,15 +71,15 @@ def _row(model: str, engine: str, *, verdict: Verdict, note: str, error: float =
                     basis=BASIS if tolerance else "", verdict=verdict, note=note)
 
 
-def _perturbed(tree: ModelTree, q: np.ndarray,
-               v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Every state moved by ±δ and ±2δ (:data:`STEP`) along each q direction of MuJoCo's
+def _perturbed(tree: ModelTree, q: np.ndarray, v: np.ndarray, *,
+               step: float = STEP) -> tuple[np.ndarray, np.ndarray]:
+    """Every state moved by ±δ and ±2δ (``step``) along each q direction of MuJoCo's
     chart (the referee's ``retract``) and each v coordinate: (S · 2 steps · 2 signs · 2 nv)
     states."""
     s, nv = v.shape
     cols = np.eye(2 * nv)
-    shift = np.array([[sign * step * cols for sign in (1.0, -1.0)]
-                      for step in (STEP, 2 * STEP)])  # (2 steps, 2 signs, 2nv, 2nv)
+    shift = np.array([[sign * size * cols for sign in (1.0, -1.0)]
+                      for size in (step, 2 * step)])  # (2 steps, 2 signs, 2nv, 2nv)
     count = shift.shape[0] * shift.shape[1] * shift.shape[2]
     dq = np.broadcast_to(shift[None, ..., :nv], (s, *shift.shape[:3], nv)).reshape(-1, nv)
     solver = TreeDynamics(bodies(tree), tree.gravity)
@@ -78,10 +87,10 @@ def _perturbed(tree: ModelTree, q: np.ndarray,
             (v[:, None, None, None, :] + shift[None, ..., nv:]).reshape(-1, nv))
 
 
-def differences(vdot: np.ndarray, s: int, nv: int) -> np.ndarray:
+def differences(vdot: np.ndarray, s: int, nv: int, *, step: float = STEP) -> np.ndarray:
     """Central differences (S, 2, nv, 2 nv) of v̇ at the :func:`_perturbed` states."""
     found = vdot.reshape(s, 2, 2, 2 * nv, nv)
-    steps = np.array([STEP, 2 * STEP])[None, :, None, None]
+    steps = np.array([step, 2 * step])[None, :, None, None]
     return np.swapaxes((found[:, :, 0] - found[:, :, 1]) / (2 * steps), 2, 3)
 
 
@@ -151,21 +160,15 @@ def rows(model: str, name: str, engine: ModelEngine, states: closures.ClosedStat
     constrained v̇ at canonical states (to measure, where it differs, whether its derivatives
     are those of its own forward dynamics)."""
     q, v = states.q[:STATES], states.v[:STATES]
-    maps, q_e, v_e, _ = layout_batch.engine_states(canon, engine.tree, q, v, np.zeros_like(v))
-    t = np.array([m.t for m in maps])
-    other = _other_chart(tree, t)
-    if other:
-        return [_row(model, name, verdict=Verdict.SKIPPED, note=(
-            f"{name}'s derivatives with its constraints are not compared on this model: its "
-            f"velocities of {other!r} are not MuJoCo's, so it differentiates in another "
-            "chart (mapped between charts on hinges and slides only, as yet)"))]
+    _, q_e, v_e, _ = layout_batch.engine_states(canon, engine.tree, q, v, np.zeros_like(v))
     try:
         found = engine.closed_derivatives(q_e, v_e, np.zeros_like(v_e))
     except Unsupported as exc:
         return [_row(model, name, verdict=Verdict.SKIPPED, note=str(exc))]
     except EngineError as exc:
         return [_row(model, name, verdict=Verdict.FAILED, note=f"{name} failed: {exc}")]
-    mine = _mapped(t, found)
+    mine = _mapped(canon, engine.tree, tree, q=q, v=v, found=found,
+                   vdot=reading.vdot[: len(q)])
     ref, jac, turn = _referee(tree, q, v,
                               reading.diagonal[: len(q), closures.engine_rows(tree)])
     if on_manifold(tree):
@@ -176,22 +179,8 @@ def rows(model: str, name: str, engine: ModelEngine, states: closures.ClosedStat
                  error=error, tolerance=tolerance,
                  note="∂v̇/∂(q, v) with its constraints, against the referee's (central "
                       "differences of its constrained method on this reading)" if ok else
-                      _why(tree, mine, ref, own(*_perturbed(tree, q, v)), jac=jac,
-                           turn=turn))]
-
-
-def _other_chart(tree: ModelTree, t: np.ndarray) -> str:
-    """The first rotating joint (ball, free) whose engine velocities are not the canonical
-    ones, permuted (T's columns there not each a single 1, at every state); empty: none."""
-    for j in tree.joints:
-        if j.layout.nv == 1 and j.layout.nq == 1:
-            continue
-        cols = t[:, :, j.layout.v_start : j.layout.v_start + j.layout.nv]
-        ones = np.round(cols)
-        if np.abs(cols - ones).max(initial=0.0) > 1e-12 or (ones < 0).any() or \
-                (np.abs(ones).sum(axis=1) != 1).any():
-            return j.name
-    return ""
+                      _why(tree, mine, ref, own(*_perturbed(tree, q, v, step=OWN_STEP)),
+                           jac=jac, turn=turn))]
 
 
 def _why(tree: ModelTree, mine: np.ndarray, ref: np.ndarray, vdot: np.ndarray, *,
@@ -200,7 +189,7 @@ def _why(tree: ModelTree, mine: np.ndarray, ref: np.ndarray, vdot: np.ndarray, *
     own forward dynamics are the referee's, its derivative routine is not the derivative of
     its own dynamics (measured, with both sizes); else the cause is unknown."""
     s, nv = jac.shape[0], tree.nv
-    theirs = differences(vdot, s, nv)
+    theirs = differences(vdot, s, nv, step=OWN_STEP)
     if on_manifold(tree):
         theirs = along(theirs, jac, turn)
     k = mine.shape[3] // 2
@@ -215,15 +204,48 @@ def _why(tree: ModelTree, mine: np.ndarray, ref: np.ndarray, vdot: np.ndarray, *
             "engine's, measured")
 
 
-def _mapped(t: np.ndarray, found: np.ndarray) -> np.ndarray:
-    """The engine's derivatives in the canonical layout: T⁻¹ D blockdiag(T, T) (T constant
-    on hinges and slides, a permutation on the rotating joints compared)."""
+def _map_rates(canon: Canonical, engine_tree: ModelTree, tree: ModelTree, *, q: np.ndarray,
+               v: np.ndarray) -> tuple[np.ndarray, ...]:
+    """T (S, nv_e, nv) of v_e = T v at the states, and by central differences of the layout
+    map (dyncheck's own smooth arithmetic, step :data:`MAP_STEP`) ∂T/∂δ (S, nv_e, nv, nv)
+    along each direction δ of the canonical chart, ∂(Ṫ v)/∂δ and ∂(Ṫ v)/∂v (S, nv_e, nv)."""
+    s, nv = v.shape
+    solver = TreeDynamics(bodies(tree), tree.gravity)
+
+    def at(qq: np.ndarray, vv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        maps = layout_batch.engine_states(canon, engine_tree, qq, vv, np.zeros_like(vv))[0]
+        return np.array([m.t for m in maps]), np.array([m.tdot_v for m in maps])
+
+    t, _ = at(q, v)
+    d_t = np.zeros((*t.shape, nv))
+    d_rate_q, d_rate_v = np.zeros((s, t.shape[1], nv)), np.zeros((s, t.shape[1], nv))
+    for k in range(nv):
+        step = np.zeros((s, nv))
+        step[:, k] = MAP_STEP
+        (ahead, rate_a), (behind, rate_b) = (at(retract(solver, q, sign * step), v)
+                                             for sign in (1.0, -1.0))
+        d_t[..., k] = (ahead - behind) / (2 * MAP_STEP)
+        d_rate_q[..., k] = (rate_a - rate_b) / (2 * MAP_STEP)
+        d_rate_v[..., k] = (at(q, v + step)[1] - at(q, v - step)[1]) / (2 * MAP_STEP)
+    return t, d_t, d_rate_q, d_rate_v
+
+
+def _mapped(canon: Canonical, engine_tree: ModelTree, tree: ModelTree, *, q: np.ndarray,
+            v: np.ndarray, found: np.ndarray, vdot: np.ndarray) -> np.ndarray:
+    """The engine's derivatives (its layout, its chart) in the canonical ones. With
+    v_e = T v, v̇ = T⁻¹ (v̇_e − Ṫ v), and its chart moving q along its own velocities
+    (δ_e = T δ: Pinocchio's ``integrate``, MuJoCo's ``mj_integratePos``):
+    ∂v̇/∂δ = T⁻¹ (D_q T + D_v (∂T/∂δ) v − ∂(Ṫ v)/∂δ − (∂T/∂δ) v̇) and
+    ∂v̇/∂v = T⁻¹ (D_v T − ∂(Ṫ v)/∂v); on hinges and slides T is constant and Ṫ v = 0."""
     s, _, nv_e, _ = found.shape
-    nv = t.shape[2]
-    out = np.zeros((s, 2, nv, 2 * nv))
+    nv = v.shape[1]
+    t, d_t, d_rate_q, d_rate_v = _map_rates(canon, engine_tree, tree, q=q, v=v)
     pinv = np.linalg.pinv(t)
+    turned_v = np.einsum("senk,sn->sek", d_t, v)
+    turned_vdot = np.einsum("senk,sn->sek", d_t, vdot)
+    out = np.zeros((s, 2, nv, 2 * nv))
     for k in range(2):
-        d = found[:, k]
-        out[:, k, :, :nv] = pinv @ d[:, :, :nv_e] @ t
-        out[:, k, :, nv:] = pinv @ d[:, :, nv_e:] @ t
+        d_q, d_v = found[:, k, :, :nv_e], found[:, k, :, nv_e:]
+        out[:, k, :, :nv] = pinv @ (d_q @ t + d_v @ turned_v - d_rate_q - turned_vdot)
+        out[:, k, :, nv:] = pinv @ (d_v @ t - d_rate_v)
     return out

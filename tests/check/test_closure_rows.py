@@ -132,3 +132,21 @@ def test_a_loop_that_cannot_close_is_named_with_its_gap(tmp_path):
     assert "'tips'" in note
     gap = float(note.split("than |C| = ")[1].split(":")[0])
     assert gap >= 0.4 - 1e-9
+
+
+def test_a_bound_that_allows_any_answer_judges_nothing(four_bar, monkeypatch):
+    """A round-off bound of the accelerations' whole scale or more (a float32 port on an
+    ill-conditioned model: MJX on dm_control's manipulator, 4.7) cannot fail: one skipped
+    forward row says so with the bound, instead of a soft and a rigid row that pass whatever
+    the engine computes. Planted: MuJoCo's bound set to 2."""
+    from dyncheck.check import closure_rows
+
+    honest = closure_rows.closures.measure
+    monkeypatch.setattr(closure_rows.closures, "measure",
+                        lambda *a, **k: replace(honest(*a, **k), bound=2.0))
+    result = check_model(four_bar, impls=("mujoco", "reference"), states=STATES,
+                         isolate=False)
+    mine = _section(result, "mujoco").set_index("subject")
+    assert "forward (soft)" not in mine.index and "forward (rigid)" not in mine.index
+    assert mine.loc["forward", "verdict"] == "skipped"
+    assert "allows any answer" in mine.loc["forward", "note"]
