@@ -29,7 +29,7 @@ import numpy as np
 
 from dyncheck.adapters import linalg
 from dyncheck.adapters.closures import ClosedReading, Closure, ClosureKind
-from dyncheck.errors import Unsupported
+from dyncheck.errors import EngineError, Unsupported
 
 
 def loops(m: Any) -> frozenset[int]:
@@ -70,6 +70,20 @@ def mimics(m: Any) -> tuple[Mimic, ...]:
         out += [(j, int(lead), float(coeffs[j][0]), float(coeffs[j][1]))
                 for j, lead in enumerate(owned.numpy()) if lead >= 0]
     return tuple(out)
+
+
+def urdf_mimics(load: Callable[[], Any], labels: list[str]) -> tuple[tuple[Mimic, ...], str]:
+    """A URDF's ``<mimic>`` joints from ``load``, a second load of the file with them (its
+    Featherstone solver enforces them: the smooth dynamics' model, whose joint ``labels``
+    these are, leaves them out), or why Newton refused them (talos_left_arm: a fixed joint
+    mimicking a hinge)."""
+    try:
+        mimicked = load()
+    except EngineError as exc:
+        return (), f"{exc} (with its <mimic> joints)"
+    if list(mimicked.joint_label) != labels:
+        return (), "newton read the URDF's joints otherwise with its <mimic> kept"
+    return mimics(mimicked), ""
 
 
 def unheld(kinds: list[str], *, loops: int, mimics: int) -> tuple[tuple[str, str], ...]:

@@ -151,7 +151,10 @@ class NewtonModel(ModelEngine):
         self.held = newton_closures.held(m, self.loops, {
             int(newton.JointType.BALL): ClosureKind.CONNECT,
             int(newton.JointType.FIXED): ClosureKind.WELD})
-        self.mimics = newton_closures.mimics(m) + self._urdf_mimics(source)
+        urdf, self._mimics_refused = newton_closures.urdf_mimics(
+            lambda: _load(replace(source, text=source.closed_text))[0], list(m.joint_label)
+        ) if source.format is Format.URDF and source.closed_text else ((), "")
+        self.mimics = newton_closures.mimics(m) + urdf
         self.state = m.state()
         notes: tuple[str, ...] = (
             f"newton: {newton.__version__} on Warp's {DEVICE} device, float32",)
@@ -159,17 +162,6 @@ class NewtonModel(ModelEngine):
             notes += ("newton: add_urdf(floating=True): a free joint at the URDF root",)
         self._corrected = corrected
         self.tree = self._tree(notes)
-
-    def _urdf_mimics(self, source: ModelFile) -> tuple[newton_closures.Mimic, ...]:
-        """A URDF's ``<mimic>`` joints as Newton reads them: the file with them loaded a
-        second time (its Featherstone solver steps a mimicking joint as its leader's: the
-        tree every engine's smooth dynamics are checked on leaves them out)."""
-        if source.format is not Format.URDF or not source.closed_text:
-            return ()
-        mimicked, _ = _load(replace(source, text=source.closed_text))
-        if list(mimicked.joint_label) != list(self.model.joint_label):
-            raise Unsupported("newton read the URDF's joints otherwise with its <mimic> kept")
-        return newton_closures.mimics(mimicked)
 
     def _name(self, joint: int) -> str:
         return _last(self.model.joint_label[joint])
@@ -285,6 +277,9 @@ class NewtonModel(ModelEngine):
         closures = newton_closures.read(
             self.model, self.held, self.mimics, bodies=bodies, pose=_pose, name=self._name,
             mover=lambda b: None if (j := mover(b)) is None else self._name(j))
+        if self._mimics_refused:
+            return replace(tree, closures=closures, closures_read=False, notes=(
+                *tree.notes, f"{self._mimics_refused}: its constraints are not read"))
         return replace(tree, closures=closures, closures_read=True,
                        closures_unheld=newton_closures.unheld(
                            self._equalities, loops=len(self.held),

@@ -93,3 +93,19 @@ def test_newtons_rows_and_their_rate_are_the_referees(name, tmp_path):
     rate = drift + np.einsum("smn,sn->sm", jac, tdot_v)
     speed = np.abs(states.v).max(axis=1) ** 2
     assert (np.abs(rate[:, pick] - ref.bias).max(axis=1) <= bound * speed).all()
+
+
+def test_a_mimic_newton_refuses_costs_only_its_constraints(tmp_path):
+    """talos_left_arm's gripper holds a fixed joint mimicking a hinge, which Newton 1.8's
+    ``set_joint_mimic`` refuses ("Mimic followers and references only support PRISMATIC,
+    REVOLUTE, D6 joints"). The file without its <mimic> still loads for the smooth dynamics
+    (as before the mimics were read); its constraints are said not read, in its words."""
+    from tests.check.test_closures import MIMIC
+
+    path = tmp_path / "gripper.urdf"
+    path.write_text(MIMIC.replace('<joint name="right" type="prismatic">',
+                                  '<joint name="right" type="fixed">'))
+    newton = NewtonModel(read(path))
+    assert not newton.tree.closures_read
+    said = [n for n in newton.tree.notes if n.endswith("its constraints are not read")]
+    assert len(said) == 1 and "Mimic followers and references only support" in said[0]
