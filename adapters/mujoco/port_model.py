@@ -103,11 +103,7 @@ class PortModel(MujocoModel):
         posed = (ClosureKind.CONNECT, ClosureKind.WELD)
         if not any(c.kind in posed for c in tree.closures):
             return tree
-        probe = mujoco.MjModel.from_xml_string(JDOTV_PROBE)
-        port = self._port_type().on_model(closures.equalities_on(probe), name=self.engine)
-        one = np.ones((1, 1))
-        held = bool(port.equality_rows(np.zeros((1, 1)), one, np.zeros((1, 1)))["aref"][0, 0]
-                    > 0.5)
+        held = _jdotv_held(self._port_type(), self.engine)
         if held == JDOTV_IN_REFERENCE:
             return tree
         said = "holds" if held else "leaves out"
@@ -287,6 +283,17 @@ class PortModel(MujocoModel):
         runs = self.port.run_many(np.asarray(q0), np.asarray(v0), dts=dts, steps=steps,
                                   integrator=integrator)
         return [(q.astype(float), v.astype(float)) for q, v in runs]
+
+
+@cache
+def _jdotv_held(kind: type[Port], engine: str) -> bool:
+    """Whether the port's soft connect holds −J̇ v in its reference acceleration: the radial
+    row's ``aref`` of :data:`.api.JDOTV_PROBE` on it (a property of the port, probed once a
+    process, not once a model)."""
+    probe = mujoco.MjModel.from_xml_string(JDOTV_PROBE)
+    port = kind.on_model(closures.equalities_on(probe), name=engine)
+    rows = port.equality_rows(np.zeros((1, 1)), np.ones((1, 1)), np.zeros((1, 1)))
+    return bool(rows["aref"][0, 0] > 0.5)
 
 
 @cache
