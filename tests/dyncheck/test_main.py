@@ -33,11 +33,14 @@ they load, whatever the machine's speed."""
 
 
 def _children(pid: int) -> list[int]:
+    """The children of ``pid``'s threads; a thread (or the process) that ends while they are
+    read counts none (a race found in CI: the thread listed, its file gone when opened)."""
     found = []
     for task in Path(f"/proc/{pid}/task").glob("*"):
-        children = task / "children"
-        if children.exists():
-            found += [int(c) for c in children.read_text().split()]
+        try:
+            found += [int(c) for c in (task / "children").read_text().split()]
+        except (FileNotFoundError, ProcessLookupError):
+            continue
     return found
 
 
