@@ -38,6 +38,7 @@ from mujoco import mjx
 
 from dyncheck.adapters.mujoco.api import INTEGRATORS
 from dyncheck.adapters.mujoco.port import STEPS, Port
+from dyncheck.adapters.mujoco.rows import rows_of
 from dyncheck.errors import Unsupported
 from dyncheck.settings import current
 
@@ -132,8 +133,7 @@ def equality_order(m: mujoco.MjModel) -> np.ndarray:
                           "tendon is not among its constraint rows")
     rows, start = {}, 0
     for kind in kinds:
-        size = {int(mujoco.mjtEq.mjEQ_CONNECT): 3, int(mujoco.mjtEq.mjEQ_WELD): 6}.get(
-            int(kind), 1)
+        size = rows_of(kind)
         for e in np.flatnonzero(m.eq_type == kind):
             rows[int(e)] = np.arange(start, start + size)
             start += size

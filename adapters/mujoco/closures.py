@@ -22,6 +22,7 @@ import numpy as np
 
 from dyncheck.adapters.closures import ClosedReading, Closure, ClosureKind
 from dyncheck.adapters.mujoco.api import JDOTV_IN_REFERENCE
+from dyncheck.adapters.mujoco.rows import equality_rows, rows_of
 
 _OFF_BUT_EQUALITIES = (mujoco.mjtDisableBit.mjDSBL_CONTACT | mujoco.mjtDisableBit.mjDSBL_LIMIT
                        | mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS)
@@ -153,6 +154,18 @@ def equalities_on(m: mujoco.MjModel) -> mujoco.MjModel:
     return on
 
 
+def diagonal(m: mujoco.MjModel) -> np.ndarray:
+    """A's diagonal on the active equalities' rows, as MuJoCo forms its soft model's R from it
+    (``efc_diagA``, in equality order): ``mj_diagApprox`` builds it from the compiled model's
+    inverse weights at ``qpos0`` (``body_invweight0``, ``dof_invweight0``), so it is one
+    vector per model, read at ``qpos0`` (measured constant over states on the closure tests'
+    models)."""
+    on = equalities_on(m)
+    d = mujoco.MjData(on)
+    mujoco.mj_forward(on, d)
+    return d.efc_diagA[equality_rows(d.efc_type, d.efc_id, d.nefc)].copy()
+
+
 def closed_derivatives(m: mujoco.MjModel, q: np.ndarray, v: np.ndarray, tau: np.ndarray, *,
                        step: float) -> np.ndarray:
     """∂v̇/∂(q, v) of its dynamics with its equalities alone on (S, 2, nv, 2 nv: at
@@ -182,16 +195,14 @@ def closed(m: mujoco.MjModel, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> 
     friction loss off; dense Jacobians), one ``mj_forward`` per state, ``qfrc_applied`` τ."""
     on = equalities_on(m)
     d = mujoco.MjData(on)
-    rows = sum(6 if t == mujoco.mjtEq.mjEQ_WELD else 3 if t == mujoco.mjtEq.mjEQ_CONNECT else 1
-               for t, active in zip(on.eq_type, on.eq_active0, strict=True) if active)
+    rows = sum(rows_of(t) for t, active in zip(on.eq_type, on.eq_active0, strict=True) if active)
     s, nv = len(q), on.nv
     value, force, diagonal = (np.zeros((s, rows)) for _ in range(3))
     jacobian, vdot = np.zeros((s, rows, nv)), np.zeros((s, nv))
     for k in range(s):
         d.qpos[:], d.qvel[:], d.qfrc_applied[:] = q[k], v[k], tau[k]
         mujoco.mj_forward(on, d)
-        picked = np.flatnonzero(d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
-        picked = picked[np.argsort(d.efc_id[picked], kind="stable")]
+        picked = equality_rows(d.efc_type, d.efc_id, d.nefc)
         value[k], force[k] = d.efc_pos[picked], d.efc_force[picked]
         diagonal[k] = d.efc_diagA[picked]
         jacobian[k] = d.efc_J.reshape(d.nefc, nv)[picked] if d.nefc else 0.0

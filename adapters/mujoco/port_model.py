@@ -254,7 +254,7 @@ class PortModel(MujocoModel):
             self._closing = self._port_type().on_model(
                 _collisionless(closures.equalities_on(self._closed)), name=self.engine)
         raw = self._closing.equality_rows(q, v, tau)
-        diagonal = closures.closed(self._closed, q, v, tau).diagonal
+        diagonal = np.broadcast_to(closures.diagonal(self._closed), raw["force"].shape)
         rate = np.einsum("smn,sn->sm", raw["J"], raw["qacc"])
         left = rate - raw["aref"] + raw["force"] / np.where(raw["D"] > 0, raw["D"], np.inf)
         return ClosedReading(value=raw["pos"], jacobian=raw["J"], vdot=raw["qacc"],

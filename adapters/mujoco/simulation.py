@@ -29,6 +29,7 @@ import numpy as np
 
 from dyncheck.adapters.base import Field
 from dyncheck.adapters.mujoco.api import INTEGRATORS, SPRINGS_APART, SPRINGS_OFF
+from dyncheck.adapters.mujoco.rows import equality_rows
 from dyncheck.cases.multibody import Coupling
 from dyncheck.errors import EngineError, Unsupported
 from dyncheck.vocabulary import Integrator
@@ -126,8 +127,7 @@ class MujocoRun:
         vdot, forces = np.empty((len(q), self.model.nv)), np.empty((len(q), self.model.neq))
         for k in self._forwards(q, v, tau):
             vdot[k] = d.qacc
-            rows = np.flatnonzero(d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
-            forces[k] = d.efc_force[rows[np.argsort(d.efc_id[rows], kind="stable")]]
+            forces[k] = d.efc_force[equality_rows(d.efc_type, d.efc_id, d.nefc)]
         return vdot, forces
 
     def _pushed(self, field: Field, out: np.ndarray) -> np.ndarray:

@@ -35,6 +35,7 @@ import warp as wp
 
 from dyncheck.adapters.mujoco.api import INTEGRATORS
 from dyncheck.adapters.mujoco.port import CHUNK, Port
+from dyncheck.adapters.mujoco.rows import equality_rows
 from dyncheck.errors import Unsupported
 from dyncheck.settings import current
 
@@ -171,11 +172,7 @@ class MujocoWarpPort(Port):
                 self.dw.efc.type, self.dw.efc.id, self.dw.efc.pos, self.dw.efc.J,
                 self.dw.efc.force, self.dw.efc.aref, self.dw.efc.D))
             nefc, qacc = self.dw.nefc.numpy(), self.dw.qacc.numpy().copy()
-        equality = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
-        picked = []
-        for w in range(CHUNK):
-            rows = np.flatnonzero(kind[w, : nefc[w]] == equality)
-            picked.append(rows[np.argsort(ident[w, rows], kind="stable")])
+        picked = [equality_rows(kind[w], ident[w], nefc[w]) for w in range(CHUNK)]
         if len({len(r) for r in picked}) != 1:
             raise Unsupported("mujoco-warp made another number of equality rows in one world")
         at = np.arange(CHUNK)[:, None]
@@ -195,10 +192,10 @@ class MujocoWarpPort(Port):
         )
         nefc = self.dw.nefc.numpy()
         for w in range(CHUNK):
-            rows = np.flatnonzero(kind[w, : nefc[w]] == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY))
+            rows = equality_rows(kind[w], ident[w], nefc[w])
             if len(rows):  # (none where the model computes with its equalities off: a check's
                 # smooth dynamics; dm_control's quadruped failed here, "could not broadcast")
-                out[w] = force[w, rows[np.argsort(ident[w, rows], kind="stable")]]
+                out[w] = force[w, rows]
         return out
 
     batches_steps: ClassVar[bool] = True
