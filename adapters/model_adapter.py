@@ -116,6 +116,17 @@ class ModelAdapter(Adapter):
         self.canon, self._carriers = self._canonical(model)
         self._unavailable: dict[str, str] = {}
 
+    def as_read(self, model: str) -> ModelEngine | None:
+        """Its engine where it is loader ``model`` (``module:class``) on the case's MJCF read
+        as a user's file is — no loader option, not read as stated — so that another study
+        of the case (its derivative rows) computes on it instead of loading the file again;
+        else None. Its couplings leave its smooth dynamics as they were (each loader's
+        derivatives and step Jacobians are of the smooth tree)."""
+        plain = (self.run_format is Format.MJCF and not self.as_stated
+                 and not self.loader_options)
+        same = f"{self.loader.__module__}:{self.loader.__name__}" == model
+        return self.engine if plain and same else None
+
     def _canonical(self, model: Multibody) -> tuple[Canonical, list[TreeJoint]]:
         """The case's joints in MuJoCo's order, each matched to the engine's joint by name (a
         free joint: the engine's free joint of that body), and each body's carrier: the

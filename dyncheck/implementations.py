@@ -12,7 +12,7 @@ Each case's system in the reference (general method and printed form) is declare
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from typing import Any, ClassVar
 
@@ -27,6 +27,7 @@ from dyncheck.adapters import (
     Trajectory,
     get_adapter,
 )
+from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.adapters.symbolic import Symbolic
@@ -426,6 +427,28 @@ def _book_effects(canon: Canonical, tree: ModelTree, m: NativeMap, s: StateSampl
         Quantity.KINETIC_ENERGY: after.kinetic - before.kinetic,
         Quantity.POTENTIAL_ENERGY: after.potential - before.potential - shift,
     }
+
+
+def engines_as_read(impls: Mapping[str, Implementation | Exception]) -> dict[str, ModelEngine]:
+    """Each file-loading engine's name (:data:`~dyncheck.adapters.MODELS`) → an engine one of
+    ``impls`` loaded by that engine's loader from the case's MJCF read as a user's file is
+    (:meth:`~dyncheck.adapters.model_adapter.ModelAdapter.as_read`; the implementation of
+    the same name first): the case's other studies compute on it rather than load the file
+    again (``pinocchio``'s derivative rows on ``pinocchio-mjcf``'s engine, ``pinocchio``
+    itself reading the case as stated)."""
+    from dyncheck.adapters import MODELS
+    from dyncheck.adapters.model_adapter import ModelAdapter
+
+    out: dict[str, ModelEngine] = {}
+    for name, registration in MODELS.items():
+        for other in sorted(impls, key=lambda n: n != name):
+            impl = impls[other]
+            adapter = impl.adapter if isinstance(impl, EngineImplementation) else None
+            if isinstance(adapter, ModelAdapter) and registration.model and \
+                    (engine := adapter.as_read(registration.model)) is not None:
+                out[name] = engine
+                break
+    return out
 
 
 def make_implementation(name: str, case: Case) -> Implementation:

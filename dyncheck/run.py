@@ -14,9 +14,7 @@ from dyncheck.comparison import Sweep, sweep
 from dyncheck.comparison import rows as rows_of
 from dyncheck.errors import UnknownName
 from dyncheck.explain.entry import Entry
-from dyncheck.implementations import (
-    IMPLEMENTATIONS,
-)
+from dyncheck.implementations import IMPLEMENTATIONS, engines_as_read
 from dyncheck.progress import Progress
 from dyncheck.provenance import engine_versions
 from dyncheck.results import (
@@ -69,7 +67,8 @@ def _run_case(
     impls = built(case, impl_names, notes)
     rows = [] if sliced else rows_of(sweep(case, impls, case.iter_states(states)))
     n = case.n_states if states is None else min(states, case.n_states)
-    rows += derivative_rows(case, impl_names, n)  # at the case's own states (or fewer)
+    # at the case's own states (or fewer), on the engines the run loaded (each loaded once)
+    rows += derivative_rows(case, impl_names, n, reuse=engines_as_read(impls))
     points, trajectory_rows, figures = study(case, impls)
     pngs = {} if render is None else render(
         case, figures, table(points, ConvergencePoint, CONVERGENCE_KEY))

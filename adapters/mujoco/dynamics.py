@@ -7,12 +7,37 @@ were a fifth of it)."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
-from dyncheck.adapters.mujoco.api import full_inertia
+from dyncheck.adapters.mujoco.api import PASSIVE_OFF, full_inertia
+
+SMOOTH_ONLY = (
+    mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    | mujoco.mjtDisableBit.mjDSBL_ACTUATION
+    | PASSIVE_OFF
+    | mujoco.mjtDisableBit.mjDSBL_SENSOR
+)
+"""What MuJoCo's smooth dynamics leave off: constraints, actuation, passive forces, sensors."""
+
+
+@contextmanager
+def smooth(m: mujoco.MjModel, timestep: float) -> Iterator[mujoco.MjModel]:
+    """``m`` computing its smooth dynamics at the file's ``timestep`` while the block runs
+    (:data:`SMOOTH_ONLY` off, the integrator as it was), its options restored after: a
+    derivative or a step Jacobian is of the smooth tree whatever a run did to the model
+    before (its couplings enabled, a study's step size and integrator set)."""
+    flags, step, integrator = m.opt.disableflags, m.opt.timestep, m.opt.integrator
+    m.opt.disableflags |= int(SMOOTH_ONLY)
+    m.opt.timestep = timestep
+    try:
+        yield m
+    finally:
+        m.opt.disableflags, m.opt.timestep, m.opt.integrator = flags, step, integrator
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -46,12 +46,11 @@ from dyncheck.adapters.mujoco.actuators import MujocoActuation
 from dyncheck.adapters.mujoco.api import (
     GYROSCOPIC_IMPLICIT,
     HAS_TENDON_ARMATURE,
-    PASSIVE_OFF,
     RK4_ON_GROUP,
     full_inertia,
     mujoco_warnings,
 )
-from dyncheck.adapters.mujoco.dynamics import evaluate, step_differences
+from dyncheck.adapters.mujoco.dynamics import SMOOTH_ONLY, evaluate, smooth, step_differences
 from dyncheck.adapters.mujoco.meshes import TEXT_MESHES, mesh_rounding
 from dyncheck.adapters.mujoco.simulation import MujocoRun
 from dyncheck.adapters.proof import Proof
@@ -66,12 +65,6 @@ _TYPES = {
     mujoco.mjtJoint.mjJNT_BALL: JointType.BALL,
     mujoco.mjtJoint.mjJNT_FREE: JointType.FREE,
 }
-_SMOOTH_ONLY = (
-    mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
-    | mujoco.mjtDisableBit.mjDSBL_ACTUATION
-    | PASSIVE_OFF
-    | mujoco.mjtDisableBit.mjDSBL_SENSOR
-)
 GRAVITY_OFF = (
     "the file switches gravity off with <flag gravity=\"disable\"/>, which MuJoCo applies and "
     "the other engines' parsers ignore (they apply <option gravity>): to switch it off in "
@@ -232,7 +225,8 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
         self._measured = frozenset(w for _, _, w in (*self._hints, *unread))
         scaled = _total_mass_hints(source)
         self._hints += scaled + unread
-        m.opt.disableflags |= int(_SMOOTH_ONLY)
+        m.opt.disableflags |= int(SMOOTH_ONLY)
+        self._timestep = float(m.opt.timestep)  # the file's (a run's study steps at others)
         m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
         self._closed.opt.disableflags = m.opt.disableflags  # (the same smooth dynamics)
         self.data = mujoco.MjData(m)
@@ -361,12 +355,10 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
                ("forward_q", "forward_v", "forward_tau", "inverse_q", "inverse_v")}
         dq, dv = np.empty((nv, nv)), np.empty((nv, nv))
         mass = np.empty((nv, nv))
-        integrator = m.opt.integrator  # mjd_inverseFD refuses RK4 (the differences of
-        m.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER  # mj_inverse do not depend on it)
-        try:
-            self._differences(q, v, a, out, dq, dv, mass)
-        finally:
-            m.opt.integrator = integrator
+        with smooth(m, self._timestep):  # (a run's couplings left off)
+            m.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER  # mjd_inverseFD refuses RK4
+            self._differences(q, v, a, out, dq, dv, mass)  # (mj_inverse's differences do
+            # not depend on it)
         return _derivatives(out, method=f"finite differences (mjd_inverseFD, one-sided, "
                             f"step {FD_STEP:g})", step=FD_STEP)
 
@@ -405,9 +397,8 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
         n, nv = len(q), m.nv
         size = 2 * nv + m.na
         matrix = np.zeros((size, size))
-        integrator = m.opt.integrator
         out = []
-        try:
+        with smooth(m, self._timestep):  # (a run's couplings and study step left off)
             for name, kind in ((Integrator.EULER, mujoco.mjtIntegrator.mjINT_EULER),
                                (Integrator.IMPLICITFAST, mujoco.mjtIntegrator.mjINT_IMPLICITFAST),
                                (Integrator.RK4, mujoco.mjtIntegrator.mjINT_RK4)):
@@ -432,8 +423,6 @@ class MujocoModel(MujocoActuation, MujocoRun, ModelEngine):
                     fd_step=FD_STEP, integrator=name, unfollowed=why,
                     implicit_bias=_standalone_free(m) if name is Integrator.IMPLICITFAST
                     else ()))
-        finally:
-            m.opt.integrator = integrator
         return tuple(out)
 
 

@@ -12,8 +12,9 @@ case's own, mapped from the book's coordinates to MuJoCo's, the canonical layout
 
 from __future__ import annotations
 
+import copy
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from dyncheck import coordinates as co
@@ -46,9 +47,12 @@ def _differentiates(entry: str) -> bool:
         ModelEngine.derivatives
 
 
-def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[Discrepancy]:
+def derivative_rows(case: Case, impl_names: Sequence[str], states: int, *,
+                    reuse: Mapping[str, ModelEngine] | None = None) -> list[Discrepancy]:
     """The case's derivative rows for the implementations of ``impl_names`` that load a file
-    (:data:`~dyncheck.adapters.MODELS`) and the referee (where ``reference`` is named)."""
+    (:data:`~dyncheck.adapters.MODELS`) and the referee (where ``reference`` is named).
+    ``reuse``: engines already loaded from the case's MJCF as read (name → engine, the run's:
+    :func:`~dyncheck.implementations.engines_as_read`), used instead of loading it again."""
     from dyncheck.adapters import layout
     from dyncheck.adapters.formats.files import read
     from dyncheck.check import derivatives, engines
@@ -71,7 +75,8 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
         path = Path(folder) / f"{case.name}.xml"
         path.write_text(to_mjcf(spec), encoding="utf-8")
         source = read(path)
-        canonical = engines.load(first, source)
+        held = dict(reuse or {})
+        canonical = held.get(first) or engines.load(first, source)
         if isinstance(canonical, engines.NotLoaded):
             return [_row(case, "derivatives", first, "", Verdict.FAILED, canonical.message)]
         for name in names:
@@ -85,7 +90,7 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
                 failed.append(_row(case, "derivatives", name, "", Verdict.SKIPPED,
                                    f"{name} offers no derivatives"))
                 continue
-            engine = canonical if name == first else engines.load(name, source)
+            engine = canonical if name == first else held.get(name) or engines.load(name, source)
             if isinstance(engine, engines.NotLoaded):  # costs its own row
                 failed.append(_row(case, "derivatives", name, "",
                                    Verdict.SKIPPED if engine.skip else Verdict.FAILED,
@@ -94,8 +99,9 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int) -> list[
                 loaded[name] = engine
     tree = canonical.tree
     canon = layout.canonical(tree)
-    for engine in loaded.values():  # Drake names a <freejoint> after its body, Pinocchio
-        engine.tree = align_by_body(tree, engine.tree)[0]
+    for name, engine in loaded.items():  # Drake names a <freejoint> after its body, Pinocchio
+        loaded[name] = copy.copy(engine)  # (the aligned tree on a copy: a reused engine's
+        loaded[name].tree = align_by_body(tree, engine.tree)[0]  # own stays its own)
     for name in list(loaded):
         theirs = {j.name for j in loaded[name].tree.joints}
         missing = [n for n in canon.names if n not in theirs]

@@ -109,3 +109,53 @@ def test_impl_names_an_accelerator_engine_without_the_flag():
     assert impls == ["reference", "mjx"]
     line = not_run(impls)
     assert line is not None and "mjx (" not in line and "(left out by --impl)" in line
+
+
+@pytest.mark.parametrize("case", ["compound_pendulum", "atwood"])
+def test_a_run_loads_each_engine_once_per_case(case, monkeypatch):
+    """Every loader's construction counted through one case's unit of work (the
+    instantaneous rows, the derivative rows, the studies): each engine implementation's
+    loader runs once — its derivative rows compute on the engine the run loaded, Pinocchio's
+    on ``pinocchio-mjcf``'s (a loader's own loads inside its construction, Pinocchio's copy
+    read without dyncheck's fixes to prove them, are not the case's file loaded again).
+    Expected: one load per implementation that loads the file, from the registrations."""
+    import importlib
+    from collections import Counter
+
+    from dyncheck import adapters
+    from dyncheck.implementations import implementations_for
+    from dyncheck.roster import ON_A_CPU
+    from dyncheck.run import _run_case
+
+    _release()
+    classes = set()
+    for registration in adapters.REGISTRY.values():
+        if registration.model and registration.run:
+            module, name = registration.model.split(":")
+            try:
+                classes.add(getattr(importlib.import_module(module), name))
+            except ImportError:
+                continue
+    loads: Counter[str] = Counter()
+    depth = [0]
+
+    def counting(original):
+        def counted(self, *args, **kwargs):
+            if depth[0] == 0:
+                loads[type(self).__name__] += 1
+            depth[0] += 1
+            try:
+                original(self, *args, **kwargs)
+            finally:
+                depth[0] -= 1
+        return counted
+
+    for cls in classes:
+        if "__init__" in vars(cls):
+            monkeypatch.setattr(cls, "__init__", counting(vars(cls)["__init__"]))
+    names = [n for n in implementations_for(get_case(case), ON_A_CPU)
+             if adapters.REGISTRY.get(n) and adapters.REGISTRY[n].run]
+    _run_case(get_case(case), list(ON_A_CPU), 8)
+    _release()
+    expected = Counter(adapters.REGISTRY[n].model.split(":")[1] for n in names)
+    assert loads == expected

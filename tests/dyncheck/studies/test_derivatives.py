@@ -59,3 +59,31 @@ def test_a_derivative_off_by_one_part_in_a_million_fails_naming_engine_case_and_
         ("d(inverse)/dq", "reference", "pinocchio"), ("d(inverse)/dq", "mujoco", "pinocchio")}
     assert all(r.case == "compound_pendulum" and "pinocchio differs" in r.note
                and "entry (0, 0)" in r.note for r in failed)
+
+
+@pytest.mark.parametrize("case", ["compound_pendulum", "atwood"])
+def test_rows_on_the_runs_engines_are_the_rows_of_a_fresh_load(case):
+    """The derivative rows computed on the engines the run loaded (``reuse``: MuJoCo's with
+    the case's cords enabled on Atwood's machine, Pinocchio's ``pinocchio-mjcf``) are those of
+    engines loaded afresh from the case's MJCF — the expected values, an independent load:
+    a run's couplings, step size and integrator leave an engine's smooth derivatives as
+    they were."""
+    from dyncheck.implementations import engines_as_read
+    from dyncheck.slices import built
+
+    spec = get_case(case)
+    names = [*CORE, "pinocchio-mjcf", "drake"]
+    impls = built(spec, names)
+    reuse = engines_as_read(impls)
+    assert {"mujoco", "pinocchio"} <= set(reuse)
+    for impl in impls.values():  # a study's step set on every engine before the rows
+        if not isinstance(impl, Exception) and impl.adapter is not None:
+            impl.simulate(0.01, impl.integrators[0])
+
+    def rows(**given):
+        return sorted((r.quantity, r.impl_a, r.impl_b, r.verdict, repr(r.max_rel_err))
+                      for r in derivative_rows(spec, CORE, 6, **given))
+
+    fresh, again = rows(), rows(reuse=reuse)
+    assert len(fresh) > 10
+    assert again == fresh
