@@ -25,7 +25,7 @@ import pytest
 from dyncheck.__main__ import main
 from dyncheck.adapters import MODELS as LOADERS
 from dyncheck.adapters import REGISTRY
-from dyncheck.cases import get_case
+from dyncheck.cases import CASES, get_case
 from dyncheck.cases.multibody import Body, Joint
 from dyncheck.errors import DyncheckError
 
@@ -40,6 +40,10 @@ CHECKED = ", ".join(sorted(["reference", *LOADERS]))
 """``check --impl``'s valid names, from the registry: the referee and every file loader."""
 VERSIONED = ", ".join(sorted(n for n, r in REGISTRY.items() if r.releases))
 """``versions --engine``'s valid names: the registrations that list releases."""
+CASE_NAMES = ", ".join(sorted(CASES))
+"""A case's valid names: the registry's."""
+RUN_NAMES = ", ".join(sorted(["reference", "book", *REGISTRY]))
+"""``run --impl``'s valid names: the book's side and every registration."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -179,7 +183,7 @@ FAULTS: tuple[Fault, ...] = (
           answer=r"unrecognized arguments: --frob"),
     # --- run
     Fault(kind="unknown case", area="run", argv=("run", "no_such_case", "--out", OUT),
-          answer=r"unknown case 'no_such_case'; valid: atwood, "),
+          answer=r"unknown case 'no_such_case'; valid: " + re.escape(CASE_NAMES) + "$"),
     Fault(kind="unknown implementation", area="run",
           argv=("run", "simple_pendulum", "--impl", "bullet", "--out", OUT),
           answer=r"unknown implementation 'bullet'; valid: "),
@@ -1098,7 +1102,7 @@ MORE_FAULTS: tuple[Fault, ...] = (
         area="check",
         argv=("check", "--case", "nope", "--out", OUT),
         exit=2,
-        answer=r"unknown case 'nope'; valid: atwood, compound_pendulum, compound_pulley",
+        answer=r"unknown case 'nope'; valid: " + re.escape(CASE_NAMES) + "$",
     ),
     Fault(
         kind="--impl given twice",
@@ -1124,7 +1128,7 @@ MORE_FAULTS: tuple[Fault, ...] = (
         area="check",
         argv=("check", BRANCHES, "--impl", "", "--out", OUT),
         exit=2,
-        answer=r"unknown implementation ''; valid: drake, mjx, mjx-f64, mujoco, mujoco-",
+        answer=r"unknown implementation ''; valid: " + re.escape(CHECKED) + "$",
     ),
     Fault(
         kind="--against a folder",
@@ -1390,7 +1394,7 @@ MORE_FAULTS: tuple[Fault, ...] = (
         area="baseline",
         argv=("baseline", "--impl", "bullet", "--out", "{tmp}/b.csv"),
         exit=2,
-        answer=r"unknown implementation 'bullet'; valid: book, drake, mjx, mjx-f64, muj",
+        answer=r"unknown implementation 'bullet'; valid: " + re.escape(RUN_NAMES) + "$",
     ),
     Fault(
         kind="--out in a read-only system folder (baseline)",
@@ -1412,7 +1416,7 @@ MORE_FAULTS: tuple[Fault, ...] = (
         area="run",
         argv=("run", "simple_pendulum", "--impl", "", "--out", OUT),
         exit=2,
-        answer=r"unknown implementation ''; valid: book, drake, mjx, mjx-f64, mujoco, m",
+        answer=r"unknown implementation ''; valid: " + re.escape(RUN_NAMES) + "$",
     ),
     Fault(
         kind="--device bogus",
