@@ -1,6 +1,6 @@
 """The interface every engine adapter implements.
 
-Canonical form, in the engine's own joint coordinates q (positions) and v (velocities):
+The standard form, in the engine's own joint coordinates q (positions) and v (velocities):
 
     M(q) v̇ + h(q, v) = τ
 
@@ -65,7 +65,7 @@ class LoadedBody:
 
 
 class Adapter(ABC):
-    """One engine behind the canonical form ``M(q) v̇ + h(q, v) = τ``."""
+    """One engine behind the standard form ``M(q) v̇ + h(q, v) = τ``."""
 
     state_layout: ClassVar[StateLayout] = StateLayout()
     """How the engine stores rotations and their velocities (the canonical layout unless the
@@ -297,7 +297,7 @@ class ModelEngine(ABC):
 
     It holds the engine-neutral ``tree`` (:class:`~dyncheck.adapters.model_tree.ModelTree`:
     what the engine read, in its own layout) and computes, over a batch of states in that
-    layout, the canonical form M(q) v̇ + h(q, v) = τ — the book's equations of motion
+    layout, the standard form M(q) v̇ + h(q, v) = τ — the book's equations of motion
     (2.2.23)–(2.2.26) in joint coordinates: M, h, τ at v̇ and v̇ at τ = 0, and T, V
     (:meth:`dynamics`). What it offers beyond that is a class fact, :attr:`offers`, never
     found by asking the object; a method it does not offer raises

@@ -71,7 +71,7 @@ from dyncheck.vocabulary import Quantity
 
 
 class ModelAdapter(Adapter):
-    """The canonical form of a book case from an engine's file loader (see the module)."""
+    """The standard form of a book case from an engine's file loader (see the module)."""
 
     run_format: ClassVar[Format]
     loader: ClassVar[type]

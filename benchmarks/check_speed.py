@@ -89,9 +89,9 @@ def scale(folder: Path, repeats: int) -> tuple[pd.DataFrame, dict[str, float]]:
     from dyncheck.adapters.formats.files import read
     from dyncheck.adapters.layout import canonical
     from dyncheck.adapters.mujoco.model import MujocoModel
-    from dyncheck.check.derivative_referee import referee
-    from dyncheck.check.referee import ReferenceModel
     from dyncheck.check.sampling import sample
+    from dyncheck.referee.derivatives import referee
+    from dyncheck.referee.tree import ReferenceModel
 
     rows = []
     families = {"chain": (chain, (10, 25, 50, 100, 200, 400)),

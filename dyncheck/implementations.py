@@ -303,7 +303,7 @@ class EngineImplementation(Implementation):
         an acceleration by the linear part of its map); an engine that computes with another
         inertia than it holds (a loader's declared ``computed_inertia``) or applies a body's
         joints in another order than written (its tree's ``as_written``), by the referee on
-        each (:func:`~dyncheck.check.computed.computing_effect`)."""
+        each (:func:`~dyncheck.referee.computed.computing_effect`)."""
         if not self.defects():
             return {}
         m, q = self.map, s.q
@@ -399,10 +399,10 @@ def _book_effects(canon: Canonical, tree: ModelTree, m: NativeMap, s: StateSampl
                  rest: np.ndarray, te: np.ndarray, ae: np.ndarray) -> dict[str, np.ndarray]:
     """What a file loader's engine computing otherwise than the file says changes (an inertia
     it computes with in place of the one it holds, a body's joints applied in another order
-    than written): the general method on each (:func:`~dyncheck.check.computed.
+    than written): the general method on each (:func:`~dyncheck.referee.computed.
     computing_effect`), in the book's coordinates (the engine's are the canonical ones), V
     relative to ``rest`` as :meth:`Implementation.evaluate` gives it."""
-    from dyncheck.check.computed import computing_effect
+    from dyncheck.referee.computed import computing_effect
 
     q, v = s.q, s.v
     found = computing_effect(canon, tree, q=m.to_engine(q), v=co.velocity_to_engine(m, q, v),

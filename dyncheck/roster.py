@@ -6,10 +6,7 @@ from __future__ import annotations
 from collections.abc import Collection
 
 from dyncheck.adapters import ACCELERATORS, ENGINE_EXTRAS, RUN
-
-REFEREE = "reference"
-"""The referee's name: the book's general method (2.2.23)–(2.2.26), implemented clean-room
-in ``reference/``, on every row that judges an engine."""
+from dyncheck.vocabulary import REFEREE
 
 BOOK_SIDE: tuple[str, ...] = (REFEREE, "book")
 """The book's side: the general method (2.2.23)–(2.2.26) and the printed equations."""

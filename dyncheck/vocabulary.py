@@ -7,6 +7,10 @@ from __future__ import annotations
 
 from enum import StrEnum
 
+REFEREE = "reference"
+"""The referee's name: the book's general method (2.2.23)–(2.2.26), implemented clean-room
+in ``reference/``, on every row that judges an engine (:mod:`dyncheck.referee`)."""
+
 
 class Quantity(StrEnum):
     """What a row compares: the smooth dynamics at sampled states (M, h, forward and inverse

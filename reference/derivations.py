@@ -1,6 +1,6 @@
 """Exact derivations cached on disk: a second run does no symbolic work.
 
-A derivation (a metric, Christoffel symbols, the canonical form M, h of (2.2.26)) is stored
+A derivation (a metric, Christoffel symbols, the standard form M, h of (2.2.26)) is stored
 as its sympy result under the user's cache folder, keyed by what it is derived from (the
 ``srepr`` of its inputs), sympy's version and the content of this package's source — an
 edit of any derivation, or another sympy, derives afresh. The store is the caller's:

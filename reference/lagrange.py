@@ -1,7 +1,7 @@
 """The general method: Lagrange's equations (2.2.23)–(2.2.26) from T and V, derived exactly.
 
 Given T(x, ẋ) and V(x) as sympy expressions, the Euler–Lagrange equations (2.2.26) with
-L = T − V (2.2.25) are written in the canonical form
+L = T − V (2.2.25) are written in the standard form
 
     M(x) ẍ + h(x, ẋ) = τ,
 
@@ -98,7 +98,7 @@ class SymbolicSystem:
     """Simplify M and h symbolically (exact either way; off where sympy's simplify is slow)."""
 
     def equations(self) -> tuple[sp.Matrix, sp.Matrix]:
-        """(M, h) of the canonical form, from (2.2.22)–(2.2.26) (cached on disk:
+        """(M, h) of the standard form, from (2.2.22)–(2.2.26) (cached on disk:
         :mod:`.derivations`)."""
         inputs = (self.q, self.qd, self.T, self.V, self.simplify)
         return derived("lagrange_equations", inputs, self._equations)

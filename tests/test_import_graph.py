@@ -16,6 +16,9 @@ FOLDERS = {"dyncheck": "dyncheck", "reference": "dyncheck.reference",
 HEIGHT = 9
 """The longest import chain among the modules under ``dyncheck/`` today (ratchet: lower it
 when a change lowers it; #62's goal of 9 is met)."""
+WHOLE_HEIGHT = 16
+"""The longest import chain over the whole package as installed — ``adapters``, ``cases`` and
+``reference`` are ``dyncheck.*`` too (ratchet: #76's goal is 11; 17 when it was filed)."""
 
 
 def modules(root: Path = ROOT, folders: dict[str, str] = FOLDERS) -> dict[str, Path]:
@@ -122,3 +125,9 @@ def test_the_import_graph_is_no_higher_than_its_ratchet():
     inner = {m for m, p in modules().items() if p.relative_to(ROOT).parts[0] == "dyncheck"}
     floors, chain = height(edges, inner)
     assert floors <= HEIGHT, f"{floors} floors (ratchet {HEIGHT}): " + " -> ".join(chain)
+
+
+def test_the_whole_packages_graph_is_no_higher_than_its_ratchet():
+    floors, chain = height(graph(modules()), set(modules()))
+    assert floors <= WHOLE_HEIGHT, f"{floors} floors (ratchet {WHOLE_HEIGHT}): " + \
+        " -> ".join(chain)

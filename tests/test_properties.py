@@ -1,4 +1,4 @@
-"""Property tests (hypothesis) over random states and parameters: the canonical form's
+"""Property tests (hypothesis) over random states and parameters: the standard form's
 invariants in the reference, the metric's definiteness, and every implementation pair's
 agreement on random states of every case — not only the seeded ones."""
 

@@ -80,7 +80,7 @@ _SOURCE = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:16]
 @dataclass(frozen=True, kw_only=True)
 class Equations:
     """What LagrangesMethod derives for a model, in plain symbols x0.., v0.. (positions,
-    velocities): M and h = −F of the canonical form, the field's generalized force, the
+    velocities): M and h = −F of the standard form, the field's generalized force, the
     cords' KKT matrix and right-hand side (with ``ncons`` multipliers), T and V."""
 
     M: tuple[sp.Expr, ...]

@@ -23,12 +23,12 @@ from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check.actuator_readings import UNKNOWN, match, reading_rows
 from dyncheck.check.actuator_readings import section_row as _row
-from dyncheck.check.computed import depth
 from dyncheck.check.dynamics import QUANTITIES
 from dyncheck.check.engines import REFEREE
 from dyncheck.check.rows import COMPUTED, CheckRow
-from dyncheck.check.states import States, condition
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
+from dyncheck.referee.computed import depth
+from dyncheck.referee.states import States, condition
 from dyncheck.reference import actuation as law
 from dyncheck.vocabulary import Quantity, Verdict
 

@@ -31,14 +31,13 @@ from dyncheck.adapters.closures import ClosedReading
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.check import closures
-from dyncheck.check.computed import bodies
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.errors import EngineError, Unsupported
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
+from dyncheck.referee.computed import bodies
 from dyncheck.reference.closure import retract
 from dyncheck.reference.tree import TreeDynamics
-from dyncheck.roster import REFEREE
-from dyncheck.vocabulary import Verdict
+from dyncheck.vocabulary import REFEREE, Verdict
 
 STATES = 8
 """States whose derivatives are compared (each costs the referee 8 nv solves)."""

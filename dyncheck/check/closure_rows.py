@@ -17,13 +17,12 @@ from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.adapters.offers import Offer
 from dyncheck.check import closure_derivatives, closure_readings, closures
-from dyncheck.check.computed import canonical_reading
 from dyncheck.check.rows import CheckRow, Section
-from dyncheck.check.states import States
 from dyncheck.errors import EngineError, Unsupported
 from dyncheck.labels import SOFT_CONSTRAINT
-from dyncheck.roster import REFEREE
-from dyncheck.vocabulary import Verdict
+from dyncheck.referee.computed import canonical_reading
+from dyncheck.referee.states import States
+from dyncheck.vocabulary import REFEREE, Verdict
 
 ROWS_BASIS = "64 eps x reach (lengths), x |J| (rows)"
 SOFT_BASIS = "64 eps x k(M) x k(A + R)"

@@ -25,8 +25,8 @@ import numpy as np
 from dyncheck.adapters.closures import ClosedReading, ClosureKind
 from dyncheck.adapters.closures import Closure as Held
 from dyncheck.adapters.model_tree import ModelTree
-from dyncheck.check.computed import bodies
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
+from dyncheck.referee.computed import bodies
 from dyncheck.reference.closure import (
     Closure,
     Connect,
@@ -52,7 +52,8 @@ after its iterations is dropped."""
 
 def referee_closures(tree: ModelTree) -> list[Closure]:
     """The tree's closures as the referee takes them (joints by their place in
-    ``tree.joints``, the order :func:`~.computed.bodies` gives the general method)."""
+    ``tree.joints``, the order :func:`~dyncheck.referee.computed.bodies` gives the general
+    method)."""
     index = {j.name: i for i, j in enumerate(tree.joints)}
 
     def at(name: str | None) -> int:

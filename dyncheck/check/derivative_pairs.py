@@ -13,16 +13,16 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from dyncheck.adapters.model_tree import Derivatives, ModelTree
-from dyncheck.check.computed import depth
-from dyncheck.check.derivative_charts import FIELDS
 from dyncheck.check.rows import CheckRow, Section
-from dyncheck.check.states import condition
 from dyncheck.labels import DEFECT, READINGS
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
+from dyncheck.referee.charts import FIELDS
+from dyncheck.referee.computed import depth
+from dyncheck.referee.states import condition
 from dyncheck.vocabulary import Verdict
 
 if TYPE_CHECKING:
-    from dyncheck.check.derivative_referee import Referee
+    from dyncheck.referee.derivatives import Referee
 
 ZERO = "0 within round-off"
 """What a derivative zero within its bound on both sides is shown as."""

@@ -3,11 +3,11 @@
 dynamics at the sampled v̇ — of every engine that offers them and of the referee, in the
 canonical chart, compared pair by pair.
 
-The chart, and an engine's own derivatives mapped into it: :mod:`dyncheck.check.derivative_charts`.
+The chart, and an engine's own derivatives mapped into it: :mod:`dyncheck.referee.charts`.
 
 The referee: the recursive Newton–Euler algorithm (:mod:`dyncheck.reference.recursive`,
 §2.2's momentum laws (2.2.48)–(2.2.49) body by body), tied to the book's general method
-(:mod:`dyncheck.reference.tree`) on this very tree (:mod:`dyncheck.check.referee`: where the
+(:mod:`dyncheck.reference.tree`) on this very tree (:mod:`dyncheck.referee.tree`: where the
 two disagree, the referee's derivatives are not compared and the tie's failed row says why),
 differentiated by a complex step along q ⊕ iη eₖ and v + iη eₖ — exact to round-off, with no
 truncation error to estimate; the forward derivatives through ∂v̇/∂x = −M⁻¹ ∂τ/∂x at
@@ -36,14 +36,14 @@ from dyncheck.adapters.model_tree import (
     Derivatives,
     ModelTree,
 )
-from dyncheck.check.derivative_charts import same_layout, to_canonical
 from dyncheck.check.derivative_pairs import across_readings, after_defects, compare
-from dyncheck.check.derivative_referee import Referee, first, referee, step_states
 from dyncheck.check.dynamics import tie_row
 from dyncheck.check.rows import CheckRow, Section
-from dyncheck.check.states import States
 from dyncheck.check.steps import step_rows
 from dyncheck.errors import Unsupported
+from dyncheck.referee.charts import same_layout, to_canonical
+from dyncheck.referee.derivatives import Referee, first, referee, step_states
+from dyncheck.referee.states import States
 from dyncheck.vocabulary import Verdict
 
 

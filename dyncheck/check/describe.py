@@ -23,7 +23,6 @@ from typing import NamedTuple
 import numpy as np
 
 from dyncheck.adapters.model_tree import JointType, ModelTree, TreeJoint
-from dyncheck.check.computed import depth, size
 from dyncheck.check.joint_fields import compare, shown_value
 from dyncheck.check.placement import Placement, placement
 from dyncheck.check.proofs import Remeasured, proved, unmeasured
@@ -31,6 +30,7 @@ from dyncheck.check.rows import CheckRow, Section
 from dyncheck.labels import MESH_ROUNDING as MESH_ROUNDING_CAUSE
 from dyncheck.labels import MESH_VOLUME, PLACEMENT, STORED_INERTIA
 from dyncheck.precision import ROUNDOFF_FACTOR, eps_name
+from dyncheck.referee.computed import depth, size
 from dyncheck.vocabulary import Quantity, Verdict
 
 

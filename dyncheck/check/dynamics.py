@@ -18,11 +18,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters.model_tree import QUANTITY_OF, Dynamics, ModelTree
-from dyncheck.check.computed import depth, size
-from dyncheck.check.referee import GENERAL, RECURSIVE, Tie
 from dyncheck.check.rows import CheckRow, Section
-from dyncheck.check.states import States, condition
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, eps_name
+from dyncheck.referee.computed import depth, size
+from dyncheck.referee.states import States, condition
+from dyncheck.referee.tree import GENERAL, RECURSIVE, Tie
 from dyncheck.vocabulary import Quantity, Verdict
 
 QUANTITIES: dict[str, str] = {q: f for f, q in QUANTITY_OF.items()}
@@ -198,7 +198,7 @@ def compare(
 
 
 def tie_row(tie: Tie, model: str) -> CheckRow:
-    """The referee's tie (:class:`~dyncheck.check.referee.Tie`) as a row of the dynamics
+    """The referee's tie (:class:`~dyncheck.referee.tree.Tie`) as a row of the dynamics
     section (failed: the referee disagrees with itself, and the general method gave every
     number on the page)."""
     served = ("the recursive algorithm gave the referee's M, h and dynamics at every "

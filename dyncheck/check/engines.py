@@ -40,8 +40,8 @@ from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.model_tree import Derivatives, Dynamics, Transition
 from dyncheck.confinement import confine
 from dyncheck.errors import DyncheckError, EngineError, Unsupported
-from dyncheck.roster import REFEREE
 from dyncheck.settings import Settings, current, in_force
+from dyncheck.vocabulary import REFEREE
 from dyncheck.workers import at_end, ending, start_method
 
 ENGINES: dict[str, Registration] = dict(MODELS)

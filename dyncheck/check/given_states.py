@@ -15,8 +15,8 @@ import numpy as np
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import ModelTree
 from dyncheck.check.sampling import sample, sampled_note
-from dyncheck.check.states import States
 from dyncheck.errors import InvalidInput
+from dyncheck.referee.states import States
 from dyncheck.vocabulary import JointType
 
 FLAG = "--states-file"

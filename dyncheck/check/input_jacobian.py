@@ -21,10 +21,10 @@ from dyncheck import labels
 from dyncheck.adapters.actuators import EULER_DAMPING, InputJacobian
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import ModelTree
-from dyncheck.check.computed import depth
-from dyncheck.check.derivative_charts import right_jacobian, rotations
 from dyncheck.check.rows import COMPUTED, CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
+from dyncheck.referee.charts import right_jacobian, rotations
+from dyncheck.referee.computed import depth
 from dyncheck.reference import actuation as law
 from dyncheck.vocabulary import Integrator, Verdict
 

@@ -43,7 +43,6 @@ from dyncheck.check import engines as engine_processes
 from dyncheck.check.against import Other, read_other
 from dyncheck.check.against import rows as against_rows
 from dyncheck.check.alignment import align_by_body, with_fixed_aligned
-from dyncheck.check.computed import canonical_of
 from dyncheck.check.derivatives import expected_seconds
 from dyncheck.check.derivatives import rows as derivative_rows
 from dyncheck.check.dynamics import (
@@ -54,11 +53,12 @@ from dyncheck.check.dynamics import (
 from dyncheck.check.engines import DEFAULT, ENGINES, IMPLEMENTATIONS, REFEREE, NotLoaded
 from dyncheck.check.given_states import GivenStates, check_states
 from dyncheck.check.given_states import given as given_states_of
-from dyncheck.check.referee import ReferenceModel, standing_of
 from dyncheck.check.rows import COLUMNS, CheckResult, CheckRow, Section
-from dyncheck.check.states import States, condition
 from dyncheck.errors import InvalidInput, UnknownName, as_defect
 from dyncheck.escaping import shown
+from dyncheck.referee.computed import canonical_of
+from dyncheck.referee.states import States, condition
+from dyncheck.referee.tree import ReferenceModel, standing_of
 from dyncheck.vocabulary import Quantity, Verdict
 
 DERIVATIVES_NOTE = (

@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from dyncheck.adapters.model_tree import NQ, NV, Dynamics, ModelTree
-from dyncheck.check.states import States
+from dyncheck.referee.states import States
 
 
 @dataclass(frozen=True, kw_only=True)

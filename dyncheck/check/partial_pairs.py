@@ -17,10 +17,10 @@ from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import partial, predicted, readings
 from dyncheck.check.dynamics import QUANTITIES, Prediction, compare
-from dyncheck.check.referee import ReferenceModel
 from dyncheck.check.rows import CheckRow
-from dyncheck.check.states import States
-from dyncheck.roster import REFEREE
+from dyncheck.referee.states import States
+from dyncheck.referee.tree import ReferenceModel
+from dyncheck.vocabulary import REFEREE
 
 
 def part_reading(batch: States, part: partial.Part, tree: ModelTree) -> readings.Reading | None:

@@ -19,11 +19,11 @@ from dyncheck.adapters.model_tree import (
     reversed_rpy,
 )
 from dyncheck.cases.coordinate_maps import quat_to_matrix
-from dyncheck.check.computed import canonical_armature, computed_inertia_effect
 from dyncheck.check.dynamics import Prediction, values
-from dyncheck.check.referee import ReferenceModel
-from dyncheck.check.states import States
 from dyncheck.labels import ARMATURE_AXES, BASE_GRAVITY, COMPUTED_INERTIA, READING, ROTOR_ENERGY
+from dyncheck.referee.computed import canonical_armature, computed_inertia_effect
+from dyncheck.referee.states import States
+from dyncheck.referee.tree import ReferenceModel
 from dyncheck.vocabulary import Quantity
 
 PREDICTIONS = (ROTOR_ENERGY, BASE_GRAVITY, ARMATURE_AXES, READING, COMPUTED_INERTIA)

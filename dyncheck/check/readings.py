@@ -19,12 +19,12 @@ import numpy as np
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import partial
-from dyncheck.check.computed import bodies, canonical_armature, in_layout, parents_first
 from dyncheck.check.dynamics import QUANTITIES, Prediction, values
 from dyncheck.check.placement import placement
-from dyncheck.check.referee import TIE_STATES, ReferenceModel
-from dyncheck.check.states import States
 from dyncheck.labels import READING
+from dyncheck.referee.computed import bodies, canonical_armature, in_layout, parents_first
+from dyncheck.referee.states import States
+from dyncheck.referee.tree import TIE_STATES, ReferenceModel
 from dyncheck.reference.recursive import RecursiveDynamics
 
 SUBSTITUTED = ("axis", "anchor", "mass", "com", "inertia", "armature")
@@ -35,9 +35,10 @@ def own_tree(canonical_tree: ModelTree, tree: ModelTree) -> ModelTree | None:
     """``tree`` (an engine's reading, joints already matched by name) in the canonical
     engine's state layout and joint order, so that the referee evaluates it at the same
     canonical states — parents first where the engine chains a body's joints in another
-    order (Newton's D6: the referee gathers the columns, :func:`~.computed.in_layout`); None
-    where its joints are not the canonical ones (other names or types: that engine holds
-    another tree, which the description rows report)."""
+    order (Newton's D6: the referee gathers the columns,
+    :func:`~dyncheck.referee.computed.in_layout`); None where its joints are not the
+    canonical ones (other names or types: that engine holds another tree, which the
+    description rows report)."""
     names = [j.name for j in canonical_tree.joints]
     if sorted(j.name for j in tree.joints) != sorted(names):
         return None

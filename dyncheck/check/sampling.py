@@ -15,7 +15,7 @@ import numpy as np
 
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import ModelTree
-from dyncheck.check.states import States
+from dyncheck.referee.states import States
 from dyncheck.vocabulary import JointType
 
 DEFAULT_INTERVAL = {JointType.HINGE: (-np.pi, np.pi), JointType.SLIDE: (-1.0, 1.0)}

@@ -14,12 +14,12 @@ from scipy.spatial.transform import Rotation
 from dyncheck.adapters.integrators import dexp_inv, quat_conj, quat_exp, quat_mul
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import JointType, ModelTree, Transition
-from dyncheck.check.computed import depth
-from dyncheck.check.derivative_charts import right_jacobian, rotations, skew
-from dyncheck.check.derivative_referee import Referee, referee
 from dyncheck.check.rows import CheckRow, Section
-from dyncheck.check.states import States
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
+from dyncheck.referee.charts import right_jacobian, rotations, skew
+from dyncheck.referee.computed import depth
+from dyncheck.referee.derivatives import Referee, referee
+from dyncheck.referee.states import States
 from dyncheck.reference.recursive import RecursiveDynamics
 from dyncheck.vocabulary import Integrator, Verdict
 
@@ -217,9 +217,9 @@ def implicit_blocks(canon: Canonical, tree: ModelTree, states: States, h: float,
     extrapolations' difference plus the round-off of x₊ over the smallest step."""
     if not joints:
         return []
-    from dyncheck.check.derivative_charts import perturb
-    from dyncheck.check.derivative_referee import STEP
-    from dyncheck.check.referee import ReferenceModel
+    from dyncheck.referee.charts import perturb
+    from dyncheck.referee.derivatives import STEP
+    from dyncheck.referee.tree import ReferenceModel
 
     solver = ReferenceModel(tree).recursive
     q, v = states.q, states.v
@@ -276,7 +276,7 @@ def step_rows(model: str, canon: Canonical, tree: ModelTree, states: States, ref
     differences: error ≈ |A(2s) − A(s)| / 3) and their round-off 2 δx/(2 s) — δv₊ being
     h v̇'s round-off, κ(M) times its own —, + the referee's own round-off in its
     derivatives times h. ``of``: the states sampled, where the step Jacobians are compared at
-    fewer (:func:`~dyncheck.check.derivative_referee.step_states`): the basis says so."""
+    fewer (:func:`~dyncheck.referee.derivatives.step_states`): the basis says so."""
     h = found.time_step
     rk4 = found.integrator == Integrator.RK4
     why = found.unfollowed

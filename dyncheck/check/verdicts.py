@@ -13,8 +13,7 @@ from enum import StrEnum
 import pandas as pd
 
 from dyncheck.check.rows import COMPUTED, WITH_FIX, WITH_FIX_READING, Section
-from dyncheck.roster import REFEREE
-from dyncheck.vocabulary import Verdict
+from dyncheck.vocabulary import REFEREE, Verdict
 
 
 class Reading(StrEnum):

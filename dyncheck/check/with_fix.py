@@ -22,11 +22,10 @@ from dyncheck.adapters.registration import Format
 from dyncheck.check import compiled_copy, describe, predicted
 from dyncheck.check.alignment import align_by_body
 from dyncheck.check.dynamics import compare
-from dyncheck.check.referee import standing_of
 from dyncheck.check.rows import COMPUTED, WITH_FIX, WITH_FIX_READING, CheckRow, Section
-from dyncheck.check.states import States
-from dyncheck.roster import REFEREE
-from dyncheck.vocabulary import Verdict
+from dyncheck.referee.states import States
+from dyncheck.referee.tree import standing_of
+from dyncheck.vocabulary import REFEREE, Verdict
 
 
 def _copy(source: ModelFile, canonical: ModelTree, tree: ModelTree) -> tuple[str, str] | None:

@@ -62,7 +62,7 @@ def impl_help() -> str:
     """``check --impl``'s help, from the registry: the engines that load a user's file, and
     which of them are checked only when named (:attr:`Registration.on_request`)."""
     from dyncheck.adapters import MODELS
-    from dyncheck.roster import REFEREE
+    from dyncheck.vocabulary import REFEREE
 
     named = [n for n, r in MODELS.items() if r.on_request]
     default = [REFEREE, *(n for n in MODELS if n not in named)]

@@ -24,14 +24,14 @@ def free_body_derivatives(states: int = 10) -> tuple[dict[str, float], dict[str,
     from dyncheck.adapters import layout_batch
     from dyncheck.adapters.model_tree import Derivatives
     from dyncheck.adapters.pinocchio.model import PinocchioModel
-    from dyncheck.check import derivative_charts, derivative_referee
+    from dyncheck.referee import charts, derivatives
 
     mine, other, canon, batch = beside_mujoco(FALLING, PinocchioModel, states)
     theirs = mine.derivatives(batch.q, batch.v, batch.a)
     _, q, v, a = layout_batch.engine_states(canon, other.tree, batch.q, batch.v, batch.a)
     raw = other.derivatives(q, v, a)
-    mapped = derivative_charts.to_canonical(canon, other.tree, batch, raw, other.dynamics(q, v, a))
-    referee = derivative_referee.referee(mine.tree, batch).derivatives
+    mapped = charts.to_canonical(canon, other.tree, batch, raw, other.dynamics(q, v, a))
+    referee = derivatives.referee(mine.tree, batch).derivatives
 
     def worst(x: Derivatives, y: Derivatives) -> dict[str, float]:
         return {f: float(np.abs(getattr(x, f) - getattr(y, f)).max()

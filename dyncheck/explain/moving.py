@@ -91,7 +91,7 @@ def newton_free_velocity() -> Entry:
     over M, h, forward and inverse dynamics at 20 sampled states."""
     from dyncheck.adapters import layout_batch
     from dyncheck.adapters.newton.model import NewtonModel
-    from dyncheck.check.referee import ReferenceModel
+    from dyncheck.referee.tree import ReferenceModel
 
     mine, newton, canon, states = beside_mujoco(FREE, NewtonModel, 20)
     expected = ReferenceModel(mine.tree).dynamics(states.q, states.v, states.a)

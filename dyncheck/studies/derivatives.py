@@ -25,8 +25,7 @@ from dyncheck.cases import Case
 from dyncheck.coordinates import NativeMap
 from dyncheck.errors import EngineNotInstalled
 from dyncheck.results import Discrepancy
-from dyncheck.roster import REFEREE
-from dyncheck.vocabulary import Verdict
+from dyncheck.vocabulary import REFEREE, Verdict
 
 TREE_ONLY = ("the smooth dynamics of the case's MJCF tree (its couplings and external field "
              "are not part of them)")
@@ -57,7 +56,7 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int, *,
     from dyncheck.adapters.formats.files import read
     from dyncheck.check import derivatives, engines
     from dyncheck.check.alignment import align_by_body
-    from dyncheck.check.states import States
+    from dyncheck.referee.states import States
 
     names = [n for n in MODELS if n in impl_names]
     if not names:

@@ -1,4 +1,4 @@
-"""Each adapter on its own: the canonical form's identities, engine coordinates, no reference.
+"""Each adapter on its own: the standard form's identities, engine coordinates, no reference.
 
 Expected values come from identities of M v̇ + h = τ (forward ∘ inverse = identity,
 T = ½ vᵀ M v, h(q, 0) = ∂V/∂q by central differences of the engine's own V) and from a

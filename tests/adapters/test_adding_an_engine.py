@@ -35,7 +35,7 @@ class ToyModel(ModelEngine):
 
     def __init__(self, source, **options):
         from dyncheck.adapters.mujoco.model import MujocoModel
-        from dyncheck.check.referee import ReferenceModel
+        from dyncheck.referee.tree import ReferenceModel
 
         self.tree = replace(MujocoModel(source).tree, engine="toy")
         self._referee = ReferenceModel(self.tree)

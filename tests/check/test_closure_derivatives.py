@@ -112,7 +112,7 @@ def test_an_engines_chart_is_mapped_into_mujocos(tmp_path):
     from dyncheck.check import closure_derivatives as cd
     from dyncheck.check import closures as checked
     from dyncheck.check.closure_rows import in_canonical
-    from dyncheck.check.computed import canonical_reading
+    from dyncheck.referee.computed import canonical_reading
     from tests.check.test_closures import _draws
 
     path = tmp_path / "floating.xml"

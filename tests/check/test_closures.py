@@ -24,8 +24,8 @@ from dyncheck.adapters.offers import Offer
 from dyncheck.check import closure_readings
 from dyncheck.check import closures as checked
 from dyncheck.check.closure_rows import in_canonical
-from dyncheck.check.computed import canonical_reading
 from dyncheck.check.engines import ENGINES
+from dyncheck.referee.computed import canonical_reading
 from tests.conftest import loader
 
 CLOSING = sorted(n for n, r in adapters.REGISTRY.items()

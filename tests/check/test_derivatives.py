@@ -70,17 +70,17 @@ def test_the_pendulum_derivatives_are_the_books_closed_form(tmp_path):
     from dyncheck.adapters import layout, layout_batch
     from dyncheck.adapters.formats.files import read
     from dyncheck.adapters.pinocchio.model import PinocchioModel
-    from dyncheck.check import derivative_charts, derivative_referee
     from dyncheck.check.sampling import sample
+    from dyncheck.referee import charts, derivatives
 
     model = PinocchioModel(read(path))
     canon = layout.canonical(model.tree)
     states = sample(canon, model.tree, 10, 0)
     theta = states.q[:, 0]
-    ref = derivative_referee.referee(model.tree, states).derivatives
+    ref = derivatives.referee(model.tree, states).derivatives
     _, q, v, a = layout_batch.engine_states(canon, model.tree, states.q, states.v, states.a)
     assert q.shape[1] == 2  # Pinocchio holds a continuous joint as (cos θ, sin θ)
-    mine = derivative_charts.to_canonical(canon, model.tree, states, model.derivatives(q, v, a),
+    mine = charts.to_canonical(canon, model.tree, states, model.derivatives(q, v, a),
                                     model.dynamics(q, v, a))
     for found in (ref, mine):
         np.testing.assert_allclose(found.forward_q[:, 0, 0], -(g / length) * np.cos(theta),
@@ -153,7 +153,8 @@ def test_the_chain_rule_is_needed():
     canonical chart as they come, only permuted), the free body's rows fail: the charts
     really differ."""
     from dyncheck.adapters.model_tree import derivatives as collect
-    from dyncheck.check import derivative_charts, derivatives
+    from dyncheck.check import derivatives
+    from dyncheck.referee import charts
 
     def plain(canon, tree, states, found, dynamics):
         from dyncheck.adapters.layout_batch import engine_states
@@ -162,7 +163,7 @@ def test_the_chain_rule_is_needed():
         t = np.array([m.t for m in maps])
         size = t.shape[2]
         mapped = {f: np.einsum("sji,sjk,skl->sil", t, getattr(found, f)[:, :, :t.shape[1]], t)
-                  [:, :size, :size] for f in derivative_charts.FIELDS}
+                  [:, :size, :size] for f in charts.FIELDS}
         return collect(mapped, method=found.method, step=found.step)
 
     with pytest.MonkeyPatch.context() as mp:

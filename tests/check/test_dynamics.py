@@ -11,8 +11,8 @@ from dataclasses import replace
 
 import pytest
 
-from dyncheck.check import referee as referee_module
 from dyncheck.check.model_check import check_model
+from dyncheck.referee import tree as referee_module
 
 PENDULUM = """<mujoco model="pendulum"><worldbody>
   <body name="upper" pos="{x} 0 1"><joint name="shoulder" type="hinge" axis="0 1 0"/>

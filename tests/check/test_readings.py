@@ -17,9 +17,9 @@ from dyncheck.adapters.mujoco.model import MujocoModel
 from dyncheck.check import predicted
 from dyncheck.check.model_check import check_model
 from dyncheck.check.readings import effect, own_tree
-from dyncheck.check.referee import ReferenceModel
-from dyncheck.check.states import States
 from dyncheck.check.verdicts import Agreement, Reading, per_engine
+from dyncheck.referee.states import States
+from dyncheck.referee.tree import ReferenceModel
 
 HINGE = """<mujoco model="h"><option gravity="{g}"/><worldbody><body name="a" pos="0 0 1">
   <joint name="j" type="hinge" axis="0 1 0" armature="{arm}"/>

@@ -151,13 +151,13 @@ def test_the_rk4_chain_rule_on_rotations_is_the_derivative_of_the_step_itself():
     derivatives out (D = 1, E = 0) is off by far more, so the test sees them."""
     from dyncheck.adapters.formats.files import read
     from dyncheck.adapters.layout import canonical
-    from dyncheck.check.derivative_charts import perturb
-    from dyncheck.check.derivative_referee import referee
     from dyncheck.check.engines import load
-    from dyncheck.check.referee import ReferenceModel
     from dyncheck.check.sampling import sample
-    from dyncheck.check.states import States
     from dyncheck.check.steps import rk4_stages, rk4_step
+    from dyncheck.referee.charts import perturb
+    from dyncheck.referee.derivatives import referee
+    from dyncheck.referee.states import States
+    from dyncheck.referee.tree import ReferenceModel
 
     tree = load("mujoco", read(MODELS / "mixed.xml")).tree
     canon = canonical(tree)
@@ -210,8 +210,8 @@ def _log(canon, centre, q):
     rotation's δ is the rotation vector of centre⁻¹ q."""
     from scipy.spatial.transform import Rotation
 
-    from dyncheck.check.derivative_charts import rotations
     from dyncheck.check.steps import _vectors
+    from dyncheck.referee.charts import rotations
 
     out = np.zeros(canon.nv)
     vel, pos = _vectors(canon)

@@ -16,8 +16,8 @@ from dyncheck.adapters.newton import closures as newton_closures
 from dyncheck.adapters.newton.model import NewtonModel, _pose
 from dyncheck.check import closure_readings
 from dyncheck.check import closures as checked
-from dyncheck.check.computed import canonical_reading
 from dyncheck.check.model_check import check_model
+from dyncheck.referee.computed import canonical_reading
 from tests.check.test_closures import MODELS, _draws
 from tests.conftest import loader
 

@@ -20,11 +20,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
-from dyncheck.check.computed import bodies, in_layout
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, standing
+from dyncheck.referee.computed import bodies, in_layout
 from dyncheck.reference.recursive import RecursiveDynamics
 from dyncheck.reference.tree import TreeDynamics
-from dyncheck.roster import REFEREE
+from dyncheck.vocabulary import REFEREE
 
 ENGINE = REFEREE
 TIE_STATES = 10
@@ -83,7 +83,7 @@ class ReferenceModel:
     engine = ENGINE
 
     def __init__(self, tree: ModelTree) -> None:
-        from dyncheck.check.computed import depth
+        from dyncheck.referee.computed import depth
 
         self.tree = tree
         self.solver = in_layout(TreeDynamics(bodies(tree), tree.gravity), tree)

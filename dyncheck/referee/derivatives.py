@@ -2,7 +2,7 @@
 :mod:`dyncheck.check.derivatives`, the step's: :mod:`dyncheck.check.steps`): the recursive
 Newton–Euler algorithm (:mod:`dyncheck.reference.recursive`, §2.2's momentum laws
 (2.2.48)–(2.2.49) body by body), tied to the book's general method
-(:mod:`dyncheck.reference.tree`) on this very tree (:mod:`dyncheck.check.referee`: where the
+(:mod:`dyncheck.reference.tree`) on this very tree (:mod:`dyncheck.referee.tree`: where the
 two disagree, the referee's derivatives are not compared and the tie's failed row says why),
 differentiated by a complex step along q ⊕ iη eₖ and v + iη eₖ — exact to round-off, with no
 truncation error to estimate; the forward derivatives through ∂v̇/∂x = −M⁻¹ ∂τ/∂x at
@@ -18,11 +18,11 @@ import numpy as np
 
 from dyncheck.adapters.model_tree import Derivatives, ModelTree
 from dyncheck.adapters.model_tree import derivatives as collect
-from dyncheck.check.computed import depth
-from dyncheck.check.derivative_charts import perturb
-from dyncheck.check.referee import TIE_STATES, ReferenceModel, Tie, tie
-from dyncheck.check.states import States
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR, standing
+from dyncheck.referee.charts import perturb
+from dyncheck.referee.computed import depth
+from dyncheck.referee.states import States
+from dyncheck.referee.tree import TIE_STATES, ReferenceModel, Tie, tie
 
 if TYPE_CHECKING:
     from dyncheck.adapters.layout import Canonical
@@ -90,7 +90,7 @@ def referee(tree: ModelTree, states: States, *, bounds: bool = True,
             tied: Tie | None = None) -> Referee:
     """The referee's derivatives at ``states`` (canonical layout and chart): the recursive
     Newton–Euler referee (:mod:`dyncheck.reference.recursive`, tied to the book's general
-    method by :class:`~dyncheck.check.referee.ReferenceModel`) differentiated by a complex
+    method by :class:`~dyncheck.referee.tree.ReferenceModel`) differentiated by a complex
     step — τ(q ⊕ iη e_k, v, v̇) and τ(q, v + iη e_k, v̇), the imaginary part over η: no
     cancellation, so no truncation error and no extrapolation; the error is the recursion's
     round-off. The second and third derivatives along the chart, which bound an engine's

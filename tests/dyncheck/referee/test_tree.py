@@ -1,4 +1,4 @@
-"""The referee's two methods tied on every checked tree (dyncheck/check/referee.py): the
+"""The referee's two methods tied on every checked tree (dyncheck/referee/tree.py): the
 recursive Newton–Euler algorithm serves the states and the derivatives only where it agrees
 with the book's general method; a defect inside the recursion (mutated here) fails the tie,
 and the referee's derivative rows give way to that failed row — never silently trusted."""
@@ -11,11 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from dyncheck.check import referee as referee_module
 from dyncheck.check.model_check import check_model
+from dyncheck.referee import tree as referee_module
 from dyncheck.reference.recursive import RecursiveDynamics
 
-MODELS = Path(__file__).parent / "models"
+MODELS = Path(__file__).parents[2] / "check" / "models"
 
 
 class _Mutated(RecursiveDynamics):

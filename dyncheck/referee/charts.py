@@ -27,7 +27,7 @@ from dyncheck.adapters.model_tree import (
 )
 from dyncheck.adapters.model_tree import derivatives as collect
 from dyncheck.cases.coordinate_maps import quat_to_matrix
-from dyncheck.check.states import States
+from dyncheck.referee.states import States
 
 FIELDS = ("forward_q", "forward_v", "forward_tau", "inverse_q", "inverse_v")
 
