@@ -129,3 +129,13 @@ def test_a_broken_package_costs_only_its_own_engine(installed, tmp_path):
     assert "broken" in done.stdout and "not added" in done.stdout
     assert "ModuleNotFoundError" in done.stdout
     assert "toy-engine 0.1.0" in done.stdout
+
+
+@pytest.mark.parametrize("command", ["check", "run"])
+def test_help_names_the_added_engine(installed, command):
+    """``--impl``'s help is built from the registry: the toy is among the names it lists."""
+    done = _dyncheck(installed, command, "--help")
+    assert done.returncode == 0, done.stderr
+    text = " ".join(done.stdout.split())
+    impl = text[text.index("--impl NAME", text.index("options:")):]
+    assert "toy" in impl[: impl.index(" --", len("--impl"))].split(), impl[:400]
