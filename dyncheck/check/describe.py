@@ -386,11 +386,14 @@ EXACT_MESHES = (
 
 
 def changes_dynamics(row: CheckRow) -> bool:
-    """An explained description row whose difference the engines' dynamics carry (a mesh's
-    volume taken two ways): the dynamics rows follow from it; other explained rows (a model
-    placed elsewhere, float32 vertices) change no dynamics beyond their bounds."""
-    return row.verdict is Verdict.EXPLAINED and row.note.startswith(
-        EXACT_MESHES_LEAD.format(a=row.impl_a))
+    """An explained description row whose difference the engines' dynamics carry — a mesh's
+    volume taken two ways, an inertia an engine stores otherwise (PyBullet's principal
+    moments): the dynamics rows follow from it, measured by the referee on each reading;
+    other explained rows (a model placed elsewhere, float32 vertices) change no dynamics
+    beyond their bounds."""
+    return row.verdict is Verdict.EXPLAINED and (
+        row.convention == STORED_INERTIA
+        or row.note.startswith(EXACT_MESHES_LEAD.format(a=row.impl_a)))
 
 
 def _exact_meshes(a: ModelTree, b: ModelTree, ja: TreeJoint, jb: TreeJoint, field: str,

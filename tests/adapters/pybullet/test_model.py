@@ -148,3 +148,46 @@ def test_a_misread_mass_is_blamed_only_where_the_file_shows_the_premise(tmp_path
     assert float(mass.value_b.iloc[0]) == pytest.approx(2 * sphere, rel=1e-6)
     j1 = described[described.subject == "j1"]
     assert not j1.note.str.contains("diaginertia").any()
+
+
+TILTED = """<robot name="arm">
+  <link name="base"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/>
+    <origin xyz="0 0 0.5"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <link name="l1"><inertial><origin xyz="0.02 0.01 0.1"/><mass value="0.8"/>
+    <inertia ixx="0.0031" ixy="-0.00041" ixz="0.00027" iyy="0.0042" iyz="0.00033"
+      izz="0.0023"/></inertial></link>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/>
+    <origin xyz="0 0 0.2"/><axis xyz="0 1 0"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <link name="l2"><inertial><origin xyz="0.1 0 0.03"/><mass value="0.5"/>
+    <inertia ixx="0.0012" ixy="0.00021" ixz="-0.00017" iyy="0.0019" iyz="0.00011"
+      izz="0.0015"/></inertial></link>
+</robot>
+"""
+"""Two links whose inertias have off-diagonal terms in their frames (as published arms do:
+found on example-robot-data's so101), which PyBullet stores as principal moments."""
+
+
+def test_inertia_stored_as_principal_moments_carries_into_the_pairs_dynamics(tmp_path):
+    """PyBullet's diagonalization (stopped at 1e-6 of the trace) moves the inertia it holds
+    by 1e-10 of the file's here: its description rows are explained (the stored inertia), and
+    its pair with MuJoCo differs by that reading's effect — measured by the referee on each
+    reading (the expected values: the general method on the two inertias), so explained,
+    never "cause unknown" (before: five failed rows, the difference 1.3e-10 against a
+    round-off tolerance of 1e-13); against the referee on its own reading it passes."""
+    path = tmp_path / "arm.urdf"
+    path.write_text(TILTED)
+    rows = check_model(path, impls=("reference", "mujoco", "pybullet"), states=20).rows
+    described = rows[(rows["section"] == "description") & (rows["impl_b"] == "pybullet")
+                     & (rows["field"] == "inertia")]
+    assert set(described["verdict"]) == {"explained"}, described["note"].tolist()
+    dynamics = rows[rows["section"] == "dynamics"]
+    pair = dynamics[(dynamics["impl_a"] == "mujoco") & (dynamics["impl_b"] == "pybullet")]
+    assert "failed" not in set(pair["verdict"]), pair["note"].tolist()
+    explained = pair[pair["verdict"] == "explained"]
+    assert len(explained) and explained["note"].str.contains("read the model differently").all()
+    assert (explained["error"] > explained["tolerance"]).all()
+    own = dynamics[(dynamics["impl_a"] == "reference") & (dynamics["impl_b"] == "pybullet")]
+    assert set(own["verdict"]) == {"passed"}
