@@ -6,6 +6,7 @@ finite differences agree) and two readings of the model (the referee on each).""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 from functools import partial
 from typing import TYPE_CHECKING
@@ -135,18 +136,25 @@ OWN_DIFFERENCES = ("{engine}'s analytic derivative is beyond the bound ({raw}); 
 
 def after_defects(model: str, tree: ModelTree, *, name_a: str, da: Derivatives, name_b: str,
                   db: Derivatives, ref: Referee, eps: float = EPS) -> list[CheckRow]:
-    """:func:`compare`, and where a side declares a defect of its analytic derivatives
-    (:attr:`Derivatives.defect`) and a row fails, the same row with that side's own finite
-    differences: explained where they agree within their predicted error (the size of the
-    defect is the failed row's error, on the note), failed where they do not either."""
-    raw = compare(model, tree, name_a=name_a, da=da, name_b=name_b, db=db, ref=ref, eps=eps)
+    """:func:`compare`, and where a side declares a defect of its analytic derivatives, the
+    failed rows again with its own finite differences (:func:`with_defects`)."""
+    return with_defects(partial(compare, model, tree, name_a=name_a, name_b=name_b, ref=ref,
+                                eps=eps), name_a=name_a, da=da, name_b=name_b, db=db)
+
+
+def with_defects(rows_of: Callable[..., list[CheckRow]], *, name_a: str, da: Derivatives,
+                 name_b: str, db: Derivatives) -> list[CheckRow]:
+    """The rows ``rows_of(da=, db=)`` gives, and where a side declares a defect of its
+    analytic derivatives (:attr:`Derivatives.defect`) and a row fails, the same row with that
+    side's own finite differences: explained where they agree within their predicted error
+    (directly, or after the readings' difference where the pair is compared across readings;
+    the size of the defect is the failed row's error, on the note), failed where they do not
+    either."""
+    raw = rows_of(da=da, db=db)
     flawed = [(n, d) for n, d in ((name_a, da), (name_b, db)) if d.own_differences is not None]
     if not flawed or all(r.verdict is not Verdict.FAILED for r in raw):
         return raw
-    own_a = da.own_differences or da
-    own_b = db.own_differences or db
-    redone = compare(model, tree, name_a=name_a, da=own_a, name_b=name_b, db=own_b, ref=ref,
-                     eps=eps)
+    redone = rows_of(da=da.own_differences or da, db=db.own_differences or db)
     engine, declared = flawed[0]
     out = []
     for first_try, second in zip(raw, redone, strict=True):
@@ -157,8 +165,9 @@ def after_defects(model: str, tree: ModelTree, *, name_a: str, da: Derivatives, 
                                f"differ too: {second.note}"))
         else:
             size = f"error {first_try.error:.3g} against {first_try.tolerance:.3g}"
+            then = f"; then {second.note}" if second.verdict is Verdict.EXPLAINED else ""
             out.append(replace(first_try, verdict=Verdict.EXPLAINED, note=OWN_DIFFERENCES.format(
-                engine=engine, raw=size, defect=declared.defect), convention=DEFECT))
+                engine=engine, raw=size, defect=declared.defect) + then, convention=DEFECT))
     return out
 
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 
@@ -36,7 +37,11 @@ from dyncheck.adapters.model_tree import (
     Derivatives,
     ModelTree,
 )
-from dyncheck.check.derivative_pairs import across_readings, after_defects, compare
+from dyncheck.check.derivative_pairs import (
+    across_readings,
+    after_defects,
+    with_defects,
+)
 from dyncheck.check.dynamics import tie_row
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.check.steps import step_rows
@@ -207,14 +212,14 @@ def _pair_rows(model: str, tree: ModelTree, *, order: list[str], found: dict[str
             if a_name == "reference" and b_name in own_refs:  # on b's own reading
                 on_b = own_refs[b_name]
                 rows.extend(replace(r, basis=f"{r.basis}; the referee on {b_name}'s reading")
-                           for r in compare(model, tree, name_a=a_name, da=on_b.derivatives,
-                                            name_b=b_name, db=found[b_name], ref=on_b,
-                                            eps=eps))
-            elif a_name in own_refs or b_name in own_refs:
-                rows.extend(across_readings(
-                    model, tree, name_a=a_name, da=found[a_name], name_b=b_name,
-                    db=found[b_name], ref_a=own_refs.get(a_name, ref),
-                    ref_b=own_refs.get(b_name, ref), eps=eps))
+                           for r in after_defects(model, tree, name_a=a_name,
+                                                  da=on_b.derivatives, name_b=b_name,
+                                                  db=found[b_name], ref=on_b, eps=eps))
+            elif a_name in own_refs or b_name in own_refs:  # (a declared defect after it)
+                rows.extend(with_defects(partial(
+                    across_readings, model, tree, name_a=a_name, name_b=b_name,
+                    ref_a=own_refs.get(a_name, ref), ref_b=own_refs.get(b_name, ref), eps=eps),
+                    name_a=a_name, da=found[a_name], name_b=b_name, db=found[b_name]))
             else:
                 rows.extend(after_defects(model, tree, name_a=a_name, da=found[a_name],
                                          name_b=b_name, db=found[b_name], ref=ref, eps=eps))
