@@ -17,10 +17,10 @@ from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.check import partial, predicted, readings
 from dyncheck.check.dynamics import QUANTITIES, Prediction, compare
-from dyncheck.check.rows import CheckRow
+from dyncheck.check.rows import CheckRow, Section
 from dyncheck.referee.states import States
 from dyncheck.referee.tree import ReferenceModel
-from dyncheck.vocabulary import REFEREE
+from dyncheck.vocabulary import REFEREE, Verdict
 
 
 def part_reading(batch: States, part: partial.Part, tree: ModelTree) -> readings.Reading | None:
@@ -48,6 +48,15 @@ def rows(model: str, canonical_tree: ModelTree, *, a: str, b: str, batch: States
     common = np.arange(canonical_tree.nv)
     for columns in held.values():
         common = np.intersect1d(common, columns) if columns is not None else common
+    if not common.size:  # two partial readings with no joint in common (dm_control's
+        # ball_in_cup: Pinocchio holds the cup's joints, PyBullet the ball's)
+        return [CheckRow(
+            model=model, section=Section.DYNAMICS, subject="model", field="dynamics",
+            impl_a=a, impl_b=b, value_a="", value_b="", error=0.0, tolerance=0.0, basis="",
+            verdict=Verdict.SKIPPED,
+            note=f"{a} and {b} hold no joint in common (each holds part of the model, the "
+                 "description rows say which): their dynamics are not compared with each "
+                 "other")]
     on = States(q=batch.q, v=batch.v[:, common], a=batch.a[:, common])
     dyn_a = partial.restrict(results[a], partial.columns(held[a], common))
     dyn_b = partial.restrict(results[b], partial.columns(held[b], common))

@@ -21,6 +21,8 @@ def condition(mass: np.ndarray) -> float:
     """The largest condition number of M over the states (the symmetric M's eigenvalues:
     a fifth of the SVD's cost; an indefinite M from a broken model still gives |λ|
     max/min)."""
+    if not mass.size:  # no coordinate: nothing to condition
+        return 1.0
     with np.errstate(all="ignore"):
         symmetric = 0.5 * (mass + np.swapaxes(mass, -1, -2))
         eig = np.abs(np.linalg.eigvalsh(symmetric))

@@ -60,3 +60,33 @@ def test_judged_on_the_canonical_reading_the_same_engine_fails(model, monkeypatc
     judged = _dynamics(result, "reference", "pinocchio")
     assert judged.loc["bias_forces", "verdict"] == "failed"
     assert judged.loc["mass_matrix", "verdict"] == "passed"
+
+
+def test_two_partial_readings_with_no_joint_in_common_are_one_skipped_row(model):
+    """Two engines each holding a different top-level tree of the model (found on
+    dm_control's ball_in_cup: Pinocchio the cup's joints, PyBullet the ball's — the check
+    then stopped on a 0 × 0 mass matrix, "a defect of its own"): their pair is one skipped
+    row saying they hold no joint in common. Expected: the two parts are disjoint by
+    construction (the first tree's joints, the second's)."""
+    from dataclasses import replace
+
+    from dyncheck.adapters import layout
+    from dyncheck.adapters.formats.files import read
+    from dyncheck.adapters.mujoco.model import MujocoModel
+    from dyncheck.check import partial
+    from dyncheck.check.sampling import sample
+    from dyncheck.vocabulary import Verdict
+
+    canonical = MujocoModel(read(model)).tree
+    first = replace(canonical, joints=tuple(j for j in canonical.joints if j.name != "h"))
+    second = replace(canonical, joints=tuple(j for j in canonical.joints if j.name == "h"))
+    parts = {"x": partial.common_part(canonical, first),
+             "y": partial.common_part(canonical, second)}
+    assert all(p is not None and len(p.v) for p in parts.values())
+    found = partial_pairs.rows(
+        "two_trees", canonical, a="x", b="y",
+        batch=sample(layout.canonical(canonical), canonical, 5, 0), results={}, trees={},
+        parts=parts, loaded={}, own={}, differing={}, eps=2.2e-16, vertices=0.0,
+        standing=1.0)
+    assert [r.verdict for r in found] == [Verdict.SKIPPED]
+    assert "x and y hold no joint in common" in found[0].note
