@@ -1942,12 +1942,12 @@ DEDICATED = (
      "tests/dyncheck/test_cli.py::test_a_closed_or_full_standard_stream_fails_no_model"),
     ("a referee whose two methods disagree (its recursion mutated by 1e-6)",
      "its own row failed naming itself, no engine judged against it, nor its derivatives",
-     "tests/check/test_referee.py::test_a_mutated_recursion_fails_the_tie"),
+     "tests/dyncheck/referee/test_tree.py::test_a_mutated_recursion_fails_the_tie"),
     ("a URDF floating joint below a moving link", "held in its parent's frame: the referee's "
      "two methods agree to round-off and Pinocchio agrees with it on every dynamics and "
      "derivative row — the referee disagreed with itself (M by 0.87) and Pinocchio's rows "
      "failed 'cause unknown'",
-     "tests/check/test_referee.py::test_a_floating_joint_below_a_moving_link_is_held_in_its_"
+     "tests/dyncheck/referee/test_tree.py::test_a_floating_joint_below_a_moving_link_is_held_in_its_"
      "parents_frame"),
     ("a known finding accepted (--accept), a new one beside it", "the accepted row on the "
      "page as accepted with its reason, exit 0; the new one fails, exit 1",
