@@ -81,7 +81,7 @@ class PortModel(MujocoModel):
         kind = self._port_type()
         colliding = int(np.count_nonzero(self.model.geom_contype | self.model.geom_conaffinity))
         self.port = kind.on_model(_collisionless(self.model), name=self.engine)
-        self._smooth = self.port  # (its derivatives' model: couplings leave it as it is)
+        self._smooth_port = self.port  # (its derivatives' port: couplings leave it as it is)
         self.max_steps, self.device = self.port.max_steps, self.port.device
         self._as_held()
         eps, version = float(np.finfo(kind.dtype).eps), self.version(self.package)
@@ -209,7 +209,7 @@ class PortModel(MujocoModel):
             raise Unsupported(f"{self.engine} offers no derivatives of its dynamics (its "
                               "kernels are not differentiated; MuJoCo C's are on MuJoCo's "
                               "rows)")
-        own = self._smooth.derivatives(q, v, a)
+        own = self._smooth_port.derivatives(q, v, a)
         return derivatives(own, method=f"automatic differentiation (JAX jacfwd, "
                            f"{np.dtype(self.port.dtype).name})")
 

@@ -391,9 +391,7 @@ def changes_dynamics(row: CheckRow) -> bool:
     moments): the dynamics rows follow from it, measured by the referee on each reading;
     other explained rows (a model placed elsewhere, float32 vertices) change no dynamics
     beyond their bounds."""
-    return row.verdict is Verdict.EXPLAINED and (
-        row.convention == STORED_INERTIA
-        or row.note.startswith(EXACT_MESHES_LEAD.format(a=row.impl_a)))
+    return row.verdict is Verdict.EXPLAINED and row.convention in (STORED_INERTIA, MESH_VOLUME)
 
 
 def _exact_meshes(a: ModelTree, b: ModelTree, ja: TreeJoint, jb: TreeJoint, field: str,
