@@ -3,11 +3,11 @@ registrations (importable without the engine), ``model.py`` its loader of a mode
 rest named for what they hold. The registrations are gathered here; MJCF and URDF handling
 shared by every engine is in :mod:`.formats`, what the engines share beside the folders.
 
-``REGISTRY`` names each implementation's module and class; modules are imported on first use.
-``ADAPTERS`` maps implementation name → adapter class for the engines that are installed;
-``MISSING`` maps the others → the reason. :func:`get_adapter` raises
-:class:`~dyncheck.errors.EngineNotInstalled` (with the pip hint) or
-:class:`~dyncheck.errors.UnknownName` (listing the valid names).
+``REGISTRY`` names each implementation's engine class (a
+:class:`~dyncheck.adapters.base.ModelEngine`), imported on first use. ``ENGINES`` maps
+implementation name → engine class for the engines that are installed; ``MISSING`` maps the
+others → the reason. :func:`get_engine` raises :class:`~dyncheck.errors.EngineNotInstalled`
+(with the pip hint) or :class:`~dyncheck.errors.UnknownName` (listing the valid names).
 """
 
 from __future__ import annotations
@@ -26,7 +26,8 @@ from dyncheck.adapters import (
     pybullet,
     sympy_mechanics,
 )
-from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.base import LoadedBody, ModelEngine, Trajectory
+from dyncheck.adapters.c_output import c_output_dropped
 from dyncheck.adapters.registration import Needs, Registration
 from dyncheck.errors import EngineNotInstalled, UnknownName
 
@@ -74,8 +75,8 @@ def _installed_engines() -> tuple[dict[str, Registration], dict[str, str]]:
 _ADDED, NOT_ADDED = _installed_engines()
 REGISTRY.update(_ADDED)
 
-RUN: tuple[str, ...] = tuple(n for n, r in REGISTRY.items() if r.module or r.run)
-"""The implementations with an adapter of a book case (``dyncheck run``)."""
+RUN: tuple[str, ...] = tuple(n for n, r in REGISTRY.items() if r.run and r.model)
+"""The implementations that take a book case (``dyncheck run``)."""
 ENGINE_PACKAGES: dict[str, str] = {name: r.package for name, r in REGISTRY.items()}
 """Every engine implementation dyncheck knows, installed or not → its pip package."""
 ENGINE_EXTRAS: dict[str, str] = {n: r.extra for n, r in REGISTRY.items() if r.extra}
@@ -98,61 +99,64 @@ LABELS: dict[str, str] = {n: r.label for n, r in MODELS.items() if r.label}
 """Implementation whose adapter reports its engine's version → the engine's name in a
 report's provenance (in the check's order: the canonical engine first)."""
 
-_ADAPTERS: dict[str, type[Adapter]] = {}
+_ENGINES: dict[str, type[ModelEngine]] = {}
 _MISSING: dict[str, str] = {}
 
 
 def _load(name: str) -> None:
-    """Import one adapter's module once; an ImportError records the engine as missing."""
-    if name in _ADAPTERS or name in _MISSING:
+    """Import one engine class once; an ImportError records the engine as missing."""
+    if name in _ENGINES or name in _MISSING:
         return
     entry = REGISTRY[name]
+    assert entry.model is not None, name
     try:
-        if entry.run is not None and entry.model is not None:
-            from dyncheck.adapters.model_adapter import for_engine
-
-            # its loader imports the engine only when it loads a model (Newton's): an engine
-            # that is not installed must be missing here, not fail in the middle of a run
-            try:
-                importlib.metadata.distribution(entry.package)
-            except importlib.metadata.PackageNotFoundError:
-                raise ImportError(f"No module named {entry.package!r}") from None
-
-            _ADAPTERS[name] = for_engine(name, entry)
-            return
-        assert entry.module is not None and entry.cls is not None, name
-        _ADAPTERS[name] = getattr(importlib.import_module(entry.module), entry.cls)
+        # a loader imports its engine only when it loads a model (Newton's): an engine that
+        # is not installed must be missing here, not fail in the middle of a run
+        try:
+            importlib.metadata.distribution(entry.package)
+        except importlib.metadata.PackageNotFoundError:
+            raise ImportError(f"No module named {entry.package!r}") from None
+        module, cls = entry.model.split(":")
+        with c_output_dropped():  # an engine's import may print a banner of its own (C)
+            _ENGINES[name] = getattr(importlib.import_module(module), cls)
     except ImportError as exc:  # depends on the environment
         _MISSING[name] = str(exc)
 
 
 def __getattr__(attr: str) -> dict[str, Any]:
-    """``ADAPTERS`` (name → class of every installed engine) and ``MISSING`` (name → why not):
-    asking for either imports every adapter (PEP 562)."""
-    if attr in ("ADAPTERS", "MISSING"):
+    """``ENGINES`` (name → engine class of every installed engine) and ``MISSING`` (name →
+    why not): asking for either imports every engine (PEP 562)."""
+    if attr in ("ENGINES", "MISSING"):
         for name in RUN:
             _load(name)
-        return _ADAPTERS if attr == "ADAPTERS" else _MISSING
+        return _ENGINES if attr == "ENGINES" else _MISSING
     raise AttributeError(f"module {__name__!r} has no attribute {attr!r}")
 
 
-def get_adapter(name: str) -> type[Adapter]:
-    """The adapter class for an installed engine implementation."""
-    if name not in RUN:
-        raise UnknownName("implementation", name, RUN)
+def get_engine(name: str) -> type[ModelEngine]:
+    """The engine class of an installed implementation (one ``dyncheck run`` or ``dyncheck
+    check`` knows)."""
+    if name not in REGISTRY or REGISTRY[name].model is None:
+        raise UnknownName("implementation", name,
+                          tuple(n for n, r in REGISTRY.items() if r.model))
     _load(name)
     if name in _MISSING:
         raise EngineNotInstalled(
             name, ENGINE_PACKAGES[name], _MISSING[name], ENGINE_EXTRAS.get(name)
         )
-    return _ADAPTERS[name]
+    return _ENGINES[name]
+
+
+def engine_version(name: str) -> str:
+    """The installed engine's version (its package's, unless its class says more)."""
+    return get_engine(name).version(REGISTRY[name].package)
 
 
 __all__ = [
     "ACCELERATORS",
-    "ADAPTERS",
     "BUILT_IN",
     "COUPLINGS_ONLY",
+    "ENGINES",
     "ENGINE_EXTRAS",
     "ENGINE_PACKAGES",
     "ENGINE_PORTS",
@@ -163,10 +167,11 @@ __all__ = [
     "NOT_ADDED",
     "REGISTRY",
     "RUN",
-    "Adapter",
     "LoadedBody",
+    "ModelEngine",
     "Needs",
     "Registration",
     "Trajectory",
-    "get_adapter",
+    "engine_version",
+    "get_engine",
 ]

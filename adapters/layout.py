@@ -17,10 +17,11 @@ This is the one home of these maps: a model check maps one state at a time (:fun
 complex-stepped for its derivatives, with a free joint's placement and offset) from the
 layouts the engine's own model declares; a run's case maps batches (:func:`to_engine`,
 :func:`from_engine`, :func:`velocity_frames`, :func:`velocity_frame_rates`) from the layouts
-its adapter declares once (``Adapter.state_layout``, a
-:class:`~dyncheck.adapters.model_tree.StateLayout`). Those were found by experiment on the
-installed versions (tests/adapters/test_state_layouts.py rotates a body by a known quaternion
-and reads the result back):
+a :class:`~dyncheck.adapters.model_tree.StateLayout` declares (the case's coordinate map into
+the canonical layout; sympy.physics.mechanics's chart of Example 9's angles). The engines'
+layouts were found by experiment on the installed versions
+(tests/adapters/test_state_layouts.py rotates a body by a known quaternion and reads the
+result back):
 
 - MuJoCo: ball-joint qpos (w, x, y, z), qvel ω in body axes; a free joint's qpos (p, w, x, y,
   z), qvel (v, ω), v of the body origin in *world* axes, ω in body axes (the canonical).

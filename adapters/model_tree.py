@@ -130,10 +130,10 @@ class Layout:
 
 @dataclass(frozen=True, kw_only=True)
 class StateLayout:
-    """How an engine holds every ball and every free joint (:class:`Layout`), declared once per
-    engine for the run's cases (``Adapter.state_layout``), measured on the installed versions
-    (tests/adapters/test_state_layouts.py rotates a body by a known quaternion and reads it
-    back); a model check reads each joint's from the engine's own model instead. The default
+    """How every ball and every free joint is held (:class:`Layout`) by a chart declared once
+    (sympy.physics.mechanics's angles); an engine's own layout is read from its model, each
+    joint's, and measured on the installed versions (tests/adapters/test_state_layouts.py
+    rotates a body by a known quaternion and reads it back). The default
     is the canonical layout, MuJoCo's: quaternion (w, x, y, z), a free joint's position first,
     ω in body axes, a free joint's linear velocity in world axes, (v, ω)."""
 

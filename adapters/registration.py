@@ -16,6 +16,9 @@ class Format(StrEnum):
 
     MJCF = "mjcf"
     URDF = "urdf"
+    CASE = "case"
+    """No file: a book case itself, the engine built from its ``Multibody`` (an engine of
+    dyncheck's own, sympy.physics.mechanics's equations of the case)."""
 
 
 A = "dyncheck.adapters."
@@ -41,14 +44,11 @@ class Needs:
 
 @dataclass(frozen=True, kw_only=True)
 class Registration:
-    """One engine implementation: where its adapter is, and the facts about its installation
-    that are needed before (or without) importing it."""
+    """One engine implementation: where its engine class is, and the facts about its
+    installation that are needed before (or without) importing it."""
 
     package: str
     """The pip package that provides the engine (its version is read from its metadata)."""
-    module: str | None = None
-    """Where its adapter of a book case is (``dyncheck run``); None: not in the run."""
-    cls: str | None = None
     integrators: tuple[str, ...] = ()
     """The fixed-step integrators its ``simulate`` accepts (its adapter's ``integrators``):
     known without importing the engine (a test session's parameters)."""
@@ -61,8 +61,9 @@ class Registration:
     """Whether it computes in float32 (its adapter's ``dtype``): the report check derives its
     rows' round-off bands from float32's ε without importing the engine."""
     model: str | None = None
-    """``module:class`` of its loader of a user's file (``dyncheck check``); None: not in
-    the check."""
+    """``module:class`` of its engine, a :class:`~dyncheck.adapters.base.ModelEngine`: the
+    loader of a user's file (``dyncheck check``, unless ``checks_files`` is False), or built
+    from a book case where ``run`` is :attr:`Format.CASE`."""
     on_request: bool = False
     """Checked only when asked for (``--impl``): a port (compiling a model for it takes
     seconds to minutes on a CPU), or an engine a user names when moving a model to it."""
@@ -92,9 +93,9 @@ class Registration:
     """The file format the engine defines (MuJoCo's MJCF): its refusal of a file in that
     format is the file's fault, and ends the check with the engine's message."""
     run: Format | None = None
-    """An engine without a run adapter of its own (``module``): the format a book case is
-    written in for its file loader (``model``), which then serves ``dyncheck run`` too
-    (:mod:`.model_adapter`); a loader given URDF takes the case's ``gravity=``."""
+    """How ``dyncheck run`` hands it a book case (:mod:`dyncheck.case_engine`): written as a
+    file in this format for its loader (``model``) — a loader given URDF takes the case's
+    ``gravity=`` — or, :attr:`Format.CASE`, the case itself; None: not in the run."""
     as_stated: bool = False
     """Its run reads a book case as stated, not as the file approximates it: its loader is
     given the case's gravity and each point mass's exact inertia (``gravity=``,

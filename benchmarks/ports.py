@@ -54,14 +54,15 @@ def main() -> None:
     import jax
 
     jax.config.update("jax_enable_compilation_cache", False)
-    from dyncheck.adapters import ADAPTERS, ENGINE_PORTS
+    from dyncheck.adapters import ENGINE_PORTS, ENGINES, engine_version
+    from dyncheck.case_engine import CaseEngine
     from dyncheck.cases import get_case
 
     cases = args.case or ["compound_pendulum", "rigid_body_free"]
     device = jax.devices()[0]
     lines = [
         f"Device: JAX {device.platform} ({device.device_kind}); host {platform.machine()}; "
-        f"ports: {', '.join(ADAPTERS[p].version() for p in ENGINE_PORTS if p in ADAPTERS)}",
+        f"ports: {', '.join(engine_version(p) for p in ENGINE_PORTS if p in ENGINES)}",
         "",
         "| case | implementation | batch | first call (s) | µs per state | × MuJoCo C |",
         "|---|---|---|---|---|---|",
@@ -69,14 +70,14 @@ def main() -> None:
     for name in cases:
         case = get_case(name)
         mb = case.multibody()
-        c = ADAPTERS["mujoco"](mb)
+        c = CaseEngine("mujoco", mb)
         raw = _raw_c(c, *_states(case, 2000))
         lines.append(f"| {name} | mujoco (C, per state) | 1 | – | {1e6 * raw:.3g} | 1 |")
         for port in ENGINE_PORTS:
-            if port not in ADAPTERS:
+            if port not in ENGINES:
                 continue
             for batch in args.batches if port != "mujoco-warp" else [256]:
-                adapter = ADAPTERS[port](mb)
+                adapter = CaseEngine(port, mb)
                 if port != "mujoco-warp":
                     adapter.engine.port.chunk = batch  # the port's states per batched call
                 x = _states(case, batch)

@@ -18,7 +18,6 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from dyncheck.adapters import get_adapter
 from dyncheck.adapters.layout import (
     from_engine,
     to_engine,
@@ -131,12 +130,12 @@ class NativeMap:
     kinds: tuple[JointType, ...]
 
     @classmethod
-    def of(cls, case: Case, engine: str, base: Any = None,
+    def of(cls, case: Case, base: Any = None,
            state_layout: StateLayout | None = None) -> NativeMap:
-        """``case``'s map (or ``base``) into the layout ``engine``'s adapter declares (or
-        ``state_layout``)."""
+        """``case``'s map (or ``base``) into ``state_layout`` (by default the canonical one,
+        MuJoCo's, which every engine's run is seen in: :mod:`dyncheck.case_engine`)."""
         kinds = tuple(JointType(j.type) for j in case.multibody().joints)
-        layouts = tuple((state_layout or get_adapter(engine).state_layout).joints(kinds))
+        layouts = tuple((state_layout or StateLayout()).joints(kinds))
         return cls(case.engine_map() if base is None else base, layouts, kinds)
 
     @property

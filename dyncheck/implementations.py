@@ -19,18 +19,12 @@ from typing import Any, ClassVar
 import numpy as np
 
 from dyncheck import coordinates as co
-from dyncheck.adapters import (
-    COUPLINGS_ONLY,
-    ENGINE_PACKAGES,
-    ENGINE_PORTS,
-    Adapter,
-    Trajectory,
-    get_adapter,
-)
+from dyncheck.adapters import COUPLINGS_ONLY, ENGINE_PACKAGES, ENGINE_PORTS, Trajectory
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.adapters.symbolic import Symbolic
+from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import Case, StateSample
 from dyncheck.coordinates import NativeMap
 from dyncheck.errors import UnknownName
@@ -101,8 +95,8 @@ class Implementation(ABC):
     integrators: tuple[str, ...] = ()
     eps: float = float(np.finfo(float).eps)
     """Unit round-off of the arithmetic the implementation computes in."""
-    adapter: Adapter | None = None
-    """The engine behind the implementation (None: the book's side)."""
+    adapter: CaseEngine | None = None
+    """The engine behind the implementation, seen by the case (None: the book's side)."""
 
     def __init__(self, case: Case) -> None:
         self.case = case
@@ -208,14 +202,15 @@ class ReferenceImplementation(_Equations):
 
 
 class EngineImplementation(Implementation):
-    """An engine adapter seen through the case's coordinate map."""
+    """An engine, loaded with the case (:class:`~dyncheck.case_engine.CaseEngine`), seen
+    through the case's coordinate map."""
 
-    def __init__(self, case: Case, adapter: type[Adapter]) -> None:
+    def __init__(self, case: Case, name: str) -> None:
         super().__init__(case)
-        self.name = adapter.name  # type: ignore[misc]
-        self.adapter: Adapter = adapter.create(case.multibody(), symbolic=CACHED)
-        self.map = NativeMap.of(case, adapter.name)
-        self.integrators = adapter.integrators
+        self.name = name  # type: ignore[misc]
+        self.adapter: CaseEngine = CaseEngine(name, case.multibody(), symbolic=CACHED)
+        self.map = NativeMap.of(case)
+        self.integrators = self.adapter.integrators
         self.eps = self.adapter.eps
         self._runs: dict[tuple[float, str], tuple[np.ndarray, np.ndarray]] = {}
         self._velocities: dict[tuple[float, str], np.ndarray] = {}
@@ -259,10 +254,8 @@ class EngineImplementation(Implementation):
         """:meth:`variant` with a rigid body's tensor as its engine computes with it
         (:attr:`~dyncheck.adapters.model_tree.TreeJoint.computed_inertia`, PyBullet's
         principal moments in the link's axes), where it declares one."""
-        from dyncheck.adapters.model_adapter import ModelAdapter
-
         held = self.variant()
-        if held is None or not held.inertia or not isinstance(self.adapter, ModelAdapter):
+        if held is None or not held.inertia or self.adapter is None:
             return held
         computed = [j.computed_inertia for j in self.adapter.tree.joints
                     if j.computed_inertia is not None]
@@ -324,9 +317,7 @@ class EngineImplementation(Implementation):
                          ae: np.ndarray) -> dict[str, np.ndarray]:
         """What a file loader's engine computing otherwise than the file says changes
         (:func:`_book_effects`)."""
-        from dyncheck.adapters.model_adapter import ModelAdapter
-
-        if not isinstance(self.adapter, ModelAdapter):
+        if self.adapter is None:
             return {}
         return _book_effects(self.adapter.canon, self.adapter.tree, self.map, s,
                             rest=self.case.rest(), te=te, ae=ae)
@@ -384,7 +375,7 @@ class EngineImplementation(Implementation):
         engine's own error-controlled integrator at ``accuracy``, and its number of steps."""
         spec = self.case.trajectory
         qe0, ve0 = self.engine_start()
-        traj, steps = self.adapter.simulate_controlled(  # type: ignore[attr-defined]
+        traj, steps = self.adapter.simulate_controlled(
             qe0, ve0, spec.duration, spec.grid_step, accuracy
         )
         return self.map.to_book(traj.q), steps.taken
@@ -432,19 +423,18 @@ def _book_effects(canon: Canonical, tree: ModelTree, m: NativeMap, s: StateSampl
 def engines_as_read(impls: Mapping[str, Implementation | Exception]) -> dict[str, ModelEngine]:
     """Each file-loading engine's name (:data:`~dyncheck.adapters.MODELS`) → an engine one of
     ``impls`` loaded by that engine's loader from the case's MJCF read as a user's file is
-    (:meth:`~dyncheck.adapters.model_adapter.ModelAdapter.as_read`; the implementation of
+    (:meth:`~dyncheck.case_engine.CaseEngine.as_read`; the implementation of
     the same name first): the case's other studies compute on it rather than load the file
     again (``pinocchio``'s derivative rows on ``pinocchio-mjcf``'s engine, ``pinocchio``
     itself reading the case as stated)."""
     from dyncheck.adapters import MODELS
-    from dyncheck.adapters.model_adapter import ModelAdapter
 
     out: dict[str, ModelEngine] = {}
     for name, registration in MODELS.items():
         for other in sorted(impls, key=lambda n: n != name):
             impl = impls[other]
             adapter = impl.adapter if isinstance(impl, EngineImplementation) else None
-            if isinstance(adapter, ModelAdapter) and registration.model and \
+            if adapter is not None and registration.model and \
                     (engine := adapter.as_read(registration.model)) is not None:
                 out[name] = engine
                 break
@@ -458,7 +448,7 @@ def make_implementation(name: str, case: Case) -> Implementation:
     if name == "reference":
         return ReferenceImplementation(case)
     if name in ENGINE_PACKAGES:
-        return EngineImplementation(case, get_adapter(name))
+        return EngineImplementation(case, name)
     raise UnknownName("implementation", name, IMPLEMENTATIONS)
 
 

@@ -29,14 +29,14 @@ def engine_versions(names: Iterable[str]) -> dict[str, str]:
     """The versions of the engines behind the implementations ``names`` (provenance name →
     version, "not installed" for an engine that is not), each implementation standing for
     its package's engine (``mujoco-stiff`` for MuJoCo)."""
-    from dyncheck.adapters import ENGINE_PACKAGES, LABELS, RUN, get_adapter
+    from dyncheck.adapters import ENGINE_PACKAGES, LABELS, RUN, engine_version
 
     packages = {ENGINE_PACKAGES[n] for n in names if n in ENGINE_PACKAGES}
     out = {}
     for name, label in LABELS.items():
         if name in RUN and ENGINE_PACKAGES[name] in packages:
             try:
-                out[label] = get_adapter(name).version()
+                out[label] = engine_version(name)
             except EngineNotInstalled:
                 out[label] = "not installed"
     return out

@@ -23,7 +23,7 @@ slices of a case loads its engines once."""
 
 def _release() -> None:
     """Drop the implementations built in this process, and what their engines compiled."""
-    engines = {type(adapter) for made in _BUILT.values() for impl in made.values()
+    engines = {adapter.loader for made in _BUILT.values() for impl in made.values()
                if not isinstance(impl, Exception) and (adapter := impl.adapter) is not None}
     _BUILT.clear()
     for engine in engines:

@@ -17,6 +17,7 @@ from hypothesis import settings
 from dyncheck import adapters
 from dyncheck.adapters import RUN
 from dyncheck.adapters.offers import Offer
+from dyncheck.adapters.registration import Format
 from dyncheck.cases import CASES, get_case
 from dyncheck.workers import exit_without_collecting
 
@@ -64,7 +65,8 @@ def loader(engine: str) -> type[ModelEngine]:
     module, cls = (adapters.REGISTRY[engine].model or ":").split(":")
     found: type[ModelEngine] = getattr(importlib.import_module(module), cls)
     return found
-FILE_LOADERS = tuple(n for n, r in adapters.REGISTRY.items() if r.run and not r.couplings_only)
+FILE_LOADERS = tuple(n for n, r in adapters.REGISTRY.items()
+                     if r.run not in (None, Format.CASE) and not r.couplings_only)
 """Engines whose book cases go through their loader of a user's file (couplings where the
 engine has constraints for them: PyBullet's gears, of two joints)."""
 MULTI_JOINT_CASES = sorted(
@@ -175,7 +177,7 @@ def _full_run() -> RunResult:
     from dyncheck.run import run
 
     # An engine that is not installed is a test failure, never a skip counted as a pass.
-    # (asked here, not at import: finding out imports every adapter, JAX and Warp included)
+    # (asked here, not at import: finding out imports every engine, JAX and Warp included)
     assert not adapters.MISSING, f"engines not installed: {adapters.MISSING}"
     # two worker processes: the same results as one (test_jobs_give_identical_results), in
     # about half the wall time on CI's two cores
@@ -187,12 +189,12 @@ def _full_run() -> RunResult:
 
 @pytest.fixture
 def pretend_missing(monkeypatch):
-    """``pretend_missing(engine, why)``: the engine as if its adapter's import failed with
-    ``why`` — skipped rows naming its extra — without importing every other adapter, as
+    """``pretend_missing(engine, why)``: the engine as if its class's import failed with
+    ``why`` — skipped rows naming its extra — without importing every other engine, as
     asking for ``adapters.MISSING`` would (~4 s with JAX and Warp)."""
 
     def hide(engine: str, why: str) -> None:
-        monkeypatch.delitem(adapters._ADAPTERS, engine, raising=False)
+        monkeypatch.delitem(adapters._ENGINES, engine, raising=False)
         monkeypatch.setitem(adapters._MISSING, engine, why)
 
     return hide

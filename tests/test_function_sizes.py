@@ -15,7 +15,7 @@ LONG: dict[str, int] = {}
 """The functions over :data:`MOST_LINES` lines, with their length (a ratchet: none since #62
 split the last two, ``reference/tree.py:_at_chunk`` and ``sympy_mechanics._derive``)."""
 
-MANY_POSITIONAL = 88
+MANY_POSITIONAL = 85
 """How many functions took five or more positional arguments (``self`` not counted) when the
 ratchet was set."""
 

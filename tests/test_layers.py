@@ -193,7 +193,7 @@ def test_no_module_reaches_into_another_modules_private_names():
 
 def test_no_module_asks_an_implementation_for_its_engine_by_duck_typing():
     """#43: an implementation's engine is ``Implementation.adapter`` (None on the book's
-    side) and an engine's facts are attributes of ``Adapter`` with defaults: a chain
+    side) and an engine's facts are attributes of ``CaseEngine`` with defaults: a chain
     ``getattr(getattr(impl, "adapter", None), ...)`` hides both from the type checker."""
     chains = [f"{path.relative_to(ROOT)}:{n}" for path in _package_files()
               for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
@@ -374,8 +374,8 @@ for top in ("dyncheck", "dyncheck.adapters", "dyncheck.cases", "dyncheck.referen
         except ImportError:
             pass
 print("modules", count)
-from dyncheck.adapters.base import Adapter
-print("adapter", sorted(k for k in ("derive", "lambdify") if k in vars(Adapter)))
+from dyncheck.adapters.base import ModelEngine
+print("adapter", sorted(k for k in ("derive", "lambdify") if k in vars(ModelEngine)))
 if "jax" in sys.modules:
     import jax
     print("jax", jax.config.jax_compilation_cache_dir, jax.config.jax_enable_x64)

@@ -1,6 +1,6 @@
 """A model on MuJoCo's ports — MJX in float32 and in float64, MuJoCo Warp — for ``dyncheck
 check --impl mjx …`` (the question of a user moving a model to a port) and for ``dyncheck
-run`` (a book case written as MJCF, :mod:`.model_adapter`): one engine interface for both.
+run`` (a book case written as MJCF, :mod:`dyncheck.case_engine`): one engine interface for both.
 
 A port reads no file: the file is compiled by MuJoCo's parser exactly as
 :class:`~.model.MujocoModel` compiles it (the same tree, the same

@@ -182,7 +182,7 @@ the inverse of ``crba``'s M, 3e-15 at the origin, 5.6e-10 at 1 km, 7.7e-4 at 100
 
 
 class PinocchioModel(ModelEngine):
-    """A Pinocchio model and its neutral tree. Options (the run's, :mod:`.model_adapter`):
+    """A Pinocchio model and its neutral tree. Options (the run's, :mod:`dyncheck.case_engine`):
     ``gravity`` as the model's (its MJCF parser reads none), ``inertias`` (body name → its
     rotational inertia about its centre of mass, body axes) in place of the file's: the
     book's point masses exact; ``fixes``: read a copy with each hint's fix applied

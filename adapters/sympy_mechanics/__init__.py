@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from dyncheck.adapters.registration import A, Registration
+from dyncheck.adapters.registration import A, Format, Registration
 from dyncheck.vocabulary import Integrator
 
 REGISTRATIONS: dict[str, Registration] = {
     "sympy-mechanics": Registration(
-        module=A + "sympy_mechanics.model", cls="SympyMechanicsAdapter", package="sympy",
-        integrators=(Integrator.EULER, Integrator.RK4),
+        model=A + "sympy_mechanics.model:SympyMechanics", run=Format.CASE, package="sympy",
+        integrators=(Integrator.EULER, Integrator.RK4), checks_files=False,
     ),
 }

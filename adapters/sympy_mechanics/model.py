@@ -19,7 +19,7 @@ Energies: ``kinetic_energy`` and V = −Σ m g·r. Couplings (cords) are ``hol_c
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
@@ -28,13 +28,15 @@ import numpy as np
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from dyncheck.adapters.base import Adapter, LoadedBody, Trajectory
+from dyncheck.adapters.base import Field, ModelEngine
 from dyncheck.adapters.integrators import integrate
 from dyncheck.adapters.linalg import solve
-from dyncheck.adapters.model_tree import Axes, Layout, Orientation, StateLayout
+from dyncheck.adapters.model_tree import Dynamics, ModelTree
+from dyncheck.adapters.offers import Offer
 from dyncheck.adapters.symbolic import AFRESH, Symbolic
-from dyncheck.adapters.sympy_mechanics import REGISTRATIONS
-from dyncheck.cases.multibody import ROTATING, Multibody
+from dyncheck.adapters.sympy_mechanics.tree import Chart, case_tree
+from dyncheck.cases.multibody import ROTATING, Coupling, Multibody
+from dyncheck.errors import Unsupported
 from dyncheck.vocabulary import Integrator
 
 
@@ -211,25 +213,26 @@ def _constrained(model: Multibody, *, T: sp.Expr, q: list, loads: list,
     return [e.subs(plain) for e in K], [e.subs(plain) for e in rhs]
 
 
-class SympyMechanicsAdapter(Adapter):
-    name: ClassVar[str] = "sympy-mechanics"
-    state_layout: ClassVar[StateLayout] = StateLayout(
-        ball=Layout.ball(quat=Orientation.EULER, angular_axes=Axes.RATES),
-        free=Layout.free(quat=Orientation.EULER, angular_axes=Axes.RATES))
-    """dyncheck's own model: a rotating body in Example 9's angles, velocities their rates."""
-    package: ClassVar[str] = "sympy"
-    integrators: ClassVar[tuple[str, ...]] = REGISTRATIONS["sympy-mechanics"].integrators
-    """MuJoCo's definitions (:mod:`.integrators`): semi-implicit Euler, shared with every
-    engine including Drake, and RK4. Each step costs Python-level evaluations of the
-    lambdified equations."""
+class SympyMechanics(ModelEngine):
+    """The case's Lagrange equations (see the module) as an engine: built from the case (its
+    registration's ``run`` is :attr:`~.registration.Format.CASE`), not read from a file. Its
+    tree holds the case's joints in the canonical layout; it computes in Example 9's angles
+    and their rates (:class:`~.tree.Chart`) and maps each batch there and back."""
 
-    @classmethod
-    def create(cls, model: Multibody, *, symbolic: Symbolic) -> Adapter:
-        return cls(model, symbolic=symbolic)
+    engine = "sympy-mechanics"
+    offers = frozenset({Offer.FORWARD, Offer.STEPPING, Offer.COUPLINGS, Offer.BODY_FORCES})
+    steps_in_a_chart = True
+    """A rotating body's state is stepped in its angles (q₊ = q + h q̇)."""
+    per_state_calls = False
+    """Its dynamics are dyncheck's own lambdified equations: no engine call to time."""
+    definitions: ClassVar[Mapping[str, str]] = {Integrator.IMPLICITFAST: Integrator.EULER}
+    """dyncheck's ``implicitfast`` has D = 0 here (no damping, no actuators): ``euler``."""
 
     def __init__(self, model: Multibody, *, symbolic: Symbolic = AFRESH) -> None:
-        super().__init__(model)
         n = model.nv
+        self.model = model
+        self.tree: ModelTree = case_tree(model, engine=self.engine)
+        self._chart = Chart(model)
         self._symbolic = symbolic
         eq = symbolic.derive("sympy_mechanics", (repr(model), _SOURCE), lambda: _derive(model))
         args = [*sp.symbols(f"x0:{n}"), *sp.symbols(f"v0:{n}")]
@@ -250,73 +253,90 @@ class SympyMechanicsAdapter(Adapter):
         self._V = batched([eq.V])
         self._n = n
 
-    @staticmethod
-    def version() -> str:
+    @classmethod
+    def version(cls, package: str) -> str:
         return sp.__version__
 
-    def loaded_bodies(self) -> list[LoadedBody]:
-        return [LoadedBody(b.name, b.mass, self.spec.body_inertia(b)) for b in self.spec.bodies]
+    def _args(self, x: np.ndarray, xd: np.ndarray | None = None) -> list[np.ndarray]:
+        """The lambdified functions' arguments: angles and rates, column by column."""
+        xd = np.zeros_like(x) if xd is None else xd
+        return [*np.atleast_2d(x).T, *np.atleast_2d(xd).T]
 
-    def loaded_gravity(self) -> np.ndarray:
-        return np.asarray(self.spec.gravity, float)
+    def _field_force(self, x: np.ndarray) -> np.ndarray:
+        return np.zeros_like(x) if self._field is None else self._field(*self._args(x))
 
-    def _args(self, q: np.ndarray, v: np.ndarray | None = None) -> list[np.ndarray]:
-        v = np.zeros_like(q) if v is None else v
-        return [*np.atleast_2d(q).T, *np.atleast_2d(v).T]
+    def _mass(self, x: np.ndarray) -> np.ndarray:
+        return self._M(*self._args(x)).reshape(-1, self._n, self._n)
 
-    def _field_force(self, q: np.ndarray) -> np.ndarray:
-        return np.zeros_like(q) if self._field is None else self._field(*self._args(q))
+    def dynamics(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Dynamics:
+        """M, h, τ at v̇ = a (without the field: the run adds its force), T and V, computed in
+        the angles and mapped to the tree's layout by the chart's T: M = Tᵀ M_x T, forces by
+        Tᵀ, h = Tᵀ (h_x + M_x Ṫ v)."""
+        s = self._chart.to_angles(q, v, a)
+        mass, bias = self._mass(s.x), self._h(*self._args(s.x, s.xd))
+        t_t = np.swapaxes(s.t, 1, 2)
+        mass_c = t_t @ mass @ s.t
+        bias_c = self._chart.force(s.t, bias + np.einsum("nij,nj->ni", mass, s.tdot_v))
+        return Dynamics(
+            mass_matrix=mass_c, bias=bias_c,
+            forward=-np.linalg.solve(mass_c, bias_c[..., None])[..., 0],
+            inverse=self._chart.force(s.t, np.einsum("nij,nj->ni", mass, s.xdd) + bias),
+            kinetic=self._T(*self._args(s.x, s.xd))[:, 0],
+            potential=self._V(*self._args(s.x))[:, 0])
 
-    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        return self._check("mass matrix", self._M(*self._args(q)).reshape(-1, self._n, self._n))
-
-    def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        return self._check("bias forces", self._h(*self._args(q, v)))
-
-    def _constrained(
-        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """(q̈, λ) of LagrangesMethod's equations with the cords (M q̈ = F + τ + Φᵀ λ)."""
-        K_fn, rhs_fn, m = self._kkt
-        args = self._args(q, v)
-        n = self._n
-        K = K_fn(*args).reshape(-1, n + m, n + m)
-        rhs = rhs_fn(*args)
-        rhs[:, :n] += tau
-        x = np.linalg.solve(K, rhs[..., None])[..., 0]
-        return x[:, :n], x[:, n:]
-
-    def constraint_force(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        return self._check("constraint force", self._constrained(q, v, tau)[1])
+    def body_forces(self, q: np.ndarray, v: np.ndarray, field: Field) -> np.ndarray:
+        """The case's central field's generalized force, derived with its equations (the
+        ``field`` a run hands is that same field: this engine is built from the case)."""
+        s = self._chart.to_angles(q, v, np.zeros_like(v))
+        return self._chart.force(s.t, self._field_force(s.x))
 
     def forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """v̇ at τ (every applied force: a run adds the field's, :meth:`body_forces`):
+        M⁻¹ (τ − h) in the angles, or with cords the first rows of LagrangesMethod's KKT
+        system (:meth:`constrained`)."""
         if self._kkt is not None:
-            return self._check("forward dynamics", self._constrained(q, v, tau)[0])
-        rhs = tau + self._field_force(q) - self.bias(q, v)
-        return self._check(
-            "forward dynamics", np.linalg.solve(self.mass_matrix(q), rhs[..., None])[..., 0]
-        )
+            return self.constrained(q, v, tau)[0]
+        s = self._chart.to_angles(q, v, np.zeros_like(v))
+        rhs = self._chart.generalized(s.t, tau) - self._h(*self._args(s.x, s.xd))
+        return self._chart.acceleration(s, np.linalg.solve(self._mass(s.x), rhs[..., None])[
+            ..., 0])
 
-    def inverse(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        out = np.einsum("nij,nj->ni", self.mass_matrix(q), a) + self.bias(q, v)
-        return self._check("inverse dynamics", out - self._field_force(q))
+    def couple(self, couplings: Sequence[Coupling]) -> None:
+        """Its equations hold the case's couplings from the start: only those are accepted."""
+        if tuple(couplings) != self.model.couplings:
+            raise Unsupported(f"{self.engine} holds its case's couplings only")
 
-    def kinetic_energy(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        return self._check("kinetic energy", self._T(*self._args(q, v))[:, 0])
+    def constraint_forces(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        return self.constrained(q, v, tau)[1]
 
-    def potential_energy(self, q: np.ndarray) -> np.ndarray:
-        return self._check("potential energy", self._V(*self._args(q))[:, 0])
+    def constrained(self, q: np.ndarray, v: np.ndarray,
+                    tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(v̇, λ) of LagrangesMethod's equations with the cords (M q̈ = F + τ + Φᵀ λ)."""
+        s = self._chart.to_angles(q, v, np.zeros_like(v))
+        out = self._kkt_solve(s.x, s.xd, self._chart.generalized(s.t, tau))
+        return self._chart.acceleration(s, out[:, : self._n]), out[:, self._n :]
 
-    def _step_acceleration(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """q̈ at one state with no applied force (a time step's stage): M⁻¹(f − h), or with
-        cords the first n rows of the KKT system's solution (as :meth:`_constrained`) — from
-        one scalar function of the state (common subexpressions shared, Python's ``math``):
-        the per-call cost of the batched path's numpy calls dominated a trajectory."""
+    def _kkt_solve(self, x: np.ndarray, xd: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """(ẍ, λ) of the KKT system with τ (in the angles) added to its forcing."""
+        if self._kkt is None:
+            raise Unsupported(f"{self.engine}: its case has no couplings")
+        K_fn, rhs_fn, m = self._kkt
+        n = self._n
+        K = K_fn(*self._args(x, xd)).reshape(-1, n + m, n + m)
+        rhs = rhs_fn(*self._args(x, xd))
+        rhs[:, :n] += tau
+        return np.linalg.solve(K, rhs[..., None])[..., 0]
+
+    def _step_acceleration(self, x: np.ndarray, xd: np.ndarray) -> np.ndarray:
+        """ẍ at one state in the angles with no applied force (a time step's stage): M⁻¹(f −
+        h), or with cords the first n rows of the KKT system's solution — from one scalar
+        function of the state (common subexpressions shared, Python's ``math``): the per-call
+        cost of the batched path's numpy calls dominated a trajectory."""
         n = self._n
         if self._step_fn is None:  # lambdified on first use: only trajectories need it
             args, exprs = self._stepping
             self._step_fn = self._symbolic.lambdify(args, exprs, "math")
-        values = np.array(self._step_fn(*q.tolist(), *v.tolist()), float)
+        values = np.array(self._step_fn(*x.tolist(), *xd.tolist()), float)
         if self._kkt is not None:
             size = n + self._kkt[2]
             K, rhs = values[: size * size].reshape(size, size), values[size * size :]
@@ -325,27 +345,27 @@ class SympyMechanicsAdapter(Adapter):
         rhs = (f - h) if len(f) else -h
         return rhs / M[0, 0] if n == 1 else solve(M, rhs)
 
-    def definition(self, integrator: str) -> str:
-        """dyncheck's ``implicitfast`` has D = 0 here (no damping, no actuators): ``euler``."""
-        return Integrator.EULER if integrator == Integrator.IMPLICITFAST else integrator
+    def _held_acceleration(self, x: np.ndarray, xd: np.ndarray,
+                           held: np.ndarray) -> np.ndarray:
+        """ẍ at one state in the angles under a generalized force ``held`` in place of the
+        field's (RK4's held-force stages: the field at the step's start)."""
+        tau = held - self._field_force(x[None])[0]
+        if self._kkt is not None:
+            return self._kkt_solve(x[None], xd[None], tau[None])[0, : self._n]
+        rhs = held - self._h(*self._args(x[None], xd[None]))[0]  # (τ + field − h)
+        return solve(self._mass(x[None])[0], rhs)
 
-    def simulate(
-        self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
-    ) -> Trajectory:
-        def acc(q: np.ndarray, v: np.ndarray, held=None) -> np.ndarray:
+    def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
+                 integrator: str, field: Field | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """MuJoCo's definitions (:mod:`.integrators`) stepped in the angles and their rates
+        (Python-level evaluations of the lambdified equations), mapped back."""
+
+        def acc(x: np.ndarray, xd: np.ndarray, held=None) -> np.ndarray:
             if held is None:
-                return self._step_acceleration(q, v)
-            rhs = held - self._field_force(q[None])
-            return self.forward(q[None], v[None], rhs)[0]
+                return self._step_acceleration(x, xd)
+            return self._held_acceleration(x, xd, held)
 
-        steps = round(duration / dt)
-        qs, vs = integrate(
-            acc,
-            np.asarray(q0, float),
-            np.asarray(v0, float),
-            dt,
-            steps,
-            integrator,
-            freeze=lambda q, v: self._field_force(q[None])[0],
-        )
-        return Trajectory(np.arange(steps + 1) * dt, self._check("simulate", qs), vs)
+        start = self._chart.to_angles(q0[None], v0[None], np.zeros_like(v0)[None])
+        xs, xds = integrate(acc, start.x[0], start.xd[0], dt, steps, integrator,
+                            freeze=lambda x, xd: self._field_force(x[None])[0])
+        return self._chart.from_angles(xs, xds)

@@ -20,19 +20,20 @@ def installed_version(package: str) -> str | None:
 
 def engine_line(name: str) -> str:
     """An engine imported: its version (and device, for a port) and its integrators."""
-    from dyncheck.adapters import ENGINE_PACKAGES, get_adapter
+    from dyncheck.adapters import ENGINE_PACKAGES, REGISTRY, engine_version, get_engine
+    from dyncheck.adapters.offers import Offer
     from dyncheck.studies.order import CONTROLLED  # (the studies' package imports sympy)
 
     try:
-        adapter = get_adapter(name)
+        offers = get_engine(name).offers
     except EngineNotInstalled as exc:  # the hint names the package or the extra
         return f"not installed: {exc.hint}"
-    steps = list(adapter.integrators)
-    if adapter.adaptive:
+    steps = list(REGISTRY[name].integrators)
+    if Offer.SOLVING in offers:
         steps.append("dop853 (scipy, error-controlled)")
-    if adapter.error_controlled:
+    if Offer.CONTROLLED_STEPPING in offers:
         steps.append(f"{CONTROLLED} (its own runge_kutta3, error-controlled)")
-    return f"{ENGINE_PACKAGES[name]} {adapter.version()}; integrators: {', '.join(steps)}"
+    return f"{ENGINE_PACKAGES[name]} {engine_version(name)}; integrators: {', '.join(steps)}"
 
 
 def list_command(*, integrators: bool = False) -> int:

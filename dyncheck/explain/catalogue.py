@@ -137,12 +137,12 @@ def not_selected(
 
 def _run(name: str) -> Entry:
     """One demonstration, or a skipped entry naming the engine that is not installed."""
-    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES, RUN, get_adapter
+    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES, RUN, get_engine
 
     for engine in REQUIRES.get(name, ()):
         try:
             if engine in RUN:
-                get_adapter(engine)
+                get_engine(engine)
             else:  # an engine of the check only: installed or not, from its metadata
                 importlib.metadata.version(ENGINE_PACKAGES[engine])
         except (EngineNotInstalled, importlib.metadata.PackageNotFoundError):

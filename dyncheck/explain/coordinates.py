@@ -30,7 +30,7 @@ def worst(case_name: str, engine: str, cmap=None,
     impl = make_implementation(engine, case)
     if cmap is not None:
         assert isinstance(impl, EngineImplementation)
-        impl.map = NativeMap.of(case, engine, cmap)
+        impl.map = NativeMap.of(case, cmap)
     if reading is not None:
         adapter: Any = impl.adapter  # a loader's run adapter
         adapter.tree = reading(adapter.tree)

@@ -61,7 +61,7 @@ def drake_fsal_caching() -> Entry:
     runs = {}
     for scheme, eps in FSAL_EPS.items():
         for caching in (True, False):
-            traj, steps = impl.adapter.simulate_controlled(  # type: ignore[attr-defined]
+            traj, steps = impl.adapter.simulate_controlled(
                 qe0, ve0, spec.duration, spec.grid_step, eps, scheme, caching
             )
             err = float(np.abs(impl.map.to_book(traj.q[-1:])[0] - ref).max())
@@ -77,7 +77,7 @@ def drake_fsal_caching() -> Entry:
     rk3_same = np.array_equal(runs["runge_kutta3", True][0], runs["runge_kutta3", False][0])
     rk3_shrunk = runs["runge_kutta3", True][1].shrunk
     loose = [  # a looser ε at which no step is rejected
-        impl.adapter.simulate_controlled(  # type: ignore[attr-defined]
+        impl.adapter.simulate_controlled(
             qe0, ve0, spec.duration, spec.grid_step, 1e-7, "runge_kutta5", caching
         )
         for caching in (True, False)

@@ -18,7 +18,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from dyncheck import coordinates as co
-from dyncheck.adapters import MODELS, RUN, get_adapter
+from dyncheck.adapters import MODELS, RUN, get_engine
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.formats.mjcf import to_mjcf
 from dyncheck.cases import Case
@@ -63,8 +63,8 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int, *,
         return []
     spec = case.multibody()
     sample = case.sample_states(states)
-    first = next(iter(MODELS))  # the canonical engine, whose layout the states are put in
-    cmap = NativeMap.of(case, first)
+    first = next(iter(MODELS))  # the canonical engine
+    cmap = NativeMap.of(case)  # the states in the canonical layout
     q = cmap.to_engine(sample.q)
     on = States(q=q, v=co.velocity_to_engine(cmap, sample.q, sample.v),
                 a=co.acceleration_to_engine(cmap, sample.q, sample.v, sample.a))
@@ -81,7 +81,7 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int, *,
         for name in names:
             if name in RUN:  # not installed: skipped rows with the pip hint, as in the run
                 try:
-                    get_adapter(name)
+                    get_engine(name)
                 except EngineNotInstalled as exc:
                     failed.append(_row(case, "derivatives", name, "", Verdict.SKIPPED, str(exc)))
                     continue

@@ -10,7 +10,8 @@ from typing import Any
 
 import numpy as np
 
-from dyncheck.adapters import Adapter, get_adapter
+from dyncheck.adapters import get_engine
+from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import NOMINAL_ORDER, Case
 from dyncheck.cases.multibody import ROTATING
 from dyncheck.comparison import soft_factor
@@ -35,7 +36,7 @@ def _charted(name: str) -> bool:
     """Whether an implementation steps a rotating joint in coordinates of its own (a chart:
     angles, a quaternion's components), not along the rotation group."""
     try:
-        return get_adapter(name).steps_in_a_chart()
+        return get_engine(name).steps_in_a_chart
     except DyncheckError:  # the reference, the book, an engine that is not installed
         return False
 
@@ -84,7 +85,7 @@ def _maps_differ(
     return None
 
 
-def _adapter(impl: Implementation | Exception) -> Adapter | None:
+def _adapter(impl: Implementation | Exception) -> CaseEngine | None:
     """The engine behind an implementation (None: the book's side, or one that failed)."""
     return impl.adapter if isinstance(impl, Implementation) else None
 

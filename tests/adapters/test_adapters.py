@@ -16,8 +16,9 @@ import pytest
 from numpy.testing import assert_allclose
 
 from dyncheck import adapters
-from dyncheck.adapters import REGISTRY, get_adapter
+from dyncheck.adapters import REGISTRY, engine_version, get_engine
 from dyncheck.adapters.formats.mjcf import to_mjcf
+from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import get_case
 from dyncheck.errors import UnknownName
 
@@ -59,7 +60,7 @@ def adapter_and_states(request):
 @cache
 def _adapter(case_name: str, engine: str):
     """One adapter per case and engine for the whole module (a port compiles per adapter)."""
-    return get_adapter(engine)(get_case(case_name).multibody())
+    return CaseEngine(engine, get_case(case_name).multibody())
 
 
 def ulps(adapter, bound: float) -> float:
@@ -101,7 +102,7 @@ def test_constrained_forward_balances(case_name, engine):
     the cords, d = 0.9 by default."""
     case = get_case(case_name)
     mb = case.multibody()
-    adapter = get_adapter(engine)(mb)
+    adapter = CaseEngine(engine, mb)
     rng = np.random.default_rng(5)
     qb = rng.uniform(*case.q_bounds(), (8, case.ndof))
     cmap = case.engine_map()
@@ -209,7 +210,8 @@ def test_sympy_mechanics_time_step_acceleration_is_its_forward_dynamics(case_nam
     n = adapter.spec.nv
     q, v = rng.uniform(-1, 1, (6, n)), rng.uniform(-1, 1, (6, n))
     batched = adapter.forward(q, v, np.zeros((6, n)))
-    stepped = np.array([adapter._step_acceleration(qi, vi) for qi, vi in zip(q, v, strict=True)])
+    stepped = np.array([adapter.engine._step_acceleration(qi, vi)  # (no angles: its chart's
+                        for qi, vi in zip(q, v, strict=True)])  # coordinates are q, v)
     assert_allclose(stepped, batched, rtol=0, atol=1e-13 * np.abs(batched).max())
 
 
@@ -222,12 +224,12 @@ def test_mjcf_point_mass_is_an_inertial_not_a_geom():
 def test_unknown_engine_lists_valid_names():
     valid = re.escape(", ".join(sorted(REGISTRY)))  # (the registry's, whatever it holds)
     with pytest.raises(UnknownName, match=f"unknown implementation 'bullet'; valid: {valid}$"):
-        get_adapter("bullet")
+        get_engine("bullet")
 
 
 @pytest.mark.slow  # imports every engine, JAX and Warp included (~4 s)
 def test_every_engine_is_installed_here():
-    assert sorted(adapters.ADAPTERS) == ALL_ENGINES
+    assert sorted(adapters.ENGINES) == ALL_ENGINES
 
 
 @pytest.mark.slow  # CI's guard that every extra is installed: the README's first test
@@ -247,12 +249,13 @@ def test_every_engine_package_is_installed_here():  # command passes without mjx
 
 @pytest.mark.parametrize("engine", ALL_ENGINES)
 def test_registration_names_the_class_that_calls_itself_so(engine):
-    """One registration line per engine: the class it names is the adapter of that name, and
-    the package it is listed under is the one the adapter reports the version of."""
+    """One registration line per engine: the class it names calls itself that engine or
+    another registration of the same package (``mujoco-stiff`` runs MuJoCo's class), and the
+    package it is listed under is the one the class reports the version of."""
     from dyncheck.adapters import ENGINE_PACKAGES
 
-    assert get_adapter(engine).name == engine
-    assert get_adapter(engine).version().startswith(importlib.metadata.version(
+    assert REGISTRY[get_engine(engine).engine].package == REGISTRY[engine].package
+    assert engine_version(engine).startswith(importlib.metadata.version(
         ENGINE_PACKAGES[engine]))
 
 
@@ -288,13 +291,23 @@ def test_drake_parser_ignores_the_tendon_equality():
     assert any("'tendon' found as a child of 'equality'" in w for w in warnings)
 
 
+@pytest.mark.slow  # loads the case in every engine, the ports compiling it (~30 s)
 @pytest.mark.parametrize("engine", ALL_ENGINES)
-def test_registered_precision_is_the_adapters(engine):
+def test_registered_precision_is_the_engines(engine):
     """The registry says which engines compute in float32 (the report check reads it without
-    importing the engine); it must be what the adapter computes in."""
+    importing the engine); it must be what the engine computes in, measured: its bias forces
+    on the compound pendulum at generic states against MuJoCo's (float64; another engine)
+    differ by float32's round-off (beyond 1e-9 of their size) exactly where it is
+    registered float32, and by float64's (within 1e-12) elsewhere."""
     from dyncheck.adapters import FLOAT32
 
-    assert (engine in FLOAT32) == (get_adapter(engine).dtype == np.float32)
+    spec = get_case("compound_pendulum").multibody()
+    rng = np.random.default_rng(3)
+    q, v = rng.uniform(-2, 2, (16, spec.nv)), rng.uniform(-2, 2, (16, spec.nv))
+    ours = CaseEngine(engine, spec).bias(q, v)
+    theirs = CaseEngine("mujoco", spec).bias(q, v)
+    relative = np.abs(ours - theirs).max() / np.abs(theirs).max()
+    assert (relative > 1e-9 if engine in FLOAT32 else relative < 1e-12), relative
 
 
 @pytest.mark.parametrize("engine", ALL_ENGINES)
@@ -308,19 +321,8 @@ def test_registered_integrators_are_those_the_engine_maps(engine):
     from dyncheck.adapters.integrators import STEPPERS
 
     entry = REGISTRY[engine]
-    if entry.module is None:  # a file loader's run adapter: its own schemes (Drake's scheme
-        # names), or one stepping whose definition is the reference's (semi-implicit Euler)
-        assert get_adapter(engine).integrators == entry.integrators
-        own = {"drake": "dyncheck.adapters.drake.simulation"}.get(engine)
-        mapped = importlib.import_module(own).INTEGRATORS if own else STEPPERS
-        assert set(entry.integrators) <= set(mapped), set(entry.integrators) - set(mapped)
-        return
-    module = importlib.import_module(entry.module)
-    # the engine's own table (Drake's scheme names), MuJoCo's one table for the C engine
-    # and its ports (adapters/mujoco_api.INTEGRATORS), or the steppers Pinocchio is run with
-    mapped = getattr(module, "_INTEGRATORS", getattr(module, "INTEGRATORS", STEPPERS))
-    assert get_adapter(engine).integrators == entry.integrators
-    if engine == "sympy-mechanics":
-        assert set(entry.integrators) < set(STEPPERS)
-    else:  # every registered integrator mapped to one of the engine's own
-        assert set(entry.integrators) <= set(mapped), set(entry.integrators) - set(mapped)
+    # its own schemes (Drake's scheme names), or steppings whose definitions are the
+    # reference's (MuJoCo's; semi-implicit Euler for Newton's and PyBullet's own)
+    own = {"drake": "dyncheck.adapters.drake.simulation"}.get(engine)
+    mapped = importlib.import_module(own).INTEGRATORS if own else STEPPERS
+    assert set(entry.integrators) <= set(mapped), set(entry.integrators) - set(mapped)

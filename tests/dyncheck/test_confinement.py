@@ -27,7 +27,7 @@ def _with_double(mp: pytest.MonkeyPatch, engine_class: str) -> None:
     from dyncheck.check import model_check
 
     mp.setitem(engines.ENGINES, "double",
-               Registration(module="", cls="", package="", integrators=(),
+               Registration(package="", integrators=(),
                                 model=f"tests.check.crashing_engine:{engine_class}"))
     mp.setattr(model_check, "IMPLEMENTATIONS", (*engines.IMPLEMENTATIONS, "double"))
 
@@ -58,7 +58,7 @@ from pathlib import Path
 from dyncheck.check import engines, model_check
 from dyncheck.adapters import Registration
 engines.ENGINES["double"] = Registration(
-    module="", cls="", package="", integrators=(),
+    package="", integrators=(),
     model="tests.check.crashing_engine:NoisyHangOnDynamics")
 model_check.IMPLEMENTATIONS = (*engines.IMPLEMENTATIONS, "double")
 model_check.check_model(Path(sys.argv[1]), impls=("mujoco", "double"), states=3)

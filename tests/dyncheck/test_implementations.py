@@ -14,8 +14,8 @@ from functools import partial
 import numpy as np
 import pytest
 
-from dyncheck.adapters import get_adapter
 from dyncheck.adapters.sympy_mechanics import model as sm
+from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import get_case
 from dyncheck.implementations import CACHED
 
@@ -26,7 +26,7 @@ def test_sympy_mechanics_reads_its_equations_back_without_deriving(
 ):
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
     model = get_case(case_name).multibody()
-    adapter = partial(get_adapter("sympy-mechanics"), symbolic=CACHED)
+    adapter = partial(CaseEngine, "sympy-mechanics", symbolic=CACHED)
     first = adapter(model)
     assert list((tmp_path / "derivations").rglob("sympy_mechanics-*.pickle"))
 
@@ -47,19 +47,19 @@ def test_sympy_mechanics_without_the_cache_derives(tmp_path, monkeypatch, no_cac
     derive = sm._derive
     monkeypatch.setattr(sm, "_derive", lambda model: calls.append(1) or derive(model))
     model = get_case("simple_pendulum").multibody()
-    get_adapter("sympy-mechanics")(model, symbolic=CACHED)
-    get_adapter("sympy-mechanics")(model, symbolic=CACHED)
+    CaseEngine("sympy-mechanics", model, symbolic=CACHED)
+    CaseEngine("sympy-mechanics", model, symbolic=CACHED)
     assert len(calls) == 2 and not (tmp_path / "derivations").exists()
 
 
 def test_the_adapter_left_to_itself_derives_afresh(tmp_path, monkeypatch):
-    """Without the comparison layer's caches (the default, ``AFRESH``) the adapter derives
+    """Without the comparison layer's caches (the default, ``AFRESH``) the engine derives
     every time and writes nothing, whether or not the comparison layer was imported."""
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
     calls = []
     derive = sm._derive
     monkeypatch.setattr(sm, "_derive", lambda model: calls.append(1) or derive(model))
     model = get_case("simple_pendulum").multibody()
-    get_adapter("sympy-mechanics")(model)
-    get_adapter("sympy-mechanics")(model)
+    CaseEngine("sympy-mechanics", model)
+    CaseEngine("sympy-mechanics", model)
     assert len(calls) == 2 and not (tmp_path / "derivations").exists()

@@ -268,18 +268,17 @@ def test_declared_rk4_order_on_the_rotation_group_is_checked(monkeypatch):
     """An adapter's declared RK4 order on ball and free joints is a prediction, not an
     excuse: MuJoCo 4.0's RK4 is order 4 there (RKMK), so declaring the 3.x order 2 makes its
     rows fail (observed 4, predicted 2) instead of passing or being explained."""
-    from dyncheck.adapters import get_adapter
+    from dyncheck.adapters import get_engine
     from dyncheck.implementations import make_implementation
     from dyncheck.studies import study
 
-    mujoco = get_adapter("mujoco")
-    if not mujoco.rk4_group_order == 4:
+    if not get_engine("mujoco").rk4_group_order == 4:
         pytest.skip("installed MuJoCo predates 4.0 (its RK4 is order 2 on the group)")
     case = get_case("rigid_body_ball")
     impls = {n: make_implementation(n, case) for n in ("reference", "mujoco")}
     honest = [r for r in study(case, impls)[1] if r.integrator == "rk4" and r.impl_b == "mujoco"]
     assert honest and {r.verdict for r in honest} == {"passed"}
-    monkeypatch.setattr(mujoco, "rk4_group_order", 2)
+    monkeypatch.setattr(impls["mujoco"].adapter, "rk4_group_order", 2)
     wrong = [r for r in study(case, impls)[1] if r.integrator == "rk4" and r.impl_b == "mujoco"]
     assert {r.verdict for r in wrong} == {"failed"}
     assert all("nominal 2" in r.note for r in wrong)

@@ -230,9 +230,9 @@ def test_an_entry_records_the_engines_it_uses_not_those_its_process_loaded():
     process held, a run without Drake that read the first entry back named Drake.)"""
     from importlib.metadata import version
 
-    from dyncheck.adapters import get_adapter
+    from dyncheck.adapters import get_engine
 
-    get_adapter("drake")  # loaded here, as a catalogue run in one process loads it
+    get_engine("drake")  # loaded here, as a catalogue run in one process loads it
     _, used = catalogue.measure("hinge-axis-sign")
     assert used == {"mujoco": version("mujoco"), "pinocchio": version("pin")}
     _, used = catalogue.measure("drake-mjcf-equality")

@@ -1,51 +1,50 @@
-"""A book case through an engine's loader of a user's file: a book case is a model in a file.
+"""A book case through an engine: the case's view of a
+:class:`~dyncheck.adapters.base.ModelEngine`, in the canonical layout (MuJoCo's, the layout
+the run's coordinate maps start from), for ``dyncheck run``.
 
-An engine registered with ``run=`` (a file format) has no adapter of its own: the case's
-model is written in that format (:func:`~dyncheck.adapters.formats.mjcf.to_mjcf` or
+An engine registered with ``run=`` a file format is handed the case as a file: its model
+written in that format (:func:`~dyncheck.adapters.formats.mjcf.to_mjcf` or
 :func:`~dyncheck.adapters.formats.urdf.to_urdf`), read as a user's file is
-(:func:`~dyncheck.adapters.formats.files.read`), loaded by the engine's ``model=`` class, and its
-dynamics mapped from the engine's layout to the canonical one (MuJoCo's, the layout the
-run's coordinate maps start from) by :mod:`.layout` — the same loader, tree and map
-``dyncheck check`` uses, so that one engine object serves both commands.
+(:func:`~dyncheck.adapters.formats.files.read`) and loaded by the engine class its
+registration names (``model=``) — the same loader, tree and map ``dyncheck check`` uses, so
+that one engine object serves both commands. One registered with ``run=case``
+(:attr:`~dyncheck.adapters.registration.Format.CASE`: sympy.physics.mechanics's) is built
+from the case itself. Its dynamics are mapped from the engine's layout to the canonical one
+by :mod:`dyncheck.adapters.layout`.
 
-Forward dynamics at τ is the engine's own where its class offers it (:attr:`~.base.Offer.
-FORWARD`: Pinocchio's ABA, MuJoCo's ``qacc``), else M⁻¹(τ − h) from the engine's M and h
-mapped to the canonical layout; T = ½ vᵀ M v and V as the loader computes them. A URDF
-states no gravity: the case's is given to the loader (``gravity=``), as its user would set
-it; a registration that reads the case as stated (``as_stated``) gives it the case's gravity
-and point masses (``inertias=``) whatever the file says. An external field (a force on a
-body at its centre of mass) enters through the engine's own means where its class offers
-them (:attr:`~.base.Offer.BODY_FORCES`: its Jacobians or its solver's sum for the
-generalized force, its stepping API at every step); couplings through its constraints
-(:attr:`~.base.Offer.COUPLINGS`: v̇ and the multipliers of one solve); either is refused
-before any work where its class does not offer it (a skipped row naming it). Its
-``integrators`` are the registration's: the engine's own stepping, named by the definition
-it is (Newton's Featherstone solver and PyBullet's ``stepSimulation`` are semi-implicit
-Euler, MuJoCo's ``euler``; Pinocchio has none, and is stepped by MuJoCo's definitions;
-measured by the order studies against the reference's discrete map of that definition).
+Forward dynamics at τ is the engine's own where its class offers it (:attr:`~dyncheck.
+adapters.offers.Offer.FORWARD`: Pinocchio's ABA, MuJoCo's ``qacc``), else M⁻¹(τ − h) from
+the engine's M and h mapped to the canonical layout; T = ½ vᵀ M v and V as the engine
+computes them. A URDF states no gravity: the case's is given to the loader (``gravity=``),
+as its user would set it; a registration that reads the case as stated (``as_stated``)
+gives it the case's gravity and point masses (``inertias=``) whatever the file says. An
+external field (a force on a body at its centre of mass) enters through the engine's own
+means where its class offers them (``BODY_FORCES``: its Jacobians or its solver's sum for
+the generalized force, its stepping API at every step); couplings through its constraints
+(``COUPLINGS``: v̇ and the multipliers of one solve); either is refused before any work
+where its class does not offer it (a skipped row naming it). Its ``integrators`` are the
+registration's: the engine's own stepping, named by the definition it is (Newton's
+Featherstone solver and PyBullet's ``stepSimulation`` are semi-implicit Euler, MuJoCo's
+``euler``; Pinocchio has none, and is stepped by MuJoCo's definitions; measured by the order
+studies against the reference's discrete map of that definition).
+
+All methods take batches: q, v, τ, v̇ of shape (n, nv); they return (n, nv, nv), (n, nv) or
+(n,), in the canonical layout (the comparison layer maps them to the book's coordinates).
 """
 
 from __future__ import annotations
 
-import importlib
 import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
-from typing import Any, ClassVar, cast
+from typing import Any
 
 import numpy as np
 
-from dyncheck.adapters.base import (
-    Adapter,
-    Field,
-    LoadedBody,
-    ModelEngine,
-    Offer,
-    Steps,
-    Trajectory,
-)
+from dyncheck.adapters import REGISTRY, get_engine
+from dyncheck.adapters.base import Field, LoadedBody, ModelEngine, Offer, Steps, Trajectory
 from dyncheck.adapters.c_output import c_output_dropped
 from dyncheck.adapters.formats.files import read
 from dyncheck.adapters.formats.mjcf import to_mjcf
@@ -63,58 +62,91 @@ from dyncheck.adapters.model_tree import (
     TreeJoint,
     reversed_rpy,
 )
-from dyncheck.adapters.registration import Format, Registration
+from dyncheck.adapters.registration import Format
+from dyncheck.adapters.symbolic import AFRESH, Symbolic
 from dyncheck.cases.coordinate_maps import quat_to_matrix
 from dyncheck.cases.multibody import Multibody
-from dyncheck.errors import Unsupported
+from dyncheck.errors import EngineError, Unsupported
 from dyncheck.vocabulary import Quantity
 
+DIVERGED = 1e12
+"""A coordinate beyond this (rad or m) means a run has blown up: no case here comes near it."""
 
-class ModelAdapter(Adapter):
-    """The standard form of a book case from an engine's file loader (see the module)."""
 
-    run_format: ClassVar[Format]
-    loader: ClassVar[type]
-    as_stated: ClassVar[bool] = False
-    """The registration's :attr:`~.registration.Registration.as_stated`."""
-    loader_options: ClassVar[dict[str, Any]] = {}
-    """The registration's :attr:`~.registration.Registration.loader_options`."""
+class CaseEngine:
+    """The standard form ``M(q) v̇ + h(q, v) = τ`` of a book case by one engine (see the
+    module): ``CaseEngine(name, model)`` loads the case in the engine registered as
+    ``name`` (:class:`~dyncheck.errors.EngineNotInstalled` where it is not installed)."""
 
-    def __init__(self, model: Multibody) -> None:
-        super().__init__(model)
-        loader = self._loader()
-        if self.requires_couplings and not model.couplings:
-            raise Unsupported(f"{self.name} differs from {loader.engine} only on couplings; "
-                              "none here")
-        offers = loader.offers
-        if model.couplings and Offer.COUPLINGS not in offers:
-            raise Unsupported(f"{self.name}: its model holds no coupling between joints (the "
-                              "equality constraints of the book's cords)")
-        if model.central_mu and Offer.BODY_FORCES not in offers:
-            raise Unsupported(f"{self.name}: {loader.no_body_forces}")
+    def __init__(self, name: str, model: Multibody, *, symbolic: Symbolic = AFRESH) -> None:
+        loader = get_engine(name)
+        registration = REGISTRY[name]
+        assert registration.run is not None, name
+        self.name, self.package, self.loader = name, registration.package, loader
+        self.run_format, self.as_stated = registration.run, registration.as_stated
+        self.integrators = registration.integrators
+        self.loader_options = dict(registration.loader_options)
+        self.dtype: type[np.floating] = np.float32 if registration.float32 else np.float64
+        self.requires_couplings = registration.couplings_only
+        self.gyroscopic_implicit = loader.gyroscopic_implicit
+        self.rk4_group_order = loader.rk4_group_order
+        self.batches_steps = loader.batches_steps
+        self.error_controlled = Offer.CONTROLLED_STEPPING in loader.offers
+        self.adaptive = Offer.SOLVING in loader.offers
+        self.spec = model
+        self._refuse(model)
         self.field: Field | None = _field(model) if model.central_mu else None
-        urdf = self.run_format is Format.URDF
-        text = to_urdf(model) if urdf else to_mjcf(model)
-        with tempfile.TemporaryDirectory(prefix="dyncheck-case-") as folder:
-            path = Path(folder) / f"{model.name}.{'urdf' if urdf else 'xml'}"
-            path.write_text(text, encoding="utf-8")
-            source = read(path, floating=urdf and root_is_free(model))
-            options: dict[str, Any] = dict(self.loader_options)
-            if urdf or self.as_stated:
-                options["gravity"] = np.asarray(model.gravity, float)
-            if self.as_stated:
-                options["inertias"] = {body.name: model.body_inertia(body)
-                                       for body in model.bodies if body.is_point_mass}
-            with c_output_dropped():  # an engine's banner and importer warnings (C)
-                self.engine = self.loader(source, **options)
+        if self.run_format is Format.CASE:
+            self.engine: ModelEngine = loader(model, symbolic=symbolic)  # type: ignore[call-arg]
+        else:
+            self.engine = self._load(model, dict(self.loader_options))
         if model.couplings:
             self.engine.couple(model.couplings)  # (refused, in its words, where it cannot)
         self.tree: ModelTree = self.engine.tree
         self.max_steps, self.device = self.engine.max_steps, self.engine.device
         self.parser_warnings = self.engine.parser_warnings
         self.inertia_rounded = self.tree.inertia_accuracy > 0.0
+        """Whether the engine stores an inertia tensor rounded beyond round-off of its
+        read-back (PyBullet's principal moments): a body's tensor as held is then part of its
+        model variant."""
         self.canon, self._carriers = self._canonical(model)
         self._unavailable: dict[str, str] = {}
+
+    def _refuse(self, model: Multibody) -> None:
+        """Refuse, before any work, what its engine class does not offer for ``model``."""
+        loader = self.loader
+        if self.requires_couplings and not model.couplings:
+            raise Unsupported(f"{self.name} differs from {loader.engine} only on couplings; "
+                              "none here")
+        if model.couplings and model.central_mu and not loader.couplings_with_field:
+            raise Unsupported(f"{self.name}: couplings together with a field")
+        if model.couplings and Offer.COUPLINGS not in loader.offers:
+            raise Unsupported(f"{self.name}: its model holds no coupling between joints (the "
+                              "equality constraints of the book's cords)")
+        if model.central_mu and Offer.BODY_FORCES not in loader.offers:
+            raise Unsupported(f"{self.name}: {loader.no_body_forces}")
+
+    def _load(self, model: Multibody, options: dict[str, Any]) -> ModelEngine:
+        """The case written in its registration's format, read as a user's file and loaded."""
+        urdf = self.run_format is Format.URDF
+        text = to_urdf(model) if urdf else to_mjcf(model)
+        with tempfile.TemporaryDirectory(prefix="dyncheck-case-") as folder:
+            path = Path(folder) / f"{model.name}.{'urdf' if urdf else 'xml'}"
+            path.write_text(text, encoding="utf-8")
+            source = read(path, floating=urdf and root_is_free(model))
+            if urdf or self.as_stated:
+                options["gravity"] = np.asarray(model.gravity, float)
+            if self.as_stated:
+                options["inertias"] = {body.name: model.body_inertia(body)
+                                       for body in model.bodies if body.is_point_mass}
+            loader: Any = self.loader  # (a file loader's constructor: source, options)
+            with c_output_dropped():  # an engine's banner and importer warnings (C)
+                return loader(source, **options)
+
+    @property
+    def eps(self) -> float:
+        """The engine's unit round-off (ε of its floating-point type)."""
+        return float(np.finfo(self.dtype).eps)
 
     def as_read(self, model: str) -> ModelEngine | None:
         """Its engine where it is loader ``model`` (``module:class``) on the case's MJCF read
@@ -179,7 +211,8 @@ class ModelAdapter(Adapter):
                 rotation = quat_to_matrix(q[i : i + 1, qs + 3 : qs + 7])[0] @ \
                     joint.layout.offset[:3, :3]
                 undone = reversed_rpy(rotation) @ rotation.T @ gravity
-                under = to_canonical(maps, self.engine.dynamics(qe, ve, ae, gravity=undone))
+                engine: Any = self.engine  # (the engine that declares the frame: PyBullet)
+                under = to_canonical(maps, engine.dynamics(qe, ve, ae, gravity=undone))
                 delta[i] += here.bias[0] - under.bias[0]
         forward = -np.linalg.solve(mass, delta[..., None])[..., 0]
         return {Quantity.BIAS_FORCES: delta, Quantity.INVERSE_DYNAMICS: delta,
@@ -187,10 +220,10 @@ class ModelAdapter(Adapter):
 
     def defects(self) -> tuple[str, ...]:
         """A free joint whose engine resolves gravity in its frame through another rotation
-        than the state's (:class:`~.model_tree.GravityFrame`, declared on the tree); a joint
-        whose engine computes with another inertia than it holds
-        (:attr:`~.model_tree.TreeJoint.computed_inertia`, declared on the tree); a body
-        whose joints the engine applies in another order than written (the tree's
+        than the state's (:class:`~dyncheck.adapters.model_tree.GravityFrame`, declared on
+        the tree); a joint whose engine computes with another inertia than it holds
+        (:attr:`~dyncheck.adapters.model_tree.TreeJoint.computed_inertia`, declared on the
+        tree); a body whose joints the engine applies in another order than written (the tree's
         ``as_written``, with its hint: Newton's D6 joint)."""
         computed = tuple(
             f"its dynamics take the inertia of {j.name!r} otherwise than it holds it (its "
@@ -214,35 +247,18 @@ class ModelAdapter(Adapter):
         return [(k, j) for k, j in enumerate(self.tree.joint(n) for n in self.canon.names)
                 if j.type is JointType.FREE and j.gravity_frame is GravityFrame.RPY_REVERSED]
 
-    @classmethod
-    def _loader(cls) -> type[ModelEngine]:
-        return cast(type[ModelEngine], cls.loader)  # (a loader is a ModelEngine)
-
-    @property
-    def _offers(self) -> frozenset[Offer]:
-        return self._loader().offers
-
     def softness(self) -> tuple[float, ...] | None:
-        """Its loader's couplings' soft-constraint model (:meth:`~.base.ModelEngine.softness`)."""
+        """Its engine's couplings' soft-constraint model
+        (:meth:`~dyncheck.adapters.base.ModelEngine.softness`)."""
         return self.engine.softness()
 
     def definition(self, integrator: str) -> str:
-        """Its loader's :attr:`~.base.ModelEngine.definitions`."""
-        return self._loader().definitions.get(integrator, integrator)
+        """Its loader's :attr:`~dyncheck.adapters.base.ModelEngine.definitions`."""
+        return self.loader.definitions.get(integrator, integrator)
 
-    @classmethod
-    def steps_in_a_chart(cls) -> bool:
-        """Its loader's stepping fact (:attr:`~.base.ModelEngine.steps_in_a_chart`): the
-        run's states are in the canonical layout, the engine's stepping is its own."""
-        return cls._loader().steps_in_a_chart
-
-    @classmethod
-    def version(cls) -> str:
-        return cls._loader().version(cls.package)
-
-    @classmethod
-    def release_compiled(cls) -> None:
-        cls._loader().release_compiled()
+    def version(self) -> str:
+        """Its engine's version (its package's, unless its class says more)."""
+        return self.loader.version(self.package)
 
     def _held(self, loaded: np.ndarray, stated: np.ndarray) -> np.ndarray:
         """The loaded value, or the stated one where they agree to the engine's rounding
@@ -281,6 +297,9 @@ class ModelAdapter(Adapter):
     def evaluate_all(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, a: np.ndarray
     ) -> dict[str, np.ndarray]:
+        """Every quantity at each state, keyed by :class:`~dyncheck.vocabulary.Quantity`: M,
+        h, forward dynamics at τ, inverse dynamics at v̇ = a, T, V and, with couplings, the
+        constraint force at τ (its multipliers)."""
         d, maps, qe, ve = self._mapped(q, v, a)
         pushed = self._pushed(maps, qe, ve)
         tau = tau + pushed
@@ -288,7 +307,7 @@ class ModelAdapter(Adapter):
         unavailable = dict(d.unavailable)
         self._unavailable = {QUANTITY_OF[field]: why for field, why in unavailable.items()}
         constraint = None
-        if "bias" in unavailable or self.spec.couplings or Offer.FORWARD in self._offers:
+        if "bias" in unavailable or self.spec.couplings or Offer.FORWARD in self.loader.offers:
             # its own forward dynamics at τ
             t = np.array([m.t for m in maps])  # (mapped: v̇_e = T v̇ + Ṫ v)
             tdot_v = np.array([m.tdot_v for m in maps])
@@ -309,8 +328,8 @@ class ModelAdapter(Adapter):
 
     def _pushed(self, maps: list[Any], qe: np.ndarray, ve: np.ndarray) -> np.ndarray:
         """The case's external field's generalized force in the canonical layout (τ_c =
-        Tᵀ τ_e), as the engine computes it (:meth:`~.base.ModelEngine.body_forces`); zero
-        without a field."""
+        Tᵀ τ_e), as the engine computes it
+        (:meth:`~dyncheck.adapters.base.ModelEngine.body_forces`); zero without a field."""
         if self.field is None:
             return np.zeros((len(qe), self.canon.nv))
         engine = self.engine.body_forces(qe, ve, self.field)
@@ -344,14 +363,16 @@ class ModelAdapter(Adapter):
         self, q0: np.ndarray, v0: np.ndarray, duration: float, dt: float, integrator: str
     ) -> Trajectory:
         """The loader's own stepping (``simulate(q0, v0, dt, steps)`` in its layout), its
-        states mapped back to the canonical layout (:func:`~.layout_batch.canonical_states`)."""
+        states mapped back to the canonical layout
+        (:func:`~dyncheck.adapters.layout_batch.canonical_states`)."""
         return self._runs(q0, v0, duration=duration, dts=[dt], integrator=integrator,
                           batched=False)[0]
 
     def simulate_many(self, q0: np.ndarray, v0: np.ndarray, duration: float,
                       dts: Sequence[float], integrator: str) -> list[Trajectory]:
         """The loader's runs at each step size, at once (its
-        :attr:`~.base.ModelEngine.batches_steps`), mapped back as :meth:`simulate`'s."""
+        :attr:`~dyncheck.adapters.base.ModelEngine.batches_steps`), mapped back as
+        :meth:`simulate`'s."""
         return self._runs(q0, v0, duration=duration, dts=dts, integrator=integrator,
                           batched=True)
 
@@ -372,17 +393,18 @@ class ModelAdapter(Adapter):
     def simulate_controlled(self, q0: np.ndarray, v0: np.ndarray, duration: float,
                             grid: float, accuracy: float, scheme: str | None = None,
                             caching: bool = True) -> tuple[Trajectory, Steps]:
-        """The loader's own error-controlled run (:attr:`~.base.Offer.CONTROLLED_STEPPING`)
-        at ``accuracy``, sampled every ``grid`` seconds, its states mapped back to the
-        canonical layout, and its step counts."""
+        """The loader's own error-controlled run
+        (:attr:`~dyncheck.adapters.offers.Offer.CONTROLLED_STEPPING`) at ``accuracy``,
+        sampled every ``grid`` seconds, its states mapped back to the canonical layout, and
+        its step counts."""
         q_e, v_e, steps = self.engine.simulate_controlled(
             *self._engine_start(q0, v0), grid, round(duration / grid), accuracy=accuracy,
             scheme=scheme, caching=caching, field=self.field)
         return self._trajectory(q_e, v_e, np.arange(len(q_e)) * grid), steps
 
     def solve(self, q0: np.ndarray, v0: np.ndarray, t_eval: np.ndarray, rtol: float) -> Trajectory:
-        """The loader's DOP853 run (:attr:`~.base.Offer.SOLVING`) at ``t_eval``, its states
-        mapped back to the canonical layout."""
+        """The loader's DOP853 run (:attr:`~dyncheck.adapters.offers.Offer.SOLVING`) at
+        ``t_eval``, its states mapped back to the canonical layout."""
         q_e, v_e = self.engine.solve(*self._engine_start(q0, v0), t_eval, rtol=rtol,
                                      field=self.field)
         return self._trajectory(q_e, v_e, t_eval)
@@ -395,7 +417,7 @@ class ModelAdapter(Adapter):
 
     def _trajectory(self, q_e: np.ndarray, v_e: np.ndarray, t: np.ndarray) -> Trajectory:
         """The engine's states at times ``t``, finite (:meth:`_finite`), in the canonical
-        layout (:func:`~.layout_batch.canonical_states`)."""
+        layout (:func:`~dyncheck.adapters.layout_batch.canonical_states`)."""
         self._finite(q_e, v_e, t)
         q, v = canonical_states(self.canon, self.tree, q_e, v_e)
         return Trajectory(t, self._check("simulate", q), v)
@@ -423,12 +445,33 @@ class ModelAdapter(Adapter):
                                    "lose every digit of its smallest pivot)"
                                    if kappa * self.eps > 1 else ""))
 
+    def _outputs(self, M: np.ndarray, bias: np.ndarray, fwd: np.ndarray, inv: np.ndarray,
+                 kin: np.ndarray, pot: np.ndarray,
+                 constraint: np.ndarray | None = None) -> dict[str, np.ndarray]:
+        """The batched quantities under their canonical names, each checked finite but those
+        the engine does not compute here (its limits: NaN, said on their rows)."""
+        out = {Quantity.MASS_MATRIX: M, Quantity.BIAS_FORCES: bias,
+               Quantity.FORWARD_DYNAMICS: fwd, Quantity.INVERSE_DYNAMICS: inv,
+               Quantity.KINETIC_ENERGY: kin, Quantity.POTENTIAL_ENERGY: pot}
+        if constraint is not None:
+            out[Quantity.CONSTRAINT_FORCE] = constraint
+        unavailable = self.unavailable_quantities()
+        return {key: val if key in unavailable else self._check(key, val)
+                for key, val in out.items()}
+
+    def _check(self, what: str, value: np.ndarray) -> np.ndarray:
+        if not np.all(np.isfinite(value)):
+            raise EngineError(f"{self.name}: {what} returned a non-finite value")
+        if what == "simulate" and np.abs(value).max() > DIVERGED:
+            raise EngineError(f"{self.name}: simulate diverged (|q| > {DIVERGED:g})")
+        return value
+
     def raw_calls(self, qe: np.ndarray, ve: np.ndarray, te: np.ndarray,
-                  ae: np.ndarray) -> Callable[[], None] | None:
+                  ae: np.ndarray) -> Callable[[], object] | None:
         """The loader's own per-state engine calls on states already in its layout (the map
         to it is dyncheck's, timed in the adapter's row); None where its dynamics is one
         compiled batch (a port: timed by its batch, first call apart)."""
-        if not self._loader().per_state_calls:
+        if not self.loader.per_state_calls:
             return None
         _, q, v, a = engine_states(self.canon, self.tree, qe, ve, ae)
         return partial(self.engine.dynamics, q, v, a)
@@ -440,25 +483,3 @@ def _field(model: Multibody) -> Field:
     masses = {body.name: body.mass for body in model.bodies}
     return lambda where: {name: model.central_force(masses[name], at)
                           for name, at in where.items() if name in masses}
-
-
-def for_engine(name: str, registration: Registration) -> type[Adapter]:
-    """The run adapter of the engine registered as ``name`` (its loader ``module:class``
-    imported here: an ImportError says the engine is missing)."""
-    assert registration.model is not None and registration.run is not None, name
-    module, cls = registration.model.split(":")
-    with c_output_dropped():  # an engine's import may print a banner of its own (C)
-        loader = getattr(importlib.import_module(module), cls)
-    attrs = {"name": name, "package": registration.package, "loader": loader,
-             "run_format": registration.run, "as_stated": registration.as_stated,
-             "dtype": np.float32 if registration.float32 else np.float64,
-             "integrators": registration.integrators,
-             "loader_options": dict(registration.loader_options),
-             "requires_couplings": registration.couplings_only,
-             "gyroscopic_implicit": loader.gyroscopic_implicit,
-             "rk4_group_order": loader.rk4_group_order,
-             "couplings_with_field": loader.couplings_with_field,
-             "batches_steps": loader.batches_steps,
-             "error_controlled": Offer.CONTROLLED_STEPPING in loader.offers,
-             "adaptive": Offer.SOLVING in loader.offers, "__module__": __name__}
-    return type(f"{cls}Adapter", (ModelAdapter,), attrs)

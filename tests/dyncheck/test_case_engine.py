@@ -5,10 +5,13 @@ PyBullet holds), and the gravity defect measured in tests/adapters/pybullet/test
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 import pytest
 
-from dyncheck.adapters import REGISTRY, get_adapter
+from dyncheck.adapters import REGISTRY, get_engine
+from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import get_case
 from dyncheck.errors import EngineNotInstalled, Unsupported
 from dyncheck.implementations import general_method, make_implementation
@@ -18,10 +21,17 @@ from ..conftest import CASE_NAMES, FILE_LOADERS, supported, unsupported_reason
 
 
 def _adapter_class(engine: str):
+    """The engine's :class:`CaseEngine` of a case (skipped where it is not installed)."""
     try:
-        return get_adapter(engine)
+        get_engine(engine)
     except EngineNotInstalled as exc:
         pytest.skip(str(exc))
+    return partial(CaseEngine, engine)
+
+
+def _eps(engine: str) -> float:
+    """The unit round-off of the precision the engine is registered to compute in."""
+    return float(np.finfo(np.float32 if REGISTRY[engine].float32 else np.float64).eps)
 
 
 @pytest.mark.parametrize(("case", "engine"), [
@@ -77,7 +87,6 @@ def test_a_declared_defect_explains_only_the_rows_it_predicts(monkeypatch):
     effect per state, the run's rows are explained by it to round-off, on the quantities it
     moves only; withdrawn, the same rows fail — the declaration is what explains them."""
     _adapter_class("pybullet")
-    from dyncheck.adapters.model_adapter import ModelAdapter
     from dyncheck.run import run
 
     def rows():
@@ -88,7 +97,7 @@ def test_a_declared_defect_explains_only_the_rows_it_predicts(monkeypatch):
     assert set(by_defect.quantity) == {"bias_forces", "forward_dynamics", "inverse_dynamics"}
     assert (by_defect.verdict == "explained").all()
     assert by_defect.note.str.contains("GravityFrame.RPY_REVERSED").all()
-    monkeypatch.setattr(ModelAdapter, "defects", lambda self: ())
+    monkeypatch.setattr(CaseEngine, "defects", lambda self: ())
     withdrawn = rows()
     failed = withdrawn[withdrawn.verdict == "failed"]
     assert set(failed.quantity) == set(by_defect.quantity)
@@ -108,9 +117,9 @@ def test_the_engines_own_step_is_mujocos_euler(engine):
     q0, v0 = np.array([0.5, -0.3]), np.array([0.2, 0.1])
     # 300 steps: within MuJoCo Warp's CPU budget (its max_steps, 400)
     ours = cls(spec).simulate(q0, v0, 0.3, 1e-3, "euler")
-    theirs = get_adapter("mujoco")(spec).simulate(q0, v0, 0.3, 1e-3, "euler")
+    theirs = CaseEngine("mujoco", spec).simulate(q0, v0, 0.3, 1e-3, "euler")
     steps = len(ours.t) - 1
-    eps = np.finfo(cls.dtype).eps
+    eps = _eps(engine)
     assert np.abs(ours.q - theirs.q).max() <= 64 * eps * steps * np.abs(theirs.q).max()
     assert np.abs(ours.q - theirs.q).max() > 0 or engine != "newton"  # float32: not bitwise
 
@@ -131,10 +140,10 @@ def test_a_rotating_body_s_steps_map_back_to_mujocos_euler(engine, case_name):
 
     cls = _adapter_class(engine)
     case = get_case(case_name)
-    q0, v0 = EngineImplementation(case, get_adapter("mujoco")).engine_start()
+    q0, v0 = EngineImplementation(case, "mujoco").engine_start()
     ours = cls(case.multibody()).simulate(q0, v0, 0.2, 2e-3, "euler")
-    theirs = get_adapter("mujoco")(case.multibody()).simulate(q0, v0, 0.2, 2e-3, "euler")
-    bound = 64 * np.finfo(cls.dtype).eps * (len(ours.t) - 1)
+    theirs = CaseEngine("mujoco", case.multibody()).simulate(q0, v0, 0.2, 2e-3, "euler")
+    bound = 64 * _eps(engine) * (len(ours.t) - 1)
     assert np.abs(ours.q - theirs.q).max() <= bound * np.abs(theirs.q).max()
     assert np.abs(ours.v - theirs.v).max() <= bound * np.abs(theirs.v).max()
     assert np.abs(ours.q[-1] - ours.q[0]).max() > 10 * bound  # it moved: a test of the map
@@ -148,7 +157,7 @@ def test_a_run_that_leaves_the_finite_states_names_its_step():
 
     cls = _adapter_class("newton")
     case = get_case("spherical_pendulum")
-    q0, v0 = EngineImplementation(case, get_adapter("mujoco")).engine_start()
+    q0, v0 = EngineImplementation(case, "mujoco").engine_start()
     with pytest.raises(FloatingPointError, match=r"step \d+ of 1000 .* condition number"):
         cls(case.multibody()).simulate(q0, v0, 2.0, 2e-3, "euler")
 
@@ -177,8 +186,8 @@ def test_an_external_field_enters_through_the_engine_s_own_means(engine):
                          for r in q])
     got = adapter.inverse(q, zero, zero)
     scale = np.abs(expected).max()
-    assert np.abs(got - expected).max() <= 64 * np.finfo(cls.dtype).eps * scale
-    assert np.abs(spec.central_force(mass, q[0])).max() > 1e3 * 64 * np.finfo(cls.dtype).eps
+    assert np.abs(got - expected).max() <= 64 * _eps(engine) * scale
+    assert np.abs(spec.central_force(mass, q[0])).max() > 1e3 * 64 * _eps(engine)
 
 
 def test_pybullet_holds_a_two_joint_coupling_as_its_gear_constraint():
