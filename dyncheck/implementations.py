@@ -30,7 +30,7 @@ from dyncheck.coordinates import NativeMap
 from dyncheck.errors import UnknownName
 from dyncheck.reference.constraints import Softness
 from dyncheck.reference.derivations import derived, lambdified
-from dyncheck.reference.systems import SYSTEMS
+from dyncheck.reference.systems import System, systems
 from dyncheck.reference.trajectory import solve
 from dyncheck.roster import IMPLEMENTATIONS
 from dyncheck.variants import TENSOR, Variant, book_variant
@@ -80,12 +80,22 @@ def general_method(case: Case, variant: Variant | None = None):
     if case.multibody().couplings:
         params["rest"] = tuple(float(x) for x in case.rest())
         params["softness"] = Softness(*variant.softness) if variant.softness else None
-    return SYSTEMS[case.name].general_method(params, variant.point_inertia)
+    return _system(case).general_method(params, variant.point_inertia)
 
 
 def printed_equations(case: Case):
     """The equations exactly as the book prints them."""
-    return SYSTEMS[case.name].printed_equations(case.params())
+    return _system(case).printed_equations(case.params())
+
+
+def _system(case: Case) -> System:
+    """The case's system in the reference; a case a package added without one (its
+    ``dyncheck.systems`` entry point) costs its reference and book rows, named."""
+    known = systems()
+    if case.name not in known:
+        raise UnknownName("system in the reference (entry point group dyncheck.systems)",
+                          case.name, known)
+    return known[case.name]
 
 
 class Implementation(ABC):

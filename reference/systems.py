@@ -4,11 +4,14 @@ equations (2.2.23)–(2.2.26) from T and V) and the equations the book prints fo
 One signature for every system: ``general(params, inertia=…)`` with the case's parameters
 (and, for cords, ``rest`` and ``softness``) as a mapping and the isotropic inertia each body
 carries where the book has a point mass; ``printed(params)`` with the book's parameters only.
-Adding a case adds one entry here (after the case's module in ``cases/``).
+Adding a built-in case adds one entry here (after the case's module in ``cases/``); an
+installed package adds its case's through :data:`ENTRY_POINTS`.
 """
 
 from __future__ import annotations
 
+import functools
+import importlib.metadata
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -80,9 +83,31 @@ _PAIRS: dict[str, tuple[Callable[..., Any], Callable[..., Any]]] = {
     ),
 }
 
+ENTRY_POINTS = "dyncheck.systems"
+"""The entry-point group through which an installed package gives a case it adds (the
+``dyncheck.cases`` group) its system in the reference: the entry's name is the case's, its
+value ``module:NAME`` a :class:`System`. A broken entry, or one whose name is taken, is left
+out: that case's reference and book rows then fail, naming it."""
+
 SYSTEMS: dict[str, System] = {
     name: System(general=general, printed=printed) for name, (general, printed) in _PAIRS.items()
 }
-"""Case name → its system (:class:`System`). For the cylindrical particle the book prints no
-equations; its "printed" form is (2.2.23) with the closed-form metric and Christoffel symbols
-(exercise 6)."""
+"""Built-in case name → its system (:class:`System`). For the cylindrical particle the book
+prints no equations; its "printed" form is (2.2.23) with the closed-form metric and
+Christoffel symbols (exercise 6)."""
+
+
+@functools.cache
+def systems() -> dict[str, System]:
+    """Every case's system: :data:`SYSTEMS` and those installed packages add
+    (:data:`ENTRY_POINTS`), read on first use — a package's module imports this one, so
+    reading them while it is imported would be circular."""
+    found = dict(SYSTEMS)
+    for point in importlib.metadata.entry_points(group=ENTRY_POINTS):
+        try:
+            system = point.load()
+        except Exception:  # a broken package costs only its own case's rows
+            continue
+        if isinstance(system, System) and point.name not in found:
+            found[point.name] = system
+    return found

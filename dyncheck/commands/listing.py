@@ -41,11 +41,14 @@ def list_command(*, integrators: bool = False) -> int:
     the package metadata — fast, nothing imported — or, with ``integrators``, imported."""
     from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES, NOT_ADDED
     from dyncheck.cases import CASES
+    from dyncheck.cases import NOT_ADDED as CASES_NOT_ADDED
     from dyncheck.roster import IMPLEMENTATIONS
 
     print("cases:")
     for name, cls in CASES.items():
         print(f"  {name:24s} {cls.title}")
+    for name, why in CASES_NOT_ADDED.items():  # an installed package's case left out
+        print(f"  {name:24s} not added: {why}")
     print("implementations:")
     for name in IMPLEMENTATIONS:
         if name == "book":

@@ -1,21 +1,28 @@
-"""Adding an engine is one module and its registration (#62): a toy engine — the referee's own
-dynamics on MuJoCo's reading of the file, so its values are known without it — is installed
-as a package of its own (a module and its ``dyncheck.engines`` entry point, in a temporary
-folder), and ``dyncheck list``, ``run``, ``check``, ``versions`` and ``bench`` show it with no
-file of dyncheck touched. Expected values: the toy computes with the referee, so its rows
-against the reference pass (an independent check of the wiring: a toy that returned
-another engine's numbers or none would fail them)."""
+"""Adding an engine is one module and its registration (#62), a case one module (#76): a toy
+engine — the referee's own dynamics on MuJoCo's reading of the file, so its values are known
+without it — and a toy case — the simple pendulum with other parameters, its reference
+system the book's — are installed as packages of their own (a module and its entry points,
+in a temporary folder), and ``dyncheck list``, ``run``, ``check``, ``versions`` and ``bench``
+show them with no file of dyncheck touched, and the quick suite passes with them. Expected
+values: the toy computes with the referee, so its rows against the reference pass (an
+independent check of the wiring: a toy that returned another engine's numbers or none would
+fail them); the toy case's rows are the simple pendulum's."""
 
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
+from pathlib import Path
+from xml.etree import ElementTree
 
 import pandas as pd
 import pytest
 
 pytestmark = pytest.mark.slow  # each test starts dyncheck in a fresh interpreter: seconds
+
+ROOT = Path(__file__).resolve().parents[2]
 
 TOY = '''
 """A toy engine: MuJoCo's reading of the file, the referee's dynamics on it."""
@@ -45,15 +52,48 @@ class ToyModel(ModelEngine):
 '''
 
 
+TOY_CASE = '''
+"""A toy case: the simple pendulum (Example 7) with another bob and rod, and its system in the
+reference, the book's general method and printed equations of that pendulum."""
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+from dyncheck.cases.pendulums import SimplePendulum
+from dyncheck.reference import pendulum
+from dyncheck.reference.systems import System
+
+
+@dataclass(frozen=True)
+class ToyPendulum(SimplePendulum):
+    name: ClassVar[str] = "toy_pendulum"
+    title: ClassVar[str] = "A toy pendulum (Example 7 with another bob and rod)"
+    m: float = 0.7
+    l: float = 1.6
+
+
+SYSTEM = System(general=pendulum.simple_pendulum, printed=pendulum.simple_pendulum_printed)
+'''
+
+
+def _package(root: Path, name: str, source: str, entry_points: str) -> None:
+    """A module and its distribution's metadata (its entry points), as pip installs them."""
+    (root / f"{name}.py").write_text(source)
+    info = root / f"{name}-0.1.0.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name.replace('_', '-')}\n"
+                                   "Version: 0.1.0\n")
+    (info / "entry_points.txt").write_text(entry_points)
+
+
 @pytest.fixture(scope="module")
 def installed(tmp_path_factory) -> dict[str, str]:
-    """The toy engine's package on a path of its own: the environment to run dyncheck in."""
+    """The toy engine's and the toy case's packages on a path of their own: the environment
+    to run dyncheck in."""
     root = tmp_path_factory.mktemp("site")
-    (root / "toy_engine.py").write_text(TOY)
-    info = root / "toy_engine-0.1.0.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: toy-engine\nVersion: 0.1.0\n")
-    (info / "entry_points.txt").write_text("[dyncheck.engines]\ntoy = toy_engine:REGISTRATION\n")
+    _package(root, "toy_engine", TOY, "[dyncheck.engines]\ntoy = toy_engine:REGISTRATION\n")
+    _package(root, "toy_case", TOY_CASE, "[dyncheck.cases]\ntoy_pendulum = toy_case:ToyPendulum"
+             "\n\n[dyncheck.systems]\ntoy_pendulum = toy_case:SYSTEM\n")
     path = os.pathsep.join(p for p in (str(root), os.environ.get("PYTHONPATH", "")) if p)
     return {**os.environ, "PYTHONPATH": path}
 
@@ -68,6 +108,33 @@ def test_list_names_the_added_engine_with_its_version(installed):
     assert done.returncode == 0, done.stderr
     line = next(x for x in done.stdout.splitlines() if x.split()[:1] == ["toy"])
     assert "toy-engine 0.1.0" in line
+    line = next(x for x in done.stdout.splitlines() if x.split()[:1] == ["toy_pendulum"])
+    assert "A toy pendulum" in line
+
+
+def test_run_compares_the_added_case_in_every_engine(installed, tmp_path):
+    """The toy case through the reference, the book and the core engines: the rows of the
+    simple pendulum's (the same model, other parameters) — nothing failed, MuJoCo's
+    point-mass inertia floor explained against the book."""
+    done = _dyncheck(installed, "run", "toy_pendulum", "--out", str(tmp_path), "--quiet")
+    assert done.returncode == 0, done.stderr
+    rows = pd.read_csv(tmp_path / "discrepancies.csv")
+    assert set(rows.case) == {"toy_pendulum"} and "failed" not in set(rows.verdict)
+    assert {"reference", "book", "mujoco", "toy"} <= set(rows.impl_a) | set(rows.impl_b)
+
+
+def test_the_whole_quick_suite_passes_with_the_toys_registered(installed, tmp_path):
+    """#76: the suites select engines by their registrations and offers, cases from the
+    registry — so with the toy engine and the toy case installed (and no test file edited)
+    the quick suite passes, and its parametrized suites ran over both toys."""
+    report = tmp_path / "junit.xml"
+    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-m", "not slow", "-p",
+                           "no:cacheprovider", f"--junitxml={report}"], env=installed, text=True,
+                          capture_output=True, timeout=900, check=False, cwd=ROOT)
+    assert done.returncode == 0, done.stdout[-4000:]
+    names = [case.get("name", "") for case in ElementTree.parse(report).iter("testcase")]
+    assert any("toy_pendulum" in n for n in names)
+    assert any(re.search(r"[\[-]toy[\]-]", n) for n in names)
 
 
 def test_run_compares_the_added_engine_with_the_referee(installed, tmp_path):
