@@ -39,69 +39,14 @@ from functools import cached_property, partial
 import numpy as np
 
 from dyncheck.adapters.model_tree import StateLayout
-from dyncheck.cases.multibody import ROTATING
+from dyncheck.cases.quaternions import dexp_inv, norm, quat_exp, quat_mul
 from dyncheck.errors import EngineError
-from dyncheck.vocabulary import Integrator, JointType
+from dyncheck.vocabulary import ROTATING, Integrator, JointType
 
 Acceleration = Callable[..., np.ndarray]
 """v̇(q, v[, held]) for one state in the :class:`Addresses`, shapes (nq,), (nv,) → (nv,): called
 with two arguments it evaluates every state-dependent external force now; with ``held``, what
 ``freeze`` returned at the start of the step, it uses that force instead."""
-
-
-def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton product of quaternions (w, x, y, z)."""
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return np.array(
-        [
-            w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-            w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-            w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
-        ]
-    )
-
-
-def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a × b of two 3-vectors (``np.cross`` costs ten times more on one pair: a stage's
-    budget)."""
-    a1, a2, a3 = a
-    b1, b2, b3 = b
-    return np.array([a2 * b3 - a3 * b2, a3 * b1 - a1 * b3, a1 * b2 - a2 * b1])
-
-
-def _norm(x: np.ndarray) -> float:
-    """|x| of a 1-D float array by numpy.linalg.norm's own formula, √(x·x) — the same
-    number without its ~1.5 µs of argument handling, a stage's budget on a small model."""
-    return math.sqrt(x.dot(x))
-
-
-def quat_conj(quat: np.ndarray) -> np.ndarray:
-    """The conjugate (w, −x, −y, −z) — a unit quaternion's inverse — components on the first
-    axis, as :func:`quat_mul` takes them."""
-    return np.array([quat[0], -quat[1], -quat[2], -quat[3]])
-
-
-def quat_exp(theta: np.ndarray) -> np.ndarray:
-    """The unit quaternion of the rotation vector θ: (cos |θ|/2, sin(|θ|/2) θ/|θ|)."""
-    angle = _norm(theta)
-    if angle == 0.0:
-        return np.array([1.0, 0.0, 0.0, 0.0])
-    return np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * theta / angle])
-
-
-def dexp_inv(theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """J_r⁻¹(θ) ω: the rate θ̇ of exponential coordinates, q(t) = q₀ exp(θ(t)), whose body
-    angular velocity is ω — θ̇ = ω + ½ θ × ω + (1/|θ|² − (1 + cos|θ|)/(2|θ| sin|θ|)) θ × (θ × ω)
-    (the Bernoulli series ω + ½ θ × ω + θ × (θ × ω)/12 + O(|θ|⁴) below 1e-4 rad)."""
-    angle = _norm(theta)
-    if angle < 1e-4:
-        k = 1.0 / 12.0 + angle**2 / 720.0
-    else:
-        k = 1.0 / angle**2 - (1.0 + np.cos(angle)) / (2.0 * angle * np.sin(angle))
-    t_x_w = cross(theta, omega)
-    return omega + 0.5 * t_x_w + k * cross(theta, t_x_w)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -144,7 +89,7 @@ class Addresses:
                 out[qa] += dq[va]
         for qa, va in self.rotations():
             quat = quat_mul(out[qa : qa + 4], quat_exp(dq[va : va + 3]))
-            out[qa : qa + 4] = quat / _norm(quat)
+            out[qa : qa + 4] = quat / norm(quat)
         return out
 
     def dexp_inv(self, theta: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -48,7 +48,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dyncheck.adapters.integrators import quat_conj, quat_mul
 from dyncheck.adapters.model_tree import (
     Axes,
     JointType,
@@ -59,6 +58,7 @@ from dyncheck.adapters.model_tree import (
     TreeJoint,
 )
 from dyncheck.cases.coordinate_maps import EulerAngleMap, quat_from_matrix, quat_to_matrix
+from dyncheck.cases.quaternions import quat_conj, quat_mul
 
 IDENTITY = np.eye(4)
 

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from dyncheck.adapters.integrators import quat_mul
 from dyncheck.adapters.layout import (
     IDENTITY,
     Canonical,
@@ -18,6 +17,7 @@ from dyncheck.adapters.layout import (
 )
 from dyncheck.adapters.model_tree import Axes, Dynamics, JointType, Layout, ModelTree, Orientation
 from dyncheck.cases.coordinate_maps import quat_from_matrix, quat_to_matrix
+from dyncheck.cases.quaternions import quat_mul
 
 
 def batch_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray,

@@ -14,7 +14,7 @@ import numpy as np
 
 from dyncheck.cases.validate import finite_array, inertia_tensor, positive
 from dyncheck.errors import InvalidInput
-from dyncheck.vocabulary import JointType
+from dyncheck.vocabulary import ROTATING, JointType
 
 Vec3 = tuple[float, float, float]
 Mat3 = tuple[Vec3, Vec3, Vec3]
@@ -27,8 +27,6 @@ NQ = {t.value: t.nq for t in JointType}
 """Position coordinates per joint type."""
 NV = {t.value: t.nv for t in JointType}
 """Velocity coordinates per joint type."""
-ROTATING = tuple(t.value for t in JointType if t.rotating)
-"""Joint types whose orientation is a quaternion."""
 
 
 @dataclass(frozen=True)

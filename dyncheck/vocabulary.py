@@ -87,6 +87,9 @@ class JointType(StrEnum):
         return self in (JointType.BALL, JointType.FREE)
 
 
+ROTATING = tuple(t.value for t in JointType if t.rotating)
+"""Joint types whose orientation is a quaternion, as text (a ``Joint``'s ``type``)."""
+
 _NQ = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 4, JointType.FREE: 7}
 _NV = {JointType.HINGE: 1, JointType.SLIDE: 1, JointType.BALL: 3, JointType.FREE: 6}
 

@@ -19,8 +19,9 @@ import numpy as np
 import pinocchio as pin
 
 from dyncheck.adapters.base import Field
-from dyncheck.adapters.integrators import Addresses, cross, integrate, solve_on_group
+from dyncheck.adapters.integrators import Addresses, integrate, solve_on_group
 from dyncheck.cases.coordinate_maps import quat_to_matrix
+from dyncheck.cases.quaternions import cross
 
 Held = tuple[str, int, np.ndarray]
 """A body a field pushes: its name, the joint that carries it, its centre of mass in that

@@ -35,9 +35,9 @@ from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.adapters.offers import Offer
 from dyncheck.adapters.symbolic import AFRESH, Symbolic
 from dyncheck.adapters.sympy_mechanics.tree import Chart, case_tree
-from dyncheck.cases.multibody import ROTATING, Coupling, Multibody
+from dyncheck.cases.multibody import Coupling, Multibody
 from dyncheck.errors import Unsupported
-from dyncheck.vocabulary import Integrator
+from dyncheck.vocabulary import ROTATING, Integrator
 
 
 def _vec(frame: me.ReferenceFrame, xyz) -> me.Vector:

@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from dyncheck.adapters.integrators import dexp_inv, quat_conj, quat_exp, quat_mul
 from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import JointType, ModelTree, Transition
+from dyncheck.cases.quaternions import dexp_inv, quat_conj, quat_exp, quat_mul
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.referee.charts import right_jacobian, rotations, skew

@@ -14,7 +14,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from dyncheck.adapters.integrators import quat_conj, quat_mul
 from dyncheck.adapters.layout import Canonical, StateMap, quat_order
 from dyncheck.adapters.model_tree import (
     Axes,
@@ -27,6 +26,7 @@ from dyncheck.adapters.model_tree import (
 )
 from dyncheck.adapters.model_tree import derivatives as collect
 from dyncheck.cases.coordinate_maps import quat_to_matrix
+from dyncheck.cases.quaternions import quat_conj, quat_mul
 from dyncheck.referee.states import States
 
 FIELDS = ("forward_q", "forward_v", "forward_tau", "inverse_q", "inverse_v")

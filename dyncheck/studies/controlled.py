@@ -6,7 +6,6 @@ from __future__ import annotations
 import numpy as np
 
 from dyncheck.cases import Case
-from dyncheck.cases.multibody import ROTATING
 from dyncheck.implementations import EngineImplementation, Implementation, general_method
 from dyncheck.results import Discrepancy, Verdict
 from dyncheck.studies.order import (
@@ -18,7 +17,7 @@ from dyncheck.studies.order import (
 from dyncheck.studies.references import References, difference
 from dyncheck.tolerances import ORDER_SLACK, REFERENCE_MARGIN, accumulated, first_near_max
 from dyncheck.variants import Variant, book_variant
-from dyncheck.vocabulary import Quantity
+from dyncheck.vocabulary import ROTATING, Quantity
 
 ADAPTIVE_RTOL = 1e-13
 

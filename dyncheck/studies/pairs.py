@@ -13,7 +13,6 @@ import numpy as np
 from dyncheck.adapters import get_engine
 from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import NOMINAL_ORDER, Case
-from dyncheck.cases.multibody import ROTATING
 from dyncheck.comparison import soft_factor
 from dyncheck.errors import DyncheckError, EngineNotInstalled, Unsupported
 from dyncheck.implementations import Implementation, compared
@@ -29,7 +28,7 @@ from dyncheck.tolerances import (
     roundoff_floor,
 )
 from dyncheck.variants import Variant
-from dyncheck.vocabulary import Integrator, Quantity, is_rk4
+from dyncheck.vocabulary import ROTATING, Integrator, Quantity, is_rk4
 
 
 def _charted(name: str) -> bool:

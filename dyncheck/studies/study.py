@@ -15,7 +15,6 @@ import numpy as np
 
 from dyncheck.adapters.integrators import STEPPERS
 from dyncheck.cases import NOMINAL_ORDER, Case
-from dyncheck.cases.multibody import ROTATING
 from dyncheck.comparison import describe
 from dyncheck.errors import Unsupported
 from dyncheck.implementations import (
@@ -40,7 +39,7 @@ from dyncheck.tolerances import (
     roundoff_floor,
 )
 from dyncheck.variants import Variant, book_variant
-from dyncheck.vocabulary import Integrator, Quantity, is_rk4
+from dyncheck.vocabulary import ROTATING, Integrator, Quantity, is_rk4
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from dyncheck.adapters.integrators import Addresses, dexp_inv, integrate, quat_exp, quat_mul
+from dyncheck.adapters.integrators import Addresses, integrate
 from dyncheck.cases import get_case
+from dyncheck.cases.quaternions import dexp_inv, quat_exp, quat_mul
 from dyncheck.implementations import make_implementation
 
 XML = """<mujoco><option integrator="{integrator}" timestep="{h}" gravity="0.3 -0.2 -9.81"/>
@@ -111,13 +112,3 @@ def test_pinocchio_runs_mujocos_rk4_to_round_off(case):
     _, qb = make_implementation("pinocchio", c).simulate(dt, "rk4")
     steps = len(qa) - 1
     assert np.abs(qa - qb).max() <= 64 * np.finfo(float).eps * steps * np.abs(qa).max()
-
-
-def test_norm_is_numpys_to_the_last_bit():
-    """The stages' vector norm is numpy.linalg.norm's number exactly (numpy computes √(x·x)
-    for a 1-D real array; rotation vectors and quaternions of many sizes)."""
-    from dyncheck.adapters.integrators import _norm
-
-    rng = np.random.default_rng(7)
-    for x in [*rng.normal(size=(200, 3)), *rng.normal(size=(200, 4)) * 1e-3, np.zeros(3)]:
-        assert _norm(x) == np.linalg.norm(x)

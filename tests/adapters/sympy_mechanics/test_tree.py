@@ -10,11 +10,11 @@ from numpy.testing import assert_allclose
 
 from dyncheck.adapters.formats.files import read
 from dyncheck.adapters.formats.mjcf import to_mjcf
-from dyncheck.adapters.integrators import quat_mul
 from dyncheck.adapters.mujoco.model import MujocoModel
 from dyncheck.adapters.sympy_mechanics.tree import Chart, case_tree
 from dyncheck.cases import get_case
 from dyncheck.cases.coordinate_maps import quat_to_matrix
+from dyncheck.cases.quaternions import quat_mul
 
 from ...conftest import CASE_NAMES
 
