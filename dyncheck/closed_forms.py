@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dyncheck.cases import Case
+from dyncheck.cases.base import Case
 from dyncheck.implementations import general_method
 from dyncheck.precision import EPS
 from dyncheck.reference import rigid

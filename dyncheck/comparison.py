@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from dyncheck.cases import Case, StateSample
+from dyncheck.cases.base import Case, StateSample
 from dyncheck.errors import EngineNotInstalled, Unsupported
 from dyncheck.implementations import (
     IMPLEMENTATIONS,

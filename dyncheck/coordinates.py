@@ -25,7 +25,7 @@ from dyncheck.adapters.layout import (
     velocity_frames,
 )
 from dyncheck.adapters.model_tree import Layout, StateLayout
-from dyncheck.cases import Case
+from dyncheck.cases.base import Case
 from dyncheck.vocabulary import JointType
 
 

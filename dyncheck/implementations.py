@@ -25,7 +25,7 @@ from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import Dynamics, ModelTree
 from dyncheck.adapters.symbolic import Symbolic
 from dyncheck.case_engine import CaseEngine
-from dyncheck.cases import Case, StateSample
+from dyncheck.cases.base import Case, StateSample
 from dyncheck.coordinates import NativeMap
 from dyncheck.errors import UnknownName
 from dyncheck.reference.constraints import Softness

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import pandas as pd
 
-from dyncheck.cases import Case
+from dyncheck.cases.base import Case
 from dyncheck.explain.entry import Entry
 from dyncheck.roster import IMPLEMENTATIONS
 from dyncheck.studies.order import TrajectoryFigures

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from dyncheck.cases import Case
+from dyncheck.cases.base import Case
 from dyncheck.comparison import Sweep, sweep
 from dyncheck.implementations import Implementation, implementations_for, make_implementation
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from dyncheck.cases import Case
+from dyncheck.cases.base import Case
 from dyncheck.labels import SOFT_CONSTRAINT
 
 __all__ = ["ENGINE_DEFECT", "GRAVITY_DEFAULT", "INERTIA_STORED", "POINT_INERTIA",

@@ -9,7 +9,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from dyncheck.adapters.formats import parsing
-from dyncheck.adapters.formats.mjcf_copy import encoding, transcoded
 from dyncheck.adapters.registration import Format
 
 ROOT_TAG = {Format.MJCF: "mujoco", Format.URDF: "robot"}
@@ -86,10 +85,10 @@ def read(path: Path, *, floating: bool = False) -> ModelFile:
     said: tuple[str, ...] = (FLOATING_MJCF,) if floating else ()
     # the text as the file declares it is encoded: the file's own where it is UTF-8,
     # else the parsed document written out again
-    text = path.read_bytes().decode("utf-8") if (declared := encoding(path)) is None else \
+    text = path.read_bytes().decode("utf-8") if (declared := parsing.encoding(path)) is None else \
         ET.tostring(root, encoding="unicode")
     if declared:
-        said += (transcoded(declared),)
+        said += (parsing.transcoded(declared),)
     return ModelFile(path=path, format=Format.MJCF, text=text, floating=False, notes=said)
 
 

@@ -13,7 +13,6 @@ the mesh, and the copy is refused naming the mesh and the conversion that would 
 
 from __future__ import annotations
 
-import re
 import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Iterator
@@ -29,6 +28,7 @@ from dyncheck.adapters.formats.includes import (
     compiler,
     inline,
 )
+from dyncheck.adapters.formats.parsing import encoding
 from dyncheck.errors import Unsupported
 
 
@@ -361,28 +361,6 @@ def standalone(root: ET.Element, folder: Path) -> str:
         for key in ("meshdir", "texturedir", "assetdir"):
             settings.attrib.pop(key, None)
     return ET.tostring(root, encoding="unicode")
-
-
-def encoding(path: Path) -> str | None:
-    """The encoding an MJCF file declares, where it is not UTF-8 (None for a UTF-8 file)."""
-    raw = path.read_bytes()
-    try:
-        raw.decode("utf-8")
-    except UnicodeDecodeError:
-        pass
-    else:
-        return None
-    declared = re.search(rb"encoding\s*=\s*[\"']([^\"']+)", raw[:400].replace(b"\0", b""))
-    if declared:
-        return declared.group(1).decode("ascii", "replace")
-    return "UTF-16" if raw[:2] in (b"\xff\xfe", b"\xfe\xff") else "not UTF-8"
-
-
-def transcoded(declared: str) -> str:
-    """The page's note for a file every engine was given as a UTF-8 copy."""
-    return (f"the file is encoded as {declared}, and every engine's MJCF parser reads UTF-8: "
-            "each was given a UTF-8 copy decoded as the file declares (includes inlined, "
-            "asset paths made absolute)")
 
 
 @contextmanager

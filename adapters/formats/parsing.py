@@ -4,12 +4,15 @@ with a prefix the file never declares (``drake:acceleration``, ``<drake:collisio
 ``<gazebo>``'s ``xacro:`` leftovers) is a name like any other to them. Python's parser
 (expat) refuses it ("unbound prefix"): dyncheck declares each such prefix on the root, as a
 namespace of its own (:data:`UNDECLARED`), and reads on — a file every engine loads is never
-refused by dyncheck's pre-read (#77)."""
+refused by dyncheck's pre-read (#77). A file in another encoding than UTF-8, which every
+engine's MJCF parser assumes, is named by :func:`encoding` (its copy for the parsers:
+:func:`~.mjcf_copy.utf8_file`)."""
 
 from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
+from pathlib import Path
 from pyexpat import errors
 
 UNDECLARED = "urn:dyncheck:undeclared:"
@@ -40,3 +43,25 @@ def root(raw: bytes | str) -> ET.Element:
             ET.register_namespace(prefix.decode(), UNDECLARED + prefix.decode())
     added = b"".join(b' xmlns:%s="%s%s"' % (p, UNDECLARED.encode(), p) for p in prefixes)
     return ET.fromstring(data[:start.end()] + added + data[start.end():])
+
+
+def encoding(path: Path) -> str | None:
+    """The encoding an MJCF file declares, where it is not UTF-8 (None for a UTF-8 file)."""
+    raw = path.read_bytes()
+    try:
+        raw.decode("utf-8")
+    except UnicodeDecodeError:
+        pass
+    else:
+        return None
+    declared = re.search(rb"encoding\s*=\s*[\"']([^\"']+)", raw[:400].replace(b"\0", b""))
+    if declared:
+        return declared.group(1).decode("ascii", "replace")
+    return "UTF-16" if raw[:2] in (b"\xff\xfe", b"\xfe\xff") else "not UTF-8"
+
+
+def transcoded(declared: str) -> str:
+    """The page's note for a file every engine was given as a UTF-8 copy."""
+    return (f"the file is encoded as {declared}, and every engine's MJCF parser reads UTF-8: "
+            "each was given a UTF-8 copy decoded as the file declares (includes inlined, "
+            "asset paths made absolute)")

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from dyncheck.cache.measured import reused
-from dyncheck.cases import Case
+from dyncheck.cases.base import Case
 from dyncheck.reference.derivations import value_bytes
 from dyncheck.results import to_csv
 from dyncheck.roster import IMPLEMENTATIONS

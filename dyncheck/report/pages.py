@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from dyncheck.cases import Case
+from dyncheck.cases.base import Case
 from dyncheck.explain.entry import Entry
 from dyncheck.explain.explanations import EXPLANATIONS
 from dyncheck.labels import TRUNCATION

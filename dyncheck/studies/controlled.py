@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dyncheck.cases import Case
+from dyncheck.cases.base import Case
 from dyncheck.implementations import EngineImplementation, Implementation, general_method
 from dyncheck.results import Discrepancy, Verdict
 from dyncheck.studies.order import (

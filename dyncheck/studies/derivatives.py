@@ -21,7 +21,7 @@ from dyncheck import coordinates as co
 from dyncheck.adapters import MODELS, RUN, get_engine
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.formats.mjcf import to_mjcf
-from dyncheck.cases import Case
+from dyncheck.cases.base import Case
 from dyncheck.coordinates import NativeMap
 from dyncheck.errors import EngineNotInstalled
 from dyncheck.results import Discrepancy

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from dyncheck.adapters.integrators import STEPPERS
-from dyncheck.cases import Case
+from dyncheck.cases.base import Case
 from dyncheck.cases.coordinate_maps import EulerAngleMap
 from dyncheck.comparison import soft_factor
 from dyncheck.implementations import Implementation, general_method

@@ -12,7 +12,7 @@ import numpy as np
 
 from dyncheck.adapters import get_engine
 from dyncheck.case_engine import CaseEngine
-from dyncheck.cases import NOMINAL_ORDER, Case
+from dyncheck.cases.base import NOMINAL_ORDER, Case
 from dyncheck.comparison import soft_factor
 from dyncheck.errors import DyncheckError, EngineNotInstalled, Unsupported
 from dyncheck.implementations import Implementation, compared

@@ -11,7 +11,7 @@ import numpy as np
 from dyncheck import coordinates as co
 from dyncheck.adapters.integrators import Addresses, integrate
 from dyncheck.cache.measured import reused
-from dyncheck.cases import Case
+from dyncheck.cases.base import Case
 from dyncheck.cases.coordinate_maps import CoordinateMap
 from dyncheck.implementations import general_method, reference_trajectory
 from dyncheck.variants import Variant

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dyncheck.adapters.integrators import STEPPERS
-from dyncheck.cases import NOMINAL_ORDER, Case
+from dyncheck.cases.base import NOMINAL_ORDER, Case
 from dyncheck.comparison import describe
 from dyncheck.errors import Unsupported
 from dyncheck.implementations import (

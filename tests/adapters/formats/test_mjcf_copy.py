@@ -16,7 +16,8 @@ import pytest
 
 from dyncheck.adapters.formats.files import read
 from dyncheck.adapters.formats.includes import inline
-from dyncheck.adapters.formats.mjcf_copy import encoding, for_parser, utf8_file
+from dyncheck.adapters.formats.mjcf_copy import for_parser, utf8_file
+from dyncheck.adapters.formats.parsing import encoding
 from dyncheck.check.engines import ENGINES, NotLoaded, load
 from dyncheck.errors import EngineError, Unsupported
 
