@@ -13,8 +13,7 @@ import numpy as np
 
 from dyncheck.cases.coordinate_maps import CoordinateMap
 from dyncheck.cases.multibody import Multibody
-from dyncheck.cases.validate import finite_array, integer, positive
-from dyncheck.errors import InvalidInput
+from dyncheck.errors import InvalidInput, finite_array, integer, positive
 from dyncheck.vocabulary import Integrator
 
 INTEGRATORS: tuple[str, ...] = tuple(Integrator)

@@ -12,8 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dyncheck.cases.validate import finite_array, inertia_tensor, positive
-from dyncheck.errors import InvalidInput
+from dyncheck.errors import InvalidInput, finite_array, inertia_tensor, positive
 from dyncheck.vocabulary import ROTATING, JointType
 
 Vec3 = tuple[float, float, float]

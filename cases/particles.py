@@ -16,7 +16,7 @@ import numpy as np
 from dyncheck.cases.base import STEPS, Case, TrajectorySpec
 from dyncheck.cases.coordinate_maps import LinearMap, SphericalToCartesian
 from dyncheck.cases.multibody import Body, Joint, Multibody
-from dyncheck.cases.validate import positive
+from dyncheck.errors import positive
 from dyncheck.vocabulary import Integrator
 
 X, Y, Z = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)

@@ -20,8 +20,7 @@ import numpy as np
 from dyncheck.cases.base import STEPS, Case, TrajectorySpec
 from dyncheck.cases.coordinate_maps import LinearMap
 from dyncheck.cases.multibody import Body, Coupling, Joint, Multibody
-from dyncheck.cases.validate import positive
-from dyncheck.errors import InvalidInput
+from dyncheck.errors import InvalidInput, positive
 
 DOWN = (0.0, 0.0, -1.0)
 

@@ -17,7 +17,7 @@ import numpy as np
 from dyncheck.cases.base import STEPS, Case, TrajectorySpec
 from dyncheck.cases.coordinate_maps import EulerAngleMap, FreeBodyMap
 from dyncheck.cases.multibody import Body, Joint, Multibody
-from dyncheck.cases.validate import inertia_tensor, positive
+from dyncheck.errors import inertia_tensor, positive
 from dyncheck.vocabulary import Integrator
 
 RIGID_STEPS = {

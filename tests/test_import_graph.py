@@ -16,7 +16,7 @@ FOLDERS = {"dyncheck": "dyncheck", "reference": "dyncheck.reference",
 HEIGHT = 9
 """The longest import chain among the modules under ``dyncheck/`` today (ratchet: lower it
 when a change lowers it; #62's goal of 9 is met)."""
-WHOLE_HEIGHT = 13
+WHOLE_HEIGHT = 12
 """The longest import chain over the whole package as installed — ``adapters``, ``cases`` and
 ``reference`` are ``dyncheck.*`` too (ratchet: #76's goal is 11; 17 when it was filed)."""
 

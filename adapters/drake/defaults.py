@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.mjcf_copy import standalone
+from dyncheck.adapters.formats.includes import standalone
 from dyncheck.adapters.proof import Proof
 
 CLASS_GAINS = (

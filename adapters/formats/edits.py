@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import NamedTuple
 
 from dyncheck.adapters.formats.files import ModelFile
-from dyncheck.adapters.formats.mjcf_copy import standalone
+from dyncheck.adapters.formats.includes import standalone
 from dyncheck.adapters.model_tree import FixedCopy
 
 

@@ -2,7 +2,8 @@
 or special file (a FIFO, a device) found here, never handed to a parser that can loop or block
 on it — and the files its assets name, resolved as MuJoCo resolves them (the compiler's
 ``meshdir``, ``texturedir``, ``assetdir``; an included file's asset beside the included file
-where the main file's folder has none)."""
+where the main file's folder has none) — and the model made standalone (:func:`standalone`: its
+asset paths absolute)."""
 
 from __future__ import annotations
 
@@ -120,3 +121,28 @@ def inline(path: Path) -> ET.Element:
         if found is not None and beside is not None and not found.exists() and beside.exists():
             element.set("file", str(beside))
     return root
+
+
+def _asset_attributes(root: ET.Element, folder: Path
+                      ) -> list[tuple[ET.Element, str, Path]]:
+    """Every file attribute of the (inlined) model's assets — meshes, skins, height fields,
+    textures (each face of a cube), attached models — with the absolute path MuJoCo resolves
+    it to (the compiler's asset folders)."""
+    return [(element, key, path) for element in root.iter() if element.tag in ASSET_TAGS
+            for key in FILE_KEYS if (path := asset_file(root, folder, element, key))]
+
+
+def asset_files(root: ET.Element, folder: Path) -> list[tuple[str, Path]]:
+    """Every file the model's assets name, as ``(<element attribute>, absolute path)``."""
+    return [(f"<{e.tag} {key}>", path) for e, key, path in _asset_attributes(root, folder)]
+
+
+def standalone(root: ET.Element, folder: Path) -> str:
+    """The (inlined) model as text whose asset files are absolute paths, so that it reads the
+    same from anywhere: the compiler's asset folders folded into them."""
+    for element, key, path in _asset_attributes(root, folder):
+        element.set(key, str(path))
+    for settings in root.iter("compiler"):
+        for key in ("meshdir", "texturedir", "assetdir"):
+            settings.attrib.pop(key, None)
+    return ET.tostring(root, encoding="unicode")

@@ -22,11 +22,10 @@ from enum import Enum
 from pathlib import Path
 
 from dyncheck.adapters.formats.includes import (
-    ASSET_TAGS,
-    FILE_KEYS,
     asset_file,
     compiler,
     inline,
+    standalone,
 )
 from dyncheck.adapters.formats.parsing import encoding
 from dyncheck.errors import Unsupported
@@ -336,31 +335,6 @@ def _without_massless(root: ET.Element, engine: str) -> list[str]:
             f"{MASSLESS.format(engine=engine)}; each of these bodies is welded to the world or "
             "has no geom with mass, so it weighs nothing either way and the dynamics are "
             "unchanged"]
-
-
-def _asset_attributes(root: ET.Element, folder: Path
-                      ) -> list[tuple[ET.Element, str, Path]]:
-    """Every file attribute of the (inlined) model's assets — meshes, skins, height fields,
-    textures (each face of a cube), attached models — with the absolute path MuJoCo resolves
-    it to (the compiler's asset folders)."""
-    return [(element, key, path) for element in root.iter() if element.tag in ASSET_TAGS
-            for key in FILE_KEYS if (path := asset_file(root, folder, element, key))]
-
-
-def asset_files(root: ET.Element, folder: Path) -> list[tuple[str, Path]]:
-    """Every file the model's assets name, as ``(<element attribute>, absolute path)``."""
-    return [(f"<{e.tag} {key}>", path) for e, key, path in _asset_attributes(root, folder)]
-
-
-def standalone(root: ET.Element, folder: Path) -> str:
-    """The (inlined) model as text whose asset files are absolute paths, so that it reads the
-    same from anywhere: the compiler's asset folders folded into them."""
-    for element, key, path in _asset_attributes(root, folder):
-        element.set(key, str(path))
-    for settings in root.iter("compiler"):
-        for key in ("meshdir", "texturedir", "assetdir"):
-            settings.attrib.pop(key, None)
-    return ET.tostring(root, encoding="unicode")
 
 
 @contextmanager

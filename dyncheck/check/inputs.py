@@ -16,8 +16,7 @@ from dyncheck.adapters.formats.files import (
     urdf_inertials,
     urdf_welded,
 )
-from dyncheck.adapters.formats.includes import inline
-from dyncheck.adapters.formats.mjcf_copy import asset_files
+from dyncheck.adapters.formats.includes import asset_files, inline
 from dyncheck.adapters.registration import Format
 from dyncheck.errors import EngineError, InvalidInput, UnknownName
 
