@@ -40,7 +40,7 @@ REGISTRY: dict[str, Registration] = {
     name: registration for module in BUILT_IN
     for name, registration in module.REGISTRATIONS.items()}
 """Implementation name → its registration (each engine's, declared in its own module). A
-module is imported when its adapter is first asked for — an engine's import (JAX and Warp take
+module is imported when its engine is first asked for — an engine's import (JAX and Warp take
 seconds) is paid only by the runs that use it."""
 
 ENTRY_POINTS = "dyncheck.engines"

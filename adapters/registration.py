@@ -1,5 +1,5 @@
 """An engine's registration: the facts about an engine implementation that are needed before
-(or without) importing it — where its adapter and loader are, its package and extra, its
+(or without) importing it — where its engine class is, its package and extra, its
 integrators, its releases. Each engine declares its own in its folder's
 ``adapters/<engine>/__init__.py``, beside its code (importable without the engine); an
 installed package adds one through the ``dyncheck.engines`` entry points
@@ -50,16 +50,16 @@ class Registration:
     package: str
     """The pip package that provides the engine (its version is read from its metadata)."""
     integrators: tuple[str, ...] = ()
-    """The fixed-step integrators its ``simulate`` accepts (its adapter's ``integrators``):
-    known without importing the engine (a test session's parameters)."""
+    """The fixed-step integrators its ``simulate`` accepts (its class maps each to its own
+    stepping): known without importing the engine (a test session's parameters)."""
     extra: str | None = None
     """The optional extra of dyncheck that installs it (core engines: None)."""
     ports: str | None = None
     """The engine this one is a port of: then compared with that engine, the reference and its
     own package's other builds only, not with every other engine."""
     float32: bool = False
-    """Whether it computes in float32 (its adapter's ``dtype``): the report check derives its
-    rows' round-off bands from float32's ε without importing the engine."""
+    """Whether it computes in float32 (the run takes its ε from it): the report check derives
+    its rows' round-off bands from float32's ε without importing the engine."""
     model: str | None = None
     """``module:class`` of its engine, a :class:`~dyncheck.adapters.base.ModelEngine`: the
     loader of a user's file (``dyncheck check``, unless ``checks_files`` is False), or built
@@ -74,7 +74,7 @@ class Registration:
     kernels a step, ~1.4 ms a step from Python: 21 s of one case's trajectory studies), so the
     README's first command runs the engines a CPU runs in seconds, and these a second one."""
     label: str | None = None
-    """Its engine's name in a report's provenance, where its adapter reports the version
+    """Its engine's name in a report's provenance, where its class reports the version
     (one implementation per engine)."""
     canonical: bool = False
     """The check's canonical engine: first in the check, whose tree the others meet."""
