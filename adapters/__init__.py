@@ -4,17 +4,14 @@ rest named for what they hold. The registrations are gathered here; MJCF and URD
 shared by every engine is in :mod:`.formats`, what the engines share beside the folders.
 
 ``REGISTRY`` names each implementation's engine class (a
-:class:`~dyncheck.adapters.base.ModelEngine`), imported on first use. ``ENGINES`` maps
-implementation name → engine class for the engines that are installed; ``MISSING`` maps the
-others → the reason. :func:`get_engine` raises :class:`~dyncheck.errors.EngineNotInstalled`
-(with the pip hint) or :class:`~dyncheck.errors.UnknownName` (listing the valid names).
+:class:`~dyncheck.adapters.base.ModelEngine`), imported on first use by
+:mod:`.installed` (``get_engine``, ``ENGINES``, ``MISSING``): this module holds the
+registrations alone, and imports no engine and no engine interface.
 """
 
 from __future__ import annotations
 
-import importlib
 import importlib.metadata
-from typing import Any
 
 from dyncheck.adapters import (
     drake,
@@ -26,10 +23,7 @@ from dyncheck.adapters import (
     pybullet,
     sympy_mechanics,
 )
-from dyncheck.adapters.base import LoadedBody, ModelEngine, Trajectory
-from dyncheck.adapters.c_output import c_output_dropped
 from dyncheck.adapters.registration import Needs, Registration
-from dyncheck.errors import EngineNotInstalled, UnknownName
 
 BUILT_IN = (sympy_mechanics, pinocchio, drake, mujoco, mjx, mujoco_warp, newton, pybullet)
 """The built-in engines' folders, whose ``__init__`` holds the engine's registrations and
@@ -99,79 +93,19 @@ LABELS: dict[str, str] = {n: r.label for n, r in MODELS.items() if r.label}
 """Implementation whose adapter reports its engine's version → the engine's name in a
 report's provenance (in the check's order: the canonical engine first)."""
 
-_ENGINES: dict[str, type[ModelEngine]] = {}
-_MISSING: dict[str, str] = {}
-
-
-def _load(name: str) -> None:
-    """Import one engine class once; an ImportError records the engine as missing."""
-    if name in _ENGINES or name in _MISSING:
-        return
-    entry = REGISTRY[name]
-    assert entry.model is not None, name
-    try:
-        # a loader imports its engine only when it loads a model (Newton's): an engine that
-        # is not installed must be missing here, not fail in the middle of a run
-        try:
-            importlib.metadata.distribution(entry.package)
-        except importlib.metadata.PackageNotFoundError:
-            raise ImportError(f"No module named {entry.package!r}") from None
-        module, cls = entry.model.split(":")
-        with c_output_dropped():  # an engine's import may print a banner of its own (C)
-            _ENGINES[name] = getattr(importlib.import_module(module), cls)
-    except ImportError as exc:  # depends on the environment
-        _MISSING[name] = str(exc)
-
-
-def __getattr__(attr: str) -> dict[str, Any]:
-    """``ENGINES`` (name → engine class of every installed engine) and ``MISSING`` (name →
-    why not): asking for either imports every engine (PEP 562)."""
-    if attr in ("ENGINES", "MISSING"):
-        for name in RUN:
-            _load(name)
-        return _ENGINES if attr == "ENGINES" else _MISSING
-    raise AttributeError(f"module {__name__!r} has no attribute {attr!r}")
-
-
-def get_engine(name: str) -> type[ModelEngine]:
-    """The engine class of an installed implementation (one ``dyncheck run`` or ``dyncheck
-    check`` knows)."""
-    if name not in REGISTRY or REGISTRY[name].model is None:
-        raise UnknownName("implementation", name,
-                          tuple(n for n, r in REGISTRY.items() if r.model))
-    _load(name)
-    if name in _MISSING:
-        raise EngineNotInstalled(
-            name, ENGINE_PACKAGES[name], _MISSING[name], ENGINE_EXTRAS.get(name)
-        )
-    return _ENGINES[name]
-
-
-def engine_version(name: str) -> str:
-    """The installed engine's version (its package's, unless its class says more)."""
-    return get_engine(name).version(REGISTRY[name].package)
-
-
 __all__ = [
     "ACCELERATORS",
     "BUILT_IN",
     "COUPLINGS_ONLY",
-    "ENGINES",
     "ENGINE_EXTRAS",
     "ENGINE_PACKAGES",
     "ENGINE_PORTS",
     "FLOAT32",
     "LABELS",
-    "MISSING",
     "MODELS",
     "NOT_ADDED",
     "REGISTRY",
     "RUN",
-    "LoadedBody",
-    "ModelEngine",
     "Needs",
     "Registration",
-    "Trajectory",
-    "engine_version",
-    "get_engine",
 ]

@@ -50,41 +50,17 @@ import numpy as np
 
 from dyncheck.adapters.model_tree import (
     Axes,
+    Canonical,
     JointType,
     Layout,
     ModelTree,
     Orientation,
-    StateLayout,
     TreeJoint,
 )
 from dyncheck.cases.coordinate_maps import EulerAngleMap, quat_from_matrix, quat_to_matrix
 from dyncheck.cases.quaternions import quat_conj, quat_mul
 
 IDENTITY = np.eye(4)
-
-
-@dataclass(frozen=True, kw_only=True)
-class Canonical:
-    """The canonical joint order and where each joint's coordinates sit in it."""
-
-    names: tuple[str, ...]
-    types: tuple[JointType, ...]
-    q_start: tuple[int, ...]
-    v_start: tuple[int, ...]
-    nq: int
-    nv: int
-    zeros: tuple[float, ...]  # a hinge's or slide's coordinate at the reference configuration
-
-
-def canonical(tree: ModelTree) -> Canonical:
-    types = tuple(j.type for j in tree.joints)
-    places = StateLayout().joints(types)  # the canonical layout: MuJoCo's
-    return Canonical(
-        names=tuple(j.name for j in tree.joints), types=types,
-        q_start=tuple(p.q_start for p in places), v_start=tuple(p.v_start for p in places),
-        nq=sum(p.nq for p in places), nv=sum(p.nv for p in places),
-        zeros=tuple(j.layout.zero for j in tree.joints),
-    )
 
 
 def rpy_from_matrix(rot: np.ndarray) -> np.ndarray:

@@ -7,15 +7,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from dyncheck.adapters.layout import (
-    IDENTITY,
+from dyncheck.adapters.layout import IDENTITY, StateMap, canonical_positions, mapper, quat_order
+from dyncheck.adapters.model_tree import (
+    Axes,
     Canonical,
-    StateMap,
-    canonical_positions,
-    mapper,
-    quat_order,
+    Dynamics,
+    JointType,
+    Layout,
+    ModelTree,
+    Orientation,
 )
-from dyncheck.adapters.model_tree import Axes, Dynamics, JointType, Layout, ModelTree, Orientation
 from dyncheck.cases.coordinate_maps import quat_from_matrix, quat_to_matrix
 from dyncheck.cases.quaternions import quat_mul
 

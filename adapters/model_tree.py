@@ -347,22 +347,6 @@ class ModelTree:
         raise KeyError(name)
 
 
-def lump(
-    masses: list[float], coms: list[np.ndarray], inertias: list[np.ndarray]
-) -> tuple[float, np.ndarray, np.ndarray]:
-    """Mass, centre of mass and inertia about it of rigidly joined bodies (world axes):
-    the parallel-axis theorem, I = Σ (Iᵢ + mᵢ (|dᵢ|² 1 − dᵢ dᵢᵀ)), dᵢ = cᵢ − c."""
-    mass = float(sum(masses))
-    if mass <= 0.0:
-        return mass, np.zeros(3), sum(inertias, np.zeros((3, 3)))
-    com = sum(m * c for m, c in zip(masses, coms, strict=True)) / mass
-    total = np.zeros((3, 3))
-    for m, c, inertia in zip(masses, coms, inertias, strict=True):
-        d = c - com
-        total += inertia + m * (d @ d * np.eye(3) - np.outer(d, d))
-    return mass, np.asarray(com, float), total
-
-
 @dataclass(frozen=True, kw_only=True)
 class Dynamics:
     """An engine's smooth dynamics at a batch of states, in its own layout: M (n, nv, nv),
@@ -478,3 +462,29 @@ def geared(tree: ModelTree, acting: Mapping[str, tuple[float, float]],
         replace(a, gear=acting[a.name][1]) if a.name in acting else a for a in tree.actuators))
     return tuple(FixedReading(subject=name, fields=("gear",), tree=fixed, fix=fix(gear))
                  for name, (gear, _) in acting.items())
+
+
+@dataclass(frozen=True, kw_only=True)
+class Canonical:
+    """The canonical joint order and where each joint's coordinates sit in it."""
+
+    names: tuple[str, ...]
+    types: tuple[JointType, ...]
+    q_start: tuple[int, ...]
+    v_start: tuple[int, ...]
+    nq: int
+    nv: int
+    zeros: tuple[float, ...]  # a hinge's or slide's coordinate at the reference configuration
+
+
+def canonical(tree: ModelTree) -> Canonical:
+    """The tree's joints in its order, each joint's coordinates where the canonical layout
+    (MuJoCo's) puts them."""
+    types = tuple(j.type for j in tree.joints)
+    places = StateLayout().joints(types)  # the canonical layout: MuJoCo's
+    return Canonical(
+        names=tuple(j.name for j in tree.joints), types=types,
+        q_start=tuple(p.q_start for p in places), v_start=tuple(p.v_start for p in places),
+        nq=sum(p.nq for p in places), nv=sum(p.nv for p in places),
+        zeros=tuple(j.layout.zero for j in tree.joints),
+    )

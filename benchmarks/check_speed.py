@@ -87,7 +87,7 @@ def scale(folder: Path, repeats: int) -> tuple[pd.DataFrame, dict[str, float]]:
     import numpy as np
 
     from dyncheck.adapters.formats.files import read
-    from dyncheck.adapters.layout import canonical
+    from dyncheck.adapters.model_tree import canonical
     from dyncheck.adapters.mujoco.model import MujocoModel
     from dyncheck.check.sampling import sample
     from dyncheck.referee.derivatives import referee

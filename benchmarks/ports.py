@@ -54,7 +54,8 @@ def main() -> None:
     import jax
 
     jax.config.update("jax_enable_compilation_cache", False)
-    from dyncheck.adapters import ENGINE_PORTS, ENGINES, engine_version
+    from dyncheck.adapters import ENGINE_PORTS
+    from dyncheck.adapters.installed import ENGINES, engine_version
     from dyncheck.case_engine import CaseEngine
     from dyncheck.cases import get_case
 

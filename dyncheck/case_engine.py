@@ -43,18 +43,20 @@ from typing import Any
 
 import numpy as np
 
-from dyncheck.adapters import REGISTRY, get_engine
+from dyncheck.adapters import REGISTRY
 from dyncheck.adapters.base import Field, LoadedBody, ModelEngine, Offer, Steps, Trajectory
 from dyncheck.adapters.c_output import c_output_dropped
 from dyncheck.adapters.formats.files import read
 from dyncheck.adapters.formats.mjcf import to_mjcf
 from dyncheck.adapters.formats.urdf import root_is_free, to_urdf
-from dyncheck.adapters.layout import Canonical, StateMap
+from dyncheck.adapters.installed import get_engine
+from dyncheck.adapters.layout import StateMap
 from dyncheck.adapters.layout_batch import canonical_states, engine_states, to_canonical
 from dyncheck.adapters.model_tree import (
     NQ,
     NV,
     QUANTITY_OF,
+    Canonical,
     Dynamics,
     GravityFrame,
     JointType,

@@ -19,10 +19,9 @@ from typing import Any, ClassVar
 import numpy as np
 
 from dyncheck import coordinates as co
-from dyncheck.adapters import COUPLINGS_ONLY, ENGINE_PACKAGES, ENGINE_PORTS, Trajectory
-from dyncheck.adapters.base import ModelEngine
-from dyncheck.adapters.layout import Canonical
-from dyncheck.adapters.model_tree import Dynamics, ModelTree
+from dyncheck.adapters import COUPLINGS_ONLY, ENGINE_PACKAGES, ENGINE_PORTS
+from dyncheck.adapters.base import ModelEngine, Trajectory
+from dyncheck.adapters.model_tree import Canonical, Dynamics, ModelTree
 from dyncheck.adapters.symbolic import Symbolic
 from dyncheck.case_engine import CaseEngine
 from dyncheck.cases.base import Case, StateSample

@@ -29,7 +29,8 @@ def engine_versions(names: Iterable[str]) -> dict[str, str]:
     """The versions of the engines behind the implementations ``names`` (provenance name →
     version, "not installed" for an engine that is not), each implementation standing for
     its package's engine (``mujoco-stiff`` for MuJoCo)."""
-    from dyncheck.adapters import ENGINE_PACKAGES, LABELS, RUN, engine_version
+    from dyncheck.adapters import ENGINE_PACKAGES, LABELS, RUN
+    from dyncheck.adapters.installed import engine_version
 
     packages = {ENGINE_PACKAGES[n] for n in names if n in ENGINE_PACKAGES}
     out = {}

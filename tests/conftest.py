@@ -15,7 +15,7 @@ from filelock import FileLock
 from hypothesis import settings
 
 from dyncheck import adapters
-from dyncheck.adapters import RUN
+from dyncheck.adapters import RUN, installed
 from dyncheck.adapters.offers import Offer
 from dyncheck.adapters.registration import Format
 from dyncheck.cases import CASES, get_case
@@ -179,7 +179,7 @@ def _full_run() -> RunResult:
 
     # An engine that is not installed is a test failure, never a skip counted as a pass.
     # (asked here, not at import: finding out imports every engine, JAX and Warp included)
-    assert not adapters.MISSING, f"engines not installed: {adapters.MISSING}"
+    assert not installed.MISSING, f"engines not installed: {installed.MISSING}"
     # two worker processes: the same results as one (test_jobs_give_identical_results), in
     # about half the wall time on CI's two cores
     from dyncheck.explain import catalogue
@@ -192,11 +192,11 @@ def _full_run() -> RunResult:
 def pretend_missing(monkeypatch):
     """``pretend_missing(engine, why)``: the engine as if its class's import failed with
     ``why`` — skipped rows naming its extra — without importing every other engine, as
-    asking for ``adapters.MISSING`` would (~4 s with JAX and Warp)."""
+    asking for ``installed.MISSING`` would (~4 s with JAX and Warp)."""
 
     def hide(engine: str, why: str) -> None:
-        monkeypatch.delitem(adapters._ENGINES, engine, raising=False)
-        monkeypatch.setitem(adapters._MISSING, engine, why)
+        monkeypatch.delitem(installed._ENGINES, engine, raising=False)
+        monkeypatch.setitem(installed._MISSING, engine, why)
 
     return hide
 

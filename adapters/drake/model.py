@@ -50,6 +50,7 @@ from dyncheck.adapters.drake.parsing import ENGINE, plant_of
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import equalities, inline
+from dyncheck.adapters.inertia import lump
 from dyncheck.adapters.model_tree import (
     Axes,
     DerivativeChart,
@@ -60,7 +61,6 @@ from dyncheck.adapters.model_tree import (
     ModelTree,
     Orientation,
     TreeJoint,
-    lump,
 )
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,

@@ -24,6 +24,7 @@ from dyncheck.adapters.closures import ClosedReading
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
+from dyncheck.adapters.inertia import lump
 from dyncheck.adapters.model_tree import (
     NQ,
     NV,
@@ -36,7 +37,6 @@ from dyncheck.adapters.model_tree import (
     Orientation,
     Transition,
     TreeJoint,
-    lump,
 )
 from dyncheck.adapters.model_tree import (
     derivatives as _derivatives,

@@ -33,6 +33,7 @@ from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import equalities, inline
 from dyncheck.adapters.formats.mjcf_copy import utf8_file
+from dyncheck.adapters.inertia import lump
 from dyncheck.adapters.model_tree import (
     Axes,
     Dynamics,
@@ -41,7 +42,6 @@ from dyncheck.adapters.model_tree import (
     ModelTree,
     Orientation,
     TreeJoint,
-    lump,
 )
 from dyncheck.adapters.newton import actuators as newton_actuators
 from dyncheck.adapters.newton import closures as newton_closures

@@ -1,8 +1,12 @@
 """Pinocchio's API differences between releases, in one place (each with the release that
 made it), as :mod:`dyncheck.adapters.mujoco.api` is for MuJoCo; the version matrix
-(``dyncheck versions``) runs them on each release."""
+(``dyncheck versions``) runs them on each release. And its MJCF parser on MJCF text
+(:func:`parse_xml`, the catalogue's demonstrations), which needs no more of dyncheck."""
 
 from __future__ import annotations
+
+import tempfile
+from pathlib import Path
 
 import pinocchio as pin
 
@@ -28,3 +32,12 @@ def mjcf_constraints(path: str) -> tuple[int, int]:
         return model.nv, sum(len(c) for c in lists)
     model, contacts = pin.buildModelFromMJCF(path, pin.JointModelFreeFlyer(), "root")
     return model.nv - 6, len(contacts)
+
+
+def parse_xml(xml: str) -> pin.Model:
+    """``pin.buildModelFromMJCF`` on MJCF text, through a private temporary file (the
+    catalogue's demonstrations)."""
+    with tempfile.TemporaryDirectory(prefix="dyncheck-pinocchio-") as folder:
+        path = Path(folder) / "model.xml"
+        path.write_text(xml, encoding="utf-8")
+        return pin.buildModelFromMJCF(str(path))

@@ -20,11 +20,9 @@ integrators' definitions and scipy's DOP853 on its forward dynamics).
 
 from __future__ import annotations
 
-import tempfile
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
-from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
@@ -74,15 +72,6 @@ def _type(shortname: str) -> JointType:
     if shortname == "JointModelFreeFlyer":
         return JointType.FREE
     raise Unsupported(f"pinocchio joint type {shortname} is not checked")
-
-
-def parse_xml(xml: str) -> pin.Model:
-    """``pin.buildModelFromMJCF`` on MJCF text, through a private temporary file (the
-    catalogue's demonstrations)."""
-    with tempfile.TemporaryDirectory(prefix="dyncheck-pinocchio-") as folder:
-        path = Path(folder) / "model.xml"
-        path.write_text(xml, encoding="utf-8")
-        return pin.buildModelFromMJCF(str(path))
 
 
 def _load(source: ModelFile) -> pin.Model:

@@ -45,6 +45,7 @@ import pybullet as pb
 
 from dyncheck.adapters.base import Field, ModelEngine, Offer
 from dyncheck.adapters.formats.files import ModelFile
+from dyncheck.adapters.inertia import lump
 from dyncheck.adapters.model_tree import (
     Axes,
     Dynamics,
@@ -54,7 +55,6 @@ from dyncheck.adapters.model_tree import (
     ModelTree,
     Orientation,
     TreeJoint,
-    lump,
 )
 from dyncheck.adapters.pybullet.base import base_state, place_base, world_linear
 from dyncheck.adapters.pybullet.counterfactual import gravity_fixed, inertial_fixed

@@ -17,6 +17,7 @@ again and replaced.
 from __future__ import annotations
 
 import hashlib
+import importlib.util
 import platform
 import shutil
 import sys
@@ -50,13 +51,12 @@ def _installed(package: str) -> str:
 
 def _source_roots() -> list[Path]:
     """The folders of dyncheck's packages (``reference``, ``adapters`` and ``cases`` live
-    beside ``dyncheck`` in a source checkout, inside it when installed)."""
-    import dyncheck.adapters
-    import dyncheck.cases
-    import dyncheck.reference
-
-    modules = (sys.modules["dyncheck"], dyncheck.reference, dyncheck.adapters, dyncheck.cases)
-    return sorted({Path(m.__file__).resolve().parent for m in modules if m.__file__})
+    beside ``dyncheck`` in a source checkout, inside it when installed): found by the import
+    system, not imported (the case registry reads installed packages' entry points)."""
+    specs = [importlib.util.find_spec(name) for name in
+             ("dyncheck", "dyncheck.reference", "dyncheck.adapters", "dyncheck.cases")]
+    return sorted({Path(spec.origin).resolve().parent for spec in specs
+                   if spec is not None and spec.origin})
 
 
 def _cpu() -> str:

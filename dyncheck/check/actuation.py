@@ -19,8 +19,7 @@ import numpy as np
 from dyncheck.adapters import layout_batch
 from dyncheck.adapters.actuators import EULER_DAMPING, Activation, Actuator
 from dyncheck.adapters.base import ModelEngine, Offer
-from dyncheck.adapters.layout import Canonical
-from dyncheck.adapters.model_tree import Dynamics, ModelTree
+from dyncheck.adapters.model_tree import Canonical, Dynamics, ModelTree
 from dyncheck.check.actuator_readings import UNKNOWN, match, reading_rows
 from dyncheck.check.actuator_readings import section_row as _row
 from dyncheck.check.dynamics import QUANTITIES

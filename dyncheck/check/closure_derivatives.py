@@ -28,8 +28,7 @@ import numpy as np
 from dyncheck.adapters import layout_batch
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.closures import ClosedReading
-from dyncheck.adapters.layout import Canonical
-from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.adapters.model_tree import Canonical, ModelTree
 from dyncheck.check import closures
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.errors import EngineError, Unsupported

@@ -10,11 +10,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from dyncheck.adapters import layout, layout_batch
+from dyncheck.adapters import layout_batch
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.closures import ClosedReading
-from dyncheck.adapters.layout import Canonical
-from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.adapters.model_tree import Canonical, ModelTree, canonical
 from dyncheck.adapters.offers import Offer
 from dyncheck.check import closure_derivatives, closure_readings, closures
 from dyncheck.check.rows import CheckRow, Section
@@ -137,7 +136,7 @@ def _engine_rows(model: str, name: str, engine: ModelEngine, states: closures.Cl
                      verdict=Verdict.SKIPPED, note=f"{name} holds part of the model (its "
                      "reading rows): its closed dynamics are compared only on the whole")]
     tau = np.zeros_like(states.v)
-    canon = layout.canonical(canonical_tree)
+    canon = canonical(canonical_tree)
     try:
         tree, reading = in_canonical(canon, engine, states, tau)
     except Unsupported as exc:  # (what it, or dyncheck, does not compute: said as such)

@@ -31,8 +31,8 @@ from functools import partial
 import numpy as np
 
 from dyncheck.adapters.base import ModelEngine, Offer
-from dyncheck.adapters.layout import Canonical
 from dyncheck.adapters.model_tree import (
+    Canonical,
     DerivativeChart,
     Derivatives,
     ModelTree,

@@ -12,8 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from dyncheck.adapters.layout import Canonical
-from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.adapters.model_tree import Canonical, ModelTree
 from dyncheck.check.sampling import sample, sampled_note
 from dyncheck.errors import InvalidInput
 from dyncheck.referee.states import States

@@ -19,8 +19,7 @@ import numpy as np
 
 from dyncheck import labels
 from dyncheck.adapters.actuators import EULER_DAMPING, InputJacobian
-from dyncheck.adapters.layout import Canonical
-from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.adapters.model_tree import Canonical, ModelTree
 from dyncheck.check.rows import COMPUTED, CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR
 from dyncheck.referee.charts import right_jacobian, rotations

@@ -22,10 +22,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from dyncheck.adapters import REGISTRY, layout, layout_batch
+from dyncheck.adapters import REGISTRY, layout_batch
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.formats.files import ModelFile, read, urdf_inertials, urdf_welded
-from dyncheck.adapters.model_tree import Dynamics, ModelTree
+from dyncheck.adapters.model_tree import Canonical, Dynamics, ModelTree, canonical
 from dyncheck.check import (
     actuation,
     closure_rows,
@@ -185,7 +185,7 @@ def _check(model: str, source_path: Path, source: ModelFile, *,
     differing = _readings(model, source, loaded, rows, notes)
     if other is not None:
         rows.extend(against_rows(model, canonical_tree, other))
-    canon = layout.canonical(canonical_tree)
+    canon = canonical(canonical_tree)
     inputs.fits_in_memory(count=states if given is None else given.n, nv=canon.nv,
                           arrays=2 + 3 * len(loaded))  # referee, engines, their readings, pairs
     parts, unmatched = _parts(canon, canonical_tree, loaded, notes)
@@ -298,7 +298,7 @@ def _readings(model: str, source: ModelFile, loaded: dict[str, ModelEngine],
     return differing
 
 
-def _parts(canon: layout.Canonical, canonical_tree: ModelTree,
+def _parts(canon: Canonical, canonical_tree: ModelTree,
            loaded: dict[str, ModelEngine],
            notes: list[str]) -> tuple[dict[str, partial.Part | None], list[str]]:
     """Which joints each engine holds: all (None), a common part of whole subtrees (its
@@ -321,7 +321,7 @@ def _parts(canon: layout.Canonical, canonical_tree: ModelTree,
     return parts, unmatched
 
 
-def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch: States,
+def _dynamics(model: str, canon: Canonical, canonical_tree: ModelTree, batch: States,
               loaded: dict[str, ModelEngine],
               parts: dict[str, partial.Part | None], unmatched: list[str], *,
               with_referee: bool, rows: list[CheckRow],
@@ -362,7 +362,7 @@ def _dynamics(model: str, canon: layout.Canonical, canonical_tree: ModelTree, ba
     return _defined(model, results, loaded, own, rows=rows)
 
 
-def _submitted(model: str, canon: layout.Canonical, batch: States,
+def _submitted(model: str, canon: Canonical, batch: States,
                loaded: dict[str, ModelEngine], *, parts: dict[str, partial.Part | None],
                unmatched: list[str], rows: list[CheckRow], seconds: dict[str, float],
                failures: dict[str, str]) -> dict[str, tuple[ModelEngine, list]]:
@@ -381,7 +381,7 @@ def _submitted(model: str, canon: layout.Canonical, batch: States,
         part = parts[engine]
         on = batch if part is None else partial.states(batch, part)
         maps, q_e, v_e, a_e = layout_batch.engine_states(
-            canon if part is None else layout.canonical(part.tree), m.tree, on.q, on.v, on.a)
+            canon if part is None else canonical(part.tree), m.tree, on.q, on.v, on.a)
         seconds[engine] = seconds.get(engine, 0.0) + time.perf_counter() - t0  # the map's
         try:
             m.submit(q_e, v_e, a_e)
@@ -448,7 +448,7 @@ def _non_finite(dyn: Dynamics) -> list[str]:
             if f not in unavailable and not np.all(np.isfinite(getattr(dyn, f)))]
 
 
-def _pairs(model: str, canon: layout.Canonical, canonical_tree: ModelTree, batch: States,
+def _pairs(model: str, canon: Canonical, canonical_tree: ModelTree, batch: States,
            loaded: dict[str, ModelEngine],
            parts: dict[str, partial.Part | None], results: dict[str, Dynamics],
            differing: dict[str, list[str]], own: dict[str, readings.Reading]) -> list[CheckRow]:

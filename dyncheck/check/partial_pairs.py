@@ -12,9 +12,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from dyncheck.adapters import layout
 from dyncheck.adapters.base import ModelEngine
-from dyncheck.adapters.model_tree import Dynamics, ModelTree
+from dyncheck.adapters.model_tree import Dynamics, ModelTree, canonical
 from dyncheck.check import partial, predicted, readings
 from dyncheck.check.dynamics import QUANTITIES, Prediction, compare
 from dyncheck.check.rows import CheckRow, Section
@@ -72,7 +71,7 @@ def rows(model: str, canonical_tree: ModelTree, *, a: str, b: str, batch: States
         if reading is not None and whole == REFEREE:  # (the referee comes first: a)
             dyn_a, judged_on, vertices = partial.restrict(
                 reading.dynamics, np.arange(len(part.v))), b, 0.0
-            explanations = predicted.differences(layout.canonical(part.tree), part.tree,
+            explanations = predicted.differences(canonical(part.tree), part.tree,
                                                  reading.tree, trees[b], mine, reading.dynamics)
         elif reading is not None and whole in own:
             theirs = _whole_on_part(batch, part, own[whole].tree, reading.tree)

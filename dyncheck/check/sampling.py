@@ -13,8 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dyncheck.adapters.layout import Canonical
-from dyncheck.adapters.model_tree import ModelTree
+from dyncheck.adapters.model_tree import Canonical, ModelTree
 from dyncheck.referee.states import States
 from dyncheck.vocabulary import JointType
 

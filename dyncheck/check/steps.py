@@ -11,8 +11,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from dyncheck.adapters.layout import Canonical
-from dyncheck.adapters.model_tree import JointType, ModelTree, Transition
+from dyncheck.adapters.model_tree import Canonical, JointType, ModelTree, Transition
 from dyncheck.cases.quaternions import dexp_inv, quat_conj, quat_exp, quat_mul
 from dyncheck.check.rows import CheckRow, Section
 from dyncheck.precision import EPS, ROUNDOFF_FACTOR

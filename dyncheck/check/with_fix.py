@@ -11,13 +11,13 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from dyncheck.adapters import layout, layout_batch
+from dyncheck.adapters import layout_batch
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.edits import applied, written
 from dyncheck.adapters.formats.files import ModelFile
 from dyncheck.adapters.formats.includes import inline
-from dyncheck.adapters.model_tree import Dynamics, ModelTree
+from dyncheck.adapters.model_tree import Canonical, Dynamics, ModelTree
 from dyncheck.adapters.registration import Format
 from dyncheck.check import compiled_copy, describe, predicted
 from dyncheck.check.alignment import align_by_body
@@ -53,7 +53,7 @@ def _row(model: str, engine: str, verdict: Verdict, note: str, *, fix: str,
                     tolerance=float("nan"), basis="", verdict=verdict, note=note)
 
 
-def rows(model: str, source: ModelFile, *, canon: layout.Canonical, canonical_tree: ModelTree,
+def rows(model: str, source: ModelFile, *, canon: Canonical, canonical_tree: ModelTree,
          batch: States, referee: Dynamics | None, loaded: dict[str, ModelEngine],
          targets: list[str], start: compiled_copy.Start) -> list[CheckRow]:
     """For each engine of ``targets`` (those reading the file in part or otherwise) that
@@ -95,7 +95,7 @@ def rows(model: str, source: ModelFile, *, canon: layout.Canonical, canonical_tr
     return out
 
 
-def _computed(model: str, engine: str, fix: str, *, canon: layout.Canonical,
+def _computed(model: str, engine: str, fix: str, *, canon: Canonical,
               canonical_tree: ModelTree, tree: ModelTree, fixed: ModelEngine, batch: States,
               referee: Dynamics) -> list[CheckRow]:
     """The engine's dynamics on the copy against the referee on the canonical reading (it

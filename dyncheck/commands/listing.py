@@ -20,7 +20,8 @@ def installed_version(package: str) -> str | None:
 
 def engine_line(name: str) -> str:
     """An engine imported: its version (and device, for a port) and its integrators."""
-    from dyncheck.adapters import ENGINE_PACKAGES, REGISTRY, engine_version, get_engine
+    from dyncheck.adapters import ENGINE_PACKAGES, REGISTRY
+    from dyncheck.adapters.installed import engine_version, get_engine
     from dyncheck.adapters.offers import Offer
     from dyncheck.studies.order import CONTROLLED  # (the studies' package imports sympy)
 

@@ -137,7 +137,8 @@ def not_selected(
 
 def _run(name: str) -> Entry:
     """One demonstration, or a skipped entry naming the engine that is not installed."""
-    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES, RUN, get_engine
+    from dyncheck.adapters import ENGINE_EXTRAS, ENGINE_PACKAGES, RUN
+    from dyncheck.adapters.installed import get_engine
 
     for engine in REQUIRES.get(name, ()):
         try:

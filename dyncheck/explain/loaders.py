@@ -7,7 +7,7 @@ from typing import Any
 
 
 def pin_mjcf(xml: str):
-    from dyncheck.adapters.pinocchio.model import parse_xml
+    from dyncheck.adapters.pinocchio.api import parse_xml
 
     return parse_xml(xml)
 
@@ -19,8 +19,8 @@ def beside_mujoco(mjcf: str, other: Any, states: int) -> tuple[Any, Any, Any, An
     import tempfile
     from pathlib import Path
 
-    from dyncheck.adapters import layout
     from dyncheck.adapters.formats.files import read
+    from dyncheck.adapters.model_tree import canonical
     from dyncheck.adapters.mujoco.model import MujocoModel
     from dyncheck.check.sampling import sample
 
@@ -29,5 +29,5 @@ def beside_mujoco(mjcf: str, other: Any, states: int) -> tuple[Any, Any, Any, An
         path.write_text(mjcf, encoding="utf-8")
         source = read(path)
         mine, theirs = MujocoModel(source), other(source)
-    canon = layout.canonical(mine.tree)
+    canon = canonical(mine.tree)
     return mine, theirs, canon, sample(canon, mine.tree, states, 0)

@@ -14,9 +14,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from dyncheck.adapters.layout import Canonical, StateMap, quat_order
+from dyncheck.adapters.layout import StateMap, quat_order
 from dyncheck.adapters.model_tree import (
     Axes,
+    Canonical,
     DerivativeChart,
     Derivatives,
     Dynamics,

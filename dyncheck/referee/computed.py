@@ -12,14 +12,15 @@ from typing import Any
 
 import numpy as np
 
-from dyncheck.adapters.layout import Canonical, canonical
 from dyncheck.adapters.model_tree import (
+    Canonical,
     Dynamics,
     JointType,
     Layout,
     ModelTree,
     StateLayout,
     TreeJoint,
+    canonical,
 )
 from dyncheck.reference.tree import Body, TreeDynamics
 

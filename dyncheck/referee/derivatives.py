@@ -25,7 +25,7 @@ from dyncheck.referee.states import States
 from dyncheck.referee.tree import TIE_STATES, ReferenceModel, Tie, tie
 
 if TYPE_CHECKING:
-    from dyncheck.adapters.layout import Canonical
+    from dyncheck.adapters.model_tree import Canonical
     from dyncheck.reference.recursive import RecursiveDynamics
 
 STEP = 4e-3
@@ -99,7 +99,7 @@ def referee(tree: ModelTree, states: States, *, bounds: bool = True,
     v). Where ``bounds`` is false (an RK4 stage's referee) only what a step's chain rule
     needs is computed: the forward derivatives (the inverse ones at v̇ = a, the bounds and
     their error estimates are zero), and the tie is ``tied``, the step's own referee's."""
-    from dyncheck.adapters.layout import canonical
+    from dyncheck.adapters.model_tree import canonical
 
     canon = canonical(tree)
     model = ReferenceModel(tree)

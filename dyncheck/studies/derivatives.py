@@ -18,9 +18,10 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from dyncheck import coordinates as co
-from dyncheck.adapters import MODELS, RUN, get_engine
+from dyncheck.adapters import MODELS, RUN
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.formats.mjcf import to_mjcf
+from dyncheck.adapters.installed import get_engine
 from dyncheck.cases.base import Case
 from dyncheck.coordinates import NativeMap
 from dyncheck.errors import EngineNotInstalled
@@ -52,8 +53,8 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int, *,
     (:data:`~dyncheck.adapters.MODELS`) and the referee (where ``reference`` is named).
     ``reuse``: engines already loaded from the case's MJCF as read (name → engine, the run's:
     :func:`~dyncheck.implementations.engines_as_read`), used instead of loading it again."""
-    from dyncheck.adapters import layout
     from dyncheck.adapters.formats.files import read
+    from dyncheck.adapters.model_tree import canonical as canonical_order
     from dyncheck.check import derivatives, engines
     from dyncheck.check.alignment import align_by_body
     from dyncheck.referee.states import States
@@ -97,7 +98,7 @@ def derivative_rows(case: Case, impl_names: Sequence[str], states: int, *,
             else:
                 loaded[name] = engine
     tree = canonical.tree
-    canon = layout.canonical(tree)
+    canon = canonical_order(tree)
     for name, engine in loaded.items():  # Drake names a <freejoint> after its body, Pinocchio
         loaded[name] = copy.copy(engine)  # (the aligned tree on a copy: a reused engine's
         loaded[name].tree = align_by_body(tree, engine.tree)[0]  # own stays its own)

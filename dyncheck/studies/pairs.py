@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from dyncheck.adapters import get_engine
+from dyncheck.adapters.installed import get_engine
 from dyncheck.case_engine import CaseEngine
 from dyncheck.cases.base import NOMINAL_ORDER, Case
 from dyncheck.comparison import soft_factor

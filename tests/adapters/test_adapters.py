@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from dyncheck import adapters
-from dyncheck.adapters import REGISTRY, engine_version, get_engine
+from dyncheck.adapters import REGISTRY, installed
 from dyncheck.adapters.formats.mjcf import to_mjcf
+from dyncheck.adapters.installed import engine_version, get_engine
 from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import get_case
 from dyncheck.errors import UnknownName
@@ -229,7 +229,7 @@ def test_unknown_engine_lists_valid_names():
 
 @pytest.mark.slow  # imports every engine, JAX and Warp included (~4 s)
 def test_every_engine_is_installed_here():
-    assert sorted(adapters.ENGINES) == ALL_ENGINES
+    assert sorted(installed.ENGINES) == ALL_ENGINES
 
 
 @pytest.mark.slow  # CI's guard that every extra is installed: the README's first test

@@ -163,9 +163,9 @@ def test_engine_states_map_back_to_the_canonical_ones(free, ball):
     canonical one."""
     from dataclasses import replace
 
-    from dyncheck.adapters.layout import Canonical, state_map
+    from dyncheck.adapters.layout import state_map
     from dyncheck.adapters.layout_batch import canonical_states
-    from dyncheck.adapters.model_tree import JointType, ModelTree
+    from dyncheck.adapters.model_tree import Canonical, JointType, ModelTree
 
     free = replace(free, q_start=0, v_start=0, placement=PLACEMENT)
     ball = replace(ball, q_start=free.nq, v_start=6)
@@ -203,8 +203,8 @@ def test_a_quaternion_normalized_by_the_engine_comes_back_as_it_gave_it(dtype):
     |‖q‖ − 1| of a few ε of ``dtype`` (its round-off, which a float32 port's rows must carry:
     the bit pattern is unchanged); one drifted by 1e-6 (Drake's components integrated) comes
     back with norm 1 to float64 round-off."""
-    from dyncheck.adapters.layout import Canonical, canonical_positions
-    from dyncheck.adapters.model_tree import JointType, ModelTree
+    from dyncheck.adapters.layout import canonical_positions
+    from dyncheck.adapters.model_tree import Canonical, JointType, ModelTree
 
     ball = Layout.ball(quat=Orientation.WXYZ, angular_axes=Axes.LOCAL)
     tree = ModelTree(engine="toy", joints=(_joint("wrist", "ball", ball),), gravity=np.zeros(3),

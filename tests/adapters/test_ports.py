@@ -12,7 +12,7 @@ from functools import cache
 import numpy as np
 import pytest
 
-from dyncheck import adapters
+from dyncheck.adapters import installed
 from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import get_case
 from dyncheck.comparison import compare_instantaneous
@@ -166,7 +166,7 @@ def test_declared_rk4_definitions_match_the_measured_orders(full_run, case_name)
 
 def test_ports_are_registered_with_their_extras():
     for port in PORTS:
-        assert port in adapters.ENGINES, adapters.MISSING.get(port)
+        assert port in installed.ENGINES, installed.MISSING.get(port)
 
 
 @pytest.mark.parametrize("case_name", ["cylindrical_coordinates", "rigid_body_free"])

@@ -107,8 +107,9 @@ def test_an_engines_chart_is_mapped_into_mujocos(tmp_path):
     import numpy as np
     import pinocchio as pin
 
-    from dyncheck.adapters import layout, layout_batch
+    from dyncheck.adapters import layout_batch
     from dyncheck.adapters.formats.files import read
+    from dyncheck.adapters.model_tree import canonical
     from dyncheck.check import closure_derivatives as cd
     from dyncheck.check import closures as checked
     from dyncheck.check.closure_rows import in_canonical
@@ -118,7 +119,7 @@ def test_an_engines_chart_is_mapped_into_mujocos(tmp_path):
     path = tmp_path / "floating.xml"
     path.write_text(FLOATING_FOUR_BAR)
     mj, pe = loader("mujoco")(read(path)), loader("pinocchio")(read(path))
-    canon = layout.canonical(mj.tree)
+    canon = canonical(mj.tree)
     tree = canonical_reading(canon, pe.tree)
     q, v = _draws(mj, seed=2)
     states = checked.on_constraints(tree, q, v, reach=1.0)

@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 
 from dyncheck import adapters
-from dyncheck.adapters import layout
 from dyncheck.adapters.formats.files import read
+from dyncheck.adapters.model_tree import canonical as canonical_order
 from dyncheck.adapters.offers import Offer
 from dyncheck.check import closure_readings
 from dyncheck.check import closures as checked
@@ -125,7 +125,7 @@ def _draws(canonical, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
 def _measured(model, canonical, **change):
     """The engine measured at the draws moved onto its reading of the closures (put in the
     canonical layout; its first closure changed by ``change`` where given)."""
-    canon = layout.canonical(canonical.tree)
+    canon = canonical_order(canonical.tree)
     tree = canonical_reading(canon, model.tree)
     if change:
         tree = replace(tree, closures=(replace(tree.closures[0], **change), *tree.closures[1:]))

@@ -67,14 +67,15 @@ def test_the_pendulum_derivatives_are_the_books_closed_form(tmp_path):
     m, length, g = 1.3, 0.7, 9.81
     path = tmp_path / "pendulum.urdf"
     path.write_text(PENDULUM.format(m=m, l=length))
-    from dyncheck.adapters import layout, layout_batch
+    from dyncheck.adapters import layout_batch
     from dyncheck.adapters.formats.files import read
+    from dyncheck.adapters.model_tree import canonical
     from dyncheck.adapters.pinocchio.model import PinocchioModel
     from dyncheck.check.sampling import sample
     from dyncheck.referee import charts, derivatives
 
     model = PinocchioModel(read(path))
-    canon = layout.canonical(model.tree)
+    canon = canonical(model.tree)
     states = sample(canon, model.tree, 10, 0)
     theta = states.q[:, 0]
     ref = derivatives.referee(model.tree, states).derivatives

@@ -70,22 +70,22 @@ def test_two_partial_readings_with_no_joint_in_common_are_one_skipped_row(model)
     construction (the first tree's joints, the second's)."""
     from dataclasses import replace
 
-    from dyncheck.adapters import layout
     from dyncheck.adapters.formats.files import read
+    from dyncheck.adapters.model_tree import canonical
     from dyncheck.adapters.mujoco.model import MujocoModel
     from dyncheck.check import partial
     from dyncheck.check.sampling import sample
     from dyncheck.vocabulary import Verdict
 
-    canonical = MujocoModel(read(model)).tree
-    first = replace(canonical, joints=tuple(j for j in canonical.joints if j.name != "h"))
-    second = replace(canonical, joints=tuple(j for j in canonical.joints if j.name == "h"))
-    parts = {"x": partial.common_part(canonical, first),
-             "y": partial.common_part(canonical, second)}
+    whole = MujocoModel(read(model)).tree
+    first = replace(whole, joints=tuple(j for j in whole.joints if j.name != "h"))
+    second = replace(whole, joints=tuple(j for j in whole.joints if j.name == "h"))
+    parts = {"x": partial.common_part(whole, first),
+             "y": partial.common_part(whole, second)}
     assert all(p is not None and len(p.v) for p in parts.values())
     found = partial_pairs.rows(
-        "two_trees", canonical, a="x", b="y",
-        batch=sample(layout.canonical(canonical), canonical, 5, 0), results={}, trees={},
+        "two_trees", whole, a="x", b="y",
+        batch=sample(canonical(whole), whole, 5, 0), results={}, trees={},
         parts=parts, loaded={}, own={}, differing={}, eps=2.2e-16, vertices=0.0,
         standing=1.0)
     assert [r.verdict for r in found] == [Verdict.SKIPPED]

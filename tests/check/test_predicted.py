@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from dyncheck.adapters import layout
 from dyncheck.adapters.formats.files import read
+from dyncheck.adapters.model_tree import canonical
 from dyncheck.check.dynamics import Prediction, _candidates
 from dyncheck.check.engines import load
 from dyncheck.check.predicted import rotor_energy
@@ -31,7 +31,7 @@ def test_the_rotor_energy_is_the_signed_difference_b_minus_a(tmp_path: Path):
     counts = load("mujoco", read(path)).tree
     leaves = replace(counts, engine="other", joints=tuple(
         replace(j, rotor_in_kinetic=False) for j in counts.joints))
-    canon = layout.canonical(counts)
+    canon = canonical(counts)
     v = np.array([[1.0, 2.0], [-3.0, 0.5]])
     by_hand = 0.5 * (0.05 * v[:, 0] ** 2 + 0.2 * v[:, 1] ** 2)
     found = rotor_energy(canon, counts, counts, leaves, v)

@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dyncheck.adapters import layout
 from dyncheck.adapters.formats.files import read
+from dyncheck.adapters.model_tree import canonical
 from dyncheck.check.engines import load
 from dyncheck.check.model_check import check_model
 from dyncheck.check.sampling import sample
@@ -29,7 +29,7 @@ def test_states_lie_in_their_ranges_on_the_rotation_group_and_repeat(tmp_path):
     path = tmp_path / "ranged.xml"
     path.write_text(RANGED)
     tree = load("mujoco", read(path)).tree
-    canon = layout.canonical(tree)
+    canon = canonical(tree)
     states = sample(canon, tree, 200, 7)
     hinge = states.q[:, canon.q_start[canon.names.index("hinge")]]
     assert hinge.min() >= -0.5 and hinge.max() <= 0.25 and np.ptp(hinge) > 0.5

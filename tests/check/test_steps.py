@@ -150,7 +150,7 @@ def test_the_rk4_chain_rule_on_rotations_is_the_derivative_of_the_step_itself():
     steps 1e-4 and 5e-5, in the canonical chart): they agree to 1e-7 — and leaving dexp⁻¹'s
     derivatives out (D = 1, E = 0) is off by far more, so the test sees them."""
     from dyncheck.adapters.formats.files import read
-    from dyncheck.adapters.layout import canonical
+    from dyncheck.adapters.model_tree import canonical
     from dyncheck.check.engines import load
     from dyncheck.check.sampling import sample
     from dyncheck.check.steps import rk4_stages, rk4_step

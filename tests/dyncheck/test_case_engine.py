@@ -10,7 +10,8 @@ from functools import partial
 import numpy as np
 import pytest
 
-from dyncheck.adapters import REGISTRY, get_engine
+from dyncheck.adapters import REGISTRY
+from dyncheck.adapters.installed import get_engine
 from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import get_case
 from dyncheck.errors import EngineNotInstalled, Unsupported

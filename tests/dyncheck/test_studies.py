@@ -268,7 +268,7 @@ def test_declared_rk4_order_on_the_rotation_group_is_checked(monkeypatch):
     """An adapter's declared RK4 order on ball and free joints is a prediction, not an
     excuse: MuJoCo 4.0's RK4 is order 4 there (RKMK), so declaring the 3.x order 2 makes its
     rows fail (observed 4, predicted 2) instead of passing or being explained."""
-    from dyncheck.adapters import get_engine
+    from dyncheck.adapters.installed import get_engine
     from dyncheck.implementations import make_implementation
     from dyncheck.studies import study
 

@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 pytest.importorskip("newton", reason="needs the 'newton' extra")
-from dyncheck.adapters import layout, layout_batch
+from dyncheck.adapters import layout_batch
 from dyncheck.adapters.formats.files import read
+from dyncheck.adapters.model_tree import canonical
 from dyncheck.adapters.newton import closures as newton_closures
 from dyncheck.adapters.newton.model import NewtonModel, _pose
 from dyncheck.check import closure_readings
@@ -74,7 +75,7 @@ def test_newtons_rows_and_their_rate_are_the_referees(name, tmp_path):
     reach, J̇ v within 64 ε₃₂ of |v|² reach (the weld's box turns about its moving centre:
     without that term, tried, the weld fails; without Ṡ, the four-bar and the ball loop)."""
     newton, mujoco, _ = _both(tmp_path, name)
-    canon = layout.canonical(mujoco.tree)
+    canon = canonical(mujoco.tree)
     q, v = _draws(mujoco, seed=5)
     states = checked.on_constraints(mujoco.tree, q, v, reach=1.0)
     maps, q_e, v_e, _ = layout_batch.engine_states(canon, newton.tree, states.q, states.v,

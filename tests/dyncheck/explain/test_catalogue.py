@@ -230,7 +230,7 @@ def test_an_entry_records_the_engines_it_uses_not_those_its_process_loaded():
     process held, a run without Drake that read the first entry back named Drake.)"""
     from importlib.metadata import version
 
-    from dyncheck.adapters import get_engine
+    from dyncheck.adapters.installed import get_engine
 
     get_engine("drake")  # loaded here, as a catalogue run in one process loads it
     _, used = catalogue.measure("hinge-axis-sign")
