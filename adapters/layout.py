@@ -43,7 +43,7 @@ result back):
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,14 +51,15 @@ import numpy as np
 from dyncheck.adapters.model_tree import (
     Axes,
     Canonical,
+    Dynamics,
     JointType,
     Layout,
     ModelTree,
     Orientation,
     TreeJoint,
 )
-from dyncheck.cases.coordinate_maps import EulerAngleMap, quat_from_matrix, quat_to_matrix
-from dyncheck.cases.quaternions import quat_conj, quat_mul
+from dyncheck.cases.coordinate_maps import quat_from_matrix, quat_to_matrix
+from dyncheck.cases.quaternions import quat_conj, quat_mul, quat_of_rpy, quat_order, unit
 
 IDENTITY = np.eye(4)
 
@@ -89,12 +90,6 @@ def _asin(z: complex) -> complex:
     if not np.iscomplexobj(z):
         return angle
     return angle + 1j * np.imag(z) / np.sqrt(max(1.0 - zr * zr, 1e-300))
-
-
-def quat_order(quat: Orientation) -> list[int]:
-    """Where an engine's quaternion components come from in (w, x, y, z): q_engine =
-    q_wxyz[..., quat_order(quat)], and back through its ``np.argsort``."""
-    return ["wxyz".index(c) for c in str(quat)]
 
 
 @dataclass(frozen=True)
@@ -209,7 +204,7 @@ def canonical_positions(canon: Canonical, tree: ModelTree, q_e: np.ndarray) -> n
     """Engine positions (n, tree.nq) back to canonical ones: :func:`state_map` inverted joint
     by joint (a free joint's placement and offset undone, a quaternion renormalized where its
     norm drifted beyond the rounding of the engine's arithmetic, ``tree.eps``:
-    :func:`_unit`)."""
+    :func:`~dyncheck.cases.quaternions.unit`)."""
     joints = [tree.joint(name) for name in canon.names]
     q_c = np.zeros((len(q_e), canon.nq))
     for joint, kind, qs, zero in zip(joints, canon.types, canon.q_start, canon.zeros,
@@ -220,8 +215,8 @@ def canonical_positions(canon: Canonical, tree: ModelTree, q_e: np.ndarray) -> n
             value = np.arctan2(chunk[:, 1], chunk[:, 0]) if lay.cos_sin else chunk[:, 0]
             q_c[:, qs] = value - lay.zero + zero
         elif kind is JointType.BALL:
-            q_c[:, qs : qs + 4] = _quat_of_rpy(chunk) if lay.quat is Orientation.RPY else \
-                _unit(chunk[:, np.argsort(quat_order(lay.quat))], tree.eps)
+            q_c[:, qs : qs + 4] = quat_of_rpy(chunk) if lay.quat is Orientation.RPY else \
+                unit(chunk[:, np.argsort(quat_order(lay.quat))], tree.eps)
         else:
             q_c[:, qs : qs + 7] = _free_back(lay, chunk, tree.eps)
     return q_c
@@ -232,7 +227,7 @@ def _free_back(lay: Layout, q_e: np.ndarray, eps: float = 0.0) -> np.ndarray:
     (:func:`_free` inverted: quat_e = P⁻¹ ⊗ quat ⊗ q(R_o), p_e = P_r⁻¹ (p + R o − P_p)),
     every state at once: the placement's and offset's quaternions are the joint's."""
     quat_e, p_e = (q_e[:, :4], q_e[:, 4:]) if lay.quat_first else (q_e[:, 3:], q_e[:, :3])
-    quat_e = _unit(quat_e[:, np.argsort(quat_order(lay.quat))], eps)
+    quat_e = unit(quat_e[:, np.argsort(quat_order(lay.quat))], eps)
     place_r, place_p = lay.placement[:3, :3], lay.placement[:3, 3]
     turned = quat_mul(quat_from_matrix(place_r[None])[0][:, None], quat_e.T)
     undo = quat_conj(quat_from_matrix(lay.offset[None, :3, :3])[0])[:, None]
@@ -243,178 +238,144 @@ def _free_back(lay: Layout, q_e: np.ndarray, eps: float = 0.0) -> np.ndarray:
     return np.concatenate([p_w, quat_w], axis=1)
 
 
-# Batched maps for the run's cases: canonical states (n, nq) and (n, nv) in the canonical
-# joint order, to and from an engine whose joints are laid out one after another
-# (:meth:`~dyncheck.adapters.model_tree.StateLayout.joints`). The same conventions as
-# :func:`state_map`, for many states at once (a trajectory's), without the check's
-# placements and offsets (a case's free body is its own frame, placed at the origin).
-
-
-def _rotating(kinds: Sequence[JointType]) -> bool:
-    return any(JointType(k).rotating for k in kinds)
-
-
-def _rpy_of(rot: np.ndarray) -> np.ndarray:
-    """(roll, pitch, yaw) with R = R_z(yaw) R_y(pitch) R_x(roll), batched (real: the run's
-    states; :func:`rpy_from_matrix` takes one state, complex-stepped or not)."""
-    return np.stack(
-        [
-            np.arctan2(rot[:, 2, 1], rot[:, 2, 2]),
-            np.arcsin(np.clip(-rot[:, 2, 0], -1.0, 1.0)),
-            np.arctan2(rot[:, 1, 0], rot[:, 0, 0]),
-        ],
-        -1,
-    )
-
-
-def _quat_of_rpy(rpy: np.ndarray) -> np.ndarray:
-    """Unit quaternion (w, x, y, z) of R_z(y) R_y(p) R_x(r), batched."""
-    r, p, y = (rpy[:, i] / 2 for i in range(3))
-    cr, sr, cp, sp_, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
-    return np.stack(
-        [
-            cr * cp * cy + sr * sp_ * sy,
-            sr * cp * cy - cr * sp_ * sy,
-            cr * sp_ * cy + sr * cp * sy,
-            cr * cp * sy - sr * sp_ * cy,
-        ],
-        -1,
-    )
-
-
-UNIT_ROUNDING = 8
-"""|‖q‖ − 1| of a quaternion an engine normalized in its own arithmetic is at most a few ε
-(its norm's four products, three sums and square root, then the division): within this many
-of its ε it is left as the engine gave it."""
-
-
-def _unit(quat: np.ndarray, eps: float = 0.0) -> np.ndarray:
-    """Engines that integrate quaternion components (Drake) let the norm drift: renormalize
-    where it drifted beyond :data:`UNIT_ROUNDING` ε of the engine's arithmetic (``eps``; 0:
-    always). A quaternion the engine normalized is its own: a float32 port's, whose norm is
-    1 to ε₃₂, carries its round-off into the comparison as the engine computed it."""
-    norm = np.linalg.norm(quat, axis=-1, keepdims=True)
-    return np.where(np.abs(norm - 1.0) <= UNIT_ROUNDING * eps, quat, quat / norm)
-
-
-def to_engine(layouts: Sequence[Layout], kinds: Sequence[JointType],
-              q_c: np.ndarray) -> np.ndarray:
-    """Canonical positions (quaternions (w, x, y, z); a free joint's position first) to the
-    engine's (each joint's orientation and order as its layout says), batched."""
-    if not _rotating(kinds):
-        return q_c
-    cols, i = [], 0
-    for lay, kind in zip(layouts, map(JointType, kinds), strict=True):
-        chunk = q_c[:, i : i + kind.nq]
-        if kind is JointType.BALL:
-            if lay.quat is Orientation.RPY:
-                cols.append(_rpy_of(quat_to_matrix(chunk)))
-            elif lay.quat is Orientation.EULER:
-                cols.append(EulerAngleMap().to_book(chunk))
+def batch_map(canon: Canonical, tree: ModelTree, q_c: np.ndarray,
+               v_c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_state_map` for every state at once (real states): q_e (n, nq_e), T (n, nv_e,
+    nv), Ṫ v (n, nv_e) — the same formulas, batched (tests/check/test_layout.py holds the two
+    equal)."""
+    n = len(q_c)
+    q_e = np.zeros((n, tree.nq))
+    t = np.zeros((n, tree.nv, canon.nv))
+    tdot_v = np.zeros((n, tree.nv))
+    for name, kind, qs, vs, zero in zip(canon.names, canon.types, canon.q_start, canon.v_start,
+                                        canon.zeros, strict=True):
+        joint = tree.joint(name)
+        lay = joint.layout
+        qe, ve = lay.q_start, lay.v_start
+        if kind in (JointType.HINGE, JointType.SLIDE):
+            value = q_c[:, qs] - zero + lay.zero
+            if lay.cos_sin:
+                q_e[:, qe], q_e[:, qe + 1] = np.cos(value), np.sin(value)
             else:
-                cols.append(chunk[:, quat_order(lay.quat)])
-        elif kind is JointType.FREE and lay.quat is Orientation.EULER:
-            cols.extend([chunk[:, :3], EulerAngleMap().to_book(chunk[:, 3:])])
-        elif kind is JointType.FREE:
-            quat = chunk[:, 3:][:, quat_order(lay.quat)]
-            cols.extend([quat, chunk[:, :3]] if lay.quat_first else [chunk[:, :3], quat])
-        else:
-            cols.append(chunk)
-        i += kind.nq
-    return np.concatenate(cols, -1)
-
-
-def from_engine(layouts: Sequence[Layout], kinds: Sequence[JointType],
-                q_e: np.ndarray) -> np.ndarray:
-    """The engine's positions back to canonical ones (:func:`to_engine` inverted), batched;
-    quaternions renormalized."""
-    if not _rotating(kinds):
-        return q_e
-    cols = []
-    for lay, kind in zip(layouts, map(JointType, kinds), strict=True):
-        chunk = q_e[:, lay.q_start : lay.q_start + lay.nq]
-        if kind is JointType.BALL and lay.quat is Orientation.RPY:
-            cols.append(_quat_of_rpy(chunk))
-        elif kind.rotating and lay.quat is Orientation.EULER:
-            if kind is JointType.FREE:
-                cols.append(chunk[:, :3])
-            cols.append(EulerAngleMap().to_engine(chunk[:, -3:]))
+                q_e[:, qe] = value
+            t[:, ve, vs] = 1.0
         elif kind is JointType.BALL:
-            cols.append(_unit(chunk[:, np.argsort(quat_order(lay.quat))]))
-        elif kind is JointType.FREE:
-            quat, pos = (chunk[:, :4], chunk[:, 4:]) if lay.quat_first else \
-                (chunk[:, 3:], chunk[:, :3])
-            cols.extend([pos, _unit(quat[:, np.argsort(quat_order(lay.quat))])])
-        else:
-            cols.append(chunk)
-    return np.concatenate(cols, -1)
-
-
-def _canonical_velocities(lay: Layout, kind: JointType) -> bool:
-    if kind is JointType.BALL:
-        return lay.angular_axes is Axes.LOCAL
-    if kind is JointType.FREE:
-        return lay.linear_axes is Axes.WORLD and lay.angular_axes is Axes.LOCAL \
-            and not lay.angular_first
-    return True
-
-
-def velocity_frames(layouts: Sequence[Layout], kinds: Sequence[JointType],
-                    q_c: np.ndarray) -> np.ndarray | None:
-    """T(q) with v_engine = T v_canonical (canonical states, batched (n, nv, nv)), or None
-    where every joint's velocities are the canonical ones: a ball joint's ω in world or parent
-    axes (T = R), a free joint's linear velocity in body axes (Rᵀ) or its ω in world axes (R),
-    an Euler chart's angle rates (J⁻¹, exercise 23 inverted)."""
-    kinds = [JointType(k) for k in kinds]
-    if all(_canonical_velocities(lay, k) for lay, k in zip(layouts, kinds, strict=True)):
-        return None
-    nv = sum(k.nv for k in kinds)
-    t = np.broadcast_to(np.eye(nv), (q_c.shape[0], nv, nv)).copy()
-    i = k = 0
-    for lay, kind in zip(layouts, kinds, strict=True):
-        if kind.rotating and lay.angular_axes is Axes.RATES:
-            a, b = (i + 3, k + 3) if kind is JointType.FREE else (i, k)
-            angles = EulerAngleMap().to_book(q_c[:, a : a + 4])
-            t[:, b : b + 3, b : b + 3] = np.linalg.inv(EulerAngleMap().jacobian(angles))
-        elif kind is JointType.BALL and lay.angular_axes in (Axes.WORLD, Axes.PARENT):
-            t[:, k : k + 3, k : k + 3] = quat_to_matrix(q_c[:, i : i + 4])
-        elif kind is JointType.FREE:
-            rot = quat_to_matrix(q_c[:, i + 3 : i + 7])
-            lin = np.swapaxes(rot, -1, -2) if lay.linear_axes is Axes.LOCAL else \
-                np.broadcast_to(np.eye(3), rot.shape)
-            ang = rot if lay.angular_axes is Axes.WORLD else np.broadcast_to(np.eye(3), rot.shape)
-            t[:, k : k + 6, k : k + 6] = 0.0
-            if lay.angular_first:
-                t[:, k : k + 3, k + 3 : k + 6] = ang
-                t[:, k + 3 : k + 6, k : k + 3] = lin
+            rot = quat_to_matrix(q_c[:, qs : qs + 4])
+            if lay.quat == Orientation.RPY:
+                q_e[:, qe : qe + 3] = rpy_batch(rot)
             else:
-                t[:, k : k + 3, k : k + 3] = lin
-                t[:, k + 3 : k + 6, k + 3 : k + 6] = ang
-        i += kind.nq
-        k += kind.nv
-    return t
+                q_e[:, qe : qe + 4] = q_c[:, qs : qs + 4][:, quat_order(lay.quat)]
+            t[:, ve : ve + 3, vs : vs + 3] = rot if lay.angular_axes is Axes.PARENT \
+                else np.eye(3)
+        else:
+            place = quat_from_matrix(lay.placement[:3, :3].T[None])[0]
+            q_e[:, qe : qe + 7], t[:, ve : ve + 6, vs : vs + 6], tdot_v[:, ve : ve + 6] = \
+                free_batch(lay, place, q_c[:, qs : qs + 7], v_c[:, vs : vs + 6])
+    return q_e, t, tdot_v
 
 
-def velocity_frame_rates(layouts: Sequence[Layout], kinds: Sequence[JointType],
-                         q_c: np.ndarray, v_c: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Ṫ v for canonical states and velocities, given T = :func:`velocity_frames` there:
-    (−ω × Rᵀ v_w, 0) for a free joint whose linear velocity is in body axes; R ω̄ in world
-    axes has Ṙ ω̄ = R (ω̄ × ω̄) = 0; an Euler chart's −J⁻¹ J̇ q̇ (the chart's own (2.2.5)
-    term, d/dt (J⁻¹ ω̄) with q̇ = J⁻¹ ω̄)."""
-    out = np.zeros_like(v_c)
-    i = k = 0
-    for lay, kind in zip(layouts, map(JointType, kinds), strict=True):
-        if kind.rotating and lay.angular_axes is Axes.RATES:
-            a, b = (i + 3, k + 3) if kind is JointType.FREE else (i, k)
-            angles = EulerAngleMap().to_book(q_c[:, a : a + 4])
-            tb = t[:, b : b + 3, b : b + 3]
-            qdot = np.einsum("nij,nj->ni", tb, v_c[:, b : b + 3])
-            out[:, b : b + 3] = -np.einsum(
-                "nij,nj->ni", tb, EulerAngleMap().hessian_term(angles, qdot))
-        elif kind is JointType.FREE and lay.linear_axes is Axes.LOCAL:
-            rot = quat_to_matrix(q_c[:, i + 3 : i + 7])
-            vb = np.einsum("nji,nj->ni", rot, v_c[:, k : k + 3])
-            out[:, k : k + 3] = -np.cross(v_c[:, k + 3 : k + 6], vb)
-        i += kind.nq
-        k += kind.nv
-    return out
+def back(t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """T⁻¹ x at each state (T: (n, engine nv, canonical nv)); where the engine holds
+    velocity coordinates beyond the canonical ones (Newton's loop joints, #78: constraints
+    with coordinates of their own, which T never reaches), T's left inverse T⁺, exact for
+    the x an engine gives there (zero on those coordinates)."""
+    if t.shape[-1] == t.shape[-2]:
+        return np.linalg.solve(t, x[..., None])[..., 0]
+    return (np.linalg.pinv(t) @ x[..., None])[..., 0]
+
+
+def canonical_states(canon: Canonical, tree: ModelTree, q_e: np.ndarray,
+                     v_e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Engine states (n, tree.nq), (n, tree.nv) back to canonical ones: the positions by
+    :func:`~.layout.canonical_positions`, and v_c = T⁻¹ v_e with T at the canonical q found,
+    every state at once (:func:`batch_map`)."""
+    q_c = canonical_positions(canon, tree, q_e)
+    if not len(q_c):
+        return q_c, np.zeros((0, canon.nv))
+    _, t, _ = batch_map(canon, tree, q_c, np.zeros((len(q_c), canon.nv)))
+    return q_c, back(t, np.asarray(v_e, float))
+
+
+def rpy_batch(rot: np.ndarray) -> np.ndarray:
+    """:func:`rpy_from_matrix` for every state at once (real)."""
+    pitch = np.arcsin(np.clip(-rot[:, 2, 0], -1.0, 1.0))
+    locked = np.abs(rot[:, 2, 0]) > 1 - 1e-12
+    roll = np.where(locked, 0.0, np.arctan2(rot[:, 2, 1], rot[:, 2, 2]))
+    yaw = np.where(locked, np.arctan2(-rot[:, 0, 1], rot[:, 1, 1]),
+                   np.arctan2(rot[:, 1, 0], rot[:, 0, 0]))
+    return np.stack([roll, pitch, yaw], -1)
+
+
+def free_batch(lay: Layout, place_quat: np.ndarray, q_c: np.ndarray,
+                v_c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_free` for every state at once (real): the same formulas, each state's row."""
+    n = len(q_c)
+    p_w, quat_w = q_c[:, :3], q_c[:, 3:7]
+    rot = quat_to_matrix(quat_w)
+    r_o = lay.offset[:3, :3]
+    offset = not np.array_equal(lay.offset, IDENTITY)
+    place_r, place_p = lay.placement[:3, :3], lay.placement[:3, 3]
+    origin = p_w + rot @ lay.offset[:3, 3] if offset else p_w
+    p_e = (origin - place_p) @ place_r  # place_rᵀ x, row by row
+    p_o = lay.offset[:3, 3] if lay.point is None else np.asarray(lay.point, float)
+    turned = quat_mul(quat_w.T, quat_from_matrix(r_o[None])[0]).T if offset else quat_w
+    quat_e = quat_mul(place_quat, turned.T).T[:, quat_order(lay.quat)]
+    q_e = np.concatenate([quat_e, p_e] if lay.quat_first else [p_e, quat_e], axis=1)
+    t = np.zeros((n, 6, 6))
+    tdot_v = np.zeros((n, 6))
+    lin = slice(3, 6) if lay.angular_first else slice(0, 3)
+    ang = slice(0, 3) if lay.angular_first else slice(3, 6)
+    omega = v_c[:, 3:6]
+    cross_p = np.array([[0.0, -p_o[2], p_o[1]], [p_o[2], 0.0, -p_o[0]], [-p_o[1], p_o[0], 0.0]])
+    centripetal = np.cross(omega, np.cross(omega, p_o))
+    if lay.linear_axes is Axes.LOCAL:
+        r_e = rot @ r_o
+        t[:, lin, 0:3] = np.swapaxes(r_e, 1, 2)
+        t[:, lin, 3:6] = -r_o.T @ cross_p
+        linear = np.einsum("nij,nj->ni", t[:, lin, :], v_c)
+        tdot_v[:, lin] = centripetal @ r_o - np.cross(omega @ r_o, linear)
+    else:
+        t[:, lin, 0:3] = np.eye(3)
+        t[:, lin, 3:6] = -rot @ cross_p
+        tdot_v[:, lin] = np.einsum("nij,nj->ni", rot, centripetal)
+    t[:, ang, 3:6] = rot if lay.angular_axes is Axes.WORLD else r_o.T
+    return q_e, t, tdot_v
+
+
+def engine_states(
+    canon: Canonical, tree: ModelTree, q: np.ndarray, v: np.ndarray, a: np.ndarray
+) -> tuple[list[StateMap], np.ndarray, np.ndarray, np.ndarray]:
+    """The batch in the engine's layout: maps, q_e, v_e, a_e (real states: every state at
+    once, :func:`batch_map`; complex-stepped: one at a
+    time, :func:`~dyncheck.adapters.layout.mapper`)."""
+    if np.iscomplexobj(q) or np.iscomplexobj(v) or not len(q):
+        one = mapper(canon, tree)
+        maps = [one(qi, vi) for qi, vi in zip(q, v, strict=True)]
+        q_e = np.array([s.q for s in maps])
+        v_e = np.array([s.t @ vi for s, vi in zip(maps, v, strict=True)])
+        a_e = np.array([s.t @ ai + s.tdot_v for s, ai in zip(maps, a, strict=True)])
+        return maps, q_e, v_e, a_e
+    q_e, t, tdot_v = batch_map(canon, tree, np.asarray(q, float), np.asarray(v, float))
+    maps = [StateMap(q=qi, t=ti, tdot_v=di) for qi, ti, di in zip(q_e, t, tdot_v, strict=True)]
+    v_e = (t @ np.asarray(v, float)[..., None])[..., 0]
+    a_e = (t @ np.asarray(a, float)[..., None])[..., 0] + tdot_v
+    return maps, q_e, v_e, a_e
+
+
+def to_canonical(maps: list[StateMap], dyn: Dynamics) -> Dynamics:
+    """An engine's dynamics in the canonical layout (see the module's docstring)."""
+    if not maps:
+        return dyn
+    t = np.array([s.t for s in maps])
+    tdot_v = np.array([s.tdot_v for s in maps])
+    m_e = np.asarray(dyn.mass_matrix)
+    # v_e = T v: accelerations map back by T⁻¹ (T is not orthogonal where a free joint's
+    # velocity is that of an offset point); forces, duals, by Tᵀ
+    t_t = np.swapaxes(t, 1, 2)
+    return Dynamics(
+        mass_matrix=t_t @ m_e @ t,
+        bias=(t_t @ (dyn.bias + (m_e @ tdot_v[..., None])[..., 0])[..., None])[..., 0],
+        forward=back(t, dyn.forward - tdot_v),
+        inverse=(t_t @ np.asarray(dyn.inverse)[..., None])[..., 0],
+        kinetic=dyn.kinetic, potential=dyn.potential, unavailable=dyn.unavailable,
+    )

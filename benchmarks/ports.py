@@ -55,7 +55,7 @@ def main() -> None:
 
     jax.config.update("jax_enable_compilation_cache", False)
     from dyncheck.adapters import ENGINE_PORTS
-    from dyncheck.adapters.installed import ENGINES, engine_version
+    from dyncheck.adapters.installed import ENGINES, engine_version, get_engine
     from dyncheck.case_engine import CaseEngine
     from dyncheck.cases import get_case
 
@@ -71,14 +71,14 @@ def main() -> None:
     for name in cases:
         case = get_case(name)
         mb = case.multibody()
-        c = CaseEngine("mujoco", mb)
+        c = CaseEngine("mujoco", mb, loader=get_engine("mujoco"))
         raw = _raw_c(c, *_states(case, 2000))
         lines.append(f"| {name} | mujoco (C, per state) | 1 | – | {1e6 * raw:.3g} | 1 |")
         for port in ENGINE_PORTS:
             if port not in ENGINES:
                 continue
             for batch in args.batches if port != "mujoco-warp" else [256]:
-                adapter = CaseEngine(port, mb)
+                adapter = CaseEngine(port, mb, loader=get_engine(port))
                 if port != "mujoco-warp":
                     adapter.engine.port.chunk = batch  # the port's states per batched call
                 x = _states(case, batch)

@@ -62,3 +62,40 @@ def dexp_inv(theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
         k = 1.0 / angle**2 - (1.0 + np.cos(angle)) / (2.0 * angle * np.sin(angle))
     t_x_w = cross(theta, omega)
     return omega + 0.5 * t_x_w + k * cross(theta, t_x_w)
+
+
+def quat_order(quat: str) -> list[int]:
+    """Where an engine's quaternion components come from in (w, x, y, z): q_engine =
+    q_wxyz[..., quat_order(quat)], and back through its ``np.argsort`` (``quat``: an order
+    such as ``"xyzw"``, an engine layout's :class:`~dyncheck.adapters.model_tree.Orientation`)."""
+    return ["wxyz".index(c) for c in str(quat)]
+
+
+def quat_of_rpy(rpy: np.ndarray) -> np.ndarray:
+    """Unit quaternion (w, x, y, z) of R_z(y) R_y(p) R_x(r), batched."""
+    r, p, y = (rpy[:, i] / 2 for i in range(3))
+    cr, sr, cp, sp_, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
+    return np.stack(
+        [
+            cr * cp * cy + sr * sp_ * sy,
+            sr * cp * cy - cr * sp_ * sy,
+            cr * sp_ * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp_ * cy,
+        ],
+        -1,
+    )
+
+
+UNIT_ROUNDING = 8
+"""|‖q‖ − 1| of a quaternion an engine normalized in its own arithmetic is at most a few ε
+(its norm's four products, three sums and square root, then the division): within this many
+of its ε it is left as the engine gave it."""
+
+
+def unit(quat: np.ndarray, eps: float = 0.0) -> np.ndarray:
+    """Engines that integrate quaternion components (Drake) let the norm drift: renormalize
+    where it drifted beyond :data:`UNIT_ROUNDING` ε of the engine's arithmetic (``eps``; 0:
+    always). A quaternion the engine normalized is its own: a float32 port's, whose norm is
+    1 to ε₃₂, carries its round-off into the comparison as the engine computed it."""
+    norm = np.linalg.norm(quat, axis=-1, keepdims=True)
+    return np.where(np.abs(norm - 1.0) <= UNIT_ROUNDING * eps, quat, quat / norm)

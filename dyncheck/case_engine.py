@@ -49,9 +49,7 @@ from dyncheck.adapters.c_output import c_output_dropped
 from dyncheck.adapters.formats.files import read
 from dyncheck.adapters.formats.mjcf import to_mjcf
 from dyncheck.adapters.formats.urdf import root_is_free, to_urdf
-from dyncheck.adapters.installed import get_engine
-from dyncheck.adapters.layout import StateMap
-from dyncheck.adapters.layout_batch import canonical_states, engine_states, to_canonical
+from dyncheck.adapters.layout import StateMap, canonical_states, engine_states, to_canonical
 from dyncheck.adapters.model_tree import (
     NQ,
     NV,
@@ -77,11 +75,12 @@ DIVERGED = 1e12
 
 class CaseEngine:
     """The standard form ``M(q) v̇ + h(q, v) = τ`` of a book case by one engine (see the
-    module): ``CaseEngine(name, model)`` loads the case in the engine registered as
-    ``name`` (:class:`~dyncheck.errors.EngineNotInstalled` where it is not installed)."""
+    module): ``CaseEngine(name, model, loader=...)`` loads the case in the engine registered
+    as ``name``, whose class ``loader`` is (:func:`dyncheck.adapters.installed.get_engine`:
+    the caller resolves it, an engine that is not installed refused there)."""
 
-    def __init__(self, name: str, model: Multibody, *, symbolic: Symbolic = AFRESH) -> None:
-        loader = get_engine(name)
+    def __init__(self, name: str, model: Multibody, *, loader: type[ModelEngine],
+                 symbolic: Symbolic = AFRESH) -> None:
         registration = REGISTRY[name]
         assert registration.run is not None, name
         self.name, self.package, self.loader = name, registration.package, loader
@@ -366,7 +365,7 @@ class CaseEngine:
     ) -> Trajectory:
         """The loader's own stepping (``simulate(q0, v0, dt, steps)`` in its layout), its
         states mapped back to the canonical layout
-        (:func:`~dyncheck.adapters.layout_batch.canonical_states`)."""
+        (:func:`~dyncheck.adapters.layout.canonical_states`)."""
         return self._runs(q0, v0, duration=duration, dts=[dt], integrator=integrator,
                           batched=False)[0]
 
@@ -419,7 +418,7 @@ class CaseEngine:
 
     def _trajectory(self, q_e: np.ndarray, v_e: np.ndarray, t: np.ndarray) -> Trajectory:
         """The engine's states at times ``t``, finite (:meth:`_finite`), in the canonical
-        layout (:func:`~dyncheck.adapters.layout_batch.canonical_states`)."""
+        layout (:func:`~dyncheck.adapters.layout.canonical_states`)."""
         self._finite(q_e, v_e, t)
         q, v = canonical_states(self.canon, self.tree, q_e, v_e)
         return Trajectory(t, self._check("simulate", q), v)

@@ -18,7 +18,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from dyncheck.adapters.layout import (
+from dyncheck.adapters.joint_layouts import (
     from_engine,
     to_engine,
     velocity_frame_rates,

@@ -21,6 +21,7 @@ import numpy as np
 from dyncheck import coordinates as co
 from dyncheck.adapters import COUPLINGS_ONLY, ENGINE_PACKAGES, ENGINE_PORTS
 from dyncheck.adapters.base import ModelEngine, Trajectory
+from dyncheck.adapters.installed import get_engine
 from dyncheck.adapters.model_tree import Canonical, Dynamics, ModelTree
 from dyncheck.adapters.symbolic import Symbolic
 from dyncheck.case_engine import CaseEngine
@@ -217,7 +218,8 @@ class EngineImplementation(Implementation):
     def __init__(self, case: Case, name: str) -> None:
         super().__init__(case)
         self.name = name  # type: ignore[misc]
-        self.adapter: CaseEngine = CaseEngine(name, case.multibody(), symbolic=CACHED)
+        self.adapter: CaseEngine = CaseEngine(name, case.multibody(), loader=get_engine(name),
+                                              symbolic=CACHED)
         self.map = NativeMap.of(case)
         self.integrators = self.adapter.integrators
         self.eps = self.adapter.eps

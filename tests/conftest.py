@@ -7,7 +7,7 @@ import os
 import pickle
 import re
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 import pytest
@@ -23,6 +23,8 @@ from dyncheck.workers import exit_without_collecting
 
 if TYPE_CHECKING:
     from dyncheck.adapters.base import ModelEngine
+    from dyncheck.case_engine import CaseEngine
+    from dyncheck.cases.multibody import Multibody
     from dyncheck.run_result import RunResult
 
 exit_without_collecting()  # each test process (xdist's workers too): ~3 s with every engine loaded
@@ -57,6 +59,15 @@ NO_COUPLINGS: tuple[str, ...] = ()
 """Engines dyncheck does not run with couplings (skipped, with the reason)."""
 PORTS = tuple(adapters.ENGINE_PORTS)
 """Ports of another engine (MuJoCo's: MJX, MuJoCo Warp), from their registrations."""
+
+
+def loaded(engine: str, model: Multibody, **options: Any) -> CaseEngine:
+    """A book case in the engine registered as ``engine`` (its class from the registry, as
+    the run resolves it)."""
+    from dyncheck.adapters.installed import get_engine
+    from dyncheck.case_engine import CaseEngine
+
+    return CaseEngine(engine, model, loader=get_engine(engine), **options)
 
 
 def loader(engine: str) -> type[ModelEngine]:

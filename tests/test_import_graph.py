@@ -16,9 +16,10 @@ FOLDERS = {"dyncheck": "dyncheck", "reference": "dyncheck.reference",
 HEIGHT = 9
 """The longest import chain among the modules under ``dyncheck/`` today (ratchet: lower it
 when a change lowers it; #62's goal of 9 is met)."""
-WHOLE_HEIGHT = 12
+WHOLE_HEIGHT = 11
 """The longest import chain over the whole package as installed — ``adapters``, ``cases`` and
-``reference`` are ``dyncheck.*`` too (ratchet: #76's goal is 11; 17 when it was filed)."""
+``reference`` are ``dyncheck.*`` too (ratchet: #76's goal of 11 is met; 17 when it was
+filed)."""
 
 
 def modules(root: Path = ROOT, folders: dict[str, str] = FOLDERS) -> dict[str, Path]:

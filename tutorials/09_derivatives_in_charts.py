@@ -25,8 +25,9 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from dyncheck.adapters import layout, layout_batch
+from dyncheck.adapters import layout
 from dyncheck.adapters.formats.files import read
+from dyncheck.adapters.model_tree import canonical
 from dyncheck.adapters.mujoco.model import MujocoModel
 from dyncheck.adapters.pinocchio.model import PinocchioModel
 from dyncheck.check import derivatives
@@ -40,7 +41,7 @@ with tempfile.TemporaryDirectory() as folder:
     source = read(path)
     mujoco_box, pinocchio_box = MujocoModel(source), PinocchioModel(source)
 
-canon = layout.canonical(mujoco_box.tree)
+canon = canonical(mujoco_box.tree)
 states = sample(canon, mujoco_box.tree, 10, 0)
 
 # %% [markdown]
@@ -51,7 +52,7 @@ states = sample(canon, mujoco_box.tree, 10, 0)
 
 # %%
 mj = mujoco_box.derivatives(states.q, states.v, states.a)
-_, q, v, a = layout_batch.engine_states(canon, pinocchio_box.tree, states.q, states.v, states.a)
+_, q, v, a = layout.engine_states(canon, pinocchio_box.tree, states.q, states.v, states.a)
 pin_raw = pinocchio_box.derivatives(q, v, a)
 np.set_printoptions(precision=3, suppress=True, linewidth=110)
 print("MuJoCo    ∂v̇/∂q\n", mj.forward_q[0])

@@ -24,8 +24,9 @@ import matplotlib.pyplot as plt
 import mujoco
 import numpy as np
 
-from dyncheck.adapters import get_adapter
 from dyncheck.adapters.c_output import c_output_dropped
+from dyncheck.adapters.installed import get_engine
+from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import get_case
 from dyncheck.explain.moving import CYLINDRICAL, NESTED
 
@@ -125,7 +126,8 @@ for label, error in position_error.items():
 
 # %%
 spec = get_case("compound_pendulum").multibody()
-newton_case, mujoco_case = get_adapter("newton")(spec), get_adapter("mujoco")(spec)
+newton_case, mujoco_case = (CaseEngine(name, spec, loader=get_engine(name))
+                             for name in ("newton", "mujoco"))
 rng = np.random.default_rng(0)
 q = rng.uniform(-np.pi, np.pi, size=(64, 2))
 m_newton, m_mujoco = newton_case.mass_matrix(q), mujoco_case.mass_matrix(q)

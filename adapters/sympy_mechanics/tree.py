@@ -8,7 +8,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dyncheck.adapters.layout import from_engine, to_engine, velocity_frame_rates, velocity_frames
+from dyncheck.adapters.joint_layouts import (
+    from_engine,
+    to_engine,
+    velocity_frame_rates,
+    velocity_frames,
+)
 from dyncheck.adapters.model_tree import (
     Axes,
     JointType,

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dyncheck.adapters import layout_batch
+from dyncheck.adapters import layout
 from dyncheck.adapters.actuators import EULER_DAMPING, Activation, Actuator
 from dyncheck.adapters.base import ModelEngine, Offer
 from dyncheck.adapters.model_tree import Canonical, Dynamics, ModelTree
@@ -121,7 +121,7 @@ def force_rows(model: str, *, canon: Canonical, canonical: ModelTree, batch: Sta
             rows.append(_row(model, subject="model", field=FORCE, a=engine, b="",
                              verdict=Verdict.SKIPPED, note=_unsupported(m)))
             continue
-        maps, q_e, v_e, _ = layout_batch.engine_states(canon, m.tree, batch.q, batch.v,
+        maps, q_e, v_e, _ = layout.engine_states(canon, m.tree, batch.q, batch.v,
                                                        batch.a)
         u_e = controls_for(canonical, m.tree, u)
         try:
@@ -300,7 +300,7 @@ def _derivative_rows(model: str, *, canon: Canonical, holding: ModelTree, batch:
         if Offer.CONTROL_DERIVATIVES not in m.offers or not m.tree.actuators or \
                 acts is None or engine not in own:
             continue
-        maps, q_e, v_e, _ = layout_batch.engine_states(canon, m.tree, batch.q[:k],
+        maps, q_e, v_e, _ = layout.engine_states(canon, m.tree, batch.q[:k],
                                                        batch.v[:k], batch.a[:k])
         u_e = controls_for(holding, m.tree, inside)
         try:
@@ -411,7 +411,7 @@ def _input_jacobian_rows(model: str, *, canon: Canonical, holding: ModelTree, ba
         if Offer.INPUT_JACOBIAN not in m.offers or acts is None or not m.tree.actuators \
                 or engine not in own:
             continue
-        maps, q_e, _, _ = layout_batch.engine_states(canon, m.tree, q, v, batch.a[:k])
+        maps, q_e, _, _ = layout.engine_states(canon, m.tree, q, v, batch.a[:k])
         if not (np.array_equal(q_e, q) and all(np.array_equal(s.t, np.eye(len(s.t)))
                                                for s in maps)):
             out.append(_row(model, subject=subject, field=COMPUTED, a=REFEREE, b=engine,

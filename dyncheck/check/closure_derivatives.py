@@ -25,7 +25,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from dyncheck.adapters import layout_batch
+from dyncheck.adapters import layout
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.closures import ClosedReading
 from dyncheck.adapters.model_tree import Canonical, ModelTree
@@ -158,7 +158,7 @@ def rows(model: str, name: str, engine: ModelEngine, states: closures.ClosedStat
     constrained v̇ at canonical states (to measure, where it differs, whether its derivatives
     are those of its own forward dynamics)."""
     q, v = states.q[:STATES], states.v[:STATES]
-    _, q_e, v_e, _ = layout_batch.engine_states(canon, engine.tree, q, v, np.zeros_like(v))
+    _, q_e, v_e, _ = layout.engine_states(canon, engine.tree, q, v, np.zeros_like(v))
     try:
         found = engine.closed_derivatives(q_e, v_e, np.zeros_like(v_e))
     except Unsupported as exc:
@@ -211,7 +211,7 @@ def _map_rates(canon: Canonical, engine_tree: ModelTree, tree: ModelTree, *, q: 
     solver = TreeDynamics(bodies(tree), tree.gravity)
 
     def at(qq: np.ndarray, vv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        maps = layout_batch.engine_states(canon, engine_tree, qq, vv, np.zeros_like(vv))[0]
+        maps = layout.engine_states(canon, engine_tree, qq, vv, np.zeros_like(vv))[0]
         return np.array([m.t for m in maps]), np.array([m.tdot_v for m in maps])
 
     t, _ = at(q, v)

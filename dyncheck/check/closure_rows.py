@@ -10,7 +10,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from dyncheck.adapters import layout_batch
+from dyncheck.adapters import layout
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.closures import ClosedReading
 from dyncheck.adapters.model_tree import Canonical, ModelTree, canonical
@@ -74,14 +74,14 @@ def in_canonical(canon: Canonical, engine: ModelEngine, states: closures.ClosedS
     """The engine's reading put in the canonical layout, and its answer at the states (given
     canonical, handed to it in its own layout): v̇ = T⁻¹ (v̇ₑ − Ṫ v), J = Jₑ T."""
     tree = canonical_reading(canon, engine.tree)
-    maps, q_e, v_e, _ = layout_batch.engine_states(canon, engine.tree, states.q, states.v,
+    maps, q_e, v_e, _ = layout.engine_states(canon, engine.tree, states.q, states.v,
                                                    np.zeros_like(states.v))
     t = np.array([m.t for m in maps])
     tdot_v = np.array([m.tdot_v for m in maps])
-    tau_e = layout_batch.back(np.swapaxes(t, 1, 2), tau)  # τ·v invariant
+    tau_e = layout.back(np.swapaxes(t, 1, 2), tau)  # τ·v invariant
     found = engine.closed(q_e, v_e, tau_e)
     return tree, replace(found, jacobian=found.jacobian @ t,
-                         vdot=layout_batch.back(t, found.vdot - tdot_v))
+                         vdot=layout.back(t, found.vdot - tdot_v))
 
 
 def rows(model: str, canonical_tree: ModelTree, loaded: dict[str, ModelEngine],

@@ -96,7 +96,7 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, Mo
     referee on one reading minus the other's) — explained where that accounts for it."""
     import time
 
-    from dyncheck.adapters import layout_batch
+    from dyncheck.adapters import layout
 
     seconds = {} if seconds is None else seconds
     names = (["reference"] if with_referee else []) + list(engines)
@@ -109,7 +109,7 @@ def rows(model: str, canon: Canonical, tree: ModelTree, engines: Mapping[str, Mo
     at_steps = step_states(tree, len(states.q))
     both: set[str] = set()
     for name, engine in engines.items():
-        inputs[name] = layout_batch.engine_states(canon, engine.tree, states.q, states.v,
+        inputs[name] = layout.engine_states(canon, engine.tree, states.q, states.v,
                                                   states.a)[1:]
         if with_referee and canonical_layout[name] and Offer.TRANSITION in engine.offers:
             engine.submit_both(*inputs[name], at_steps)

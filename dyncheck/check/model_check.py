@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from dyncheck.adapters import REGISTRY, layout_batch
+from dyncheck.adapters import REGISTRY, layout
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.formats.files import ModelFile, read, urdf_inertials, urdf_welded
 from dyncheck.adapters.model_tree import Canonical, Dynamics, ModelTree, canonical
@@ -353,7 +353,7 @@ def _dynamics(model: str, canon: Canonical, canonical_tree: ModelTree, batch: St
     for engine, (proxy, maps) in pending.items():
         try:
             answer, took = proxy.collect()
-            results[engine] = layout_batch.to_canonical(maps, answer)
+            results[engine] = layout.to_canonical(maps, answer)
             seconds[engine] += took
         except Exception as exc:
             failures[engine] = f"{type(exc).__name__}: {exc}"
@@ -380,7 +380,7 @@ def _submitted(model: str, canon: Canonical, batch: States,
         t0 = time.perf_counter()
         part = parts[engine]
         on = batch if part is None else partial.states(batch, part)
-        maps, q_e, v_e, a_e = layout_batch.engine_states(
+        maps, q_e, v_e, a_e = layout.engine_states(
             canon if part is None else canonical(part.tree), m.tree, on.q, on.v, on.a)
         seconds[engine] = seconds.get(engine, 0.0) + time.perf_counter() - t0  # the map's
         try:

@@ -9,7 +9,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from dyncheck.adapters.layout_batch import engine_states
+from dyncheck.adapters.layout import engine_states
 from dyncheck.adapters.model_tree import (
     Canonical,
     Dynamics,

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from dyncheck.adapters import layout_batch
+from dyncheck.adapters import layout
 from dyncheck.adapters.base import ModelEngine
 from dyncheck.adapters.formats import parsing
 from dyncheck.adapters.formats.edits import applied, written
@@ -100,9 +100,9 @@ def _computed(model: str, engine: str, fix: str, *, canon: Canonical,
               referee: Dynamics) -> list[CheckRow]:
     """The engine's dynamics on the copy against the referee on the canonical reading (it
     reads the copy alike), with the differences its computing conventions predict."""
-    maps, q_e, v_e, a_e = layout_batch.engine_states(canon, tree, batch.q, batch.v, batch.a)
+    maps, q_e, v_e, a_e = layout.engine_states(canon, tree, batch.q, batch.v, batch.a)
     try:
-        dyn = layout_batch.to_canonical(maps, fixed.dynamics(q_e, v_e, a_e))
+        dyn = layout.to_canonical(maps, fixed.dynamics(q_e, v_e, a_e))
     except Exception as exc:  # its failure on the copy costs this row only
         return [replace(_row(model, engine, Verdict.FAILED, f"{fix}: {type(exc).__name__}: "
                              f"{exc}", fix=fix, value="computing failed"), subject="dynamics",

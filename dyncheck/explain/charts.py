@@ -21,14 +21,14 @@ def free_body_derivatives(states: int = 10) -> tuple[dict[str, float], dict[str,
     axes) and Pinocchio's (analytic, in its tangent: origin moved in body axes), first as
     they come, then with Pinocchio's mapped to MuJoCo's chart; and the referee's difference
     from Pinocchio's mapped ones."""
-    from dyncheck.adapters import layout_batch
+    from dyncheck.adapters import layout
     from dyncheck.adapters.model_tree import Derivatives
     from dyncheck.adapters.pinocchio.model import PinocchioModel
     from dyncheck.referee import charts, derivatives
 
     mine, other, canon, batch = beside_mujoco(FALLING, PinocchioModel, states)
     theirs = mine.derivatives(batch.q, batch.v, batch.a)
-    _, q, v, a = layout_batch.engine_states(canon, other.tree, batch.q, batch.v, batch.a)
+    _, q, v, a = layout.engine_states(canon, other.tree, batch.q, batch.v, batch.a)
     raw = other.derivatives(q, v, a)
     mapped = charts.to_canonical(canon, other.tree, batch, raw, other.dynamics(q, v, a))
     referee = derivatives.referee(mine.tree, batch).derivatives

@@ -89,7 +89,7 @@ def newton_free_velocity() -> Entry:
     velocity read as its origin's (MuJoCo's convention) and as its centre of mass's (its own,
     declared in its tree), against the referee on MuJoCo's reading: the worst relative error
     over M, h, forward and inverse dynamics at 20 sampled states."""
-    from dyncheck.adapters import layout_batch
+    from dyncheck.adapters import layout
     from dyncheck.adapters.newton.model import NewtonModel
     from dyncheck.referee.tree import ReferenceModel
 
@@ -99,8 +99,8 @@ def newton_free_velocity() -> Entry:
         replace(j, layout=replace(j.layout, point=None)) for j in newton.tree.joints))
     errors = []
     for tree in (as_origin, newton.tree):
-        maps, q, v, a = layout_batch.engine_states(canon, tree, states.q, states.v, states.a)
-        got = layout_batch.to_canonical(maps, newton.dynamics(q, v, a))
+        maps, q, v, a = layout.engine_states(canon, tree, states.q, states.v, states.a)
+        got = layout.to_canonical(maps, newton.dynamics(q, v, a))
         errors.append(max(
             float(np.abs(getattr(got, f) - getattr(expected, f)).max())
             / float(np.abs(getattr(expected, f)).max())

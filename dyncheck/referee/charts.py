@@ -14,7 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from dyncheck.adapters.layout import StateMap, quat_order
+from dyncheck.adapters.layout import StateMap
 from dyncheck.adapters.model_tree import (
     Axes,
     Canonical,
@@ -27,7 +27,7 @@ from dyncheck.adapters.model_tree import (
 )
 from dyncheck.adapters.model_tree import derivatives as collect
 from dyncheck.cases.coordinate_maps import quat_to_matrix
-from dyncheck.cases.quaternions import quat_conj, quat_mul
+from dyncheck.cases.quaternions import quat_conj, quat_mul, quat_order
 from dyncheck.referee.states import States
 
 FIELDS = ("forward_q", "forward_v", "forward_tau", "inverse_q", "inverse_v")

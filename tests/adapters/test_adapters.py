@@ -18,9 +18,9 @@ from numpy.testing import assert_allclose
 from dyncheck.adapters import REGISTRY, installed
 from dyncheck.adapters.formats.mjcf import to_mjcf
 from dyncheck.adapters.installed import engine_version, get_engine
-from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import get_case
 from dyncheck.errors import UnknownName
+from tests.conftest import loaded
 
 from ..conftest import (
     ALL_ENGINES,
@@ -60,7 +60,7 @@ def adapter_and_states(request):
 @cache
 def _adapter(case_name: str, engine: str):
     """One adapter per case and engine for the whole module (a port compiles per adapter)."""
-    return CaseEngine(engine, get_case(case_name).multibody())
+    return loaded(engine, get_case(case_name).multibody())
 
 
 def ulps(adapter, bound: float) -> float:
@@ -102,7 +102,7 @@ def test_constrained_forward_balances(case_name, engine):
     the cords, d = 0.9 by default."""
     case = get_case(case_name)
     mb = case.multibody()
-    adapter = CaseEngine(engine, mb)
+    adapter = loaded(engine, mb)
     rng = np.random.default_rng(5)
     qb = rng.uniform(*case.q_bounds(), (8, case.ndof))
     cmap = case.engine_map()
@@ -304,8 +304,8 @@ def test_registered_precision_is_the_engines(engine):
     spec = get_case("compound_pendulum").multibody()
     rng = np.random.default_rng(3)
     q, v = rng.uniform(-2, 2, (16, spec.nv)), rng.uniform(-2, 2, (16, spec.nv))
-    ours = CaseEngine(engine, spec).bias(q, v)
-    theirs = CaseEngine("mujoco", spec).bias(q, v)
+    ours = loaded(engine, spec).bias(q, v)
+    theirs = loaded("mujoco", spec).bias(q, v)
     relative = np.abs(ours - theirs).max() / np.abs(theirs).max()
     assert (relative > 1e-9 if engine in FLOAT32 else relative < 1e-12), relative
 

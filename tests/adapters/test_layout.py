@@ -109,7 +109,7 @@ def test_the_batched_free_joint_map_is_the_one_state_map(lay):
     placement as well (a parser placing the model elsewhere)."""
     from dataclasses import replace
 
-    from dyncheck.adapters.layout_batch import free_batch
+    from dyncheck.adapters.layout import free_batch
     from dyncheck.cases.coordinate_maps import quat_from_matrix
 
     lay = replace(lay, placement=PLACEMENT)
@@ -129,8 +129,7 @@ def test_the_batched_free_joint_map_is_the_one_state_map(lay):
 def test_the_batched_ball_map_is_the_one_state_map():
     """A ball joint in roll-pitch-yaw with ω in the parent's axes (Drake's), batched against
     the one-state map, gimbal lock included (pitch ±π/2: roll taken 0)."""
-    from dyncheck.adapters.layout import rpy_from_matrix
-    from dyncheck.adapters.layout_batch import rpy_batch
+    from dyncheck.adapters.layout import rpy_batch, rpy_from_matrix
 
     rot = Rotation.random(30, random_state=3).as_matrix()
     rot[0] = Rotation.from_euler("ZYX", [0.3, np.pi / 2, 0.0]).as_matrix()
@@ -163,8 +162,7 @@ def test_engine_states_map_back_to_the_canonical_ones(free, ball):
     canonical one."""
     from dataclasses import replace
 
-    from dyncheck.adapters.layout import state_map
-    from dyncheck.adapters.layout_batch import canonical_states
+    from dyncheck.adapters.layout import canonical_states, state_map
     from dyncheck.adapters.model_tree import Canonical, JointType, ModelTree
 
     free = replace(free, q_start=0, v_start=0, placement=PLACEMENT)

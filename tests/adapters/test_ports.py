@@ -13,13 +13,12 @@ import numpy as np
 import pytest
 
 from dyncheck.adapters import installed
-from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import get_case
 from dyncheck.comparison import compare_instantaneous
 from dyncheck.implementations import EngineImplementation, make_implementation
 from dyncheck.precision import EPS, EPS32, ROUNDOFF_FACTOR
 
-from ..conftest import BALL_CASES, CASE_NAMES, PORTS, supported
+from ..conftest import BALL_CASES, CASE_NAMES, PORTS, loaded, supported
 
 pytestmark = pytest.mark.slow  # JAX and Warp compile per model
 
@@ -29,7 +28,7 @@ PORT_CASES = [c for c in CASE_NAMES if supported(c, "mjx")]
 @cache
 def _pair(case_name: str, port: str):
     mb = get_case(case_name).multibody()
-    return CaseEngine("mujoco", mb), CaseEngine(port, mb)
+    return loaded("mujoco", mb), loaded(port, mb)
 
 
 def _states(case_name: str, n: int = 16):
@@ -143,7 +142,7 @@ def test_field_refused_with_the_reason(port):
     from dyncheck.errors import Unsupported
 
     with pytest.raises(Unsupported, match="mjcb_passive"):
-        CaseEngine(port, get_case("kepler").multibody())
+        loaded(port, get_case("kepler").multibody())
 
 
 @pytest.mark.parametrize("case_name", [c for c in BALL_CASES if supported(c, "mjx")])

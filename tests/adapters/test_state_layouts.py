@@ -179,8 +179,8 @@ def test_pinocchio_free_flyer_velocity_is_body_frame(name):
 
 def _loaded(name: str, case_name: str, canonical: np.ndarray):
     """An engine's loader of the case's MJCF, and the canonical configuration in the
-    engine's q as its run maps it (:func:`~dyncheck.adapters.layout_batch.engine_states`)."""
-    from dyncheck.adapters.layout_batch import engine_states
+    engine's q as its run maps it (:func:`~dyncheck.adapters.layout.engine_states`)."""
+    from dyncheck.adapters.layout import engine_states
 
     adapter = make_implementation(name, get_case(case_name)).adapter
     zero = np.zeros((1, adapter.canon.nv))
@@ -194,7 +194,7 @@ def _drake(case_name: str, canonical: np.ndarray):
 def test_drake_ball_joint_is_rpy_with_world_angular_velocity():
     """Drake's BallRpyJoint: q = (r, p, y) with R = R_z(y) R_y(p) R_x(r); v = ω in world
     axes. Checked on the plant Drake's parser builds from the spherical pendulum's MJCF."""
-    from dyncheck.adapters.layout_batch import canonical_states
+    from dyncheck.adapters.layout import canonical_states
 
     adapter, q = _drake("spherical_pendulum", ROT)
     plant, ctx = adapter.engine.plant, adapter.engine.context

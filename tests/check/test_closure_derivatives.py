@@ -107,7 +107,7 @@ def test_an_engines_chart_is_mapped_into_mujocos(tmp_path):
     import numpy as np
     import pinocchio as pin
 
-    from dyncheck.adapters import layout_batch
+    from dyncheck.adapters import layout
     from dyncheck.adapters.formats.files import read
     from dyncheck.adapters.model_tree import canonical
     from dyncheck.check import closure_derivatives as cd
@@ -124,7 +124,7 @@ def test_an_engines_chart_is_mapped_into_mujocos(tmp_path):
     q, v = _draws(mj, seed=2)
     states = checked.on_constraints(tree, q, v, reach=1.0)
     states = replace(states, q=states.q[:2], v=states.v[:2])
-    _, q_e, v_e, _ = layout_batch.engine_states(canon, pe.tree, states.q, states.v,
+    _, q_e, v_e, _ = layout.engine_states(canon, pe.tree, states.q, states.v,
                                                 np.zeros_like(states.v))
     m, nv, step = pe.model, pe.model.nv, 1e-4
     zero = np.zeros((1, nv))

@@ -67,7 +67,7 @@ def test_the_pendulum_derivatives_are_the_books_closed_form(tmp_path):
     m, length, g = 1.3, 0.7, 9.81
     path = tmp_path / "pendulum.urdf"
     path.write_text(PENDULUM.format(m=m, l=length))
-    from dyncheck.adapters import layout_batch
+    from dyncheck.adapters import layout
     from dyncheck.adapters.formats.files import read
     from dyncheck.adapters.model_tree import canonical
     from dyncheck.adapters.pinocchio.model import PinocchioModel
@@ -79,7 +79,7 @@ def test_the_pendulum_derivatives_are_the_books_closed_form(tmp_path):
     states = sample(canon, model.tree, 10, 0)
     theta = states.q[:, 0]
     ref = derivatives.referee(model.tree, states).derivatives
-    _, q, v, a = layout_batch.engine_states(canon, model.tree, states.q, states.v, states.a)
+    _, q, v, a = layout.engine_states(canon, model.tree, states.q, states.v, states.a)
     assert q.shape[1] == 2  # Pinocchio holds a continuous joint as (cos θ, sin θ)
     mine = charts.to_canonical(canon, model.tree, states, model.derivatives(q, v, a),
                                     model.dynamics(q, v, a))
@@ -158,7 +158,7 @@ def test_the_chain_rule_is_needed():
     from dyncheck.referee import charts
 
     def plain(canon, tree, states, found, dynamics):
-        from dyncheck.adapters.layout_batch import engine_states
+        from dyncheck.adapters.layout import engine_states
 
         maps = engine_states(canon, tree, states.q, states.v, states.a)[0]
         t = np.array([m.t for m in maps])

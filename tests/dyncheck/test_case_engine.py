@@ -18,7 +18,7 @@ from dyncheck.errors import EngineNotInstalled, Unsupported
 from dyncheck.implementations import general_method, make_implementation
 from dyncheck.variants import ENGINE_DEFECT, INERTIA_STORED, book_variant
 
-from ..conftest import CASE_NAMES, FILE_LOADERS, supported, unsupported_reason
+from ..conftest import CASE_NAMES, FILE_LOADERS, loaded, supported, unsupported_reason
 
 
 def _adapter_class(engine: str):
@@ -27,7 +27,7 @@ def _adapter_class(engine: str):
         get_engine(engine)
     except EngineNotInstalled as exc:
         pytest.skip(str(exc))
-    return partial(CaseEngine, engine)
+    return partial(loaded, engine)
 
 
 def _eps(engine: str) -> float:
@@ -45,15 +45,15 @@ def test_the_bodies_read_back_are_the_cases(case, engine):
     subtraction of m |c|² leaves round-off of that size."""
     spec = get_case(case).multibody()
     adapter = _adapter_class(engine)(spec)
-    for body, loaded in zip(spec.bodies, adapter.loaded_bodies(), strict=True):
+    for body, held in zip(spec.bodies, adapter.loaded_bodies(), strict=True):
         stated = np.asarray(body.inertia, float)
         if body.is_point_mass:  # the file's floor, or the case as stated (exact)
             stated = spec.body_inertia(body) if REGISTRY[engine].as_stated else \
                 spec.mjcf_point_inertia * np.eye(3)
         com = np.asarray(body.com, float)
         scale = max(float(np.abs(stated).max()), body.mass * float(com @ com))
-        assert loaded.mass == body.mass
-        assert np.abs(loaded.inertia - stated).max() <= 64 * adapter.eps * scale
+        assert held.mass == body.mass
+        assert np.abs(held.inertia - stated).max() <= 64 * adapter.eps * scale
     # Newton's MJCF importer and Pinocchio's MJCF parser keep their default gravity whatever
     # <option gravity> says (the convention "MJCF gravity option not read", explained on
     # kepler's rows); ``pinocchio`` is given the case's (its loader's ``gravity=``)
@@ -118,7 +118,7 @@ def test_the_engines_own_step_is_mujocos_euler(engine):
     q0, v0 = np.array([0.5, -0.3]), np.array([0.2, 0.1])
     # 300 steps: within MuJoCo Warp's CPU budget (its max_steps, 400)
     ours = cls(spec).simulate(q0, v0, 0.3, 1e-3, "euler")
-    theirs = CaseEngine("mujoco", spec).simulate(q0, v0, 0.3, 1e-3, "euler")
+    theirs = loaded("mujoco", spec).simulate(q0, v0, 0.3, 1e-3, "euler")
     steps = len(ours.t) - 1
     eps = _eps(engine)
     assert np.abs(ours.q - theirs.q).max() <= 64 * eps * steps * np.abs(theirs.q).max()
@@ -144,7 +144,7 @@ def test_a_rotating_body_s_steps_map_back_to_mujocos_euler(engine, case_name):
     case = get_case(case_name)
     q0, v0 = EngineImplementation(case, "mujoco").engine_start()
     ours = cls(case.multibody()).simulate(q0, v0, 0.2, 2e-3, "euler")
-    theirs = CaseEngine("mujoco", case.multibody()).simulate(q0, v0, 0.2, 2e-3, "euler")
+    theirs = loaded("mujoco", case.multibody()).simulate(q0, v0, 0.2, 2e-3, "euler")
     bound = 64 * _eps(engine) * (len(ours.t) - 1)
     assert np.abs(ours.q - theirs.q).max() <= bound * np.abs(theirs.q).max()
     assert np.abs(ours.v - theirs.v).max() <= bound * np.abs(theirs.v).max()

@@ -23,6 +23,7 @@ from dyncheck.implementations import (
 from dyncheck.results import DISCREPANCY_KEY, Discrepancy, table
 from dyncheck.variants import ENGINE_DEFECT, INERTIA_STORED, SOFT_CONSTRAINT
 from dyncheck.vocabulary import INSTANTANEOUS
+from tests.conftest import loaded
 
 from ..conftest import (
     ALL_ENGINES,
@@ -305,9 +306,8 @@ def test_missing_engine_is_skipped_never_passed(monkeypatch, tmp_path, pretend_m
 
 
 def test_drake_parser_reports_what_it_ignores():
-    from dyncheck.case_engine import CaseEngine
 
-    drake = CaseEngine("drake", get_case("simple_pendulum").multibody())
+    drake = loaded("drake", get_case("simple_pendulum").multibody())
     assert any("timestep" in w for w in drake.parser_warnings)
 
 

@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 from dyncheck.adapters.sympy_mechanics import model as sm
-from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import get_case
 from dyncheck.implementations import CACHED
+from tests.conftest import loaded
 
 
 @pytest.mark.parametrize("case_name", ["compound_pendulum", "atwood", "kepler"])
@@ -26,7 +26,7 @@ def test_sympy_mechanics_reads_its_equations_back_without_deriving(
 ):
     monkeypatch.setenv("DYNCHECK_CACHE", str(tmp_path))
     model = get_case(case_name).multibody()
-    adapter = partial(CaseEngine, "sympy-mechanics", symbolic=CACHED)
+    adapter = partial(loaded, "sympy-mechanics", symbolic=CACHED)
     first = adapter(model)
     assert list((tmp_path / "derivations").rglob("sympy_mechanics-*.pickle"))
 
@@ -47,8 +47,8 @@ def test_sympy_mechanics_without_the_cache_derives(tmp_path, monkeypatch, no_cac
     derive = sm._derive
     monkeypatch.setattr(sm, "_derive", lambda model: calls.append(1) or derive(model))
     model = get_case("simple_pendulum").multibody()
-    CaseEngine("sympy-mechanics", model, symbolic=CACHED)
-    CaseEngine("sympy-mechanics", model, symbolic=CACHED)
+    loaded("sympy-mechanics", model, symbolic=CACHED)
+    loaded("sympy-mechanics", model, symbolic=CACHED)
     assert len(calls) == 2 and not (tmp_path / "derivations").exists()
 
 
@@ -60,6 +60,6 @@ def test_the_adapter_left_to_itself_derives_afresh(tmp_path, monkeypatch):
     derive = sm._derive
     monkeypatch.setattr(sm, "_derive", lambda model: calls.append(1) or derive(model))
     model = get_case("simple_pendulum").multibody()
-    CaseEngine("sympy-mechanics", model)
-    CaseEngine("sympy-mechanics", model)
+    loaded("sympy-mechanics", model)
+    loaded("sympy-mechanics", model)
     assert len(calls) == 2 and not (tmp_path / "derivations").exists()

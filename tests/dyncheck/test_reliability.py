@@ -17,12 +17,11 @@ import pytest
 
 from dyncheck.__main__ import main
 from dyncheck.adapters import REGISTRY
-from dyncheck.case_engine import CaseEngine
 from dyncheck.cases import get_case
 from dyncheck.errors import EngineError
 from dyncheck.run import run
 
-from ..conftest import ENGINES
+from ..conftest import ENGINES, loaded
 
 REPORTS = Path(__file__).resolve().parents[2] / "reports"
 
@@ -34,7 +33,7 @@ REPORTS = Path(__file__).resolve().parents[2] / "reports"
 def test_divergence_is_an_error_not_a_hang(engine):
     """A run that blows up is stopped and reported (MuJoCo would silently reset the state)."""
     case = get_case("simple_pendulum")
-    adapter = CaseEngine(engine, case.multibody())
+    adapter = loaded(engine, case.multibody())
     integrator = "euler" if "euler" in adapter.integrators else adapter.integrators[0]
     with pytest.raises((EngineError, FloatingPointError)) as caught:
         adapter.simulate(np.array([0.1]), np.array([1e200]), 0.1, 0.01, integrator)

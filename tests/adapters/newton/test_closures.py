@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 pytest.importorskip("newton", reason="needs the 'newton' extra")
-from dyncheck.adapters import layout_batch
+from dyncheck.adapters import layout
 from dyncheck.adapters.formats.files import read
 from dyncheck.adapters.model_tree import canonical
 from dyncheck.adapters.newton import closures as newton_closures
@@ -78,7 +78,7 @@ def test_newtons_rows_and_their_rate_are_the_referees(name, tmp_path):
     canon = canonical(mujoco.tree)
     q, v = _draws(mujoco, seed=5)
     states = checked.on_constraints(mujoco.tree, q, v, reach=1.0)
-    maps, q_e, v_e, _ = layout_batch.engine_states(canon, newton.tree, states.q, states.v,
+    maps, q_e, v_e, _ = layout.engine_states(canon, newton.tree, states.q, states.v,
                                                    np.zeros_like(states.v))
     value, jac, drift = newton_closures.rows(newton.model, newton.newton, newton.state,
                                              loops=newton.held, mimicked=newton.mimics,
