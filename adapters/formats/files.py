@@ -4,6 +4,7 @@ would otherwise need every mesh — the only rewrite, stated in every report."""
 
 from __future__ import annotations
 
+import functools
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -132,6 +133,20 @@ class Inertial:
     inertia: tuple[tuple[float, float, float], ...]
 
 
+@functools.lru_cache(maxsize=4)
+def _urdf(text: str) -> ET.Element:
+    """A URDF's document, parsed once per text for the readers below, which only look at it
+    (a check asks for its welded links, inertials and links several times)."""
+    return parsing.root(text)
+
+
+def urdf_links(source: ModelFile) -> frozenset[str]:
+    """The URDF's link names (none for MJCF)."""
+    if source.format is not Format.URDF:
+        return frozenset()
+    return frozenset(link.get("name", "") for link in _urdf(source.text).findall("link"))
+
+
 def urdf_welded(source: ModelFile) -> set[str]:
     """The URDF links welded to the world: its root link (unless ``--floating`` frees it)
     and every link joined to one of those by a ``fixed`` joint — bodies that never move,
@@ -139,7 +154,7 @@ def urdf_welded(source: ModelFile) -> set[str]:
     base" idiom leaves such a link massless)."""
     if source.format is not Format.URDF:
         return set()
-    robot = parsing.root(source.text)
+    robot = _urdf(source.text)
     root = urdf_root_link(robot)
     if root is None or source.floating:
         return set()
@@ -162,7 +177,7 @@ def urdf_inertials(source: ModelFile) -> list[Inertial]:
     if source.format is not Format.URDF:
         return []
     out = []
-    for link in parsing.root(source.text).findall("link"):
+    for link in _urdf(source.text).findall("link"):
         inertial = link.find("inertial")
         if inertial is None:
             continue

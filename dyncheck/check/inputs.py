@@ -14,6 +14,7 @@ from dyncheck.adapters.formats.files import (
     ROOT_TAG,
     ModelFile,
     urdf_inertials,
+    urdf_links,
     urdf_welded,
 )
 from dyncheck.adapters.formats.includes import asset_files, inline
@@ -265,7 +266,7 @@ def massive(path: Path, source: ModelFile) -> None:
     if source.format.value != "urdf":
         return
     welded = urdf_welded(source)
-    links = {link.get("name") for link in parsing.root(source.text).findall("link")}
+    links = urdf_links(source)
     if links <= welded:  # nothing moves: the check's own refusal says so
         return
     if not any(i.mass > 0 for i in urdf_inertials(source) if i.link not in welded):
