@@ -203,15 +203,21 @@ def test_one_step_matches_integrator_definition(engine, integrator):
 @pytest.mark.parametrize("case_name", [c for c in CASE_NAMES if supported(c, "sympy-mechanics")])
 def test_sympy_mechanics_time_step_acceleration_is_its_forward_dynamics(case_name):
     """The one-state function a trajectory's stages call (one scalar lambdified function of
-    M, h and f, or of the cords' KKT system) against the batched forward dynamics of the same
-    equations (numpy lambdified, a linear solve per state): equal to round-off."""
-    adapter = _adapter(case_name, "sympy-mechanics")
+    M, h and f, or of the cords' KKT system) against the batched equations (numpy
+    lambdified, a linear solve per state), both in its chart's angles and rates: equal to
+    round-off. (The chart's map to the canonical layout is tests/adapters/sympy_mechanics/
+    test_tree.py's.)"""
+    engine = _adapter(case_name, "sympy-mechanics").engine
     rng = np.random.default_rng(3)
-    n = adapter.spec.nv
-    q, v = rng.uniform(-1, 1, (6, n)), rng.uniform(-1, 1, (6, n))
-    batched = adapter.forward(q, v, np.zeros((6, n)))
-    stepped = np.array([adapter.engine._step_acceleration(qi, vi)  # (no angles: its chart's
-                        for qi, vi in zip(q, v, strict=True)])  # coordinates are q, v)
+    n = engine.tree.nv
+    x, xd = rng.uniform(0.4, 1.2, (6, n)), rng.uniform(-1, 1, (6, n))
+    if engine.model.couplings:
+        batched = engine._kkt_solve(x, xd, np.zeros((6, n)))[:, :n]
+    else:
+        rhs = engine._field_force(x) - engine._h(*engine._args(x, xd))
+        batched = np.linalg.solve(engine._mass(x), rhs[..., None])[..., 0]
+    stepped = np.array([engine._step_acceleration(xi, xdi)
+                        for xi, xdi in zip(x, xd, strict=True)])
     assert_allclose(stepped, batched, rtol=0, atol=1e-13 * np.abs(batched).max())
 
 
@@ -296,12 +302,14 @@ def test_drake_parser_ignores_the_tendon_equality():
 def test_registered_precision_is_the_engines(engine):
     """The registry says which engines compute in float32 (the report check reads it without
     importing the engine); it must be what the engine computes in, measured: its bias forces
-    on the compound pendulum at generic states against MuJoCo's (float64; another engine)
-    differ by float32's round-off (beyond 1e-9 of their size) exactly where it is
-    registered float32, and by float64's (within 1e-12) elsewhere."""
+    on the compound pendulum (Atwood's machine for an engine run only with couplings) at
+    generic states against MuJoCo's (float64; another engine) differ by float32's round-off
+    (beyond 1e-9 of their size) exactly where it is registered float32, and by float64's
+    (within 1e-12) elsewhere."""
     from dyncheck.adapters import FLOAT32
 
-    spec = get_case("compound_pendulum").multibody()
+    case = "atwood" if REGISTRY[engine].couplings_only else "compound_pendulum"
+    spec = get_case(case).multibody()
     rng = np.random.default_rng(3)
     q, v = rng.uniform(-2, 2, (16, spec.nv)), rng.uniform(-2, 2, (16, spec.nv))
     ours = loaded(engine, spec).bias(q, v)
