@@ -191,6 +191,10 @@ class TreeJoint:
     where a measured defect makes it differ from the ``inertia`` it holds (PyBullet's
     spherical joint: its link's principal moments taken in the link's axes); None: the held
     one."""
+    inertia_derived_from: float = 0.0
+    """The size (kg m², a trace) of the tensor the engine's ``inertia`` was derived from where
+    it holds another (Drake: about the body's origin, m d² larger; the one about the centre
+    of mass is its difference, known to that tensor's round-off); 0: held as stated."""
     parts: int = 1
     """How many bodies' mass properties the engine summed into this joint's body (rigidly
     joined links lumped): the round-off of its mass, centre of mass and inertia grows with

@@ -153,7 +153,7 @@ class DrakeModel(ModelEngine):
         for joint in moving:
             kind = _TYPES[joint.type_name()]
             group = plant.GetBodiesWeldedTo(joint.child_body())
-            masses, coms, inertias = [], [], []
+            masses, coms, inertias, held = [], [], [], 0.0
             for body in group:
                 m = body.default_mass()
                 p = np.asarray(body.default_com())  # from the body origin, body axes
@@ -161,6 +161,7 @@ class DrakeModel(ModelEngine):
                 rot = pose.rotation().matrix()
                 i_origin = body.default_rotational_inertia().CopyToFullMatrix3()  # about Bo
                 i_com = i_origin - m * (p @ p * np.eye(3) - np.outer(p, p))  # parallel axis
+                held += abs(float(np.trace(i_origin)))
                 masses.append(m)
                 coms.append(pose.translation() + rot @ p)
                 inertias.append(rot @ i_com @ rot.T)
@@ -186,7 +187,7 @@ class DrakeModel(ModelEngine):
                     body=joint.child_body().name(), axis=np.asarray(axis, float),
                     anchor=np.asarray(child_pose.translation(), float),
                     frame=child_pose.rotation().matrix(), mass=mass, com=com, inertia=inertia,
-                    parts=len(masses),
+                    parts=len(masses), inertia_derived_from=held,
                     armature=(reflected.get(joint.name(), 0.0),) if nv == 1 else (0.0,) * nv,
                     damping=self._damping.get(joint.name(), (0.0,) * nv),
                     range=(float(lower[0]), float(upper[0])) if limited else None,

@@ -5,6 +5,9 @@ because each is a sum of m (r² − rᵢ²) ≥ 0 terms. Tolerance: 64 ε × tra
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import NamedTuple
+
 import numpy as np
 
 from dyncheck.adapters.model_tree import ModelTree
@@ -25,9 +28,11 @@ FIXES = {
 """A fix hint for each violated condition of :func:`validity` (the page shows it first)."""
 
 
-def _violation(mass: float, inertia: np.ndarray,
-               eps: float = EPS) -> tuple[str, object, float, float, str] | None:
-    """(field, value, error, tolerance, note) of the first violated condition, or None."""
+def _violation(mass: float, inertia: np.ndarray, eps: float = EPS,
+               held: float = 0.0) -> tuple[str, object, float, float, str] | None:
+    """(field, value, error, tolerance, note) of the first violated condition, or None; the
+    tolerance is round-off of the tensor's size (its trace), or of ``held``, the size of what
+    an engine's tensor was derived from where that is larger (:func:`tree_bodies`)."""
     if not mass > 0.0:
         return "mass", mass, abs(mass), 0.0, f"mass {mass:g} (must be > 0)"
     if not np.isfinite(mass) or not np.all(np.isfinite(inertia)):
@@ -39,7 +44,7 @@ def _violation(mass: float, inertia: np.ndarray,
     if not np.all(np.isfinite(moments)):
         return ("finite", mass, float("inf"), 0.0,
                 f"principal moments of inertia {shown_value(np.asarray(inertia).ravel())} overflow")
-    tol = ROUNDOFF_FACTOR * eps * max(float(np.abs(moments).sum()), 1e-300)
+    tol = ROUNDOFF_FACTOR * eps * max(float(np.abs(moments).sum()), held, 1e-300)
     if moments[0] < -tol:
         return ("inertia", moments, -float(moments[0]), tol,
                 f"principal moments {shown_value(moments)}: not positive semi-definite (2.2.39)")
@@ -49,20 +54,32 @@ def _violation(mass: float, inertia: np.ndarray,
     return None
 
 
+class Held(NamedTuple):
+    """A body as it is checked: its name, mass and inertia about its centre of mass, and the
+    size (kg m²) of what that tensor was derived from (0: the tensor itself, a file's)."""
+
+    name: str
+    mass: float
+    inertia: np.ndarray
+    derived_from: float = 0.0
+
+
 def validity(
-    model: str, holder: str, bodies: list[tuple[str, float, np.ndarray]], *, eps: float = EPS
+    model: str, holder: str, bodies: Sequence[tuple[str, float, np.ndarray] | Held], *,
+    eps: float = EPS,
 ) -> list[CheckRow]:
     """Positive mass, positive semi-definite inertia, triangle inequality for each
-    ``(name, mass, inertia)`` an engine holds (its rigid groups) or the file states (a URDF's
-    links): a failed row per violation, else one passed row. Massless, inertia-less links
-    (frames) are not bodies and are skipped."""
+    ``(name, mass, inertia)`` an engine holds (its rigid groups, :func:`tree_bodies`) or the
+    file states (a URDF's links): a failed row per violation, else one passed row. Massless,
+    inertia-less links (frames) are not bodies and are skipped."""
     rows: list[CheckRow] = []
     checked = 0
-    for name, mass, inertia in bodies:
+    for body in bodies:
+        name, mass, inertia, held = Held(*body)
         if mass == 0.0 and not np.any(inertia):
             continue
         checked += 1
-        found = _violation(mass, inertia, eps)
+        found = _violation(mass, inertia, eps, held)
         if found is not None:
             field, value, err, tol, note = found
             note = f"{note}; {FIXES[field]}"
@@ -71,8 +88,10 @@ def validity(
                     model=model, section=Section.VALIDITY, subject=name, field=field,
                     impl_a=holder, impl_b="", value_a=shown_value(value), value_b="", error=err,
                     tolerance=tol,
-                    basis=f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x trace(I)" if tol
-                    else "",
+                    basis=(f"round-off: {ROUNDOFF_FACTOR} {eps_name(eps)} x "
+                           + ("trace(I about the origin)"
+                              if held > abs(float(np.trace(inertia))) else "trace(I)"))
+                    if tol else "",
                     verdict=Verdict.FAILED, note=note,
                 )
             )
@@ -89,5 +108,11 @@ def validity(
     return rows
 
 
-def tree_bodies(tree: ModelTree) -> list[tuple[str, float, np.ndarray]]:
-    return [(j.body, j.mass, j.inertia) for j in tree.joints]
+def tree_bodies(tree: ModelTree) -> list[Held]:
+    """Each joint's body as the engine holds it, with the size of what its tensor was derived
+    from (:attr:`~dyncheck.adapters.model_tree.TreeJoint.inertia_derived_from`): Drake holds
+    the inertia about the body's origin, and the one about the centre of mass is their
+    difference by the parallel-axis theorem — a link of 1e-20 kg m² 2 cm off its origin
+    (example-robot-data's iCub ankle) is then round-off of a 2e-4 kg m² tensor, not an
+    invalid one."""
+    return [Held(j.body, j.mass, j.inertia, j.inertia_derived_from) for j in tree.joints]
