@@ -4,9 +4,9 @@ one after another (:meth:`~dyncheck.adapters.model_tree.StateLayout.joints`): a 
 order, roll-pitch-yaw or Example 9's angles, and the frames (or angle rates) of a rotating
 joint's velocities, v = T v_canonical. The conventions of :mod:`.layout`'s tree maps, for
 many states at once, without a model check's placements and offsets (a case's free body is
-its own frame, placed at the origin): the run's coordinate maps
-(:class:`dyncheck.coordinates.NativeMap`) and sympy.physics.mechanics's chart
-(:class:`~dyncheck.adapters.sympy_mechanics.tree.Chart`)."""
+its own frame, placed at the origin): sympy.physics.mechanics's chart
+(:class:`~dyncheck.adapters.sympy_mechanics.tree.Chart`), and the run's coordinate map's
+quaternions renormalized (:class:`dyncheck.coordinates.NativeMap`)."""
 
 from __future__ import annotations
 

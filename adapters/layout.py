@@ -15,10 +15,11 @@ whose T depends on q: d(Rᵀ)/dt = −ω̂ Rᵀ, ω in local axes).
 
 This is the one home of these maps: a model check maps one state at a time (:func:`state_map`,
 complex-stepped for its derivatives, with a free joint's placement and offset) from the
-layouts the engine's own model declares; a run's case maps batches (:func:`to_engine`,
-:func:`from_engine`, :func:`velocity_frames`, :func:`velocity_frame_rates`) from the layouts
-a :class:`~dyncheck.adapters.model_tree.StateLayout` declares (the case's coordinate map into
-the canonical layout; sympy.physics.mechanics's chart of Example 9's angles). The engines'
+layouts the engine's own model declares, and a run's case many states at once
+(:func:`engine_states`, :func:`canonical_states`) from its engine's tree;
+:mod:`.joint_layouts` maps batches through the layouts a
+:class:`~dyncheck.adapters.model_tree.StateLayout` declares (sympy.physics.mechanics's chart of
+Example 9's angles; the run's quaternions renormalized). The engines'
 layouts were found by experiment on the installed versions
 (tests/adapters/test_state_layouts.py rotates a body by a known quaternion and reads the
 result back):
@@ -36,9 +37,10 @@ result back):
   integrates the quaternion's components, so its norm drifts: :func:`from_engine`
   renormalizes.
 - sympy-mechanics (dyncheck's own model): a rotating body in Example 9's angles (body Z, X,
-  Z), velocities their rates, so v = J⁻¹ ω̄ (exercise 23) and v̇ picks up −J⁻¹ J̇ q̇. Where
-  the book has fewer coordinates than the engine (a point mass's spin), least squares and
-  least-norm forces are taken in the canonical metric W = T⁻ᵀT⁻¹, not in the angle rates'.
+  Z), velocities their rates, so v = J⁻¹ ω̄ (exercise 23) and v̇ picks up −J⁻¹ J̇ q̇ — its
+  own chart, which it maps to the canonical layout itself (:mod:`.joint_layouts`): where the
+  book has fewer coordinates than the engine (a point mass's spin), least squares and
+  least-norm forces are then taken in the canonical coordinates, as for every engine.
 """
 
 from __future__ import annotations

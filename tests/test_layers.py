@@ -206,7 +206,6 @@ NOT_ENGINES = {
     ("dyncheck/commands/options.py", "device"): "an argparse namespace",
     ("dyncheck/commands/options.py", "out"): "an argparse namespace",
     ("dyncheck/commands/options.py", "no_cache"): "an argparse namespace",
-    ("dyncheck/coordinates.py", "weight"): "a case's coordinate map",
     ("dyncheck/implementations.py", "softness"): "the reference's general method of a case",
     ("dyncheck/studies/references.py", "softness"): "the reference's general method",
     ("dyncheck/studies/drift.py", "field_potential"): "the reference's general method",
