@@ -349,10 +349,10 @@ class SympyMechanics(ModelEngine):
                            held: np.ndarray) -> np.ndarray:
         """ẍ at one state in the angles under a generalized force ``held`` in place of the
         field's (RK4's held-force stages: the field at the step's start)."""
-        tau = held - self._field_force(x[None])[0]
-        if self._kkt is not None:
+        if self._kkt is not None:  # (its forcing holds no field: the held force less it)
+            tau = held - self._field_force(x[None])[0]
             return self._kkt_solve(x[None], xd[None], tau[None])[0, : self._n]
-        rhs = held - self._h(*self._args(x[None], xd[None]))[0]  # (τ + field − h)
+        rhs = held - self._h(*self._args(x[None], xd[None]))[0]
         return solve(self._mass(x[None])[0], rhs)
 
     def simulate(self, q0: np.ndarray, v0: np.ndarray, dt: float, steps: int, *,
